@@ -1,0 +1,120 @@
+#include "frontend/builtins.h"
+
+#include <array>
+
+namespace psys {
+namespace {
+
+using R = BuiltinRule;
+
+constexpr BuiltinFunction kFunctions[] = {
+    // componentwise maths
+    {"sin", 1, 1, R::Componentwise, 0, "sin(x: T) -> T"},
+    {"cos", 1, 1, R::Componentwise, 0, "cos(x: T) -> T"},
+    {"tan", 1, 1, R::Componentwise, 0, "tan(x: T) -> T"},
+    {"asin", 1, 1, R::Componentwise, 0, "asin(x: T) -> T"},
+    {"acos", 1, 1, R::Componentwise, 0, "acos(x: T) -> T"},
+    {"atan", 1, 1, R::Componentwise, 0, "atan(x: T) -> T"},
+    {"atan2", 2, 2, R::Componentwise, 0, "atan2(y: T, x: T) -> T"},
+    {"exp", 1, 1, R::Componentwise, 0, "exp(x: T) -> T"},
+    {"log", 1, 1, R::Componentwise, 0, "log(x: T) -> T"},
+    {"pow", 2, 2, R::Componentwise, 0, "pow(x: T, y: T|float) -> T"},
+    {"sqrt", 1, 1, R::Componentwise, 0, "sqrt(x: T) -> T"},
+    {"abs", 1, 1, R::Componentwise, 0, "abs(x: T) -> T"},
+    {"sign", 1, 1, R::Componentwise, 0, "sign(x: T) -> T"},
+    {"floor", 1, 1, R::Componentwise, 0, "floor(x: T) -> T"},
+    {"ceil", 1, 1, R::Componentwise, 0, "ceil(x: T) -> T"},
+    {"round", 1, 1, R::Componentwise, 0, "round(x: T) -> T"},
+    {"fract", 1, 1, R::Componentwise, 0, "fract(x: T) -> T"},
+    {"mod", 2, 2, R::Componentwise, 0, "mod(x: T, y: T|float) -> T"},
+    {"min", 2, 2, R::Componentwise, 0, "min(a: T, b: T|float) -> T"},
+    {"max", 2, 2, R::Componentwise, 0, "max(a: T, b: T|float) -> T"},
+    {"clamp", 1, 3, R::Componentwise, 0, "clamp(x: T, lo: T|float = 0, hi: T|float = 1) -> T"},
+    {"saturate", 1, 1, R::Componentwise, 0, "saturate(x: T) -> T"},
+    {"mix", 3, 3, R::Componentwise, 0, "mix(a: T, b: T, t: T|float) -> T"},
+    {"lerp", 3, 3, R::Componentwise, 0, "lerp(a: T, b: T, t: T|float) -> T"},
+    {"step", 2, 2, R::Componentwise, 0, "step(edge: T|float, x: T) -> T"},
+    {"smoothstep", 3, 3, R::Componentwise, 0, "smoothstep(e0: T|float, e1: T|float, x: T) -> T"},
+    {"radians", 1, 1, R::Componentwise, 0, "radians(degrees: T) -> T"},
+    {"degrees", 1, 1, R::Componentwise, 0, "degrees(radians: T) -> T"},
+    // geometry
+    {"length", 1, 1, R::ToScalar, 0, "length(v: T) -> float"},
+    {"distance", 2, 2, R::ToScalar, 0, "distance(a: T, b: T) -> float"},
+    {"dot", 2, 2, R::ToScalar, 0, "dot(a: T, b: T) -> float"},
+    {"normalize", 1, 1, R::SameVector, 0, "normalize(v: vecN) -> vecN"},
+    {"reflect", 2, 2, R::SameVector, 0, "reflect(v: vecN, normal: vecN) -> vecN"},
+    {"cross", 2, 2, R::Cross, 0, "cross(a: vec3, b: vec3) -> vec3"},
+    {"rotate_x", 2, 2, R::Rotate, 0, "rotate_x(v: vec3, angle: float) -> vec3"},
+    {"rotate_y", 2, 2, R::Rotate, 0, "rotate_y(v: vec3, angle: float) -> vec3"},
+    {"rotate_z", 2, 2, R::Rotate, 0, "rotate_z(v: vec3, angle: float) -> vec3"},
+    // constructors
+    {"vec2", 1, 2, R::Construct, 2, "vec2(x: float) or vec2(components…) -> vec2"},
+    {"vec3", 1, 3, R::Construct, 3, "vec3(x: float) or vec3(components…) -> vec3"},
+    {"vec4", 1, 4, R::Construct, 4, "vec4(x: float) or vec4(components…) -> vec4"},
+    {"rgba", 1, 4, R::Construct, 4, "rgba(r, g, b, a) -> color"},
+    // time and state
+    {"integrate", 1, 1, R::Integrate, 0, "integrate(x: T) -> T"},
+    {"derive", 1, 1, R::Integrate, 0, "derive(x: T) -> T"},
+    {"snapshot", 1, 1, R::Snapshot, 0, "snapshot(x) -> x"},
+    {"prev", 1, 1, R::Prev, 0, "prev(x) -> x"},
+    // randomness
+    {"rand", 0, 0, R::Random, 1, "rand() -> float in [0, 1]"},
+    {"rand2", 0, 0, R::Random, 2, "rand2() -> vec2 in [0, 1]²"},
+    {"rand3", 0, 0, R::Random, 3, "rand3() -> vec3 in [0, 1]³"},
+    {"rand4", 0, 0, R::Random, 4, "rand4() -> vec4 in [0, 1]⁴"},
+    {"nrand", 0, 0, R::Random, 1, "nrand() -> float in [-1, 1]"},
+    {"nrand2", 0, 0, R::Random, 2, "nrand2() -> vec2 in [-1, 1]²"},
+    {"nrand3", 0, 0, R::Random, 3, "nrand3() -> vec3 in [-1, 1]³"},
+    {"nrand4", 0, 0, R::Random, 4, "nrand4() -> vec4 in [-1, 1]⁴"},
+};
+
+const BuiltinConstant kConstants[] = {
+    {"pi", Type::scalar(), {3.14159265358979f, 0, 0, 0}},
+    {"tau", Type::scalar(), {6.28318530717959f, 0, 0, 0}},
+    {"origin", Type::vec(3), {0, 0, 0, 0}},
+    {"red", Type::vec(4), {1, 0, 0, 1}},
+    {"green", Type::vec(4), {0, 1, 0, 1}},
+    {"blue", Type::vec(4), {0, 0, 1, 1}},
+    {"white", Type::vec(4), {1, 1, 1, 1}},
+    {"black", Type::vec(4), {0, 0, 0, 1}},
+    {"grey", Type::vec(4), {0.5f, 0.5f, 0.5f, 1}},
+    {"gray", Type::vec(4), {0.5f, 0.5f, 0.5f, 1}},
+    {"yellow", Type::vec(4), {1, 1, 0, 1}},
+    {"cyan", Type::vec(4), {0, 1, 1, 1}},
+    {"magenta", Type::vec(4), {1, 0, 1, 1}},
+    {"orange", Type::vec(4), {1, 0.5f, 0, 1}},
+    {"purple", Type::vec(4), {0.5f, 0, 0.5f, 1}},
+    {"transparent", Type::vec(4), {0, 0, 0, 0}},
+};
+
+constexpr std::array<std::string_view, 6> kIntegrators = {"euler", "semi_implicit", "midpoint", "rk2", "rk4", "exact"};
+
+}  // namespace
+
+std::span<const BuiltinFunction> builtinFunctions() { return kFunctions; }
+
+int findBuiltinFunction(std::string_view name) {
+    for (size_t i = 0; i < std::size(kFunctions); ++i)
+        if (kFunctions[i].name == name) return static_cast<int>(i);
+    return -1;
+}
+
+const BuiltinFunction& builtinFunction(int index) { return kFunctions[index]; }
+
+bool isTemporal(BuiltinRule rule) {
+    return rule == R::Integrate || rule == R::Snapshot || rule == R::Prev;
+}
+
+std::span<const BuiltinConstant> builtinConstants() { return kConstants; }
+
+int findBuiltinConstant(std::string_view name) {
+    for (size_t i = 0; i < std::size(kConstants); ++i)
+        if (kConstants[i].name == name) return static_cast<int>(i);
+    return -1;
+}
+
+bool isBuiltinVariable(std::string_view name) { return name == "age" || name == "time" || name == "dt"; }
+
+std::span<const std::string_view> integratorNames() { return kIntegrators; }
+
+}  // namespace psys

@@ -1,0 +1,60 @@
+// The built-in functions, variables and constants of .psys, with their typing rules.
+//
+// One table, so the type checker, `--emit=ast`, the docs and (later) lowering agree on
+// what exists. Numeric functions work on float and vectors componentwise, and a float
+// argument broadcasts to the width of the others (as the thesis's NOp class did).
+#pragma once
+
+#include <optional>
+#include <span>
+#include <string_view>
+
+#include "frontend/types.h"
+
+namespace psys {
+
+enum class BuiltinRule {
+    Componentwise,   // f(T, …) -> T, float arguments broadcast: sin, min, clamp, mix, pow, …
+    ToScalar,        // f(T, …) -> float: length, distance, dot
+    SameVector,      // f(vecN, …) -> vecN: normalize, reflect
+    Cross,           // cross(vec3, vec3) -> vec3
+    Rotate,          // rotate_y(vec3, float) -> vec3
+    Construct,       // vec2/vec3/vec4(components…) or (float) broadcast
+    Integrate,       // integrate(T) / derive(T) -> T over the object's age
+    Snapshot,        // snapshot(x) -> x, evaluated once at creation
+    Prev,            // prev(x) -> x at the previous update
+    Random,          // rand()/nrand() -> float, rand3() -> vec3, …
+};
+
+struct BuiltinFunction {
+    std::string_view name;
+    int minArgs;
+    int maxArgs;
+    BuiltinRule rule;
+    int width;                  // Construct and Random: the result's width
+    std::string_view signature; // for notes: "clamp(x: T, lo: T|float, hi: T|float) -> T"
+};
+
+std::span<const BuiltinFunction> builtinFunctions();
+int findBuiltinFunction(std::string_view name);  // -1 when none
+const BuiltinFunction& builtinFunction(int index);
+
+// Functions whose value depends on an object's history: only in object equations.
+bool isTemporal(BuiltinRule rule);
+
+// Predefined constants: pi, tau, origin and the named colours.
+struct BuiltinConstant {
+    std::string_view name;
+    Type type;
+    float value[4];
+};
+std::span<const BuiltinConstant> builtinConstants();
+int findBuiltinConstant(std::string_view name);  // -1 when none
+
+// `age`, `time`, `dt`: names that always mean the same thing inside an object.
+bool isBuiltinVariable(std::string_view name);
+
+// The integrators `@integrator(…)` accepts.
+std::span<const std::string_view> integratorNames();
+
+}  // namespace psys

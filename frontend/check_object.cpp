@@ -1,0 +1,295 @@
+// Checking objects: their names, equations, commands and nested objects.
+//
+// Equations are a set: each may refer to any other, and recursion through `integrate`,
+// `prev` or `->` is legal (thesis §3.1.5). So their types are inferred together: start
+// from the annotations, re-check all equations until no type changes (diagnostics held
+// back), then check once more with diagnostics on. A recursive equation whose width
+// nothing fixes defaults to float.
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "frontend/builtins.h"
+#include "frontend/checker.h"
+#include "frontend/consteval.h"
+
+namespace psys::detail {
+
+using namespace ast;
+
+void Checker::declareObjectNames(ObjectDecl& object) {
+    ObjectScope& scope = objectScopes_[&object];
+    auto declare = [&](const std::string& name, SourceRange range, Ref ref, const char* what) {
+        if (!checkDeclarableName(name, range, what)) return;
+        if (auto it = scope.declaredAt.find(name); it != scope.declaredAt.end()) {
+            diags_.error(range, fmt::format("`{}` is defined twice in object `{}`", name, object.name))
+                .notes.push_back({it->second, "first defined here"});
+            return;
+        }
+        if (auto g = globals_.find(name); g != globals_.end() &&
+                                          (g->second->kind == DeclKind::Const || g->second->kind == DeclKind::Extern))
+            diags_.warning(range, fmt::format("{} `{}` hides the file-level {} of the same name", what, name,
+                                              g->second->kind == DeclKind::Const ? "constant" : "extern"))
+                .notes.push_back({g->second->nameRange, "hidden declaration"});
+        scope.names[name] = ref;
+        scope.declaredAt[name] = range;
+    };
+    checkParams(object.params, "object");
+    for (size_t i = 0; i < object.params.size(); ++i) {
+        Ref ref;
+        ref.kind = Ref::Kind::Param;
+        ref.object = &object;
+        ref.index = static_cast<int>(i);
+        declare(object.params[i].name, object.params[i].nameRange, ref, "parameter");
+    }
+    for (auto& eq : object.equations) {
+        eq->types.assign(eq->names.size(), Type::unknown());
+        if (eq->annotation) eq->types[0] = eq->annotation->type;
+        for (size_t i = 0; i < eq->names.size(); ++i) {
+            Ref ref;
+            ref.kind = Ref::Kind::Equation;
+            ref.object = &object;
+            ref.equation = eq.get();
+            ref.index = static_cast<int>(i);
+            declare(eq->names[i], eq->nameRanges[i], ref, "equation");
+        }
+    }
+}
+
+// Checks one equation's value and records the types of the names it defines. On the final
+// pass, also reports shape mismatches.
+void Checker::checkEquation(Equation& eq, const Context& ctx, bool final) {
+    Type t = check(*eq.value, ctx);
+    if (!eq.isTuple()) {
+        if (t.isTuple()) {
+            if (final)
+                diags_.error(eq.value->range, fmt::format("the value is a tuple {}, but `{}` names one value; write "
+                                                          "`({}) = …` to take it apart", t.str(), eq.names[0],
+                                                          [&] {
+                                                              std::string s;
+                                                              for (size_t i = 0; i < t.elements().size(); ++i)
+                                                                  s += (i ? ", " : "") + fmt::format("{}{}", eq.names[0], i + 1);
+                                                              return s;
+                                                          }()));
+            t = Type::error();
+        }
+        if (eq.annotation) {
+            if (final && !t.isVague() && t != eq.annotation->type)
+                diags_.error(eq.value->range, fmt::format("`{}` is declared {} but its value is {}", eq.names[0],
+                                                          eq.annotation->type.str(), t.str()))
+                    .notes.push_back({eq.annotation->range, "declared type"});
+            return;  // an annotation is authoritative
+        }
+        eq.types[0] = t;
+        return;
+    }
+    if (t.isVague()) {
+        for (auto& et : eq.types)
+            if (et.isUnknown() && t.isError()) et = Type::error();
+        return;
+    }
+    if (!t.isTuple() || t.elements().size() != eq.names.size()) {
+        if (final)
+            diags_.error(eq.value->range, fmt::format("{} names are defined here, but the value is {}", eq.names.size(),
+                                                      t.str()))
+                .notes.push_back({eq.range, "a composite equation needs a tuple with one value per name"});
+        for (auto& et : eq.types) et = Type::error();
+        return;
+    }
+    eq.types = t.elements();
+}
+
+void Checker::inferEquations(ObjectDecl& object) {
+    Context ctx;
+    ctx.where = Where::Object;
+    ctx.object = &object;
+    bool wasSuppressed = diags_.suppressed();
+    diags_.setSuppressed(true);
+    for (int round = 0; round < 16; ++round) {
+        std::vector<std::vector<Type>> before;
+        for (auto& eq : object.equations) before.push_back(eq->types);
+        for (auto& eq : object.equations) checkEquation(*eq, ctx, false);
+        bool changed = false;
+        for (size_t i = 0; i < object.equations.size(); ++i) changed |= before[i] != object.equations[i]->types;
+        if (changed) continue;
+        // Stable: give any still-unknown recursive equation the default type float and go on.
+        bool defaulted = false;
+        for (auto& eq : object.equations)
+            for (auto& t : eq->types)
+                if (t.isUnknown()) {
+                    t = Type::scalar();
+                    defaulted = true;
+                }
+        if (!defaulted) break;
+    }
+    diags_.setSuppressed(wasSuppressed);
+    for (auto& eq : object.equations) checkEquation(*eq, ctx, true);
+}
+
+void Checker::checkArguments(std::vector<ExprPtr>& args, const ObjectDecl& target, SourceRange callRange,
+                             const Context& ctx) {
+    std::vector<Type> types;
+    for (auto& a : args) types.push_back(check(*a, ctx));
+    if (args.size() != target.params.size()) {
+        std::string params;
+        for (auto& p : target.params) params += (params.empty() ? "" : ", ") + p.name + ": " + p.type.type.str();
+        diags_.error(callRange, fmt::format("`{}` takes {} argument{} ({}), but {} {} given", target.name,
+                                            target.params.size(), target.params.size() == 1 ? "" : "s", params,
+                                            args.size(), args.size() == 1 ? "was" : "were"))
+            .notes.push_back({target.nameRange, fmt::format("`{}` declared here", target.name)});
+        return;
+    }
+    for (size_t i = 0; i < args.size(); ++i) {
+        const Param& p = target.params[i];
+        if (!types[i].isVague() && !p.type.type.isVague() && types[i] != p.type.type)
+            diags_.error(args[i]->range, fmt::format("argument {} of `{}` (`{}`) must be {}, found {}", i + 1,
+                                                     target.name, p.name, p.type.type.str(), types[i].str()))
+                .notes.push_back({p.nameRange, "parameter declared here"});
+    }
+}
+
+void Checker::checkEmit(Command& emit, const Context& ctx) {
+    emit.targetDecl = findEmitTarget(emit.target, emit.targetRange, ctx);
+    SourceRange callRange = emit.args.empty() ? emit.targetRange
+                                              : SourceRange::join(emit.targetRange, emit.args.back()->range);
+    if (emit.targetDecl) {
+        createdObjects_.insert(emit.targetDecl);
+        checkArguments(emit.args, *emit.targetDecl, callRange, ctx);
+    } else {
+        for (auto& a : emit.args) check(*a, ctx);
+    }
+    if (emit.rate) {
+        if (ctx.where == Where::Trigger) {
+            diags_.error(emit.rate->range, "a trigger runs once when fired: it cannot emit at a rate; use `count N`");
+        } else {
+            check(*emit.rate, ctx);
+            if (expectType(*emit.rate, Type::scalar(), "an emission rate (per second)"))
+                if (auto v = evaluateConstant(*emit.rate); v && v->v[0] < 0)
+                    diags_.error(emit.rate->range, fmt::format("the emission rate is negative ({})", v->v[0]));
+        }
+    }
+    if (emit.count) {
+        check(*emit.count, ctx);
+        if (expectType(*emit.count, Type::scalar(), "an emission count"))
+            if (auto v = evaluateConstant(*emit.count); v && v->v[0] < 0)
+                diags_.error(emit.count->range, fmt::format("the emission count is negative ({})", v->v[0]));
+    }
+}
+
+void Checker::checkCommands(std::vector<CommandPtr>& commands, const Context& ctx, const Command** point) {
+    for (auto& cmd : commands) {
+        switch (cmd->kind) {
+            case CommandKind::Point: {
+                if (ctx.where != Where::Object) {
+                    diags_.error(cmd->keywordRange, "`point` draws an object; a trigger can only emit objects");
+                    break;
+                }
+                if (*point) {
+                    diags_.error(cmd->keywordRange, fmt::format("object `{}` already draws a point; an object draws "
+                                                                "at most one", ctx.object->name))
+                        .notes.push_back({(*point)->keywordRange, "the first `point` is here"});
+                } else {
+                    *point = cmd.get();
+                }
+                std::vector<Type> types;
+                for (auto& a : cmd->args) types.push_back(check(*a, ctx));
+                if (cmd->args.size() != 3) {
+                    diags_.error(cmd->range, fmt::format("`point` takes 3 arguments (position: vec3, colour: vec4, "
+                                                         "size: float), but {} {} given", cmd->args.size(),
+                                                         cmd->args.size() == 1 ? "was" : "were"));
+                    break;
+                }
+                expectType(*cmd->args[0], Type::vec(3), "the position of a point");
+                if (types[1] == Type::vec(3))
+                    diags_.error(cmd->args[1]->range, "the colour of a point must be vec4 (color), found vec3")
+                        .notes.push_back({cmd->args[1]->range, "add an alpha: `vec4(c, 1)`"});
+                else
+                    expectType(*cmd->args[1], Type::vec(4), "the colour of a point");
+                expectType(*cmd->args[2], Type::scalar(), "the size of a point");
+                break;
+            }
+            case CommandKind::Kill:
+                if (ctx.where != Where::Object) {
+                    diags_.error(cmd->keywordRange, "`kill` removes an object; a trigger can only emit objects");
+                    break;
+                }
+                if (cmd->cond) {
+                    check(*cmd->cond, ctx);
+                    expectType(*cmd->cond, Type::boolean(), "the condition of `kill when`");
+                }
+                break;
+            case CommandKind::Emit: checkEmit(*cmd, ctx); break;
+            case CommandKind::When:
+                check(*cmd->cond, ctx);
+                expectType(*cmd->cond, Type::boolean(), "the condition of `when`");
+                checkCommands(cmd->body, ctx, point);
+                break;
+        }
+    }
+}
+
+void Checker::checkAttributes(const std::vector<Attribute*>& attributes) {
+    std::map<std::string, SourceRange> seen;
+    Context ctx;
+    ctx.where = Where::Attribute;
+    for (Attribute* attribute : attributes) {
+        Attribute& a = *attribute;
+        if (auto it = seen.find(a.name); it != seen.end()) {
+            diags_.error(a.range, fmt::format("`@{}` is given twice", a.name)).notes.push_back({it->second, "first given here"});
+            continue;
+        }
+        seen[a.name] = a.range;
+        auto wantOneArg = [&](const char* what) {
+            if (a.args.size() == 1) return true;
+            diags_.error(a.range, fmt::format("`@{}` takes one argument: {}", a.name, what));
+            return false;
+        };
+        if (a.name == "integrator") {
+            std::string names;
+            for (auto n : integratorNames()) names += (names.empty() ? "" : ", ") + std::string(n);
+            if (!wantOneArg("the integration method")) continue;
+            auto* name = a.args[0]->kind == ExprKind::Name ? static_cast<NameExpr*>(a.args[0].get()) : nullptr;
+            bool known = false;
+            for (auto n : integratorNames()) known |= name && name->name == n;
+            if (!known)
+                diags_.error(a.args[0]->range, name ? fmt::format("unknown integrator `{}`", name->name)
+                                                    : std::string("the integrator must be named"))
+                    .notes.push_back({a.args[0]->range, "the integrators are " + names});
+        } else if (a.name == "step") {
+            if (!wantOneArg("the fixed sub-step in seconds, such as 1/240")) continue;
+            check(*a.args[0], ctx);
+            if (!expectType(*a.args[0], Type::scalar(), "the step")) continue;
+            auto v = evaluateConstant(*a.args[0]);
+            if (!a.args[0]->type.isError() && (!v || !(v->v[0] > 0)))
+                diags_.error(a.args[0]->range, "the step must be a positive constant number of seconds");
+        } else if (a.name == "capacity") {
+            if (!wantOneArg("the most objects of this type alive at once")) continue;
+            check(*a.args[0], ctx);
+            if (!expectType(*a.args[0], Type::scalar(), "the capacity")) continue;
+            auto v = evaluateConstant(*a.args[0]);
+            if (!a.args[0]->type.isError() && (!v || !(v->v[0] >= 1) || v->v[0] != std::floor(v->v[0])))
+                diags_.error(a.args[0]->range, "the capacity must be a positive constant whole number");
+        } else {
+            diags_.error(a.nameRange, fmt::format("unknown attribute `@{}`", a.name))
+                .notes.push_back({a.nameRange, "the attributes are @integrator(method), @step(seconds) and "
+                                               "@capacity(count)"});
+        }
+    }
+}
+
+void Checker::checkObject(ObjectDecl& object) {
+    std::vector<Attribute*> attributes;
+    for (auto& a : object.attributes) attributes.push_back(&a);
+    checkAttributes(attributes);
+    declareObjectNames(object);
+    inferEquations(object);
+    Context ctx;
+    ctx.where = Where::Object;
+    ctx.object = &object;
+    const Command* point = nullptr;
+    checkCommands(object.commands, ctx, &point);
+    // Parents before children: a child reads its parent's equations, whose types are now known.
+    for (auto& child : object.children) checkObject(*child);
+}
+
+}  // namespace psys::detail

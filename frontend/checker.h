@@ -1,0 +1,104 @@
+// Name resolution and type checking of a loaded program (internal to frontend/).
+//
+// One Checker walks the whole program once: it fills in every NameExpr's Ref, every
+// Expr's Type, every emit's target and every equation's types, and reports what is wrong.
+// Split over files by concern: symbols.cpp (scopes and lookup), check_expr.cpp
+// (expressions), check_object.cpp (objects, equations, commands), check_decls.cpp
+// (constants, functions, externs, triggers, spawns, attributes).
+#pragma once
+
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "frontend/ast.h"
+#include "frontend/diagnostics.h"
+
+namespace psys::detail {
+
+// Where an expression appears decides what it may use.
+enum class Where { Object, Fn, Const, ExternValue, Trigger, Spawn, Attribute };
+
+struct Context {
+    Where where = Where::Object;
+    const ast::ObjectDecl* object = nullptr;
+    const ast::FnDecl* fn = nullptr;
+    size_t letsVisible = 0;  // lets of `fn` declared before the expression
+    const ast::TriggerDecl* trigger = nullptr;
+};
+
+// The names an object declares: its parameters and equations.
+struct ObjectScope {
+    std::map<std::string, ast::Ref> names;
+    std::map<std::string, SourceRange> declaredAt;
+};
+
+class Checker {
+public:
+    Checker(ast::Program& program, DiagnosticEngine& diags) : program_(program), diags_(diags) {}
+    void run();
+
+private:
+    // symbols.cpp
+    void collectGlobals();
+    void declareGlobal(ast::Decl& decl);
+    bool checkDeclarableName(const std::string& name, SourceRange range, const char* what);
+    ast::Ref lookupName(const std::string& name, SourceRange range, const Context& ctx);
+    const ast::ObjectDecl* findEmitTarget(const std::string& name, SourceRange range, const Context& ctx);
+    void reportUnknown(const std::string& what, const std::string& name, SourceRange range,
+                       const std::vector<std::string>& candidates);
+    std::vector<std::string> namesInScope(const Context& ctx) const;
+    const ast::ObjectDecl* enclosingObject(const std::string& name, const Context& ctx, int* depth) const;
+
+    // check_expr.cpp
+    Type check(ast::Expr& expr, const Context& ctx);
+    Type checkName(ast::NameExpr& name, const Context& ctx);
+    Type checkCall(ast::CallExpr& call, const Context& ctx);
+    Type checkBuiltinCall(ast::CallExpr& call, const std::vector<Type>& args, const Context& ctx);
+    Type checkUserCall(ast::CallExpr& call, const ast::FnDecl& fn, const std::vector<Type>& args);
+    Type checkMember(ast::MemberExpr& member, const Context& ctx);
+    Type checkUnary(ast::UnaryExpr& unary, const Context& ctx);
+    Type checkBinary(ast::BinaryExpr& binary, const Context& ctx);
+    Type typeOfRef(const ast::Ref& ref);
+    bool expectType(const ast::Expr& expr, const Type& want, const std::string& what);
+
+    // check_object.cpp
+    void checkObject(ast::ObjectDecl& object);
+    void declareObjectNames(ast::ObjectDecl& object);
+    void inferEquations(ast::ObjectDecl& object);
+    void checkEquation(ast::Equation& eq, const Context& ctx, bool final);
+    void checkCommands(std::vector<ast::CommandPtr>& commands, const Context& ctx, const ast::Command** point);
+    void checkEmit(ast::Command& emit, const Context& ctx);
+    void checkArguments(std::vector<ast::ExprPtr>& args, const ast::ObjectDecl& target, SourceRange callRange,
+                        const Context& ctx);
+    void checkAttributes(const std::vector<ast::Attribute*>& attributes);
+
+    // check_decls.cpp
+    void checkConst(ast::ConstDecl& decl);
+    void checkFn(const ast::FnDecl& decl);
+    void checkExtern(ast::ExternDecl& decl);
+    void checkTrigger(ast::TriggerDecl& decl);
+    void checkSpawn(ast::SpawnDecl& decl);
+    void checkParams(const std::vector<ast::Param>& params, const char* owner);
+    void reportUnused();
+
+    ast::Program& program_;
+    DiagnosticEngine& diags_;
+
+    std::map<std::string, ast::Decl*> globals_;
+    std::multimap<std::string, const ast::ObjectDecl*> nestedObjects_;
+    std::map<const ast::ObjectDecl*, ObjectScope> objectScopes_;
+
+    // Lazily checked declarations: 1 while being checked (a second visit is a cycle), 2 when done.
+    std::map<const ast::Decl*, int> progress_;
+    std::vector<const ast::Decl*> checking_;
+
+    std::set<const ast::Equation*> usedEquations_;
+    std::set<const ast::ObjectDecl*> createdObjects_;
+};
+
+// Levenshtein-nearest candidate within a small distance, for "did you mean …?".
+std::string closestName(const std::string& name, const std::vector<std::string>& candidates);
+
+}  // namespace psys::detail

@@ -1,0 +1,23 @@
+// Compile-time evaluation of constant expressions.
+//
+// Used where the front end must know a value to check it: extern defaults and ranges,
+// `@step`, `@capacity`, constant emission rates and counts. Returns nullopt for anything
+// that is not a constant (an extern, `age`, `rand()`, a user function call, …).
+#pragma once
+
+#include <array>
+#include <optional>
+
+#include "frontend/ast.h"
+
+namespace psys {
+
+struct ConstValue {
+    Type type;                      // bool, float or vecN
+    std::array<double, 4> v{};      // components; a bool is 0 or 1
+    bool isTrue() const { return v[0] != 0; }
+};
+
+std::optional<ConstValue> evaluateConstant(const ast::Expr& expr);
+
+}  // namespace psys

@@ -1,0 +1,116 @@
+#include "frontend/diagnostics.h"
+
+#include <algorithm>
+#include <ostream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+namespace psys {
+namespace {
+
+constexpr const char* kReset = "\x1b[0m";
+constexpr const char* kBold = "\x1b[1m";
+constexpr const char* kRed = "\x1b[1;31m";
+constexpr const char* kMagenta = "\x1b[1;35m";
+constexpr const char* kCyan = "\x1b[1;36m";
+constexpr const char* kGreen = "\x1b[1;32m";
+
+const char* severityWord(Severity s) {
+    switch (s) {
+        case Severity::Error: return "error";
+        case Severity::Warning: return "warning";
+        case Severity::Note: return "note";
+    }
+    return "error";
+}
+
+const char* severityColour(Severity s) {
+    switch (s) {
+        case Severity::Error: return kRed;
+        case Severity::Warning: return kMagenta;
+        case Severity::Note: return kCyan;
+    }
+    return kRed;
+}
+
+// Prints `path:line:col: severity: message`, then the source line with the range
+// underlined: a caret at its start and tildes over the rest of it on that line.
+void printOne(std::ostream& out, const SourceManager& sources, Severity severity,
+              SourceRange range, const std::string& message, bool colour) {
+    auto paint = [&](const char* code) { return colour ? code : ""; };
+    if (!range.valid()) {
+        out << paint(kBold) << "psysc: " << paint(kReset) << paint(severityColour(severity))
+            << severityWord(severity) << ": " << paint(kReset) << paint(kBold) << message
+            << paint(kReset) << '\n';
+        return;
+    }
+    const SourceFile& file = sources.file(range.file);
+    LineColumn at = file.lineColumn(range.begin);
+    out << paint(kBold) << file.path() << ':' << at.line << ':' << at.column << ": "
+        << paint(kReset) << paint(severityColour(severity)) << severityWord(severity) << ": "
+        << paint(kReset) << paint(kBold) << message << paint(kReset) << '\n';
+
+    std::string_view line = file.lineText(at.line);
+    std::string number = std::to_string(at.line);
+    std::string gutter(number.size(), ' ');
+    out << ' ' << number << " | " << line << '\n';
+
+    // Underline: tabs are copied from the source so the caret lines up.
+    uint32_t startCol = at.column - 1;
+    uint32_t endCol = startCol + 1;
+    if (range.end > range.begin) {
+        LineColumn last = file.lineColumn(range.end - 1);
+        endCol = last.line == at.line ? last.column : static_cast<uint32_t>(line.size());
+    }
+    endCol = std::max(endCol, startCol + 1);
+    std::string marks;
+    for (uint32_t i = 0; i < startCol; ++i) marks += (i < line.size() && line[i] == '\t') ? '\t' : ' ';
+    std::string underline = "^";
+    for (uint32_t i = startCol + 1; i < endCol; ++i) underline += '~';
+    out << ' ' << gutter << " | " << marks << paint(kGreen) << underline << paint(kReset) << '\n';
+}
+
+}  // namespace
+
+Diagnostic& DiagnosticEngine::add(Severity severity, SourceRange range, std::string message) {
+    if (suppressed_) {
+        discarded_ = {};
+        return discarded_;
+    }
+    if (severity == Severity::Error) ++errors_;
+    if (severity == Severity::Warning) ++warnings_;
+    diagnostics_.push_back({severity, range, std::move(message), {}});
+    return diagnostics_.back();
+}
+
+Diagnostic& DiagnosticEngine::error(SourceRange range, std::string message) {
+    return add(Severity::Error, range, std::move(message));
+}
+
+Diagnostic& DiagnosticEngine::warning(SourceRange range, std::string message) {
+    return add(Severity::Warning, range, std::move(message));
+}
+
+void DiagnosticEngine::print(std::ostream& out, bool colour) const {
+    for (const Diagnostic& d : diagnostics_) {
+        printOne(out, sources_, d.severity, d.range, d.message, colour);
+        for (const DiagnosticNote& n : d.notes)
+            printOne(out, sources_, Severity::Note, n.range, n.message, colour);
+    }
+    if (errors_ > 0 || warnings_ > 0) {
+        std::vector<std::string> parts;
+        if (errors_ > 0) parts.push_back(fmt::format("{} error{}", errors_, errors_ == 1 ? "" : "s"));
+        if (warnings_ > 0)
+            parts.push_back(fmt::format("{} warning{}", warnings_, warnings_ == 1 ? "" : "s"));
+        out << (parts.size() == 2 ? parts[0] + " and " + parts[1] : parts[0]) << " generated.\n";
+    }
+}
+
+std::string DiagnosticEngine::render(bool colour) const {
+    std::ostringstream out;
+    print(out, colour);
+    return out.str();
+}
+
+}  // namespace psys

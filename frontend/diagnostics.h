@@ -1,0 +1,63 @@
+// Diagnostics: collected during a run, printed in the style of a mature compiler:
+//
+//   fire.psys:12:9: error: cannot add vec3 and vec4
+//      12 |     acc = gravity + tint;
+//         |           ~~~~~~~~^~~~~~
+//   fire.psys:3:1: note: `tint` declared here
+//
+// Several errors per run; colour only when asked (the driver asks on a terminal).
+#pragma once
+
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "frontend/source.h"
+
+namespace psys {
+
+enum class Severity { Error, Warning, Note };
+
+struct DiagnosticNote {
+    SourceRange range;
+    std::string message;
+};
+
+struct Diagnostic {
+    Severity severity = Severity::Error;
+    SourceRange range;
+    std::string message;
+    std::vector<DiagnosticNote> notes;
+};
+
+class DiagnosticEngine {
+public:
+    explicit DiagnosticEngine(const SourceManager& sources) : sources_(sources) {}
+
+    // Returns the diagnostic so a caller can attach notes.
+    Diagnostic& error(SourceRange range, std::string message);
+    Diagnostic& warning(SourceRange range, std::string message);
+
+    int errorCount() const { return errors_; }
+    int warningCount() const { return warnings_; }
+    const std::vector<Diagnostic>& all() const { return diagnostics_; }
+
+    // While suppressed, reports are dropped (used for trial passes of type inference).
+    void setSuppressed(bool suppressed) { suppressed_ = suppressed; }
+    bool suppressed() const { return suppressed_; }
+
+    void print(std::ostream& out, bool colour) const;
+    std::string render(bool colour = false) const;
+
+private:
+    Diagnostic& add(Severity severity, SourceRange range, std::string message);
+
+    const SourceManager& sources_;
+    std::vector<Diagnostic> diagnostics_;
+    Diagnostic discarded_;
+    int errors_ = 0;
+    int warnings_ = 0;
+    bool suppressed_ = false;
+};
+
+}  // namespace psys

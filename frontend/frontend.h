@@ -1,0 +1,25 @@
+// The front end in one call: load (parse every file, follow imports), resolve names,
+// check types. What later stages receive is a fully annotated AST, or nothing.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "frontend/ast.h"
+#include "frontend/diagnostics.h"
+
+namespace psys {
+
+// Returns the checked program, or null when there were errors (reported to `diags`).
+// Warnings do not stop it.
+std::unique_ptr<ast::Program> checkFile(const std::string& path, SourceManager& sources, DiagnosticEngine& diags);
+std::unique_ptr<ast::Program> checkText(const std::string& displayPath, std::string text, SourceManager& sources,
+                                        DiagnosticEngine& diags);
+
+// Resolves and type-checks an already loaded program in place.
+void checkProgram(ast::Program& program, DiagnosticEngine& diags);
+
+// `--emit=ast`: an indented, typed rendering of the checked tree.
+std::string printAst(const ast::Program& program, const SourceManager& sources);
+
+}  // namespace psys

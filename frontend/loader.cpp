@@ -1,0 +1,118 @@
+#include "frontend/loader.h"
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "frontend/parse.h"
+
+namespace psys {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::optional<std::string> readFile(const fs::path& path, std::string& error) {
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) {
+        error = "it is a directory";
+        return std::nullopt;
+    }
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        error = std::strerror(errno);
+        return std::nullopt;
+    }
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+class Loader {
+public:
+    Loader(SourceManager& sources, DiagnosticEngine& diags) : sources_(sources), diags_(diags) {}
+
+    std::unique_ptr<ast::Program> run(const std::string& displayPath, std::string text) {
+        program_ = std::make_unique<ast::Program>();
+        bool ok = loadText(fs::path(displayPath), std::move(text));
+        return ok && diags_.errorCount() == 0 ? std::move(program_) : nullptr;
+    }
+
+    bool loadText(const fs::path& displayPath, std::string text) {
+        std::string key = canonicalKey(displayPath);
+        int file = sources_.add(displayPath.string(), std::move(text));
+        auto module = parseModule(file, sources_, diags_);
+        if (!module) return false;
+        loaded_[key] = static_cast<int>(program_->modules.size());
+        ast::Module* raw = module.get();
+        program_->modules.push_back(std::move(module));
+        stack_.push_back({key, displayPath.string()});
+        bool ok = true;
+        for (auto& decl : raw->decls)
+            if (decl->kind == ast::DeclKind::Import) ok &= loadImport(static_cast<ast::ImportDecl&>(*decl), displayPath);
+        stack_.pop_back();
+        return ok;
+    }
+
+private:
+    static std::string canonicalKey(const fs::path& path) {
+        std::error_code ec;
+        fs::path canonical = fs::weakly_canonical(path, ec);
+        return (ec ? path.lexically_normal() : canonical).string();
+    }
+
+    bool loadImport(ast::ImportDecl& import, const fs::path& importer) {
+        fs::path target = (importer.parent_path() / import.path).lexically_normal();
+        std::string key = canonicalKey(target);
+        for (size_t i = 0; i < stack_.size(); ++i) {
+            if (stack_[i].first != key) continue;
+            std::string chain;
+            for (size_t j = i; j < stack_.size(); ++j) chain += stack_[j].second + " → ";
+            diags_.error(import.pathRange, fmt::format("import cycle: {}{}", chain, target.string()))
+                .notes.push_back({import.pathRange, "a file cannot import itself, directly or through others"});
+            return false;
+        }
+        if (auto it = loaded_.find(key); it != loaded_.end()) {
+            import.module = it->second;
+            return true;
+        }
+        std::string error;
+        auto text = readFile(target, error);
+        if (!text) {
+            diags_.error(import.pathRange, fmt::format("cannot open imported file `{}`: {}", target.string(), error));
+            return false;
+        }
+        bool ok = loadText(target, std::move(*text));
+        if (auto it = loaded_.find(key); it != loaded_.end()) import.module = it->second;
+        return ok;
+    }
+
+    SourceManager& sources_;
+    DiagnosticEngine& diags_;
+    std::unique_ptr<ast::Program> program_;
+    std::map<std::string, int> loaded_;
+    std::vector<std::pair<std::string, std::string>> stack_;  // (canonical, display) of files being loaded
+};
+
+}  // namespace
+
+std::unique_ptr<ast::Program> loadProgram(const std::string& mainPath, SourceManager& sources, DiagnosticEngine& diags) {
+    std::string error;
+    auto text = readFile(mainPath, error);
+    if (!text) {
+        diags.error({}, fmt::format("cannot read `{}`: {}", mainPath, error));
+        return nullptr;
+    }
+    return loadProgramFromText(mainPath, std::move(*text), sources, diags);
+}
+
+std::unique_ptr<ast::Program> loadProgramFromText(const std::string& displayPath, std::string text,
+                                                  SourceManager& sources, DiagnosticEngine& diags) {
+    return Loader(sources, diags).run(displayPath, std::move(text));
+}
+
+}  // namespace psys

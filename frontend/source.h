@@ -1,0 +1,54 @@
+// Source text and locations.
+//
+// Every AST node and every diagnostic carries a SourceRange: a file and a half-open byte
+// range in it. Line and column are computed only when a diagnostic is printed.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace psys {
+
+struct SourceRange {
+    int file = -1;        // index into SourceManager; -1: no location (command line, built-in)
+    uint32_t begin = 0;   // byte offsets, half-open
+    uint32_t end = 0;
+
+    bool valid() const { return file >= 0; }
+    static SourceRange join(SourceRange a, SourceRange b);
+};
+
+struct LineColumn {
+    uint32_t line = 1;    // 1-based
+    uint32_t column = 1;  // 1-based, in bytes
+};
+
+class SourceFile {
+public:
+    SourceFile(std::string displayPath, std::string text);
+
+    const std::string& path() const { return path_; }
+    const std::string& text() const { return text_; }
+    LineColumn lineColumn(uint32_t offset) const;
+    std::string_view lineText(uint32_t line) const;  // without the newline
+
+private:
+    std::string path_;
+    std::string text_;
+    std::vector<uint32_t> lineStarts_;
+};
+
+class SourceManager {
+public:
+    int add(std::string displayPath, std::string text);
+    const SourceFile& file(int id) const { return *files_.at(static_cast<size_t>(id)); }
+    int count() const { return static_cast<int>(files_.size()); }
+
+private:
+    std::vector<std::unique_ptr<SourceFile>> files_;
+};
+
+}  // namespace psys

@@ -1,0 +1,298 @@
+// Scopes and name lookup.
+//
+// Scopes, innermost first: a fn's lets and parameters, or an object's parameters and
+// equations; then the file scope (constants, externs, functions, objects and triggers of
+// the main file and of everything it imports, one namespace); then the built-ins. An
+// enclosing object's equations are not in scope by their bare names: a child reads them
+// live and explicitly, as `rocket.pos`.
+#include <algorithm>
+#include <functional>
+
+#include <fmt/format.h>
+
+#include "frontend/builtins.h"
+#include "frontend/checker.h"
+
+namespace psys::detail {
+
+using namespace ast;
+
+namespace {
+
+const char* declWord(DeclKind kind) {
+    switch (kind) {
+        case DeclKind::Const: return "constant";
+        case DeclKind::Fn: return "function";
+        case DeclKind::Extern: return "extern";
+        case DeclKind::Trigger: return "trigger";
+        case DeclKind::Object: return "object";
+        default: return "declaration";
+    }
+}
+
+size_t editDistance(const std::string& a, const std::string& b) {
+    std::vector<size_t> row(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (size_t i = 1; i <= a.size(); ++i) {
+        size_t diagonal = row[0];
+        row[0] = i;
+        for (size_t j = 1; j <= b.size(); ++j) {
+            size_t up = row[j];
+            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+            diagonal = up;
+        }
+    }
+    return row[b.size()];
+}
+
+}  // namespace
+
+std::string closestName(const std::string& name, const std::vector<std::string>& candidates) {
+    std::string best;
+    size_t bestDistance = std::max<size_t>(1, name.size() / 3) + 1;
+    for (const std::string& c : candidates) {
+        size_t d = editDistance(name, c);
+        if (d < bestDistance) {
+            bestDistance = d;
+            best = c;
+        }
+    }
+    return best;
+}
+
+// A user's name may not redefine what the language defines.
+bool Checker::checkDeclarableName(const std::string& name, SourceRange range, const char* what) {
+    if (isBuiltinVariable(name)) {
+        diags_.error(range, fmt::format("cannot declare a {} named `{}`: `{}` is a built-in variable", what, name, name));
+        return false;
+    }
+    if (findBuiltinConstant(name) >= 0) {
+        diags_.error(range, fmt::format("cannot declare a {} named `{}`: `{}` is a built-in constant", what, name, name));
+        return false;
+    }
+    if (Type::fromName(name)) {
+        diags_.error(range, fmt::format("cannot declare a {} named `{}`: `{}` is a type", what, name, name));
+        return false;
+    }
+    return true;
+}
+
+void Checker::declareGlobal(Decl& decl) {
+    if (findBuiltinFunction(decl.name) >= 0) {
+        diags_.error(decl.nameRange, fmt::format("cannot declare a {} named `{}`: `{}` is a built-in function",
+                                                 declWord(decl.kind), decl.name, decl.name));
+        return;
+    }
+    if (!checkDeclarableName(decl.name, decl.nameRange, declWord(decl.kind))) return;
+    auto [it, inserted] = globals_.emplace(decl.name, &decl);
+    if (!inserted) {
+        diags_.error(decl.nameRange, fmt::format("redefinition of `{}`", decl.name))
+            .notes.push_back({it->second->nameRange,
+                              fmt::format("`{}` was first declared here as a {}", decl.name, declWord(it->second->kind))});
+    }
+}
+
+void Checker::collectGlobals() {
+    std::function<void(const ObjectDecl&)> collectNested = [&](const ObjectDecl& object) {
+        std::map<std::string, const ObjectDecl*> siblings;
+        for (auto& child : object.children) {
+            nestedObjects_.emplace(child->name, child.get());
+            auto [it, inserted] = siblings.emplace(child->name, child.get());
+            if (!inserted)
+                diags_.error(child->nameRange, fmt::format("redefinition of object `{}` inside `{}`", child->name, object.name))
+                    .notes.push_back({it->second->nameRange, "first declared here"});
+            collectNested(*child);
+        }
+    };
+    for (auto& module : program_.modules) {
+        for (auto& decl : module->decls) {
+            switch (decl->kind) {
+                case DeclKind::Const: case DeclKind::Fn: case DeclKind::Extern: case DeclKind::Trigger:
+                    declareGlobal(*decl);
+                    break;
+                case DeclKind::Object:
+                    declareGlobal(*decl);
+                    collectNested(static_cast<ObjectDecl&>(*decl));
+                    break;
+                default: break;
+            }
+        }
+    }
+}
+
+// The enclosing object called `name`, if any, and how many levels up it is.
+const ObjectDecl* Checker::enclosingObject(const std::string& name, const Context& ctx, int* depth) const {
+    if (ctx.where != Where::Object || !ctx.object) return nullptr;
+    int level = 0;
+    for (const ObjectDecl* p = ctx.object->parent; p; p = p->parent) {
+        ++level;
+        if (p->name == name) {
+            *depth = level;
+            return p;
+        }
+    }
+    return nullptr;
+}
+
+std::vector<std::string> Checker::namesInScope(const Context& ctx) const {
+    std::vector<std::string> names;
+    if (ctx.where == Where::Object && ctx.object) {
+        auto it = objectScopes_.find(ctx.object);
+        if (it != objectScopes_.end())
+            for (auto& [n, _] : it->second.names) names.push_back(n);
+        names.insert(names.end(), {"age", "time", "dt"});
+    }
+    if (ctx.fn) {
+        for (auto& p : ctx.fn->params) names.push_back(p.name);
+        for (size_t i = 0; i < ctx.letsVisible; ++i) names.push_back(ctx.fn->lets[i]->name);
+    }
+    if (ctx.trigger)
+        for (auto& p : ctx.trigger->params) names.push_back(p.name);
+    for (auto& [n, d] : globals_)
+        if (d->kind == DeclKind::Const || d->kind == DeclKind::Extern) names.push_back(n);
+    for (auto& c : builtinConstants()) names.emplace_back(c.name);
+    return names;
+}
+
+void Checker::reportUnknown(const std::string& what, const std::string& name, SourceRange range,
+                            const std::vector<std::string>& candidates) {
+    std::string suggestion = closestName(name, candidates);
+    diags_.error(range, suggestion.empty() ? fmt::format("unknown {} `{}`", what, name)
+                                           : fmt::format("unknown {} `{}`; did you mean `{}`?", what, name, suggestion));
+}
+
+Ref Checker::lookupName(const std::string& name, SourceRange range, const Context& ctx) {
+    Ref ref;
+    // Inner scopes: fn lets and parameters, trigger parameters, the object's own names.
+    if (ctx.fn) {
+        for (size_t i = ctx.letsVisible; i-- > 0;) {
+            if (ctx.fn->lets[i]->name == name) {
+                ref.kind = Ref::Kind::Let;
+                ref.let = ctx.fn->lets[i].get();
+                return ref;
+            }
+        }
+        for (size_t i = 0; i < ctx.fn->params.size(); ++i) {
+            if (ctx.fn->params[i].name == name) {
+                ref.kind = Ref::Kind::FnParam;
+                ref.fn = ctx.fn;
+                ref.index = static_cast<int>(i);
+                return ref;
+            }
+        }
+    }
+    if (ctx.trigger) {
+        for (size_t i = 0; i < ctx.trigger->params.size(); ++i) {
+            if (ctx.trigger->params[i].name == name) {
+                ref.kind = Ref::Kind::TriggerParam;
+                ref.trigger = ctx.trigger;
+                ref.index = static_cast<int>(i);
+                return ref;
+            }
+        }
+    }
+    if (isBuiltinVariable(name)) {
+        bool allowed = ctx.where == Where::Object || (name == "time" && (ctx.where == Where::Trigger || ctx.where == Where::Spawn));
+        if (!allowed) {
+            const char* place = ctx.where == Where::Fn ? "a function: functions are pure; pass it as a parameter"
+                                : ctx.where == Where::Trigger ? "a trigger: a trigger has no age or step of its own"
+                                : ctx.where == Where::Spawn ? "a spawn: nothing has aged yet"
+                                : "a constant expression";
+            diags_.error(range, fmt::format("`{}` cannot be used in {}", name, place));
+            return ref;
+        }
+        ref.kind = name == "age" ? Ref::Kind::Age : name == "time" ? Ref::Kind::Time : Ref::Kind::Dt;
+        return ref;
+    }
+    if (ctx.where == Where::Object && ctx.object) {
+        auto& scope = objectScopes_[ctx.object];
+        if (auto it = scope.names.find(name); it != scope.names.end()) return it->second;
+        int level = 0;
+        for (const ObjectDecl* p = ctx.object->parent; p; p = p->parent) {
+            ++level;
+            auto& outer = objectScopes_[p];
+            if (auto it = outer.names.find(name); it != outer.names.end()) {
+                diags_.error(range, fmt::format("`{}` belongs to the enclosing object `{}`; read it live as `{}.{}`",
+                                                name, p->name, p->name, name))
+                    .notes.push_back({outer.declaredAt[name], fmt::format("`{}` is declared here", name)});
+                return ref;
+            }
+        }
+    }
+    // File scope.
+    if (auto it = globals_.find(name); it != globals_.end()) {
+        Decl* decl = it->second;
+        switch (decl->kind) {
+            case DeclKind::Const:
+                ref.kind = Ref::Kind::Const;
+                ref.constant = static_cast<ConstDecl*>(decl);
+                checkConst(*static_cast<ConstDecl*>(decl));
+                return ref;
+            case DeclKind::Extern:
+                if (ctx.where == Where::Fn || ctx.where == Where::Const || ctx.where == Where::ExternValue ||
+                    ctx.where == Where::Attribute) {
+                    const char* place = ctx.where == Where::Fn ? "a function: functions are pure; pass it as a parameter"
+                                                               : "a constant expression: externs change while the system runs";
+                    diags_.error(range, fmt::format("extern `{}` cannot be used in {}", name, place))
+                        .notes.push_back({decl->nameRange, "declared here"});
+                    return ref;
+                }
+                ref.kind = Ref::Kind::Extern;
+                ref.externVar = static_cast<ExternDecl*>(decl);
+                return ref;
+            case DeclKind::Fn:
+                diags_.error(range, fmt::format("`{}` is a function; call it with arguments: `{}(…)`", name, name))
+                    .notes.push_back({decl->nameRange, "declared here"});
+                return ref;
+            case DeclKind::Object:
+                diags_.error(range, fmt::format("`{}` is an object type, not a value; create one with `emit {}(…)`", name, name))
+                    .notes.push_back({decl->nameRange, "declared here"});
+                return ref;
+            case DeclKind::Trigger:
+                diags_.error(range, fmt::format("`{}` is a trigger, not a value; the host fires it", name))
+                    .notes.push_back({decl->nameRange, "declared here"});
+                return ref;
+            default: break;
+        }
+    }
+    if (int c = findBuiltinConstant(name); c >= 0) {
+        ref.kind = Ref::Kind::BuiltinConst;
+        ref.index = c;
+        return ref;
+    }
+    if (findBuiltinFunction(name) >= 0) {
+        diags_.error(range, fmt::format("`{}` is a built-in function; call it with arguments: `{}(…)`", name, name));
+        return ref;
+    }
+    reportUnknown("name", name, range, namesInScope(ctx));
+    return ref;
+}
+
+const ObjectDecl* Checker::findEmitTarget(const std::string& name, SourceRange range, const Context& ctx) {
+    if (ctx.where == Where::Object && ctx.object)
+        for (auto& child : ctx.object->children)
+            if (child->name == name) return child.get();
+    if (auto it = globals_.find(name); it != globals_.end()) {
+        if (it->second->kind == DeclKind::Object) return static_cast<const ObjectDecl*>(it->second);
+        diags_.error(range, fmt::format("`{}` is a {}, not an object", name, declWord(it->second->kind)))
+            .notes.push_back({it->second->nameRange, "declared here"});
+        return nullptr;
+    }
+    auto nested = nestedObjects_.find(name);
+    if (nested != nestedObjects_.end()) {
+        const ObjectDecl* parent = nested->second->parent;
+        diags_.error(range, fmt::format("`{}` is declared inside `{}`; only `{}` can create it, since it reads its parent",
+                                        name, parent->name, parent->name))
+            .notes.push_back({nested->second->nameRange, "declared here"});
+        return nullptr;
+    }
+    std::vector<std::string> candidates;
+    for (auto& [n, d] : globals_)
+        if (d->kind == DeclKind::Object) candidates.push_back(n);
+    if (ctx.where == Where::Object && ctx.object)
+        for (auto& child : ctx.object->children) candidates.push_back(child->name);
+    reportUnknown("object", name, range, candidates);
+    return nullptr;
+}
+
+}  // namespace psys::detail

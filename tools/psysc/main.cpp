@@ -1,0 +1,84 @@
+// psysc: the psys compiler driver.
+//
+//   psysc check FILE…            type-check; exit 0 when clean, 1 on errors
+//   psysc --emit=ast FILE        print the checked AST
+//
+// Exit status: 0 success, 1 errors in the input, 2 bad usage.
+#include <unistd.h>
+
+#include <cstdlib>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "frontend/frontend.h"
+
+namespace {
+
+bool useColour(const std::string& mode) {
+    if (mode == "always") return true;
+    if (mode == "never") return false;
+    const char* noColour = std::getenv("NO_COLOR");
+    return isatty(STDERR_FILENO) && !(noColour && *noColour);
+}
+
+// Checks one file; prints its diagnostics; returns the program when it is clean.
+std::unique_ptr<psys::ast::Program> checkOne(const std::string& path, psys::SourceManager& sources,
+                                             bool colour, bool* failed) {
+    psys::DiagnosticEngine diags(sources);
+    auto program = psys::checkFile(path, sources, diags);
+    diags.print(std::cerr, colour);
+    if (!program) *failed = true;
+    return program;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"psysc: compiler for .psys particle systems"};
+    app.set_version_flag("--version", std::string("psysc ") + PSYS_VERSION);
+    std::string colourMode = "auto";
+    app.add_option("--color", colourMode, "Colour diagnostics: auto (on a terminal), always or never")
+        ->check(CLI::IsMember({"auto", "always", "never"}));
+
+    std::string emit;
+    std::vector<std::string> emitFiles;
+    app.add_option("--emit", emit, "Print an intermediate form of FILE")->check(CLI::IsMember({"ast"}));
+    app.add_option("files", emitFiles, "Source file for --emit")->type_name("FILE");
+
+    auto* check = app.add_subcommand("check", "Type-check .psys files and report every error");
+    std::vector<std::string> checkFiles;
+    check->add_option("files", checkFiles, "Files to check")->required()->type_name("FILE");
+
+    app.require_subcommand(0, 1);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        int code = app.exit(e);
+        return e.get_exit_code() == 0 ? 0 : (code == 0 ? 0 : 2);
+    }
+    bool colour = useColour(colourMode);
+
+    if (check->parsed()) {
+        bool failed = false;
+        for (const std::string& file : checkFiles) {
+            psys::SourceManager sources;
+            checkOne(file, sources, colour, &failed);
+        }
+        return failed ? 1 : 0;
+    }
+    if (!emit.empty()) {
+        if (emitFiles.size() != 1) {
+            std::cerr << "psysc: --emit=" << emit << " takes exactly one FILE\n";
+            return 2;
+        }
+        psys::SourceManager sources;
+        bool failed = false;
+        auto program = checkOne(emitFiles[0], sources, colour, &failed);
+        if (!program) return 1;
+        std::cout << psys::printAst(*program, sources);
+        return 0;
+    }
+    std::cerr << app.help();
+    return 2;
+}
