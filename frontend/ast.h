@@ -290,8 +290,8 @@ struct Module {
 
 // The main file and everything it imports, each file once.
 struct Program {
-    std::vector<std::unique_ptr<Module>> modules;  // modules[0] is the main file
-    const Module& main() const { return *modules.front(); }
+    std::vector<std::unique_ptr<Module>> modules;  // imported files before their importers; the main file last
+    const Module& main() const { return *modules.back(); }
 };
 
 }  // namespace psys::ast

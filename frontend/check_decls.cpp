@@ -32,7 +32,7 @@ void Checker::checkParams(const std::vector<Param>& params, const char* owner) {
     std::map<std::string, SourceRange> seen;
     for (const Param& p : params) {
         if (p.type.type.isTuple())
-            diags_.error(p.type.range, fmt::format("a parameter of a {} cannot be a tuple; pass its parts separately",
+            diags_.error(p.type.range, fmt::format("a parameter of {} cannot be a tuple; pass its parts separately",
                                                    owner));
         if (auto it = seen.find(p.name); it != seen.end())
             diags_.error(p.nameRange, fmt::format("parameter `{}` is declared twice", p.name))
@@ -83,7 +83,7 @@ void Checker::checkFn(const FnDecl& constDecl) {
     }
     state = 1;
     checking_.push_back(&decl);
-    checkParams(decl.params, "function");
+    checkParams(decl.params, "a function");
     Context ctx;
     ctx.where = Where::Fn;
     ctx.fn = &decl;
@@ -185,7 +185,7 @@ void Checker::checkExtern(ExternDecl& decl) {
 }
 
 void Checker::checkTrigger(TriggerDecl& decl) {
-    checkParams(decl.params, "trigger");
+    checkParams(decl.params, "a trigger");
     Context ctx;
     ctx.where = Where::Trigger;
     ctx.trigger = &decl;
@@ -222,7 +222,7 @@ void Checker::reportUnused() {
             auto& object = static_cast<const ObjectDecl&>(*decl);
             visit(object);
             // Only the main file's objects: a library may declare objects its users never create.
-            if (anySpawn && module.get() == program_.modules.front().get() && !createdObjects_.count(&object))
+            if (anySpawn && module.get() == program_.modules.back().get() && !createdObjects_.count(&object))
                 diags_.warning(object.nameRange, fmt::format("object `{}` is never created: nothing spawns or emits it",
                                                              object.name));
         }

@@ -219,8 +219,11 @@ Type Checker::checkMember(MemberExpr& member, const Context& ctx) {
                 if (it == scope.names.end()) {
                     std::vector<std::string> names = {"alive", "age"};
                     for (auto& [n, _] : scope.names) names.push_back(n);
-                    reportUnknown(fmt::format("equation or parameter of `{}`", parent->name), member.member,
-                                  member.memberRange, names);
+                    std::string suggestion = closestName(member.member, names);
+                    diags_.error(member.memberRange,
+                                 fmt::format("`{}` has no equation or parameter named `{}`{}", parent->name, member.member,
+                                             suggestion.empty() ? "" : fmt::format("; did you mean `{}`?", suggestion)))
+                        .notes.push_back({parent->nameRange, fmt::format("`{}` declared here", parent->name)});
                     return Type::error();
                 }
                 ref = it->second;

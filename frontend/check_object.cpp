@@ -22,25 +22,28 @@ void Checker::declareObjectNames(ObjectDecl& object) {
     auto declare = [&](const std::string& name, SourceRange range, Ref ref, const char* what) {
         if (!checkDeclarableName(name, range, what)) return;
         if (auto it = scope.declaredAt.find(name); it != scope.declaredAt.end()) {
+            bool bothParams = ref.kind == Ref::Kind::Param && scope.names[name].kind == Ref::Kind::Param;
+            if (bothParams) return;  // checkParams has said so
             diags_.error(range, fmt::format("`{}` is defined twice in object `{}`", name, object.name))
                 .notes.push_back({it->second, "first defined here"});
             return;
         }
         if (auto g = globals_.find(name); g != globals_.end() &&
                                           (g->second->kind == DeclKind::Const || g->second->kind == DeclKind::Extern))
-            diags_.warning(range, fmt::format("{} `{}` hides the file-level {} of the same name", what, name,
+            diags_.warning(range, fmt::format("{} `{}` hides the file-level {} of the same name",
+                                              std::string_view(what).substr(std::string_view(what).find(' ') + 1), name,
                                               g->second->kind == DeclKind::Const ? "constant" : "extern"))
                 .notes.push_back({g->second->nameRange, "hidden declaration"});
         scope.names[name] = ref;
         scope.declaredAt[name] = range;
     };
-    checkParams(object.params, "object");
+    checkParams(object.params, "an object");
     for (size_t i = 0; i < object.params.size(); ++i) {
         Ref ref;
         ref.kind = Ref::Kind::Param;
         ref.object = &object;
         ref.index = static_cast<int>(i);
-        declare(object.params[i].name, object.params[i].nameRange, ref, "parameter");
+        declare(object.params[i].name, object.params[i].nameRange, ref, "a parameter");
     }
     for (auto& eq : object.equations) {
         eq->types.assign(eq->names.size(), Type::unknown());
@@ -51,7 +54,7 @@ void Checker::declareObjectNames(ObjectDecl& object) {
             ref.object = &object;
             ref.equation = eq.get();
             ref.index = static_cast<int>(i);
-            declare(eq->names[i], eq->nameRanges[i], ref, "equation");
+            declare(eq->names[i], eq->nameRanges[i], ref, "an equation");
         }
     }
 }
@@ -60,6 +63,9 @@ void Checker::declareObjectNames(ObjectDecl& object) {
 // pass, also reports shape mismatches.
 void Checker::checkEquation(Equation& eq, const Context& ctx, bool final) {
     Type t = check(*eq.value, ctx);
+    // While inferring, a failed check keeps the last good guess: the final pass then
+    // reports the real mismatch instead of a silent cascade from an error type.
+    if (!final && t.isError()) return;
     if (!eq.isTuple()) {
         if (t.isTuple()) {
             if (final)
@@ -84,8 +90,8 @@ void Checker::checkEquation(Equation& eq, const Context& ctx, bool final) {
         return;
     }
     if (t.isVague()) {
-        for (auto& et : eq.types)
-            if (et.isUnknown() && t.isError()) et = Type::error();
+        if (t.isError())
+            for (auto& et : eq.types) et = Type::error();
         return;
     }
     if (!t.isTuple() || t.elements().size() != eq.names.size()) {
@@ -246,7 +252,9 @@ void Checker::checkAttributes(const std::vector<Attribute*>& attributes) {
         };
         if (a.name == "integrator") {
             std::string names;
-            for (auto n : integratorNames()) names += (names.empty() ? "" : ", ") + std::string(n);
+            auto all = integratorNames();
+            for (size_t i = 0; i < all.size(); ++i)
+                names += (i == 0 ? "" : i + 1 == all.size() ? " and " : ", ") + std::string(all[i]);
             if (!wantOneArg("the integration method")) continue;
             auto* name = a.args[0]->kind == ExprKind::Name ? static_cast<NameExpr*>(a.args[0].get()) : nullptr;
             bool known = false;

@@ -47,14 +47,15 @@ public:
         int file = sources_.add(displayPath.string(), std::move(text));
         auto module = parseModule(file, sources_, diags_);
         if (!module) return false;
-        loaded_[key] = static_cast<int>(program_->modules.size());
-        ast::Module* raw = module.get();
-        program_->modules.push_back(std::move(module));
         stack_.push_back({key, displayPath.string()});
         bool ok = true;
-        for (auto& decl : raw->decls)
+        for (auto& decl : module->decls)
             if (decl->kind == ast::DeclKind::Import) ok &= loadImport(static_cast<ast::ImportDecl&>(*decl), displayPath);
         stack_.pop_back();
+        // Imports first, so a name declared both in a library and in its importer is
+        // reported at the importer's declaration.
+        loaded_[key] = static_cast<int>(program_->modules.size());
+        program_->modules.push_back(std::move(module));
         return ok;
     }
 
@@ -66,6 +67,10 @@ private:
     }
 
     bool loadImport(ast::ImportDecl& import, const fs::path& importer) {
+        if (import.path.empty()) {
+            diags_.error(import.pathRange, "an import needs a file name");
+            return false;
+        }
         fs::path target = (importer.parent_path() / import.path).lexically_normal();
         std::string key = canonicalKey(target);
         for (size_t i = 0; i < stack_.size(); ++i) {

@@ -123,7 +123,7 @@ private:
     TypeAnnotation typeRef(PsysParser::TypeRefContext* ctx) {
         TypeAnnotation t{Type::error(), range(ctx)};
         if (auto* named = dynamic_cast<PsysParser::NamedTypeContext*>(ctx)) {
-            std::string spelled = named->IDENT()->getText();
+            std::string spelled = named->getText();
             if (auto known = Type::fromName(spelled)) t.type = *known;
             else
                 diags_.error(t.range, fmt::format("unknown type `{}`", spelled))
@@ -328,13 +328,13 @@ private:
         }
         if (auto* n = dynamic_cast<PsysParser::NameExprContext*>(ctx))
             return std::make_unique<NameExpr>(r, n->IDENT()->getText());
-        if (auto* t = dynamic_cast<PsysParser::TupleExprContext*>(ctx)) {
+        auto* p = static_cast<PsysParser::ParenExprContext*>(ctx);
+        if (p->expr().size() > 1) {
             auto tuple = std::make_unique<TupleExpr>(r);
-            for (auto* e : t->expr()) tuple->elements.push_back(expr(e));
+            for (auto* e : p->expr()) tuple->elements.push_back(expr(e));
             return tuple;
         }
-        auto* p = static_cast<PsysParser::ParenExprContext*>(ctx);
-        ExprPtr inner = expr(p->expr());
+        ExprPtr inner = expr(p->expr(0));
         inner->range = r;  // keep the parentheses in the range for carets
         return inner;
     }

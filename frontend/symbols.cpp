@@ -21,28 +21,28 @@ namespace {
 
 const char* declWord(DeclKind kind) {
     switch (kind) {
-        case DeclKind::Const: return "constant";
-        case DeclKind::Fn: return "function";
-        case DeclKind::Extern: return "extern";
-        case DeclKind::Trigger: return "trigger";
-        case DeclKind::Object: return "object";
-        default: return "declaration";
+        case DeclKind::Const: return "a constant";
+        case DeclKind::Fn: return "a function";
+        case DeclKind::Extern: return "an extern";
+        case DeclKind::Trigger: return "a trigger";
+        case DeclKind::Object: return "an object";
+        default: return "a declaration";
     }
 }
 
+// Edits to turn `a` into `b`: insertions, deletions, substitutions and swaps of
+// neighbours (the commonest typo), each costing one.
 size_t editDistance(const std::string& a, const std::string& b) {
-    std::vector<size_t> row(b.size() + 1);
-    for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-    for (size_t i = 1; i <= a.size(); ++i) {
-        size_t diagonal = row[0];
-        row[0] = i;
+    std::vector<std::vector<size_t>> d(a.size() + 1, std::vector<size_t>(b.size() + 1));
+    for (size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+    for (size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+    for (size_t i = 1; i <= a.size(); ++i)
         for (size_t j = 1; j <= b.size(); ++j) {
-            size_t up = row[j];
-            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-            diagonal = up;
+            d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+                d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
         }
-    }
-    return row[b.size()];
+    return d[a.size()][b.size()];
 }
 
 }  // namespace
@@ -63,15 +63,15 @@ std::string closestName(const std::string& name, const std::vector<std::string>&
 // A user's name may not redefine what the language defines.
 bool Checker::checkDeclarableName(const std::string& name, SourceRange range, const char* what) {
     if (isBuiltinVariable(name)) {
-        diags_.error(range, fmt::format("cannot declare a {} named `{}`: `{}` is a built-in variable", what, name, name));
+        diags_.error(range, fmt::format("cannot declare {} named `{}`: `{}` is a built-in variable", what, name, name));
         return false;
     }
     if (findBuiltinConstant(name) >= 0) {
-        diags_.error(range, fmt::format("cannot declare a {} named `{}`: `{}` is a built-in constant", what, name, name));
+        diags_.error(range, fmt::format("cannot declare {} named `{}`: `{}` is a built-in constant", what, name, name));
         return false;
     }
     if (Type::fromName(name)) {
-        diags_.error(range, fmt::format("cannot declare a {} named `{}`: `{}` is a type", what, name, name));
+        diags_.error(range, fmt::format("cannot declare {} named `{}`: `{}` is a type", what, name, name));
         return false;
     }
     return true;
@@ -79,7 +79,7 @@ bool Checker::checkDeclarableName(const std::string& name, SourceRange range, co
 
 void Checker::declareGlobal(Decl& decl) {
     if (findBuiltinFunction(decl.name) >= 0) {
-        diags_.error(decl.nameRange, fmt::format("cannot declare a {} named `{}`: `{}` is a built-in function",
+        diags_.error(decl.nameRange, fmt::format("cannot declare {} named `{}`: `{}` is a built-in function",
                                                  declWord(decl.kind), decl.name, decl.name));
         return;
     }
@@ -88,7 +88,7 @@ void Checker::declareGlobal(Decl& decl) {
     if (!inserted) {
         diags_.error(decl.nameRange, fmt::format("redefinition of `{}`", decl.name))
             .notes.push_back({it->second->nameRange,
-                              fmt::format("`{}` was first declared here as a {}", decl.name, declWord(it->second->kind))});
+                              fmt::format("`{}` was first declared here as {}", decl.name, declWord(it->second->kind))});
     }
 }
 
@@ -274,7 +274,7 @@ const ObjectDecl* Checker::findEmitTarget(const std::string& name, SourceRange r
             if (child->name == name) return child.get();
     if (auto it = globals_.find(name); it != globals_.end()) {
         if (it->second->kind == DeclKind::Object) return static_cast<const ObjectDecl*>(it->second);
-        diags_.error(range, fmt::format("`{}` is a {}, not an object", name, declWord(it->second->kind)))
+        diags_.error(range, fmt::format("`{}` is {}, not an object", name, declWord(it->second->kind)))
             .notes.push_back({it->second->nameRange, "declared here"});
         return nullptr;
     }

@@ -76,7 +76,7 @@ std::string describeExpected(antlr4::Parser* parser, const antlr4::misc::Interva
         drop({"import", "const", "fn", "extern", "trigger", "object", "spawn", "@"});
         types.erase(static_cast<size_t>(antlr4::Token::EOF));
     } else if (objectBody) {
-        words.push_back("an equation, a command or a nested object");
+        words.push_back("an equation, a command, a nested object");
         drop({"point", "kill", "emit", "when", "object", "@", "("});
         types.erase(PsysParser::IDENT);
     } else if (exprStart) {
@@ -103,6 +103,9 @@ std::string describeExpected(antlr4::Parser* parser, const antlr4::misc::Interva
         else if (t == static_cast<size_t>(antlr4::Token::EOF)) words.push_back("end of file");
         else words.push_back(literal(parser, t));
     }
+    // Every ')' of the grammar closes a comma-separated list (arguments, parameters, tuples),
+    // but once the list's loop has exited ANTLR expects only the ')'.
+    if (words.size() == 1 && words[0] == "')'") words.insert(words.begin(), "','");
     if (words.empty()) return "something else";
     std::string out;
     for (size_t i = 0; i < words.size(); ++i) {
@@ -154,12 +157,18 @@ void SyntaxErrorReporter::report(antlr4::Parser* parser, antlr4::Token* found,
     std::string in = context.empty() ? "" : " in " + context;
     std::string foundLit = literal(parser, found->getType());
     if (expected.contains(static_cast<size_t>(PsysParser::IDENT)) && isKeyword(foundLit)) {
-        diags_.error(where, fmt::format("expected a name{}, found the keyword {}", in, describeFound(found)))
-            .notes.push_back({where, fmt::format("{} is reserved; choose another name", describeFound(found))});
+        diags_.error(where, fmt::format("expected a name{}, found the keyword {}, which is reserved", in,
+                                        describeFound(found)));
         return;
     }
     diags_.error(where, fmt::format("expected {}{}, found {}", describeExpected(parser, expected), in,
                                     describeFound(found)));
+}
+
+antlr4::Token* SyntaxErrorReporter::singleTokenDeletion(antlr4::Parser* parser) {
+    std::string text = parser->getCurrentToken()->getText();
+    if (text == ";" || text == "}") return nullptr;
+    return DefaultErrorStrategy::singleTokenDeletion(parser);
 }
 
 void SyntaxErrorReporter::reportNoViableAlternative(antlr4::Parser* parser, const antlr4::NoViableAltException& e) {

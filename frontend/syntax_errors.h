@@ -24,6 +24,9 @@ protected:
     void reportFailedPredicate(antlr4::Parser* parser, const antlr4::FailedPredicateException& e) override;
     void reportUnwantedToken(antlr4::Parser* parser) override;
     void reportMissingToken(antlr4::Parser* parser) override;
+    // Never skips a ';' or '}' to go on with the current rule: they end statements, and
+    // skipping one glues two statements together and turns one error into several.
+    antlr4::Token* singleTokenDeletion(antlr4::Parser* parser) override;
 
 private:
     void report(antlr4::Parser* parser, antlr4::Token* found, const antlr4::misc::IntervalSet& expected);

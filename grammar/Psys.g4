@@ -45,7 +45,7 @@ spawnDecl   : 'spawn' IDENT ( '(' argList? ')' )? ';' ;
 paramList   : param ( ',' param )* ;
 param       : IDENT ':' typeRef ;
 
-typeRef     : IDENT                                          # namedType
+typeRef     : ( IDENT | 'point' )                            # namedType
             | '(' typeRef ( ',' typeRef )+ ')'               # tupleType
             ;
 
@@ -96,9 +96,10 @@ primary     : NUMBER                                                 # numberLit
             | ( 'true' | 'false' )                                   # boolLit
             | IDENT '(' argList? ')'                                 # callExpr
             | IDENT                                                  # nameExpr
-            | '(' expr ( ',' expr )+ ')'                             # tupleExpr
-            | '(' expr ')'                                           # parenExpr
+            | '(' expr ( ',' expr )* ')'                             # parenExpr
             ;
+// One rule for `(e)` and the tuple `(a, b)`: telling them apart needs no look-ahead, so a
+// syntax error inside is reported where it is, not at the opening parenthesis.
 
 // ---------------------------------------------------------------- tokens
 

@@ -51,6 +51,7 @@ int main(int argc, char** argv) {
     check->add_option("files", checkFiles, "Files to check")->required()->type_name("FILE");
 
     app.require_subcommand(0, 1);
+    check->fallthrough();
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -1,0 +1,77 @@
+#include <doctest/doctest.h>
+
+#include "frontend/diagnostics.h"
+
+using namespace psys;
+
+TEST_CASE("a diagnostic prints location, source line and an underline under its range") {
+    SourceManager sources;
+    int f = sources.add("fire.psys", "object a {\n    acc = g + tint;\n}\n");
+    DiagnosticEngine diags(sources);
+    diags.error({f, 21, 29}, "cannot add vec3 and vec4").notes.push_back({{f, 0, 6}, "declared here"});
+    CHECK(diags.errorCount() == 1);
+    CHECK(diags.render() ==
+          "fire.psys:2:11: error: cannot add vec3 and vec4\n"
+          " 2 |     acc = g + tint;\n"
+          "   |           ^~~~~~~~\n"
+          "fire.psys:1:1: note: declared here\n"
+          " 1 | object a {\n"
+          "   | ^~~~~~\n"
+          "1 error generated.\n");
+}
+
+TEST_CASE("tabs in the source line are kept in the underline so the caret lines up") {
+    SourceManager sources;
+    int f = sources.add("t.psys", "\tx = $;\n");
+    DiagnosticEngine diags(sources);
+    diags.error({f, 5, 6}, "unexpected character '$'");
+    CHECK(diags.render().find(" 1 | \tx = $;\n   | \t    ^\n") != std::string::npos);
+}
+
+TEST_CASE("an empty range gets one caret; a range past its line is cut at the line end") {
+    SourceManager sources;
+    int f = sources.add("t.psys", "ab\ncd\n");
+    DiagnosticEngine diags(sources);
+    diags.error({f, 2, 2}, "here");
+    diags.error({f, 0, 5}, "long");
+    std::string out = diags.render();
+    CHECK(out.find(" 1 | ab\n   |   ^\n") != std::string::npos);
+    CHECK(out.find(" 1 | ab\n   | ^~\n") != std::string::npos);
+}
+
+TEST_CASE("colour codes only when asked") {
+    SourceManager sources;
+    int f = sources.add("t.psys", "x\n");
+    DiagnosticEngine diags(sources);
+    diags.warning({f, 0, 1}, "w");
+    CHECK(diags.render(false).find('\x1b') == std::string::npos);
+    CHECK(diags.render(true).find("\x1b[1;35mwarning") != std::string::npos);
+    CHECK(diags.render(false).find("1 warning generated.") != std::string::npos);
+}
+
+TEST_CASE("diagnostics without a location name the tool") {
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    diags.error({}, "cannot read `x.psys`: No such file or directory");
+    CHECK(diags.render() == "psysc: error: cannot read `x.psys`: No such file or directory\n1 error generated.\n");
+}
+
+TEST_CASE("the summary counts errors and warnings") {
+    SourceManager sources;
+    int f = sources.add("t.psys", "x\n");
+    DiagnosticEngine diags(sources);
+    diags.error({f, 0, 1}, "a");
+    diags.error({f, 0, 1}, "b");
+    diags.warning({f, 0, 1}, "c");
+    CHECK(diags.render().find("2 errors and 1 warning generated.") != std::string::npos);
+}
+
+TEST_CASE("suppressed reports are dropped and not counted") {
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    diags.setSuppressed(true);
+    diags.error({}, "hidden").notes.push_back({{}, "also hidden"});
+    diags.setSuppressed(false);
+    CHECK(diags.errorCount() == 0);
+    CHECK(diags.all().empty());
+}

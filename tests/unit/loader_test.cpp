@@ -1,0 +1,90 @@
+// Imports: relative paths, each file once, cycles reported.
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "test_support.h"
+
+using namespace psys;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A scratch directory with files, removed afterwards.
+struct TempTree {
+    fs::path root;
+    TempTree() {
+        root = fs::temp_directory_path() / ("psys_loader_" + std::to_string(::getpid()) + "_" +
+                                            std::to_string(reinterpret_cast<uintptr_t>(this)));
+        fs::create_directories(root);
+    }
+    ~TempTree() { fs::remove_all(root); }
+    void write(const std::string& name, const std::string& text) {
+        fs::create_directories((root / name).parent_path());
+        std::ofstream(root / name) << text;
+    }
+};
+
+}  // namespace
+
+TEST_CASE("imports resolve relative to the importing file and each file loads once") {
+    TempTree t;
+    t.write("lib/physics/gravity.psys", "const g = vec3(0, -9.82, 0);\n");
+    t.write("lib/forces.psys", "import \"physics/gravity.psys\";\nfn fall(m: float) -> vec3 = g * m;\n");
+    t.write("lib/colours.psys", "import \"physics/gravity.psys\";\nconst ember = vec4(1, 0.4, 0, 1);\n");
+    t.write("main.psys",
+            "import \"lib/forces.psys\";\nimport \"lib/colours.psys\";\n"
+            "object a { point(integrate(integrate(fall(0.5))), ember, 1); }\nspawn a;\n");
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    auto program = checkFile((t.root / "main.psys").string(), sources, diags);
+    REQUIRE_MESSAGE(program, diags.render());
+    CHECK(program->modules.size() == 4);  // gravity.psys once, though imported twice
+    CHECK(fs::path(program->modules.front()->path).filename() == "gravity.psys");
+    CHECK(fs::path(program->main().path).filename() == "main.psys");
+}
+
+TEST_CASE("an import cycle names the chain of files") {
+    TempTree t;
+    t.write("a.psys", "import \"b.psys\";\n");
+    t.write("b.psys", "import \"sub/c.psys\";\n");
+    t.write("sub/c.psys", "import \"../a.psys\";\n");
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    auto program = checkFile((t.root / "a.psys").string(), sources, diags);
+    CHECK(program == nullptr);
+    std::string out = diags.render();
+    CHECK(out.find("import cycle: ") != std::string::npos);
+    CHECK(out.find("a.psys → ") != std::string::npos);
+    CHECK(out.find("b.psys → ") != std::string::npos);
+    CHECK(out.find("c.psys → ") != std::string::npos);
+    CHECK(diags.errorCount() == 1);
+}
+
+TEST_CASE("a file importing itself is a cycle") {
+    TempTree t;
+    t.write("self.psys", "import \"./self.psys\";\n");
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    CHECK(checkFile((t.root / "self.psys").string(), sources, diags) == nullptr);
+    CHECK(diags.render().find("import cycle") != std::string::npos);
+}
+
+TEST_CASE("syntax errors in an imported file are reported in that file") {
+    TempTree t;
+    t.write("lib.psys", "const x = ;\n");
+    t.write("main.psys", "import \"lib.psys\";\n");
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    CHECK(checkFile((t.root / "main.psys").string(), sources, diags) == nullptr);
+    CHECK(diags.render().find("lib.psys:1:11: error: expected an expression") != std::string::npos);
+}
+
+TEST_CASE("a directory or a missing main file is an error without a location") {
+    TempTree t;
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    CHECK(checkFile(t.root.string(), sources, diags) == nullptr);
+    CHECK(diags.render().find("it is a directory") != std::string::npos);
+}
