@@ -291,6 +291,7 @@ void Checker::checkObject(ObjectDecl& object) {
     checkAttributes(attributes);
     declareObjectNames(object);
     inferEquations(object);
+    checkAlgebraicLoops(object);
     Context ctx;
     ctx.where = Where::Object;
     ctx.object = &object;

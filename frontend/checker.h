@@ -4,7 +4,8 @@
 // Expr's Type, every emit's target and every equation's types, and reports what is wrong.
 // Split over files by concern: symbols.cpp (scopes and lookup), check_expr.cpp
 // (expressions), check_object.cpp (objects, equations, commands), check_decls.cpp
-// (constants, functions, externs, triggers, spawns, attributes).
+// (constants, functions, externs, triggers, spawns, attributes), check_cycles.cpp
+// (algebraic loops among an object's equations).
 #pragma once
 
 #include <map>
@@ -73,6 +74,9 @@ private:
     void checkArguments(std::vector<ast::ExprPtr>& args, const ast::ObjectDecl& target, SourceRange callRange,
                         const Context& ctx);
     void checkAttributes(const std::vector<ast::Attribute*>& attributes);
+
+    // check_cycles.cpp
+    void checkAlgebraicLoops(const ast::ObjectDecl& object);
 
     // check_decls.cpp
     void checkConst(ast::ConstDecl& decl);

@@ -184,3 +184,18 @@ TEST_CASE("a failed composite equation does not cascade into its users") {
     CHECK(c.diags->errorCount() == 1);
     CHECK(c.output.find("unknown function `undefined_fn`") != std::string::npos);
 }
+
+TEST_CASE("cycles through integrate, prev or the next side of -> are legal; others are algebraic loops") {
+    auto legal = test::check(R"(object a {
+        p = integrate(v); v = 1 - p;               // through integrate
+        q = prev(r) + 1; r = q * 2;                // through prev
+        n = 0 -> n + 1;                            // through the next side of ->
+        point(vec3(p + r + n), red, 1);
+    })");
+    CHECK_MESSAGE(legal.ok(), legal.output);
+    CHECK(hasError("object a { d = derive(e); e = d + age; }", "algebraic loop: `d` needs its own value"));
+    CHECK(hasError("object a { x = y ? 1 : 2; y = x > 1; }", "(x → y → x)"));
+    // Each loop is reported once, however many equations it has.
+    auto c = test::check("object a { a1 = a2; a2 = a3; a3 = a1; b1 = b1 * 2; }");
+    CHECK(c.diags->errorCount() == 2);
+}

@@ -6,12 +6,14 @@
 // Exit status: 0 success, 1 errors in the input, 2 bad usage.
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
 
 #include "frontend/frontend.h"
+#include "frontend/loader.h"
 
 namespace {
 
@@ -22,12 +24,28 @@ bool useColour(const std::string& mode) {
     return isatty(STDERR_FILENO) && !(noColour && *noColour);
 }
 
-// Checks one file; prints its diagnostics; returns the program when it is clean.
-std::unique_ptr<psys::ast::Program> checkOne(const std::string& path, psys::SourceManager& sources,
-                                             bool colour, bool* failed) {
+double millisecondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Checks one file; prints its diagnostics (and, with `time`, how long loading and checking
+// took); returns the program when it is clean.
+std::unique_ptr<psys::ast::Program> checkOne(const std::string& path, psys::SourceManager& sources, bool colour,
+                                             bool time, bool* failed) {
     psys::DiagnosticEngine diags(sources);
-    auto program = psys::checkFile(path, sources, diags);
+    auto start = std::chrono::steady_clock::now();
+    auto program = psys::loadProgram(path, sources, diags);
+    double parseMs = millisecondsSince(start);
+    start = std::chrono::steady_clock::now();
+    if (program) {
+        psys::checkProgram(*program, diags);
+        if (diags.errorCount() > 0) program.reset();
+    }
+    double checkMs = millisecondsSince(start);
     diags.print(std::cerr, colour);
+    if (time)
+        std::cerr << path << ": parse " << parseMs << " ms, check " << checkMs << " ms (" << sources.count()
+                  << " file" << (sources.count() == 1 ? "" : "s") << ")\n";
     if (!program) *failed = true;
     return program;
 }
@@ -49,6 +67,8 @@ int main(int argc, char** argv) {
     auto* check = app.add_subcommand("check", "Type-check .psys files and report every error");
     std::vector<std::string> checkFiles;
     check->add_option("files", checkFiles, "Files to check")->required()->type_name("FILE");
+    bool time = false;
+    check->add_flag("--time", time, "Print how long parsing and checking took");
 
     app.require_subcommand(0, 1);
     check->fallthrough();
@@ -64,7 +84,7 @@ int main(int argc, char** argv) {
         bool failed = false;
         for (const std::string& file : checkFiles) {
             psys::SourceManager sources;
-            checkOne(file, sources, colour, &failed);
+            checkOne(file, sources, colour, time, &failed);
         }
         return failed ? 1 : 0;
     }
@@ -75,7 +95,7 @@ int main(int argc, char** argv) {
         }
         psys::SourceManager sources;
         bool failed = false;
-        auto program = checkOne(emitFiles[0], sources, colour, &failed);
+        auto program = checkOne(emitFiles[0], sources, colour, false, &failed);
         if (!program) return 1;
         std::cout << psys::printAst(*program, sources);
         return 0;
