@@ -357,10 +357,25 @@ std::unique_ptr<Module> parseModule(int file, const SourceManager& sources, Diag
     SilentListener silent;
     parser.addErrorListener(&silent);
     std::vector<uint32_t> offsets = codePointOffsets(text);
-    parser.setErrorHandler(std::make_shared<SyntaxErrorReporter>(diags, file, offsets));
 
     int errorsBefore = diags.errorCount();
-    PsysParser::FileContext* tree = parser.file();
+    // Two-stage parsing: the fast SLL prediction parses every valid file of this grammar;
+    // only if it fails does the full LL parse run, with worded errors and recovery.
+    PsysParser::FileContext* tree = nullptr;
+    parser.getInterpreter<antlr4::atn::ParserATNSimulator>()->setPredictionMode(antlr4::atn::PredictionMode::SLL);
+    parser.setErrorHandler(std::make_shared<antlr4::BailErrorStrategy>());
+    try {
+        tree = parser.file();
+    } catch (const antlr4::ParseCancellationException&) {
+        tree = nullptr;
+    }
+    if (!tree) {
+        tokens.seek(0);
+        parser.reset();
+        parser.getInterpreter<antlr4::atn::ParserATNSimulator>()->setPredictionMode(antlr4::atn::PredictionMode::LL);
+        parser.setErrorHandler(std::make_shared<SyntaxErrorReporter>(diags, file, offsets));
+        tree = parser.file();
+    }
     if (diags.errorCount() > errorsBefore || parser.getNumberOfSyntaxErrors() > 0) return nullptr;
     AstBuilder builder(file, std::move(offsets), diags);
     auto module = builder.build(tree);

@@ -117,7 +117,7 @@ std::string describeExpected(antlr4::Parser* parser, const antlr4::misc::Interva
 
 std::string describeFound(antlr4::Token* token) {
     if (token->getType() == antlr4::Token::EOF) return "end of file";
-    return "'" + token->getText() + "'";
+    return fmt::format("'{}'", token->getText());
 }
 
 }  // namespace
