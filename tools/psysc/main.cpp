@@ -14,6 +14,8 @@
 
 #include "frontend/frontend.h"
 #include "frontend/loader.h"
+#include "ir/lower.h"
+#include "ir/printer.h"
 
 namespace {
 
@@ -61,7 +63,7 @@ int main(int argc, char** argv) {
 
     std::string emit;
     std::vector<std::string> emitFiles;
-    app.add_option("--emit", emit, "Print an intermediate form of FILE")->check(CLI::IsMember({"ast"}));
+    app.add_option("--emit", emit, "Print an intermediate form of FILE")->check(CLI::IsMember({"ast", "ir"}));
     app.add_option("files", emitFiles, "Source file for --emit")->type_name("FILE");
 
     auto* check = app.add_subcommand("check", "Type-check .psys files and report every error");
@@ -97,7 +99,12 @@ int main(int argc, char** argv) {
         bool failed = false;
         auto program = checkOne(emitFiles[0], sources, colour, false, &failed);
         if (!program) return 1;
-        std::cout << psys::printAst(*program, sources);
+        if (emit == "ast") {
+            std::cout << psys::printAst(*program, sources);
+            return 0;
+        }
+        psys::ir::Module module = psys::ir::lower(*program);
+        std::cout << psys::ir::print(module);
         return 0;
     }
     std::cerr << app.help();

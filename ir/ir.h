@@ -1,0 +1,184 @@
+// The psys IR: typed SSA kernels, one set per object type.
+//
+// A Kernel is a straight-line list of instructions (conditionals are `select`; the loop
+// over particles belongs to each backend) and a list of yields: what the kernel produces
+// (next state, kill flag, point, emission rates, spawn arguments, …). Instructions are
+// hash-consed: building an instruction equal to an existing one returns the existing
+// value, and commutative operands are put in canonical order first, so `a*b` and `b*a`
+// meet. That is value numbering for free.
+//
+// Right after lowering, an object has a single `behaviour` kernel that still holds the
+// thesis's temporal constructs (integrate, derive, snapshot, prev, `->`, rand, parent
+// reads) and may refer forward through them (recursive equations). The passes in opt/
+// turn those into explicit state, keyed random numbers and parent exports, and split the
+// behaviour into `init`, `update` and the post-update kernels `render`, `exports` and one
+// `spawn.N` per emit site. See ir/ops.h for the instruction set and docs/ir.md for the
+// text form.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "ir/ops.h"
+#include "ir/types.h"
+
+namespace psys::ir {
+
+using ValueId = uint32_t;
+
+struct Inst {
+    Op op = Op::Const;
+    Type type;
+    std::vector<ValueId> operands;
+    int32_t attr = 0;                 // slot / param / extern / export / site / component index
+    int32_t attr2 = 0;                // parent reads: how many levels up
+    std::array<float, 4> constant{};  // Const: components (bool: 0 or 1)
+    std::vector<uint8_t> lanes;       // Shuffle: component indices
+    std::string name;                 // for reading only: the equation it came from
+
+    bool sameAs(const Inst& other) const;  // equal but for the name
+};
+
+enum class YieldKind {
+    StateNext,  // index: state slot
+    Kill,
+    Visible,    // render: whether the point is drawn
+    Position,
+    Color,
+    Size,
+    EmitRate,   // index: emit site; objects per second (rate emitters)
+    EmitCount,  // index: emit site; objects per event (rate emitters) or in all (bursts)
+    EmitArg,    // index: emit site, sub: argument
+    Export,     // index: export (a value children read live)
+};
+
+struct Yield {
+    YieldKind kind;
+    int index = 0;
+    int sub = 0;
+    ValueId value = 0;
+};
+
+enum class KernelKind { Behaviour, Init, Update, Render, Exports, Spawn, Trigger, Start };
+
+class Kernel {
+public:
+    KernelKind kind = KernelKind::Behaviour;
+    int site = -1;  // Spawn: the emit site it computes the arguments of
+
+    const std::vector<Inst>& insts() const { return insts_; }
+    const Inst& at(ValueId v) const { return insts_.at(v); }
+    Inst& mutableAt(ValueId v) { return insts_.at(v); }
+    size_t size() const { return insts_.size(); }
+
+    std::vector<Yield> yields;
+
+    // Adds `inst` unless an equal one exists (hash-consing); returns its value.
+    // Operands of commutative ops are sorted first. Temporal ops are never merged: each
+    // is its own call site.
+    ValueId add(Inst inst);
+    // Appends without merging, for operands not known yet (recursive equations).
+    ValueId addUnique(Inst inst);
+    // Convenience builders.
+    ValueId constant(Type type, std::array<float, 4> value);
+    ValueId scalar(float value) { return constant(Type::f32(), {value, 0, 0, 0}); }
+    ValueId boolean(bool value) { return constant(Type::boolean(), {value ? 1.0f : 0.0f, 0, 0, 0}); }
+    ValueId op(Op op, Type type, std::vector<ValueId> operands, int32_t attr = 0);
+
+    // Yields of one kind (and index), in order.
+    std::vector<const Yield*> find(YieldKind kind, int index = -1) const;
+    const Yield* findOne(YieldKind kind, int index = 0, int sub = 0) const;
+
+    // Rebuilds the hash-consing table after instructions were edited in place.
+    void rehash();
+
+private:
+    std::vector<Inst> insts_;
+    std::unordered_map<std::string, ValueId> table_;
+};
+
+// ---------------------------------------------------------------- objects
+
+struct Param {
+    std::string name;
+    Type type;
+};
+
+enum class StateInit {
+    Zero,  // the slot starts at zero (an integral at creation)
+    Next,  // the slot starts at its next-value evaluated when the object is created
+};
+
+struct StateSlot {
+    std::string name;
+    Type type;
+    StateInit init = StateInit::Next;
+};
+
+struct EmitSite {
+    std::string target;  // the created object type
+    bool rate = false;   // `at R per second` (else a burst at creation)
+};
+
+struct Export {
+    std::string name;  // the parent's equation (or parameter) children read
+    Type type;
+};
+
+// `rocket.pos` in a nested object, before scoping turns it into a parent export.
+struct ParentRead {
+    int depth = 1;        // 1: the enclosing object, 2: its parent, …
+    std::string member;   // the equation or parameter read
+    Type type;
+};
+
+struct Object {
+    std::string name;
+    std::string parent;  // the enclosing object type; empty at file level
+    std::vector<Param> params;
+    std::vector<StateSlot> state;
+    std::vector<EmitSite> emits;
+    std::vector<Export> exports;
+    std::vector<ParentRead> parentReads;
+    std::map<std::string, std::string> attributes;  // integrator, step, capacity
+    std::vector<Kernel> kernels;
+
+    const Kernel* kernel(KernelKind kind, int site = -1) const;
+    Kernel* kernel(KernelKind kind, int site = -1);
+};
+
+struct Extern {
+    std::string name;
+    Type type;
+    std::array<float, 4> defaultValue{};
+    std::optional<std::array<float, 4>> low, high;
+};
+
+// `trigger NAME(params) { emits }` and the start of the system (`spawn …`) are kernels
+// with emit yields, run once when fired.
+struct Trigger {
+    std::string name;
+    std::vector<Param> params;
+    std::vector<EmitSite> emits;
+    Kernel kernel;
+};
+
+struct Module {
+    std::vector<Extern> externs;
+    std::vector<Object> objects;  // parents before children
+    std::vector<Trigger> triggers;
+    Trigger start;                // the `spawn`s: emits at time 0
+
+    const Object* object(const std::string& name) const;
+    int objectIndex(const std::string& name) const;
+    int externIndex(const std::string& name) const;
+};
+
+const char* kernelName(KernelKind kind);
+
+}  // namespace psys::ir

@@ -1,0 +1,131 @@
+#include <algorithm>
+#include <cstring>
+
+#include "ir/ir.h"
+
+namespace psys::ir {
+namespace {
+
+// The hash-consing key: everything but the name.
+std::string keyOf(const Inst& inst) {
+    std::string key;
+    auto put = [&](const void* p, size_t n) { key.append(static_cast<const char*>(p), n); };
+    put(&inst.op, sizeof inst.op);
+    put(&inst.type, sizeof inst.type);
+    put(&inst.attr, sizeof inst.attr);
+    put(&inst.attr2, sizeof inst.attr2);
+    if (inst.op == Op::Const) put(inst.constant.data(), sizeof(float) * 4);
+    for (ValueId v : inst.operands) put(&v, sizeof v);
+    key.push_back('|');
+    for (uint8_t l : inst.lanes) key.push_back(static_cast<char>(l));
+    return key;
+}
+
+}  // namespace
+
+bool Inst::sameAs(const Inst& other) const {
+    return op == other.op && type == other.type && operands == other.operands && attr == other.attr &&
+           attr2 == other.attr2 && lanes == other.lanes &&
+           (op != Op::Const || std::memcmp(constant.data(), other.constant.data(), sizeof(float) * 4) == 0);
+}
+
+ValueId Kernel::add(Inst inst) {
+    if (isCommutative(inst.op) && inst.operands.size() == 2 && inst.operands[0] > inst.operands[1])
+        std::swap(inst.operands[0], inst.operands[1]);
+    if (isTemporal(inst.op)) return addUnique(std::move(inst));
+    std::string key = keyOf(inst);
+    if (auto it = table_.find(key); it != table_.end()) {
+        if (insts_[it->second].name.empty()) insts_[it->second].name = inst.name;
+        return it->second;
+    }
+    auto id = static_cast<ValueId>(insts_.size());
+    table_.emplace(std::move(key), id);
+    insts_.push_back(std::move(inst));
+    return id;
+}
+
+ValueId Kernel::addUnique(Inst inst) {
+    auto id = static_cast<ValueId>(insts_.size());
+    insts_.push_back(std::move(inst));
+    return id;
+}
+
+ValueId Kernel::constant(Type type, std::array<float, 4> value) {
+    Inst inst;
+    inst.op = Op::Const;
+    inst.type = type;
+    for (int i = type.width; i < 4; ++i) value[static_cast<size_t>(i)] = 0;
+    inst.constant = value;
+    return add(std::move(inst));
+}
+
+ValueId Kernel::op(Op op, Type type, std::vector<ValueId> operands, int32_t attr) {
+    Inst inst;
+    inst.op = op;
+    inst.type = type;
+    inst.operands = std::move(operands);
+    inst.attr = attr;
+    return add(std::move(inst));
+}
+
+std::vector<const Yield*> Kernel::find(YieldKind kind, int index) const {
+    std::vector<const Yield*> out;
+    for (const Yield& y : yields)
+        if (y.kind == kind && (index < 0 || y.index == index)) out.push_back(&y);
+    return out;
+}
+
+const Yield* Kernel::findOne(YieldKind kind, int index, int sub) const {
+    for (const Yield& y : yields)
+        if (y.kind == kind && y.index == index && y.sub == sub) return &y;
+    return nullptr;
+}
+
+void Kernel::rehash() {
+    table_.clear();
+    for (ValueId v = 0; v < insts_.size(); ++v)
+        if (!isTemporal(insts_[v].op)) table_.emplace(keyOf(insts_[v]), v);
+}
+
+const Kernel* Object::kernel(KernelKind kind, int site) const {
+    for (const Kernel& k : kernels)
+        if (k.kind == kind && (kind != KernelKind::Spawn || k.site == site)) return &k;
+    return nullptr;
+}
+
+Kernel* Object::kernel(KernelKind kind, int site) {
+    return const_cast<Kernel*>(static_cast<const Object*>(this)->kernel(kind, site));
+}
+
+const Object* Module::object(const std::string& name) const {
+    int i = objectIndex(name);
+    return i < 0 ? nullptr : &objects[static_cast<size_t>(i)];
+}
+
+int Module::objectIndex(const std::string& name) const {
+    for (size_t i = 0; i < objects.size(); ++i)
+        if (objects[i].name == name) return static_cast<int>(i);
+    return -1;
+}
+
+int Module::externIndex(const std::string& name) const {
+    for (size_t i = 0; i < externs.size(); ++i)
+        if (externs[i].name == name) return static_cast<int>(i);
+    return -1;
+}
+
+const char* kernelName(KernelKind kind) {
+    switch (kind) {
+        case KernelKind::Behaviour: return "behaviour";
+        case KernelKind::Init: return "init";
+        case KernelKind::Update: return "update";
+        case KernelKind::Render: return "render";
+        case KernelKind::Exports: return "exports";
+        case KernelKind::Spawn: return "spawn";
+        case KernelKind::Trigger: return "trigger";
+        case KernelKind::Start: return "start";
+    }
+    return "?";
+}
+
+}  // namespace psys::ir

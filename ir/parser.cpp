@@ -1,0 +1,294 @@
+#include "ir/parser.h"
+
+#include <cstdlib>
+#include <sstream>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "ir/printer.h"
+
+namespace psys::ir {
+namespace {
+
+struct ParseError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+std::vector<std::string> words(const std::string& line) {
+    std::vector<std::string> out;
+    std::istringstream in(line);
+    std::string w;
+    while (in >> w) out.push_back(w);
+    return out;
+}
+
+float number(const std::string& text) {
+    char* end = nullptr;
+    float v = std::strtof(text.c_str(), &end);
+    if (end == text.c_str() || *end != '\0') throw ParseError("expected a number, found `" + text + "`");
+    return v;
+}
+
+int integer(const std::string& text) {
+    char* end = nullptr;
+    long v = std::strtol(text.c_str(), &end, 10);
+    if (end == text.c_str() || *end != '\0') throw ParseError("expected an integer, found `" + text + "`");
+    return static_cast<int>(v);
+}
+
+Type type(const std::string& text) {
+    auto t = Type::parse(text);
+    if (!t) throw ParseError("unknown type `" + text + "`");
+    return *t;
+}
+
+// "name: type, name: type" inside the parentheses of a header.
+std::vector<Param> params(const std::string& header) {
+    std::vector<Param> out;
+    auto open = header.find('('), close = header.rfind(')');
+    if (open == std::string::npos || close == std::string::npos) throw ParseError("expected (parameters)");
+    std::string inside = header.substr(open + 1, close - open - 1);
+    std::istringstream in(inside);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        auto colon = item.find(':');
+        if (colon == std::string::npos) throw ParseError("expected `name: type`");
+        auto trim = [](std::string s) {
+            s.erase(0, s.find_first_not_of(' '));
+            s.erase(s.find_last_not_of(' ') + 1);
+            return s;
+        };
+        out.push_back({trim(item.substr(0, colon)), type(trim(item.substr(colon + 1)))});
+    }
+    return out;
+}
+
+std::string nameBeforeParen(const std::string& header, size_t skip) {
+    return header.substr(skip, header.find('(') - skip);
+}
+
+std::optional<YieldKind> yieldKind(const std::string& name) {
+    for (YieldKind k : {YieldKind::StateNext, YieldKind::Kill, YieldKind::Visible, YieldKind::Position,
+                        YieldKind::Color, YieldKind::Size, YieldKind::EmitRate, YieldKind::EmitCount,
+                        YieldKind::EmitArg, YieldKind::Export})
+        if (yieldKindName(k) == name) return k;
+    return std::nullopt;
+}
+
+std::optional<KernelKind> kernelKind(const std::string& name) {
+    for (KernelKind k : {KernelKind::Behaviour, KernelKind::Init, KernelKind::Update, KernelKind::Render,
+                         KernelKind::Exports, KernelKind::Spawn, KernelKind::Trigger, KernelKind::Start})
+        if (name == kernelName(k)) return k;
+    return std::nullopt;
+}
+
+ValueId valueRef(const std::string& text) {
+    if (text.empty() || text[0] != '%') throw ParseError("expected a value `%n`, found `" + text + "`");
+    return static_cast<ValueId>(integer(text.substr(1)));
+}
+
+class Parser {
+public:
+    explicit Parser(const std::string& text) {
+        std::istringstream in(text);
+        std::string line;
+        while (std::getline(in, line)) lines_.push_back(line);
+    }
+
+    Module run() {
+        Module m;
+        for (; pos_ < lines_.size(); ++pos_) {
+            std::string line = current();
+            auto w = words(line);
+            if (w.empty()) continue;
+            if (w[0] == "extern") m.externs.push_back(externDecl(line));
+            else if (w[0] == "object") m.objects.push_back(object(line));
+            else if (w[0] == "trigger") {
+                Trigger t;
+                t.name = nameBeforeParen(trimmed(line), 8);
+                t.params = params(line);
+                triggerBody(t);
+                m.triggers.push_back(std::move(t));
+            } else if (w[0] == "start") {
+                triggerBody(m.start);
+            } else {
+                throw ParseError("expected extern, object, trigger or start, found `" + w[0] + "`");
+            }
+        }
+        return m;
+    }
+
+    size_t lineNumber() const { return pos_ + 1; }
+
+private:
+    std::string current() const { return lines_.at(pos_); }
+    static std::string trimmed(std::string s) {
+        s.erase(0, s.find_first_not_of(' '));
+        return s;
+    }
+
+    Extern externDecl(const std::string& line) {
+        // extern NAME: TYPE = v… [range lo… to hi…]
+        auto w = words(line);
+        if (w.size() < 4 || w[1].back() != ':' || w[3] != "=") throw ParseError("expected `extern name: type = value`");
+        Extern e;
+        e.name = w[1].substr(0, w[1].size() - 1);
+        e.type = type(w[2]);
+        size_t i = 4;
+        for (int c = 0; c < e.type.width; ++c) e.defaultValue[static_cast<size_t>(c)] = number(w.at(i++));
+        if (i < w.size()) {
+            if (w[i] != "range") throw ParseError("expected `range`");
+            ++i;
+            std::array<float, 4> lo{}, hi{};
+            for (int c = 0; c < e.type.width; ++c) lo[static_cast<size_t>(c)] = number(w.at(i++));
+            if (w.at(i++) != "to") throw ParseError("expected `to`");
+            for (int c = 0; c < e.type.width; ++c) hi[static_cast<size_t>(c)] = number(w.at(i++));
+            e.low = lo;
+            e.high = hi;
+        }
+        return e;
+    }
+
+    Object object(const std::string& header) {
+        Object o;
+        o.name = nameBeforeParen(trimmed(header), 7);
+        o.params = params(header);
+        for (++pos_; pos_ < lines_.size(); ++pos_) {
+            auto w = words(current());
+            if (w.empty()) continue;
+            if (w[0] == "end") return o;
+            if (w[0] == "parent") o.parent = w.at(1);
+            else if (w[0] == "attribute") o.attributes[w.at(1)] = w.at(2);
+            else if (w[0] == "state") {
+                if (w.size() != 4 || w[1].back() != ':') throw ParseError("expected `state name: type zero|next`");
+                StateInit init = w[3] == "zero" ? StateInit::Zero : w[3] == "next" ? StateInit::Next
+                                 : throw ParseError("a state starts `zero` or `next`");
+                o.state.push_back({w[1].substr(0, w[1].size() - 1), type(w[2]), init});
+            } else if (w[0] == "emit") {
+                o.emits.push_back(emitSite(w));
+            } else if (w[0] == "export") {
+                if (w.size() != 3 || w[1].back() != ':') throw ParseError("expected `export name: type`");
+                o.exports.push_back({w[1].substr(0, w[1].size() - 1), type(w[2])});
+            } else if (w[0] == "read") {
+                if (w.size() != 4 || w[1].back() != ':' || w[3][0] != '^') throw ParseError("expected `read name: type ^depth`");
+                o.parentReads.push_back({integer(w[3].substr(1)), w[1].substr(0, w[1].size() - 1), type(w[2])});
+            } else if (w[0] == "kernel") {
+                o.kernels.push_back(kernel(w));
+            } else {
+                throw ParseError("unexpected `" + w[0] + "` in an object");
+            }
+        }
+        throw ParseError("object `" + o.name + "` has no `end`");
+    }
+
+    static EmitSite emitSite(const std::vector<std::string>& w) {
+        if (w.size() != 3 || (w[2] != "rate" && w[2] != "burst")) throw ParseError("expected `emit object rate|burst`");
+        return {w[1], w[2] == "rate"};
+    }
+
+    void triggerBody(Trigger& t) {
+        for (++pos_; pos_ < lines_.size(); ++pos_) {
+            auto w = words(current());
+            if (w.empty()) continue;
+            if (w[0] == "end") return;
+            if (w[0] == "emit") t.emits.push_back(emitSite(w));
+            else if (w[0] == "kernel") t.kernel = kernel(w);
+            else throw ParseError("unexpected `" + w[0] + "` in a trigger");
+        }
+        throw ParseError("a trigger has no `end`");
+    }
+
+    Kernel kernel(const std::vector<std::string>& header) {
+        Kernel k;
+        auto kind = kernelKind(header.at(1));
+        if (!kind) throw ParseError("unknown kernel kind `" + header[1] + "`");
+        k.kind = *kind;
+        if (k.kind == KernelKind::Spawn) k.site = integer(header.at(2).substr(1));
+        for (++pos_; pos_ < lines_.size(); ++pos_) {
+            std::string line = current();
+            auto w = words(line);
+            if (w.empty()) continue;
+            if (w[0] == "end") {
+                for (const Inst& inst : k.insts())
+                    for (ValueId v : inst.operands)
+                        if (v >= k.size()) throw ParseError(fmt::format("value %{} is not defined", v));
+                for (const Yield& y : k.yields)
+                    if (y.value >= k.size()) throw ParseError(fmt::format("value %{} is not defined", y.value));
+                k.rehash();
+                return k;
+            }
+            if (w[0] == "yield") k.yields.push_back(yield(w));
+            else instruction(k, line);
+        }
+        throw ParseError("a kernel has no `end`");
+    }
+
+    static Yield yield(const std::vector<std::string>& w) {
+        // yield KIND [#index [#sub]] = %v
+        Yield y;
+        auto kind = yieldKind(w.at(1));
+        if (!kind) throw ParseError("unknown yield `" + w[1] + "`");
+        y.kind = *kind;
+        size_t i = 2;
+        if (w.at(i)[0] == '#') y.index = integer(w[i++].substr(1));
+        if (w.at(i)[0] == '#') y.sub = integer(w[i++].substr(1));
+        if (w.at(i++) != "=") throw ParseError("expected `=` in a yield");
+        y.value = valueRef(w.at(i));
+        return y;
+    }
+
+    void instruction(Kernel& k, std::string line) {
+        Inst inst;
+        if (auto semi = line.find(';'); semi != std::string::npos) {
+            inst.name = trimmed(line.substr(semi + 1));
+            line = line.substr(0, semi);
+        }
+        if (auto open = line.find('<'); open != std::string::npos) {
+            auto close = line.find('>', open);
+            if (close == std::string::npos) throw ParseError("expected `>`");
+            for (auto& lane : words(line.substr(open + 1, close - open - 1)))
+                inst.lanes.push_back(static_cast<uint8_t>(integer(lane)));
+            line.erase(open, close - open + 1);
+        }
+        for (char& c : line)
+            if (c == ',') c = ' ';
+        auto w = words(line);
+        if (w.size() < 3 || w[1] != "=") throw ParseError("expected `%n = op.type …`");
+        if (valueRef(w[0]) != k.size())
+            throw ParseError(fmt::format("expected %{} next, found {}", k.size(), w[0]));
+        auto dot = w[2].rfind('.');
+        if (dot == std::string::npos) throw ParseError("expected `op.type`, found `" + w[2] + "`");
+        auto op = opFromName(w[2].substr(0, dot));
+        if (!op) throw ParseError("unknown instruction `" + w[2].substr(0, dot) + "`");
+        inst.op = *op;
+        inst.type = type(w[2].substr(dot + 1));
+        size_t components = 0;
+        for (size_t i = 3; i < w.size(); ++i) {
+            const std::string& t = w[i];
+            if (t[0] == '%') inst.operands.push_back(valueRef(t));
+            else if (t[0] == '#') inst.attr = integer(t.substr(1));
+            else if (t[0] == '^') inst.attr2 = integer(t.substr(1));
+            else if (inst.op == Op::Const && components < 4) inst.constant[components++] = number(t);
+            else throw ParseError("unexpected `" + t + "`");
+        }
+        k.addUnique(std::move(inst));
+    }
+
+    std::vector<std::string> lines_;
+    size_t pos_ = 0;
+};
+
+}  // namespace
+
+std::optional<Module> parseModule(const std::string& text, std::string& error) {
+    Parser parser(text);
+    try {
+        return parser.run();
+    } catch (const std::exception& e) {
+        error = fmt::format("line {}: {}", parser.lineNumber(), e.what());
+        return std::nullopt;
+    }
+}
+
+}  // namespace psys::ir

@@ -1,0 +1,116 @@
+#include "ir/printer.h"
+
+#include <fmt/format.h>
+
+namespace psys::ir {
+namespace {
+
+std::string number(float x) {
+    std::string s = fmt::format("{}", x);  // shortest form that reads back exactly
+    return s;
+}
+
+std::string constantText(const Inst& inst) {
+    std::string s;
+    int n = inst.type.isFloat() ? inst.type.width : 1;
+    for (int i = 0; i < n; ++i) s += (i ? " " : "") + number(inst.constant[static_cast<size_t>(i)]);
+    return s;
+}
+
+std::string params(const std::vector<Param>& ps) {
+    std::string s;
+    for (auto& p : ps) s += (s.empty() ? "" : ", ") + p.name + ": " + p.type.str();
+    return s;
+}
+
+std::string values(const std::array<float, 4>& v, Type t) {
+    std::string s;
+    for (int i = 0; i < t.width; ++i) s += (i ? " " : "") + number(v[static_cast<size_t>(i)]);
+    return s;
+}
+
+}  // namespace
+
+std::string yieldKindName(YieldKind kind) {
+    switch (kind) {
+        case YieldKind::StateNext: return "state";
+        case YieldKind::Kill: return "kill";
+        case YieldKind::Visible: return "visible";
+        case YieldKind::Position: return "position";
+        case YieldKind::Color: return "color";
+        case YieldKind::Size: return "size";
+        case YieldKind::EmitRate: return "emit.rate";
+        case YieldKind::EmitCount: return "emit.count";
+        case YieldKind::EmitArg: return "emit.arg";
+        case YieldKind::Export: return "export";
+    }
+    return "?";
+}
+
+std::string print(const Kernel& kernel, int indent) {
+    std::string pad(static_cast<size_t>(indent), ' ');
+    std::string out = pad + "kernel " + kernelName(kernel.kind);
+    if (kernel.kind == KernelKind::Spawn) out += fmt::format(" #{}", kernel.site);
+    out += "\n";
+    for (ValueId v = 0; v < kernel.size(); ++v) {
+        const Inst& inst = kernel.at(v);
+        std::string line = fmt::format("{}  %{} = {}.{}", pad, v, opInfo(inst.op).name, inst.type.str());
+        if (inst.op == Op::Const) line += " " + constantText(inst);
+        for (size_t i = 0; i < inst.operands.size(); ++i) line += fmt::format("{} %{}", i ? "," : "", inst.operands[i]);
+        bool showAttr = inst.attr != 0 || inst.op == Op::Param || inst.op == Op::StateRead || inst.op == Op::Extern ||
+                        inst.op == Op::TriggerParam || inst.op == Op::ParentRead || inst.op == Op::ParentExport ||
+                        inst.op == Op::Extract || isTemporal(inst.op);
+        if (showAttr) line += fmt::format(" #{}", inst.attr);
+        if (inst.attr2 != 0) line += fmt::format(" ^{}", inst.attr2);
+        if (!inst.lanes.empty()) {
+            line += " <";
+            for (size_t i = 0; i < inst.lanes.size(); ++i) line += fmt::format("{}{}", i ? " " : "", inst.lanes[i]);
+            line += ">";
+        }
+        if (!inst.name.empty()) line += "  ; " + inst.name;
+        out += line + "\n";
+    }
+    for (const Yield& y : kernel.yields) {
+        std::string line = pad + "  yield " + yieldKindName(y.kind);
+        bool indexed = y.kind == YieldKind::StateNext || y.kind == YieldKind::EmitRate ||
+                       y.kind == YieldKind::EmitCount || y.kind == YieldKind::EmitArg || y.kind == YieldKind::Export;
+        if (indexed) line += fmt::format(" #{}", y.index);
+        if (y.kind == YieldKind::EmitArg) line += fmt::format(" #{}", y.sub);
+        out += line + fmt::format(" = %{}\n", y.value);
+    }
+    return out + pad + "end\n";
+}
+
+std::string print(const Object& o) {
+    std::string out = fmt::format("object {}({})\n", o.name, params(o.params));
+    if (!o.parent.empty()) out += "  parent " + o.parent + "\n";
+    for (auto& [key, value] : o.attributes) out += fmt::format("  attribute {} {}\n", key, value);
+    for (auto& s : o.state)
+        out += fmt::format("  state {}: {} {}\n", s.name, s.type.str(), s.init == StateInit::Zero ? "zero" : "next");
+    for (auto& e : o.emits) out += fmt::format("  emit {} {}\n", e.target, e.rate ? "rate" : "burst");
+    for (auto& e : o.exports) out += fmt::format("  export {}: {}\n", e.name, e.type.str());
+    for (auto& r : o.parentReads) out += fmt::format("  read {}: {} ^{}\n", r.member, r.type.str(), r.depth);
+    for (auto& k : o.kernels) out += print(k, 2);
+    return out + "end\n";
+}
+
+std::string print(const Module& m) {
+    std::string out;
+    for (auto& e : m.externs) {
+        out += fmt::format("extern {}: {} = {}", e.name, e.type.str(), values(e.defaultValue, e.type));
+        if (e.low) out += fmt::format(" range {} to {}", values(*e.low, e.type), values(*e.high, e.type));
+        out += "\n";
+    }
+    for (auto& o : m.objects) out += print(o);
+    auto trigger = [&](const Trigger& t, const std::string& head) {
+        out += head + "\n";
+        for (auto& e : t.emits) out += fmt::format("  emit {} {}\n", e.target, e.rate ? "rate" : "burst");
+        out += print(t.kernel, 2);
+        out += "end\n";
+    };
+    for (auto& t : m.triggers) trigger(t, fmt::format("trigger {}({})", t.name, params(t.params)));
+    trigger(m.start, "start");
+    return out;
+}
+
+}  // namespace psys::ir
