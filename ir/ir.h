@@ -77,6 +77,9 @@ public:
     size_t size() const { return insts_.size(); }
 
     std::vector<Yield> yields;
+    // The values of the object's equations (and parameters) by name, for passes that look
+    // them up (scoping) and for people reading the IR. Printed as `let name = %v`.
+    std::map<std::string, ValueId> equations;
 
     // Adds `inst` unless an equal one exists (hash-consing); returns its value.
     // Operands of commutative ops are sorted first. Temporal ops are never merged: each

@@ -11,6 +11,9 @@
 //   must read an equation evaluated later in this order — one that closes a cycle, which
 //   the front end allows only through `integrate`, `prev` or the `next` side of `->` — is
 //   a `recur` instruction: opt/resolve_cycles makes it the value of the previous update.
+//   The operand of `prev` is the exception: it is only needed for the slot's next value,
+//   once the update has computed everything, so it is lowered last and reads this
+//   update's values.
 //
 // Functions are inlined; every inlined `rand` gets its own call site. Broadcasts become
 // explicit `splat`s and the library functions (mix, clamp, rotate_y, normalize, …) become
@@ -21,6 +24,7 @@
 #include <functional>
 #include <map>
 #include <set>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -54,17 +58,38 @@ public:
 
     // The object's equations, in evaluation order.
     void lowerEquations() {
+        for (size_t i = 0; i < decl_->params.size(); ++i)
+            k_.equations[decl_->params[i].name] = input(Op::Param, irType(decl_->params[i].type.type), static_cast<int>(i));
         std::vector<const Equation*> order = evaluationOrder();
         for (const Equation* eq : order) {
             current_ = eq;
             Values v = lower(*eq->value);
-            for (size_t i = 0; i < eq->names.size() && i < v.size(); ++i) name(v[i], eq->names[i]);
+            for (size_t i = 0; i < eq->names.size() && i < v.size(); ++i) {
+                name(v[i], eq->names[i]);
+                k_.equations[eq->names[i]] = v[i];
+            }
             values_[eq] = v;
         }
         current_ = nullptr;
         for (auto& [recur, target] : pendingRecurs_) {
             ValueId value = values_.at(target.first).at(target.second);
             k_.mutableAt(recur).operands = {value};
+        }
+        flushDeferred();
+    }
+
+    // `prev(e)` reads a slot; `e` itself is needed only for the slot's next value, at the
+    // end of the update, when every equation has its current value. So `e` is lowered
+    // last, and what it reads is this update's value even where it refers forward.
+    void flushDeferred() {
+        while (!deferred_.empty()) {
+            auto [prev, arg, frames] = std::move(deferred_.back());
+            deferred_.pop_back();
+            auto saved = std::move(frames_);
+            frames_ = std::move(frames);
+            ValueId v = lowerOne(*arg);
+            frames_ = std::move(saved);
+            k_.mutableAt(prev).operands = {v};
         }
     }
 
@@ -115,6 +140,7 @@ private:
         inst.type = t;
         inst.operands = std::move(operands);
         inst.attr = site_++;
+        if ((op == Op::Rand || op == Op::NRand) && (perChild_ || !decl_)) inst.attr2 = 1;
         return k_.addUnique(std::move(inst));
     }
     ValueId input(Op op, Type t, int attr = 0, int attr2 = 0) {
@@ -127,6 +153,12 @@ private:
     }
     ValueId parentRead(const MemberExpr& m);
 
+public:
+    // While lowering emit arguments: random draws there are one per created object.
+    bool perChild_ = false;
+
+private:
+
     const Module& module_;
     Kernel& k_;
     Object* object_;
@@ -137,6 +169,7 @@ private:
     std::vector<std::pair<ValueId, std::pair<const Equation*, size_t>>> pendingRecurs_;
     const Equation* current_ = nullptr;
     std::vector<FnFrame> frames_;
+    std::vector<std::tuple<ValueId, const Expr*, std::vector<FnFrame>>> deferred_;
 };
 
 // ---------------------------------------------------------------- evaluation order
@@ -389,6 +422,11 @@ Values ObjectLowering::lowerCall(const CallExpr& c) {
     }
     const BuiltinFunction& fn = builtinFunction(c.builtin);
     Type t = irType(c.type);
+    if (fn.rule == BuiltinRule::Prev) {
+        ValueId prev = temporal(Op::Prev, t, {0});
+        deferred_.push_back({prev, c.args[0].get(), frames_});
+        return {prev};
+    }
     std::vector<ValueId> a;
     for (auto& arg : c.args) a.push_back(lowerOne(*arg));
     auto b = [&](size_t i) { return broadcastTo(a.at(i), t); };
@@ -483,7 +521,7 @@ Values ObjectLowering::lowerCall(const CallExpr& c) {
         case BuiltinRule::Integrate:
             return {temporal(n == "integrate" ? Op::Integrate : Op::Derive, t, {a[0]})};
         case BuiltinRule::Snapshot: return {temporal(Op::Snapshot, t, {a[0]})};
-        case BuiltinRule::Prev: return {temporal(Op::Prev, t, {a[0]})};
+        case BuiltinRule::Prev: break;  // handled above
         case BuiltinRule::Random:
             return {temporal(n.substr(0, 1) == "n" ? Op::NRand : Op::Rand, t, {})};
     }
@@ -528,8 +566,10 @@ struct CommandLowering {
                     } else {
                         k.yields.push_back({YieldKind::EmitCount, site, 0, k.op(Op::Select, Type::f32(), {on, count, zero})});
                     }
+                    lowering.perChild_ = true;
                     for (size_t i = 0; i < cmd->args.size(); ++i)
                         k.yields.push_back({YieldKind::EmitArg, site, static_cast<int>(i), lowering.lowerOne(*cmd->args[i])});
+                    lowering.perChild_ = false;
                     break;
                 }
                 case CommandKind::When: {
@@ -621,6 +661,7 @@ Module lower(const ast::Program& program) {
         ValueId kill = k.boolean(false);
         CommandLowering commands{lowering, k, o.emits, program, qualified};
         commands.run(decl->commands, {}, kill);
+        lowering.flushDeferred();
         k.yields.push_back({YieldKind::Kill, 0, 0, kill});
         o.kernels.push_back(std::move(k));
     }

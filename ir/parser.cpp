@@ -215,10 +215,16 @@ private:
                         if (v >= k.size()) throw ParseError(fmt::format("value %{} is not defined", v));
                 for (const Yield& y : k.yields)
                     if (y.value >= k.size()) throw ParseError(fmt::format("value %{} is not defined", y.value));
+                for (auto& [name, v] : k.equations)
+                    if (v >= k.size()) throw ParseError(fmt::format("value %{} is not defined", v));
                 k.rehash();
                 return k;
             }
             if (w[0] == "yield") k.yields.push_back(yield(w));
+            else if (w[0] == "let") {
+                if (w.size() != 4 || w[2] != "=") throw ParseError("expected `let name = %v`");
+                k.equations[w[1]] = valueRef(w[3]);
+            }
             else instruction(k, line);
         }
         throw ParseError("a kernel has no `end`");

@@ -70,6 +70,7 @@ std::string print(const Kernel& kernel, int indent) {
         if (!inst.name.empty()) line += "  ; " + inst.name;
         out += line + "\n";
     }
+    for (auto& [name, value] : kernel.equations) out += fmt::format("{}  let {} = %{}\n", pad, name, value);
     for (const Yield& y : kernel.yields) {
         std::string line = pad + "  yield " + yieldKindName(y.kind);
         bool indexed = y.kind == YieldKind::StateNext || y.kind == YieldKind::EmitRate ||

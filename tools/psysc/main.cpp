@@ -16,6 +16,7 @@
 #include "frontend/loader.h"
 #include "ir/lower.h"
 #include "ir/printer.h"
+#include "opt/passes.h"
 
 namespace {
 
@@ -65,6 +66,11 @@ int main(int argc, char** argv) {
     std::vector<std::string> emitFiles;
     app.add_option("--emit", emit, "Print an intermediate form of FILE")->check(CLI::IsMember({"ast", "ir"}));
     app.add_option("files", emitFiles, "Source file for --emit")->type_name("FILE");
+    std::vector<std::string> printAfter;
+    bool printAfterAll = false;
+    app.add_option("--print-after", printAfter, "With --emit=ir: print the IR after this pass (repeatable)")
+        ->type_name("PASS");
+    app.add_flag("--print-after-all", printAfterAll, "With --emit=ir: print the IR after every pass");
 
     auto* check = app.add_subcommand("check", "Type-check .psys files and report every error");
     std::vector<std::string> checkFiles;
@@ -104,7 +110,26 @@ int main(int argc, char** argv) {
             return 0;
         }
         psys::ir::Module module = psys::ir::lower(*program);
-        std::cout << psys::ir::print(module);
+        psys::opt::PipelineOptions options;
+        options.printAfter = {printAfter.begin(), printAfter.end()};
+        options.printAfterAll = printAfterAll;
+        options.log = &std::cout;
+        for (const std::string& pass : printAfter) {
+            bool known = false;
+            for (auto& info : psys::opt::passCatalogue()) known |= pass == info.name;
+            if (!known) {
+                std::cerr << "psysc: error: unknown pass `" << pass << "` for --print-after; the passes are:\n";
+                for (auto& info : psys::opt::passCatalogue()) std::cerr << "  " << info.name << ": " << info.summary << "\n";
+                return 2;
+            }
+        }
+        if (printAfterAll || !printAfter.empty()) std::cout << "; IR after lowering\n" << psys::ir::print(module);
+        psys::opt::PassErrors errors;
+        if (!psys::opt::runPipeline(module, options, errors)) {
+            for (const std::string& e : errors) std::cerr << "psysc: error: " << e << "\n";
+            return 1;
+        }
+        if (!printAfterAll && printAfter.empty()) std::cout << psys::ir::print(module);
         return 0;
     }
     std::cerr << app.help();

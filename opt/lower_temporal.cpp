@@ -1,0 +1,109 @@
+// lower-temporal: the thesis's behaviours become explicit state (thesis §3.3.7, §4.3.6).
+//
+// Each object's behaviour is evaluated at creation (`first` is true) and at every update
+// after (`first` is false, `dt` is the update's length). Every temporal construct gets
+// what it needs:
+//
+//   integrate(e)   slot A, starting at 0:     value = first ? 0 : A + e·dt    next A = value
+//   derive(e)      slot P, starting at e:     value = first || dt <= 0 ? 0 : (e − P)/dt
+//                                                                             next P = e
+//   prev(e)        slot P, starting at e:     value = first ? 0 : P           next P = e
+//   snapshot(e)    slot S, starting at e:     value = first ? e : S           next S = value
+//   a -> b         no state:                  value = first ? a : b
+//
+// `A`, `P` and `S` read the slot as it was before this update. This is Euler's method
+// evaluated in the order lowering chose: an integrand reads this update's values of what
+// was evaluated before it and the previous update's value of what closes a cycle (which
+// resolve-cycles made a `prev`), so a velocity integrated from an acceleration that reads
+// the previous velocity, and a position integrated from that new velocity, is the
+// semi-implicit Euler step games use. Other methods (midpoint, RK4) integrate an
+// object's integrals together and will slot in here as further cases of `integrate`.
+#include <fmt/format.h>
+
+#include "opt/passes.h"
+#include "opt/rewrite.h"
+
+namespace psys::opt {
+
+using namespace ir;
+
+namespace {
+
+ValueId input(Kernel& k, Op op, Type t, int attr = 0) {
+    Inst inst;
+    inst.op = op;
+    inst.type = t;
+    inst.attr = attr;
+    return k.add(std::move(inst));
+}
+
+ValueId broadcast(Kernel& k, ValueId scalar, Type t) {
+    return t.width == 1 ? scalar : k.op(Op::Splat, t, {scalar});
+}
+
+}  // namespace
+
+void lowerTemporal(Module& module, const PassOptions&, PassErrors&) {
+    for (Object& object : module.objects) {
+        Kernel* behaviour = object.kernel(KernelKind::Behaviour);
+        if (!behaviour) continue;
+        std::vector<std::pair<int, ValueId>> nextOld;  // (slot, old value its next is)
+        std::vector<std::pair<int, ValueId>> nextNew;  // (slot, new value)
+        auto addSlot = [&](const char* kind, const Inst& inst, StateInit init) {
+            object.state.push_back({fmt::format("{}#{}", kind, inst.attr), inst.type, init});
+            return static_cast<int>(object.state.size() - 1);
+        };
+        Rewriter rewriter(*behaviour);
+        Kernel lowered = rewriter.run([&](Rewriter& rw, ValueId, const Inst& inst,
+                                          const std::vector<ValueId>& ops) -> std::optional<ValueId> {
+            Kernel& k = rw.to();
+            Type t = inst.type;
+            ValueId first = input(k, Op::First, Type::boolean());
+            ValueId zero = zeroOf(k, t);
+            switch (inst.op) {
+                case Op::Integrate: {
+                    int slot = addSlot("integrate", inst, StateInit::Zero);
+                    ValueId a = input(k, Op::StateRead, t, slot);
+                    ValueId dt = broadcast(k, input(k, Op::Dt, Type::f32()), t);
+                    ValueId step = k.op(Op::Add, t, {a, k.op(Op::Mul, t, {ops[0], dt})});
+                    ValueId value = rw.emit({Op::Select, t, {first, zero, step}, 0, 0, {}, {}, ""});
+                    nextNew.push_back({slot, value});
+                    return value;
+                }
+                case Op::Derive: {
+                    int slot = addSlot("derive", inst, StateInit::Next);
+                    ValueId p = input(k, Op::StateRead, t, slot);
+                    ValueId dtScalar = input(k, Op::Dt, Type::f32());
+                    ValueId moving = k.op(Op::Gt, Type::boolean(), {dtScalar, k.scalar(0)});
+                    ValueId slope = k.op(Op::Div, t, {k.op(Op::Sub, t, {ops[0], p}), broadcast(k, dtScalar, t)});
+                    ValueId ready = k.op(Op::And, Type::boolean(), {k.op(Op::Not, Type::boolean(), {first}), moving});
+                    nextNew.push_back({slot, ops[0]});
+                    return rw.emit({Op::Select, t, {ready, slope, zero}, 0, 0, {}, {}, ""});
+                }
+                case Op::Prev: {
+                    int slot = addSlot("prev", inst, StateInit::Next);
+                    ValueId p = input(k, Op::StateRead, t, slot);
+                    nextOld.push_back({slot, inst.operands[0]});  // may be defined later
+                    return rw.emit({Op::Select, t, {first, zero, p}, 0, 0, {}, {}, ""});
+                }
+                case Op::Snapshot: {
+                    int slot = addSlot("snapshot", inst, StateInit::Next);
+                    ValueId s = input(k, Op::StateRead, t, slot);
+                    ValueId value = rw.emit({Op::Select, t, {first, ops[0], s}, 0, 0, {}, {}, ""});
+                    nextNew.push_back({slot, value});
+                    return value;
+                }
+                case Op::FollowedBy:
+                    // The next side may refer forward only through a `prev`, which reads
+                    // state: by now both operands exist.
+                    return rw.emit({Op::Select, t, {first, ops[0], ops[1]}, 0, 0, {}, {}, ""});
+                default: return std::nullopt;
+            }
+        });
+        for (auto& [slot, value] : nextNew) lowered.yields.push_back({YieldKind::StateNext, slot, 0, value});
+        for (auto& [slot, old] : nextOld) lowered.yields.push_back({YieldKind::StateNext, slot, 0, rewriter.map(old)});
+        *behaviour = std::move(lowered);
+    }
+}
+
+}  // namespace psys::opt

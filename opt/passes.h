@@ -1,0 +1,62 @@
+// The catalogue of IR passes, in pipeline order. Each lives in its own file, whose header
+// says why it exists; pipeline.cpp runs them in this order (thesis §4.3.1).
+//
+//   resolve-cycles   recursive references (`recur`) become the previous update's value;
+//                    a cycle through no integrate/prev/-> is an algebraic loop (§3.1.5,
+//                    §4.3.3–4.3.4)
+//   scoping          a child's `rocket.pos` becomes a value the parent exports once per
+//                    update; the child reads it through its parent handle (§4.3.5)
+//   lower-temporal   integrate, derive, prev, snapshot and `->` become state slots,
+//                    reads and next values (§4.3.6, §3.3.7); the integration method is a
+//                    parameter (Euler now)
+//   key-random       every random draw is keyed by (object id, draw index) so that the
+//                    same seed gives the same particles on every backend (§3.1.4)
+//   split-kernels    the behaviour becomes the kernels init, update, render, exports and
+//                    spawn.N; what the post-update kernels need from before the update is
+//                    carried in state (§3.3.1: split stateful from stateless)
+#pragma once
+
+#include <iosfwd>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "ir/ir.h"
+
+namespace psys::opt {
+
+enum class Integrator { Euler };
+
+struct PassOptions {
+    Integrator integrator = Integrator::Euler;
+};
+
+// Errors a pass reports about the program (not about the compiler).
+using PassErrors = std::vector<std::string>;
+
+void resolveCycles(ir::Module& module, PassErrors& errors);
+void scoping(ir::Module& module, PassErrors& errors);
+void lowerTemporal(ir::Module& module, const PassOptions& options, PassErrors& errors);
+void keyRandom(ir::Module& module, PassErrors& errors);
+void splitKernels(ir::Module& module, PassErrors& errors);
+
+struct PassInfo {
+    const char* name;
+    const char* summary;
+};
+// The catalogue above, for --print-after and --help.
+const std::vector<PassInfo>& passCatalogue();
+
+struct PipelineOptions {
+    PassOptions pass;
+    std::set<std::string> printAfter;  // pass names
+    bool printAfterAll = false;
+    bool verifyEach = false;           // run the verifier after every pass
+    std::ostream* log = nullptr;       // where --print-after goes
+};
+
+// Runs every pass in order. Returns false (with `errors`) when the program is wrong or a
+// pass broke an invariant (the verifier's message names the pass).
+bool runPipeline(ir::Module& module, const PipelineOptions& options, PassErrors& errors);
+
+}  // namespace psys::opt

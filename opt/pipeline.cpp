@@ -1,0 +1,58 @@
+// The pipeline: every pass in order, as one readable function (thesis §4.3.1). With
+// --print-after the IR is logged after the named passes; in debug builds (and with
+// verifyEach) the verifier checks the IR after every pass.
+#include <ostream>
+
+#include <fmt/format.h>
+
+#include "ir/printer.h"
+#include "ir/verifier.h"
+#include "opt/passes.h"
+
+namespace psys::opt {
+
+const std::vector<PassInfo>& passCatalogue() {
+    static const std::vector<PassInfo> passes = {
+        {"resolve-cycles", "recursive references become the previous update's value"},
+        {"scoping", "parent references become values the parent exports"},
+        {"lower-temporal", "integrate, derive, prev, snapshot and -> become state"},
+        {"key-random", "random draws are keyed by (object id, draw index)"},
+        {"split-kernels", "the behaviour becomes init, update, render, exports and spawn kernels"},
+    };
+    return passes;
+}
+
+bool runPipeline(ir::Module& module, const PipelineOptions& options, PassErrors& errors) {
+#ifndef NDEBUG
+    const bool verifyEach = true;
+#else
+    const bool verifyEach = options.verifyEach;
+#endif
+    auto after = [&](const char* pass) {
+        if (!errors.empty()) return false;
+        if (options.log && (options.printAfterAll || options.printAfter.count(pass)))
+            *options.log << "; IR after " << pass << "\n" << ir::print(module);
+        if (verifyEach) {
+            for (const std::string& problem : ir::verify(module))
+                errors.push_back(fmt::format("internal error: the IR after {} is malformed: {}", pass, problem));
+        }
+        return errors.empty();
+    };
+    if (verifyEach)
+        for (const std::string& problem : ir::verify(module))
+            errors.push_back("internal error: the lowered IR is malformed: " + problem);
+    if (!errors.empty()) return false;
+
+    resolveCycles(module, errors);
+    if (!after("resolve-cycles")) return false;
+    scoping(module, errors);
+    if (!after("scoping")) return false;
+    lowerTemporal(module, options.pass, errors);
+    if (!after("lower-temporal")) return false;
+    keyRandom(module, errors);
+    if (!after("key-random")) return false;
+    splitKernels(module, errors);
+    return after("split-kernels");
+}
+
+}  // namespace psys::opt

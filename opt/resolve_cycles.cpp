@@ -1,0 +1,69 @@
+// resolve-cycles: recursive equations become state (thesis §3.1.5, §4.3.3–4.3.4).
+//
+// Lowering evaluates an object's equations in dependency order and writes each
+// reference to an equation evaluated later as `recur %x`: a reference that closes a
+// cycle. Such a cycle has a value only if it passes through something with a value of
+// its own at the start (`integrate`, `prev`, the `next` side of `->`): then `recur %x`
+// means x at the previous update, i.e. `prev %x`, which lower-temporal makes a state
+// slot. A cycle that does not is an algebraic loop, reported with its path. (The front
+// end reports those on the source already; this check keeps the IR honest on its own.)
+#include <fmt/format.h>
+
+#include "opt/passes.h"
+
+namespace psys::opt {
+
+using namespace ir;
+
+namespace {
+
+// A path from `from` to `target` along operands that are used in the same update (not
+// through delaying operands), or empty.
+std::vector<ValueId> immediatePath(const Kernel& k, ValueId from, ValueId target) {
+    std::vector<int> parent(k.size(), -2);
+    std::vector<ValueId> work = {from};
+    parent[from] = -1;
+    while (!work.empty()) {
+        ValueId v = work.back();
+        work.pop_back();
+        if (v == target) {
+            std::vector<ValueId> path;
+            for (int p = static_cast<int>(v); p >= 0; p = parent[static_cast<size_t>(p)]) path.push_back(static_cast<ValueId>(p));
+            return {path.rbegin(), path.rend()};
+        }
+        const Inst& inst = k.at(v);
+        for (size_t i = 0; i < inst.operands.size(); ++i) {
+            ValueId o = inst.operands[i];
+            if (mayReferForward(inst.op, i) || parent[o] != -2) continue;
+            parent[o] = static_cast<int>(v);
+            work.push_back(o);
+        }
+    }
+    return {};
+}
+
+}  // namespace
+
+void resolveCycles(Module& module, PassErrors& errors) {
+    for (Object& object : module.objects) {
+        Kernel* k = object.kernel(KernelKind::Behaviour);
+        if (!k) continue;
+        for (ValueId v = 0; v < k->size(); ++v) {
+            if (k->at(v).op != Op::Recur) continue;
+            std::vector<ValueId> loop = immediatePath(*k, k->at(v).operands[0], v);
+            if (!loop.empty()) {
+                std::string path;
+                for (ValueId p : loop) {
+                    const std::string& n = k->at(p).name;
+                    path += (path.empty() ? "" : " → ") + (n.empty() ? fmt::format("%{}", p) : n);
+                }
+                errors.push_back(fmt::format("object {}: algebraic loop: {} → {}", object.name,
+                                             k->at(v).name.empty() ? fmt::format("%{}", v) : k->at(v).name, path));
+                continue;
+            }
+            k->mutableAt(v).op = Op::Prev;
+        }
+    }
+}
+
+}  // namespace psys::opt
