@@ -111,6 +111,7 @@ public:
                 triggerBody(t);
                 m.triggers.push_back(std::move(t));
             } else if (w[0] == "start") {
+                m.start.name = "start";
                 triggerBody(m.start);
             } else {
                 throw ParseError("expected extern, object, trigger or start, found `" + w[0] + "`");

@@ -59,7 +59,7 @@ std::string print(const Kernel& kernel, int indent) {
         for (size_t i = 0; i < inst.operands.size(); ++i) line += fmt::format("{} %{}", i ? "," : "", inst.operands[i]);
         bool showAttr = inst.attr != 0 || inst.op == Op::Param || inst.op == Op::StateRead || inst.op == Op::Extern ||
                         inst.op == Op::TriggerParam || inst.op == Op::ParentRead || inst.op == Op::ParentExport ||
-                        inst.op == Op::Extract || isTemporal(inst.op);
+                        inst.op == Op::Extract || inst.op == Op::DrawIndex || isTemporal(inst.op);
         if (showAttr) line += fmt::format(" #{}", inst.attr);
         if (inst.attr2 != 0) line += fmt::format(" ^{}", inst.attr2);
         if (!inst.lanes.empty()) {
@@ -110,7 +110,7 @@ std::string print(const Module& m) {
         out += "end\n";
     };
     for (auto& t : m.triggers) trigger(t, fmt::format("trigger {}({})", t.name, params(t.params)));
-    trigger(m.start, "start");
+    if (!m.start.emits.empty() || m.start.kernel.size() > 0) trigger(m.start, "start");
     return out;
 }
 

@@ -14,6 +14,8 @@ public:
         object_ = object;
         trigger_ = trigger;
         bool behaviour = k.kind == KernelKind::Behaviour;
+        // Trigger and start kernels are written like behaviours: their draws are keyed later.
+        unkeyedDrawsAllowed_ = behaviour || k.kind == KernelKind::Trigger || k.kind == KernelKind::Start;
         for (ValueId v = 0; v < k.size(); ++v) inst(k, v, behaviour);
         for (const Yield& y : k.yields) yield(k, y);
     }
@@ -25,7 +27,7 @@ private:
     void inst(const Kernel& k, ValueId v, bool behaviour) {
         const Inst& i = k.at(v);
         const OpInfo& info = opInfo(i.op);
-        bool keyedRandom = (i.op == Op::Rand || i.op == Op::NRand) && i.operands.size() == 2;
+        bool keyedRandom = (i.op == Op::Rand || i.op == Op::NRand) && (i.operands.size() == 2 || unkeyedDrawsAllowed_);
         if (isTemporal(i.op) && !behaviour && !keyedRandom) fail(v, fmt::format("`{}` outside a behaviour kernel", info.name));
         if (info.arity >= 0 && static_cast<int>(i.operands.size()) != info.arity)
             return fail(v, fmt::format("`{}` takes {} operands, has {}", info.name, info.arity, i.operands.size()));
@@ -166,6 +168,7 @@ private:
     std::string where_;
     const Object* object_ = nullptr;
     const Trigger* trigger_ = nullptr;
+    bool unkeyedDrawsAllowed_ = false;
 };
 
 }  // namespace

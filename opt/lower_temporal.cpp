@@ -56,6 +56,9 @@ void lowerTemporal(Module& module, const PassOptions&, PassErrors&) {
         Rewriter rewriter(*behaviour);
         Kernel lowered = rewriter.run([&](Rewriter& rw, ValueId, const Inst& inst,
                                           const std::vector<ValueId>& ops) -> std::optional<ValueId> {
+            if (inst.op != Op::Integrate && inst.op != Op::Derive && inst.op != Op::Prev &&
+                inst.op != Op::Snapshot && inst.op != Op::FollowedBy)
+                return std::nullopt;
             Kernel& k = rw.to();
             Type t = inst.type;
             ValueId first = input(k, Op::First, Type::boolean());

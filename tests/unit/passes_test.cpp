@@ -1,0 +1,240 @@
+// Each pass on its own: IR text in, one pass, IR text out (read and checked by hand).
+#include <doctest/doctest.h>
+
+#include "ir/parser.h"
+#include "ir/printer.h"
+#include "ir/verifier.h"
+#include "opt/passes.h"
+
+using namespace psys;
+using namespace psys::ir;
+
+namespace {
+
+Module parse(const std::string& text) {
+    std::string error;
+    auto m = parseModule(text, error);
+    INFO(error);
+    REQUIRE(m.has_value());
+    return *m;
+}
+
+std::string after(const std::string& text, void (*pass)(Module&, opt::PassErrors&)) {
+    Module m = parse(text);
+    opt::PassErrors errors;
+    pass(m, errors);
+    std::string all;
+    for (auto& e : errors) all += "error: " + e + "\n";
+    for (auto& e : verify(m)) all += "malformed: " + e + "\n";
+    return all + print(m);
+}
+
+void lowerTemporalEuler(Module& m, opt::PassErrors& e) { opt::lowerTemporal(m, {}, e); }
+
+}  // namespace
+
+TEST_CASE("resolve-cycles: a recursive reference through integrate becomes prev") {
+    // vel = 1 + integrate(acc); acc = 2 - vel
+    CHECK(after(R"(object p()
+  kernel behaviour
+    %0 = const.f32 1
+    %1 = recur.f32 %4 #0  ; acc
+    %2 = integrate.f32 %1 #1
+    %3 = add.f32 %0, %2  ; vel
+    %4 = sub.f32 %0, %3  ; acc
+    yield size = %3
+  end
+end
+)", opt::resolveCycles) == R"(object p()
+  kernel behaviour
+    %0 = const.f32 1
+    %1 = prev.f32 %4 #0  ; acc
+    %2 = integrate.f32 %1 #1
+    %3 = add.f32 %0, %2  ; vel
+    %4 = sub.f32 %0, %3  ; acc
+    yield size = %3
+  end
+end
+)");
+}
+
+TEST_CASE("resolve-cycles: a cycle through no delaying construct is an algebraic loop") {
+    std::string out = after(R"(object p()
+  kernel behaviour
+    %0 = recur.f32 %2 #0  ; b
+    %1 = add.f32 %0, %0  ; a
+    %2 = mul.f32 %1, %1  ; b
+    yield size = %2
+  end
+end
+)", opt::resolveCycles);
+    CHECK(out.find("error: object p: algebraic loop: b → b → a → b") != std::string::npos);
+}
+
+TEST_CASE("scoping: a parent read becomes an export of the parent") {
+    CHECK(after(R"(object rocket()
+  emit rocket.spark rate
+  kernel behaviour
+    %0 = age.f32
+    %1 = splat.vec3 %0  ; pos
+    let pos = %1
+  end
+end
+object rocket.spark()
+  parent rocket
+  read pos: vec3 ^1
+  kernel behaviour
+    %0 = parent.read.vec3 #0
+    yield position = %0
+  end
+end
+)", opt::scoping) == R"(object rocket()
+  emit rocket.spark rate
+  export pos: vec3
+  kernel behaviour
+    %0 = age.f32
+    %1 = splat.vec3 %0  ; pos
+    let pos = %1
+    yield export #0 = %1
+  end
+end
+object rocket.spark()
+  parent rocket
+  kernel behaviour
+    %0 = parent.export.vec3 #0 ^1
+    yield position = %0
+  end
+end
+)");
+}
+
+TEST_CASE("lower-temporal: integrate, prev, snapshot, derive and -> become state") {
+    CHECK(after(R"(object p(v: f32)
+  kernel behaviour
+    %0 = param.f32 #0
+    %1 = integrate.f32 %0 #0  ; x
+    %2 = prev.f32 %1 #1
+    %3 = snapshot.f32 %1 #2
+    %4 = derive.f32 %1 #3
+    %5 = fby.f32 %0, %2 #4
+    %6 = add.f32 %3, %4
+    %7 = add.f32 %5, %6
+    yield size = %7
+  end
+end
+)", lowerTemporalEuler) == R"(object p(v: f32)
+  state integrate#0: f32 zero
+  state prev#1: f32 next
+  state snapshot#2: f32 next
+  state derive#3: f32 next
+  kernel behaviour
+    %0 = param.f32 #0
+    %1 = first.bool
+    %2 = const.f32 0
+    %3 = state.f32 #0
+    %4 = dt.f32
+    %5 = mul.f32 %0, %4
+    %6 = add.f32 %3, %5
+    %7 = select.f32 %1, %2, %6  ; x
+    %8 = state.f32 #1
+    %9 = select.f32 %1, %2, %8
+    %10 = state.f32 #2
+    %11 = select.f32 %1, %7, %10
+    %12 = state.f32 #3
+    %13 = gt.bool %4, %2
+    %14 = sub.f32 %7, %12
+    %15 = div.f32 %14, %4
+    %16 = not.bool %1
+    %17 = and.bool %13, %16
+    %18 = select.f32 %17, %15, %2
+    %19 = select.f32 %1, %0, %9
+    %20 = add.f32 %11, %18
+    %21 = add.f32 %19, %20
+    yield size = %21
+    yield state #0 = %7
+    yield state #2 = %11
+    yield state #3 = %7
+    yield state #1 = %7
+  end
+end
+)");
+}
+
+TEST_CASE("key-random: draws are keyed by object id and draw index") {
+    std::string out = after(R"(object p()
+  emit p burst
+  kernel behaviour
+    %0 = rand.f32 #0
+    %1 = nrand.vec3 #1 ^1
+    yield size = %0
+    yield emit.count #0 = %0
+  end
+end
+)", opt::keyRandom);
+    INFO(out);
+    CHECK(out.find("%0 = object.id.u32\n    %1 = draw.index.u32 #0\n    %2 = rand.f32 %0, %1 #0") != std::string::npos);
+    CHECK(out.find("draw.index.u32 #1") == std::string::npos);  // %1 was not used: dropped
+}
+
+TEST_CASE("split-kernels: init, update and render; render reads the new state") {
+    // pos = integrate(v) with v a parameter; point(pos, white, prev-based size)
+    Module m = parse(R"(object p(v: vec3)
+  state integrate#0: vec3 zero
+  state prev#1: f32 next
+  kernel behaviour
+    %0 = param.vec3 #0
+    %1 = first.bool
+    %2 = const.vec3 0 0 0
+    %3 = state.vec3 #0
+    %4 = dt.f32
+    %5 = splat.vec3 %4
+    %6 = mul.vec3 %0, %5
+    %7 = add.vec3 %3, %6
+    %8 = select.vec3 %1, %2, %7  ; pos
+    %9 = const.f32 0
+    %10 = state.f32 #1
+    %11 = select.f32 %1, %9, %10
+    %12 = age.f32
+    %13 = const.vec4 1 1 1 1
+    %14 = const.bool 1
+    yield state #0 = %8
+    yield state #1 = %12
+    yield position = %8
+    yield color = %13
+    yield size = %11
+    yield visible = %14
+    yield kill = %1
+  end
+end
+)");
+    opt::PassErrors errors;
+    opt::splitKernels(m, errors);
+    CHECK(errors.empty());
+    CHECK(verify(m).empty());
+    std::string out = print(m);
+    INFO(out);
+    // prev's value is needed after the update, so update carries it in a slot of its own.
+    CHECK(out.find("state carried%11: f32 next") != std::string::npos);
+    // At creation the prev slot starts from age, and prev (hence the carried value) is 0.
+    CHECK(out.find(R"(  kernel init
+    %0 = const.f32 0
+    %1 = age.f32
+    yield state #1 = %1
+    yield state #2 = %0
+  end
+)") != std::string::npos);
+    // The carried slot takes the prev slot's old value before the slot moves on.
+    CHECK(out.find("    %7 = state.f32 #1\n    %8 = age.f32\n    yield state #0 = %6\n    yield state #1 = %8\n"
+                   "    yield kill = %1\n    yield state #2 = %7\n") != std::string::npos);
+    CHECK(out.find(R"(  kernel render
+    %0 = state.vec3 #0
+    %1 = const.vec4 1 1 1 1
+    %2 = state.f32 #2
+    %3 = const.bool 1
+    yield position = %0
+    yield color = %1
+    yield size = %2
+    yield visible = %3
+  end
+)") != std::string::npos);
+}
