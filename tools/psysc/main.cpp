@@ -17,6 +17,7 @@
 #include "ir/lower.h"
 #include "ir/printer.h"
 #include "opt/passes.h"
+#include "run_command.h"
 
 namespace {
 
@@ -78,6 +79,20 @@ int main(int argc, char** argv) {
     bool time = false;
     check->add_flag("--time", time, "Print how long parsing and checking took");
 
+    auto* run = app.add_subcommand("run", "Compile FILE and run the system with the interpreter");
+    psys::tools::RunOptions runOptions;
+    run->add_option("file", runOptions.file, "The system to run")->required()->type_name("FILE");
+    run->add_option("--frames", runOptions.frames, "Frames to run (600)")->check(CLI::NonNegativeNumber);
+    run->add_option("--dt", runOptions.dt, "Seconds per frame (1/60)");
+    run->add_option("--seed", runOptions.seed, "Random seed (1)");
+    run->add_option("--capacity", runOptions.capacity, "Most live objects per type, unless @capacity says (1048576)");
+    run->add_option("--set", runOptions.sets, "Set an extern: NAME=VALUE or NAME=X,Y,Z (repeatable)");
+    run->add_option("--fire", runOptions.fires, "Fire a trigger before a frame: TRIGGER[:X,Y,Z]@FRAME (repeatable)");
+    run->add_option("--dump", runOptions.dump, "Write every drawn point per frame to FILE.csv or FILE.json");
+    run->add_option("--dump-every", runOptions.dumpEvery, "Dump every Nth frame (1)")->check(CLI::PositiveNumber);
+    run->add_flag("--quiet", runOptions.quiet, "No line per frame, only the summary");
+    run->fallthrough();
+
     app.require_subcommand(0, 1);
     check->fallthrough();
     try {
@@ -88,6 +103,10 @@ int main(int argc, char** argv) {
     }
     bool colour = useColour(colourMode);
 
+    if (run->parsed()) {
+        runOptions.colour = colour;
+        return psys::tools::runSystem(runOptions);
+    }
     if (check->parsed()) {
         bool failed = false;
         for (const std::string& file : checkFiles) {

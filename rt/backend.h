@@ -1,0 +1,54 @@
+// What the run-time asks of a backend: evaluate one kernel for one object.
+//
+// The run-time (pools, time, spawning, killing, parents, externs, triggers) is the same
+// for every backend; a backend only computes kernels. The inputs are gathered from the
+// object's row of its pool and from the system; the yields come back in the kernel's
+// order and the run-time scatters them.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "ir/ir.h"
+
+namespace psys::rt {
+
+// One IR value: up to four floats, or a bool (f[0] != 0), or a u32.
+struct Value {
+    std::array<float, 4> f{};
+    uint32_t u = 0;
+    bool truth() const { return f[0] != 0; }
+    static Value scalar(float x) { return {{x, 0, 0, 0}, 0}; }
+    static Value boolean(bool b) { return {{b ? 1.0f : 0.0f, 0, 0, 0}, 0}; }
+};
+
+struct KernelInputs {
+    const Value* params = nullptr;        // the object's (or a trigger's) parameters
+    const Value* state = nullptr;         // its slots before this kernel
+    const Value* externs = nullptr;
+    float age = 0;
+    float dt = 0;
+    float time = 0;
+    bool first = false;                   // true while the object is being created
+    uint32_t seed = 0;
+    uint32_t objectId = 0;
+    uint32_t draw = 0;                    // draw.index #0: the step, or kCreationDraw
+    uint32_t childDraw = 0;               // draw.index #1: the id of the object being spawned
+    // Live reads of an ancestor `depth` levels up (1: the parent).
+    std::function<Value(int depth, int exportIndex)> parentExport;
+    std::function<bool(int depth)> parentAlive;
+    std::function<float(int depth)> parentAge;
+};
+
+class Backend {
+public:
+    virtual ~Backend() = default;
+    virtual std::string name() const = 0;
+    // Evaluates `kernel` once; `yields[i]` receives the value of `kernel.yields[i]`.
+    virtual void run(const ir::Kernel& kernel, const KernelInputs& in, std::vector<Value>& yields) = 0;
+};
+
+}  // namespace psys::rt

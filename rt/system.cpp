@@ -1,0 +1,409 @@
+#include "rt/system.h"
+
+#include <cmath>
+#include <cstdlib>
+
+#include <fmt/format.h>
+
+#include "rt/rng.h"
+
+namespace psys::rt {
+
+using ir::KernelKind;
+using ir::YieldKind;
+
+namespace {
+
+// An emission count or rate from a kernel: NaN, infinite and negative values count as
+// invalid and emit nothing.
+double validCount(float x, uint64_t& invalid) {
+    if (!std::isfinite(x) || x < 0) {
+        ++invalid;
+        return 0;
+    }
+    return x;
+}
+
+bool finite(const Value& v, int width) {
+    for (int i = 0; i < width; ++i)
+        if (!std::isfinite(v.f[static_cast<size_t>(i)])) return false;
+    return true;
+}
+
+}  // namespace
+
+System::System(ir::Module module, Backend& backend, SystemOptions options)
+    : module_(std::move(module)), backend_(backend), options_(options) {
+    for (const ir::Object& o : module_.objects) {
+        size_t capacity = options_.capacity;
+        if (auto it = o.attributes.find("capacity"); it != o.attributes.end())
+            capacity = static_cast<size_t>(std::strtod(it->second.c_str(), nullptr));
+        pools_.emplace_back(o, capacity);
+        parentType_.push_back(o.parent.empty() ? -1 : module_.objectIndex(o.parent));
+        typeStats_.push_back({o.name, 0, 0, 0, 0, 0});
+    }
+    for (const ir::Extern& e : module_.externs) externs_.push_back({e.defaultValue, 0});
+    render_.resize(pools_.size());
+    renderStale_.assign(pools_.size(), true);
+    queued_.assign(pools_.size(), 0);
+    emitFromKernel(module_.start, {}, kStartObject);
+    drain(now_);
+}
+
+int System::typeIndex(std::string_view name) const { return module_.objectIndex(std::string(name)); }
+
+KernelInputs System::inputs(size_t type, uint32_t row, double at, float dt, bool first, std::vector<Value>& params,
+                            std::vector<Value>& state) {
+    Pool& pool = pools_[type];
+    params.resize(pool.params.count());
+    for (size_t i = 0; i < params.size(); ++i) params[i] = pool.params.get(i, row);
+    state.resize(pool.state.count());
+    for (size_t i = 0; i < state.size(); ++i) state[i] = pool.state.get(i, row);
+    KernelInputs in;
+    in.params = params.data();
+    in.state = state.data();
+    in.externs = externs_.data();
+    in.age = static_cast<float>(at - pool.created[row]);
+    in.dt = dt;
+    in.time = static_cast<float>(at);
+    in.first = first;
+    in.seed = options_.seed;
+    in.objectId = pool.id[row];
+    in.draw = first ? kCreationDraw : static_cast<uint32_t>(step_);
+    // The ancestor `depth` levels up, or (type, row) = (-1, 0) when there is none.
+    auto ancestor = [this, type, row](int depth) -> std::pair<int, uint32_t> {
+        int t = static_cast<int>(type);
+        uint32_t r = row;
+        for (int d = 0; d < depth; ++d) {
+            Handle h = pools_[static_cast<size_t>(t)].parent[r];
+            t = parentType_[static_cast<size_t>(t)];
+            if (t < 0 || !h.valid() || !pools_[static_cast<size_t>(t)].matches(h)) return {-1, 0};
+            r = h.row;
+        }
+        return {t, r};
+    };
+    in.parentExport = [this, ancestor](int depth, int e) {
+        auto [t, r] = ancestor(depth);
+        return t < 0 ? Value{} : pools_[static_cast<size_t>(t)].exports.get(static_cast<size_t>(e), r);
+    };
+    in.parentAlive = [this, ancestor](int depth) {
+        auto [t, r] = ancestor(depth);
+        return t >= 0 && pools_[static_cast<size_t>(t)].status(r) == Status::Alive;
+    };
+    in.parentAge = [this, ancestor, at](int depth) {
+        auto [t, r] = ancestor(depth);
+        return t < 0 ? 0.0f : static_cast<float>(at - pools_[static_cast<size_t>(t)].created[r]);
+    };
+    return in;
+}
+
+void System::runKernel(size_t, uint32_t, const ir::Kernel& kernel, const KernelInputs& in) {
+    backend_.run(kernel, in, yields_);
+}
+
+// One update of an existing object over (t1 − dt, t1]: its next state, whether it dies,
+// its exports and what it emits.
+void System::update(size_t type, uint32_t row, double dt, double t1) {
+    Pool& pool = pools_[type];
+    const ir::Object& o = pool.object();
+    std::vector<Value> params, state;
+    const ir::Kernel* k = o.kernel(KernelKind::Update);
+    KernelInputs in = inputs(type, row, t1, static_cast<float>(dt), false, params, state);
+    runKernel(type, row, *k, in);
+    bool killed = false;
+    std::vector<float> rate(o.emits.size(), 0), count(o.emits.size(), 1);
+    for (size_t i = 0; i < k->yields.size(); ++i) {
+        const ir::Yield& y = k->yields[i];
+        switch (y.kind) {
+            case YieldKind::StateNext: pool.state.set(static_cast<size_t>(y.index), row, yields_[i]); break;
+            case YieldKind::Kill: killed = yields_[i].truth(); break;
+            case YieldKind::EmitRate: rate[static_cast<size_t>(y.index)] = yields_[i].f[0]; break;
+            case YieldKind::EmitCount: count[static_cast<size_t>(y.index)] = yields_[i].f[0]; break;
+            default: break;
+        }
+    }
+    if (killed) {
+        kill(type, row);
+        return;
+    }
+    if (const ir::Kernel* ek = o.kernel(KernelKind::Exports)) {
+        KernelInputs post = inputs(type, row, t1, static_cast<float>(dt), false, params, state);
+        runKernel(type, row, *ek, post);
+        for (size_t i = 0; i < ek->yields.size(); ++i)
+            pool.exports.set(static_cast<size_t>(ek->yields[i].index), row, yields_[i]);
+    }
+    // Rate emitters: events fall where the accumulated rate crosses a whole number, so
+    // a stream is smooth within a step and a rate of 0.25/s emits at 4 s, 8 s, …
+    for (size_t s = 0; s < o.emits.size(); ++s) {
+        if (!o.emits[s].rate) continue;
+        double r = validCount(rate[s], stats_.invalidEmissions);
+        double perEvent = std::floor(validCount(count[s], stats_.invalidEmissions));
+        double before = pool.emitted[s][row];
+        double total = before + r * dt;
+        // A whole number reached by adding up rounded rates (0.25 · 1/60, 240 times) counts as reached.
+        double events = std::floor(total + 1e-9);
+        pool.emitted[s][row] = std::max(0.0, total - events);
+        if (events < 1 || perEvent < 1) continue;
+        double firstTime = (t1 - dt) + (1.0 - before) / r;
+        double children = events * perEvent;
+        queueChildren(type, row, static_cast<int>(s), static_cast<uint64_t>(std::min(children, 1e18)),
+                      static_cast<uint64_t>(perEvent), firstTime, 1.0 / r, t1, false);
+    }
+}
+
+// Queues `count` children of emit site `site`, `perEvent` at a time; the k-th event is at
+// firstTime + k·spacing (spacing 0: all at once). Beyond the target's free capacity the
+// rest are dropped and counted, without work per dropped child.
+void System::queueChildren(size_t type, uint32_t row, int site, uint64_t count, uint64_t perEvent, double firstTime,
+                           double spacing, double evalTime, bool first) {
+    Pool& pool = pools_[type];
+    const ir::EmitSite& emit = pool.object().emits[static_cast<size_t>(site)];
+    size_t target = static_cast<size_t>(module_.objectIndex(emit.target));
+    size_t room = pools_[target].free() > queued_[target] ? pools_[target].free() - queued_[target] : 0;
+    uint64_t kept = std::min<uint64_t>(count, room);
+    typeStats_[target].dropped += count - kept;
+    if (kept == 0) return;
+    const ir::Kernel* spawn = pool.object().kernel(KernelKind::Spawn, site);
+    Handle parent = parentType_[target] == static_cast<int>(type) ? pool.handle(row) : Handle{};
+    std::vector<Value> params, state;
+    for (uint64_t k = 0; k < kept; ++k) {
+        Creation c;
+        c.type = target;
+        c.parent = parent;
+        c.time = firstTime + static_cast<double>(k / perEvent) * spacing;
+        c.id = nextId_++;
+        if (spawn) {
+            KernelInputs in = inputs(type, row, evalTime, static_cast<float>(lastDt_), first, params, state);
+            in.childDraw = c.id;
+            runKernel(type, row, *spawn, in);
+            c.args.resize(pools_[target].params.count());
+            for (size_t i = 0; i < spawn->yields.size(); ++i)
+                if (spawn->yields[i].kind == YieldKind::EmitArg)
+                    c.args.at(static_cast<size_t>(spawn->yields[i].sub)) = yields_[i];
+        }
+        ++queued_[target];
+        queue_.push_back(std::move(c));
+    }
+}
+
+// Creates one object at c.time and advances it to t1: init, its bursts, its exports, and
+// a first update of the rest of the step.
+void System::create(const Creation& c, double t1) {
+    Pool& pool = pools_[c.type];
+    auto allocated = pool.allocate();
+    if (!allocated) {
+        ++typeStats_[c.type].dropped;
+        return;
+    }
+    uint32_t row = *allocated;
+    const ir::Object& o = pool.object();
+    ++typeStats_[c.type].created;
+    pool.created[row] = c.time;
+    pool.id[row] = c.id;
+    pool.parent[row] = c.parent;
+    pool.createdStep[row] = step_;
+    if (c.parent.valid()) ++pools_[static_cast<size_t>(parentType_[c.type])].readers[c.parent.row];
+    for (size_t i = 0; i < pool.params.count() && i < c.args.size(); ++i) pool.params.set(i, row, c.args[i]);
+    for (size_t i = 0; i < pool.state.count(); ++i) pool.state.set(i, row, Value{});
+
+    std::vector<Value> params, state;
+    std::vector<double> bursts(o.emits.size(), 0);
+    if (const ir::Kernel* init = o.kernel(KernelKind::Init)) {
+        KernelInputs in = inputs(c.type, row, c.time, 0, true, params, state);
+        runKernel(c.type, row, *init, in);
+        for (size_t i = 0; i < init->yields.size(); ++i) {
+            const ir::Yield& y = init->yields[i];
+            if (y.kind == YieldKind::StateNext) pool.state.set(static_cast<size_t>(y.index), row, yields_[i]);
+            if (y.kind == YieldKind::EmitCount)
+                bursts[static_cast<size_t>(y.index)] = std::floor(validCount(yields_[i].f[0], stats_.invalidEmissions));
+        }
+    }
+    if (const ir::Kernel* ek = o.kernel(KernelKind::Exports)) {
+        KernelInputs in = inputs(c.type, row, c.time, 0, true, params, state);
+        runKernel(c.type, row, *ek, in);
+        for (size_t i = 0; i < ek->yields.size(); ++i)
+            pool.exports.set(static_cast<size_t>(ek->yields[i].index), row, yields_[i]);
+    }
+    for (size_t s = 0; s < o.emits.size(); ++s)
+        if (!o.emits[s].rate && bursts[s] >= 1)
+            queueChildren(c.type, row, static_cast<int>(s), static_cast<uint64_t>(std::min(bursts[s], 1e18)), 1, c.time,
+                          0, c.time, true);
+    update(c.type, row, t1 - c.time, t1);
+}
+
+void System::drain(double t1) {
+    for (size_t i = 0; i < queue_.size(); ++i) {
+        Creation c = queue_[i];  // a copy: creating may queue more
+        --queued_[c.type];
+        create(c, t1);
+    }
+    queue_.clear();
+}
+
+void System::kill(size_t type, uint32_t row) {
+    ++typeStats_[type].killed;
+    pools_[type].freeze(row);  // no longer alive; freed at the end of the step if nobody reads it
+    dying_.push_back({type, row});
+}
+
+// A reader of `parent` is gone; a frozen parent without readers is freed, and so on up.
+void System::releaseReader(size_t childType, Handle parent) {
+    int t = parentType_[childType];
+    while (t >= 0 && parent.valid()) {
+        Pool& pool = pools_[static_cast<size_t>(t)];
+        if (!pool.matches(parent)) return;
+        if (--pool.readers[parent.row] > 0 || pool.status(parent.row) != Status::Frozen) return;
+        Handle up = pool.parent[parent.row];
+        pool.release(parent.row);
+        parent = up;
+        childType = static_cast<size_t>(t);
+        t = parentType_[childType];
+    }
+}
+
+std::optional<std::string> System::step(double dt) {
+    if (!std::isfinite(dt) || dt < 0) {
+        ++stats_.rejectedSteps;
+        return fmt::format("a step must be a finite, non-negative number of seconds, not {}", dt);
+    }
+    ++step_;
+    lastDt_ = dt;
+    double t1 = now_ + dt;
+    for (size_t type = 0; type < pools_.size(); ++type) {
+        Pool& pool = pools_[type];
+        size_t rows = pool.rows();
+        for (uint32_t row = 0; row < rows; ++row)
+            if (pool.status(row) == Status::Alive && pool.createdStep[row] != step_) update(type, row, dt, t1);
+        drain(t1);
+    }
+    now_ = t1;
+    for (auto [type, row] : dying_) {
+        Pool& pool = pools_[type];
+        if (pool.status(row) != Status::Frozen || pool.readers[row] > 0) continue;
+        Handle parent = pool.parent[row];
+        pool.release(row);
+        releaseReader(type, parent);
+    }
+    dying_.clear();
+    renderStale_.assign(pools_.size(), true);
+    ++stats_.steps;
+    return std::nullopt;
+}
+
+std::optional<std::string> System::setExtern(std::string_view name, std::span<const float> value) {
+    int index = module_.externIndex(std::string(name));
+    if (index < 0) return fmt::format("there is no extern `{}`", name);
+    const ir::Extern& e = module_.externs[static_cast<size_t>(index)];
+    if (value.size() != static_cast<size_t>(e.type.width))
+        return fmt::format("extern `{}` is {}: it takes {} value{}, not {}", name, e.type.str(), e.type.width,
+                           e.type.width == 1 ? "" : "s", value.size());
+    Value v;
+    for (size_t i = 0; i < value.size(); ++i) v.f[i] = value[i];
+    if (!finite(v, e.type.width)) ++stats_.nonFiniteExterns;
+    externs_[static_cast<size_t>(index)] = v;
+    return std::nullopt;
+}
+
+// Runs a trigger's (or the start's) kernel: once for the counts, then once per created
+// object for its arguments, so each draws its own random numbers.
+void System::emitFromKernel(const ir::Trigger& trigger, std::span<const Value> params, uint32_t objectId) {
+    const ir::Kernel& k = trigger.kernel;
+    KernelInputs in;
+    in.params = params.data();
+    in.externs = externs_.data();
+    in.time = static_cast<float>(now_);
+    in.seed = options_.seed;
+    in.objectId = objectId;
+    in.draw = static_cast<uint32_t>(step_);
+    backend_.run(k, in, yields_);
+    std::vector<double> counts(trigger.emits.size(), 0);
+    for (size_t i = 0; i < k.yields.size(); ++i)
+        if (k.yields[i].kind == YieldKind::EmitCount)
+            counts[static_cast<size_t>(k.yields[i].index)] = std::floor(validCount(yields_[i].f[0], stats_.invalidEmissions));
+    for (size_t s = 0; s < trigger.emits.size(); ++s) {
+        size_t target = static_cast<size_t>(module_.objectIndex(trigger.emits[s].target));
+        size_t room = pools_[target].free() > queued_[target] ? pools_[target].free() - queued_[target] : 0;
+        auto kept = static_cast<uint64_t>(std::min(counts[s], static_cast<double>(room)));
+        typeStats_[target].dropped += static_cast<uint64_t>(counts[s]) - kept;
+        for (uint64_t n = 0; n < kept; ++n) {
+            Creation c{target, std::vector<Value>(pools_[target].params.count()), {}, now_, nextId_++};
+            in.childDraw = c.id;
+            backend_.run(k, in, yields_);
+            for (size_t i = 0; i < k.yields.size(); ++i)
+                if (k.yields[i].kind == YieldKind::EmitArg && k.yields[i].index == static_cast<int>(s))
+                    c.args.at(static_cast<size_t>(k.yields[i].sub)) = yields_[i];
+            ++queued_[target];
+            queue_.push_back(std::move(c));
+        }
+    }
+}
+
+std::optional<std::string> System::fire(std::string_view name, std::span<const float> args) {
+    const ir::Trigger* trigger = nullptr;
+    for (const ir::Trigger& t : module_.triggers)
+        if (t.name == name) trigger = &t;
+    if (!trigger) return fmt::format("there is no trigger `{}`", name);
+    size_t width = 0;
+    for (auto& p : trigger->params) width += static_cast<size_t>(p.type.width);
+    if (args.size() != width)
+        return fmt::format("trigger `{}` takes {} number{}, not {}", name, width, width == 1 ? "" : "s", args.size());
+    std::vector<Value> params;
+    size_t at = 0;
+    for (auto& p : trigger->params) {
+        Value v;
+        for (int c = 0; c < p.type.width; ++c) v.f[static_cast<size_t>(c)] = args[at++];
+        params.push_back(v);
+    }
+    emitFromKernel(*trigger, params, kTriggerObject);
+    drain(now_);
+    renderStale_.assign(pools_.size(), true);
+    return std::nullopt;
+}
+
+const std::vector<RenderPoint>& System::render(size_t type) {
+    if (!renderStale_[type]) return render_[type];
+    renderStale_[type] = false;
+    auto& out = render_[type];
+    out.clear();
+    Pool& pool = pools_[type];
+    const ir::Kernel* k = pool.object().kernel(KernelKind::Render);
+    if (!k || k->yields.empty()) return out;
+    std::vector<Value> params, state;
+    for (uint32_t row = 0; row < pool.rows(); ++row) {
+        if (pool.status(row) != Status::Alive) continue;
+        KernelInputs in = inputs(type, row, now_, static_cast<float>(lastDt_), false, params, state);
+        runKernel(type, row, *k, in);
+        RenderPoint p{pool.id[row], {}, {}, 0};
+        bool visible = false;
+        bool ok = true;
+        for (size_t i = 0; i < k->yields.size(); ++i) {
+            const Value& v = yields_[i];
+            switch (k->yields[i].kind) {
+                case YieldKind::Visible: visible = v.truth(); break;
+                case YieldKind::Position: p.position = {v.f[0], v.f[1], v.f[2]}; ok &= finite(v, 3); break;
+                case YieldKind::Color: p.color = v.f; ok &= finite(v, 4); break;
+                case YieldKind::Size: p.size = v.f[0]; ok &= finite(v, 1); break;
+                default: break;
+            }
+        }
+        if (!visible) continue;
+        if (!ok) {
+            ++stats_.nonFiniteRender;
+            continue;
+        }
+        out.push_back(p);
+    }
+    return out;
+}
+
+Stats System::stats() const {
+    Stats s = stats_;
+    s.types = typeStats_;
+    for (size_t t = 0; t < pools_.size(); ++t) {
+        s.types[t].live = pools_[t].live();
+        s.types[t].frozen = pools_[t].frozen();
+    }
+    return s;
+}
+
+}  // namespace psys::rt

@@ -1,0 +1,122 @@
+// The run-time every backend shares: a compiled system, stepped through time.
+//
+// The host API in the LambdaCube spirit: build a System from a compiled module and a
+// backend, set externs, fire triggers, step(dt), read the render values and the stats.
+// What it guarantees (docs/runtime.md):
+//   - parents are updated before children, so a child reads its parent's values of the
+//     same step; a killed parent that children still read stays readable, frozen, with
+//     `alive` false, and is freed after its last reader;
+//   - objects created during a step get their exact creation time (rates below one per
+//     second emit on time) and are advanced by the rest of the step at once;
+//   - global time is a double and ages are float(now − created), exact for long runs;
+//   - a pool never grows past its capacity: spawns beyond it are dropped and counted;
+//   - bad input from the host (a NaN or negative dt, an unknown extern, NaN in an
+//     extern, a NaN or negative emission rate) is an error value or a counted event,
+//     never undefined behaviour.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "ir/ir.h"
+#include "rt/backend.h"
+#include "rt/pool.h"
+
+namespace psys::rt {
+
+struct SystemOptions {
+    uint32_t seed = 1;
+    size_t capacity = 1 << 20;  // per object type, unless its @capacity says otherwise
+};
+
+struct TypeStats {
+    std::string name;
+    size_t live = 0;
+    size_t frozen = 0;
+    uint64_t created = 0;
+    uint64_t killed = 0;
+    uint64_t dropped = 0;  // spawns refused at capacity
+};
+
+struct Stats {
+    std::vector<TypeStats> types;
+    uint64_t steps = 0;
+    uint64_t rejectedSteps = 0;        // NaN, infinite or negative dt
+    uint64_t nonFiniteExterns = 0;     // NaN or infinite values set on an extern
+    uint64_t invalidEmissions = 0;     // NaN or negative rates and counts (taken as 0)
+    uint64_t nonFiniteRender = 0;      // points not drawn because a value was NaN or infinite
+};
+
+struct RenderPoint {
+    uint32_t id;
+    std::array<float, 3> position;
+    std::array<float, 4> color;
+    float size;
+};
+
+class System {
+public:
+    System(ir::Module module, Backend& backend, SystemOptions options = {});
+
+    // Host API. Errors come back as a message; nothing is changed then.
+    std::optional<std::string> setExtern(std::string_view name, std::span<const float> value);
+    std::optional<std::string> fire(std::string_view trigger, std::span<const float> args);
+    std::optional<std::string> step(double dt);
+
+    double time() const { return now_; }
+    uint64_t stepCount() const { return step_; }
+    const ir::Module& module() const { return module_; }
+    const Pool& pool(size_t type) const { return pools_[type]; }
+    size_t typeCount() const { return pools_.size(); }
+    int typeIndex(std::string_view name) const;
+
+    // What is drawn for each type after the latest step (or trigger): visible objects only.
+    const std::vector<RenderPoint>& render(size_t type);
+    Stats stats() const;
+
+private:
+    struct Creation {
+        size_t type;
+        std::vector<Value> args;
+        Handle parent;
+        double time;
+        uint32_t id;
+    };
+
+    KernelInputs inputs(size_t type, uint32_t row, double at, float dt, bool first, std::vector<Value>& params,
+                        std::vector<Value>& state);
+    void runKernel(size_t type, uint32_t row, const ir::Kernel& kernel, const KernelInputs& in);
+    void update(size_t type, uint32_t row, double dt, double t1);
+    void create(const Creation& c, double t1);
+    void queueChildren(size_t type, uint32_t row, int site, uint64_t count, uint64_t perEvent, double firstTime,
+                       double spacing, double evalTime, bool first);
+    void drain(double t1);
+    void kill(size_t type, uint32_t row);
+    void releaseReader(size_t type, Handle parent);
+    void emitFromKernel(const ir::Trigger& trigger, std::span<const Value> params, uint32_t objectId);
+
+    ir::Module module_;
+    Backend& backend_;
+    SystemOptions options_;
+    std::vector<Pool> pools_;
+    std::vector<int> parentType_;  // per type: the type of its parent, or -1
+    std::vector<Value> externs_;
+    std::vector<std::vector<RenderPoint>> render_;
+    std::vector<bool> renderStale_;
+    std::vector<Creation> queue_;
+    std::vector<size_t> queued_;  // per type: creations waiting in the queue
+    std::vector<std::pair<size_t, uint32_t>> dying_;
+    std::vector<TypeStats> typeStats_;
+    Stats stats_;
+    double now_ = 0;
+    double lastDt_ = 0;
+    uint64_t step_ = 0;
+    uint32_t nextId_ = 0;
+    std::vector<Value> yields_;
+};
+
+}  // namespace psys::rt

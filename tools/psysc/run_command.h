@@ -1,0 +1,26 @@
+// `psysc run`: compile a system and step it through time with the interpreter.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace psys::tools {
+
+struct RunOptions {
+    std::string file;
+    int frames = 600;
+    std::string dt = "1/60";
+    uint32_t seed = 1;
+    size_t capacity = 1 << 20;
+    std::vector<std::string> sets;   // NAME=V[,V…]
+    std::vector<std::string> fires;  // TRIGGER[:V,…]@FRAME
+    std::string dump;                // FILE.csv or FILE.json
+    int dumpEvery = 1;
+    bool quiet = false;
+    bool colour = false;
+};
+
+// Returns the process exit status: 0, 1 (errors in the program), 2 (bad options).
+int runSystem(const RunOptions& options);
+
+}  // namespace psys::tools
