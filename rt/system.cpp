@@ -46,6 +46,12 @@ System::System(ir::Module module, Backend& backend, SystemOptions options)
     render_.resize(pools_.size());
     renderStale_.assign(pools_.size(), true);
     queued_.assign(pools_.size(), 0);
+}
+
+// The `spawn`s run when the system is first used, so externs set before that apply.
+void System::start() {
+    if (started_) return;
+    started_ = true;
     emitFromKernel(module_.start, {}, kStartObject);
     drain(now_);
 }
@@ -266,6 +272,7 @@ std::optional<std::string> System::step(double dt) {
         ++stats_.rejectedSteps;
         return fmt::format("a step must be a finite, non-negative number of seconds, not {}", dt);
     }
+    start();
     ++step_;
     lastDt_ = dt;
     double t1 = now_ + dt;
@@ -354,6 +361,7 @@ std::optional<std::string> System::fire(std::string_view name, std::span<const f
         for (int c = 0; c < p.type.width; ++c) v.f[static_cast<size_t>(c)] = args[at++];
         params.push_back(v);
     }
+    start();
     emitFromKernel(*trigger, params, kTriggerObject);
     drain(now_);
     renderStale_.assign(pools_.size(), true);
@@ -361,6 +369,7 @@ std::optional<std::string> System::fire(std::string_view name, std::span<const f
 }
 
 const std::vector<RenderPoint>& System::render(size_t type) {
+    start();
     if (!renderStale_[type]) return render_[type];
     renderStale_[type] = false;
     auto& out = render_[type];

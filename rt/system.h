@@ -98,6 +98,7 @@ private:
     void kill(size_t type, uint32_t row);
     void releaseReader(size_t type, Handle parent);
     void emitFromKernel(const ir::Trigger& trigger, std::span<const Value> params, uint32_t objectId);
+    void start();
 
     ir::Module module_;
     Backend& backend_;
@@ -116,6 +117,7 @@ private:
     double lastDt_ = 0;
     uint64_t step_ = 0;
     uint32_t nextId_ = 0;
+    bool started_ = false;
     std::vector<Value> yields_;
 };
 

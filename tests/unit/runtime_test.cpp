@@ -1,0 +1,290 @@
+// The run-time and the interpreter, checked against exact answers: the Euler recurrence,
+// emission counts and times, kill frames, live parent reads, determinism, and the
+// extremes of docs/quality.md.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "driver/compile.h"
+#include "interp/interpreter.h"
+#include "rt/system.h"
+
+using namespace psys;
+
+namespace {
+
+struct Run {
+    interp::Interpreter backend;
+    std::unique_ptr<rt::System> system;
+
+    explicit Run(const std::string& source, rt::SystemOptions options = {}) {
+        SourceManager sources;
+        DiagnosticEngine diags(sources);
+        auto module = compileText("test.psys", source, sources, diags);
+        INFO(diags.render());
+        REQUIRE(module.has_value());
+        system = std::make_unique<rt::System>(std::move(*module), backend, options);
+    }
+
+    void steps(int n, double dt) {
+        for (int i = 0; i < n; ++i) REQUIRE_FALSE(system->step(dt).has_value());
+    }
+    size_t type(const std::string& name) const { return static_cast<size_t>(system->typeIndex(name)); }
+    const std::vector<rt::RenderPoint>& points(const std::string& name) { return system->render(type(name)); }
+    rt::TypeStats stats(const std::string& name) const { return system->stats().types[type(name)]; }
+};
+
+std::string readFile(const std::filesystem::path& p) {
+    std::ifstream in(p);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+}  // namespace
+
+TEST_CASE("a projectile under Euler is the Euler recurrence, bit for bit") {
+    Run run(R"(
+        object p {
+            pos = integrate(vel);
+            vel = vec3(1, 10, 0) + integrate(vec3(0, -9.8, 0));
+            point(pos, white, 1);
+        }
+        spawn p;)");
+    const float dt = 1.0f / 60.0f;
+    float av = 0, apx = 0, apy = 0;  // the integrals of gravity (y) and of velocity
+    for (int frame = 1; frame <= 300; ++frame) {
+        run.steps(1, 1.0 / 60.0);
+        av = av + (-9.8f) * dt;        // vel = v0 + ∫g: this update's value
+        float vy = 10.0f + av, vx = 1.0f + 0.0f;
+        apx = apx + vx * dt;           // pos = ∫vel, with this update's velocity
+        apy = apy + vy * dt;
+        const auto& p = run.points("p");
+        REQUIRE(p.size() == 1);
+        CHECK(p[0].position[0] == apx);
+        CHECK(p[0].position[1] == apy);
+    }
+    // and close to the closed form p0 + v0·t + ½·g·t² (Euler's error is O(dt))
+    float t = 5.0f;
+    CHECK(run.points("p")[0].position[1] == doctest::Approx(10 * t - 4.9f * t * t).epsilon(0.01));
+}
+
+TEST_CASE("a rate-R emitter over T seconds creates R·T ± 1 objects") {
+    for (double rate : {1.0, 7.5, 50.0, 600.0}) {
+        Run run("object s { point(origin, white, 1); }\nobject e { emit s at " + std::to_string(rate) +
+                " per second; }\nspawn e;");
+        run.steps(600, 1.0 / 60);  // 10 s
+        double created = static_cast<double>(run.stats("s").created);
+        CHECK(std::abs(created - rate * 10) <= 1);
+    }
+}
+
+TEST_CASE("objects spawned within one frame have evenly spaced ages") {
+    Run run("object s { point(origin, white, age); }\nobject e { emit s at 600 per second; }\nspawn e;");
+    run.steps(1, 1.0 / 60);
+    std::vector<float> ages;
+    for (auto& p : run.points("s")) ages.push_back(p.size);
+    REQUIRE(ages.size() == 10);
+    std::sort(ages.begin(), ages.end());
+    for (size_t i = 0; i < ages.size(); ++i) CHECK(ages[i] == doctest::Approx(i / 600.0).epsilon(1e-4));
+}
+
+TEST_CASE("a rate of 0.25 per second emits at 4 s, 8 s, 12 s") {
+    Run run("object s { point(origin, white, age); }\nobject e { emit s at 0.25 per second; }\nspawn e;");
+    for (int frame = 1; frame <= 60 * 12; ++frame) {
+        run.steps(1, 1.0 / 60);
+        uint64_t expected = static_cast<uint64_t>(frame / 240);
+        REQUIRE_MESSAGE(run.stats("s").created == expected, "frame " << frame);
+    }
+}
+
+TEST_CASE("kill happens at the first update where the condition holds") {
+    Run run("object a { point(origin, white, age); kill when age > 1; }\nspawn a;");
+    for (int frame = 1; frame <= 4; ++frame) {
+        run.steps(1, 0.25);
+        CHECK(run.stats("a").live == 1);  // ages 0.25 … 1.0
+    }
+    run.steps(1, 0.25);  // age 1.25
+    CHECK(run.stats("a").live == 0);
+    CHECK(run.stats("a").killed == 1);
+}
+
+TEST_CASE("a burst happens at creation, before a bare kill removes the emitter") {
+    Run run("object s { point(origin, white, 1); }\nobject b { emit s count 3; kill; }\nspawn b;");
+    run.steps(1, 1.0 / 60);
+    CHECK(run.stats("s").created == 3);
+    CHECK(run.stats("b").live == 0);
+}
+
+TEST_CASE("a child reads its parent live, then the frozen value with alive false") {
+    Run run(R"(
+        object parent {
+            x = age;
+            emit child count 1;
+            kill when age > 1;
+            object child {
+                point(vec3(parent.x, parent.alive ? 1 : 0, 0), white, 1);
+            }
+        }
+        spawn parent;)");
+    for (int frame = 1; frame <= 4; ++frame) {
+        run.steps(1, 0.25);
+        const auto& c = run.points("parent.child");
+        REQUIRE(c.size() == 1);
+        CHECK(c[0].position[0] == doctest::Approx(0.25 * frame));  // the parent's age this frame
+        CHECK(c[0].position[1] == 1);
+    }
+    run.steps(3, 0.25);  // the parent dies at age 1.25
+    const auto& c = run.points("parent.child");
+    REQUIRE(c.size() == 1);
+    CHECK(c[0].position[0] == doctest::Approx(1.0));  // its last exported value, frozen
+    CHECK(c[0].position[1] == 0);
+    CHECK(run.stats("parent").frozen == 1);
+}
+
+TEST_CASE("a frozen parent is freed after its last reader dies") {
+    Run run(R"(
+        object parent {
+            emit child count 2;
+            kill when age > 0.5;
+            object child { point(vec3(parent.age), white, 1); kill when age > 1; }
+        }
+        spawn parent;)");
+    run.steps(3, 0.25);
+    CHECK(run.stats("parent").frozen == 1);
+    run.steps(2, 0.25);
+    CHECK(run.stats("parent.child").live == 0);
+    CHECK(run.stats("parent").frozen == 0);
+}
+
+TEST_CASE("the same seed gives the same run; another seed another") {
+    std::string fireworks = readFile(std::filesystem::path(PSYS_SAMPLES_DIR) / "fireworks.psys");
+    auto positions = [&](uint32_t seed) {
+        Run run(fireworks, {seed, 1 << 20});
+        run.steps(120, 1.0 / 60);
+        std::vector<float> all;
+        for (auto& p : run.points("spark")) all.insert(all.end(), p.position.begin(), p.position.end());
+        return all;
+    };
+    auto a = positions(7), b = positions(7), c = positions(8);
+    CHECK(!a.empty());
+    CHECK(a == b);
+    CHECK(a != c);
+}
+
+TEST_CASE("every sample compiles, verifies and runs 600 frames at dt = 1/60") {
+    int count = 0;
+    for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
+        if (entry.path().extension() != ".psys") continue;
+        ++count;
+        INFO(entry.path().filename().string());
+        Run run(readFile(entry.path()));
+        run.steps(600, 1.0 / 60);
+        for (size_t t = 0; t < run.system->typeCount(); ++t) run.system->render(t);
+        CHECK(run.system->stats().nonFiniteRender == 0);
+    }
+    CHECK(count >= 12);
+}
+
+// ---------------------------------------------------------------- extremes
+
+TEST_CASE("dt = 0 changes nothing; negative, NaN and infinite dt are refused and counted") {
+    Run run("object a { pos = integrate(vec3(1)); point(pos, white, age); }\nspawn a;");
+    run.steps(1, 0.5);
+    auto before = run.points("a");
+    run.steps(10, 0.0);
+    CHECK(run.points("a")[0].position == before[0].position);
+    CHECK(run.points("a")[0].size == before[0].size);
+    for (double bad : {-1.0, std::nan(""), static_cast<double>(INFINITY)}) {
+        auto error = run.system->step(bad);
+        REQUIRE(error.has_value());
+        CHECK(error->find("finite, non-negative") != std::string::npos);
+    }
+    CHECK(run.system->stats().rejectedSteps == 3);
+    CHECK(run.system->time() == 0.5);
+}
+
+TEST_CASE("tiny steps and a 10 s hitch") {
+    Run run("object s { point(origin, white, age); kill when age > 3; }\n"
+            "object e { emit s at 100 per second; }\nspawn e;");
+    run.steps(1000, 1e-7);
+    CHECK(run.system->time() == doctest::Approx(1e-4));
+    run.steps(1, 10.0);  // a hitch: every object of it gets its exact creation time
+    CHECK(run.stats("s").created == 1000);
+    CHECK(run.stats("s").live == doctest::Approx(300).epsilon(0.01));
+    for (auto& p : run.points("s")) CHECK(p.size <= 3.0f);
+}
+
+TEST_CASE("emission rates at the extremes") {
+    SUBCASE("rate 0 never emits") {
+        Run run("object s { point(origin, white, 1); }\nobject e { emit s at 0 per second; }\nspawn e;");
+        run.steps(600, 1.0 / 60);
+        CHECK(run.stats("s").created == 0);
+    }
+    SUBCASE("rate 1e-3 emits once, at 1000 s") {
+        Run run("object s { point(origin, white, 1); }\nobject e { emit s at 1e-3 per second; }\nspawn e;");
+        run.steps(999, 1.0);
+        CHECK(run.stats("s").created == 0);
+        run.steps(1, 1.0);
+        CHECK(run.stats("s").created == 1);
+    }
+    SUBCASE("rate 1e9 fills the capacity and counts what it drops") {
+        Run run("@capacity(1000) object s { point(origin, white, 1); }\nobject e { emit s at 1e9 per second; }\nspawn e;");
+        run.steps(3, 1.0 / 60);
+        CHECK(run.stats("s").live == 1000);
+        CHECK(run.stats("s").dropped > 40'000'000);
+        CHECK(run.system->pool(run.type("s")).rows() == 1000);  // memory bounded
+    }
+    SUBCASE("negative and NaN rates emit nothing and are counted") {
+        Run run("extern r: float = 0;\nobject s { point(origin, white, 1); }\nobject e { emit s at r per second; }\nspawn e;");
+        float negative = -5, nan = std::nanf("");
+        REQUIRE_FALSE(run.system->setExtern("r", {&negative, 1}));
+        run.steps(10, 1.0 / 60);
+        REQUIRE_FALSE(run.system->setExtern("r", {&nan, 1}));
+        run.steps(10, 1.0 / 60);
+        CHECK(run.stats("s").created == 0);
+        CHECK(run.system->stats().invalidEmissions == 21);  // 20 steps and the emitter's update at creation
+    }
+}
+
+TEST_CASE("after 10^7 s ages are still exact to a millisecond") {
+    Run run("object a { point(origin, white, age); }\ntrigger go { emit a count 1; }");
+    run.steps(1, 1e7);
+    REQUIRE_FALSE(run.system->fire("go", {}));
+    run.steps(1, 0.001);
+    REQUIRE(run.points("a").size() == 1);
+    CHECK(run.points("a")[0].size == doctest::Approx(0.001).epsilon(1e-3));
+}
+
+TEST_CASE("NaN and infinity in an extern never crash, are counted and are not drawn") {
+    Run run("extern w: vec3 = 0;\nobject a(k: float) { point(vec3(k) + w * k, white, 1); }\n"
+            "spawn a(0); spawn a(1);");
+    float bad[3] = {std::nanf(""), 0, INFINITY};
+    REQUIRE_FALSE(run.system->setExtern("w", bad));
+    run.steps(1, 1.0 / 60);
+    // a(0): 0 · NaN is NaN too; both points have non-finite positions and are not drawn
+    CHECK(run.points("a").size() == 0);
+    CHECK(run.system->stats().nonFiniteExterns == 1);
+    CHECK(run.system->stats().nonFiniteRender == 2);
+    float good[3] = {1, 2, 3};
+    REQUIRE_FALSE(run.system->setExtern("w", good));
+    run.steps(1, 1.0 / 60);
+    CHECK(run.points("a").size() == 2);
+}
+
+TEST_CASE("host API misuse is an error value") {
+    Run run("extern w: vec3 = 0;\nobject a(p: vec3) { point(p, white, 1); }\ntrigger go(at_pos: vec3) { emit a(at_pos) count 2; }");
+    float one = 1;
+    CHECK(run.system->setExtern("nope", {&one, 1}).value() == "there is no extern `nope`");
+    CHECK(run.system->setExtern("w", {&one, 1}).value() == "extern `w` is vec3: it takes 3 values, not 1");
+    CHECK(run.system->fire("boom", {}).value() == "there is no trigger `boom`");
+    CHECK(run.system->fire("go", {&one, 1}).value() == "trigger `go` takes 3 numbers, not 1");
+    float at[3] = {1, 2, 3};
+    REQUIRE_FALSE(run.system->fire("go", at));
+    const auto& p = run.points("a");
+    REQUIRE(p.size() == 2);
+    CHECK(p[0].position == std::array<float, 3>{1, 2, 3});
+}
