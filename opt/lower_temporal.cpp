@@ -43,10 +43,15 @@ ValueId broadcast(Kernel& k, ValueId scalar, Type t) {
 
 }  // namespace
 
-void lowerTemporal(Module& module, const PassOptions&, PassErrors&) {
+void lowerTemporal(Module& module, const PassOptions&, PassErrors& errors) {
     for (Object& object : module.objects) {
         Kernel* behaviour = object.kernel(KernelKind::Behaviour);
         if (!behaviour) continue;
+        if (auto it = object.attributes.find("integrator"); it != object.attributes.end() && it->second != "euler") {
+            errors.push_back(fmt::format("object {}: @integrator({}) is not implemented yet; euler is", object.name,
+                                         it->second));
+            continue;
+        }
         std::vector<std::pair<int, ValueId>> nextOld;  // (slot, old value its next is)
         std::vector<std::pair<int, ValueId>> nextNew;  // (slot, new value)
         auto addSlot = [&](const char* kind, const Inst& inst, StateInit init) {

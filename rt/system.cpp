@@ -39,6 +39,8 @@ System::System(ir::Module module, Backend& backend, SystemOptions options)
         if (auto it = o.attributes.find("capacity"); it != o.attributes.end())
             capacity = static_cast<size_t>(std::strtod(it->second.c_str(), nullptr));
         pools_.emplace_back(o, capacity);
+        auto step = o.attributes.find("step");
+        stepLimit_.push_back(step == o.attributes.end() ? 0 : std::strtod(step->second.c_str(), nullptr));
         parentType_.push_back(o.parent.empty() ? -1 : module_.objectIndex(o.parent));
         typeStats_.push_back({o.name, 0, 0, 0, 0, 0});
     }
@@ -107,9 +109,24 @@ void System::runKernel(size_t, uint32_t, const ir::Kernel& kernel, const KernelI
     backend_.run(kernel, in, yields_);
 }
 
+// Advances an object over (t1 − dt, t1]; with `@step(h)` in sub-steps no longer than h.
+void System::update(size_t type, uint32_t row, double dt, double t1) {
+    double h = stepLimit_[type];
+    if (h <= 0 || dt <= h) {
+        updateOnce(type, row, dt, t1);
+        return;
+    }
+    double n = std::ceil(dt / h);
+    double t0 = t1 - dt;
+    for (double i = 1; i <= n; ++i) {
+        updateOnce(type, row, dt / n, i == n ? t1 : t0 + dt * (i / n));
+        if (pools_[type].status(row) != Status::Alive) return;
+    }
+}
+
 // One update of an existing object over (t1 − dt, t1]: its next state, whether it dies,
 // its exports and what it emits.
-void System::update(size_t type, uint32_t row, double dt, double t1) {
+void System::updateOnce(size_t type, uint32_t row, double dt, double t1) {
     Pool& pool = pools_[type];
     const ir::Object& o = pool.object();
     std::vector<Value> params, state;
@@ -300,7 +317,14 @@ std::optional<std::string> System::step(double dt) {
 std::optional<std::string> System::setExtern(std::string_view name, std::span<const float> value) {
     int index = module_.externIndex(std::string(name));
     if (index < 0) return fmt::format("there is no extern `{}`", name);
+    return setExtern(index, value);
+}
+
+std::optional<std::string> System::setExtern(int index, std::span<const float> value) {
+    if (index < 0 || static_cast<size_t>(index) >= module_.externs.size())
+        return fmt::format("there is no extern with handle {}", index);
     const ir::Extern& e = module_.externs[static_cast<size_t>(index)];
+    const std::string& name = e.name;
     if (value.size() != static_cast<size_t>(e.type.width))
         return fmt::format("extern `{}` is {}: it takes {} value{}, not {}", name, e.type.str(), e.type.width,
                            e.type.width == 1 ? "" : "s", value.size());

@@ -64,6 +64,9 @@ public:
 
     // Host API. Errors come back as a message; nothing is changed then.
     std::optional<std::string> setExtern(std::string_view name, std::span<const float> value);
+    // The same by handle, for hosts that set an extern every frame: -1 for an unknown name.
+    int externHandle(std::string_view name) const { return module_.externIndex(std::string(name)); }
+    std::optional<std::string> setExtern(int handle, std::span<const float> value);
     std::optional<std::string> fire(std::string_view trigger, std::span<const float> args);
     std::optional<std::string> step(double dt);
 
@@ -91,6 +94,7 @@ private:
                         std::vector<Value>& state);
     void runKernel(size_t type, uint32_t row, const ir::Kernel& kernel, const KernelInputs& in);
     void update(size_t type, uint32_t row, double dt, double t1);
+    void updateOnce(size_t type, uint32_t row, double dt, double t1);
     void create(const Creation& c, double t1);
     void queueChildren(size_t type, uint32_t row, int site, uint64_t count, uint64_t perEvent, double firstTime,
                        double spacing, double evalTime, bool first);
@@ -105,6 +109,7 @@ private:
     SystemOptions options_;
     std::vector<Pool> pools_;
     std::vector<int> parentType_;  // per type: the type of its parent, or -1
+    std::vector<double> stepLimit_;  // per type: the longest update (@step), or 0
     std::vector<Value> externs_;
     std::vector<std::vector<RenderPoint>> render_;
     std::vector<bool> renderStale_;

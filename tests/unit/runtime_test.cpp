@@ -280,6 +280,10 @@ TEST_CASE("host API misuse is an error value") {
     float one = 1;
     CHECK(run.system->setExtern("nope", {&one, 1}).value() == "there is no extern `nope`");
     CHECK(run.system->setExtern("w", {&one, 1}).value() == "extern `w` is vec3: it takes 3 values, not 1");
+    CHECK(run.system->setExtern(7, {&one, 1}).value() == "there is no extern with handle 7");
+    CHECK(run.system->externHandle("nope") == -1);
+    float wind[3] = {4, 5, 6};
+    CHECK_FALSE(run.system->setExtern(run.system->externHandle("w"), wind).has_value());
     CHECK(run.system->fire("boom", {}).value() == "there is no trigger `boom`");
     CHECK(run.system->fire("go", {&one, 1}).value() == "trigger `go` takes 3 numbers, not 1");
     float at[3] = {1, 2, 3};
@@ -287,4 +291,26 @@ TEST_CASE("host API misuse is an error value") {
     const auto& p = run.points("a");
     REQUIRE(p.size() == 2);
     CHECK(p[0].position == std::array<float, 3>{1, 2, 3});
+}
+
+TEST_CASE("@step(h) advances an object in sub-steps no longer than h") {
+    // x' = -x: one Euler step of 1 s gives 0; four sub-steps of 0.25 s give 0.75^4.
+    auto after = [](const std::string& attribute) {
+        Run run(attribute + " object a { x = 1 -> prev(x) - prev(x) * dt; point(vec3(x), white, 1); }\nspawn a;");
+        run.steps(1, 1.0);
+        return run.points("a").at(0).position[0];
+    };
+    CHECK(after("") == 0.0f);
+    CHECK(after("@step(0.25)") == doctest::Approx(std::pow(0.75, 4)));
+    CHECK(after("@step(0.3)") == doctest::Approx(std::pow(0.75, 4)));  // 4 equal sub-steps of 0.25
+}
+
+TEST_CASE("an integrator that is not implemented is an error, not a silent euler") {
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    auto module = compileText("t.psys", "@integrator(rk4) object a { p = integrate(vec3(1)); point(p, white, 1); }",
+                              sources, diags);
+    CHECK_FALSE(module.has_value());
+    CHECK(diags.render().find("psysc: error: object a: @integrator(rk4) is not implemented yet; euler is") !=
+          std::string::npos);
 }

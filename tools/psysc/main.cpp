@@ -70,7 +70,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> printAfter;
     bool printAfterAll = false;
     app.add_option("--print-after", printAfter, "With --emit=ir: print the IR after this pass (repeatable)")
-        ->type_name("PASS");
+        ->type_name("PASS")->allow_extra_args(false);
     app.add_flag("--print-after-all", printAfterAll, "With --emit=ir: print the IR after every pass");
 
     auto* check = app.add_subcommand("check", "Type-check .psys files and report every error");
@@ -86,8 +86,9 @@ int main(int argc, char** argv) {
     run->add_option("--dt", runOptions.dt, "Seconds per frame (1/60)");
     run->add_option("--seed", runOptions.seed, "Random seed (1)");
     run->add_option("--capacity", runOptions.capacity, "Most live objects per type, unless @capacity says (1048576)");
-    run->add_option("--set", runOptions.sets, "Set an extern: NAME=VALUE or NAME=X,Y,Z (repeatable)");
-    run->add_option("--fire", runOptions.fires, "Fire a trigger before a frame: TRIGGER[:X,Y,Z]@FRAME (repeatable)");
+    run->add_option("--set", runOptions.sets, "Set an extern: NAME=VALUE or NAME=X,Y,Z (repeatable)")
+        ->allow_extra_args(false);
+    run->add_option("--fire", runOptions.fires, "Fire a trigger before a frame: TRIGGER[:X,Y,Z]@FRAME (repeatable)")->allow_extra_args(false);
     run->add_option("--dump", runOptions.dump, "Write every drawn point per frame to FILE.csv or FILE.json");
     run->add_option("--dump-every", runOptions.dumpEvery, "Dump every Nth frame (1)")->check(CLI::PositiveNumber);
     run->add_flag("--quiet", runOptions.quiet, "No line per frame, only the summary");
