@@ -30,6 +30,7 @@
 
 #include "frontend/builtins.h"
 #include "frontend/consteval.h"
+#include "frontend/equation_graph.h"
 
 namespace psys::ir {
 namespace {
@@ -174,111 +175,32 @@ private:
 
 // ---------------------------------------------------------------- evaluation order
 
-void collectRefs(const Expr& e, const ObjectDecl& object, bool delayed,
-                 std::vector<std::pair<const Equation*, bool>>& out) {
-    switch (e.kind) {
-        case ExprKind::Name: {
-            auto& n = static_cast<const NameExpr&>(e);
-            if (n.ref.kind == Ref::Kind::Equation && n.ref.object == &object) out.push_back({n.ref.equation, delayed});
-            return;
-        }
-        case ExprKind::Call: {
-            auto& c = static_cast<const CallExpr&>(e);
-            bool delays = false;
-            if (c.builtin >= 0) {
-                const BuiltinFunction& fn = builtinFunction(c.builtin);
-                delays = fn.rule == BuiltinRule::Prev || fn.name == "integrate";
-            }
-            for (auto& a : c.args) collectRefs(*a, object, delayed || delays, out);
-            return;
-        }
-        case ExprKind::FollowedBy: {
-            auto& f = static_cast<const FollowedByExpr&>(e);
-            collectRefs(*f.init, object, delayed, out);
-            collectRefs(*f.next, object, true, out);
-            return;
-        }
-        case ExprKind::Member: {
-            auto& m = static_cast<const MemberExpr&>(e);
-            if (!m.parent) collectRefs(*m.base, object, delayed, out);
-            return;
-        }
-        case ExprKind::Unary: collectRefs(*static_cast<const UnaryExpr&>(e).operand, object, delayed, out); return;
-        case ExprKind::Binary:
-            collectRefs(*static_cast<const BinaryExpr&>(e).lhs, object, delayed, out);
-            collectRefs(*static_cast<const BinaryExpr&>(e).rhs, object, delayed, out);
-            return;
-        case ExprKind::Conditional: {
-            auto& c = static_cast<const ConditionalExpr&>(e);
-            collectRefs(*c.cond, object, delayed, out);
-            collectRefs(*c.thenExpr, object, delayed, out);
-            collectRefs(*c.elseExpr, object, delayed, out);
-            return;
-        }
-        case ExprKind::Tuple:
-            for (auto& el : static_cast<const TupleExpr&>(e).elements) collectRefs(*el, object, delayed, out);
-            return;
-        default: return;
-    }
-}
-
 std::vector<const Equation*> ObjectLowering::evaluationOrder() {
-    const auto& eqs = decl_->equations;
-    size_t n = eqs.size();
-    std::map<const Equation*, size_t> index;
-    for (size_t i = 0; i < n; ++i) index[eqs[i].get()] = i;
-    std::vector<std::vector<size_t>> all(n), immediate(n);
-    for (size_t i = 0; i < n; ++i) {
-        std::vector<std::pair<const Equation*, bool>> refs;
-        collectRefs(*eqs[i]->value, *decl_, false, refs);
-        for (auto& [target, delayed] : refs) {
-            all[i].push_back(index.at(target));
-            if (!delayed) immediate[i].push_back(index.at(target));
-        }
-    }
-    // Strongly connected components over every reference (Tarjan): a component is emitted
-    // after every component it reads, so emission order is evaluation order.
-    std::vector<size_t> order(n, SIZE_MAX), low(n, 0), stack;
-    std::vector<bool> onStack(n, false);
-    size_t counter = 0;
+    EquationGraph graph = buildEquationGraph(*decl_);
+    // Components over every reference, each after those it reads: evaluation order.
+    auto components = stronglyConnectedComponents(graph.equations.size(), [&](size_t v) {
+        std::vector<size_t> next;
+        for (const EquationUse& u : graph.uses[v]) next.push_back(u.target);
+        return next;
+    });
     std::vector<const Equation*> result;
-    std::function<void(size_t)> visit = [&](size_t v) {
-        order[v] = low[v] = counter++;
-        stack.push_back(v);
-        onStack[v] = true;
-        for (size_t w : all[v]) {
-            if (order[w] == SIZE_MAX) {
-                visit(w);
-                low[v] = std::min(low[v], low[w]);
-            } else if (onStack[w]) {
-                low[v] = std::min(low[v], order[w]);
-            }
-        }
-        if (low[v] != order[v]) return;
-        std::set<size_t> component;
-        size_t w;
-        do {
-            w = stack.back();
-            stack.pop_back();
-            onStack[w] = false;
-            component.insert(w);
-        } while (w != v);
-        // Inside a component: what an equation reads immediately first, else source order.
-        std::set<size_t> done;
+    for (const auto& members : components) {
+        // Inside a component: what an equation reads in the same update first, else
+        // source order (members are sorted).
+        std::set<size_t> component(members.begin(), members.end()), done;
         while (done.size() < component.size()) {
-            for (size_t c : component) {
+            for (size_t c : members) {
                 if (done.count(c)) continue;
                 bool ready = true;
-                for (size_t d : immediate[c]) ready &= !component.count(d) || done.count(d) || d == c;
+                for (const EquationUse& u : graph.uses[c])
+                    if (!u.delayed && u.target != c && component.count(u.target) && !done.count(u.target)) ready = false;
                 if (!ready) continue;
                 done.insert(c);
-                result.push_back(eqs[c].get());
+                result.push_back(graph.equations[c]);
                 break;
             }
         }
-    };
-    for (size_t v = 0; v < n; ++v)
-        if (order[v] == SIZE_MAX) visit(v);
+    }
     return result;
 }
 
