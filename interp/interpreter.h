@@ -13,6 +13,8 @@ public:
 
 private:
     std::vector<rt::Value> registers_;
+    std::vector<rt::Value> operandValues_;
+    std::vector<ir::Type> operandTypes_;
 };
 
 }  // namespace psys::interp

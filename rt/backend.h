@@ -13,17 +13,11 @@
 #include <vector>
 
 #include "ir/ir.h"
+#include "ir/value.h"
 
 namespace psys::rt {
 
-// One IR value: up to four floats, or a bool (f[0] != 0), or a u32.
-struct Value {
-    std::array<float, 4> f{};
-    uint32_t u = 0;
-    bool truth() const { return f[0] != 0; }
-    static Value scalar(float x) { return {{x, 0, 0, 0}, 0}; }
-    static Value boolean(bool b) { return {{b ? 1.0f : 0.0f, 0, 0, 0}, 0}; }
-};
+using Value = ir::Value;
 
 struct KernelInputs {
     const Value* params = nullptr;        // the object's (or a trigger's) parameters
