@@ -110,6 +110,7 @@ private:
 struct Param {
     std::string name;
     Type type;
+    bool kept = true;  // false: read only at creation, so the pool does not store it
 };
 
 enum class StateInit {

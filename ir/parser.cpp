@@ -59,7 +59,10 @@ std::vector<Param> params(const std::string& header) {
             s.erase(s.find_last_not_of(' ') + 1);
             return s;
         };
-        out.push_back({trim(item.substr(0, colon)), type(trim(item.substr(colon + 1)))});
+        std::string typeText = trim(item.substr(colon + 1));
+        bool once = typeText.ends_with(" once");
+        if (once) typeText = trim(typeText.substr(0, typeText.size() - 5));
+        out.push_back({trim(item.substr(0, colon)), type(typeText), !once});
     }
     return out;
 }

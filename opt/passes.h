@@ -14,6 +14,14 @@
 //   split-kernels    the behaviour becomes the kernels init, update, render, exports and
 //                    spawn.N; what the post-update kernels need from before the update is
 //                    carried in state (§3.3.1: split stateful from stateless)
+//
+// and, unless optimisation is off, the optimizer (§4.3.8, docs/optimizer.md):
+//
+//   simplify         constant folding and exact identities to a fixpoint; snapshot of
+//                    what is fixed at creation needs no state (runs on the behaviour,
+//                    before lower-temporal, and as simplify-kernels after the split)
+//   dead-state       slots nothing needs go, equal slots merge, unchanged slots are not
+//                    stored, parameters read only at creation are not kept
 #pragma once
 
 #include <iosfwd>
@@ -39,6 +47,8 @@ void scoping(ir::Module& module, PassErrors& errors);
 void lowerTemporal(ir::Module& module, const PassOptions& options, PassErrors& errors);
 void keyRandom(ir::Module& module, PassErrors& errors);
 void splitKernels(ir::Module& module, PassErrors& errors);
+void simplify(ir::Module& module, PassErrors& errors);
+void deadState(ir::Module& module, PassErrors& errors);
 
 struct PassInfo {
     const char* name;
@@ -49,6 +59,7 @@ const std::vector<PassInfo>& passCatalogue();
 
 struct PipelineOptions {
     PassOptions pass;
+    bool optimize = true;              // false: only the lowering passes
     std::set<std::string> printAfter;  // pass names
     bool printAfterAll = false;
     bool verifyEach = false;           // run the verifier after every pass

@@ -18,6 +18,9 @@ const std::vector<PassInfo>& passCatalogue() {
         {"lower-temporal", "integrate, derive, prev, snapshot and -> become state"},
         {"key-random", "random draws are keyed by (object id, draw index)"},
         {"split-kernels", "the behaviour becomes init, update, render, exports and spawn kernels"},
+        {"simplify", "constant folding and exact identities (on the behaviour)"},
+        {"simplify-kernels", "constant folding and exact identities (on the split kernels)"},
+        {"dead-state", "unneeded slots go, equal slots merge, parameters used only at creation are not kept"},
     };
     return passes;
 }
@@ -47,12 +50,21 @@ bool runPipeline(ir::Module& module, const PipelineOptions& options, PassErrors&
     if (!after("resolve-cycles")) return false;
     scoping(module, errors);
     if (!after("scoping")) return false;
+    if (options.optimize) {
+        simplify(module, errors);
+        if (!after("simplify")) return false;
+    }
     lowerTemporal(module, options.pass, errors);
     if (!after("lower-temporal")) return false;
     keyRandom(module, errors);
     if (!after("key-random")) return false;
     splitKernels(module, errors);
-    return after("split-kernels");
+    if (!after("split-kernels")) return false;
+    if (!options.optimize) return true;
+    simplify(module, errors);
+    if (!after("simplify-kernels")) return false;
+    deadState(module, errors);
+    return after("dead-state");
 }
 
 }  // namespace psys::opt

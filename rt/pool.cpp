@@ -32,7 +32,10 @@ Pool::Pool(const ir::Object& object, size_t capacity) : object_(&object), capaci
     for (auto& s : object.state) types.push_back(s.type);
     state.define(types);
     types.clear();
-    for (auto& p : object.params) types.push_back(p.type);
+    for (auto& p : object.params) {
+        paramColumn.push_back(p.kept ? static_cast<int>(types.size()) : -1);
+        if (p.kept) types.push_back(p.type);
+    }
     params.define(types);
     types.clear();
     for (auto& e : object.exports) types.push_back(e.type);

@@ -59,7 +59,8 @@ public:
     bool matches(Handle h) const { return h.row < rows() && generation_[h.row] == h.generation && status_[h.row] != Status::Free; }
     Handle handle(uint32_t row) const { return {row, generation_[row]}; }
 
-    Columns state, params, exports;
+    Columns state, params, exports;  // params: only the kept ones
+    std::vector<int> paramColumn;     // per parameter: its column in `params`, or -1
     std::vector<double> created;
     std::vector<uint32_t> id;
     std::vector<Handle> parent;

@@ -63,8 +63,9 @@ int System::typeIndex(std::string_view name) const { return module_.objectIndex(
 KernelInputs System::inputs(size_t type, uint32_t row, double at, float dt, bool first, std::vector<Value>& params,
                             std::vector<Value>& state) {
     Pool& pool = pools_[type];
-    params.resize(pool.params.count());
-    for (size_t i = 0; i < params.size(); ++i) params[i] = pool.params.get(i, row);
+    params.assign(pool.paramColumn.size(), Value{});
+    for (size_t i = 0; i < params.size(); ++i)
+        if (pool.paramColumn[i] >= 0) params[i] = pool.params.get(static_cast<size_t>(pool.paramColumn[i]), row);
     state.resize(pool.state.count());
     for (size_t i = 0; i < state.size(); ++i) state[i] = pool.state.get(i, row);
     KernelInputs in;
@@ -199,7 +200,7 @@ void System::queueChildren(size_t type, uint32_t row, int site, uint64_t count, 
             KernelInputs in = inputs(type, row, evalTime, static_cast<float>(lastDt_), first, params, state);
             in.childDraw = c.id;
             runKernel(type, row, *spawn, in);
-            c.args.resize(pools_[target].params.count());
+            c.args.resize(pools_[target].paramColumn.size());
             for (size_t i = 0; i < spawn->yields.size(); ++i)
                 if (spawn->yields[i].kind == YieldKind::EmitArg)
                     c.args.at(static_cast<size_t>(spawn->yields[i].sub)) = yields_[i];
@@ -226,13 +227,17 @@ void System::create(const Creation& c, double t1) {
     pool.parent[row] = c.parent;
     pool.createdStep[row] = step_;
     if (c.parent.valid()) ++pools_[static_cast<size_t>(parentType_[c.type])].readers[c.parent.row];
-    for (size_t i = 0; i < pool.params.count() && i < c.args.size(); ++i) pool.params.set(i, row, c.args[i]);
+    for (size_t i = 0; i < pool.paramColumn.size() && i < c.args.size(); ++i)
+        if (pool.paramColumn[i] >= 0) pool.params.set(static_cast<size_t>(pool.paramColumn[i]), row, c.args[i]);
     for (size_t i = 0; i < pool.state.count(); ++i) pool.state.set(i, row, Value{});
 
     std::vector<Value> params, state;
     std::vector<double> bursts(o.emits.size(), 0);
     if (const ir::Kernel* init = o.kernel(KernelKind::Init)) {
         KernelInputs in = inputs(c.type, row, c.time, 0, true, params, state);
+        std::vector<Value> args = c.args;  // every parameter, kept or not
+        args.resize(pool.paramColumn.size());
+        in.params = args.data();
         runKernel(c.type, row, *init, in);
         for (size_t i = 0; i < init->yields.size(); ++i) {
             const ir::Yield& y = init->yields[i];
@@ -357,7 +362,7 @@ void System::emitFromKernel(const ir::Trigger& trigger, std::span<const Value> p
         auto kept = static_cast<uint64_t>(std::min(counts[s], static_cast<double>(room)));
         typeStats_[target].dropped += static_cast<uint64_t>(counts[s]) - kept;
         for (uint64_t n = 0; n < kept; ++n) {
-            Creation c{target, std::vector<Value>(pools_[target].params.count()), {}, now_, nextId_++};
+            Creation c{target, std::vector<Value>(pools_[target].paramColumn.size()), {}, now_, nextId_++};
             in.childDraw = c.id;
             backend_.run(k, in, yields_);
             for (size_t i = 0; i < k.yields.size(); ++i)

@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -20,10 +21,12 @@ struct Run {
     interp::Interpreter backend;
     std::unique_ptr<rt::System> system;
 
-    explicit Run(const std::string& source, rt::SystemOptions options = {}) {
+    explicit Run(const std::string& source, rt::SystemOptions options = {}, bool optimize = true) {
         SourceManager sources;
         DiagnosticEngine diags(sources);
-        auto module = compileText("test.psys", source, sources, diags);
+        CompileOptions compile;
+        compile.pipeline.optimize = optimize;
+        auto module = compileText("test.psys", source, sources, diags, compile);
         INFO(diags.render());
         REQUIRE(module.has_value());
         system = std::make_unique<rt::System>(std::move(*module), backend, options);
@@ -313,4 +316,40 @@ TEST_CASE("an integrator that is not implemented is an error, not a silent euler
     CHECK_FALSE(module.has_value());
     CHECK(diags.render().find("psysc: error: object a: @integrator(rk4) is not implemented yet; euler is") !=
           std::string::npos);
+}
+
+TEST_CASE("the optimizer leaves every sample's output unchanged, bit for bit, over 600 frames") {
+    for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
+        if (entry.path().extension() != ".psys") continue;
+        INFO(entry.path().filename().string());
+        std::string text = readFile(entry.path());
+        Run plain(text, {}, false), optimized(text, {}, true);
+        // Triggers are fired too, so that every object type runs.
+        for (const ir::Trigger& t : plain.system->module().triggers) {
+            size_t width = 0;
+            for (auto& p : t.params) width += static_cast<size_t>(p.type.width);
+            std::vector<float> args(width, 1.5f);
+            REQUIRE_FALSE(plain.system->fire(t.name, args));
+            REQUIRE_FALSE(optimized.system->fire(t.name, args));
+        }
+        size_t differences = 0, points = 0;
+        for (int frame = 0; frame < 600; ++frame) {
+            plain.steps(1, 1.0 / 60);
+            optimized.steps(1, 1.0 / 60);
+            for (size_t t = 0; t < plain.system->typeCount(); ++t) {
+                const auto& a = plain.system->render(t);
+                const auto& b = optimized.system->render(t);
+                REQUIRE(a.size() == b.size());
+                for (size_t i = 0; i < a.size(); ++i) {
+                    ++points;
+                    bool same = a[i].id == b[i].id && std::memcmp(&a[i].position, &b[i].position, sizeof a[i].position) == 0 &&
+                                std::memcmp(&a[i].color, &b[i].color, sizeof a[i].color) == 0 &&
+                                std::memcmp(&a[i].size, &b[i].size, sizeof a[i].size) == 0;
+                    differences += same ? 0 : 1;
+                }
+            }
+        }
+        CHECK(differences == 0);
+        CHECK(points > 0);
+    }
 }

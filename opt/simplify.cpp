@@ -1,0 +1,191 @@
+// simplify: local rewriting to a fixpoint (thesis §4.3.8, "local optimization").
+//
+// Every rule here gives bit-for-bit the value of what it replaces, for every input
+// (NaN, ±Inf and −0 included), so the program's output does not change:
+//
+//   constant folding        pure instructions on constants, computed by ir/evaluate —
+//                           the same code the interpreter runs
+//   x·1, x/1, x−(+0),       identities that hold in IEEE arithmetic. Not applied: x+0
+//   x+(−0), −(−x), !!x      (−0+0 is +0), x·0 (NaN·0, Inf·0), x−x (Inf−Inf), x/x.
+//   x/c → x·(1/c)           only when 1/c is exact (c a power of two): otherwise it
+//                           changes the last bit (see docs/optimizer.md)
+//   min(x,x), max(x,x),     select on a constant, select with equal branches,
+//   x&&x, x||x              select(!c, a, b) → select(c, b, a)
+//   vectors                 extract of compose / splat / shuffle, shuffles and composes
+//                           that rebuild a vector unchanged, shuffles of a splat
+//   snapshot(x)             → x when x depends only on parameters and constants: it
+//                           cannot change after creation, so it needs no state
+#include <cmath>
+#include <cstring>
+
+#include "ir/evaluate.h"
+#include "ir/printer.h"
+#include "opt/passes.h"
+#include "opt/rewrite.h"
+
+namespace psys::opt {
+
+using namespace ir;
+
+namespace {
+
+bool isConst(const Kernel& k, ValueId v) { return k.at(v).op == Op::Const; }
+
+// Whether every component of constant `v` has exactly the bits of `x`.
+bool constAll(const Kernel& k, ValueId v, float x) {
+    const Inst& i = k.at(v);
+    if (i.op != Op::Const || !i.type.isFloat()) return false;
+    for (int c = 0; c < i.type.width; ++c)
+        if (std::memcmp(&i.constant[static_cast<size_t>(c)], &x, sizeof x) != 0) return false;
+    return true;
+}
+
+// 1/c exactly, when every component of the constant c is ± a power of two (and 1/c is a
+// normal float).
+std::optional<std::array<float, 4>> exactReciprocal(const Inst& c) {
+    if (c.op != Op::Const || !c.type.isFloat()) return std::nullopt;
+    std::array<float, 4> out{};
+    for (int i = 0; i < c.type.width; ++i) {
+        float x = c.constant[static_cast<size_t>(i)];
+        int exponent = 0;
+        float mantissa = std::frexp(x, &exponent);
+        if (!std::isfinite(x) || std::fabs(mantissa) != 0.5f) return std::nullopt;
+        float r = 1.0f / x;
+        if (!std::isnormal(r) || r * x != 1.0f) return std::nullopt;
+        out[static_cast<size_t>(i)] = r;
+    }
+    return out;
+}
+
+// Depends on nothing that can change after creation: parameters and constants only.
+bool creationInvariant(const Kernel& k, ValueId v) {
+    const Inst& i = k.at(v);
+    if (i.op == Op::Param || i.op == Op::Const) return true;
+    if (!isPure(i.op)) return false;
+    for (ValueId o : i.operands)
+        if (!creationInvariant(k, o)) return false;
+    return true;
+}
+
+std::optional<ValueId> rule(Rewriter& rw, const Inst& old, const std::vector<ValueId>& ops) {
+    Kernel& k = rw.to();
+    auto at = [&](size_t i) -> const Inst& { return k.at(ops[i]); };
+    Inst inst = old;
+    inst.operands = ops;
+    // Temporal instructions: only snapshot of something fixed at creation.
+    if (old.op == Op::Snapshot && creationInvariant(k, ops[0])) return ops[0];
+    if (isTemporal(old.op) || isInput(old.op)) return std::nullopt;
+
+    if (isPure(old.op)) {
+        bool allConst = !ops.empty();
+        for (ValueId o : ops) allConst &= isConst(k, o);
+        if (allConst) {
+            std::vector<Value> values;
+            std::vector<Type> types;
+            for (ValueId o : ops) {
+                values.push_back({k.at(o).constant, 0});
+                types.push_back(k.at(o).type);
+            }
+            Value v = evaluate(inst, values.data(), types.data());
+            return k.constant(inst.type, v.f);
+        }
+    }
+    switch (old.op) {
+        case Op::Mul:
+            for (size_t i = 0; i < 2; ++i)
+                if (constAll(k, ops[i], 1.0f)) return ops[1 - i];
+            break;
+        case Op::Add:
+            for (size_t i = 0; i < 2; ++i)
+                if (constAll(k, ops[i], -0.0f)) return ops[1 - i];
+            break;
+        case Op::Sub:
+            if (constAll(k, ops[1], 0.0f)) return ops[0];
+            break;
+        case Op::Div:
+            if (constAll(k, ops[1], 1.0f)) return ops[0];
+            if (auto r = exactReciprocal(at(1))) return rw.emit({Op::Mul, inst.type, {ops[0], k.constant(inst.type, *r)}, 0, 0, {}, {}, ""});
+            break;
+        case Op::Neg:
+            if (at(0).op == Op::Neg) return at(0).operands[0];
+            break;
+        case Op::Not:
+            if (at(0).op == Op::Not) return at(0).operands[0];
+            break;
+        case Op::Min: case Op::Max: case Op::And: case Op::Or:
+            if (ops[0] == ops[1]) return ops[0];
+            break;
+        case Op::Select:
+            if (at(0).op == Op::Not) return rw.emit({Op::Select, inst.type, {at(0).operands[0], ops[2], ops[1]}, 0, 0, {}, {}, ""});
+            break;
+        case Op::Extract: {
+            const Inst& v = at(0);
+            if (v.op == Op::Splat) return v.operands[0];
+            if (v.op == Op::Shuffle)
+                return rw.emit({Op::Extract, inst.type, {v.operands[0]}, v.lanes.at(static_cast<size_t>(inst.attr)), 0, {}, {}, ""});
+            if (v.op == Op::Compose) {
+                int lane = inst.attr;
+                for (ValueId part : v.operands) {
+                    int w = k.at(part).type.width;
+                    if (lane < w) {
+                        if (w == 1) return part;
+                        return rw.emit({Op::Extract, inst.type, {part}, lane, 0, {}, {}, ""});
+                    }
+                    lane -= w;
+                }
+            }
+            break;
+        }
+        case Op::Shuffle: {
+            const Inst& v = at(0);
+            if (v.op == Op::Splat) {
+                if (inst.type.width == 1) return v.operands[0];
+                return rw.emit({Op::Splat, inst.type, {v.operands[0]}, 0, 0, {}, {}, ""});
+            }
+            bool identity = static_cast<int>(inst.lanes.size()) == v.type.width;
+            for (size_t i = 0; i < inst.lanes.size(); ++i) identity &= inst.lanes[i] == i;
+            if (identity) return ops[0];
+            break;
+        }
+        case Op::Compose: {
+            // compose(v.x, v.y, v.z) of a vec3 v is v
+            ValueId source = 0;
+            bool same = true;
+            for (size_t i = 0; i < ops.size() && same; ++i) {
+                const Inst& part = at(i);
+                same = part.op == Op::Extract && part.attr == static_cast<int>(i) && (i == 0 || part.operands[0] == source);
+                if (same) source = part.operands[0];
+            }
+            if (same && k.at(source).type == inst.type) return source;
+            break;
+        }
+        default: break;
+    }
+    return std::nullopt;
+}
+
+void simplifyKernel(Kernel& kernel) {
+    for (int round = 0; round < 16; ++round) {
+        std::string before = print(kernel);
+        Rewriter rw(kernel);
+        Kernel next = rw.run([](Rewriter& r, ValueId, const Inst& inst, const std::vector<ValueId>& ops) {
+            return rule(r, inst, ops);
+        });
+        next.kind = kernel.kind;
+        next.site = kernel.site;
+        kernel = std::move(next);
+        bool changed = print(kernel) != before;
+        if (!changed) break;
+    }
+}
+
+}  // namespace
+
+void simplify(Module& module, PassErrors&) {
+    for (Object& o : module.objects)
+        for (Kernel& k : o.kernels) simplifyKernel(k);
+    for (Trigger& t : module.triggers) simplifyKernel(t.kernel);
+    simplifyKernel(module.start.kernel);
+}
+
+}  // namespace psys::opt

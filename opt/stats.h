@@ -1,0 +1,24 @@
+// What a compiled system costs per object: the figures `psysc --stats` prints and
+// docs/optimizer.md tabulates.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "ir/ir.h"
+
+namespace psys::opt {
+
+struct ObjectCost {
+    std::string name;
+    size_t opsPerUpdate = 0;   // instructions (not inputs or constants) run per object per frame:
+                               // update + render + exports
+    size_t opsAtCreation = 0;  // init and the spawn kernels
+    size_t stateBytes = 0;     // state slots kept per object
+    size_t paramBytes = 0;     // parameters kept per object
+};
+
+std::vector<ObjectCost> measure(const ir::Module& module);
+size_t countOps(const ir::Kernel& kernel);
+
+}  // namespace psys::opt
