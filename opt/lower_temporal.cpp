@@ -18,6 +18,7 @@
 // the previous velocity, and a position integrated from that new velocity, is the
 // semi-implicit Euler step games use. Other methods (midpoint, RK4) integrate an
 // object's integrals together and will slot in here as further cases of `integrate`.
+// With relaxed maths, the integral of something fixed at creation is c·age, no state.
 #include <fmt/format.h>
 
 #include "opt/passes.h"
@@ -43,7 +44,7 @@ ValueId broadcast(Kernel& k, ValueId scalar, Type t) {
 
 }  // namespace
 
-void lowerTemporal(Module& module, const PassOptions&, PassErrors& errors) {
+void lowerTemporal(Module& module, const PassOptions& options, PassErrors& errors) {
     for (Object& object : module.objects) {
         Kernel* behaviour = object.kernel(KernelKind::Behaviour);
         if (!behaviour) continue;
@@ -70,6 +71,10 @@ void lowerTemporal(Module& module, const PassOptions&, PassErrors& errors) {
             ValueId zero = zeroOf(k, t);
             switch (inst.op) {
                 case Op::Integrate: {
+                    // Relaxed: the Euler sum of something fixed at creation is c·age, exact
+                    // in real arithmetic; no state needed (docs/optimizer.md).
+                    if (options.relaxed && creationInvariant(k, ops[0]))
+                        return rw.emit({Op::Mul, t, {ops[0], broadcast(k, input(k, Op::Age, Type::f32()), t)}, 0, 0, {}, {}, ""});
                     int slot = addSlot("integrate", inst, StateInit::Zero);
                     ValueId a = input(k, Op::StateRead, t, slot);
                     ValueId dt = broadcast(k, input(k, Op::Dt, Type::f32()), t);

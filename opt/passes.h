@@ -20,6 +20,8 @@
 //   simplify         constant folding and exact identities to a fixpoint; snapshot of
 //                    what is fixed at creation needs no state (runs on the behaviour,
 //                    before lower-temporal, and as simplify-kernels after the split)
+//   reassociate      (relaxed only) sums and products in one canonical order, so
+//                    (a+b+c)·(a+b+d) computes a+b once
 //   dead-state       slots nothing needs go, equal slots merge, unchanged slots are not
 //                    stored, parameters read only at creation are not kept
 #pragma once
@@ -37,6 +39,10 @@ enum class Integrator { Euler };
 
 struct PassOptions {
     Integrator integrator = Integrator::Euler;
+    // Rewrites that may change the last bits of a result (docs/optimizer.md): x+0 → x,
+    // x/c → x·(1/c), sums and products put in one canonical order so they share parts,
+    // and integrals of what is fixed at creation in closed form (c·age).
+    bool relaxed = false;
 };
 
 // Errors a pass reports about the program (not about the compiler).
@@ -47,7 +53,8 @@ void scoping(ir::Module& module, PassErrors& errors);
 void lowerTemporal(ir::Module& module, const PassOptions& options, PassErrors& errors);
 void keyRandom(ir::Module& module, PassErrors& errors);
 void splitKernels(ir::Module& module, PassErrors& errors);
-void simplify(ir::Module& module, PassErrors& errors);
+void simplify(ir::Module& module, const PassOptions& options, PassErrors& errors);
+void reassociate(ir::Module& module, PassErrors& errors);
 void deadState(ir::Module& module, PassErrors& errors);
 
 struct PassInfo {

@@ -20,6 +20,7 @@ const std::vector<PassInfo>& passCatalogue() {
         {"split-kernels", "the behaviour becomes init, update, render, exports and spawn kernels"},
         {"simplify", "constant folding and exact identities (on the behaviour)"},
         {"simplify-kernels", "constant folding and exact identities (on the split kernels)"},
+        {"reassociate", "(relaxed) sums and products in one canonical order, sharing common parts"},
         {"dead-state", "unneeded slots go, equal slots merge, parameters used only at creation are not kept"},
     };
     return passes;
@@ -51,7 +52,7 @@ bool runPipeline(ir::Module& module, const PipelineOptions& options, PassErrors&
     scoping(module, errors);
     if (!after("scoping")) return false;
     if (options.optimize) {
-        simplify(module, errors);
+        simplify(module, options.pass, errors);
         if (!after("simplify")) return false;
     }
     lowerTemporal(module, options.pass, errors);
@@ -61,7 +62,11 @@ bool runPipeline(ir::Module& module, const PipelineOptions& options, PassErrors&
     splitKernels(module, errors);
     if (!after("split-kernels")) return false;
     if (!options.optimize) return true;
-    simplify(module, errors);
+    if (options.pass.relaxed) {
+        reassociate(module, errors);
+        if (!after("reassociate")) return false;
+    }
+    simplify(module, options.pass, errors);
     if (!after("simplify-kernels")) return false;
     deadState(module, errors);
     return after("dead-state");

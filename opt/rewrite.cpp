@@ -21,6 +21,15 @@ ValueId zeroOf(Kernel& k, Type t) {
     return k.constant(t, {0, 0, 0, 0});
 }
 
+bool creationInvariant(const Kernel& k, ValueId v) {
+    const Inst& i = k.at(v);
+    if (i.op == Op::Param || i.op == Op::Const) return true;
+    if (!(i.op >= Op::Add && i.op <= Op::Dot)) return false;
+    for (ValueId o : i.operands)
+        if (!creationInvariant(k, o)) return false;
+    return true;
+}
+
 ValueId Rewriter::emit(Inst inst) {
     auto c = [&](size_t i) { return constantBool(to_, inst.operands[i]); };
     switch (inst.op) {

@@ -44,4 +44,8 @@ private:
 // The zero value of a type: false, 0 or a zero vector.
 ir::ValueId zeroOf(ir::Kernel& k, ir::Type t);
 
+// Whether `v` depends only on what is fixed when an object is created: its parameters and
+// constants, through pure instructions.
+bool creationInvariant(const ir::Kernel& k, ir::ValueId v);
+
 }  // namespace psys::opt

@@ -15,6 +15,12 @@
 //                           that rebuild a vector unchanged, shuffles of a splat
 //   snapshot(x)             → x when x depends only on parameters and constants: it
 //                           cannot change after creation, so it needs no state
+//   x·(−1) → −x             exact in IEEE arithmetic
+//   narrowing               one lane of a componentwise operation used by nothing else is
+//                           that operation on that lane: extract(u+v, 1) → u.y + v.y
+//
+// With relaxed maths (PassOptions::relaxed) also: x+0 → x (wrong only in the sign of a
+// zero: −0+0 is +0) and x/c → x·(1/c) for any finite non-zero c (at most 2 ulp away).
 #include <cmath>
 #include <cstring>
 
@@ -57,17 +63,17 @@ std::optional<std::array<float, 4>> exactReciprocal(const Inst& c) {
     return out;
 }
 
-// Depends on nothing that can change after creation: parameters and constants only.
-bool creationInvariant(const Kernel& k, ValueId v) {
-    const Inst& i = k.at(v);
-    if (i.op == Op::Param || i.op == Op::Const) return true;
-    if (!isPure(i.op)) return false;
-    for (ValueId o : i.operands)
-        if (!creationInvariant(k, o)) return false;
-    return true;
+bool componentwise(Op op) {
+    return (op >= Op::Add && op <= Op::Fract) || op == Op::Select;
 }
 
-std::optional<ValueId> rule(Rewriter& rw, const Inst& old, const std::vector<ValueId>& ops) {
+struct Context {
+    bool relaxed = false;
+    std::vector<int> users;  // per old value: how many instructions and yields use it
+    const Kernel* old = nullptr;
+};
+
+std::optional<ValueId> rule(Rewriter& rw, const Inst& old, const std::vector<ValueId>& ops, const Context& ctx) {
     Kernel& k = rw.to();
     auto at = [&](size_t i) -> const Inst& { return k.at(ops[i]); };
     Inst inst = old;
@@ -92,12 +98,16 @@ std::optional<ValueId> rule(Rewriter& rw, const Inst& old, const std::vector<Val
     }
     switch (old.op) {
         case Op::Mul:
-            for (size_t i = 0; i < 2; ++i)
+            for (size_t i = 0; i < 2; ++i) {
                 if (constAll(k, ops[i], 1.0f)) return ops[1 - i];
+                if (constAll(k, ops[i], -1.0f)) return rw.emit({Op::Neg, inst.type, {ops[1 - i]}, 0, 0, {}, {}, ""});
+            }
             break;
         case Op::Add:
-            for (size_t i = 0; i < 2; ++i)
+            for (size_t i = 0; i < 2; ++i) {
                 if (constAll(k, ops[i], -0.0f)) return ops[1 - i];
+                if (ctx.relaxed && constAll(k, ops[i], 0.0f)) return ops[1 - i];
+            }
             break;
         case Op::Sub:
             if (constAll(k, ops[1], 0.0f)) return ops[0];
@@ -105,6 +115,16 @@ std::optional<ValueId> rule(Rewriter& rw, const Inst& old, const std::vector<Val
         case Op::Div:
             if (constAll(k, ops[1], 1.0f)) return ops[0];
             if (auto r = exactReciprocal(at(1))) return rw.emit({Op::Mul, inst.type, {ops[0], k.constant(inst.type, *r)}, 0, 0, {}, {}, ""});
+            if (ctx.relaxed && at(1).op == Op::Const) {
+                std::array<float, 4> r{};
+                bool ok = true;
+                for (int c = 0; c < inst.type.width; ++c) {
+                    float x = at(1).constant[static_cast<size_t>(c)];
+                    ok &= std::isfinite(x) && x != 0 && std::isnormal(1.0f / x);
+                    r[static_cast<size_t>(c)] = 1.0f / x;
+                }
+                if (ok) return rw.emit({Op::Mul, inst.type, {ops[0], k.constant(inst.type, r)}, 0, 0, {}, {}, ""});
+            }
             break;
         case Op::Neg:
             if (at(0).op == Op::Neg) return at(0).operands[0];
@@ -121,6 +141,18 @@ std::optional<ValueId> rule(Rewriter& rw, const Inst& old, const std::vector<Val
         case Op::Extract: {
             const Inst& v = at(0);
             if (v.op == Op::Splat) return v.operands[0];
+            // Narrowing: only this lane of a componentwise vector operation is used.
+            if (componentwise(v.op) && v.type.isVector() && ctx.users[old.operands[0]] == 1) {
+                Inst lane = v;  // a copy: emitting below may move the kernel's instructions
+                lane.type = Type::f32();
+                lane.name.clear();
+                for (size_t i = 0; i < lane.operands.size(); ++i) {
+                    ValueId o = lane.operands[i];
+                    if (lane.op == Op::Select && i == 0) continue;  // the condition is a bool
+                    lane.operands[i] = rw.emit({Op::Extract, Type::f32(), {o}, inst.attr, 0, {}, {}, ""});
+                }
+                return rw.emit(std::move(lane));
+            }
             if (v.op == Op::Shuffle)
                 return rw.emit({Op::Extract, inst.type, {v.operands[0]}, v.lanes.at(static_cast<size_t>(inst.attr)), 0, {}, {}, ""});
             if (v.op == Op::Compose) {
@@ -164,12 +196,19 @@ std::optional<ValueId> rule(Rewriter& rw, const Inst& old, const std::vector<Val
     return std::nullopt;
 }
 
-void simplifyKernel(Kernel& kernel) {
+void simplifyKernel(Kernel& kernel, bool relaxed) {
     for (int round = 0; round < 16; ++round) {
         std::string before = print(kernel);
+        Context ctx;
+        ctx.relaxed = relaxed;
+        ctx.users.assign(kernel.size(), 0);
+        for (const Inst& i : kernel.insts())
+            for (ValueId o : i.operands) ++ctx.users[o];
+        for (const Yield& y : kernel.yields) ++ctx.users[y.value];
+        for (auto& [name, v] : kernel.equations) ++ctx.users[v];
         Rewriter rw(kernel);
-        Kernel next = rw.run([](Rewriter& r, ValueId, const Inst& inst, const std::vector<ValueId>& ops) {
-            return rule(r, inst, ops);
+        Kernel next = rw.run([&ctx](Rewriter& r, ValueId, const Inst& inst, const std::vector<ValueId>& ops) {
+            return rule(r, inst, ops, ctx);
         });
         next.kind = kernel.kind;
         next.site = kernel.site;
@@ -181,11 +220,11 @@ void simplifyKernel(Kernel& kernel) {
 
 }  // namespace
 
-void simplify(Module& module, PassErrors&) {
+void simplify(Module& module, const PassOptions& options, PassErrors&) {
     for (Object& o : module.objects)
-        for (Kernel& k : o.kernels) simplifyKernel(k);
-    for (Trigger& t : module.triggers) simplifyKernel(t.kernel);
-    simplifyKernel(module.start.kernel);
+        for (Kernel& k : o.kernels) simplifyKernel(k, options.relaxed);
+    for (Trigger& t : module.triggers) simplifyKernel(t.kernel, options.relaxed);
+    simplifyKernel(module.start.kernel, options.relaxed);
 }
 
 }  // namespace psys::opt

@@ -4,9 +4,20 @@ namespace psys::opt {
 
 using namespace ir;
 
+// Scalar operations: a vec3 addition is three, a dot product of vec3s five (three
+// multiplications, two additions); moving lanes around (splat, compose, extract,
+// shuffle) is free, as it is in registers.
 size_t countOps(const Kernel& kernel) {
     size_t n = 0;
-    for (const Inst& i : kernel.insts()) n += isInput(i.op) ? 0 : 1;
+    for (const Inst& i : kernel.insts()) {
+        if (isInput(i.op)) continue;
+        switch (i.op) {
+            case Op::Splat: case Op::Compose: case Op::Extract: case Op::Shuffle: break;
+            case Op::Dot: n += 2u * kernel.at(i.operands[0]).type.width - 1; break;
+            case Op::Eq: case Op::Ne: n += kernel.at(i.operands[0]).type.width; break;
+            default: n += i.type.width; break;
+        }
+    }
     return n;
 }
 

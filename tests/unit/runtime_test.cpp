@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <sstream>
 
@@ -21,11 +22,12 @@ struct Run {
     interp::Interpreter backend;
     std::unique_ptr<rt::System> system;
 
-    explicit Run(const std::string& source, rt::SystemOptions options = {}, bool optimize = true) {
+    explicit Run(const std::string& source, rt::SystemOptions options = {}, bool optimize = true, bool relaxed = false) {
         SourceManager sources;
         DiagnosticEngine diags(sources);
         CompileOptions compile;
         compile.pipeline.optimize = optimize;
+        compile.pipeline.pass.relaxed = relaxed;
         auto module = compileText("test.psys", source, sources, diags, compile);
         INFO(diags.render());
         REQUIRE(module.has_value());
@@ -318,13 +320,16 @@ TEST_CASE("an integrator that is not implemented is an error, not a silent euler
           std::string::npos);
 }
 
-TEST_CASE("the optimizer leaves every sample's output unchanged, bit for bit, over 600 frames") {
+// Runs every sample for 600 frames without the optimizer and with `options`, firing every
+// trigger once, and compares what is drawn: the same objects, and values compared by
+// `close`. Returns the number of points compared.
+size_t compareWithUnoptimized(bool relaxed, const std::function<bool(float, float)>& close) {
+    size_t points = 0;
     for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
         if (entry.path().extension() != ".psys") continue;
         INFO(entry.path().filename().string());
         std::string text = readFile(entry.path());
-        Run plain(text, {}, false), optimized(text, {}, true);
-        // Triggers are fired too, so that every object type runs.
+        Run plain(text, {}, false), optimized(text, {}, true, relaxed);
         for (const ir::Trigger& t : plain.system->module().triggers) {
             size_t width = 0;
             for (auto& p : t.params) width += static_cast<size_t>(p.type.width);
@@ -332,7 +337,7 @@ TEST_CASE("the optimizer leaves every sample's output unchanged, bit for bit, ov
             REQUIRE_FALSE(plain.system->fire(t.name, args));
             REQUIRE_FALSE(optimized.system->fire(t.name, args));
         }
-        size_t differences = 0, points = 0;
+        size_t differences = 0;
         for (int frame = 0; frame < 600; ++frame) {
             plain.steps(1, 1.0 / 60);
             optimized.steps(1, 1.0 / 60);
@@ -342,14 +347,29 @@ TEST_CASE("the optimizer leaves every sample's output unchanged, bit for bit, ov
                 REQUIRE(a.size() == b.size());
                 for (size_t i = 0; i < a.size(); ++i) {
                     ++points;
-                    bool same = a[i].id == b[i].id && std::memcmp(&a[i].position, &b[i].position, sizeof a[i].position) == 0 &&
-                                std::memcmp(&a[i].color, &b[i].color, sizeof a[i].color) == 0 &&
-                                std::memcmp(&a[i].size, &b[i].size, sizeof a[i].size) == 0;
+                    bool same = a[i].id == b[i].id && close(a[i].size, b[i].size);
+                    for (int c = 0; c < 3; ++c) same &= close(a[i].position[static_cast<size_t>(c)], b[i].position[static_cast<size_t>(c)]);
+                    for (int c = 0; c < 4; ++c) same &= close(a[i].color[static_cast<size_t>(c)], b[i].color[static_cast<size_t>(c)]);
                     differences += same ? 0 : 1;
                 }
             }
         }
         CHECK(differences == 0);
-        CHECK(points > 0);
     }
+    return points;
+}
+
+TEST_CASE("the optimizer leaves every sample's output unchanged, bit for bit, over 600 frames") {
+    size_t points = compareWithUnoptimized(false, [](float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; });
+    CHECK(points > 100000);
+}
+
+TEST_CASE("with relaxed maths every sample's output stays within 1e-4 (relative) over 600 frames") {
+    // What differs: the last bits of reassociated sums and of x/c as x·(1/c), and integrals of
+    // constants taken as c·age instead of a float sum over 600 steps (the closed form is the
+    // more accurate of the two). Measured worst case: 6.3e-5, first_particle's position.
+    size_t points = compareWithUnoptimized(true, [](float a, float b) {
+        return std::fabs(a - b) <= 1e-4f * std::max(std::fabs(a), 1e-3f);
+    });
+    CHECK(points > 100000);
 }

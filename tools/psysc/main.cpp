@@ -59,36 +59,38 @@ std::unique_ptr<psys::ast::Program> checkOne(const std::string& path, psys::Sour
 
 // `psysc --stats FILE`: the cost of each object type without and with the optimizer.
 int printStats(const std::string& file, bool colour) {
-    psys::SourceManager sources;
-    psys::DiagnosticEngine diags(sources);
-    psys::CompileOptions plain;
-    plain.pipeline.optimize = false;
-    auto before = psys::compileFile(file, sources, diags, plain);
-    psys::SourceManager sources2;
-    psys::DiagnosticEngine diags2(sources2);
-    auto after = psys::compileFile(file, sources2, diags2);
-    diags.print(std::cerr, colour);
-    if (!before || !after) {
-        diags2.print(std::cerr, colour);
-        return 1;
+    // Three compilations: no optimizer, the exact optimizer, and with relaxed maths.
+    std::vector<std::vector<psys::opt::ObjectCost>> costs;
+    for (int level = 0; level < 3; ++level) {
+        psys::SourceManager sources;
+        psys::DiagnosticEngine diags(sources);
+        psys::CompileOptions options;
+        options.pipeline.optimize = level > 0;
+        options.pipeline.pass.relaxed = level == 2;
+        auto module = psys::compileFile(file, sources, diags, options);
+        if (level == 0 || !module) diags.print(std::cerr, colour);
+        if (!module) return 1;
+        costs.push_back(psys::opt::measure(*module));
     }
-    auto b = psys::opt::measure(*before), a = psys::opt::measure(*after);
-    std::cout << fmt::format("{:24} {:>20} {:>7} {:>22} {:>16} {:>16}\n", "object", "ops/update", "ratio",
-                             "state bytes/object", "param bytes", "ops at creation");
-    size_t totalBefore = 0, totalAfter = 0;
-    for (size_t i = 0; i < a.size(); ++i) {
-        totalBefore += b[i].opsPerUpdate;
-        totalAfter += a[i].opsPerUpdate;
-        std::string ratio = b[i].opsPerUpdate ? fmt::format("{:.0f}%", 100.0 * a[i].opsPerUpdate / b[i].opsPerUpdate) : "-";
-        std::cout << fmt::format("{:24} {:>20} {:>7} {:>22} {:>16} {:>16}\n", a[i].name,
-                                 fmt::format("{} -> {}", b[i].opsPerUpdate, a[i].opsPerUpdate), ratio,
-                                 fmt::format("{} -> {}", b[i].stateBytes, a[i].stateBytes),
-                                 fmt::format("{} -> {}", b[i].paramBytes, a[i].paramBytes),
-                                 fmt::format("{} -> {}", b[i].opsAtCreation, a[i].opsAtCreation));
+    auto percent = [](size_t a, size_t b) { return b ? fmt::format("{:.0f}%", 100.0 * a / b) : std::string("-"); };
+    std::cout << fmt::format("{:24} {:>22} {:>6} {:>6} {:>24} {:>16}\n", "object", "ops/update", "exact", "relax",
+                             "state bytes/object", "param bytes");
+    size_t total[3] = {0, 0, 0};
+    for (size_t i = 0; i < costs[0].size(); ++i) {
+        const auto &b = costs[0][i], &e = costs[1][i], &r = costs[2][i];
+        total[0] += b.opsPerUpdate;
+        total[1] += e.opsPerUpdate;
+        total[2] += r.opsPerUpdate;
+        std::cout << fmt::format("{:24} {:>22} {:>6} {:>6} {:>24} {:>16}\n", b.name,
+                                 fmt::format("{} / {} / {}", b.opsPerUpdate, e.opsPerUpdate, r.opsPerUpdate),
+                                 percent(e.opsPerUpdate, b.opsPerUpdate), percent(r.opsPerUpdate, b.opsPerUpdate),
+                                 fmt::format("{} / {} / {}", b.stateBytes, e.stateBytes, r.stateBytes),
+                                 fmt::format("{} / {} / {}", b.paramBytes, e.paramBytes, r.paramBytes));
     }
-    if (totalBefore)
-        std::cout << fmt::format("{:24} {:>20} {:>7}\n", "all", fmt::format("{} -> {}", totalBefore, totalAfter),
-                                 fmt::format("{:.0f}%", 100.0 * totalAfter / totalBefore));
+    std::cout << fmt::format("{:24} {:>22} {:>6} {:>6}\n", "all", fmt::format("{} / {} / {}", total[0], total[1], total[2]),
+                             percent(total[1], total[0]), percent(total[2], total[0]));
+    std::cout << "(columns: without the optimizer / optimized / optimized with --relaxed-math; ops are scalar "
+                 "operations per object per frame)\n";
     std::cout << "uniform ops per step: 0 (nothing is hoisted out of the per-object loop yet)\n";
     return 0;
 }
@@ -111,6 +113,10 @@ int main(int argc, char** argv) {
     app.add_option("--print-after", printAfter, "With --emit=ir: print the IR after this pass (repeatable)")
         ->type_name("PASS")->allow_extra_args(false);
     app.add_flag("--print-after-all", printAfterAll, "With --emit=ir: print the IR after every pass");
+    bool relaxedMath = false, noOptimize = false;
+    app.add_flag("--relaxed-math", relaxedMath,
+                 "Allow rewrites that may change the last bits of a result (docs/optimizer.md)");
+    app.add_flag("--no-optimize", noOptimize, "Only the lowering passes");
     std::string statsFile;
     app.add_option("--stats", statsFile, "Per object type: operations per update before and after optimization, "
                    "state bytes per object")->type_name("FILE");
@@ -149,6 +155,8 @@ int main(int argc, char** argv) {
     if (!statsFile.empty()) return printStats(statsFile, colour);
     if (run->parsed()) {
         runOptions.colour = colour;
+        runOptions.relaxed = relaxedMath;
+        runOptions.optimize = !noOptimize;
         return psys::tools::runSystem(runOptions);
     }
     if (check->parsed()) {
@@ -174,6 +182,8 @@ int main(int argc, char** argv) {
         }
         psys::ir::Module module = psys::ir::lower(*program);
         psys::opt::PipelineOptions options;
+        options.optimize = !noOptimize;
+        options.pass.relaxed = relaxedMath;
         options.printAfter = {printAfter.begin(), printAfter.end()};
         options.printAfterAll = printAfterAll;
         options.log = &std::cout;

@@ -134,7 +134,10 @@ int runSystem(const RunOptions& options) {
 
     SourceManager sources;
     DiagnosticEngine diags(sources);
-    auto module = compileFile(options.file, sources, diags);
+    CompileOptions compile;
+    compile.pipeline.optimize = options.optimize;
+    compile.pipeline.pass.relaxed = options.relaxed;
+    auto module = compileFile(options.file, sources, diags, compile);
     diags.print(std::cerr, options.colour);
     if (!module) return 1;
 

@@ -17,6 +17,8 @@ struct RunOptions {
     std::string dump;                // FILE.csv or FILE.json
     int dumpEvery = 1;
     bool quiet = false;
+    bool optimize = true;
+    bool relaxed = false;
     bool colour = false;
 };
 
