@@ -23,6 +23,7 @@ void Interpreter::run(const Kernel& kernel, const rt::KernelInputs& in, std::vec
             case Op::Param: case Op::TriggerParam: out = in.params[inst.attr]; break;
             case Op::StateRead: out = in.state[inst.attr]; break;
             case Op::Extern: out = in.externs[inst.attr]; break;
+            case Op::Uniform: out = in.uniforms[inst.attr]; break;
             case Op::Age: out = Value::scalar(in.age); break;
             case Op::Dt: out = Value::scalar(in.dt); break;
             case Op::Time: out = Value::scalar(in.time); break;

@@ -55,6 +55,7 @@ enum class YieldKind {
     EmitCount,  // index: emit site; objects per event (rate emitters) or in all (bursts)
     EmitArg,    // index: emit site, sub: argument
     Export,     // index: export (a value children read live)
+    Uniform,    // index: a value of a uniform kernel, the same for every object of the type
 };
 
 struct Yield {
@@ -64,7 +65,14 @@ struct Yield {
     ValueId value = 0;
 };
 
-enum class KernelKind { Behaviour, Init, Update, Render, Exports, Spawn, Trigger, Start };
+enum class KernelKind {
+    Behaviour, Init, Update, Render, Exports, Spawn, Trigger, Start,
+    // Once per step (and per distinct dt, time and externs) for a whole type: what the
+    // kernel it serves computes identically for every object (opt/hoist_uniform).
+    UniformUpdate, UniformRender, UniformExports,
+};
+// The uniform kernel serving `kind`, if it can have one.
+std::optional<KernelKind> uniformFor(KernelKind kind);
 
 class Kernel {
 public:

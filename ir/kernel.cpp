@@ -97,6 +97,15 @@ Kernel* Object::kernel(KernelKind kind, int site) {
     return const_cast<Kernel*>(static_cast<const Object*>(this)->kernel(kind, site));
 }
 
+std::optional<KernelKind> uniformFor(KernelKind kind) {
+    switch (kind) {
+        case KernelKind::Update: return KernelKind::UniformUpdate;
+        case KernelKind::Render: return KernelKind::UniformRender;
+        case KernelKind::Exports: return KernelKind::UniformExports;
+        default: return std::nullopt;
+    }
+}
+
 const Object* Module::object(const std::string& name) const {
     int i = objectIndex(name);
     return i < 0 ? nullptr : &objects[static_cast<size_t>(i)];
@@ -124,6 +133,9 @@ const char* kernelName(KernelKind kind) {
         case KernelKind::Spawn: return "spawn";
         case KernelKind::Trigger: return "trigger";
         case KernelKind::Start: return "start";
+        case KernelKind::UniformUpdate: return "uniform.update";
+        case KernelKind::UniformRender: return "uniform.render";
+        case KernelKind::UniformExports: return "uniform.exports";
     }
     return "?";
 }

@@ -21,7 +21,7 @@ std::optional<Op> opFromName(std::string_view name) {
     return std::nullopt;
 }
 
-bool isInput(Op op) { return op <= Op::DrawIndex; }
+bool isInput(Op op) { return op <= Op::Uniform; }
 
 bool mayReferForward(Op op, size_t operand) {
     if (op == Op::FollowedBy) return operand == 1;

@@ -25,6 +25,7 @@ namespace psys::ir {
     X(ParentAge, "parent.age", 0, 0)      /* attr2: levels up */                              \
     X(ObjectId, "object.id", 0, 0)        /* u32: this object's id */                         \
     X(DrawIndex, "draw.index", 0, 0)      /* u32: which draw of every random site this is */  \
+    X(Uniform, "uniform", 0, 0)           /* attr: a value of the uniform kernel */            \
     /* arithmetic, componentwise on equal types */                                             \
     X(Add, "add", 2, kCommutative)                                                             \
     X(Sub, "sub", 2, 0)                                                                        \

@@ -74,14 +74,15 @@ std::string nameBeforeParen(const std::string& header, size_t skip) {
 std::optional<YieldKind> yieldKind(const std::string& name) {
     for (YieldKind k : {YieldKind::StateNext, YieldKind::Kill, YieldKind::Visible, YieldKind::Position,
                         YieldKind::Color, YieldKind::Size, YieldKind::EmitRate, YieldKind::EmitCount,
-                        YieldKind::EmitArg, YieldKind::Export})
+                        YieldKind::EmitArg, YieldKind::Export, YieldKind::Uniform})
         if (yieldKindName(k) == name) return k;
     return std::nullopt;
 }
 
 std::optional<KernelKind> kernelKind(const std::string& name) {
     for (KernelKind k : {KernelKind::Behaviour, KernelKind::Init, KernelKind::Update, KernelKind::Render,
-                         KernelKind::Exports, KernelKind::Spawn, KernelKind::Trigger, KernelKind::Start})
+                         KernelKind::Exports, KernelKind::Spawn, KernelKind::Trigger, KernelKind::Start,
+                         KernelKind::UniformUpdate, KernelKind::UniformRender, KernelKind::UniformExports})
         if (name == kernelName(k)) return k;
     return std::nullopt;
 }

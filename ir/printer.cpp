@@ -43,6 +43,7 @@ std::string yieldKindName(YieldKind kind) {
         case YieldKind::EmitCount: return "emit.count";
         case YieldKind::EmitArg: return "emit.arg";
         case YieldKind::Export: return "export";
+        case YieldKind::Uniform: return "uniform";
     }
     return "?";
 }
@@ -59,7 +60,8 @@ std::string print(const Kernel& kernel, int indent) {
         for (size_t i = 0; i < inst.operands.size(); ++i) line += fmt::format("{} %{}", i ? "," : "", inst.operands[i]);
         bool showAttr = inst.attr != 0 || inst.op == Op::Param || inst.op == Op::StateRead || inst.op == Op::Extern ||
                         inst.op == Op::TriggerParam || inst.op == Op::ParentRead || inst.op == Op::ParentExport ||
-                        inst.op == Op::Extract || inst.op == Op::DrawIndex || isTemporal(inst.op);
+                        inst.op == Op::Extract || inst.op == Op::DrawIndex || inst.op == Op::Uniform ||
+                        isTemporal(inst.op);
         if (showAttr) line += fmt::format(" #{}", inst.attr);
         if (inst.attr2 != 0) line += fmt::format(" ^{}", inst.attr2);
         if (!inst.lanes.empty()) {
@@ -74,7 +76,8 @@ std::string print(const Kernel& kernel, int indent) {
     for (const Yield& y : kernel.yields) {
         std::string line = pad + "  yield " + yieldKindName(y.kind);
         bool indexed = y.kind == YieldKind::StateNext || y.kind == YieldKind::EmitRate ||
-                       y.kind == YieldKind::EmitCount || y.kind == YieldKind::EmitArg || y.kind == YieldKind::Export;
+                       y.kind == YieldKind::EmitCount || y.kind == YieldKind::EmitArg || y.kind == YieldKind::Export ||
+                       y.kind == YieldKind::Uniform;
         if (indexed) line += fmt::format(" #{}", y.index);
         if (y.kind == YieldKind::EmitArg) line += fmt::format(" #{}", y.sub);
         out += line + fmt::format(" = %{}\n", y.value);

@@ -11,6 +11,7 @@ public:
 
     void kernel(const Kernel& k, const Object* object, const Trigger* trigger, const std::string& where) {
         where_ = where + ", kernel " + kernelName(k.kind);
+        kernel_ = &k;
         object_ = object;
         trigger_ = trigger;
         bool behaviour = k.kind == KernelKind::Behaviour;
@@ -83,6 +84,13 @@ private:
             case Op::Age: case Op::Dt: case Op::Time: expect(i.type.isScalarFloat(), "an f32"); break;
             case Op::First: expect(i.type.isBool(), "a bool"); break;
             case Op::ObjectId: case Op::DrawIndex: expect(i.type == Type::u32(), "a u32"); break;
+            case Op::Uniform: {
+                auto served = uniformFor(kernel_->kind);
+                const Kernel* u = object_ && served ? object_->kernel(*served) : nullptr;
+                const Yield* y = u ? u->findOne(YieldKind::Uniform, i.attr) : nullptr;
+                expect(y && u->at(y->value).type == i.type, "no uniform value of this index and type");
+                break;
+            }
             case Op::Lt: case Op::Le: case Op::Gt: case Op::Ge:
                 expect(i.type.isBool() && t(0).isScalarFloat() && t(1).isScalarFloat(), "compares two f32 to a bool");
                 break;
@@ -155,6 +163,7 @@ private:
                        "not an argument of the emitted object");
                 break;
             }
+            case YieldKind::Uniform: expect(y.index >= 0, "a uniform index"); break;
             case YieldKind::Export:
                 expect(object_ && y.index >= 0 && static_cast<size_t>(y.index) < object_->exports.size() &&
                            object_->exports[static_cast<size_t>(y.index)].type == t,
@@ -169,6 +178,7 @@ private:
     const Object* object_ = nullptr;
     const Trigger* trigger_ = nullptr;
     bool unkeyedDrawsAllowed_ = false;
+    const Kernel* kernel_ = nullptr;
 };
 
 }  // namespace

@@ -24,6 +24,8 @@
 //                    (a+b+c)·(a+b+d) computes a+b once
 //   dead-state       slots nothing needs go, equal slots merge, unchanged slots are not
 //                    stored, parameters read only at creation are not kept
+//   hoist-uniform    what is the same for every object of a type (constants, dt, time,
+//                    externs) is computed once per step in a uniform kernel
 #pragma once
 
 #include <iosfwd>
@@ -55,6 +57,7 @@ void keyRandom(ir::Module& module, PassErrors& errors);
 void splitKernels(ir::Module& module, PassErrors& errors);
 void simplify(ir::Module& module, const PassOptions& options, PassErrors& errors);
 void reassociate(ir::Module& module, PassErrors& errors);
+void hoistUniform(ir::Module& module, PassErrors& errors);
 void deadState(ir::Module& module, PassErrors& errors);
 
 struct PassInfo {

@@ -21,6 +21,7 @@ const std::vector<PassInfo>& passCatalogue() {
         {"simplify", "constant folding and exact identities (on the behaviour)"},
         {"simplify-kernels", "constant folding and exact identities (on the split kernels)"},
         {"reassociate", "(relaxed) sums and products in one canonical order, sharing common parts"},
+        {"hoist-uniform", "per-type work (constants, dt, time, externs) is done once per step"},
         {"dead-state", "unneeded slots go, equal slots merge, parameters used only at creation are not kept"},
     };
     return passes;
@@ -69,7 +70,9 @@ bool runPipeline(ir::Module& module, const PipelineOptions& options, PassErrors&
     simplify(module, options.pass, errors);
     if (!after("simplify-kernels")) return false;
     deadState(module, errors);
-    return after("dead-state");
+    if (!after("dead-state")) return false;
+    hoistUniform(module, errors);
+    return after("hoist-uniform");
 }
 
 }  // namespace psys::opt

@@ -16,6 +16,8 @@
 //   snapshot(x)             → x when x depends only on parameters and constants: it
 //                           cannot change after creation, so it needs no state
 //   x·(−1) → −x             exact in IEEE arithmetic
+//   if-floating             f(select(c, k1, k2), k3) → select(c, f(k1, k3), f(k2, k3)) for
+//                           constants k (thesis §4.3.7): the branches then fold
 //   narrowing               one lane of a componentwise operation used by nothing else is
 //                           that operation on that lane: extract(u+v, 1) → u.y + v.y
 //
@@ -94,6 +96,28 @@ std::optional<ValueId> rule(Rewriter& rw, const Inst& old, const std::vector<Val
             }
             Value v = evaluate(inst, values.data(), types.data());
             return k.constant(inst.type, v.f);
+        }
+    }
+    // If-floating: an operation on a choice between constants and a constant is a choice
+    // between two constants.
+    if (isPure(old.op) && ops.size() == 2 && old.op != Op::Select) {
+        for (size_t s = 0; s < 2; ++s) {
+            const Inst& sel = at(s);
+            if (sel.op != Op::Select || !isConst(k, sel.operands[1]) || !isConst(k, sel.operands[2]) ||
+                !isConst(k, ops[1 - s]))
+                continue;
+            ValueId cond = sel.operands[0], branches[2] = {sel.operands[1], sel.operands[2]}, other = ops[1 - s];
+            ValueId folded[2];
+            for (int b = 0; b < 2; ++b) {
+                Inst f = inst;
+                f.name.clear();
+                f.operands[s] = branches[b];
+                f.operands[1 - s] = other;
+                Value values[2] = {{k.at(f.operands[0]).constant, 0}, {k.at(f.operands[1]).constant, 0}};
+                Type types[2] = {k.at(f.operands[0]).type, k.at(f.operands[1]).type};
+                folded[b] = k.constant(inst.type, evaluate(f, values, types).f);
+            }
+            return rw.emit({Op::Select, inst.type, {cond, folded[0], folded[1]}, 0, 0, {}, {}, ""});
         }
     }
     switch (old.op) {

@@ -28,7 +28,9 @@ std::vector<ObjectCost> measure(const Module& module) {
         c.name = o.name;
         for (const Kernel& k : o.kernels) {
             bool perFrame = k.kind == KernelKind::Update || k.kind == KernelKind::Render || k.kind == KernelKind::Exports;
-            (perFrame ? c.opsPerUpdate : c.opsAtCreation) += countOps(k);
+            bool uniform = k.kind == KernelKind::UniformUpdate || k.kind == KernelKind::UniformRender ||
+                           k.kind == KernelKind::UniformExports;
+            (uniform ? c.uniformOps : perFrame ? c.opsPerUpdate : c.opsAtCreation) += countOps(k);
         }
         for (const StateSlot& s : o.state) c.stateBytes += 4u * s.type.width;
         for (const Param& p : o.params)

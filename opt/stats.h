@@ -13,6 +13,7 @@ struct ObjectCost {
     std::string name;
     size_t opsPerUpdate = 0;   // scalar operations run per object per frame: update + render + exports
     size_t opsAtCreation = 0;  // the same for init and the spawn kernels
+    size_t uniformOps = 0;     // scalar operations per type per step (uniform kernels)
     size_t stateBytes = 0;     // state slots kept per object
     size_t paramBytes = 0;     // parameters kept per object
 };

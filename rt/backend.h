@@ -23,6 +23,7 @@ struct KernelInputs {
     const Value* params = nullptr;        // the object's (or a trigger's) parameters
     const Value* state = nullptr;         // its slots before this kernel
     const Value* externs = nullptr;
+    const Value* uniforms = nullptr;      // the values of the kernel's uniform kernel
     float age = 0;
     float dt = 0;
     float time = 0;

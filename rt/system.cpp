@@ -48,6 +48,7 @@ System::System(ir::Module module, Backend& backend, SystemOptions options)
     render_.resize(pools_.size());
     renderStale_.assign(pools_.size(), true);
     queued_.assign(pools_.size(), 0);
+    uniformCache_.resize(pools_.size());
 }
 
 // The `spawn`s run when the system is first used, so externs set before that apply.
@@ -106,7 +107,35 @@ KernelInputs System::inputs(size_t type, uint32_t row, double at, float dt, bool
     return in;
 }
 
-void System::runKernel(size_t, uint32_t, const ir::Kernel& kernel, const KernelInputs& in) {
+// The values of `kernel`'s uniform kernel for the step context of `in`, computed again
+// only when dt, time or an extern changed.
+const Value* System::uniforms(size_t type, const ir::Kernel& kernel, const KernelInputs& in) {
+    auto served = ir::uniformFor(kernel.kind);
+    if (!served) return nullptr;
+    const ir::Kernel* u = pools_[type].object().kernel(*served);
+    if (!u) return nullptr;
+    UniformCache& cache = uniformCache_[type][static_cast<size_t>(kernel.kind) - static_cast<size_t>(KernelKind::Update)];
+    if (!cache.valid || cache.dt != in.dt || cache.time != in.time || cache.externs != externsVersion_) {
+        KernelInputs ui;
+        ui.externs = externs_.data();
+        ui.dt = in.dt;
+        ui.time = in.time;
+        ui.seed = in.seed;
+        std::vector<Value> values;
+        backend_.run(*u, ui, values);
+        cache.values.assign(values.size(), Value{});
+        for (size_t i = 0; i < u->yields.size(); ++i) cache.values.at(static_cast<size_t>(u->yields[i].index)) = values[i];
+        cache.valid = true;
+        cache.dt = in.dt;
+        cache.time = in.time;
+        cache.externs = externsVersion_;
+        ++stats_.uniformEvaluations;
+    }
+    return cache.values.data();
+}
+
+void System::runKernel(size_t type, uint32_t, const ir::Kernel& kernel, KernelInputs in) {
+    in.uniforms = uniforms(type, kernel, in);
     backend_.run(kernel, in, yields_);
 }
 
@@ -337,6 +366,7 @@ std::optional<std::string> System::setExtern(int index, std::span<const float> v
     for (size_t i = 0; i < value.size(); ++i) v.f[i] = value[i];
     if (!finite(v, e.type.width)) ++stats_.nonFiniteExterns;
     externs_[static_cast<size_t>(index)] = v;
+    ++externsVersion_;
     return std::nullopt;
 }
 

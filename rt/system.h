@@ -49,6 +49,7 @@ struct Stats {
     uint64_t nonFiniteExterns = 0;     // NaN or infinite values set on an extern
     uint64_t invalidEmissions = 0;     // NaN or negative rates and counts (taken as 0)
     uint64_t nonFiniteRender = 0;      // points not drawn because a value was NaN or infinite
+    uint64_t uniformEvaluations = 0;   // runs of uniform kernels (once per step per type, mostly)
 };
 
 struct RenderPoint {
@@ -92,7 +93,8 @@ private:
 
     KernelInputs inputs(size_t type, uint32_t row, double at, float dt, bool first, std::vector<Value>& params,
                         std::vector<Value>& state);
-    void runKernel(size_t type, uint32_t row, const ir::Kernel& kernel, const KernelInputs& in);
+    void runKernel(size_t type, uint32_t row, const ir::Kernel& kernel, KernelInputs in);
+    const Value* uniforms(size_t type, const ir::Kernel& kernel, const KernelInputs& in);
     void update(size_t type, uint32_t row, double dt, double t1);
     void updateOnce(size_t type, uint32_t row, double dt, double t1);
     void create(const Creation& c, double t1);
@@ -124,6 +126,16 @@ private:
     uint32_t nextId_ = 0;
     bool started_ = false;
     std::vector<Value> yields_;
+    // Per type and served kernel: the uniform values and the (dt, time, externs) they
+    // were computed for.
+    struct UniformCache {
+        bool valid = false;
+        float dt = 0, time = 0;
+        uint64_t externs = 0;
+        std::vector<Value> values;
+    };
+    std::vector<std::array<UniformCache, 3>> uniformCache_;
+    uint64_t externsVersion_ = 0;
 };
 
 }  // namespace psys::rt

@@ -461,3 +461,72 @@ end
 end
 )");
 }
+
+TEST_CASE("simplify: if-floating folds an operation into a choice between constants") {
+    CHECK(after(R"(object p()
+  kernel update
+    %0 = age.f32
+    %1 = const.f32 1
+    %2 = gt.bool %0, %1
+    %3 = const.f32 0.9
+    %4 = select.f32 %2, %3, %1
+    %5 = const.f32 2
+    %6 = mul.f32 %4, %5
+    yield size = %6
+  end
+end
+)", simplifyExact) == R"(object p()
+  kernel update
+    %0 = age.f32
+    %1 = const.f32 1
+    %2 = gt.bool %0, %1
+    %3 = const.f32 2
+    %4 = const.f32 1.8
+    %5 = select.f32 %2, %4, %3
+    yield size = %5
+  end
+end
+)");
+}
+
+TEST_CASE("hoist-uniform: what every object of a type computes alike moves to a uniform kernel") {
+    std::string out = after(R"(extern g: f32 = 2
+object p(v: vec3)
+  kernel render
+    %0 = param.vec3 #0
+    %1 = dt.f32
+    %2 = extern.f32 #0
+    %3 = mul.f32 %1, %2
+    %4 = splat.vec3 %3
+    %5 = mul.vec3 %0, %4
+    %6 = age.f32
+    %7 = mul.f32 %6, %1
+    yield position = %5
+    yield size = %7
+  end
+end
+)", opt::hoistUniform);
+    // dt·g is the same for every object: once per step. The splat stays (it is free), and
+    // age·dt depends on the object.
+    CHECK(out == R"(extern g: f32 = 2
+object p(v: vec3)
+  kernel render
+    %0 = param.vec3 #0
+    %1 = dt.f32
+    %2 = uniform.f32 #0
+    %3 = splat.vec3 %2
+    %4 = mul.vec3 %0, %3
+    %5 = age.f32
+    %6 = mul.f32 %1, %5
+    yield position = %4
+    yield size = %6
+  end
+  kernel uniform.render
+    %0 = dt.f32
+    %1 = extern.f32 #0
+    %2 = mul.f32 %0, %1
+    yield uniform #0 = %2
+  end
+end
+)");
+}
