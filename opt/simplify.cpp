@@ -20,6 +20,12 @@
 //                           constants k (thesis §4.3.7): the branches then fold
 //   narrowing               one lane of a componentwise operation used by nothing else is
 //                           that operation on that lane: extract(u+v, 1) → u.y + v.y
+//   lane splitting          splat(a)·K with K a constant vector, some of whose lanes are
+//                           ±0 or ±1, and `a` known finite and ≥ 0 (age, dt): each lane
+//                           alone, a·(±0) = ±0 exactly; then K2 + compose(…) lane by lane,
+//                           folding what became constant: mix(green, black, age) is
+//                           (0, 1 − age, 0, 1), one operation instead of eight
+//   x + (−y) → x − y        exact
 //
 // With relaxed maths (PassOptions::relaxed) also: x+0 → x (wrong only in the sign of a
 // zero: −0+0 is +0) and x/c → x·(1/c) for any finite non-zero c (at most 2 ulp away).
@@ -63,6 +69,18 @@ std::optional<std::array<float, 4>> exactReciprocal(const Inst& c) {
         out[static_cast<size_t>(i)] = r;
     }
     return out;
+}
+
+// Known to be finite and ≥ +0 (never −0): ages and step lengths (the run-time refuses a
+// negative or non-finite dt), and such constants.
+bool finiteNonNegative(const Kernel& k, ValueId v) {
+    const Inst& i = k.at(v);
+    if (i.op == Op::Age || i.op == Op::Dt) return true;
+    if (i.op == Op::Const && i.type.isScalarFloat()) {
+        float x = i.constant[0];
+        return std::isfinite(x) && x >= 0 && !std::signbit(x);
+    }
+    return false;
 }
 
 bool componentwise(Op op) {
@@ -126,11 +144,56 @@ std::optional<ValueId> rule(Rewriter& rw, const Inst& old, const std::vector<Val
                 if (constAll(k, ops[i], 1.0f)) return ops[1 - i];
                 if (constAll(k, ops[i], -1.0f)) return rw.emit({Op::Neg, inst.type, {ops[1 - i]}, 0, 0, {}, {}, ""});
             }
+            // splat(a)·K, a finite and ≥ +0: lanes of K that are ±0 or ±1 need no multiplication.
+            for (size_t i = 0; i < 2; ++i) {
+                const Inst& s = at(1 - i);
+                if (!inst.type.isVector() || at(i).op != Op::Const || s.op != Op::Splat) continue;
+                ValueId a = s.operands[0];
+                if (!finiteNonNegative(k, a)) continue;
+                std::array<float, 4> constant = at(i).constant;
+                bool special = false;
+                for (int l = 0; l < inst.type.width; ++l) {
+                    float c = constant[static_cast<size_t>(l)];
+                    special |= c == 0 || c == 1 || c == -1;
+                }
+                if (!special) continue;
+                std::vector<ValueId> lanes;
+                for (int l = 0; l < inst.type.width; ++l) {
+                    float c = constant[static_cast<size_t>(l)];
+                    if (c == 0) lanes.push_back(k.scalar(c));  // a·(±0) is ±0 for finite a ≥ +0
+                    else if (c == 1) lanes.push_back(a);
+                    else if (c == -1) lanes.push_back(rw.emit({Op::Neg, Type::f32(), {a}, 0, 0, {}, {}, ""}));
+                    else lanes.push_back(rw.emit({Op::Mul, Type::f32(), {a, k.scalar(c)}, 0, 0, {}, {}, ""}));
+                }
+                return rw.emit({Op::Compose, inst.type, lanes, 0, 0, {}, {}, ""});
+            }
             break;
         case Op::Add:
             for (size_t i = 0; i < 2; ++i) {
                 if (constAll(k, ops[i], -0.0f)) return ops[1 - i];
                 if (ctx.relaxed && constAll(k, ops[i], 0.0f)) return ops[1 - i];
+                if (at(i).op == Op::Neg) return rw.emit({Op::Sub, inst.type, {ops[1 - i], at(i).operands[0]}, 0, 0, {}, {}, ""});
+            }
+            // Lane by lane when that makes lanes constant: K + compose(…) with constant parts.
+            for (size_t i = 0; i < 2; ++i) {
+                const Inst& parts = at(1 - i);
+                if (!inst.type.isVector() || at(i).op != Op::Const || parts.op != Op::Compose) continue;
+                bool anyConstant = false, scalarParts = true;
+                for (ValueId p : parts.operands) {
+                    anyConstant |= isConst(k, p);
+                    scalarParts &= k.at(p).type.width == 1;
+                }
+                if (!anyConstant || !scalarParts) continue;
+                std::array<float, 4> constant = at(i).constant;
+                std::vector<ValueId> laneParts = parts.operands;  // a copy: emitting may move instructions
+                std::vector<ValueId> lanes;
+                for (size_t l = 0; l < laneParts.size(); ++l) {
+                    ValueId kl = k.scalar(constant[l]);
+                    Inst add{Op::Add, Type::f32(), {kl, laneParts[l]}, 0, 0, {}, {}, ""};
+                    auto folded = rule(rw, add, add.operands, ctx);
+                    lanes.push_back(folded ? *folded : rw.emit(add));
+                }
+                return rw.emit({Op::Compose, inst.type, lanes, 0, 0, {}, {}, ""});
             }
             break;
         case Op::Sub:

@@ -530,3 +530,28 @@ object p(v: vec3)
 end
 )");
 }
+
+TEST_CASE("simplify: lane splitting turns mix(green, black, age) into (0, 1 - age, 0, 1)") {
+    CHECK(after(R"(object p()
+  kernel render
+    %0 = const.vec4 0 1 0 1
+    %1 = age.f32
+    %2 = splat.vec4 %1
+    %3 = const.vec4 0 -1 0 0
+    %4 = mul.vec4 %2, %3
+    %5 = add.vec4 %0, %4
+    yield color = %5
+  end
+end
+)", simplifyExact) == R"(object p()
+  kernel render
+    %0 = age.f32
+    %1 = const.f32 0
+    %2 = const.f32 1
+    %3 = sub.f32 %2, %0
+    %4 = compose.vec4 %1, %3, %1, %2
+    yield color = %4
+  end
+end
+)");
+}
