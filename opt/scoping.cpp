@@ -28,8 +28,8 @@ void scoping(Module& module, PassErrors& errors) {
             }
             Object& ancestor = module.objects[static_cast<size_t>(ancestorIndex)];
             Kernel* ak = ancestor.kernel(KernelKind::Behaviour);
-            auto value = ak ? ak->equations.find(read.member) : decltype(ak->equations.end()){};
-            if (!ak || value == ak->equations.end()) {
+            bool found = ak && ak->equations.count(read.member);
+            if (!found) {
                 errors.push_back(fmt::format("object {}: `{}` has no equation `{}`", child.name, ancestor.name, read.member));
                 resolved.push_back({0, read.depth});
                 continue;
@@ -40,7 +40,7 @@ void scoping(Module& module, PassErrors& errors) {
             if (exportIndex < 0) {
                 exportIndex = static_cast<int>(ancestor.exports.size());
                 ancestor.exports.push_back({read.member, read.type});
-                ak->yields.push_back({YieldKind::Export, exportIndex, 0, value->second});
+                ak->yields.push_back({YieldKind::Export, exportIndex, 0, ak->equations.at(read.member)});
             }
             resolved.push_back({exportIndex, read.depth});
         }
