@@ -80,6 +80,7 @@ KernelInputs System::inputs(size_t type, uint32_t row, double at, float dt, bool
     in.seed = options_.seed;
     in.objectId = pool.id[row];
     in.draw = first ? kCreationDraw : static_cast<uint32_t>(step_);
+    if (parentType_[type] < 0) return in;  // no live parent reads: nothing more to set up
     // The ancestor `depth` levels up, or (type, row) = (-1, 0) when there is none.
     auto ancestor = [this, type, row](int depth) -> std::pair<int, uint32_t> {
         int t = static_cast<int>(type);

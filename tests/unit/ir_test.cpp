@@ -53,12 +53,7 @@ TEST_CASE("every sample's IR prints, parses back and prints the same, before and
     for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
         if (entry.path().extension() != ".psys") continue;
         ++count;
-        auto c = test::check([&] {
-            std::ifstream in(entry.path());
-            std::ostringstream s;
-            s << in.rdbuf();
-            return s.str();
-        }(), entry.path().string());
+        auto c = test::check(test::readFile(entry.path().string()), entry.path().string());
         REQUIRE_MESSAGE(c.ok(), c.output);
         Module m = lower(*c.program);
         INFO(entry.path().filename().string());

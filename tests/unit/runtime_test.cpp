@@ -13,6 +13,7 @@
 #include "driver/compile.h"
 #include "interp/interpreter.h"
 #include "rt/system.h"
+#include "test_support.h"
 
 using namespace psys;
 
@@ -42,12 +43,6 @@ struct Run {
     rt::TypeStats stats(const std::string& name) const { return system->stats().types[type(name)]; }
 };
 
-std::string readFile(const std::filesystem::path& p) {
-    std::ifstream in(p);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
 
 }  // namespace
 
@@ -166,7 +161,7 @@ TEST_CASE("a frozen parent is freed after its last reader dies") {
 }
 
 TEST_CASE("the same seed gives the same run; another seed another") {
-    std::string fireworks = readFile(std::filesystem::path(PSYS_SAMPLES_DIR) / "fireworks.psys");
+    std::string fireworks = test::readFile((std::filesystem::path(PSYS_SAMPLES_DIR) / "fireworks.psys").string());
     auto positions = [&](uint32_t seed) {
         Run run(fireworks, {seed, 1 << 20});
         run.steps(120, 1.0 / 60);
@@ -186,7 +181,7 @@ TEST_CASE("every sample compiles, verifies and runs 600 frames at dt = 1/60") {
         if (entry.path().extension() != ".psys") continue;
         ++count;
         INFO(entry.path().filename().string());
-        Run run(readFile(entry.path()));
+        Run run(test::readFile(entry.path().string()));
         run.steps(600, 1.0 / 60);
         for (size_t t = 0; t < run.system->typeCount(); ++t) run.system->render(t);
         CHECK(run.system->stats().nonFiniteRender == 0);
@@ -328,7 +323,7 @@ size_t compareWithUnoptimized(bool relaxed, const std::function<bool(float, floa
     for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
         if (entry.path().extension() != ".psys") continue;
         INFO(entry.path().filename().string());
-        std::string text = readFile(entry.path());
+        std::string text = test::readFile(entry.path().string());
         Run plain(text, {}, false), optimized(text, {}, true, relaxed);
         for (const ir::Trigger& t : plain.system->module().triggers) {
             size_t width = 0;

@@ -11,13 +11,6 @@ using namespace psys;
 
 namespace {
 
-std::string readSample(const std::filesystem::path& path) {
-    std::ifstream in(path);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
 // ANTLR's own phrasing must never reach a user.
 void checkWording(const std::string& output) {
     CHECK(output.find("mismatched input") == std::string::npos);
@@ -52,7 +45,7 @@ TEST_CASE("truncated and damaged samples give located, worded errors and never c
     for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
         if (entry.path().extension() != ".psys") continue;
         ++files;
-        std::string text = readSample(entry.path());
+        std::string text = test::readFile(entry.path().string());
         for (size_t cut = 0; cut < text.size(); cut += 13) {
             // Cut the file short, and separately drop one character from the middle.
             for (std::string variant : {text.substr(0, cut), text.substr(0, cut) + text.substr(cut + 1)}) {

@@ -1,9 +1,18 @@
 #include "test_support.h"
 
+#include <fstream>
 #include <functional>
+#include <sstream>
 #include <stdexcept>
 
 namespace psys::test {
+
+std::string readFile(const std::string& path) {
+    std::ifstream in(path);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
 
 Checked check(const std::string& text, const std::string& path) {
     Checked c;

@@ -23,4 +23,7 @@ struct Checked {
 // Checks `text` as the file `path` (imports resolve relative to it).
 Checked check(const std::string& text, const std::string& path = "test.psys");
 
+// The whole of a file, such as a sample.
+std::string readFile(const std::string& path);
+
 }  // namespace psys::test
