@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <fstream>
 #include <sstream>
 
@@ -367,4 +368,14 @@ TEST_CASE("with relaxed maths every sample's output stays within 1e-4 (relative)
         return std::fabs(a - b) <= 1e-4f * std::max(std::fabs(a), 1e-3f);
     });
     CHECK(points > 100000);
+}
+
+TEST_CASE("each emission event creates `count` objects, all at the event's time") {
+    Run run("object s { point(origin, white, age); }\nobject e { emit s at 2 per second count 3; }\nspawn e;");
+    run.steps(300, 1.0 / 60);  // 5 s: events at 0.5 s, 1 s, …, 5 s
+    CHECK(run.stats("s").created == 30);
+    std::map<float, int> perAge;
+    for (auto& p : run.points("s")) ++perAge[std::round(p.size * 1000) / 1000];
+    CHECK(perAge.size() == 10);
+    for (auto& [age, n] : perAge) CHECK(n == 3);
 }
