@@ -144,6 +144,8 @@ int main(int argc, char** argv) {
     run->add_option("--dump", runOptions.dump, "Write every drawn point per frame to FILE.csv or FILE.json");
     run->add_option("--dump-every", runOptions.dumpEvery, "Dump every Nth frame (1)")->check(CLI::PositiveNumber);
     run->add_flag("--quiet", runOptions.quiet, "No line per frame, only the summary");
+    run->add_option("--backend", runOptions.backend, "interp (the reference) or llvm (JIT-compiled)")
+        ->check(CLI::IsMember({"interp", "llvm"}));
     run->fallthrough();
 
     app.require_subcommand(0, 1);

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "driver/compile.h"
+#include "codegen_llvm/llvm_backend.h"
 #include "interp/interpreter.h"
 #include "rt/system.h"
 
@@ -141,8 +142,10 @@ int runSystem(const RunOptions& options) {
     diags.print(std::cerr, options.colour);
     if (!module) return 1;
 
-    interp::Interpreter backend;
-    rt::System system(std::move(*module), backend, {options.seed, options.capacity});
+    std::unique_ptr<rt::Backend> backend;
+    if (options.backend == "llvm") backend = std::make_unique<codegen_llvm::LlvmBackend>();
+    else backend = std::make_unique<interp::Interpreter>();
+    rt::System system(std::move(*module), *backend, {options.seed, options.capacity});
     for (auto& [name, values] : sets)
         if (auto error = system.setExtern(name, values)) {
             std::cerr << "psysc: error: --set " << name << ": " << *error << "\n";

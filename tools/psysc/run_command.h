@@ -19,6 +19,7 @@ struct RunOptions {
     bool quiet = false;
     bool optimize = true;
     bool relaxed = false;
+    std::string backend = "interp";  // or "llvm"
     bool colour = false;
 };
 
