@@ -1,9 +1,11 @@
-// What the run-time asks of a backend: evaluate one kernel for one object.
+// What the run-time asks of a backend: evaluate a kernel for one object (`run`), or for a
+// range of rows of a pool, column by column (`runRows`, rt/batch.h).
 //
 // The run-time (pools, time, spawning, killing, parents, externs, triggers) is the same
-// for every backend; a backend only computes kernels. The inputs are gathered from the
-// object's row of its pool and from the system; the yields come back in the kernel's
-// order and the run-time scatters them.
+// for every backend; a backend only computes kernels. For `run`, the inputs are gathered
+// from the object's row of its pool and from the system; the yields come back in the
+// kernel's order and the run-time scatters them. `runRows` reads and writes the pool's
+// columns in place; its default runs `run` row by row, so every backend has it.
 #pragma once
 
 #include <array>
@@ -14,6 +16,7 @@
 
 #include "ir/ir.h"
 #include "ir/value.h"
+#include "rt/batch.h"
 
 namespace psys::rt {
 
@@ -44,6 +47,15 @@ public:
     virtual std::string name() const = 0;
     // Evaluates `kernel` once; `yields[i]` receives the value of `kernel.yields[i]`.
     virtual void run(const ir::Kernel& kernel, const KernelInputs& in, std::vector<Value>& yields) = 0;
+
+    // Called once for every module a System runs, before any kernel of it: a compiling
+    // backend compiles them all here.
+    virtual void prepare(const ir::Module&) {}
+    // Evaluates an update or exports kernel of `object` on the masked rows of `batch`.
+    virtual void runRows(const ir::Object& object, const ir::Kernel& kernel, const BatchLayout& layout,
+                         const RowBatch& batch);
+    // Whether runRows may run on several threads at once (on disjoint rows).
+    virtual bool concurrent() const { return false; }
 };
 
 }  // namespace psys::rt

@@ -58,13 +58,15 @@ std::optional<uint32_t> Pool::allocate() {
         id.resize(n, 0);
         parent.resize(n);
         readers.resize(n, 0);
-        createdStep.resize(n, 0);
+        updatable.resize(n, 0);
         for (auto& e : emitted) e.resize(n, 0);
         state.resize(n);
         params.resize(n);
         exports.resize(n);
     }
     status_[row] = Status::Alive;
+    updatable[row] = 0;
+    fresh.push_back(row);
     ++live_;
     readers[row] = 0;
     parent[row] = {};
@@ -75,6 +77,7 @@ std::optional<uint32_t> Pool::allocate() {
 void Pool::freeze(uint32_t row) {
     if (status_[row] != Status::Alive) return;
     status_[row] = Status::Frozen;
+    updatable[row] = 0;
     --live_;
     ++frozen_;
 }
@@ -84,8 +87,15 @@ void Pool::release(uint32_t row) {
     else if (status_[row] == Status::Frozen) --frozen_;
     else return;
     status_[row] = Status::Free;
+    updatable[row] = 0;
     ++generation_[row];
     freeRows_.push_back(row);
+}
+
+void Pool::beginStep() {
+    for (uint32_t row : fresh)
+        if (status_[row] == Status::Alive) updatable[row] = 1;
+    fresh.clear();
 }
 
 }  // namespace psys::rt

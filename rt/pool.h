@@ -34,6 +34,7 @@ public:
     void set(size_t i, size_t row, const Value& v);
     size_t count() const { return types_.size(); }
     const std::vector<float>& column(size_t i, size_t component) const { return columns_[offset_[i] + component]; }
+    float* data(size_t i, size_t component) { return columns_[offset_[i] + component].data(); }
 
 private:
     std::vector<ir::Type> types_;
@@ -65,7 +66,11 @@ public:
     std::vector<uint32_t> id;
     std::vector<Handle> parent;
     std::vector<uint32_t> readers;       // children that read this object live
-    std::vector<uint64_t> createdStep;   // the step that created it (updated at creation)
+    // 1 for rows a step updates: alive and not created during the current step. Rows
+    // created during a step are listed in `fresh` until the next step begins.
+    std::vector<uint8_t> updatable;
+    std::vector<uint32_t> fresh;
+    void beginStep();  // the rows created before this step become updatable
     std::vector<std::vector<double>> emitted;  // per rate site: events accumulated, in [0, 1)
     Status status(uint32_t row) const { return status_[row]; }
 

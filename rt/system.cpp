@@ -4,6 +4,7 @@
 #include <cstdlib>
 
 #include <fmt/format.h>
+#include <tbb/parallel_for.h>
 
 #include "rt/rng.h"
 
@@ -49,6 +50,24 @@ System::System(ir::Module module, Backend& backend, SystemOptions options)
     renderStale_.assign(pools_.size(), true);
     queued_.assign(pools_.size(), 0);
     uniformCache_.resize(pools_.size());
+    for (const ir::Object& o : module_.objects) {
+        PoolBatch b;
+        const ir::Kernel* update = o.kernel(KernelKind::Update);
+        b.update = batchLayout(o, *update);
+        if (const ir::Kernel* ek = o.kernel(KernelKind::Exports)) b.exports = batchLayout(o, *ek);
+        b.counted.assign(o.emits.size(), false);
+        b.rated.assign(o.emits.size(), false);
+        for (const ir::Yield& y : update->yields) {
+            if (y.kind == YieldKind::Kill) b.kills = true;
+            if (y.kind == YieldKind::EmitCount) b.counted[static_cast<size_t>(y.index)] = true;
+            if (y.kind == YieldKind::EmitRate) b.rated[static_cast<size_t>(y.index)] = true;
+        }
+        for (const ir::EmitSite& e : o.emits) b.rateEmits |= e.rate;
+        batches_.push_back(std::move(b));
+    }
+    arena_ = std::make_unique<tbb::task_arena>(options_.threads ? static_cast<int>(options_.threads)
+                                                                 : tbb::task_arena::automatic);
+    backend_.prepare(module_);
 }
 
 // The `spawn`s run when the system is first used, so externs set before that apply.
@@ -81,18 +100,7 @@ KernelInputs System::inputs(size_t type, uint32_t row, double at, float dt, bool
     in.objectId = pool.id[row];
     in.draw = first ? kCreationDraw : static_cast<uint32_t>(step_);
     if (parentType_[type] < 0) return in;  // no live parent reads: nothing more to set up
-    // The ancestor `depth` levels up, or (type, row) = (-1, 0) when there is none.
-    auto ancestor = [this, type, row](int depth) -> std::pair<int, uint32_t> {
-        int t = static_cast<int>(type);
-        uint32_t r = row;
-        for (int d = 0; d < depth; ++d) {
-            Handle h = pools_[static_cast<size_t>(t)].parent[r];
-            t = parentType_[static_cast<size_t>(t)];
-            if (t < 0 || !h.valid() || !pools_[static_cast<size_t>(t)].matches(h)) return {-1, 0};
-            r = h.row;
-        }
-        return {t, r};
-    };
+    auto ancestor = [this, type, row](int depth) { return this->ancestor(type, row, depth); };
     in.parentExport = [this, ancestor](int depth, int e) {
         auto [t, r] = ancestor(depth);
         return t < 0 ? Value{} : pools_[static_cast<size_t>(t)].exports.get(static_cast<size_t>(e), r);
@@ -106,6 +114,19 @@ KernelInputs System::inputs(size_t type, uint32_t row, double at, float dt, bool
         return t < 0 ? 0.0f : static_cast<float>(at - pools_[static_cast<size_t>(t)].created[r]);
     };
     return in;
+}
+
+// The ancestor `depth` levels up, or (type, row) = (-1, 0) when there is none.
+std::pair<int, uint32_t> System::ancestor(size_t type, uint32_t row, int depth) const {
+    int t = static_cast<int>(type);
+    uint32_t r = row;
+    for (int d = 0; d < depth; ++d) {
+        Handle h = pools_[static_cast<size_t>(t)].parent[r];
+        t = parentType_[static_cast<size_t>(t)];
+        if (t < 0 || !h.valid() || !pools_[static_cast<size_t>(t)].matches(h)) return {-1, 0};
+        r = h.row;
+    }
+    return {t, r};
 }
 
 // The values of `kernel`'s uniform kernel for the step context of `in`, computed again
@@ -186,8 +207,15 @@ void System::updateOnce(size_t type, uint32_t row, double dt, double t1) {
         for (size_t i = 0; i < ek->yields.size(); ++i)
             pool.exports.set(static_cast<size_t>(ek->yields[i].index), row, yields_[i]);
     }
-    // Rate emitters: events fall where the accumulated rate crosses a whole number, so
-    // a stream is smooth within a step and a rate of 0.25/s emits at 4 s, 8 s, …
+    emitAtRate(type, row, rate, count, dt, t1);
+}
+
+// Rate emitters: events fall where the accumulated rate crosses a whole number, so a
+// stream is smooth within a step and a rate of 0.25/s emits at 4 s, 8 s, …
+void System::emitAtRate(size_t type, uint32_t row, std::span<const float> rate, std::span<const float> count,
+                        double dt, double t1) {
+    Pool& pool = pools_[type];
+    const ir::Object& o = pool.object();
     for (size_t s = 0; s < o.emits.size(); ++s) {
         if (!o.emits[s].rate) continue;
         double r = validCount(rate[s], stats_.invalidEmissions);
@@ -202,6 +230,129 @@ void System::updateOnce(size_t type, uint32_t row, double dt, double t1) {
         double children = events * perEvent;
         queueChildren(type, row, static_cast<int>(s), static_cast<uint64_t>(std::min(children, 1e18)),
                       static_cast<uint64_t>(perEvent), firstTime, 1.0 / r, t1, false);
+    }
+}
+
+// Points the column table of a batched kernel at the pool's columns and the scratch
+// columns (emission rates and counts, gathered parent values).
+void System::bindColumns(size_t type, const BatchLayout& layout, std::vector<std::vector<float>>& scratch,
+                         std::vector<void*>& table) {
+    Pool& pool = pools_[type];
+    PoolBatch& b = batches_[type];
+    const ir::Object& o = pool.object();
+    size_t rows = pool.rows();
+    table.assign(static_cast<size_t>(layout.total), nullptr);
+    table[BatchLayout::kCreated] = pool.created.data();
+    table[BatchLayout::kIds] = pool.id.data();
+    table[BatchLayout::kKill] = b.kill.data();
+    for (size_t s = 0; s < o.state.size(); ++s)
+        for (int c = 0; c < o.state[s].type.width; ++c)
+            table[static_cast<size_t>(layout.stateOffset[s] + c)] = pool.state.data(s, static_cast<size_t>(c));
+    for (size_t p = 0; p < o.params.size(); ++p)
+        if (pool.paramColumn[p] >= 0)
+            for (int c = 0; c < o.params[p].type.width; ++c)
+                table[static_cast<size_t>(layout.paramOffset[p] + c)] =
+                    pool.params.data(static_cast<size_t>(pool.paramColumn[p]), static_cast<size_t>(c));
+    for (size_t e = 0; e < o.exports.size(); ++e)
+        for (int c = 0; c < o.exports[e].type.width; ++c)
+            table[static_cast<size_t>(layout.exportOffset[e] + c)] = pool.exports.data(e, static_cast<size_t>(c));
+    scratch.resize(static_cast<size_t>(layout.total - layout.emits));
+    for (int column = layout.emits; column < layout.total; ++column) {
+        auto& s = scratch[static_cast<size_t>(column - layout.emits)];
+        s.resize(rows);
+        table[static_cast<size_t>(column)] = s.data();
+    }
+}
+
+// Fills the parent columns of a batched kernel for the masked rows of [begin, end).
+void System::gatherParents(size_t type, const BatchLayout& layout, void* const* table, const uint8_t* mask,
+                           size_t begin, size_t end, double at) const {
+    for (const auto& p : layout.parentColumns) {
+        for (size_t row = begin; row < end; ++row) {
+            if (!mask[row]) continue;
+            auto [t, r] = ancestor(type, static_cast<uint32_t>(row), p.depth);
+            const Pool* parent = t < 0 ? nullptr : &pools_[static_cast<size_t>(t)];
+            Value v;
+            if (p.op == ir::Op::ParentExport && parent) v = parent->exports.get(static_cast<size_t>(p.exportIndex), r);
+            if (p.op == ir::Op::ParentAlive) v = Value::boolean(parent && parent->status(r) == Status::Alive);
+            if (p.op == ir::Op::ParentAge && parent) v = Value::scalar(static_cast<float>(at - parent->created[r]));
+            for (int c = 0; c < p.width; ++c) static_cast<float*>(table[p.offset + c])[row] = v.f[static_cast<size_t>(c)];
+        }
+    }
+}
+
+// One update of every updatable object of a type, as `updateOnce` would do object by
+// object: the update kernel and the exports kernel run over chunks of rows (on several
+// threads where the backend allows), then kills and emissions follow in row order, so
+// that ids, the queue and the free list come out the same with any number of threads.
+void System::updatePool(size_t type, double dt, double t1) {
+    Pool& pool = pools_[type];
+    PoolBatch& b = batches_[type];
+    const ir::Object& o = pool.object();
+    const ir::Kernel& update = *o.kernel(KernelKind::Update);
+    const ir::Kernel* exports = o.kernel(KernelKind::Exports);
+    size_t rows = pool.rows();
+    if (rows == 0 || pool.live() == 0) return;
+    b.kill.resize(rows);
+    bindColumns(type, b.update, b.updateScratch, b.updateColumns);
+    KernelInputs context;
+    context.dt = static_cast<float>(dt);
+    context.time = static_cast<float>(t1);
+    context.seed = options_.seed;
+    RowBatch batch;
+    batch.mask = pool.updatable.data();
+    batch.columns = b.updateColumns.data();
+    batch.externs = externs_.data();
+    batch.uniforms = uniforms(type, update, context);
+    batch.time = t1;
+    batch.dt = static_cast<float>(dt);
+    batch.seed = options_.seed;
+    batch.draw = static_cast<uint32_t>(step_);
+    RowBatch exportBatch = batch;
+    if (exports) {
+        b.exportMask.resize(rows);
+        bindColumns(type, b.exports, b.exportScratch, b.exportColumns);
+        exportBatch.mask = b.exportMask.data();
+        exportBatch.columns = b.exportColumns.data();
+        exportBatch.uniforms = uniforms(type, *exports, context);
+    }
+    auto chunk = [&](size_t c) {
+        RowBatch part = batch;
+        part.begin = c * kRowsPerChunk;
+        part.end = std::min(rows, part.begin + kRowsPerChunk);
+        gatherParents(type, b.update, part.columns, part.mask, part.begin, part.end, t1);
+        backend_.runRows(o, update, b.update, part);
+        if (!exports) return;
+        for (size_t row = part.begin; row < part.end; ++row)
+            b.exportMask[row] = pool.updatable[row] && !(b.kills && b.kill[row]);
+        RowBatch post = exportBatch;
+        post.begin = part.begin;
+        post.end = part.end;
+        gatherParents(type, b.exports, post.columns, post.mask, post.begin, post.end, t1);
+        backend_.runRows(o, *exports, b.exports, post);
+    };
+    size_t chunks = (rows + kRowsPerChunk - 1) / kRowsPerChunk;
+    if (chunks > 1 && backend_.concurrent() && arena_->max_concurrency() > 1) {
+        arena_->execute([&] { tbb::parallel_for(size_t{0}, chunks, chunk); });
+    } else {
+        for (size_t c = 0; c < chunks; ++c) chunk(c);
+    }
+    if (!b.kills && !b.rateEmits) return;
+    std::vector<float> rate(o.emits.size(), 0), count(o.emits.size(), 1);
+    for (uint32_t row = 0; row < rows; ++row) {
+        if (!pool.updatable[row]) continue;
+        if (b.kills && b.kill[row]) {
+            kill(type, row);
+            continue;
+        }
+        if (!b.rateEmits) continue;
+        for (size_t s = 0; s < o.emits.size(); ++s) {
+            if (b.rated[s])
+                rate[s] = static_cast<float*>(b.updateColumns[static_cast<size_t>(b.update.emitRate(static_cast<int>(s)))])[row];
+            if (b.counted[s])
+                count[s] = static_cast<float*>(b.updateColumns[static_cast<size_t>(b.update.emitCount(static_cast<int>(s)))])[row];
+        }
+        emitAtRate(type, row, rate, count, dt, t1);
     }
 }
 
@@ -255,7 +406,6 @@ void System::create(const Creation& c, double t1) {
     pool.created[row] = c.time;
     pool.id[row] = c.id;
     pool.parent[row] = c.parent;
-    pool.createdStep[row] = step_;
     if (c.parent.valid()) ++pools_[static_cast<size_t>(parentType_[c.type])].readers[c.parent.row];
     for (size_t i = 0; i < pool.paramColumn.size() && i < c.args.size(); ++i)
         if (pool.paramColumn[i] >= 0) pool.params.set(static_cast<size_t>(pool.paramColumn[i]), row, c.args[i]);
@@ -328,11 +478,16 @@ std::optional<std::string> System::step(double dt) {
     ++step_;
     lastDt_ = dt;
     double t1 = now_ + dt;
+    for (Pool& pool : pools_) pool.beginStep();
     for (size_t type = 0; type < pools_.size(); ++type) {
         Pool& pool = pools_[type];
-        size_t rows = pool.rows();
-        for (uint32_t row = 0; row < rows; ++row)
-            if (pool.status(row) == Status::Alive && pool.createdStep[row] != step_) update(type, row, dt, t1);
+        if (stepLimit_[type] > 0 && dt > stepLimit_[type]) {
+            // Sub-steps: object by object, each through all its sub-steps.
+            for (uint32_t row = 0; row < pool.rows(); ++row)
+                if (pool.updatable[row]) update(type, row, dt, t1);
+        } else {
+            updatePool(type, dt, t1);
+        }
         drain(t1);
     }
     now_ = t1;

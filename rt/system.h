@@ -16,11 +16,14 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include <tbb/task_arena.h>
 
 #include "ir/ir.h"
 #include "rt/backend.h"
@@ -31,6 +34,8 @@ namespace psys::rt {
 struct SystemOptions {
     uint32_t seed = 1;
     size_t capacity = 1 << 20;  // per object type, unless its @capacity says otherwise
+    // Threads for the pool updates: 0 for every core. Results do not depend on it.
+    unsigned threads = 0;
 };
 
 struct TypeStats {
@@ -95,6 +100,14 @@ private:
                         std::vector<Value>& state);
     void runKernel(size_t type, uint32_t row, const ir::Kernel& kernel, KernelInputs in);
     const Value* uniforms(size_t type, const ir::Kernel& kernel, const KernelInputs& in);
+    std::pair<int, uint32_t> ancestor(size_t type, uint32_t row, int depth) const;
+    void updatePool(size_t type, double dt, double t1);
+    void bindColumns(size_t type, const BatchLayout& layout, std::vector<std::vector<float>>& scratch,
+                     std::vector<void*>& table);
+    void gatherParents(size_t type, const BatchLayout& layout, void* const* table, const uint8_t* mask,
+                       size_t begin, size_t end, double at) const;
+    void emitAtRate(size_t type, uint32_t row, std::span<const float> rate, std::span<const float> count, double dt,
+                    double t1);
     void update(size_t type, uint32_t row, double dt, double t1);
     void updateOnce(size_t type, uint32_t row, double dt, double t1);
     void create(const Creation& c, double t1);
@@ -136,6 +149,17 @@ private:
     };
     std::vector<std::array<UniformCache, 3>> uniformCache_;
     uint64_t externsVersion_ = 0;
+    // Per type: the batched update and exports kernels' layouts and scratch columns.
+    struct PoolBatch {
+        BatchLayout update, exports;
+        bool kills = false, rateEmits = false;
+        std::vector<bool> counted, rated;  // per emit site: whether the update yields its count, its rate
+        std::vector<uint8_t> kill, exportMask;
+        std::vector<std::vector<float>> updateScratch, exportScratch;
+        std::vector<void*> updateColumns, exportColumns;
+    };
+    std::vector<PoolBatch> batches_;
+    std::unique_ptr<tbb::task_arena> arena_;
 };
 
 }  // namespace psys::rt
