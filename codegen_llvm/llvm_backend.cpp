@@ -2,19 +2,14 @@
 
 #include <chrono>
 #include <map>
+#include <mutex>
 #include <stdexcept>
+#include <unordered_map>
 
-#include <llvm/ExecutionEngine/Orc/ExecutionUtils.h>
-#include <llvm/ExecutionEngine/Orc/LLJIT.h>
-#include <llvm/ExecutionEngine/Orc/ThreadSafeModule.h>
 #include <llvm/IR/IRBuilder.h>
-#include <llvm/IR/Intrinsics.h>
-#include <llvm/IR/LLVMContext.h>
-#include <llvm/IR/Module.h>
-#include <llvm/IR/Verifier.h>
-#include <llvm/Support/TargetSelect.h>
 
-#include "rt/rng.h"
+#include "codegen_llvm/jit_engine.h"
+#include "ir/printer.h"
 
 namespace psys::codegen_llvm {
 
@@ -22,310 +17,429 @@ using namespace ir;
 
 namespace {
 
-// The per-object calling convention:
-//   void kernel(const Value* params, const Value* state, const Value* externs,
-//               const Value* uniforms, const Value* parents, const float* scalars,
-//               const uint32_t* keys, Value* yields)
+// The first render column of a render yield.
+int renderColumn(YieldKind kind) {
+    switch (kind) {
+        case YieldKind::Visible: return rt::BatchLayout::kVisible;
+        case YieldKind::Position: return rt::BatchLayout::kPosition;
+        case YieldKind::Color: return rt::BatchLayout::kColor;
+        default: return rt::BatchLayout::kSize;
+    }
+}
+
+// void kernel(const Value* params, const Value* state, const Value* externs,
+//             const Value* uniforms, const Value* parents, const float* scalars,
+//             const uint32_t* keys, Value* yields)
 // scalars: age, dt, time, first; keys: seed, object id, draw, child draw; parents: the
 // values of the kernel's parent reads, gathered by the caller in instruction order.
-using KernelFn = void (*)(const rt::Value*, const rt::Value*, const rt::Value*, const rt::Value*, const rt::Value*,
+using ObjectFn = void (*)(const rt::Value*, const rt::Value*, const rt::Value*, const rt::Value*, const rt::Value*,
                           const float*, const uint32_t*, rt::Value*);
 
-class KernelCompiler {
-public:
-    KernelCompiler(llvm::LLVMContext& ctx, llvm::Module& module, const Kernel& kernel)
-        : ctx_(ctx), module_(module), kernel_(kernel), b_(ctx) {}
+// void rows(void* const* columns, const uint8_t* mask, int64_t begin, int64_t end,
+//           const Value* externs, const Value* uniforms, double time, float dt,
+//           uint32_t seed, uint32_t draw)
+using RowsFn = void (*)(void* const*, const uint8_t*, int64_t, int64_t, const rt::Value*, const rt::Value*, double,
+                        float, uint32_t, uint32_t);
 
-    void compile(const std::string& name) {
+// The parts of both function shapes: Value arrays, lanes to and from memory.
+class FunctionBuilder {
+protected:
+    FunctionBuilder(llvm::Module& module, MathMode mode)
+        : ctx_(module.getContext()), module_(module), mode_(mode), b_(ctx_) {
+        valueType_ = llvm::StructType::get(ctx_, {llvm::ArrayType::get(b_.getFloatTy(), 4), b_.getInt32Ty()});
+    }
+
+    // The lanes of element `index` of a Value array.
+    Lanes loadValue(llvm::Value* array, int index, Type t) {
+        auto i = static_cast<unsigned>(index);
+        if (t.kind == Type::Kind::U32)
+            return {b_.CreateAlignedLoad(b_.getInt32Ty(), b_.CreateConstGEP2_32(valueType_, array, i, 1), llvm::Align(4))};
+        Lanes out;
+        for (int l = 0; l < t.width; ++l) {
+            llvm::Value* p = b_.CreateGEP(valueType_, array, {b_.getInt32(i), b_.getInt32(0), b_.getInt32(static_cast<unsigned>(l))});
+            out.push_back(fromFloat(b_.CreateAlignedLoad(b_.getFloatTy(), p, llvm::Align(4)), t));
+        }
+        return out;
+    }
+
+    // Memory holds floats; bools are 0 or 1, u32 values their bits.
+    llvm::Value* fromFloat(llvm::Value* x, Type t) {
+        if (t.isBool()) return b_.CreateFCmpUNE(x, llvm::ConstantFP::get(b_.getFloatTy(), 0.0));
+        if (t.kind == Type::Kind::U32) return b_.CreateBitCast(x, b_.getInt32Ty());
+        return x;
+    }
+    llvm::Value* toFloat(llvm::Value* x, Type t) {
+        if (t.isBool()) return b_.CreateUIToFP(x, b_.getFloatTy());
+        if (t.kind == Type::Kind::U32) return b_.CreateBitCast(x, b_.getFloatTy());
+        return x;
+    }
+
+    llvm::LLVMContext& ctx_;
+    llvm::Module& module_;
+    MathMode mode_;
+    llvm::IRBuilder<> b_;
+    llvm::StructType* valueType_;
+};
+
+// A kernel for one object, called as the interpreter is.
+class ObjectFunctionBuilder : FunctionBuilder {
+public:
+    ObjectFunctionBuilder(llvm::Module& module, MathMode mode) : FunctionBuilder(module, mode) {}
+
+    void build(const Kernel& kernel, const std::string& name) {
         auto* ptr = llvm::PointerType::getUnqual(ctx_);
-        auto* fnType = llvm::FunctionType::get(b_.getVoidTy(), {ptr, ptr, ptr, ptr, ptr, ptr, ptr, ptr}, false);
-        fn_ = llvm::Function::Create(fnType, llvm::Function::ExternalLinkage, name, module_);
+        auto* type = llvm::FunctionType::get(b_.getVoidTy(), std::vector<llvm::Type*>(8, ptr), false);
+        fn_ = llvm::Function::Create(type, llvm::Function::ExternalLinkage, name, module_);
         for (auto& arg : fn_->args()) arg.addAttr(llvm::Attribute::NoAlias);
         b_.SetInsertPoint(llvm::BasicBlock::Create(ctx_, "entry", fn_));
-        valueType_ = llvm::StructType::get(ctx_, {llvm::ArrayType::get(b_.getFloatTy(), 4), b_.getInt32Ty()});
-        int parentIndex = 0;
-        values_.resize(kernel_.size());
-        for (ValueId v = 0; v < kernel_.size(); ++v) values_[v] = emit(kernel_.at(v), parentIndex);
+        llvm::Value* seed = scalar(6, 0, b_.getInt32Ty());
+        auto values = emitKernelBody(b_, module_, kernel, mode_, seed, [&](const Inst& i, int parent) { return leaf(i, parent); });
         llvm::Value* yields = fn_->getArg(7);
-        for (size_t i = 0; i < kernel_.yields.size(); ++i) {
-            ValueId v = kernel_.yields[i].value;
-            store(yields, static_cast<int>(i), values_[v], kernel_.at(v).type);
+        for (size_t y = 0; y < kernel.yields.size(); ++y) {
+            ValueId v = kernel.yields[y].value;
+            auto index = static_cast<unsigned>(y);
+            // Lanes past the type's width are zero, as the interpreter's.
+            b_.CreateAlignedStore(llvm::Constant::getNullValue(valueType_), b_.CreateConstGEP1_32(valueType_, yields, index),
+                                  llvm::Align(4));
+            Type t = kernel.at(v).type;
+            if (t.kind == Type::Kind::U32) {
+                b_.CreateAlignedStore(values[v][0], b_.CreateConstGEP2_32(valueType_, yields, index, 1), llvm::Align(4));
+                continue;
+            }
+            for (int l = 0; l < t.width; ++l) {
+                llvm::Value* p = b_.CreateGEP(valueType_, yields, {b_.getInt32(index), b_.getInt32(0), b_.getInt32(static_cast<unsigned>(l))});
+                b_.CreateAlignedStore(toFloat(values[v][static_cast<size_t>(l)], t), p, llvm::Align(4));
+            }
         }
         b_.CreateRetVoid();
     }
 
 private:
-    llvm::Type* typeOf(Type t) {
-        if (t.isBool()) return b_.getInt1Ty();
-        if (t.kind == Type::Kind::U32) return b_.getInt32Ty();
-        if (t.width == 1) return b_.getFloatTy();
-        return llvm::FixedVectorType::get(b_.getFloatTy(), t.width);
+    llvm::Value* scalar(unsigned arg, unsigned index, llvm::Type* type) {
+        return b_.CreateAlignedLoad(type, b_.CreateConstGEP1_32(type, fn_->getArg(arg), index), llvm::Align(4));
     }
 
-    // Loads element `index` of a Value array as type `t`.
-    llvm::Value* load(llvm::Value* array, int index, Type t) {
-        llvm::Value* base = b_.CreateConstGEP2_32(valueType_, array, static_cast<unsigned>(index), 0);
-        if (t.kind == Type::Kind::U32) {
-            llvm::Value* u = b_.CreateConstGEP2_32(valueType_, array, static_cast<unsigned>(index), 1);
-            return b_.CreateAlignedLoad(b_.getInt32Ty(), u, llvm::Align(4));
-        }
-        if (t.isBool()) {
-            llvm::Value* f = b_.CreateAlignedLoad(b_.getFloatTy(), base, llvm::Align(4));
-            return b_.CreateFCmpUNE(f, llvm::ConstantFP::get(b_.getFloatTy(), 0.0));
-        }
-        return b_.CreateAlignedLoad(typeOf(t), base, llvm::Align(4));
-    }
-
-    void store(llvm::Value* array, int index, llvm::Value* v, Type t) {
-        llvm::Value* base = b_.CreateConstGEP2_32(valueType_, array, static_cast<unsigned>(index), 0);
-        // Clear the Value first: lanes past the type's width are zero, as the interpreter's.
-        b_.CreateAlignedStore(llvm::Constant::getNullValue(valueType_),
-                              b_.CreateConstGEP1_32(valueType_, array, static_cast<unsigned>(index)), llvm::Align(4));
-        if (t.kind == Type::Kind::U32) {
-            b_.CreateAlignedStore(v, b_.CreateConstGEP2_32(valueType_, array, static_cast<unsigned>(index), 1), llvm::Align(4));
-        } else if (t.isBool()) {
-            b_.CreateAlignedStore(b_.CreateUIToFP(v, b_.getFloatTy()), base, llvm::Align(4));
-        } else {
-            b_.CreateAlignedStore(v, base, llvm::Align(4));
-        }
-    }
-
-    llvm::Value* scalarArg(int arg, int index, llvm::Type* type) {
-        llvm::Value* p = b_.CreateConstGEP1_32(type, fn_->getArg(static_cast<unsigned>(arg)), static_cast<unsigned>(index));
-        return b_.CreateAlignedLoad(type, p, llvm::Align(4));
-    }
-
-    llvm::Value* constant(const Inst& i) {
-        if (i.type.isBool()) return b_.getInt1(i.constant[0] != 0);
-        if (i.type.width == 1) return llvm::ConstantFP::get(b_.getFloatTy(), i.constant[0]);
-        std::vector<llvm::Constant*> lanes;
-        for (int l = 0; l < i.type.width; ++l)
-            lanes.push_back(llvm::ConstantFP::get(b_.getFloatTy(), i.constant[static_cast<size_t>(l)]));
-        return llvm::ConstantVector::get(lanes);
-    }
-
-    llvm::Value* floatConst(Type t, float x) {
-        llvm::Value* c = llvm::ConstantFP::get(b_.getFloatTy(), x);
-        return t.width == 1 ? c : b_.CreateVectorSplat(t.width, c);
-    }
-
-    llvm::Value* intrinsic(llvm::Intrinsic::ID id, llvm::Value* x) {
-        return b_.CreateUnaryIntrinsic(id, x);
-    }
-
-    // A libm function (float → float, or two floats), applied lane by lane: the same
-    // functions the interpreter calls.
-    llvm::Value* libm(const char* name, Type t, llvm::Value* x, llvm::Value* y = nullptr) {
-        std::vector<llvm::Type*> params(y ? 2 : 1, b_.getFloatTy());
-        llvm::FunctionCallee f =
-            module_.getOrInsertFunction(name, llvm::FunctionType::get(b_.getFloatTy(), params, false));
-        if (t.width == 1) return y ? b_.CreateCall(f, {x, y}) : b_.CreateCall(f, {x});
-        llvm::Value* out = llvm::PoisonValue::get(typeOf(t));
-        for (int l = 0; l < t.width; ++l) {
-            llvm::Value* a = b_.CreateExtractElement(x, static_cast<uint64_t>(l));
-            llvm::Value* r = y ? b_.CreateCall(f, {a, b_.CreateExtractElement(y, static_cast<uint64_t>(l))}) : b_.CreateCall(f, {a});
-            out = b_.CreateInsertElement(out, r, static_cast<uint64_t>(l));
-        }
-        return out;
-    }
-
-    llvm::Value* pcg(llvm::Value* v) {
-        llvm::Value* state = b_.CreateAdd(b_.CreateMul(v, b_.getInt32(747796405u)), b_.getInt32(2891336453u));
-        llvm::Value* shift = b_.CreateAdd(b_.CreateLShr(state, b_.getInt32(28)), b_.getInt32(4));
-        llvm::Value* word = b_.CreateMul(b_.CreateXor(b_.CreateLShr(state, shift), state), b_.getInt32(277803737u));
-        return b_.CreateXor(b_.CreateLShr(word, b_.getInt32(22)), word);
-    }
-
-    llvm::Value* random(const Inst& i, llvm::Value* object, llvm::Value* draw) {
-        llvm::Value* seed = scalarArg(6, 0, b_.getInt32Ty());
-        llvm::Value* out = i.type.width == 1 ? nullptr : static_cast<llvm::Value*>(llvm::PoisonValue::get(typeOf(i.type)));
-        llvm::Value* single = nullptr;
-        for (int l = 0; l < i.type.width; ++l) {
-            // drawBits(seed, object, site, draw, component), as rt/rng.h
-            llvm::Value* h = pcg(b_.CreateXor(b_.getInt32(static_cast<uint32_t>(l)), pcg(draw)));
-            h = pcg(b_.CreateXor(h, b_.getInt32(static_cast<uint32_t>(i.attr) * 0x9E3779B9u)));
-            h = pcg(b_.CreateXor(h, object));
-            h = pcg(b_.CreateXor(h, seed));
-            llvm::Value* u = b_.CreateFMul(b_.CreateUIToFP(b_.CreateLShr(h, b_.getInt32(8)), b_.getFloatTy()),
-                                           llvm::ConstantFP::get(b_.getFloatTy(), 1.0 / 16777216.0));
-            if (i.op == Op::NRand)
-                u = b_.CreateFSub(b_.CreateFMul(u, llvm::ConstantFP::get(b_.getFloatTy(), 2.0)),
-                                  llvm::ConstantFP::get(b_.getFloatTy(), 1.0));
-            if (i.type.width == 1) single = u;
-            else out = b_.CreateInsertElement(out, u, static_cast<uint64_t>(l));
-        }
-        return i.type.width == 1 ? single : out;
-    }
-
-    llvm::Value* emit(const Inst& i, int& parentIndex) {
-        auto op = [&](size_t n) { return values_[i.operands[n]]; };
-        auto opType = [&](size_t n) { return kernel_.at(i.operands[n]).type; };
-        Type t = i.type;
+    Lanes leaf(const Inst& i, int parent) {
         switch (i.op) {
-            case Op::Const: return constant(i);
-            case Op::Param: case Op::TriggerParam: return load(fn_->getArg(0), i.attr, t);
-            case Op::StateRead: return load(fn_->getArg(1), i.attr, t);
-            case Op::Extern: return load(fn_->getArg(2), i.attr, t);
-            case Op::Uniform: return load(fn_->getArg(3), i.attr, t);
-            case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge: return load(fn_->getArg(4), parentIndex++, t);
-            case Op::Age: return scalarArg(5, 0, b_.getFloatTy());
-            case Op::Dt: return scalarArg(5, 1, b_.getFloatTy());
-            case Op::Time: return scalarArg(5, 2, b_.getFloatTy());
-            case Op::First: return b_.CreateFCmpUNE(scalarArg(5, 3, b_.getFloatTy()), llvm::ConstantFP::get(b_.getFloatTy(), 0.0));
-            case Op::ObjectId: return scalarArg(6, 1, b_.getInt32Ty());
-            case Op::DrawIndex: return scalarArg(6, i.attr == 1 ? 3 : 2, b_.getInt32Ty());
-            case Op::Add: return b_.CreateFAdd(op(0), op(1));
-            case Op::Sub: return b_.CreateFSub(op(0), op(1));
-            case Op::Mul: return b_.CreateFMul(op(0), op(1));
-            case Op::Div: return b_.CreateFDiv(op(0), op(1));
-            case Op::Mod:  // x - y * floor(x / y)
-                return b_.CreateFSub(op(0), b_.CreateFMul(op(1), intrinsic(llvm::Intrinsic::floor, b_.CreateFDiv(op(0), op(1)))));
-            case Op::Neg: return b_.CreateFNeg(op(0));
-            case Op::Min: return b_.CreateSelect(b_.CreateFCmpOLT(op(1), op(0)), op(1), op(0));
-            case Op::Max: return b_.CreateSelect(b_.CreateFCmpOLT(op(0), op(1)), op(1), op(0));
-            case Op::Step: return b_.CreateSelect(b_.CreateFCmpOLT(op(1), op(0)), floatConst(t, 0), floatConst(t, 1));
-            case Op::Atan2: return libm("atan2f", t, op(0), op(1));
-            case Op::Pow: return libm("powf", t, op(0), op(1));
-            case Op::Sin: return libm("sinf", t, op(0));
-            case Op::Cos: return libm("cosf", t, op(0));
-            case Op::Tan: return libm("tanf", t, op(0));
-            case Op::Asin: return libm("asinf", t, op(0));
-            case Op::Acos: return libm("acosf", t, op(0));
-            case Op::Atan: return libm("atanf", t, op(0));
-            case Op::Exp: return libm("expf", t, op(0));
-            case Op::Log: return libm("logf", t, op(0));
-            case Op::Sqrt: return intrinsic(llvm::Intrinsic::sqrt, op(0));
-            case Op::Abs: return intrinsic(llvm::Intrinsic::fabs, op(0));
-            case Op::Floor: return intrinsic(llvm::Intrinsic::floor, op(0));
-            case Op::Ceil: return intrinsic(llvm::Intrinsic::ceil, op(0));
-            case Op::Round: return intrinsic(llvm::Intrinsic::nearbyint, op(0));
-            case Op::Fract: return b_.CreateFSub(op(0), intrinsic(llvm::Intrinsic::floor, op(0)));
-            case Op::Sign: {
-                llvm::Value* positive = b_.CreateFCmpOGT(op(0), floatConst(t, 0));
-                llvm::Value* negative = b_.CreateFCmpOLT(op(0), floatConst(t, 0));
-                return b_.CreateSelect(positive, floatConst(t, 1), b_.CreateSelect(negative, floatConst(t, -1), floatConst(t, 0)));
-            }
-            case Op::Lt: return b_.CreateFCmpOLT(op(0), op(1));
-            case Op::Le: return b_.CreateFCmpOLE(op(0), op(1));
-            case Op::Gt: return b_.CreateFCmpOGT(op(0), op(1));
-            case Op::Ge: return b_.CreateFCmpOGE(op(0), op(1));
-            case Op::Eq: case Op::Ne: {
-                Type ot = opType(0);
-                llvm::Value* equal;
-                if (!ot.isFloat()) {
-                    equal = b_.CreateICmpEQ(op(0), op(1));
-                } else if (ot.width == 1) {
-                    equal = b_.CreateFCmpOEQ(op(0), op(1));
-                } else {
-                    equal = b_.CreateAndReduce(b_.CreateFCmpOEQ(op(0), op(1)));
-                }
-                return i.op == Op::Eq ? equal : b_.CreateNot(equal);
-            }
-            case Op::And: return b_.CreateAnd(op(0), op(1));
-            case Op::Or: return b_.CreateOr(op(0), op(1));
-            case Op::Not: return b_.CreateNot(op(0));
-            case Op::Select: return b_.CreateSelect(op(0), op(1), op(2));
-            case Op::Splat: return b_.CreateVectorSplat(t.width, op(0));
-            case Op::Compose: {
-                llvm::Value* out = llvm::PoisonValue::get(typeOf(t));
-                uint64_t lane = 0;
-                for (size_t n = 0; n < i.operands.size(); ++n) {
-                    Type pt = opType(n);
-                    if (pt.width == 1) {
-                        out = b_.CreateInsertElement(out, op(n), lane++);
-                    } else {
-                        for (int l = 0; l < pt.width; ++l)
-                            out = b_.CreateInsertElement(out, b_.CreateExtractElement(op(n), static_cast<uint64_t>(l)), lane++);
-                    }
-                }
-                return out;
-            }
-            case Op::Extract: return b_.CreateExtractElement(op(0), static_cast<uint64_t>(i.attr));
-            case Op::Shuffle: {
-                std::vector<int> mask(i.lanes.begin(), i.lanes.end());
-                if (mask.size() == 1) return b_.CreateExtractElement(op(0), static_cast<uint64_t>(mask[0]));
-                return b_.CreateShuffleVector(op(0), mask);
-            }
-            case Op::Dot: {  // ((0 + x0·y0) + x1·y1) + …, the interpreter's order
-                llvm::Value* product = b_.CreateFMul(op(0), op(1));
-                llvm::Value* sum = llvm::ConstantFP::get(b_.getFloatTy(), 0.0);
-                for (int l = 0; l < opType(0).width; ++l)
-                    sum = b_.CreateFAdd(sum, b_.CreateExtractElement(product, static_cast<uint64_t>(l)));
-                return sum;
-            }
-            case Op::Rand: case Op::NRand: return random(i, op(0), op(1));
-            default:
-                throw std::runtime_error("the LLVM backend cannot compile `" + std::string(opInfo(i.op).name) + "`");
+            case Op::Param: case Op::TriggerParam: return loadValue(fn_->getArg(0), i.attr, i.type);
+            case Op::StateRead: return loadValue(fn_->getArg(1), i.attr, i.type);
+            case Op::Extern: return loadValue(fn_->getArg(2), i.attr, i.type);
+            case Op::Uniform: return loadValue(fn_->getArg(3), i.attr, i.type);
+            case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge: return loadValue(fn_->getArg(4), parent, i.type);
+            case Op::Age: return {scalar(5, 0, b_.getFloatTy())};
+            case Op::Dt: return {scalar(5, 1, b_.getFloatTy())};
+            case Op::Time: return {scalar(5, 2, b_.getFloatTy())};
+            case Op::First: return {b_.CreateFCmpUNE(scalar(5, 3, b_.getFloatTy()), llvm::ConstantFP::get(b_.getFloatTy(), 0.0))};
+            case Op::ObjectId: return {scalar(6, 1, b_.getInt32Ty())};
+            case Op::DrawIndex: return {scalar(6, i.attr == 1 ? 3 : 2, b_.getInt32Ty())};
+            default: throw std::logic_error("not a leaf");
         }
     }
 
-    llvm::LLVMContext& ctx_;
-    llvm::Module& module_;
-    const Kernel& kernel_;
-    llvm::IRBuilder<> b_;
     llvm::Function* fn_ = nullptr;
-    llvm::StructType* valueType_ = nullptr;
-    std::vector<llvm::Value*> values_;
 };
+
+// An update or exports kernel as a loop over rows [begin, end) of a pool. The entry
+// function reads the column table and calls the loop with one noalias pointer per
+// column, which is what lets the loop vectorize without run-time alias checks.
+class RowsFunctionBuilder : FunctionBuilder {
+public:
+    RowsFunctionBuilder(llvm::Module& module, MathMode mode) : FunctionBuilder(module, mode) {}
+
+    void build(const Object& object, const Kernel& kernel, const rt::BatchLayout& layout, const std::string& name) {
+        // The columns the kernel touches, in first-use order.
+        std::map<int, unsigned> argOf;
+        std::vector<int> columns;
+        auto use = [&](int column) {
+            if (argOf.emplace(column, static_cast<unsigned>(kFixedArgs + columns.size())).second) columns.push_back(column);
+        };
+        use(rt::BatchLayout::kCreated);
+        for (const Inst& i : kernel.insts()) {
+            auto lanes = [&](int first) { for (int l = 0; l < i.type.width; ++l) use(first + l); };
+            if (i.op == Op::Param) lanes(layout.paramOffset.at(static_cast<size_t>(i.attr)));
+            if (i.op == Op::StateRead) lanes(layout.stateOffset.at(static_cast<size_t>(i.attr)));
+            if (i.op == Op::ObjectId) use(rt::BatchLayout::kIds);
+        }
+        for (const auto& p : layout.parentColumns)
+            for (int l = 0; l < p.width; ++l) use(p.offset + l);
+        for (const Yield& y : kernel.yields) {
+            int width = kernel.at(y.value).type.width;
+            auto lanes = [&](int first) { for (int l = 0; l < width; ++l) use(first + l); };
+            switch (y.kind) {
+                case YieldKind::StateNext: lanes(layout.stateOffset.at(static_cast<size_t>(y.index))); break;
+                case YieldKind::Export: lanes(layout.exportOffset.at(static_cast<size_t>(y.index))); break;
+                case YieldKind::Kill: use(rt::BatchLayout::kKill); break;
+                case YieldKind::EmitRate: use(layout.emitRate(y.index)); break;
+                case YieldKind::EmitCount: use(layout.emitCount(y.index)); break;
+                case YieldKind::Visible: case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:
+                    lanes(layout.render + renderColumn(y.kind));
+                    break;
+                default: break;
+            }
+        }
+        (void)object;
+
+        auto* ptr = llvm::PointerType::getUnqual(ctx_);
+        llvm::Type* i64 = b_.getInt64Ty();
+        llvm::Type* i32 = b_.getInt32Ty();
+        std::vector<llvm::Type*> entryParams = {ptr, ptr, i64, i64, ptr, ptr, b_.getDoubleTy(), b_.getFloatTy(), i32, i32};
+        // The loop: the entry's parameters but the table, then the columns.
+        std::vector<llvm::Type*> loopParams(entryParams.begin() + 1, entryParams.end());
+        loopParams.resize(kFixedArgs + columns.size(), ptr);
+        auto* loopType = llvm::FunctionType::get(b_.getVoidTy(), loopParams, false);
+        loop_ = llvm::Function::Create(loopType, llvm::Function::InternalLinkage, name + ".loop", module_);
+        loop_->addFnAttr(llvm::Attribute::NoInline);
+        for (unsigned a = 0; a < loop_->arg_size(); ++a)
+            if (loopParams[a]->isPointerTy()) loop_->getArg(a)->addAttr(llvm::Attribute::NoAlias);
+        buildLoop(kernel, layout, argOf);
+
+        auto* entryType = llvm::FunctionType::get(b_.getVoidTy(), entryParams, false);
+        auto* entry = llvm::Function::Create(entryType, llvm::Function::ExternalLinkage, name, module_);
+        b_.SetInsertPoint(llvm::BasicBlock::Create(ctx_, "entry", entry));
+        std::vector<llvm::Value*> args;
+        for (unsigned a = 1; a < entry->arg_size(); ++a) args.push_back(entry->getArg(a));
+        for (int column : columns) {
+            llvm::Value* slot = b_.CreateConstGEP1_32(ptr, entry->getArg(0), static_cast<unsigned>(column));
+            args.push_back(b_.CreateAlignedLoad(ptr, slot, llvm::Align(8)));
+        }
+        b_.CreateCall(loop_, args);
+        b_.CreateRetVoid();
+    }
+
+private:
+    // The loop's fixed parameters: mask, begin, end, externs, uniforms, time, dt, seed, draw.
+    static constexpr unsigned kMask = 0, kBegin = 1, kEnd = 2, kExterns = 3, kUniforms = 4, kTime = 5, kDt = 6,
+                              kSeed = 7, kDraw = 8, kFixedArgs = 9;
+
+    llvm::Value* columnAt(const std::map<int, unsigned>& argOf, int column, llvm::Type* type) {
+        return b_.CreateInBoundsGEP(type, loop_->getArg(argOf.at(column)), row_);
+    }
+
+    void buildLoop(const Kernel& kernel, const rt::BatchLayout& layout, const std::map<int, unsigned>& argOf) {
+        llvm::BasicBlock* entry = llvm::BasicBlock::Create(ctx_, "entry", loop_);
+        llvm::BasicBlock* body = llvm::BasicBlock::Create(ctx_, "row", loop_);
+        llvm::BasicBlock* exit = llvm::BasicBlock::Create(ctx_, "exit", loop_);
+        b_.SetInsertPoint(entry);
+        llvm::Value* begin = loop_->getArg(kBegin);
+        llvm::Value* end = loop_->getArg(kEnd);
+        b_.CreateCondBr(b_.CreateICmpSLT(begin, end), body, exit);
+
+        b_.SetInsertPoint(body);
+        llvm::PHINode* row = b_.CreatePHI(b_.getInt64Ty(), 2, "r");
+        row->addIncoming(begin, entry);
+        row_ = row;
+        llvm::Type* f32 = b_.getFloatTy();
+        auto loadFloat = [&](int column) { return b_.CreateAlignedLoad(f32, columnAt(argOf, column, f32), llvm::Align(4)); };
+        auto leaf = [&](const Inst& i, int parent) -> Lanes {
+            auto lanes = [&](int first) {
+                Lanes out;
+                for (int l = 0; l < i.type.width; ++l) out.push_back(fromFloat(loadFloat(first + l), i.type));
+                return out;
+            };
+            switch (i.op) {
+                case Op::Param: return lanes(layout.paramOffset.at(static_cast<size_t>(i.attr)));
+                case Op::StateRead: return lanes(layout.stateOffset.at(static_cast<size_t>(i.attr)));
+                case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge:
+                    return lanes(layout.parentColumns.at(static_cast<size_t>(parent)).offset);
+                case Op::Extern: return loadValue(loop_->getArg(kExterns), i.attr, i.type);
+                case Op::Uniform: return loadValue(loop_->getArg(kUniforms), i.attr, i.type);
+                case Op::Age: {  // float(time − created), as the run-time computes it
+                    llvm::Value* created = b_.CreateAlignedLoad(b_.getDoubleTy(), columnAt(argOf, rt::BatchLayout::kCreated, b_.getDoubleTy()), llvm::Align(8));
+                    return {b_.CreateFPTrunc(b_.CreateFSub(loop_->getArg(kTime), created), f32)};
+                }
+                case Op::Dt: return {loop_->getArg(kDt)};
+                case Op::Time: return {b_.CreateFPTrunc(loop_->getArg(kTime), f32)};
+                case Op::First: return {b_.getFalse()};
+                case Op::ObjectId:
+                    return {b_.CreateAlignedLoad(b_.getInt32Ty(), columnAt(argOf, rt::BatchLayout::kIds, b_.getInt32Ty()), llvm::Align(4))};
+                case Op::DrawIndex: return {i.attr == 1 ? b_.getInt32(0) : static_cast<llvm::Value*>(loop_->getArg(kDraw))};
+                default: throw std::runtime_error("a loop kernel cannot read `" + std::string(opInfo(i.op).name) + "`");
+            }
+        };
+        auto values = emitKernelBody(b_, module_, kernel, mode_, loop_->getArg(kSeed), leaf);
+
+        // Stores: masked rows keep their state and exports, and never die.
+        llvm::Value* mask = b_.CreateICmpNE(
+            b_.CreateAlignedLoad(b_.getInt8Ty(), b_.CreateInBoundsGEP(b_.getInt8Ty(), loop_->getArg(kMask), row_), llvm::Align(1)),
+            b_.getInt8(0));
+        auto maskedStore = [&](int column, llvm::Value* value) {
+            llvm::Value* old = loadFloat(column);
+            b_.CreateAlignedStore(b_.CreateSelect(mask, value, old), columnAt(argOf, column, f32), llvm::Align(4));
+        };
+        for (const Yield& y : kernel.yields) {
+            Type t = kernel.at(y.value).type;
+            const Lanes& v = values[y.value];
+            switch (y.kind) {
+                case YieldKind::StateNext:
+                    for (int l = 0; l < t.width; ++l)
+                        maskedStore(layout.stateOffset.at(static_cast<size_t>(y.index)) + l, toFloat(v[static_cast<size_t>(l)], t));
+                    break;
+                case YieldKind::Export:
+                    for (int l = 0; l < t.width; ++l)
+                        maskedStore(layout.exportOffset.at(static_cast<size_t>(y.index)) + l, toFloat(v[static_cast<size_t>(l)], t));
+                    break;
+                case YieldKind::Kill:
+                    b_.CreateAlignedStore(b_.CreateZExt(b_.CreateAnd(mask, v[0]), b_.getInt8Ty()),
+                                          columnAt(argOf, rt::BatchLayout::kKill, b_.getInt8Ty()), llvm::Align(1));
+                    break;
+                case YieldKind::EmitRate: case YieldKind::EmitCount: {
+                    int column = y.kind == YieldKind::EmitRate ? layout.emitRate(y.index) : layout.emitCount(y.index);
+                    b_.CreateAlignedStore(toFloat(v[0], t), columnAt(argOf, column, f32), llvm::Align(4));
+                    break;
+                }
+                case YieldKind::Visible: case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:
+                    for (int l = 0; l < t.width; ++l)
+                        b_.CreateAlignedStore(toFloat(v[static_cast<size_t>(l)], t),
+                                              columnAt(argOf, layout.render + renderColumn(y.kind) + l, f32), llvm::Align(4));
+                    break;
+                default: break;
+            }
+        }
+        llvm::Value* next = b_.CreateAdd(row_, b_.getInt64(1), "", true, true);
+        row->addIncoming(next, b_.GetInsertBlock());
+        b_.CreateCondBr(b_.CreateICmpSLT(next, end), body, exit);
+        b_.SetInsertPoint(exit);
+        b_.CreateRetVoid();
+    }
+
+    llvm::Function* loop_ = nullptr;
+    llvm::Value* row_ = nullptr;
+};
+
+const char* modeName(MathMode mode) { return mode == MathMode::Exact ? "exact" : "fast"; }
 
 }  // namespace
 
 struct LlvmBackend::Impl {
-    std::unique_ptr<llvm::orc::LLJIT> jit;
-    std::map<const Kernel*, KernelFn> compiled;
-    double compileSeconds = 0;
+    MathMode mode;
+    JitEngine engine;
+    std::mutex mutex;  // runRows may be called from several threads
+    std::unordered_map<std::string, void*> byText;     // compiled code by kernel text
+    struct ObjectEntry {
+        ObjectFn fn;
+        std::vector<const Inst*> parentReads;  // gathered by the caller, in order
+    };
+    std::unordered_map<const Kernel*, ObjectEntry> objectFns;  // the kernels of prepared modules
+    std::map<const Kernel*, RowsFn> rowsFns;
+    CompileStats stats;
     int counter = 0;
     std::vector<rt::Value> parents;
 
-    KernelFn compile(const Kernel& kernel) {
+    explicit Impl(MathMode m) : mode(m), engine(m) {}
+
+    struct Request {
+        const Object* object;  // null: a function for one object
+        const Kernel* kernel;
+        std::string key;
+    };
+
+    static bool loops(const Kernel& k) {
+        return k.kind == KernelKind::Update || k.kind == KernelKind::Exports || k.kind == KernelKind::Render;
+    }
+
+    // Compiles what is not compiled yet, in one LLVM module, and fills the maps.
+    void compile(const std::vector<Request>& requests) {
         auto start = std::chrono::steady_clock::now();
-        auto ctx = std::make_unique<llvm::LLVMContext>();
-        auto module = std::make_unique<llvm::Module>("psys", *ctx);
-        std::string name = "kernel" + std::to_string(counter++);
-        KernelCompiler(*ctx, *module, kernel).compile(name);
-        if (llvm::verifyModule(*module, &llvm::errs())) throw std::runtime_error("the LLVM backend built invalid IR");
-        if (auto err = jit->addIRModule(llvm::orc::ThreadSafeModule(std::move(module), std::move(ctx))))
-            throw std::runtime_error(llvm::toString(std::move(err)));
-        auto symbol = jit->lookup(name);
-        if (!symbol) throw std::runtime_error(llvm::toString(symbol.takeError()));
-        compileSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        return symbol->toPtr<KernelFn>();
+        auto context = engine.newContext();
+        auto module = engine.newModule(*context);
+        std::vector<std::string> names;
+        std::vector<const Request*> built;
+        std::map<std::string, size_t> inThisModule;
+        for (const Request& r : requests) {
+            if (byText.count(r.key) || inThisModule.count(r.key)) {
+                ++stats.cacheHits;
+                continue;
+            }
+            std::string name = (r.object ? "rows" : "object") + std::to_string(counter++);
+            if (r.object) {
+                RowsFunctionBuilder(*module, mode).build(*r.object, *r.kernel, rt::batchLayout(*r.object, *r.kernel), name);
+            } else {
+                ObjectFunctionBuilder(*module, mode).build(*r.kernel, name);
+            }
+            inThisModule[r.key] = names.size();
+            names.push_back(name);
+            built.push_back(&r);
+        }
+        if (!names.empty()) {
+            auto addresses = engine.add(std::move(context), std::move(module), names);
+            for (size_t n = 0; n < names.size(); ++n) byText[built[n]->key] = addresses[n];
+            stats.kernels += names.size();
+        }
+        for (const Request& r : requests) {
+            void* code = byText.at(r.key);
+            if (r.object) rowsFns[r.kernel] = reinterpret_cast<RowsFn>(code);
+            else objectFns[r.kernel] = {reinterpret_cast<ObjectFn>(code), parentReads(*r.kernel)};
+        }
+        stats.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+
+    static std::vector<const Inst*> parentReads(const Kernel& k) {
+        std::vector<const Inst*> reads;
+        for (const Inst& i : k.insts())
+            if (i.op == Op::ParentExport || i.op == Op::ParentAlive || i.op == Op::ParentAge) reads.push_back(&i);
+        return reads;
+    }
+
+    Request objectRequest(const Kernel& k) { return {nullptr, &k, std::string("object ") + modeName(mode) + "\n" + print(k)}; }
+    Request rowsRequest(const Object& o, const Kernel& k) {
+        return {&o, &k, std::string("rows ") + modeName(mode) + " " + rt::batchLayout(o, k).signature() + "\n" + print(k)};
     }
 };
 
-LlvmBackend::LlvmBackend() : impl_(std::make_unique<Impl>()) {
-    llvm::InitializeNativeTarget();
-    llvm::InitializeNativeTargetAsmPrinter();
-    auto jit = llvm::orc::LLJITBuilder().create();
-    if (!jit) throw std::runtime_error(llvm::toString(jit.takeError()));
-    impl_->jit = std::move(*jit);
-    // libm's functions come from this process, as the interpreter's do.
-    auto generator = llvm::orc::DynamicLibrarySearchGenerator::GetForCurrentProcess(
-        impl_->jit->getDataLayout().getGlobalPrefix());
-    if (!generator) throw std::runtime_error(llvm::toString(generator.takeError()));
-    impl_->jit->getMainJITDylib().addGenerator(std::move(*generator));
-}
-
+LlvmBackend::LlvmBackend(MathMode mode) : impl_(std::make_unique<Impl>(mode)) {}
 LlvmBackend::~LlvmBackend() = default;
 
-size_t LlvmBackend::compiledKernels() const { return impl_->compiled.size(); }
-double LlvmBackend::compileSeconds() const { return impl_->compileSeconds; }
+CompileStats LlvmBackend::compileStats() const { return impl_->stats; }
+std::vector<VectorizeRemark> LlvmBackend::remarks() const { return impl_->engine.remarks(); }
+std::string LlvmBackend::cpu() const { return impl_->engine.cpu(); }
+
+void LlvmBackend::prepare(const Module& module) {
+    std::lock_guard lock(impl_->mutex);
+    std::vector<Impl::Request> requests;
+    for (const Object& o : module.objects)
+        for (const Kernel& k : o.kernels) {
+            requests.push_back(impl_->objectRequest(k));
+            if (Impl::loops(k)) requests.push_back(impl_->rowsRequest(o, k));
+        }
+    for (const Trigger& t : module.triggers) requests.push_back(impl_->objectRequest(t.kernel));
+    requests.push_back(impl_->objectRequest(module.start.kernel));
+    impl_->compile(requests);
+}
 
 void LlvmBackend::run(const Kernel& kernel, const rt::KernelInputs& in, std::vector<rt::Value>& yields) {
-    auto it = impl_->compiled.find(&kernel);
-    if (it == impl_->compiled.end()) it = impl_->compiled.emplace(&kernel, impl_->compile(kernel)).first;
+    auto it = impl_->objectFns.find(&kernel);
+    if (it == impl_->objectFns.end()) {
+        std::lock_guard lock(impl_->mutex);
+        impl_->compile({impl_->objectRequest(kernel)});
+        it = impl_->objectFns.find(&kernel);
+    }
     // Parent reads are gathered here, in instruction order.
     auto& parents = impl_->parents;
     parents.clear();
-    for (const Inst& i : kernel.insts()) {
-        if (i.op == Op::ParentExport) parents.push_back(in.parentExport(i.attr2, i.attr));
-        else if (i.op == Op::ParentAlive) parents.push_back(rt::Value::boolean(in.parentAlive(i.attr2)));
-        else if (i.op == Op::ParentAge) parents.push_back(rt::Value::scalar(in.parentAge(i.attr2)));
+    for (const Inst* i : it->second.parentReads) {
+        if (i->op == Op::ParentExport) parents.push_back(in.parentExport(i->attr2, i->attr));
+        else if (i->op == Op::ParentAlive) parents.push_back(rt::Value::boolean(in.parentAlive(i->attr2)));
+        else parents.push_back(rt::Value::scalar(in.parentAge(i->attr2)));
     }
     float scalars[4] = {in.age, in.dt, in.time, in.first ? 1.0f : 0.0f};
     uint32_t keys[4] = {in.seed, in.objectId, in.draw, in.childDraw};
     yields.resize(kernel.yields.size());
-    it->second(in.params, in.state, in.externs, in.uniforms, parents.data(), scalars, keys, yields.data());
+    it->second.fn(in.params, in.state, in.externs, in.uniforms, parents.data(), scalars, keys, yields.data());
+}
+
+void LlvmBackend::runRows(const Object& object, const Kernel& kernel, const rt::BatchLayout&, const rt::RowBatch& batch) {
+    RowsFn fn;
+    {
+        std::lock_guard lock(impl_->mutex);
+        auto it = impl_->rowsFns.find(&kernel);
+        if (it == impl_->rowsFns.end()) {
+            impl_->compile({impl_->rowsRequest(object, kernel)});
+            it = impl_->rowsFns.find(&kernel);
+        }
+        fn = it->second;
+    }
+    fn(batch.columns, batch.mask, static_cast<int64_t>(batch.begin), static_cast<int64_t>(batch.end), batch.externs,
+       batch.uniforms, batch.time, batch.dt, batch.seed, batch.draw);
 }
 
 }  // namespace psys::codegen_llvm

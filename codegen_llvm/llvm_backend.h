@@ -1,29 +1,46 @@
 // The LLVM backend: IR kernels compiled to machine code with LLVM 19's ORC LLJIT.
 //
-// This first version keeps the run-time's per-object calling convention (one call per
-// object per kernel, like the interpreter) so that it can be checked against the
-// interpreter bit for bit; the loops over whole pools come with the batched interface.
-// Every operation is compiled to give exactly the interpreter's float result: no
-// fast-math flags, no contraction into fused multiply-adds, the same libm functions.
+// Each update and exports kernel becomes a loop over a range of a pool's rows, reading
+// and writing the pool's columns in place (noalias pointers, one per column, so the loop
+// vectorizes without run-time alias checks); every other kernel (init, spawn, render,
+// uniform, trigger) becomes a function for one object, called as the interpreter is.
+//
+// Compiled code is cached by the kernel's text (and, for loops, its column layout): a
+// system compiled again unchanged, or a second system with the same kernels, compiles
+// nothing. See lane_emitter.h for the math modes; `Exact` gives the interpreter's
+// results bit for bit.
 #pragma once
 
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "codegen_llvm/jit_options.h"
 #include "rt/backend.h"
 
 namespace psys::codegen_llvm {
 
+struct CompileStats {
+    size_t kernels = 0;      // functions compiled
+    size_t cacheHits = 0;    // kernels found already compiled
+    double seconds = 0;      // building LLVM IR, optimizing, generating machine code
+};
+
 class LlvmBackend : public rt::Backend {
 public:
-    LlvmBackend();
+    explicit LlvmBackend(MathMode mode = MathMode::Fast);
     ~LlvmBackend() override;
     std::string name() const override { return "llvm"; }
     void run(const ir::Kernel& kernel, const rt::KernelInputs& in, std::vector<rt::Value>& yields) override;
+    void prepare(const ir::Module& module) override;
+    void runRows(const ir::Object& object, const ir::Kernel& kernel, const rt::BatchLayout& layout,
+                 const rt::RowBatch& batch) override;
+    bool concurrent() const override { return true; }
 
-    // Kernels compiled so far, and the time spent compiling them.
-    size_t compiledKernels() const;
-    double compileSeconds() const;
+    CompileStats compileStats() const;
+    // What the loop vectorizer said about every loop compiled so far.
+    std::vector<VectorizeRemark> remarks() const;
+    std::string cpu() const;
 
 private:
     struct Impl;

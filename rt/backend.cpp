@@ -78,6 +78,10 @@ void Backend::runRows(const ir::Object& object, const ir::Kernel& kernel, const 
                 case ir::YieldKind::Kill: if (kill) kill[row] = v.truth() ? 1 : 0; break;
                 case ir::YieldKind::EmitRate: floats(batch, layout.emitRate(y.index))[row] = v.f[0]; break;
                 case ir::YieldKind::EmitCount: floats(batch, layout.emitCount(y.index))[row] = v.f[0]; break;
+                case ir::YieldKind::Visible: floats(batch, layout.render + BatchLayout::kVisible)[row] = v.f[0]; break;
+                case ir::YieldKind::Position: scatter(batch, layout.render + BatchLayout::kPosition, 3, row, v); break;
+                case ir::YieldKind::Color: scatter(batch, layout.render + BatchLayout::kColor, 4, row, v); break;
+                case ir::YieldKind::Size: floats(batch, layout.render + BatchLayout::kSize)[row] = v.f[0]; break;
                 default: break;
             }
         }

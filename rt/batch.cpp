@@ -20,6 +20,8 @@ BatchLayout batchLayout(const ir::Object& object, const ir::Kernel& kernel) {
     l.exports = section(l.exportOffset, object.exports);
     l.emits = next;
     next += 2 * static_cast<int>(object.emits.size());
+    l.render = next;
+    next += BatchLayout::kRenderColumns;
     l.parents = next;
     for (const ir::Inst& i : kernel.insts()) {
         if (i.op != ir::Op::ParentExport && i.op != ir::Op::ParentAlive && i.op != ir::Op::ParentAge) continue;
@@ -31,8 +33,8 @@ BatchLayout batchLayout(const ir::Object& object, const ir::Kernel& kernel) {
 }
 
 std::string BatchLayout::signature() const {
-    std::string s = fmt::format("state {} params {} exports {} emits {} parents {} total {} |", state, params,
-                                exports, emits, parents, total);
+    std::string s = fmt::format("state {} params {} exports {} emits {} render {} parents {} total {} |", state,
+                                params, exports, emits, render, parents, total);
     for (int o : stateOffset) s += fmt::format(" s{}", o);
     for (int o : paramOffset) s += fmt::format(" p{}", o);
     for (int o : exportOffset) s += fmt::format(" e{}", o);

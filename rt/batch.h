@@ -25,11 +25,14 @@ namespace psys::rt {
 //   state, params, exports: one float column per component, in declaration order;
 //     a parameter the pool does not keep has a null column
 //   emits: per emit site, a rate and a count column (floats), written for every row
+//   render: visible (0 or 1), position x y z, colour r g b a, size: floats, written for
+//     every row by render kernels
 //   parents: per parent read of the kernel, in instruction order, one float column per
 //     component (gathered by the run-time; `alive` is 0 or 1)
 struct BatchLayout {
     static constexpr int kCreated = 0, kIds = 1, kKill = 2, kFirstColumn = 3;
-    int state = 0, params = 0, exports = 0, emits = 0, parents = 0, total = 0;
+    int state = 0, params = 0, exports = 0, emits = 0, render = 0, parents = 0, total = 0;
+    static constexpr int kVisible = 0, kPosition = 1, kColor = 4, kSize = 8, kRenderColumns = 9;
     std::vector<int> stateOffset, paramOffset, exportOffset;
     struct ParentColumn {
         ir::Op op;

@@ -1,5 +1,6 @@
 #include "rt/system.h"
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 
@@ -14,6 +15,9 @@ using ir::KernelKind;
 using ir::YieldKind;
 
 namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
 // An emission count or rate from a kernel: NaN, infinite and negative values count as
 // invalid and emit nothing.
@@ -55,6 +59,16 @@ System::System(ir::Module module, Backend& backend, SystemOptions options)
         const ir::Kernel* update = o.kernel(KernelKind::Update);
         b.update = batchLayout(o, *update);
         if (const ir::Kernel* ek = o.kernel(KernelKind::Exports)) b.exports = batchLayout(o, *ek);
+        b.drawn.assign(4, false);
+        if (const ir::Kernel* rk = o.kernel(KernelKind::Render)) {
+            b.render = batchLayout(o, *rk);
+            for (const ir::Yield& y : rk->yields) {
+                if (y.kind == YieldKind::Visible) b.drawn[0] = true;
+                if (y.kind == YieldKind::Position) b.drawn[1] = true;
+                if (y.kind == YieldKind::Color) b.drawn[2] = true;
+                if (y.kind == YieldKind::Size) b.drawn[3] = true;
+            }
+        }
         b.counted.assign(o.emits.size(), false);
         b.rated.assign(o.emits.size(), false);
         for (const ir::Yield& y : update->yields) {
@@ -181,12 +195,14 @@ void System::update(size_t type, uint32_t row, double dt, double t1) {
 void System::updateOnce(size_t type, uint32_t row, double dt, double t1) {
     Pool& pool = pools_[type];
     const ir::Object& o = pool.object();
-    std::vector<Value> params, state;
     const ir::Kernel* k = o.kernel(KernelKind::Update);
-    KernelInputs in = inputs(type, row, t1, static_cast<float>(dt), false, params, state);
+    KernelInputs in = inputs(type, row, t1, static_cast<float>(dt), false, params_, state_);
     runKernel(type, row, *k, in);
     bool killed = false;
-    std::vector<float> rate(o.emits.size(), 0), count(o.emits.size(), 1);
+    std::vector<float>& rate = rate_;
+    std::vector<float>& count = count_;
+    rate.assign(o.emits.size(), 0);
+    count.assign(o.emits.size(), 1);
     for (size_t i = 0; i < k->yields.size(); ++i) {
         const ir::Yield& y = k->yields[i];
         switch (y.kind) {
@@ -202,7 +218,7 @@ void System::updateOnce(size_t type, uint32_t row, double dt, double t1) {
         return;
     }
     if (const ir::Kernel* ek = o.kernel(KernelKind::Exports)) {
-        KernelInputs post = inputs(type, row, t1, static_cast<float>(dt), false, params, state);
+        KernelInputs post = inputs(type, row, t1, static_cast<float>(dt), false, params_, state_);
         runKernel(type, row, *ek, post);
         for (size_t i = 0; i < ek->yields.size(); ++i)
             pool.exports.set(static_cast<size_t>(ek->yields[i].index), row, yields_[i]);
@@ -281,6 +297,18 @@ void System::gatherParents(size_t type, const BatchLayout& layout, void* const* 
     }
 }
 
+// Runs chunk(c) for every chunk of `rows` rows: on the arena's threads when the backend
+// allows it and there is more than one chunk.
+template <typename Chunk>
+void System::forChunks(size_t rows, Chunk chunk) {
+    size_t chunks = (rows + kRowsPerChunk - 1) / kRowsPerChunk;
+    if (chunks > 1 && backend_.concurrent() && arena_->max_concurrency() > 1) {
+        arena_->execute([&] { tbb::parallel_for(size_t{0}, chunks, chunk); });
+    } else {
+        for (size_t c = 0; c < chunks; ++c) chunk(c);
+    }
+}
+
 // One update of every updatable object of a type, as `updateOnce` would do object by
 // object: the update kernel and the exports kernel run over chunks of rows (on several
 // threads where the backend allows), then kills and emissions follow in row order, so
@@ -331,14 +359,20 @@ void System::updatePool(size_t type, double dt, double t1) {
         gatherParents(type, b.exports, post.columns, post.mask, post.begin, post.end, t1);
         backend_.runRows(o, *exports, b.exports, post);
     };
-    size_t chunks = (rows + kRowsPerChunk - 1) / kRowsPerChunk;
-    if (chunks > 1 && backend_.concurrent() && arena_->max_concurrency() > 1) {
-        arena_->execute([&] { tbb::parallel_for(size_t{0}, chunks, chunk); });
-    } else {
-        for (size_t c = 0; c < chunks; ++c) chunk(c);
-    }
+    auto start = Clock::now();
+    forChunks(rows, chunk);
+    auto loopsDone = Clock::now();
+    stats_.loopSeconds += seconds(start, loopsDone);
+    struct Timer {
+        Stats& stats;
+        Clock::time_point start;
+        ~Timer() { stats.emitSeconds += seconds(start, Clock::now()); }
+    } timer{stats_, loopsDone};
     if (!b.kills && !b.rateEmits) return;
-    std::vector<float> rate(o.emits.size(), 0), count(o.emits.size(), 1);
+    std::vector<float>& rate = rate_;
+    std::vector<float>& count = count_;
+    rate.assign(o.emits.size(), 0);
+    count.assign(o.emits.size(), 1);
     for (uint32_t row = 0; row < rows; ++row) {
         if (!pool.updatable[row]) continue;
         if (b.kills && b.kill[row]) {
@@ -370,24 +404,21 @@ void System::queueChildren(size_t type, uint32_t row, int site, uint64_t count, 
     if (kept == 0) return;
     const ir::Kernel* spawn = pool.object().kernel(KernelKind::Spawn, site);
     Handle parent = parentType_[target] == static_cast<int>(type) ? pool.handle(row) : Handle{};
-    std::vector<Value> params, state;
+    size_t params = pools_[target].paramColumn.size();
+    KernelInputs in;
+    if (spawn) in = inputs(type, row, evalTime, static_cast<float>(lastDt_), first, params_, state_);
     for (uint64_t k = 0; k < kept; ++k) {
-        Creation c;
-        c.type = target;
-        c.parent = parent;
-        c.time = firstTime + static_cast<double>(k / perEvent) * spacing;
-        c.id = nextId_++;
+        Creation c{target, queueArgs_.size(), parent, firstTime + static_cast<double>(k / perEvent) * spacing, nextId_++};
+        queueArgs_.resize(queueArgs_.size() + params);
         if (spawn) {
-            KernelInputs in = inputs(type, row, evalTime, static_cast<float>(lastDt_), first, params, state);
             in.childDraw = c.id;
             runKernel(type, row, *spawn, in);
-            c.args.resize(pools_[target].paramColumn.size());
             for (size_t i = 0; i < spawn->yields.size(); ++i)
                 if (spawn->yields[i].kind == YieldKind::EmitArg)
-                    c.args.at(static_cast<size_t>(spawn->yields[i].sub)) = yields_[i];
+                    queueArgs_.at(c.args + static_cast<size_t>(spawn->yields[i].sub)) = yields_[i];
         }
         ++queued_[target];
-        queue_.push_back(std::move(c));
+        queue_.push_back(c);
     }
 }
 
@@ -407,17 +438,19 @@ void System::create(const Creation& c, double t1) {
     pool.id[row] = c.id;
     pool.parent[row] = c.parent;
     if (c.parent.valid()) ++pools_[static_cast<size_t>(parentType_[c.type])].readers[c.parent.row];
-    for (size_t i = 0; i < pool.paramColumn.size() && i < c.args.size(); ++i)
-        if (pool.paramColumn[i] >= 0) pool.params.set(static_cast<size_t>(pool.paramColumn[i]), row, c.args[i]);
+    // A copy: creating may queue more, and move the queue's arguments.
+    std::vector<Value>& args = createArgs_;
+    args.assign(queueArgs_.begin() + static_cast<std::ptrdiff_t>(c.args),
+                queueArgs_.begin() + static_cast<std::ptrdiff_t>(c.args + pool.paramColumn.size()));
+    for (size_t i = 0; i < pool.paramColumn.size(); ++i)
+        if (pool.paramColumn[i] >= 0) pool.params.set(static_cast<size_t>(pool.paramColumn[i]), row, args[i]);
     for (size_t i = 0; i < pool.state.count(); ++i) pool.state.set(i, row, Value{});
 
-    std::vector<Value> params, state;
-    std::vector<double> bursts(o.emits.size(), 0);
+    std::vector<double>& bursts = bursts_;
+    bursts.assign(o.emits.size(), 0);
     if (const ir::Kernel* init = o.kernel(KernelKind::Init)) {
-        KernelInputs in = inputs(c.type, row, c.time, 0, true, params, state);
-        std::vector<Value> args = c.args;  // every parameter, kept or not
-        args.resize(pool.paramColumn.size());
-        in.params = args.data();
+        KernelInputs in = inputs(c.type, row, c.time, 0, true, params_, state_);
+        in.params = args.data();  // every parameter, kept or not
         runKernel(c.type, row, *init, in);
         for (size_t i = 0; i < init->yields.size(); ++i) {
             const ir::Yield& y = init->yields[i];
@@ -427,7 +460,7 @@ void System::create(const Creation& c, double t1) {
         }
     }
     if (const ir::Kernel* ek = o.kernel(KernelKind::Exports)) {
-        KernelInputs in = inputs(c.type, row, c.time, 0, true, params, state);
+        KernelInputs in = inputs(c.type, row, c.time, 0, true, params_, state_);
         runKernel(c.type, row, *ek, in);
         for (size_t i = 0; i < ek->yields.size(); ++i)
             pool.exports.set(static_cast<size_t>(ek->yields[i].index), row, yields_[i]);
@@ -446,6 +479,7 @@ void System::drain(double t1) {
         create(c, t1);
     }
     queue_.clear();
+    queueArgs_.clear();
 }
 
 void System::kill(size_t type, uint32_t row) {
@@ -483,12 +517,16 @@ std::optional<std::string> System::step(double dt) {
         Pool& pool = pools_[type];
         if (stepLimit_[type] > 0 && dt > stepLimit_[type]) {
             // Sub-steps: object by object, each through all its sub-steps.
+            auto start = Clock::now();
             for (uint32_t row = 0; row < pool.rows(); ++row)
                 if (pool.updatable[row]) update(type, row, dt, t1);
+            stats_.loopSeconds += seconds(start, Clock::now());
         } else {
             updatePool(type, dt, t1);
         }
+        auto start = Clock::now();
         drain(t1);
+        stats_.createSeconds += seconds(start, Clock::now());
     }
     now_ = t1;
     for (auto [type, row] : dying_) {
@@ -548,14 +586,15 @@ void System::emitFromKernel(const ir::Trigger& trigger, std::span<const Value> p
         auto kept = static_cast<uint64_t>(std::min(counts[s], static_cast<double>(room)));
         typeStats_[target].dropped += static_cast<uint64_t>(counts[s]) - kept;
         for (uint64_t n = 0; n < kept; ++n) {
-            Creation c{target, std::vector<Value>(pools_[target].paramColumn.size()), {}, now_, nextId_++};
+            Creation c{target, queueArgs_.size(), {}, now_, nextId_++};
+            queueArgs_.resize(queueArgs_.size() + pools_[target].paramColumn.size());
             in.childDraw = c.id;
             backend_.run(k, in, yields_);
             for (size_t i = 0; i < k.yields.size(); ++i)
                 if (k.yields[i].kind == YieldKind::EmitArg && k.yields[i].index == static_cast<int>(s))
-                    c.args.at(static_cast<size_t>(k.yields[i].sub)) = yields_[i];
+                    queueArgs_.at(c.args + static_cast<size_t>(k.yields[i].sub)) = yields_[i];
             ++queued_[target];
-            queue_.push_back(std::move(c));
+            queue_.push_back(c);
         }
     }
 }
@@ -590,27 +629,48 @@ const std::vector<RenderPoint>& System::render(size_t type) {
     auto& out = render_[type];
     out.clear();
     Pool& pool = pools_[type];
+    PoolBatch& b = batches_[type];
     const ir::Kernel* k = pool.object().kernel(KernelKind::Render);
-    if (!k || k->yields.empty()) return out;
-    std::vector<Value> params, state;
-    for (uint32_t row = 0; row < pool.rows(); ++row) {
-        if (pool.status(row) != Status::Alive) continue;
-        KernelInputs in = inputs(type, row, now_, static_cast<float>(lastDt_), false, params, state);
-        runKernel(type, row, *k, in);
+    size_t rows = pool.rows();
+    if (!k || !b.drawn[0] || rows == 0) return out;
+    b.aliveMask.resize(rows);
+    bindColumns(type, b.render, b.renderScratch, b.renderColumns);
+    KernelInputs context;
+    context.dt = static_cast<float>(lastDt_);
+    context.time = static_cast<float>(now_);
+    context.seed = options_.seed;
+    RowBatch batch;
+    batch.mask = b.aliveMask.data();
+    batch.columns = b.renderColumns.data();
+    batch.externs = externs_.data();
+    batch.uniforms = uniforms(type, *k, context);
+    batch.time = now_;
+    batch.dt = static_cast<float>(lastDt_);
+    batch.seed = options_.seed;
+    batch.draw = static_cast<uint32_t>(step_);
+    forChunks(rows, [&](size_t c) {
+        RowBatch part = batch;
+        part.begin = c * kRowsPerChunk;
+        part.end = std::min(rows, part.begin + kRowsPerChunk);
+        for (size_t row = part.begin; row < part.end; ++row)
+            b.aliveMask[row] = pool.status(static_cast<uint32_t>(row)) == Status::Alive;
+        gatherParents(type, b.render, part.columns, part.mask, part.begin, part.end, now_);
+        backend_.runRows(pool.object(), *k, b.render, part);
+    });
+    auto column = [&](int offset) { return static_cast<const float*>(b.renderColumns[static_cast<size_t>(b.render.render + offset)]); };
+    const float* visible = column(BatchLayout::kVisible);
+    for (uint32_t row = 0; row < rows; ++row) {
+        if (!b.aliveMask[row] || visible[row] == 0) continue;
         RenderPoint p{pool.id[row], {}, {}, 0};
-        bool visible = false;
+        if (b.drawn[1])
+            for (int c = 0; c < 3; ++c) p.position[static_cast<size_t>(c)] = column(BatchLayout::kPosition + c)[row];
+        if (b.drawn[2])
+            for (int c = 0; c < 4; ++c) p.color[static_cast<size_t>(c)] = column(BatchLayout::kColor + c)[row];
+        if (b.drawn[3]) p.size = column(BatchLayout::kSize)[row];
         bool ok = true;
-        for (size_t i = 0; i < k->yields.size(); ++i) {
-            const Value& v = yields_[i];
-            switch (k->yields[i].kind) {
-                case YieldKind::Visible: visible = v.truth(); break;
-                case YieldKind::Position: p.position = {v.f[0], v.f[1], v.f[2]}; ok &= finite(v, 3); break;
-                case YieldKind::Color: p.color = v.f; ok &= finite(v, 4); break;
-                case YieldKind::Size: p.size = v.f[0]; ok &= finite(v, 1); break;
-                default: break;
-            }
-        }
-        if (!visible) continue;
+        for (float x : p.position) ok &= std::isfinite(x);
+        for (float x : p.color) ok &= std::isfinite(x);
+        ok &= std::isfinite(p.size);
         if (!ok) {
             ++stats_.nonFiniteRender;
             continue;

@@ -55,6 +55,9 @@ struct Stats {
     uint64_t invalidEmissions = 0;     // NaN or negative rates and counts (taken as 0)
     uint64_t nonFiniteRender = 0;      // points not drawn because a value was NaN or infinite
     uint64_t uniformEvaluations = 0;   // runs of uniform kernels (once per step per type, mostly)
+    // Where the steps' time went: the update loops over pools, kills and emissions (with
+    // the emitters' spawn kernels), creating objects (init and their first update).
+    double loopSeconds = 0, emitSeconds = 0, createSeconds = 0;
 };
 
 struct RenderPoint {
@@ -90,7 +93,7 @@ public:
 private:
     struct Creation {
         size_t type;
-        std::vector<Value> args;
+        size_t args;  // the first of its arguments in queueArgs_, one per parameter of the type
         Handle parent;
         double time;
         uint32_t id;
@@ -109,6 +112,8 @@ private:
     void emitAtRate(size_t type, uint32_t row, std::span<const float> rate, std::span<const float> count, double dt,
                     double t1);
     void update(size_t type, uint32_t row, double dt, double t1);
+    template <typename Chunk>
+    void forChunks(size_t rows, Chunk chunk);
     void updateOnce(size_t type, uint32_t row, double dt, double t1);
     void create(const Creation& c, double t1);
     void queueChildren(size_t type, uint32_t row, int site, uint64_t count, uint64_t perEvent, double firstTime,
@@ -129,6 +134,7 @@ private:
     std::vector<std::vector<RenderPoint>> render_;
     std::vector<bool> renderStale_;
     std::vector<Creation> queue_;
+    std::vector<Value> queueArgs_;
     std::vector<size_t> queued_;  // per type: creations waiting in the queue
     std::vector<std::pair<size_t, uint32_t>> dying_;
     std::vector<TypeStats> typeStats_;
@@ -139,6 +145,11 @@ private:
     uint32_t nextId_ = 0;
     bool started_ = false;
     std::vector<Value> yields_;
+    // Scratch for the object-by-object paths (creation, sub-steps, triggers), reused so
+    // that creating an object allocates nothing.
+    std::vector<Value> params_, state_, createArgs_;
+    std::vector<float> rate_, count_;
+    std::vector<double> bursts_;
     // Per type and served kernel: the uniform values and the (dt, time, externs) they
     // were computed for.
     struct UniformCache {
@@ -151,12 +162,13 @@ private:
     uint64_t externsVersion_ = 0;
     // Per type: the batched update and exports kernels' layouts and scratch columns.
     struct PoolBatch {
-        BatchLayout update, exports;
+        BatchLayout update, exports, render;
+        std::vector<bool> drawn;  // per render yield kind (visible, position, colour, size): whether it is yielded
         bool kills = false, rateEmits = false;
         std::vector<bool> counted, rated;  // per emit site: whether the update yields its count, its rate
-        std::vector<uint8_t> kill, exportMask;
-        std::vector<std::vector<float>> updateScratch, exportScratch;
-        std::vector<void*> updateColumns, exportColumns;
+        std::vector<uint8_t> kill, exportMask, aliveMask;
+        std::vector<std::vector<float>> updateScratch, exportScratch, renderScratch;
+        std::vector<void*> updateColumns, exportColumns, renderColumns;
     };
     std::vector<PoolBatch> batches_;
     std::unique_ptr<tbb::task_arena> arena_;

@@ -1,11 +1,24 @@
 // The LLVM backend against the interpreter: every sample and a program that uses every
-// operation, run side by side from the same seed, must draw the same objects with the
-// same values, bit for bit. The JIT compiles each operation to the interpreter's float
-// semantics (no fused multiply-add, no fast-math, the same libm functions), so no
-// tolerance is needed; a difference is a bug.
+// operation, run side by side from the same seed for 600 frames (triggers fired), must
+// create, kill and draw the same objects.
+//
+// In exact maths the values must be the same bit for bit: each operation is compiled to
+// the interpreter's float semantics (no fused multiply-add, the same libm functions), so
+// a difference is a bug. In fast maths (the default) two things move the last bits:
+//   - FMA contraction: a·b + c rounds once instead of twice (≤ 0.5 ulp of the product
+//     per fused operation);
+//   - libmvec: sin, cos, tan, exp, log and pow on eight objects at a time are within
+//     4 ulp of libm's (glibc's documented bound), not equal to them.
+// Both are relative errors of about 1e-7 per operation; Euler integration adds them up
+// over the steps. Measured, relative to max(1, |value|): at most 3.8e-6 on the samples
+// after 600 frames, 9.5e-5 on the every-operation program (tan and pow of values near
+// their poles). The tolerance is 5e-4: above both, far below anything visible, and tight
+// enough that a wrong operation, lane or column fails.
 #define DOCTEST_CONFIG_IMPLEMENT_WITH_MAIN
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -38,15 +51,37 @@ ir::Module compile(const std::string& text, bool optimize) {
     return *module;
 }
 
+using codegen_llvm::MathMode;
+
+constexpr double kTolerance = 5e-4;
+
 bool same(const rt::RenderPoint& a, const rt::RenderPoint& b) {
     return a.id == b.id && std::memcmp(&a.position, &b.position, sizeof a.position) == 0 &&
            std::memcmp(&a.color, &b.color, sizeof a.color) == 0 && std::memcmp(&a.size, &b.size, sizeof a.size) == 0;
 }
 
-// Runs `text` on both backends for `frames` frames; returns the number of points compared.
-size_t compareBackends(const std::string& text, int frames, bool optimize) {
+// The largest difference between two points' values, relative to max(1, |value|).
+double difference(const rt::RenderPoint& a, const rt::RenderPoint& b) {
+    double worst = 0;
+    auto compare = [&worst](float x, float y) {
+        double d = std::fabs(double(x) - double(y)) / std::max(1.0, std::fabs(double(x)));
+        worst = std::max(worst, std::isnan(d) ? (std::isnan(x) && std::isnan(y) ? 0.0 : 1e9) : d);
+    };
+    for (size_t i = 0; i < 3; ++i) compare(a.position[i], b.position[i]);
+    for (size_t i = 0; i < 4; ++i) compare(a.color[i], b.color[i]);
+    compare(a.size, b.size);
+    return worst;
+}
+
+struct Comparison {
+    size_t points = 0;
+    double worst = 0;
+};
+
+// Runs `text` on both backends for `frames` frames.
+Comparison compareBackends(const std::string& text, int frames, bool optimize, MathMode mode) {
     interp::Interpreter interpreter;
-    codegen_llvm::LlvmBackend jit;
+    codegen_llvm::LlvmBackend jit(mode);
     rt::System a(compile(text, optimize), interpreter), b(compile(text, optimize), jit);
     for (const ir::Trigger& t : a.module().triggers) {
         size_t width = 0;
@@ -55,7 +90,8 @@ size_t compareBackends(const std::string& text, int frames, bool optimize) {
         REQUIRE_FALSE(a.fire(t.name, args));
         REQUIRE_FALSE(b.fire(t.name, args));
     }
-    size_t points = 0, differences = 0;
+    Comparison result;
+    size_t differences = 0;
     for (int frame = 0; frame < frames; ++frame) {
         REQUIRE_FALSE(a.step(1.0 / 60));
         REQUIRE_FALSE(b.step(1.0 / 60));
@@ -63,27 +99,33 @@ size_t compareBackends(const std::string& text, int frames, bool optimize) {
             const auto& pa = a.render(t);
             const auto& pb = b.render(t);
             REQUIRE(pa.size() == pb.size());
-            for (size_t i = 0; i < pa.size(); ++i) differences += same(pa[i], pb[i]) ? 0 : 1;
-            points += pa.size();
+            for (size_t i = 0; i < pa.size(); ++i) {
+                REQUIRE(pa[i].id == pb[i].id);
+                differences += same(pa[i], pb[i]) ? 0 : 1;
+                result.worst = std::max(result.worst, difference(pa[i], pb[i]));
+            }
+            result.points += pa.size();
         }
     }
-    CHECK(differences == 0);
+    if (mode == MathMode::Exact) CHECK(differences == 0);
+    CHECK(result.worst <= kTolerance);
     CHECK(a.stats().types.size() == b.stats().types.size());
     for (size_t t = 0; t < a.stats().types.size(); ++t) {
         CHECK(a.stats().types[t].created == b.stats().types[t].created);
         CHECK(a.stats().types[t].killed == b.stats().types[t].killed);
     }
-    return points;
+    return result;
 }
 
 }  // namespace
 
 TEST_CASE("every sample draws the same on the LLVM backend as on the interpreter, for 600 frames") {
-    for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
-        if (entry.path().extension() != ".psys") continue;
-        INFO(entry.path().filename().string());
-        std::string text = readFile(entry.path());
-        CHECK(compareBackends(text, 600, true) > 0);
+    for (MathMode mode : {MathMode::Exact, MathMode::Fast}) {
+        for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
+            if (entry.path().extension() != ".psys") continue;
+            INFO((entry.path().filename().string() + (mode == MathMode::Exact ? " exact" : " fast")));
+            CHECK(compareBackends(readFile(entry.path()), 600, true, mode).points > 0);
+        }
     }
 }
 
@@ -107,6 +149,9 @@ TEST_CASE("every operation compiles to the interpreter's result") {
         }
         object source { emit probe(rand()) at 30 per second; }
         spawn source;)";
-    CHECK(compareBackends(text, 300, false) > 1000);
-    CHECK(compareBackends(text, 300, true) > 1000);
+    for (MathMode mode : {MathMode::Exact, MathMode::Fast}) {
+        INFO(std::string(mode == MathMode::Exact ? "exact" : "fast"));
+        CHECK(compareBackends(text, 300, false, mode).points > 1000);
+        CHECK(compareBackends(text, 300, true, mode).points > 1000);
+    }
 }

@@ -131,7 +131,7 @@ int main(int argc, char** argv) {
     bool time = false;
     check->add_flag("--time", time, "Print how long parsing and checking took");
 
-    auto* run = app.add_subcommand("run", "Compile FILE and run the system with the interpreter");
+    auto* run = app.add_subcommand("run", "Compile FILE and run the system (JIT-compiled with LLVM, or interpreted)");
     psys::tools::RunOptions runOptions;
     run->add_option("file", runOptions.file, "The system to run")->required()->type_name("FILE");
     run->add_option("--frames", runOptions.frames, "Frames to run (600)")->check(CLI::NonNegativeNumber);
@@ -144,8 +144,16 @@ int main(int argc, char** argv) {
     run->add_option("--dump", runOptions.dump, "Write every drawn point per frame to FILE.csv or FILE.json");
     run->add_option("--dump-every", runOptions.dumpEvery, "Dump every Nth frame (1)")->check(CLI::PositiveNumber);
     run->add_flag("--quiet", runOptions.quiet, "No line per frame, only the summary");
-    run->add_option("--backend", runOptions.backend, "interp (the reference) or llvm (JIT-compiled)")
+    run->add_option("--backend", runOptions.backend, "llvm (JIT-compiled, the default) or interp (the reference)")
         ->check(CLI::IsMember({"interp", "llvm"}));
+    run->add_option("--math", runOptions.math,
+                    "llvm backend: fast (fused multiply-adds, vector math functions; the default) or exact "
+                    "(the interpreter's results bit for bit)")
+        ->check(CLI::IsMember({"fast", "exact"}));
+    run->add_option("--threads", runOptions.threads, "Threads for pool updates: 0 for every core (0)")
+        ->check(CLI::NonNegativeNumber);
+    run->add_flag("--timing", runOptions.timing, "Print compile time and the time spent stepping and drawing");
+    run->add_flag("--remarks", runOptions.remarks, "llvm backend: print whether each update loop vectorized");
     run->fallthrough();
 
     app.require_subcommand(0, 1);

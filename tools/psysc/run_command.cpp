@@ -1,5 +1,7 @@
 #include "run_command.h"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -143,9 +145,25 @@ int runSystem(const RunOptions& options) {
     if (!module) return 1;
 
     std::unique_ptr<rt::Backend> backend;
-    if (options.backend == "llvm") backend = std::make_unique<codegen_llvm::LlvmBackend>();
-    else backend = std::make_unique<interp::Interpreter>();
-    rt::System system(std::move(*module), *backend, {options.seed, options.capacity});
+    codegen_llvm::LlvmBackend* jit = nullptr;
+    if (options.backend == "llvm") {
+        auto llvm = std::make_unique<codegen_llvm::LlvmBackend>(options.math == "exact" ? codegen_llvm::MathMode::Exact
+                                                                                       : codegen_llvm::MathMode::Fast);
+        jit = llvm.get();
+        backend = std::move(llvm);
+    } else {
+        backend = std::make_unique<interp::Interpreter>();
+    }
+    rt::SystemOptions systemOptions;
+    systemOptions.seed = options.seed;
+    systemOptions.capacity = options.capacity;
+    systemOptions.threads = options.threads;
+    rt::System system(std::move(*module), *backend, systemOptions);
+    if (jit && options.remarks)
+        for (const auto& r : jit->remarks())
+            std::cout << fmt::format("{}: {}: {}\n", r.function, r.vectorized ? "vectorized" : "not vectorized", r.message);
+    using Clock = std::chrono::steady_clock;
+    double stepSeconds = 0, renderSeconds = 0;
     for (auto& [name, values] : sets)
         if (auto error = system.setExtern(name, values)) {
             std::cerr << "psysc: error: --set " << name << ": " << *error << "\n";
@@ -163,10 +181,13 @@ int runSystem(const RunOptions& options) {
                     std::cerr << "psysc: error: --fire " << f.trigger << ": " << *error << "\n";
                     return 2;
                 }
+        auto stepStart = Clock::now();
         if (auto error = system.step(*dt)) {
             std::cerr << "psysc: error: " << *error << "\n";
             return 2;
         }
+        auto renderStart = Clock::now();
+        stepSeconds += std::chrono::duration<double>(renderStart - stepStart).count();
         if (!options.quiet) {
             std::string line = fmt::format("frame {:4}  t={:.4f}", frame, system.time());
             rt::Stats stats = system.stats();
@@ -176,6 +197,7 @@ int runSystem(const RunOptions& options) {
         // Every frame is drawn (as a host would), so points with NaN or infinite values
         // are counted even when nothing is dumped.
         for (size_t t = 0; t < system.typeCount(); ++t) system.render(t);
+        renderSeconds += std::chrono::duration<double>(Clock::now() - renderStart).count();
         if (options.dumpEvery > 0 && frame % options.dumpEvery == 0) dump.frame(frame, system);
     }
     if (!dump.finish()) {
@@ -183,6 +205,19 @@ int runSystem(const RunOptions& options) {
         return 2;
     }
     rt::Stats stats = system.stats();
+    if (options.timing) {
+        if (jit) {
+            auto c = jit->compileStats();
+            std::cout << fmt::format("compiled {} kernels in {:.1f} ms ({}, {} math)\n", c.kernels, c.seconds * 1e3,
+                                     jit->cpu(), options.math);
+        }
+        int frames = std::max(options.frames, 1);
+        std::cout << fmt::format("stepping {:.3f} ms per frame (update loops {:.3f}, kills and emissions {:.3f}, "
+                                 "creation {:.3f}), drawing {:.3f} ms per frame\n",
+                                 stepSeconds * 1e3 / frames, stats.loopSeconds * 1e3 / frames,
+                                 stats.emitSeconds * 1e3 / frames, stats.createSeconds * 1e3 / frames,
+                                 renderSeconds * 1e3 / frames);
+    }
     std::cout << fmt::format("after {} frames ({:.3f} s):\n", options.frames, system.time());
     for (auto& t : stats.types)
         std::cout << fmt::format("  {:24} live {:8}  created {:10}  killed {:10}  frozen {:4}  dropped {}\n", t.name,

@@ -1,4 +1,4 @@
-// `psysc run`: compile a system and step it through time with the interpreter.
+// `psysc run`: compile a system and step it through time, JIT-compiled or interpreted.
 #pragma once
 
 #include <string>
@@ -19,7 +19,11 @@ struct RunOptions {
     bool quiet = false;
     bool optimize = true;
     bool relaxed = false;
-    std::string backend = "interp";  // or "llvm"
+    std::string backend = "llvm";    // or "interp"
+    std::string math = "fast";       // or "exact" (llvm)
+    unsigned threads = 0;            // 0: every core
+    bool timing = false;
+    bool remarks = false;
     bool colour = false;
 };
 

@@ -1,0 +1,134 @@
+#include "codegen_llvm/jit_engine.h"
+
+#include <stdexcept>
+
+#include <llvm/Analysis/TargetLibraryInfo.h>
+#include <llvm/ExecutionEngine/Orc/ExecutionUtils.h>
+#include <llvm/ExecutionEngine/Orc/JITTargetMachineBuilder.h>
+#include <llvm/ExecutionEngine/Orc/LLJIT.h>
+#include <llvm/ExecutionEngine/Orc/ThreadSafeModule.h>
+#include <llvm/IR/DiagnosticInfo.h>
+#include <llvm/IR/DiagnosticPrinter.h>
+#include <llvm/IR/Verifier.h>
+#include <llvm/Passes/PassBuilder.h>
+#include <llvm/Support/TargetSelect.h>
+#include <llvm/Target/TargetMachine.h>
+#include <llvm/TargetParser/Host.h>
+
+namespace psys::codegen_llvm {
+
+namespace {
+
+// Keeps what the loop vectorizer says about each loop; every other diagnostic goes to
+// LLVM's default printing (none is expected).
+struct RemarkCollector : llvm::DiagnosticHandler {
+    std::vector<VectorizeRemark>* out;
+    explicit RemarkCollector(std::vector<VectorizeRemark>* remarks) : out(remarks) {}
+    bool isPassedOptRemarkEnabled(llvm::StringRef pass) const override { return pass == "loop-vectorize"; }
+    bool isMissedOptRemarkEnabled(llvm::StringRef pass) const override { return pass == "loop-vectorize"; }
+    bool isAnalysisRemarkEnabled(llvm::StringRef pass) const override { return pass == "loop-vectorize"; }
+    bool isAnyRemarkEnabled() const override { return true; }
+    bool handleDiagnostics(const llvm::DiagnosticInfo& info) override {
+        auto* remark = llvm::dyn_cast<llvm::DiagnosticInfoOptimizationBase>(&info);
+        if (!remark) return false;
+        if (remark->getPassName() != "loop-vectorize") return true;
+        if (!remark->isPassed() && !remark->isMissed()) return true;  // analyses explain misses
+        out->push_back({remark->getFunction().getName().str(), remark->isPassed(), remark->getMsg()});
+        return true;
+    }
+};
+
+}  // namespace
+
+struct JitEngine::Impl {
+    MathMode mode;
+    std::unique_ptr<llvm::orc::LLJIT> jit;
+    std::unique_ptr<llvm::TargetMachine> machine;
+    std::string cpu;
+
+    void optimize(llvm::Module& module) {
+        llvm::LoopAnalysisManager lam;
+        llvm::FunctionAnalysisManager fam;
+        llvm::CGSCCAnalysisManager cgam;
+        llvm::ModuleAnalysisManager mam;
+        llvm::PipelineTuningOptions tuning;
+        tuning.LoopVectorization = true;
+        tuning.SLPVectorization = true;
+        llvm::PassBuilder builder(machine.get(), tuning);
+        llvm::TargetLibraryInfoImpl library(llvm::Triple(module.getTargetTriple()));
+        if (mode == MathMode::Fast)
+            library.addVectorizableFunctionsFromVecLib(llvm::TargetLibraryInfoImpl::LIBMVEC_X86,
+                                                       llvm::Triple(module.getTargetTriple()));
+        fam.registerPass([&] { return llvm::TargetLibraryAnalysis(library); });
+        builder.registerModuleAnalyses(mam);
+        builder.registerCGSCCAnalyses(cgam);
+        builder.registerFunctionAnalyses(fam);
+        builder.registerLoopAnalyses(lam);
+        builder.crossRegisterProxies(lam, fam, cgam, mam);
+        builder.buildPerModuleDefaultPipeline(llvm::OptimizationLevel::O3).run(module, mam);
+    }
+};
+
+JitEngine::JitEngine(MathMode mode) : impl_(std::make_unique<Impl>()) {
+    impl_->mode = mode;
+    llvm::InitializeNativeTarget();
+    llvm::InitializeNativeTargetAsmPrinter();
+    auto host = llvm::orc::JITTargetMachineBuilder::detectHost();
+    if (!host) throw std::runtime_error(llvm::toString(host.takeError()));
+    host->setCodeGenOptLevel(llvm::CodeGenOptLevel::Aggressive);
+    impl_->cpu = host->getCPU();
+    auto machine = host->createTargetMachine();
+    if (!machine) throw std::runtime_error(llvm::toString(machine.takeError()));
+    impl_->machine = std::move(*machine);
+    auto jit = llvm::orc::LLJITBuilder().setJITTargetMachineBuilder(std::move(*host)).create();
+    if (!jit) throw std::runtime_error(llvm::toString(jit.takeError()));
+    impl_->jit = std::move(*jit);
+    // libm's functions come from this process, as the interpreter's do; libmvec's vector
+    // functions from glibc's libmvec.
+    const char prefix = impl_->jit->getDataLayout().getGlobalPrefix();
+    auto process = llvm::orc::DynamicLibrarySearchGenerator::GetForCurrentProcess(prefix);
+    if (!process) throw std::runtime_error(llvm::toString(process.takeError()));
+    impl_->jit->getMainJITDylib().addGenerator(std::move(*process));
+    if (mode == MathMode::Fast) {
+        auto vectorMath = llvm::orc::DynamicLibrarySearchGenerator::Load("libmvec.so.1", prefix);
+        if (!vectorMath) throw std::runtime_error("glibc's vector math library: " + llvm::toString(vectorMath.takeError()));
+        impl_->jit->getMainJITDylib().addGenerator(std::move(*vectorMath));
+    }
+}
+
+JitEngine::~JitEngine() = default;
+
+std::string JitEngine::cpu() const { return impl_->cpu; }
+
+std::unique_ptr<llvm::LLVMContext> JitEngine::newContext() const {
+    auto context = std::make_unique<llvm::LLVMContext>();
+    return context;
+}
+
+std::unique_ptr<llvm::Module> JitEngine::newModule(llvm::LLVMContext& context) const {
+    auto module = std::make_unique<llvm::Module>("psys", context);
+    module->setDataLayout(impl_->jit->getDataLayout());
+    module->setTargetTriple(impl_->jit->getTargetTriple().str());
+    return module;
+}
+
+std::vector<void*> JitEngine::add(std::unique_ptr<llvm::LLVMContext> context, std::unique_ptr<llvm::Module> module,
+                                  const std::vector<std::string>& names) {
+    std::string problems;
+    llvm::raw_string_ostream stream(problems);
+    if (llvm::verifyModule(*module, &stream)) throw std::runtime_error("the LLVM backend built invalid IR: " + problems);
+    context->setDiagnosticHandler(std::make_unique<RemarkCollector>(&remarks_));
+    impl_->optimize(*module);
+    context->setDiagnosticHandler(std::make_unique<llvm::DiagnosticHandler>());
+    if (auto err = impl_->jit->addIRModule(llvm::orc::ThreadSafeModule(std::move(module), std::move(context))))
+        throw std::runtime_error(llvm::toString(std::move(err)));
+    std::vector<void*> addresses;
+    for (const std::string& name : names) {
+        auto symbol = impl_->jit->lookup(name);
+        if (!symbol) throw std::runtime_error(llvm::toString(symbol.takeError()));
+        addresses.push_back(symbol->toPtr<void*>());
+    }
+    return addresses;
+}
+
+}  // namespace psys::codegen_llvm

@@ -1,0 +1,210 @@
+#include "codegen_llvm/lane_emitter.h"
+
+#include <stdexcept>
+#include <string>
+
+#include <llvm/IR/Intrinsics.h>
+
+namespace psys::codegen_llvm {
+
+using namespace ir;
+
+llvm::Type* laneType(llvm::IRBuilder<>& b, Type t) {
+    if (t.isBool()) return b.getInt1Ty();
+    if (t.kind == Type::Kind::U32) return b.getInt32Ty();
+    return b.getFloatTy();
+}
+
+namespace {
+
+class BodyEmitter {
+public:
+    BodyEmitter(llvm::IRBuilder<>& b, llvm::Module& m, const Kernel& k, MathMode mode, llvm::Value* seed)
+        : b_(b), module_(m), kernel_(k), mode_(mode), seed_(seed) {}
+
+    std::vector<Lanes> run(const LeafReader& leaf) {
+        llvm::FastMathFlags flags;
+        if (mode_ == MathMode::Fast) flags.setAllowContract(true);
+        b_.setFastMathFlags(flags);
+        int parentOrdinal = 0;
+        values_.resize(kernel_.size());
+        for (ValueId v = 0; v < kernel_.size(); ++v) {
+            const Inst& i = kernel_.at(v);
+            if (isLeaf(i.op)) {
+                values_[v] = leaf(i, parentOrdinal);
+                if (i.op == Op::ParentExport || i.op == Op::ParentAlive || i.op == Op::ParentAge) ++parentOrdinal;
+            } else {
+                values_[v] = emit(i);
+            }
+        }
+        b_.clearFastMathFlags();
+        return std::move(values_);
+    }
+
+private:
+    static bool isLeaf(Op op) {
+        switch (op) {
+            case Op::Param: case Op::TriggerParam: case Op::StateRead: case Op::Extern: case Op::Uniform:
+            case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge: case Op::Age: case Op::Dt:
+            case Op::Time: case Op::First: case Op::ObjectId: case Op::DrawIndex:
+                return true;
+            default:
+                return false;
+        }
+    }
+
+    llvm::Value* f(float x) { return llvm::ConstantFP::get(b_.getFloatTy(), x); }
+
+    // One lane through a libm function: a plain call in exact mode (the interpreter's
+    // function), an intrinsic the vectorizer can map onto libmvec in fast mode.
+    llvm::Value* math(llvm::Intrinsic::ID id, const char* name, llvm::Value* x, llvm::Value* y = nullptr) {
+        if (mode_ == MathMode::Fast && id != llvm::Intrinsic::not_intrinsic)
+            return y ? b_.CreateBinaryIntrinsic(id, x, y) : b_.CreateUnaryIntrinsic(id, x);
+        std::vector<llvm::Type*> params(y ? 2 : 1, b_.getFloatTy());
+        llvm::FunctionCallee callee =
+            module_.getOrInsertFunction(name, llvm::FunctionType::get(b_.getFloatTy(), params, false));
+        llvm::CallInst* call = y ? b_.CreateCall(callee, {x, y}) : b_.CreateCall(callee, {x});
+        if (mode_ == MathMode::Fast) {  // no errno is read: the call may move and widen
+            call->setDoesNotAccessMemory();
+            call->setDoesNotThrow();
+            call->addFnAttr(llvm::Attribute::WillReturn);
+        }
+        return call;
+    }
+
+    llvm::Value* pcg(llvm::Value* v) {  // rt/rng.h's pcgHash
+        llvm::Value* state = b_.CreateAdd(b_.CreateMul(v, b_.getInt32(747796405u)), b_.getInt32(2891336453u));
+        llvm::Value* shift = b_.CreateAdd(b_.CreateLShr(state, b_.getInt32(28)), b_.getInt32(4));
+        llvm::Value* word = b_.CreateMul(b_.CreateXor(b_.CreateLShr(state, shift), state), b_.getInt32(277803737u));
+        return b_.CreateXor(b_.CreateLShr(word, b_.getInt32(22)), word);
+    }
+
+    // rt/rng.h's drawBits(seed, object, site, draw, component) → uniform01, per lane.
+    Lanes random(const Inst& i) {
+        llvm::Value* object = values_[i.operands[0]][0];
+        llvm::Value* draw = values_[i.operands[1]][0];
+        llvm::Value* drawHash = pcg(draw);
+        Lanes out;
+        for (int l = 0; l < i.type.width; ++l) {
+            llvm::Value* h = pcg(b_.CreateXor(b_.getInt32(static_cast<uint32_t>(l)), drawHash));
+            h = pcg(b_.CreateXor(h, b_.getInt32(static_cast<uint32_t>(i.attr) * 0x9E3779B9u)));
+            h = pcg(b_.CreateXor(h, object));
+            h = pcg(b_.CreateXor(h, seed_));
+            llvm::Value* u = b_.CreateFMul(b_.CreateUIToFP(b_.CreateLShr(h, b_.getInt32(8)), b_.getFloatTy()),
+                                           f(1.0f / 16777216.0f));
+            if (i.op == Op::NRand) u = b_.CreateFSub(b_.CreateFMul(u, f(2.0f)), f(1.0f));
+            out.push_back(u);
+        }
+        return out;
+    }
+
+    template <typename F>
+    Lanes map(const Inst& i, F lane) {
+        Lanes out;
+        for (int l = 0; l < i.type.width; ++l) out.push_back(lane(static_cast<size_t>(l)));
+        return out;
+    }
+
+    Lanes emit(const Inst& i) {
+        auto x = [&](size_t n, size_t l) { return values_[i.operands[n]][l]; };
+        auto width = [&](size_t n) { return kernel_.at(i.operands[n]).type.width; };
+        switch (i.op) {
+            case Op::Const:
+                return map(i, [&](size_t l) -> llvm::Value* {
+                    if (i.type.isBool()) return b_.getInt1(i.constant[0] != 0);
+                    return f(i.constant[l]);
+                });
+            case Op::Add: return map(i, [&](size_t l) { return b_.CreateFAdd(x(0, l), x(1, l)); });
+            case Op::Sub: return map(i, [&](size_t l) { return b_.CreateFSub(x(0, l), x(1, l)); });
+            case Op::Mul: return map(i, [&](size_t l) { return b_.CreateFMul(x(0, l), x(1, l)); });
+            case Op::Div: return map(i, [&](size_t l) { return b_.CreateFDiv(x(0, l), x(1, l)); });
+            case Op::Mod:  // x − y·floor(x / y)
+                return map(i, [&](size_t l) {
+                    llvm::Value* q = b_.CreateUnaryIntrinsic(llvm::Intrinsic::floor, b_.CreateFDiv(x(0, l), x(1, l)));
+                    return b_.CreateFSub(x(0, l), b_.CreateFMul(x(1, l), q));
+                });
+            case Op::Neg: return map(i, [&](size_t l) { return b_.CreateFNeg(x(0, l)); });
+            case Op::Min: return map(i, [&](size_t l) { return b_.CreateSelect(b_.CreateFCmpOLT(x(1, l), x(0, l)), x(1, l), x(0, l)); });
+            case Op::Max: return map(i, [&](size_t l) { return b_.CreateSelect(b_.CreateFCmpOLT(x(0, l), x(1, l)), x(1, l), x(0, l)); });
+            case Op::Step: return map(i, [&](size_t l) { return b_.CreateSelect(b_.CreateFCmpOLT(x(1, l), x(0, l)), f(0), f(1)); });
+            case Op::Atan2: return map(i, [&](size_t l) { return math(llvm::Intrinsic::not_intrinsic, "atan2f", x(0, l), x(1, l)); });
+            case Op::Pow: return map(i, [&](size_t l) { return math(llvm::Intrinsic::pow, "powf", x(0, l), x(1, l)); });
+            case Op::Sin: return map(i, [&](size_t l) { return math(llvm::Intrinsic::sin, "sinf", x(0, l)); });
+            case Op::Cos: return map(i, [&](size_t l) { return math(llvm::Intrinsic::cos, "cosf", x(0, l)); });
+            case Op::Tan: return map(i, [&](size_t l) { return math(llvm::Intrinsic::tan, "tanf", x(0, l)); });
+            case Op::Asin: return map(i, [&](size_t l) { return math(llvm::Intrinsic::asin, "asinf", x(0, l)); });
+            case Op::Acos: return map(i, [&](size_t l) { return math(llvm::Intrinsic::acos, "acosf", x(0, l)); });
+            case Op::Atan: return map(i, [&](size_t l) { return math(llvm::Intrinsic::atan, "atanf", x(0, l)); });
+            case Op::Exp: return map(i, [&](size_t l) { return math(llvm::Intrinsic::exp, "expf", x(0, l)); });
+            case Op::Log: return map(i, [&](size_t l) { return math(llvm::Intrinsic::log, "logf", x(0, l)); });
+            case Op::Sqrt: return map(i, [&](size_t l) { return b_.CreateUnaryIntrinsic(llvm::Intrinsic::sqrt, x(0, l)); });
+            case Op::Abs: return map(i, [&](size_t l) { return b_.CreateUnaryIntrinsic(llvm::Intrinsic::fabs, x(0, l)); });
+            case Op::Floor: return map(i, [&](size_t l) { return b_.CreateUnaryIntrinsic(llvm::Intrinsic::floor, x(0, l)); });
+            case Op::Ceil: return map(i, [&](size_t l) { return b_.CreateUnaryIntrinsic(llvm::Intrinsic::ceil, x(0, l)); });
+            case Op::Round: return map(i, [&](size_t l) { return b_.CreateUnaryIntrinsic(llvm::Intrinsic::nearbyint, x(0, l)); });
+            case Op::Fract:
+                return map(i, [&](size_t l) { return b_.CreateFSub(x(0, l), b_.CreateUnaryIntrinsic(llvm::Intrinsic::floor, x(0, l))); });
+            case Op::Sign:
+                return map(i, [&](size_t l) {
+                    llvm::Value* negative = b_.CreateSelect(b_.CreateFCmpOLT(x(0, l), f(0)), f(-1), f(0));
+                    return b_.CreateSelect(b_.CreateFCmpOGT(x(0, l), f(0)), f(1), negative);
+                });
+            case Op::Lt: return {b_.CreateFCmpOLT(x(0, 0), x(1, 0))};
+            case Op::Le: return {b_.CreateFCmpOLE(x(0, 0), x(1, 0))};
+            case Op::Gt: return {b_.CreateFCmpOGT(x(0, 0), x(1, 0))};
+            case Op::Ge: return {b_.CreateFCmpOGE(x(0, 0), x(1, 0))};
+            case Op::Eq: case Op::Ne: {
+                Type t = kernel_.at(i.operands[0]).type;
+                llvm::Value* equal = nullptr;
+                for (int l = 0; l < (t.isFloat() ? t.width : 1); ++l) {
+                    auto lane = static_cast<size_t>(l);
+                    llvm::Value* e = t.isFloat() ? b_.CreateFCmpOEQ(x(0, lane), x(1, lane)) : b_.CreateICmpEQ(x(0, lane), x(1, lane));
+                    equal = equal ? b_.CreateAnd(equal, e) : e;
+                }
+                return {i.op == Op::Eq ? equal : b_.CreateNot(equal)};
+            }
+            case Op::And: return {b_.CreateAnd(x(0, 0), x(1, 0))};
+            case Op::Or: return {b_.CreateOr(x(0, 0), x(1, 0))};
+            case Op::Not: return {b_.CreateNot(x(0, 0))};
+            case Op::Select: return map(i, [&](size_t l) { return b_.CreateSelect(x(0, 0), x(1, l), x(2, l)); });
+            case Op::Splat: return map(i, [&](size_t) { return x(0, 0); });
+            case Op::Compose: {
+                Lanes out;
+                for (size_t n = 0; n < i.operands.size(); ++n)
+                    for (int l = 0; l < width(n) && out.size() < 4; ++l) out.push_back(x(n, static_cast<size_t>(l)));
+                return out;
+            }
+            case Op::Extract: return {x(0, static_cast<size_t>(i.attr))};
+            case Op::Shuffle: {
+                Lanes out;
+                for (auto lane : i.lanes) out.push_back(x(0, static_cast<size_t>(lane)));
+                return out;
+            }
+            case Op::Dot: {  // ((0 + x0·y0) + x1·y1) + …, the interpreter's order
+                llvm::Value* sum = f(0);
+                for (int l = 0; l < width(0); ++l)
+                    sum = b_.CreateFAdd(sum, b_.CreateFMul(x(0, static_cast<size_t>(l)), x(1, static_cast<size_t>(l))));
+                return {sum};
+            }
+            case Op::Rand: case Op::NRand: return random(i);
+            default:
+                throw std::runtime_error("the LLVM backend cannot compile `" + std::string(opInfo(i.op).name) + "`");
+        }
+    }
+
+    llvm::IRBuilder<>& b_;
+    llvm::Module& module_;
+    const Kernel& kernel_;
+    MathMode mode_;
+    llvm::Value* seed_;
+    std::vector<Lanes> values_;
+};
+
+}  // namespace
+
+std::vector<Lanes> emitKernelBody(llvm::IRBuilder<>& builder, llvm::Module& module, const Kernel& kernel,
+                                  MathMode mode, llvm::Value* seed, const LeafReader& leaf) {
+    return BodyEmitter(builder, module, kernel, mode, seed).run(leaf);
+}
+
+}  // namespace psys::codegen_llvm
