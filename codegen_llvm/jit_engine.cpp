@@ -1,6 +1,9 @@
 #include "codegen_llvm/jit_engine.h"
 
+#include <algorithm>
+#include <optional>
 #include <stdexcept>
+#include <thread>
 
 #include <llvm/Analysis/TargetLibraryInfo.h>
 #include <llvm/ExecutionEngine/Orc/ExecutionUtils.h>
@@ -23,7 +26,8 @@ namespace {
 // LLVM's default printing (none is expected).
 struct RemarkCollector : llvm::DiagnosticHandler {
     std::vector<VectorizeRemark>* out;
-    explicit RemarkCollector(std::vector<VectorizeRemark>* remarks) : out(remarks) {}
+    std::mutex* mutex;  // modules are optimized on several threads
+    RemarkCollector(std::vector<VectorizeRemark>* remarks, std::mutex* m) : out(remarks), mutex(m) {}
     bool isPassedOptRemarkEnabled(llvm::StringRef pass) const override { return pass == "loop-vectorize"; }
     bool isMissedOptRemarkEnabled(llvm::StringRef pass) const override { return pass == "loop-vectorize"; }
     bool isAnalysisRemarkEnabled(llvm::StringRef pass) const override { return pass == "loop-vectorize"; }
@@ -33,6 +37,7 @@ struct RemarkCollector : llvm::DiagnosticHandler {
         if (!remark) return false;
         if (remark->getPassName() != "loop-vectorize") return true;
         if (!remark->isPassed() && !remark->isMissed()) return true;  // analyses explain misses
+        std::lock_guard lock(*mutex);
         out->push_back({remark->getFunction().getName().str(), remark->isPassed(), remark->getMsg()});
         return true;
     }
@@ -43,17 +48,25 @@ struct RemarkCollector : llvm::DiagnosticHandler {
 struct JitEngine::Impl {
     MathMode mode;
     std::unique_ptr<llvm::orc::LLJIT> jit;
-    std::unique_ptr<llvm::TargetMachine> machine;
+    std::optional<llvm::orc::JITTargetMachineBuilder> host;
     std::string cpu;
+    std::mutex remarksMutex;
+    std::vector<VectorizeRemark> remarks;
 
+    // Runs on the JIT's compile threads: a target machine of its own for the cost model.
     void optimize(llvm::Module& module) {
+        auto made = llvm::orc::JITTargetMachineBuilder(*host).createTargetMachine();
+        if (!made) throw std::runtime_error(llvm::toString(made.takeError()));
+        std::unique_ptr<llvm::TargetMachine> machine = std::move(*made);
         llvm::LoopAnalysisManager lam;
         llvm::FunctionAnalysisManager fam;
         llvm::CGSCCAnalysisManager cgam;
         llvm::ModuleAnalysisManager mam;
         llvm::PipelineTuningOptions tuning;
-        tuning.LoopVectorization = true;
+        tuning.LoopVectorization = !getenv("PSYS_NOVEC");
         tuning.SLPVectorization = true;
+        // Interleaving adds code (and compile time) for loops that are bound by memory.
+        tuning.LoopInterleaving = false;
         llvm::PassBuilder builder(machine.get(), tuning);
         llvm::TargetLibraryInfoImpl library(llvm::Triple(module.getTargetTriple()));
         if (mode == MathMode::Fast)
@@ -65,7 +78,7 @@ struct JitEngine::Impl {
         builder.registerFunctionAnalyses(fam);
         builder.registerLoopAnalyses(lam);
         builder.crossRegisterProxies(lam, fam, cgam, mam);
-        builder.buildPerModuleDefaultPipeline(llvm::OptimizationLevel::O3).run(module, mam);
+        builder.buildPerModuleDefaultPipeline(getenv("PSYS_O1") ? llvm::OptimizationLevel::O1 : llvm::OptimizationLevel::O3).run(module, mam);
     }
 };
 
@@ -77,12 +90,17 @@ JitEngine::JitEngine(MathMode mode) : impl_(std::make_unique<Impl>()) {
     if (!host) throw std::runtime_error(llvm::toString(host.takeError()));
     host->setCodeGenOptLevel(llvm::CodeGenOptLevel::Aggressive);
     impl_->cpu = host->getCPU();
-    auto machine = host->createTargetMachine();
-    if (!machine) throw std::runtime_error(llvm::toString(machine.takeError()));
-    impl_->machine = std::move(*machine);
-    auto jit = llvm::orc::LLJITBuilder().setJITTargetMachineBuilder(std::move(*host)).create();
+    impl_->host = *host;
+    unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+    auto jit = llvm::orc::LLJITBuilder().setJITTargetMachineBuilder(std::move(*host)).setNumCompileThreads(threads).create();
     if (!jit) throw std::runtime_error(llvm::toString(jit.takeError()));
     impl_->jit = std::move(*jit);
+    impl_->jit->getIRTransformLayer().setTransform(
+        [impl = impl_.get()](llvm::orc::ThreadSafeModule module, llvm::orc::MaterializationResponsibility&)
+            -> llvm::Expected<llvm::orc::ThreadSafeModule> {
+            module.withModuleDo([impl](llvm::Module& m) { impl->optimize(m); });
+            return module;
+        });
     // libm's functions come from this process, as the interpreter's do; libmvec's vector
     // functions from glibc's libmvec.
     const char prefix = impl_->jit->getDataLayout().getGlobalPrefix();
@@ -112,22 +130,32 @@ std::unique_ptr<llvm::Module> JitEngine::newModule(llvm::LLVMContext& context) c
     return module;
 }
 
-std::vector<void*> JitEngine::add(std::unique_ptr<llvm::LLVMContext> context, std::unique_ptr<llvm::Module> module,
-                                  const std::vector<std::string>& names) {
-    std::string problems;
-    llvm::raw_string_ostream stream(problems);
-    if (llvm::verifyModule(*module, &stream)) throw std::runtime_error("the LLVM backend built invalid IR: " + problems);
-    context->setDiagnosticHandler(std::make_unique<RemarkCollector>(&remarks_));
-    impl_->optimize(*module);
-    context->setDiagnosticHandler(std::make_unique<llvm::DiagnosticHandler>());
-    if (auto err = impl_->jit->addIRModule(llvm::orc::ThreadSafeModule(std::move(module), std::move(context))))
-        throw std::runtime_error(llvm::toString(std::move(err)));
-    std::vector<void*> addresses;
-    for (const std::string& name : names) {
-        auto symbol = impl_->jit->lookup(name);
-        if (!symbol) throw std::runtime_error(llvm::toString(symbol.takeError()));
-        addresses.push_back(symbol->toPtr<void*>());
+std::vector<VectorizeRemark> JitEngine::remarks() const {
+    std::lock_guard lock(impl_->remarksMutex);
+    return impl_->remarks;
+}
+
+std::vector<void*> JitEngine::add(std::vector<Unit> units) {
+    llvm::orc::SymbolLookupSet symbols;
+    std::vector<llvm::orc::SymbolStringPtr> names;
+    for (Unit& unit : units) {
+        std::string problems;
+        llvm::raw_string_ostream stream(problems);
+        if (llvm::verifyModule(*unit.module, &stream))
+            throw std::runtime_error("the LLVM backend built invalid IR: " + problems);
+        unit.context->setDiagnosticHandler(std::make_unique<RemarkCollector>(&impl_->remarks, &impl_->remarksMutex));
+        if (auto err = impl_->jit->addIRModule(llvm::orc::ThreadSafeModule(std::move(unit.module), std::move(unit.context))))
+            throw std::runtime_error(llvm::toString(std::move(err)));
+        names.push_back(impl_->jit->mangleAndIntern(unit.name));
+        symbols.add(names.back());
     }
+    // One lookup for all: the modules are optimized and compiled on every compile thread.
+    auto& session = impl_->jit->getExecutionSession();
+    auto found = session.lookup({{&impl_->jit->getMainJITDylib(), llvm::orc::JITDylibLookupFlags::MatchAllSymbols}},
+                                std::move(symbols));
+    if (!found) throw std::runtime_error(llvm::toString(found.takeError()));
+    std::vector<void*> addresses;
+    for (const auto& name : names) addresses.push_back(found->at(name).getAddress().toPtr<void*>());
     return addresses;
 }
 

@@ -1,9 +1,11 @@
 // LLVM's ORC LLJIT set up for psys kernels: the host CPU's features, the O3 pipeline
-// (with glibc's vector math functions when fast maths is allowed), and the loop
+// (with glibc's vector math functions when fast maths is allowed), every core compiling
+// (one module per kernel, optimized and compiled concurrently), and the loop
 // vectorizer's remarks kept, so a tool or a test can say whether a loop vectorized.
 #pragma once
 
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -23,18 +25,22 @@ public:
     std::unique_ptr<llvm::LLVMContext> newContext() const;
     std::unique_ptr<llvm::Module> newModule(llvm::LLVMContext& context) const;
 
-    // Verifies and optimizes `module`, hands it to the JIT and returns the address of
-    // each of `names`. Throws std::runtime_error when LLVM refuses it.
-    std::vector<void*> add(std::unique_ptr<llvm::LLVMContext> context, std::unique_ptr<llvm::Module> module,
-                           const std::vector<std::string>& names);
+    // One module that defines the function `name`.
+    struct Unit {
+        std::unique_ptr<llvm::LLVMContext> context;
+        std::unique_ptr<llvm::Module> module;
+        std::string name;
+    };
+    // Verifies the units, optimizes and compiles them (concurrently) and returns the
+    // address of each one's function. Throws std::runtime_error when LLVM refuses one.
+    std::vector<void*> add(std::vector<Unit> units);
 
-    const std::vector<VectorizeRemark>& remarks() const { return remarks_; }
+    std::vector<VectorizeRemark> remarks() const;
     std::string cpu() const;
 
 private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
-    std::vector<VectorizeRemark> remarks_;
 };
 
 }  // namespace psys::codegen_llvm

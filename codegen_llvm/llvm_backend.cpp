@@ -9,6 +9,7 @@
 #include <llvm/IR/IRBuilder.h>
 
 #include "codegen_llvm/jit_engine.h"
+#include "interp/interpreter.h"
 #include "ir/printer.h"
 
 namespace psys::codegen_llvm {
@@ -34,6 +35,10 @@ int renderColumn(YieldKind kind) {
 // values of the kernel's parent reads, gathered by the caller in instruction order.
 using ObjectFn = void (*)(const rt::Value*, const rt::Value*, const rt::Value*, const rt::Value*, const rt::Value*,
                           const float*, const uint32_t*, rt::Value*);
+
+// The spawn kernel over several children (ObjectFunctionBuilder::buildChildren).
+using ChildrenFn = void (*)(const rt::Value*, const rt::Value*, const rt::Value*, const rt::Value*, const rt::Value*,
+                            const float*, const uint32_t*, rt::Value*, int64_t, int64_t);
 
 // void rows(void* const* columns, const uint8_t* mask, int64_t begin, int64_t end,
 //           const Value* externs, const Value* uniforms, double time, float dt,
@@ -94,29 +99,66 @@ public:
         b_.SetInsertPoint(llvm::BasicBlock::Create(ctx_, "entry", fn_));
         llvm::Value* seed = scalar(6, 0, b_.getInt32Ty());
         auto values = emitKernelBody(b_, module_, kernel, mode_, seed, [&](const Inst& i, int parent) { return leaf(i, parent); });
-        llvm::Value* yields = fn_->getArg(7);
-        for (size_t y = 0; y < kernel.yields.size(); ++y) {
-            ValueId v = kernel.yields[y].value;
-            auto index = static_cast<unsigned>(y);
-            // Lanes past the type's width are zero, as the interpreter's.
-            b_.CreateAlignedStore(llvm::Constant::getNullValue(valueType_), b_.CreateConstGEP1_32(valueType_, yields, index),
-                                  llvm::Align(4));
-            Type t = kernel.at(v).type;
-            if (t.kind == Type::Kind::U32) {
-                b_.CreateAlignedStore(values[v][0], b_.CreateConstGEP2_32(valueType_, yields, index, 1), llvm::Align(4));
-                continue;
-            }
-            for (int l = 0; l < t.width; ++l) {
-                llvm::Value* p = b_.CreateGEP(valueType_, yields, {b_.getInt32(index), b_.getInt32(0), b_.getInt32(static_cast<unsigned>(l))});
-                b_.CreateAlignedStore(toFloat(values[v][static_cast<size_t>(l)], t), p, llvm::Align(4));
-            }
-        }
+        for (size_t y = 0; y < kernel.yields.size(); ++y)
+            storeValue(fn_->getArg(7), b_.getInt64(y), values[kernel.yields[y].value], kernel.at(kernel.yields[y].value).type);
+        b_.CreateRetVoid();
+    }
+
+    // A spawn kernel over `count` children: the arguments of child k (childDraw =
+    // keys[3] + k) go to args[k·stride + sub]. The emitter's part of the kernel does not
+    // depend on k, and is hoisted out of the loop.
+    //   void children(params, state, externs, uniforms, parents, scalars, keys,
+    //                 Value* args, int64_t count, int64_t stride)
+    void buildChildren(const Kernel& kernel, const std::string& name) {
+        auto* ptr = llvm::PointerType::getUnqual(ctx_);
+        std::vector<llvm::Type*> params(8, ptr);
+        params.push_back(b_.getInt64Ty());
+        params.push_back(b_.getInt64Ty());
+        fn_ = llvm::Function::Create(llvm::FunctionType::get(b_.getVoidTy(), params, false), llvm::Function::ExternalLinkage,
+                                     name, module_);
+        for (unsigned a = 0; a < 8; ++a) fn_->getArg(a)->addAttr(llvm::Attribute::NoAlias);
+        llvm::BasicBlock* entry = llvm::BasicBlock::Create(ctx_, "entry", fn_);
+        llvm::BasicBlock* body = llvm::BasicBlock::Create(ctx_, "child", fn_);
+        llvm::BasicBlock* exit = llvm::BasicBlock::Create(ctx_, "exit", fn_);
+        b_.SetInsertPoint(entry);
+        llvm::Value* count = fn_->getArg(8);
+        b_.CreateCondBr(b_.CreateICmpSGT(count, b_.getInt64(0)), body, exit);
+        b_.SetInsertPoint(body);
+        llvm::PHINode* k = b_.CreatePHI(b_.getInt64Ty(), 2, "k");
+        k->addIncoming(b_.getInt64(0), entry);
+        childDraw_ = b_.CreateAdd(scalar(6, 3, b_.getInt32Ty()), b_.CreateTrunc(k, b_.getInt32Ty()));
+        llvm::Value* seed = scalar(6, 0, b_.getInt32Ty());
+        auto values = emitKernelBody(b_, module_, kernel, mode_, seed, [&](const Inst& i, int parent) { return leaf(i, parent); });
+        llvm::Value* first = b_.CreateMul(k, fn_->getArg(9));
+        for (const Yield& y : kernel.yields)
+            if (y.kind == YieldKind::EmitArg)
+                storeValue(fn_->getArg(7), b_.CreateAdd(first, b_.getInt64(static_cast<uint64_t>(y.sub))), values[y.value],
+                           kernel.at(y.value).type);
+        llvm::Value* next = b_.CreateAdd(k, b_.getInt64(1), "", true, true);
+        k->addIncoming(next, b_.GetInsertBlock());
+        b_.CreateCondBr(b_.CreateICmpSLT(next, count), body, exit);
+        b_.SetInsertPoint(exit);
         b_.CreateRetVoid();
     }
 
 private:
     llvm::Value* scalar(unsigned arg, unsigned index, llvm::Type* type) {
         return b_.CreateAlignedLoad(type, b_.CreateConstGEP1_32(type, fn_->getArg(arg), index), llvm::Align(4));
+    }
+
+    // Stores a value as element `index` of a Value array: lanes past the type's width are
+    // zero, as the interpreter's.
+    void storeValue(llvm::Value* array, llvm::Value* index, const Lanes& lanes, Type t) {
+        llvm::Value* element = b_.CreateGEP(valueType_, array, index);
+        b_.CreateAlignedStore(llvm::Constant::getNullValue(valueType_), element, llvm::Align(4));
+        if (t.kind == Type::Kind::U32) {
+            b_.CreateAlignedStore(lanes[0], b_.CreateStructGEP(valueType_, element, 1), llvm::Align(4));
+            return;
+        }
+        for (int l = 0; l < t.width; ++l) {
+            llvm::Value* p = b_.CreateGEP(valueType_, element, {b_.getInt32(0), b_.getInt32(0), b_.getInt32(static_cast<unsigned>(l))});
+            b_.CreateAlignedStore(toFloat(lanes[static_cast<size_t>(l)], t), p, llvm::Align(4));
+        }
     }
 
     Lanes leaf(const Inst& i, int parent) {
@@ -131,12 +173,15 @@ private:
             case Op::Time: return {scalar(5, 2, b_.getFloatTy())};
             case Op::First: return {b_.CreateFCmpUNE(scalar(5, 3, b_.getFloatTy()), llvm::ConstantFP::get(b_.getFloatTy(), 0.0))};
             case Op::ObjectId: return {scalar(6, 1, b_.getInt32Ty())};
-            case Op::DrawIndex: return {scalar(6, i.attr == 1 ? 3 : 2, b_.getInt32Ty())};
+            case Op::DrawIndex:
+                if (i.attr == 1 && childDraw_) return {childDraw_};
+                return {scalar(6, i.attr == 1 ? 3 : 2, b_.getInt32Ty())};
             default: throw std::logic_error("not a leaf");
         }
     }
 
     llvm::Function* fn_ = nullptr;
+    llvm::Value* childDraw_ = nullptr;
 };
 
 // An update or exports kernel as a loop over rows [begin, end) of a pool. The entry
@@ -146,7 +191,12 @@ class RowsFunctionBuilder : FunctionBuilder {
 public:
     RowsFunctionBuilder(llvm::Module& module, MathMode mode) : FunctionBuilder(module, mode) {}
 
-    void build(const Object& object, const Kernel& kernel, const rt::BatchLayout& layout, const std::string& name) {
+    void build(const Object& object, const Kernel& kernel, const rt::BatchLayout& layout, rt::RowsMode rowsMode,
+               const std::string& name) {
+        rowsMode_ = rowsMode;
+        uniformKernel_ = nullptr;
+        if (rowsMode == rt::RowsMode::FirstUpdate)
+            if (auto served = uniformFor(kernel.kind)) uniformKernel_ = object.kernel(*served);
         // The columns the kernel touches, in first-use order.
         std::map<int, unsigned> argOf;
         std::vector<int> columns;
@@ -177,7 +227,6 @@ public:
                 default: break;
             }
         }
-        (void)object;
 
         auto* ptr = llvm::PointerType::getUnqual(ctx_);
         llvm::Type* i64 = b_.getInt64Ty();
@@ -230,6 +279,17 @@ private:
         row_ = row;
         llvm::Type* f32 = b_.getFloatTy();
         auto loadFloat = [&](int column) { return b_.CreateAlignedLoad(f32, columnAt(argOf, column, f32), llvm::Align(4)); };
+        llvm::Value* created = nullptr;
+        auto creationTime = [&]() {
+            if (!created)
+                created = b_.CreateAlignedLoad(b_.getDoubleTy(), columnAt(argOf, rt::BatchLayout::kCreated, b_.getDoubleTy()), llvm::Align(8));
+            return created;
+        };
+        // The time of this row: the step's end, or its creation time while it is created.
+        auto now = [&]() { return rowsMode_ == rt::RowsMode::Init ? creationTime() : loop_->getArg(kTime); };
+        auto age = [&]() { return b_.CreateFPTrunc(b_.CreateFSub(now(), creationTime()), f32); };
+        std::map<int, Lanes> uniforms;
+        llvm::Value* seed = loop_->getArg(kSeed);
         auto leaf = [&](const Inst& i, int parent) -> Lanes {
             auto lanes = [&](int first) {
                 Lanes out;
@@ -242,21 +302,24 @@ private:
                 case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge:
                     return lanes(layout.parentColumns.at(static_cast<size_t>(parent)).offset);
                 case Op::Extern: return loadValue(loop_->getArg(kExterns), i.attr, i.type);
-                case Op::Uniform: return loadValue(loop_->getArg(kUniforms), i.attr, i.type);
-                case Op::Age: {  // float(time − created), as the run-time computes it
-                    llvm::Value* created = b_.CreateAlignedLoad(b_.getDoubleTy(), columnAt(argOf, rt::BatchLayout::kCreated, b_.getDoubleTy()), llvm::Align(8));
-                    return {b_.CreateFPTrunc(b_.CreateFSub(loop_->getArg(kTime), created), f32)};
-                }
-                case Op::Dt: return {loop_->getArg(kDt)};
-                case Op::Time: return {b_.CreateFPTrunc(loop_->getArg(kTime), f32)};
-                case Op::First: return {b_.getFalse()};
+                case Op::Uniform:
+                    if (uniformKernel_) return uniforms.at(i.attr);
+                    return loadValue(loop_->getArg(kUniforms), i.attr, i.type);
+                case Op::Age: return {age()};  // float(time − created), as the run-time computes it
+                case Op::Dt: return {rowsMode_ == rt::RowsMode::FirstUpdate ? age() : loop_->getArg(kDt)};
+                case Op::Time: return {b_.CreateFPTrunc(now(), f32)};
+                case Op::First: return {b_.getInt1(rowsMode_ == rt::RowsMode::Init)};
                 case Op::ObjectId:
                     return {b_.CreateAlignedLoad(b_.getInt32Ty(), columnAt(argOf, rt::BatchLayout::kIds, b_.getInt32Ty()), llvm::Align(4))};
                 case Op::DrawIndex: return {i.attr == 1 ? b_.getInt32(0) : static_cast<llvm::Value*>(loop_->getArg(kDraw))};
                 default: throw std::runtime_error("a loop kernel cannot read `" + std::string(opInfo(i.op).name) + "`");
             }
         };
-        auto values = emitKernelBody(b_, module_, kernel, mode_, loop_->getArg(kSeed), leaf);
+        if (uniformKernel_) {  // this row's uniform values, for its own dt
+            auto values = emitKernelBody(b_, module_, *uniformKernel_, mode_, seed, leaf);
+            for (const Yield& y : uniformKernel_->yields) uniforms[y.index] = values[y.value];
+        }
+        auto values = emitKernelBody(b_, module_, kernel, mode_, seed, leaf);
 
         // Stores: masked rows keep their state and exports, and never die.
         llvm::Value* mask = b_.CreateICmpNE(
@@ -304,6 +367,8 @@ private:
 
     llvm::Function* loop_ = nullptr;
     llvm::Value* row_ = nullptr;
+    rt::RowsMode rowsMode_ = rt::RowsMode::Step;
+    const Kernel* uniformKernel_ = nullptr;
 };
 
 const char* modeName(MathMode mode) { return mode == MathMode::Exact ? "exact" : "fast"; }
@@ -320,57 +385,89 @@ struct LlvmBackend::Impl {
         std::vector<const Inst*> parentReads;  // gathered by the caller, in order
     };
     std::unordered_map<const Kernel*, ObjectEntry> objectFns;  // the kernels of prepared modules
-    std::map<const Kernel*, RowsFn> rowsFns;
+    std::map<std::pair<const Kernel*, rt::RowsMode>, RowsFn> rowsFns;
+    struct ChildrenEntry {
+        ChildrenFn fn;
+        std::vector<const Inst*> parentReads;
+    };
+    std::unordered_map<const Kernel*, ChildrenEntry> childrenFns;
     CompileStats stats;
     int counter = 0;
     std::vector<rt::Value> parents;
+    interp::Interpreter interpreter;
 
     explicit Impl(MathMode m) : mode(m), engine(m) {}
 
+    enum class Shape { Object, Children, Rows };
     struct Request {
-        const Object* object;  // null: a function for one object
+        const Object* object;  // Rows only
         const Kernel* kernel;
         std::string key;
+        Shape shape;
+        rt::RowsMode rowsMode = rt::RowsMode::Step;
     };
 
-    static bool loops(const Kernel& k) {
-        return k.kind == KernelKind::Update || k.kind == KernelKind::Exports || k.kind == KernelKind::Render;
-    }
-
-    // Compiles what is not compiled yet, in one LLVM module, and fills the maps.
+    // Compiles what is not compiled yet (one module per function, compiled concurrently)
+    // and fills the maps.
     void compile(const std::vector<Request>& requests) {
         auto start = std::chrono::steady_clock::now();
-        auto context = engine.newContext();
-        auto module = engine.newModule(*context);
-        std::vector<std::string> names;
+        std::vector<JitEngine::Unit> units;
         std::vector<const Request*> built;
-        std::map<std::string, size_t> inThisModule;
+        std::unordered_map<std::string, size_t> inThisBatch;
         for (const Request& r : requests) {
-            if (byText.count(r.key) || inThisModule.count(r.key)) {
+            if (byText.count(r.key) || inThisBatch.count(r.key)) {
                 ++stats.cacheHits;
                 continue;
             }
-            std::string name = (r.object ? "rows" : "object") + std::to_string(counter++);
-            if (r.object) {
-                RowsFunctionBuilder(*module, mode).build(*r.object, *r.kernel, rt::batchLayout(*r.object, *r.kernel), name);
-            } else {
-                ObjectFunctionBuilder(*module, mode).build(*r.kernel, name);
+            // Names say what a function is, for remarks and profiles: drop.update.7
+            std::string name = (r.object ? r.object->name + "." : std::string()) + kernelName(r.kernel->kind);
+            if (r.rowsMode == rt::RowsMode::FirstUpdate) name += ".first";
+            if (r.shape == Shape::Object) name += ".object";
+            if (r.shape == Shape::Children) name += ".children";
+            name += "." + std::to_string(counter++);
+            JitEngine::Unit unit{engine.newContext(), nullptr, name};
+            unit.module = engine.newModule(*unit.context);
+            switch (r.shape) {
+                case Shape::Rows:
+                    RowsFunctionBuilder(*unit.module, mode)
+                        .build(*r.object, *r.kernel, rt::batchLayout(*r.object, *r.kernel), r.rowsMode, name);
+                    break;
+                case Shape::Object: ObjectFunctionBuilder(*unit.module, mode).build(*r.kernel, name); break;
+                case Shape::Children: ObjectFunctionBuilder(*unit.module, mode).buildChildren(*r.kernel, name); break;
             }
-            inThisModule[r.key] = names.size();
-            names.push_back(name);
+            inThisBatch[r.key] = units.size();
+            units.push_back(std::move(unit));
             built.push_back(&r);
         }
-        if (!names.empty()) {
-            auto addresses = engine.add(std::move(context), std::move(module), names);
-            for (size_t n = 0; n < names.size(); ++n) byText[built[n]->key] = addresses[n];
-            stats.kernels += names.size();
+        if (!units.empty()) {
+            size_t count = units.size();
+            auto addresses = engine.add(std::move(units));
+            for (size_t n = 0; n < count; ++n) byText[built[n]->key] = addresses[n];
+            stats.kernels += count;
         }
         for (const Request& r : requests) {
             void* code = byText.at(r.key);
-            if (r.object) rowsFns[r.kernel] = reinterpret_cast<RowsFn>(code);
-            else objectFns[r.kernel] = {reinterpret_cast<ObjectFn>(code), parentReads(*r.kernel)};
+            switch (r.shape) {
+                case Shape::Rows: rowsFns[{r.kernel, r.rowsMode}] = reinterpret_cast<RowsFn>(code); break;
+                case Shape::Object: objectFns[r.kernel] = {reinterpret_cast<ObjectFn>(code), parentReads(*r.kernel)}; break;
+                case Shape::Children:
+                    childrenFns[r.kernel] = {reinterpret_cast<ChildrenFn>(code), parentReads(*r.kernel)};
+                    break;
+            }
         }
         stats.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+
+    // Kernels that run once per step or per trigger: the interpreter runs them in less
+    // time than compiling them would take.
+    static bool interpreted(const Kernel& k) {
+        switch (k.kind) {
+            case KernelKind::Start: case KernelKind::Trigger: case KernelKind::UniformUpdate:
+            case KernelKind::UniformRender: case KernelKind::UniformExports:
+                return true;
+            default:
+                return false;
+        }
     }
 
     static std::vector<const Inst*> parentReads(const Kernel& k) {
@@ -380,9 +477,19 @@ struct LlvmBackend::Impl {
         return reads;
     }
 
-    Request objectRequest(const Kernel& k) { return {nullptr, &k, std::string("object ") + modeName(mode) + "\n" + print(k)}; }
-    Request rowsRequest(const Object& o, const Kernel& k) {
-        return {&o, &k, std::string("rows ") + modeName(mode) + " " + rt::batchLayout(o, k).signature() + "\n" + print(k)};
+    Request objectRequest(const Kernel& k) {
+        return {nullptr, &k, std::string("object ") + modeName(mode) + "\n" + print(k), Shape::Object};
+    }
+    Request childrenRequest(const Kernel& k) {
+        return {nullptr, &k, std::string("children ") + modeName(mode) + "\n" + print(k), Shape::Children};
+    }
+    Request rowsRequest(const Object& o, const Kernel& k, rt::RowsMode rowsMode) {
+        std::string key = std::string("rows ") + modeName(mode) + " " + std::to_string(static_cast<int>(rowsMode)) + " " +
+                          rt::batchLayout(o, k).signature() + "\n" + print(k);
+        if (rowsMode == rt::RowsMode::FirstUpdate)
+            if (auto served = uniformFor(k.kind))
+                if (const Kernel* u = o.kernel(*served)) key += "uniform\n" + print(*u);
+        return {&o, &k, std::move(key), Shape::Rows, rowsMode};
     }
 };
 
@@ -393,21 +500,38 @@ CompileStats LlvmBackend::compileStats() const { return impl_->stats; }
 std::vector<VectorizeRemark> LlvmBackend::remarks() const { return impl_->engine.remarks(); }
 std::string LlvmBackend::cpu() const { return impl_->engine.cpu(); }
 
-void LlvmBackend::prepare(const Module& module) {
+void LlvmBackend::prepare(const Plan& plan) {
     std::lock_guard lock(impl_->mutex);
     std::vector<Impl::Request> requests;
-    for (const Object& o : module.objects)
-        for (const Kernel& k : o.kernels) {
-            requests.push_back(impl_->objectRequest(k));
-            if (Impl::loops(k)) requests.push_back(impl_->rowsRequest(o, k));
-        }
-    for (const Trigger& t : module.triggers) requests.push_back(impl_->objectRequest(t.kernel));
-    requests.push_back(impl_->objectRequest(module.start.kernel));
+    for (const Kernel* k : plan.objectKernels) {
+        if (Impl::interpreted(*k)) continue;
+        // The run-time asks for spawn kernels' arguments a batch of children at a time.
+        requests.push_back(k->kind == KernelKind::Spawn ? impl_->childrenRequest(*k) : impl_->objectRequest(*k));
+    }
+    for (const Plan::Loop& l : plan.loops) requests.push_back(impl_->rowsRequest(*l.object, *l.kernel, l.mode));
     impl_->compile(requests);
+}
+
+// Compiled code stays (it is cached by text); only the addresses are dropped.
+void LlvmBackend::forget(const Module& module) {
+    std::lock_guard lock(impl_->mutex);
+    auto drop = [this](const Kernel& k) {
+        impl_->objectFns.erase(&k);
+        impl_->childrenFns.erase(&k);
+        for (auto mode : {rt::RowsMode::Step, rt::RowsMode::Init, rt::RowsMode::FirstUpdate}) impl_->rowsFns.erase({&k, mode});
+    };
+    drop(module.start.kernel);
+    for (const Trigger& t : module.triggers) drop(t.kernel);
+    for (const Object& o : module.objects)
+        for (const Kernel& k : o.kernels) drop(k);
 }
 
 void LlvmBackend::run(const Kernel& kernel, const rt::KernelInputs& in, std::vector<rt::Value>& yields) {
     auto it = impl_->objectFns.find(&kernel);
+    if (it == impl_->objectFns.end() && Impl::interpreted(kernel)) {
+        impl_->interpreter.run(kernel, in, yields);
+        return;
+    }
     if (it == impl_->objectFns.end()) {
         std::lock_guard lock(impl_->mutex);
         impl_->compile({impl_->objectRequest(kernel)});
@@ -427,14 +551,35 @@ void LlvmBackend::run(const Kernel& kernel, const rt::KernelInputs& in, std::vec
     it->second.fn(in.params, in.state, in.externs, in.uniforms, parents.data(), scalars, keys, yields.data());
 }
 
+void LlvmBackend::runChildren(const Kernel& spawn, const rt::KernelInputs& in, uint32_t firstChild, size_t count,
+                              rt::Value* args, size_t stride) {
+    auto it = impl_->childrenFns.find(&spawn);
+    if (it == impl_->childrenFns.end()) {
+        std::lock_guard lock(impl_->mutex);
+        impl_->compile({impl_->childrenRequest(spawn)});
+        it = impl_->childrenFns.find(&spawn);
+    }
+    auto& parents = impl_->parents;
+    parents.clear();
+    for (const Inst* i : it->second.parentReads) {
+        if (i->op == Op::ParentExport) parents.push_back(in.parentExport(i->attr2, i->attr));
+        else if (i->op == Op::ParentAlive) parents.push_back(rt::Value::boolean(in.parentAlive(i->attr2)));
+        else parents.push_back(rt::Value::scalar(in.parentAge(i->attr2)));
+    }
+    float scalars[4] = {in.age, in.dt, in.time, in.first ? 1.0f : 0.0f};
+    uint32_t keys[4] = {in.seed, in.objectId, in.draw, firstChild};
+    it->second.fn(in.params, in.state, in.externs, in.uniforms, parents.data(), scalars, keys, args,
+                  static_cast<int64_t>(count), static_cast<int64_t>(stride));
+}
+
 void LlvmBackend::runRows(const Object& object, const Kernel& kernel, const rt::BatchLayout&, const rt::RowBatch& batch) {
     RowsFn fn;
     {
         std::lock_guard lock(impl_->mutex);
-        auto it = impl_->rowsFns.find(&kernel);
+        auto it = impl_->rowsFns.find({&kernel, batch.mode});
         if (it == impl_->rowsFns.end()) {
-            impl_->compile({impl_->rowsRequest(object, kernel)});
-            it = impl_->rowsFns.find(&kernel);
+            impl_->compile({impl_->rowsRequest(object, kernel, batch.mode)});
+            it = impl_->rowsFns.find({&kernel, batch.mode});
         }
         fn = it->second;
     }

@@ -32,7 +32,10 @@ public:
     ~LlvmBackend() override;
     std::string name() const override { return "llvm"; }
     void run(const ir::Kernel& kernel, const rt::KernelInputs& in, std::vector<rt::Value>& yields) override;
-    void prepare(const ir::Module& module) override;
+    void runChildren(const ir::Kernel& spawn, const rt::KernelInputs& in, uint32_t firstChild, size_t count,
+                     rt::Value* args, size_t stride) override;
+    void prepare(const Plan& plan) override;
+    void forget(const ir::Module& module) override;
     void runRows(const ir::Object& object, const ir::Kernel& kernel, const rt::BatchLayout& layout,
                  const rt::RowBatch& batch) override;
     bool concurrent() const override { return true; }

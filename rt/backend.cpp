@@ -18,10 +18,23 @@ void scatter(const RowBatch& b, int column, int width, size_t row, const Value& 
 
 }  // namespace
 
+void Backend::runChildren(const ir::Kernel& spawn, const KernelInputs& in, uint32_t firstChild, size_t count,
+                          Value* args, size_t stride) {
+    KernelInputs child = in;
+    std::vector<Value> yields;
+    for (size_t k = 0; k < count; ++k) {
+        child.childDraw = firstChild + static_cast<uint32_t>(k);
+        run(spawn, child, yields);
+        for (size_t i = 0; i < spawn.yields.size(); ++i)
+            if (spawn.yields[i].kind == ir::YieldKind::EmitArg)
+                args[k * stride + static_cast<size_t>(spawn.yields[i].sub)] = yields[i];
+    }
+}
+
 // Row by row through `run`: the reference for what a compiled loop must compute.
 void Backend::runRows(const ir::Object& object, const ir::Kernel& kernel, const BatchLayout& layout,
                       const RowBatch& batch) {
-    std::vector<Value> params(object.params.size()), state(object.state.size()), yields;
+    std::vector<Value> params(object.params.size()), state(object.state.size()), yields, uniformValues, uniforms;
     const auto* created = static_cast<const double*>(batch.columns[BatchLayout::kCreated]);
     const auto* ids = static_cast<const uint32_t*>(batch.columns[BatchLayout::kIds]);
     // The kill column is written only by kernels that can kill.
@@ -42,9 +55,11 @@ void Backend::runRows(const ir::Object& object, const ir::Kernel& kernel, const 
         in.state = state.data();
         in.externs = batch.externs;
         in.uniforms = batch.uniforms;
-        in.age = static_cast<float>(batch.time - created[row]);
-        in.dt = batch.dt;
-        in.time = static_cast<float>(batch.time);
+        double time = batch.mode == RowsMode::Init ? created[row] : batch.time;
+        in.age = static_cast<float>(time - created[row]);
+        in.dt = batch.mode == RowsMode::FirstUpdate ? in.age : batch.dt;
+        in.time = static_cast<float>(time);
+        in.first = batch.mode == RowsMode::Init;
         in.seed = batch.seed;
         in.objectId = ids[row];
         in.draw = batch.draw;
@@ -66,6 +81,19 @@ void Backend::runRows(const ir::Object& object, const ir::Kernel& kernel, const 
                 auto* p = column(ir::Op::ParentAge, depth, -1);
                 return p ? floats(batch, p->offset)[row] : 0.0f;
             };
+        }
+        if (batch.mode == RowsMode::FirstUpdate && batch.uniformKernel) {
+            // The uniform values for this object's dt, as System::uniforms computes them.
+            KernelInputs u;
+            u.externs = batch.externs;
+            u.dt = in.dt;
+            u.time = in.time;
+            u.seed = batch.seed;
+            run(*batch.uniformKernel, u, uniformValues);
+            uniforms.assign(uniformValues.size(), Value{});
+            for (size_t i = 0; i < batch.uniformKernel->yields.size(); ++i)
+                uniforms.at(static_cast<size_t>(batch.uniformKernel->yields[i].index)) = uniformValues[i];
+            in.uniforms = uniforms.data();
         }
         run(kernel, in, yields);
         for (size_t i = 0; i < kernel.yields.size(); ++i) {

@@ -48,9 +48,29 @@ public:
     // Evaluates `kernel` once; `yields[i]` receives the value of `kernel.yields[i]`.
     virtual void run(const ir::Kernel& kernel, const KernelInputs& in, std::vector<Value>& yields) = 0;
 
-    // Called once for every module a System runs, before any kernel of it: a compiling
-    // backend compiles them all here.
-    virtual void prepare(const ir::Module&) {}
+    // The arguments of `count` children that `in`'s object emits at once: a spawn kernel
+    // run with childDraw firstChild, firstChild + 1, …; child k's argument `sub` goes to
+    // args[k·stride + sub]. The default runs `run` once per child.
+    virtual void runChildren(const ir::Kernel& spawn, const KernelInputs& in, uint32_t firstChild, size_t count,
+                             Value* args, size_t stride);
+
+    // What a System will ask of a backend for a module: the kernels it runs one object at
+    // a time, and the loops it runs over rows. Called once, before any kernel of the
+    // module runs, so a compiling backend compiles them all here (and anything else when
+    // it is first asked for).
+    struct Plan {
+        std::vector<const ir::Kernel*> objectKernels;
+        struct Loop {
+            const ir::Object* object;
+            const ir::Kernel* kernel;
+            RowsMode mode;
+        };
+        std::vector<Loop> loops;
+    };
+    virtual void prepare(const Plan&) {}
+    // The module's kernels are about to be destroyed: a backend that keeps anything by a
+    // kernel's address drops it here (a later kernel may get the same address).
+    virtual void forget(const ir::Module&) {}
     // Evaluates an update or exports kernel of `object` on the masked rows of `batch`.
     virtual void runRows(const ir::Object& object, const ir::Kernel& kernel, const BatchLayout& layout,
                          const RowBatch& batch);

@@ -52,6 +52,20 @@ struct BatchLayout {
 
 BatchLayout batchLayout(const ir::Object& object, const ir::Kernel& kernel);
 
+// What time it is for the rows of a batch.
+enum class RowsMode : uint8_t {
+    // Objects stepped together: time is `time`, age float(time − created), dt `dt`, and
+    // the uniform values are `uniforms`.
+    Step,
+    // Objects being created (their init kernel): time is their creation time, age 0, dt
+    // 0, `first` true.
+    Init,
+    // Objects just created, advanced over the rest of the step: time is `time`, dt is
+    // float(time − created), different for each, and so are the uniform values, which
+    // are computed for each object from `uniformKernel`.
+    FirstUpdate,
+};
+
 // One call of a batched kernel: rows [begin, end) of a pool.
 struct RowBatch {
     size_t begin = 0, end = 0;
@@ -63,6 +77,8 @@ struct RowBatch {
     float dt = 0;
     uint32_t seed = 0;
     uint32_t draw = 0;               // the step
+    RowsMode mode = RowsMode::Step;
+    const ir::Kernel* uniformKernel = nullptr;  // FirstUpdate
 };
 
 // Rows per chunk when a pool's update is split over threads. Chunks never depend on the

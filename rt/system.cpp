@@ -53,6 +53,7 @@ System::System(ir::Module module, Backend& backend, SystemOptions options)
     render_.resize(pools_.size());
     renderStale_.assign(pools_.size(), true);
     queued_.assign(pools_.size(), 0);
+    pending_.assign(pools_.size(), 0);
     uniformCache_.resize(pools_.size());
     for (const ir::Object& o : module_.objects) {
         PoolBatch b;
@@ -76,12 +77,63 @@ System::System(ir::Module module, Backend& backend, SystemOptions options)
             if (y.kind == YieldKind::EmitCount) b.counted[static_cast<size_t>(y.index)] = true;
             if (y.kind == YieldKind::EmitRate) b.rated[static_cast<size_t>(y.index)] = true;
         }
-        for (const ir::EmitSite& e : o.emits) b.rateEmits |= e.rate;
+        bool bursts = false;
+        for (const ir::EmitSite& e : o.emits) {
+            b.rateEmits |= e.rate;
+            bursts |= !e.rate;
+        }
+        b.createInBatches = options_.createInBatches && stepLimit_[batches_.size()] <= 0 && !o.kernel(KernelKind::Exports) && !bursts &&
+                            parentType_[batches_.size()] < 0;
         batches_.push_back(std::move(b));
     }
-    arena_ = std::make_unique<tbb::task_arena>(options_.threads ? static_cast<int>(options_.threads)
-                                                                 : tbb::task_arena::automatic);
-    backend_.prepare(module_);
+    setThreads(options_.threads);
+    backend_.prepare(plan());
+}
+
+System::~System() { backend_.forget(module_); }
+
+void System::setThreads(unsigned threads) {
+    options_.threads = threads;
+    arena_ = std::make_unique<tbb::task_arena>(threads ? static_cast<int>(threads) : tbb::task_arena::automatic);
+}
+
+// The kernels this system runs object by object and the loops it runs over rows.
+Backend::Plan System::plan() const {
+    Backend::Plan plan;
+    plan.objectKernels.push_back(&module_.start.kernel);
+    for (const ir::Trigger& t : module_.triggers) plan.objectKernels.push_back(&t.kernel);
+    for (size_t type = 0; type < pools_.size(); ++type) {
+        const ir::Object& o = module_.objects[type];
+        bool oneByOne = !batches_[type].createInBatches;
+        bool subSteps = stepLimit_[type] > 0;
+        for (const ir::Kernel& k : o.kernels) {
+            switch (k.kind) {
+                case KernelKind::Spawn: case KernelKind::UniformUpdate: case KernelKind::UniformRender:
+                case KernelKind::UniformExports:
+                    plan.objectKernels.push_back(&k);
+                    break;
+                case KernelKind::Init:
+                    if (oneByOne) plan.objectKernels.push_back(&k);
+                    else plan.loops.push_back({&o, &k, RowsMode::Init});
+                    break;
+                case KernelKind::Update:
+                    if (oneByOne || subSteps) plan.objectKernels.push_back(&k);
+                    plan.loops.push_back({&o, &k, RowsMode::Step});
+                    if (!oneByOne) plan.loops.push_back({&o, &k, RowsMode::FirstUpdate});
+                    break;
+                case KernelKind::Exports:
+                    if (oneByOne || subSteps) plan.objectKernels.push_back(&k);
+                    plan.loops.push_back({&o, &k, RowsMode::Step});
+                    break;
+                case KernelKind::Render:
+                    plan.loops.push_back({&o, &k, RowsMode::Step});
+                    break;
+                default:
+                    break;
+            }
+        }
+    }
+    return plan;
 }
 
 // The `spawn`s run when the system is first used, so externs set before that apply.
@@ -344,12 +396,21 @@ void System::updatePool(size_t type, double dt, double t1) {
         exportBatch.columns = b.exportColumns.data();
         exportBatch.uniforms = uniforms(type, *exports, context);
     }
+    // Objects that only die (no rate emits) are found while their chunk is in cache.
+    bool listKills = b.kills && !b.rateEmits;
+    size_t chunks = (rows + kRowsPerChunk - 1) / kRowsPerChunk;
+    if (listKills) b.killed.resize(chunks);
     auto chunk = [&](size_t c) {
         RowBatch part = batch;
         part.begin = c * kRowsPerChunk;
         part.end = std::min(rows, part.begin + kRowsPerChunk);
         gatherParents(type, b.update, part.columns, part.mask, part.begin, part.end, t1);
         backend_.runRows(o, update, b.update, part);
+        if (listKills) {
+            b.killed[c].clear();
+            for (size_t row = part.begin; row < part.end; ++row)
+                if (b.kill[row]) b.killed[c].push_back(static_cast<uint32_t>(row));
+        }
         if (!exports) return;
         for (size_t row = part.begin; row < part.end; ++row)
             b.exportMask[row] = pool.updatable[row] && !(b.kills && b.kill[row]);
@@ -369,6 +430,11 @@ void System::updatePool(size_t type, double dt, double t1) {
         ~Timer() { stats.emitSeconds += seconds(start, Clock::now()); }
     } timer{stats_, loopsDone};
     if (!b.kills && !b.rateEmits) return;
+    if (listKills) {
+        for (size_t c = 0; c < chunks; ++c)
+            for (uint32_t row : b.killed[c]) kill(type, row);
+        return;
+    }
     std::vector<float>& rate = rate_;
     std::vector<float>& count = count_;
     rate.assign(o.emits.size(), 0);
@@ -398,27 +464,25 @@ void System::queueChildren(size_t type, uint32_t row, int site, uint64_t count, 
     Pool& pool = pools_[type];
     const ir::EmitSite& emit = pool.object().emits[static_cast<size_t>(site)];
     size_t target = static_cast<size_t>(module_.objectIndex(emit.target));
-    size_t room = pools_[target].free() > queued_[target] ? pools_[target].free() - queued_[target] : 0;
+    size_t free = pools_[target].free() + pending_[target];
+    size_t room = free > queued_[target] ? free - queued_[target] : 0;
     uint64_t kept = std::min<uint64_t>(count, room);
     typeStats_[target].dropped += count - kept;
     if (kept == 0) return;
     const ir::Kernel* spawn = pool.object().kernel(KernelKind::Spawn, site);
     Handle parent = parentType_[target] == static_cast<int>(type) ? pool.handle(row) : Handle{};
     size_t params = pools_[target].paramColumn.size();
-    KernelInputs in;
-    if (spawn) in = inputs(type, row, evalTime, static_cast<float>(lastDt_), first, params_, state_);
+    size_t base = queueArgs_.size();
+    queueArgs_.resize(base + static_cast<size_t>(kept) * params);
+    if (spawn) {
+        KernelInputs in = inputs(type, row, evalTime, static_cast<float>(lastDt_), first, params_, state_);
+        in.uniforms = uniforms(type, *spawn, in);
+        backend_.runChildren(*spawn, in, nextId_, static_cast<size_t>(kept), queueArgs_.data() + base, params);
+    }
     for (uint64_t k = 0; k < kept; ++k) {
-        Creation c{target, queueArgs_.size(), parent, firstTime + static_cast<double>(k / perEvent) * spacing, nextId_++};
-        queueArgs_.resize(queueArgs_.size() + params);
-        if (spawn) {
-            in.childDraw = c.id;
-            runKernel(type, row, *spawn, in);
-            for (size_t i = 0; i < spawn->yields.size(); ++i)
-                if (spawn->yields[i].kind == YieldKind::EmitArg)
-                    queueArgs_.at(c.args + static_cast<size_t>(spawn->yields[i].sub)) = yields_[i];
-        }
+        queue_.push_back({target, base + static_cast<size_t>(k) * params, parent,
+                          firstTime + static_cast<double>(k / perEvent) * spacing, nextId_++});
         ++queued_[target];
-        queue_.push_back(c);
     }
 }
 
@@ -472,14 +536,141 @@ void System::create(const Creation& c, double t1) {
     update(c.type, row, t1 - c.time, t1);
 }
 
+// Creates the queued objects in queue order (and those their creation queues). Runs of
+// one type that can be created in batches are; the rest one by one.
 void System::drain(double t1) {
-    for (size_t i = 0; i < queue_.size(); ++i) {
+    for (size_t i = 0; i < queue_.size();) {
+        size_t type = queue_[i].type;
+        if (batches_[type].createInBatches) {
+            size_t end = i + 1;
+            while (end < queue_.size() && queue_[end].type == type) ++end;
+            createBatch(type, i, end, t1);
+            i = end;
+            continue;
+        }
         Creation c = queue_[i];  // a copy: creating may queue more
         --queued_[c.type];
         create(c, t1);
+        ++i;
     }
     queue_.clear();
     queueArgs_.clear();
+}
+
+// Creates queue_[from, to), all of one type, as `create` would one by one: the rows are
+// allocated in order, the init kernel and the first update run over all of them at once
+// (on scratch columns, where every parameter has a column, kept or not), and kills and
+// emissions follow object by object in queue order. While an object emits, the rows
+// allocated for the objects after it count as free, as they still are in `create`.
+void System::createBatch(size_t type, size_t from, size_t to, double t1) {
+    Pool& pool = pools_[type];
+    PoolBatch& b = batches_[type];
+    const ir::Object& o = pool.object();
+    b.newRows.clear();
+    b.newQueueIndex.clear();
+    for (size_t q = from; q < to; ++q) {
+        auto row = pool.allocate();
+        if (!row) {
+            ++typeStats_[type].dropped;
+            continue;
+        }
+        b.newRows.push_back(*row);
+        b.newQueueIndex.push_back(q);
+    }
+    size_t n = b.newRows.size();
+    // The queue entries leave the queue one by one below, as objects are created in order.
+    if (n == 0) {
+        queued_[type] -= to - from;
+        return;
+    }
+    typeStats_[type].created += n;
+
+    // Scratch columns in the layout's positions.
+    const BatchLayout& layout = b.update;
+    b.newColumns.resize(static_cast<size_t>(layout.total));
+    b.newTable.assign(static_cast<size_t>(layout.total), nullptr);
+    for (int column = BatchLayout::kFirstColumn; column < layout.total; ++column) {
+        auto& c = b.newColumns[static_cast<size_t>(column)];
+        c.assign(n, 0.0f);
+        b.newTable[static_cast<size_t>(column)] = c.data();
+    }
+    b.newCreated.resize(n);
+    b.newIds.resize(n);
+    b.newKill.assign(n, 0);
+    b.newMask.assign(n, 1);
+    b.newTable[BatchLayout::kCreated] = b.newCreated.data();
+    b.newTable[BatchLayout::kIds] = b.newIds.data();
+    b.newTable[BatchLayout::kKill] = b.newKill.data();
+    for (size_t r = 0; r < n; ++r) {
+        const Creation& c = queue_[b.newQueueIndex[r]];
+        uint32_t row = b.newRows[r];
+        pool.created[row] = c.time;
+        pool.id[row] = c.id;
+        pool.parent[row] = c.parent;
+        b.newCreated[r] = c.time;
+        b.newIds[r] = c.id;
+        for (size_t p = 0; p < o.params.size(); ++p) {
+            const Value& v = queueArgs_[c.args + p];
+            for (int k = 0; k < o.params[p].type.width; ++k)
+                b.newColumns[static_cast<size_t>(layout.paramOffset[p] + k)][r] = v.f[static_cast<size_t>(k)];
+            if (pool.paramColumn[p] >= 0) pool.params.set(static_cast<size_t>(pool.paramColumn[p]), row, v);
+        }
+    }
+
+    RowBatch batch;
+    batch.mask = b.newMask.data();
+    batch.columns = b.newTable.data();
+    batch.externs = externs_.data();
+    batch.seed = options_.seed;
+    auto runAll = [&](const ir::Kernel& kernel, const RowBatch& all) {
+        forChunks(n, [&](size_t c) {
+            RowBatch part = all;
+            part.begin = c * kRowsPerChunk;
+            part.end = std::min(n, part.begin + kRowsPerChunk);
+            backend_.runRows(o, kernel, layout, part);
+        });
+    };
+    if (const ir::Kernel* init = o.kernel(KernelKind::Init)) {
+        RowBatch in = batch;
+        in.mode = RowsMode::Init;
+        in.draw = kCreationDraw;
+        runAll(*init, in);
+    }
+    RowBatch first = batch;
+    first.mode = RowsMode::FirstUpdate;
+    first.time = t1;
+    first.draw = static_cast<uint32_t>(step_);
+    first.uniformKernel = o.kernel(KernelKind::UniformUpdate);
+    runAll(*o.kernel(KernelKind::Update), first);
+
+    for (size_t s = 0; s < o.state.size(); ++s)
+        for (int k = 0; k < o.state[s].type.width; ++k) {
+            const float* from = b.newColumns[static_cast<size_t>(layout.stateOffset[s] + k)].data();
+            float* to = pool.state.data(s, static_cast<size_t>(k));
+            for (size_t r = 0; r < n; ++r) to[b.newRows[r]] = from[r];
+        }
+    std::vector<float>& rate = rate_;
+    std::vector<float>& count = count_;
+    rate.assign(o.emits.size(), 0);
+    count.assign(o.emits.size(), 1);
+    size_t r = 0;
+    for (size_t q = from; q < to; ++q) {
+        --queued_[type];
+        if (r == n || b.newQueueIndex[r] != q) continue;  // dropped at capacity
+        uint32_t row = b.newRows[r];
+        if (b.kills && b.newKill[r]) {
+            kill(type, row);
+        } else if (b.rateEmits) {
+            for (size_t s = 0; s < o.emits.size(); ++s) {
+                if (b.rated[s]) rate[s] = b.newColumns[static_cast<size_t>(layout.emitRate(static_cast<int>(s)))][r];
+                if (b.counted[s]) count[s] = b.newColumns[static_cast<size_t>(layout.emitCount(static_cast<int>(s)))][r];
+            }
+            pending_[type] = n - 1 - r;
+            emitAtRate(type, row, rate, count, t1 - b.newCreated[r], t1);
+        }
+        ++r;
+    }
+    pending_[type] = 0;
 }
 
 void System::kill(size_t type, uint32_t row) {

@@ -36,6 +36,9 @@ struct SystemOptions {
     size_t capacity = 1 << 20;  // per object type, unless its @capacity says otherwise
     // Threads for the pool updates: 0 for every core. Results do not depend on it.
     unsigned threads = 0;
+    // Create objects of simple types in batches (System::createBatch); false creates every
+    // object one by one. Results are the same; tests compare the two.
+    bool createInBatches = true;
 };
 
 struct TypeStats {
@@ -70,6 +73,9 @@ struct RenderPoint {
 class System {
 public:
     System(ir::Module module, Backend& backend, SystemOptions options = {});
+    ~System();
+    System(const System&) = delete;
+    System& operator=(const System&) = delete;
 
     // Host API. Errors come back as a message; nothing is changed then.
     std::optional<std::string> setExtern(std::string_view name, std::span<const float> value);
@@ -78,6 +84,8 @@ public:
     std::optional<std::string> setExtern(int handle, std::span<const float> value);
     std::optional<std::string> fire(std::string_view trigger, std::span<const float> args);
     std::optional<std::string> step(double dt);
+    // Threads for the pool updates from now on: 0 for every core. Results do not change.
+    void setThreads(unsigned threads);
 
     double time() const { return now_; }
     uint64_t stepCount() const { return step_; }
@@ -119,10 +127,12 @@ private:
     void queueChildren(size_t type, uint32_t row, int site, uint64_t count, uint64_t perEvent, double firstTime,
                        double spacing, double evalTime, bool first);
     void drain(double t1);
+    void createBatch(size_t type, size_t from, size_t to, double t1);
     void kill(size_t type, uint32_t row);
     void releaseReader(size_t type, Handle parent);
     void emitFromKernel(const ir::Trigger& trigger, std::span<const Value> params, uint32_t objectId);
     void start();
+    Backend::Plan plan() const;
 
     ir::Module module_;
     Backend& backend_;
@@ -136,6 +146,7 @@ private:
     std::vector<Creation> queue_;
     std::vector<Value> queueArgs_;
     std::vector<size_t> queued_;  // per type: creations waiting in the queue
+    std::vector<size_t> pending_;  // per type: rows a batch allocated for objects not yet created in order
     std::vector<std::pair<size_t, uint32_t>> dying_;
     std::vector<TypeStats> typeStats_;
     Stats stats_;
@@ -167,8 +178,19 @@ private:
         bool kills = false, rateEmits = false;
         std::vector<bool> counted, rated;  // per emit site: whether the update yields its count, its rate
         std::vector<uint8_t> kill, exportMask, aliveMask;
+        std::vector<std::vector<uint32_t>> killed;  // per chunk: the rows that died, in order
         std::vector<std::vector<float>> updateScratch, exportScratch, renderScratch;
         std::vector<void*> updateColumns, exportColumns, renderColumns;
+        // Creation in batches (createBatch): for types without sub-steps, exports, bursts
+        // or a parent; the others are created one by one.
+        bool createInBatches = false;
+        std::vector<uint32_t> newRows;
+        std::vector<size_t> newQueueIndex;
+        std::vector<double> newCreated;
+        std::vector<uint32_t> newIds;
+        std::vector<uint8_t> newKill, newMask;
+        std::vector<std::vector<float>> newColumns;  // one per column position of the layout
+        std::vector<void*> newTable;
     };
     std::vector<PoolBatch> batches_;
     std::unique_ptr<tbb::task_arena> arena_;

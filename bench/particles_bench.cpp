@@ -1,0 +1,289 @@
+// psys_bench: million particle-updates per second for the fountain, the fire and the
+// fireworks, JIT-compiled, against the same effects written by hand (bench/hand_written.h)
+// and the interpreter, with the memory-bandwidth bound measured in the same run (STREAM
+// triad) and the JIT's compile time per sample. docs/performance.md shows a run and reads it.
+//
+// Each effect is run to its steady population (its extern scaled so that about N
+// particles are alive), then `--frames` steps are timed one by one; the figure is live
+// particles ÷ the median step time. A step is everything: updates, kills, emissions and
+// creations. Nothing is drawn.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <iostream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "codegen_llvm/llvm_backend.h"
+#include "driver/compile.h"
+#include "hand_written.h"
+#include "interp/interpreter.h"
+#include "rt/system.h"
+
+using namespace psys;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0 : v[v.size() / 2];
+}
+
+// What an effect is: its sample, the extern that sets its size, the object type that
+// holds its particles, and how long it takes to reach its steady population.
+struct Effect {
+    std::string name;
+    std::string knob;
+    std::string particles;
+    int warmFrames;
+};
+
+const std::vector<Effect> kEffects = {
+    {"fountain", "population", "drop", 200},
+    {"fire", "rate", "part", 540},
+    {"fireworks", "sparks", "spark", 420},
+};
+
+ir::Module compile(const std::string& name) {
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    auto module = compileFile(std::string(PSYS_SAMPLES_DIR) + "/" + name + ".psys", sources, diags, {});
+    if (!module) {
+        diags.print(std::cerr, false);
+        std::exit(1);
+    }
+    return std::move(*module);
+}
+
+// STREAM's triad, a[i] = b[i] + s·c[i] over arrays far larger than the caches: the
+// bandwidth a streaming loop can reach, in bytes per second (3 floats per element).
+double triad(unsigned threads, size_t elements) {
+    std::vector<float> a(elements, 0), b(elements, 1), c(elements, 2);
+    tbb::task_arena arena(threads ? static_cast<int>(threads) : tbb::task_arena::automatic);
+    std::vector<double> times;
+    for (int run = 0; run < 7; ++run) {
+        auto start = Clock::now();
+        arena.execute([&] {
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, elements, 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
+                float* __restrict pa = a.data();
+                const float* __restrict pb = b.data();
+                const float* __restrict pc = c.data();
+                for (size_t i = r.begin(); i < r.end(); ++i) pa[i] = pb[i] + 3.0f * pc[i];
+            });
+        });
+        times.push_back(seconds(start, Clock::now()));
+    }
+    volatile float sink = a[elements / 2];
+    (void)sink;
+    return 3.0 * sizeof(float) * static_cast<double>(elements) / *std::min_element(times.begin(), times.end());
+}
+
+struct Rate {
+    double live = 0;
+    double perSecond = 0;  // particle updates
+};
+
+// Times `frames` steps of each contender, interleaved frame by frame so that the machine's
+// drift hits them alike; a figure is live ÷ median step.
+std::vector<Rate> timeInterleaved(const std::vector<std::function<size_t()>>& steps, int frames) {
+    std::vector<std::vector<double>> times(steps.size());
+    std::vector<double> live(steps.size(), 0);
+    for (int f = 0; f < frames; ++f)
+        for (size_t k = 0; k < steps.size(); ++k) {
+            auto start = Clock::now();
+            size_t n = steps[k]();
+            times[k].push_back(seconds(start, Clock::now()));
+            live[k] += static_cast<double>(n) / frames;
+        }
+    std::vector<Rate> rates;
+    for (size_t k = 0; k < steps.size(); ++k) rates.push_back({live[k], live[k] / median(times[k])});
+    return rates;
+}
+
+// The extern value that keeps about `particles` alive: populations are proportional to
+// it, so one short run at a small value tells.
+double calibrate(const Effect& e, codegen_llvm::LlvmBackend& jit, double particles) {
+    if (e.name == "fountain") return particles;
+    double probe = e.name == "fire" ? 2000 : 200;
+    rt::System system(compile(e.name), jit);
+    float value = static_cast<float>(probe);
+    system.setExtern(e.knob, {&value, 1});
+    for (int f = 0; f < e.warmFrames; ++f) system.step(1.0 / 60);
+    double live = static_cast<double>(system.pool(static_cast<size_t>(system.typeIndex(e.particles))).live());
+    return probe * particles / std::max(live, 1.0);
+}
+
+// Bytes the pool's update loop must read and write per particle: every state slot read
+// and written, every kept parameter read.
+double stateBytes(const ir::Object& o) {
+    double bytes = 0;
+    for (const auto& s : o.state) bytes += 2 * 4 * s.type.width;
+    for (const auto& p : o.params)
+        if (p.kept) bytes += 4 * p.type.width;
+    return bytes;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app("psys_bench: particle updates per second, JIT against hand-written C++ and the bandwidth bound");
+    std::vector<double> sizes = {1e6, 1e7};
+    int frames = 15;
+    std::vector<std::string> effects = {"fountain", "fire", "fireworks"};
+    double interpParticles = 1e5;
+    size_t triadElements = size_t{1} << 26;
+    bool skipCompile = false;
+    app.add_option("--particles", sizes, "Live particles per effect (1e6 1e7)");
+    app.add_option("--frames", frames, "Timed steps per measurement; the median counts (15)")->check(CLI::Range(5, 100000));
+    app.add_option("--effects", effects, "fountain fire fireworks");
+    app.add_option("--interp-particles", interpParticles, "Live particles for the interpreter (1e5)");
+    app.add_option("--triad-elements", triadElements, "Floats per STREAM array (2^26)");
+    app.add_flag("--skip-compile", skipCompile, "Leave out the compile times");
+    CLI11_PARSE(app, argc, argv);
+
+    unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+    codegen_llvm::LlvmBackend jit;
+    std::cout << fmt::format("# psys_bench on {} ({} cores), {} timed steps per figure (median)\n\n", jit.cpu(), cores,
+                             frames);
+    double bandwidth1 = triad(1, triadElements), bandwidthAll = triad(0, triadElements);
+    std::cout << fmt::format("STREAM triad: {:.1f} GB/s on 1 thread, {:.1f} GB/s on {} threads\n\n", bandwidth1 / 1e9,
+                             bandwidthAll / 1e9, cores);
+
+    std::string breakdown;
+    std::cout << "| effect | live | threads | psys JIT | hand SoA | hand AoS | JIT / SoA | JIT / AoS | bound | JIT / bound |\n";
+    std::cout << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    for (const std::string& name : effects) {
+        auto effect = std::find_if(kEffects.begin(), kEffects.end(), [&](const Effect& e) { return e.name == name; });
+        if (effect == kEffects.end()) {
+            std::cerr << "psys_bench: no effect `" << name << "`\n";
+            return 2;
+        }
+        for (double particles : sizes) {
+            double knob = calibrate(*effect, jit, particles);
+            auto capacity = static_cast<size_t>(particles * 1.5) + 1024;
+            rt::SystemOptions options;
+            options.capacity = capacity;
+            rt::System system(compile(name), jit, options);
+            float value = static_cast<float>(knob);
+            system.setExtern(effect->knob, {&value, 1});
+            auto type = static_cast<size_t>(system.typeIndex(effect->particles));
+            for (int f = 0; f < effect->warmFrames; ++f) system.step(1.0 / 60);
+            auto soa = bench::makeHandWritten(name, true, knob, capacity);
+            auto aos = bench::makeHandWritten(name, false, knob, capacity);
+            for (int f = 0; f < effect->warmFrames; ++f) {
+                soa->step(1.0f / 60);
+                aos->step(1.0f / 60);
+            }
+            double bytes = stateBytes(system.module().objects[type]);
+            for (unsigned threads : {1u, cores}) {
+                system.setThreads(threads);
+                soa->setThreads(threads);
+                aos->setThreads(threads);
+                rt::Stats before = system.stats();
+                auto rates = timeInterleaved(
+                    {[&] {
+                         system.step(1.0 / 60);
+                         return system.pool(type).live();
+                     },
+                     [&] {
+                         soa->step(1.0f / 60);
+                         return soa->live();
+                     },
+                     [&] {
+                         aos->step(1.0f / 60);
+                         return aos->live();
+                     }},
+                    frames);
+                rt::Stats after = system.stats();
+                Rate j = rates[0], s = rates[1], a = rates[2];
+                breakdown += fmt::format("| {} | {:.2g} | {} | {:.2f} | {:.2f} | {:.2f} | {:.2g} / {:.2g} |\n", name, j.live,
+                                         threads, (after.loopSeconds - before.loopSeconds) * 1e3 / frames,
+                                         (after.emitSeconds - before.emitSeconds) * 1e3 / frames,
+                                         (after.createSeconds - before.createSeconds) * 1e3 / frames, s.live, a.live);
+                double bound = (threads == 1 ? bandwidth1 : bandwidthAll) / bytes;
+                std::cout << fmt::format("| {} | {:.2g} | {} | {:.0f} | {:.0f} | {:.0f} | {:.2f} | {:.2f} | {:.0f} | {:.0f}% |\n",
+                                         name, j.live, threads, j.perSecond / 1e6, s.perSecond / 1e6,
+                                         a.perSecond / 1e6, j.perSecond / s.perSecond, j.perSecond / a.perSecond,
+                                         bound / 1e6, 100 * j.perSecond / bound);
+                std::cout.flush();
+            }
+        }
+    }
+    std::cout << "\n(million particle updates per second; bound: triad bandwidth ÷ the bytes psys's update loop "
+                 "must move per particle (state read and written, kept parameters read))\n\n";
+    std::cout << "Where psys's steps went (ms per step), and the hand-written populations:\n\n"
+                 "| effect | live | threads | update loops | kills and emissions | creation | live SoA / AoS |\n"
+                 "|---|---:|---:|---:|---:|---:|---:|\n"
+              << breakdown << "\n";
+
+    // The interpreter, on fewer particles (its rate hardly depends on how many).
+    std::cout << "| effect | live | interpreter (1 thread) | JIT (1 thread) | JIT / interpreter |\n|---|---:|---:|---:|---:|\n";
+    for (const std::string& name : effects) {
+        const Effect& effect = *std::find_if(kEffects.begin(), kEffects.end(), [&](const Effect& e) { return e.name == name; });
+        double knob = calibrate(effect, jit, interpParticles);
+        interp::Interpreter interpreter;
+        rt::SystemOptions options;
+        options.threads = 1;
+        rt::System slow(compile(name), interpreter, options), fast(compile(name), jit, options);
+        float value = static_cast<float>(knob);
+        slow.setExtern(effect.knob, {&value, 1});
+        fast.setExtern(effect.knob, {&value, 1});
+        auto type = static_cast<size_t>(slow.typeIndex(effect.particles));
+        for (int f = 0; f < effect.warmFrames; ++f) {
+            slow.step(1.0 / 60);
+            fast.step(1.0 / 60);
+        }
+        auto rates = timeInterleaved({[&] {
+                                          slow.step(1.0 / 60);
+                                          return slow.pool(type).live();
+                                      },
+                                      [&] {
+                                          fast.step(1.0 / 60);
+                                          return fast.pool(type).live();
+                                      }},
+                                     frames);
+        Rate i = rates[0], j = rates[1];
+        std::cout << fmt::format("| {} | {:.2g} | {:.1f} | {:.0f} | {:.0f}× |\n", name, i.live, i.perSecond / 1e6,
+                                 j.perSecond / 1e6, j.perSecond / i.perSecond);
+    }
+
+    if (skipCompile) return 0;
+    // Compile time, parse → callable: front end, optimizer, and the JIT of every kernel
+    // (a fresh backend each time, so nothing is cached); the median of 5.
+    std::cout << "\n| sample | front end + optimizer (ms) | JIT (ms) | kernels | parse → callable (ms) |\n|---|---:|---:|---:|---:|\n";
+    std::vector<std::filesystem::path> samples;
+    for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR))
+        if (entry.path().extension() == ".psys") samples.push_back(entry.path());
+    std::sort(samples.begin(), samples.end());
+    for (const auto& path : samples) {
+        std::vector<double> front, total, jitTimes;
+        size_t kernels = 0;
+        for (int run = 0; run < 5; ++run) {
+            auto start = Clock::now();
+            ir::Module module = compile(path.stem().string());
+            auto compiled = Clock::now();
+            codegen_llvm::LlvmBackend backend;
+            rt::System system(std::move(module), backend);
+            auto ready = Clock::now();
+            front.push_back(seconds(start, compiled));
+            total.push_back(seconds(start, ready));
+            jitTimes.push_back(backend.compileStats().seconds);
+            kernels = backend.compileStats().kernels;
+        }
+        std::cout << fmt::format("| {} | {:.1f} | {:.1f} | {} | {:.1f} |\n", path.filename().string(), median(front) * 1e3,
+                                 median(jitTimes) * 1e3, kernels, median(total) * 1e3);
+    }
+    return 0;
+}
