@@ -55,6 +55,9 @@ struct JitEngine::Impl {
 
     // Runs on the JIT's compile threads: a target machine of its own for the cost model.
     void optimize(llvm::Module& module) {
+        // The module may be in a context of the compile thread's by now: the remarks are
+        // collected from whichever context it is in.
+        module.getContext().setDiagnosticHandler(std::make_unique<RemarkCollector>(&remarks, &remarksMutex));
         auto made = llvm::orc::JITTargetMachineBuilder(*host).createTargetMachine();
         if (!made) throw std::runtime_error(llvm::toString(made.takeError()));
         std::unique_ptr<llvm::TargetMachine> machine = std::move(*made);
@@ -63,7 +66,7 @@ struct JitEngine::Impl {
         llvm::CGSCCAnalysisManager cgam;
         llvm::ModuleAnalysisManager mam;
         llvm::PipelineTuningOptions tuning;
-        tuning.LoopVectorization = !getenv("PSYS_NOVEC");
+        tuning.LoopVectorization = true;
         tuning.SLPVectorization = true;
         // Interleaving adds code (and compile time) for loops that are bound by memory.
         tuning.LoopInterleaving = false;
@@ -78,7 +81,7 @@ struct JitEngine::Impl {
         builder.registerFunctionAnalyses(fam);
         builder.registerLoopAnalyses(lam);
         builder.crossRegisterProxies(lam, fam, cgam, mam);
-        builder.buildPerModuleDefaultPipeline(getenv("PSYS_O1") ? llvm::OptimizationLevel::O1 : llvm::OptimizationLevel::O3).run(module, mam);
+        builder.buildPerModuleDefaultPipeline(llvm::OptimizationLevel::O3).run(module, mam);
     }
 };
 
@@ -143,7 +146,6 @@ std::vector<void*> JitEngine::add(std::vector<Unit> units) {
         llvm::raw_string_ostream stream(problems);
         if (llvm::verifyModule(*unit.module, &stream))
             throw std::runtime_error("the LLVM backend built invalid IR: " + problems);
-        unit.context->setDiagnosticHandler(std::make_unique<RemarkCollector>(&impl_->remarks, &impl_->remarksMutex));
         if (auto err = impl_->jit->addIRModule(llvm::orc::ThreadSafeModule(std::move(unit.module), std::move(unit.context))))
             throw std::runtime_error(llvm::toString(std::move(err)));
         names.push_back(impl_->jit->mangleAndIntern(unit.name));

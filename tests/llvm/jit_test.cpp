@@ -1,0 +1,110 @@
+// The JIT's own promises: update loops vectorize, compiled code is cached by kernel text,
+// one backend serves system after system, and the number of threads never changes a
+// result.
+#include <doctest/doctest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "codegen_llvm/llvm_backend.h"
+#include "driver/compile.h"
+#include "interp/interpreter.h"
+#include "rt/system.h"
+
+using namespace psys;
+
+namespace {
+
+std::string sample(const std::string& name) {
+    std::ifstream in(std::string(PSYS_SAMPLES_DIR) + "/" + name + ".psys");
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+ir::Module compile(const std::string& text) {
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    auto module = compileText("test.psys", text, sources, diags, {});
+    INFO(diags.render());
+    REQUIRE(module.has_value());
+    return std::move(*module);
+}
+
+// Everything drawn after each of `frames` steps, as bytes.
+std::string drawn(rt::System& system, int frames) {
+    std::string out;
+    for (int f = 0; f < frames; ++f) {
+        REQUIRE_FALSE(system.step(1.0 / 60));
+        for (size_t t = 0; t < system.typeCount(); ++t)
+            for (const rt::RenderPoint& p : system.render(t))
+                out.append(reinterpret_cast<const char*>(&p), sizeof p);
+    }
+    return out;
+}
+
+}  // namespace
+
+TEST_CASE("the update loops of the benchmark effects vectorize") {
+    for (std::string name : {"fountain", "fire", "fireworks"}) {
+        INFO(name);
+        codegen_llvm::LlvmBackend jit;
+        rt::System system(compile(sample(name)), jit);
+        size_t updates = 0, vectorized = 0;
+        for (const auto& r : jit.remarks()) {
+            bool update = r.function.find(".update.") != std::string::npos;  // not .update.first
+            updates += update;
+            vectorized += update && r.vectorized;
+            INFO(r.function, ": ", r.message);
+            if (update) CHECK(r.vectorized);
+        }
+        CHECK(updates >= 1);
+        CHECK(vectorized == updates);
+    }
+}
+
+TEST_CASE("kernels are cached by their text: compiling a system again compiles nothing") {
+    codegen_llvm::LlvmBackend jit;
+    std::string text = sample("fireworks");
+    { rt::System first(compile(text), jit); }
+    auto before = jit.compileStats();
+    CHECK(before.kernels > 0);
+    rt::System again(compile(text), jit);
+    CHECK(jit.compileStats().kernels == before.kernels);
+    CHECK(jit.compileStats().cacheHits > before.cacheHits);
+    drawn(again, 60);
+}
+
+TEST_CASE("one backend runs system after system, each as a fresh interpreter would") {
+    // Systems come and go (a viewer reloading on save): kernels of a destroyed system
+    // must never be mistaken for those of a new one at the same address.
+    codegen_llvm::LlvmBackend jit(codegen_llvm::MathMode::Exact);
+    for (int round = 0; round < 2; ++round)
+        for (std::string name : {"fire", "fountain", "fireworks", "swamp", "follow_parent"}) {
+            INFO((name + " round " + std::to_string(round)));
+            interp::Interpreter interpreter;
+            rt::System a(compile(sample(name)), interpreter), b(compile(sample(name)), jit);
+            CHECK(drawn(a, 90) == drawn(b, 90));
+        }
+}
+
+TEST_CASE("the number of threads never changes a result") {
+    // 60 000 drops: eight chunks of rows, so the update loops really split.
+    std::string text = sample("fountain");
+    std::string reference;
+    for (unsigned threads : {1u, 2u, 0u}) {
+        INFO("threads ", threads);
+        codegen_llvm::LlvmBackend jit;
+        rt::SystemOptions options;
+        options.threads = threads;
+        rt::System system(compile(text), jit, options);
+        float population = 60000;
+        REQUIRE_FALSE(system.setExtern("population", {&population, 1}));
+        std::string out = drawn(system, 200);
+        CHECK(system.pool(static_cast<size_t>(system.typeIndex("drop"))).live() > 50000);
+        if (reference.empty()) reference = out;
+        CHECK(out == reference);
+    }
+}
