@@ -121,6 +121,14 @@ JitEngine::~JitEngine() = default;
 
 std::string JitEngine::cpu() const { return impl_->cpu; }
 
+// Floats in the host's widest vector register.
+unsigned JitEngine::floatLanes() const {
+    llvm::StringMap<bool> features = llvm::sys::getHostCPUFeatures();
+    if (features.lookup("avx512f")) return 16;
+    if (features.lookup("avx")) return 8;
+    return 4;
+}
+
 std::unique_ptr<llvm::LLVMContext> JitEngine::newContext() const {
     auto context = std::make_unique<llvm::LLVMContext>();
     return context;

@@ -37,6 +37,7 @@ public:
 
     std::vector<VectorizeRemark> remarks() const;
     std::string cpu() const;
+    unsigned floatLanes() const;
 
 private:
     struct Impl;

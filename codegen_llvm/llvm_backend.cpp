@@ -189,7 +189,8 @@ private:
 // column, which is what lets the loop vectorize without run-time alias checks.
 class RowsFunctionBuilder : FunctionBuilder {
 public:
-    RowsFunctionBuilder(llvm::Module& module, MathMode mode) : FunctionBuilder(module, mode) {}
+    RowsFunctionBuilder(llvm::Module& module, MathMode mode, unsigned lanes)
+        : FunctionBuilder(module, mode), lanes_(lanes) {}
 
     void build(const Object& object, const Kernel& kernel, const rt::BatchLayout& layout, rt::RowsMode rowsMode,
                const std::string& name) {
@@ -360,7 +361,17 @@ private:
         }
         llvm::Value* next = b_.CreateAdd(row_, b_.getInt64(1), "", true, true);
         row->addIncoming(next, b_.GetInsertBlock());
-        b_.CreateCondBr(b_.CreateICmpSLT(next, end), body, exit);
+        llvm::BranchInst* latch = b_.CreateCondBr(b_.CreateICmpSLT(next, end), body, exit);
+        // A whole register of floats per operation. Left alone, the vectorizer sizes the
+        // loop by its widest type (the double creation times: 4 on AVX2) and runs the
+        // float work at half width; measured on the fountain at 10M, 8 lanes update 20%
+        // more particles per second than 4.
+        llvm::Metadata* width[] = {llvm::MDString::get(ctx_, "llvm.loop.vectorize.width"),
+                                   llvm::ConstantAsMetadata::get(b_.getInt32(lanes_))};
+        llvm::Metadata* loopProperties[] = {nullptr, llvm::MDNode::get(ctx_, width)};
+        llvm::MDNode* loopId = llvm::MDNode::getDistinct(ctx_, loopProperties);
+        loopId->replaceOperandWith(0, loopId);
+        latch->setMetadata(llvm::LLVMContext::MD_loop, loopId);
         b_.SetInsertPoint(exit);
         b_.CreateRetVoid();
     }
@@ -369,6 +380,7 @@ private:
     llvm::Value* row_ = nullptr;
     rt::RowsMode rowsMode_ = rt::RowsMode::Step;
     const Kernel* uniformKernel_ = nullptr;
+    unsigned lanes_;
 };
 
 const char* modeName(MathMode mode) { return mode == MathMode::Exact ? "exact" : "fast"; }
@@ -396,7 +408,9 @@ struct LlvmBackend::Impl {
     std::vector<rt::Value> parents;
     interp::Interpreter interpreter;
 
-    explicit Impl(MathMode m) : mode(m), engine(m) {}
+    unsigned lanes;
+
+    explicit Impl(MathMode m) : mode(m), engine(m), lanes(engine.floatLanes()) {}
 
     enum class Shape { Object, Children, Rows };
     struct Request {
@@ -429,7 +443,7 @@ struct LlvmBackend::Impl {
             unit.module = engine.newModule(*unit.context);
             switch (r.shape) {
                 case Shape::Rows:
-                    RowsFunctionBuilder(*unit.module, mode)
+                    RowsFunctionBuilder(*unit.module, mode, lanes)
                         .build(*r.object, *r.kernel, rt::batchLayout(*r.object, *r.kernel), r.rowsMode, name);
                     break;
                 case Shape::Object: ObjectFunctionBuilder(*unit.module, mode).build(*r.kernel, name); break;

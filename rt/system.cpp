@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
@@ -408,7 +409,15 @@ void System::updatePool(size_t type, double dt, double t1) {
         backend_.runRows(o, update, b.update, part);
         if (listKills) {
             b.killed[c].clear();
-            for (size_t row = part.begin; row < part.end; ++row)
+            size_t row = part.begin;
+            for (; row + 8 <= part.end; row += 8) {  // most objects live: eight flags at a time
+                uint64_t flags;
+                std::memcpy(&flags, b.kill.data() + row, sizeof flags);
+                if (!flags) continue;
+                for (size_t r = row; r < row + 8; ++r)
+                    if (b.kill[r]) b.killed[c].push_back(static_cast<uint32_t>(r));
+            }
+            for (; row < part.end; ++row)
                 if (b.kill[row]) b.killed[c].push_back(static_cast<uint32_t>(row));
         }
         if (!exports) return;
