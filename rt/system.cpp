@@ -729,6 +729,7 @@ std::optional<std::string> System::step(double dt) {
         stats_.createSeconds += seconds(start, Clock::now());
     }
     now_ = t1;
+    auto releasing = Clock::now();
     for (auto [type, row] : dying_) {
         Pool& pool = pools_[type];
         if (pool.status(row) != Status::Frozen || pool.readers[row] > 0) continue;
@@ -737,6 +738,7 @@ std::optional<std::string> System::step(double dt) {
         releaseReader(type, parent);
     }
     dying_.clear();
+    stats_.emitSeconds += seconds(releasing, Clock::now());
     renderStale_.assign(pools_.size(), true);
     ++stats_.steps;
     return std::nullopt;
