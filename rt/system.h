@@ -16,6 +16,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -120,8 +121,7 @@ private:
     void emitAtRate(size_t type, uint32_t row, std::span<const float> rate, std::span<const float> count, double dt,
                     double t1);
     void update(size_t type, uint32_t row, double dt, double t1);
-    template <typename Chunk>
-    void forChunks(size_t rows, Chunk chunk);
+    void forChunks(size_t rows, const std::function<void(size_t)>& chunk);
     void updateOnce(size_t type, uint32_t row, double dt, double t1);
     void create(const Creation& c, double t1);
     void queueChildren(size_t type, uint32_t row, int site, uint64_t count, uint64_t perEvent, double firstTime,
