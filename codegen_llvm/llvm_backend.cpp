@@ -26,17 +26,15 @@ struct LlvmBackend::Impl {
     JitEngine engine;
     std::mutex mutex;  // runRows may be called from several threads
     std::unordered_map<std::string, void*> byText;     // compiled code by kernel text
-    struct ObjectEntry {
-        ObjectFn fn;
-        std::vector<const Inst*> parentReads;  // gathered by the caller, in order
+    // A function for one object or for children, with the parent reads its caller gathers.
+    template <typename Fn>
+    struct Entry {
+        Fn fn;
+        std::vector<const Inst*> parentReads;  // in instruction order
     };
-    std::unordered_map<const Kernel*, ObjectEntry> objectFns;  // the kernels of prepared modules
+    std::unordered_map<const Kernel*, Entry<ObjectFn>> objectFns;  // the kernels of prepared modules
     std::map<std::pair<const Kernel*, rt::RowsMode>, RowsFn> rowsFns;
-    struct ChildrenEntry {
-        ChildrenFn fn;
-        std::vector<const Inst*> parentReads;
-    };
-    std::unordered_map<const Kernel*, ChildrenEntry> childrenFns;
+    std::unordered_map<const Kernel*, Entry<ChildrenFn>> childrenFns;
     CompileStats stats;
     int counter = 0;
     std::vector<rt::Value> parents;
@@ -115,6 +113,17 @@ struct LlvmBackend::Impl {
         }
     }
 
+    // The values of a kernel's parent reads for one object, in instruction order.
+    const std::vector<rt::Value>& gatherParents(const std::vector<const Inst*>& reads, const rt::KernelInputs& in) {
+        parents.clear();
+        for (const Inst* i : reads) {
+            if (i->op == Op::ParentExport) parents.push_back(in.parentExport(i->attr2, i->attr));
+            else if (i->op == Op::ParentAlive) parents.push_back(rt::Value::boolean(in.parentAlive(i->attr2)));
+            else parents.push_back(rt::Value::scalar(in.parentAge(i->attr2)));
+        }
+        return parents;
+    }
+
     static std::vector<const Inst*> parentReads(const Kernel& k) {
         std::vector<const Inst*> reads;
         for (const Inst& i : k.insts())
@@ -182,14 +191,7 @@ void LlvmBackend::run(const Kernel& kernel, const rt::KernelInputs& in, std::vec
         impl_->compile({impl_->objectRequest(kernel)});
         it = impl_->objectFns.find(&kernel);
     }
-    // Parent reads are gathered here, in instruction order.
-    auto& parents = impl_->parents;
-    parents.clear();
-    for (const Inst* i : it->second.parentReads) {
-        if (i->op == Op::ParentExport) parents.push_back(in.parentExport(i->attr2, i->attr));
-        else if (i->op == Op::ParentAlive) parents.push_back(rt::Value::boolean(in.parentAlive(i->attr2)));
-        else parents.push_back(rt::Value::scalar(in.parentAge(i->attr2)));
-    }
+    const auto& parents = impl_->gatherParents(it->second.parentReads, in);
     float scalars[4] = {in.age, in.dt, in.time, in.first ? 1.0f : 0.0f};
     uint32_t keys[4] = {in.seed, in.objectId, in.draw, in.childDraw};
     yields.resize(kernel.yields.size());
@@ -204,13 +206,7 @@ void LlvmBackend::runChildren(const Kernel& spawn, const rt::KernelInputs& in, u
         impl_->compile({impl_->childrenRequest(spawn)});
         it = impl_->childrenFns.find(&spawn);
     }
-    auto& parents = impl_->parents;
-    parents.clear();
-    for (const Inst* i : it->second.parentReads) {
-        if (i->op == Op::ParentExport) parents.push_back(in.parentExport(i->attr2, i->attr));
-        else if (i->op == Op::ParentAlive) parents.push_back(rt::Value::boolean(in.parentAlive(i->attr2)));
-        else parents.push_back(rt::Value::scalar(in.parentAge(i->attr2)));
-    }
+    const auto& parents = impl_->gatherParents(it->second.parentReads, in);
     float scalars[4] = {in.age, in.dt, in.time, in.first ? 1.0f : 0.0f};
     uint32_t keys[4] = {in.seed, in.objectId, in.draw, firstChild};
     it->second.fn(in.params, in.state, in.externs, in.uniforms, parents.data(), scalars, keys, args,

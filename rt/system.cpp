@@ -18,7 +18,6 @@ using ir::YieldKind;
 using detail::Clock;
 using detail::finite;
 using detail::seconds;
-using detail::validCount;
 
 System::System(ir::Module module, Backend& backend, SystemOptions options)
     : module_(std::move(module)), backend_(backend), options_(options) {
@@ -212,9 +211,6 @@ std::optional<std::string> System::setExtern(int index, std::span<const float> v
     ++externsVersion_;
     return std::nullopt;
 }
-
-// Runs a trigger's (or the start's) kernel: once for the counts, then once per created
-// object for its arguments, so each draws its own random numbers.
 
 std::optional<std::string> System::fire(std::string_view name, std::span<const float> args) {
     const ir::Trigger* trigger = nullptr;

@@ -122,6 +122,8 @@ private:
                     double t1);
     void update(size_t type, uint32_t row, double dt, double t1);
     void forChunks(size_t rows, const std::function<void(size_t)>& chunk);
+    RowBatch stepBatch(size_t type, const ir::Kernel& kernel, const uint8_t* mask, const std::vector<void*>& columns,
+                       double time, double dt);
     void updateOnce(size_t type, uint32_t row, double dt, double t1);
     void create(const Creation& c, double t1);
     void queueChildren(size_t type, uint32_t row, int site, uint64_t count, uint64_t perEvent, double firstTime,

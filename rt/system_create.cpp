@@ -12,11 +12,11 @@ namespace psys::rt {
 
 using ir::KernelKind;
 using ir::YieldKind;
-using detail::Clock;
-using detail::finite;
-using detail::seconds;
 using detail::validCount;
 
+// Queues `count` children of emit site `site`, `perEvent` at a time; the k-th event is at
+// firstTime + k·spacing (spacing 0: all at once). Beyond the target's free capacity the
+// rest are dropped and counted, without work per dropped child.
 void System::queueChildren(size_t type, uint32_t row, int site, uint64_t count, uint64_t perEvent, double firstTime,
                            double spacing, double evalTime, bool first) {
     Pool& pool = pools_[type];
@@ -232,6 +232,8 @@ void System::createBatch(size_t type, size_t from, size_t to, double t1) {
 }
 
 
+// Runs a trigger's (or the start's) kernel: once for the counts, then once per created
+// object for its arguments, so each draws its own random numbers.
 void System::emitFromKernel(const ir::Trigger& trigger, std::span<const Value> params, uint32_t objectId) {
     const ir::Kernel& k = trigger.kernel;
     KernelInputs in;

@@ -225,8 +225,25 @@ void System::gatherParents(size_t type, const BatchLayout& layout, void* const* 
     }
 }
 
-// Runs chunk(c) for every chunk of `rows` rows: on the arena's threads when the backend
-// allows it and there is more than one chunk.
+// A batch of `kernel` over a type's pool for the step that ends at `time`: its uniform
+// values, the externs, the seed and the draw of this step. The rows are set per chunk.
+RowBatch System::stepBatch(size_t type, const ir::Kernel& kernel, const uint8_t* mask, const std::vector<void*>& columns,
+                           double time, double dt) {
+    KernelInputs context;
+    context.dt = static_cast<float>(dt);
+    context.time = static_cast<float>(time);
+    context.seed = options_.seed;
+    RowBatch batch;
+    batch.mask = mask;
+    batch.columns = columns.data();
+    batch.externs = externs_.data();
+    batch.uniforms = uniforms(type, kernel, context);
+    batch.time = time;
+    batch.dt = static_cast<float>(dt);
+    batch.seed = options_.seed;
+    batch.draw = static_cast<uint32_t>(step_);
+    return batch;
+}
 
 // Runs chunk(c) for every chunk of `rows` rows: on the arena's threads when the backend
 // allows it and there is more than one chunk.
@@ -253,26 +270,12 @@ void System::updatePool(size_t type, double dt, double t1) {
     if (rows == 0 || pool.live() == 0) return;
     b.kill.resize(rows);
     bindColumns(type, b.update, b.updateScratch, b.updateColumns);
-    KernelInputs context;
-    context.dt = static_cast<float>(dt);
-    context.time = static_cast<float>(t1);
-    context.seed = options_.seed;
-    RowBatch batch;
-    batch.mask = pool.updatable.data();
-    batch.columns = b.updateColumns.data();
-    batch.externs = externs_.data();
-    batch.uniforms = uniforms(type, update, context);
-    batch.time = t1;
-    batch.dt = static_cast<float>(dt);
-    batch.seed = options_.seed;
-    batch.draw = static_cast<uint32_t>(step_);
+    RowBatch batch = stepBatch(type, update, pool.updatable.data(), b.updateColumns, t1, dt);
     RowBatch exportBatch = batch;
     if (exports) {
         b.exportMask.resize(rows);
         bindColumns(type, b.exports, b.exportScratch, b.exportColumns);
-        exportBatch.mask = b.exportMask.data();
-        exportBatch.columns = b.exportColumns.data();
-        exportBatch.uniforms = uniforms(type, *exports, context);
+        exportBatch = stepBatch(type, *exports, b.exportMask.data(), b.exportColumns, t1, dt);
     }
     // Objects that only die (no rate emits) are found while their chunk is in cache.
     bool listKills = b.kills && !b.rateEmits;
@@ -342,10 +345,6 @@ void System::updatePool(size_t type, double dt, double t1) {
     }
 }
 
-// Queues `count` children of emit site `site`, `perEvent` at a time; the k-th event is at
-// firstTime + k·spacing (spacing 0: all at once). Beyond the target's free capacity the
-// rest are dropped and counted, without work per dropped child.
-
 const std::vector<RenderPoint>& System::render(size_t type) {
     start();
     if (!renderStale_[type]) return render_[type];
@@ -359,19 +358,7 @@ const std::vector<RenderPoint>& System::render(size_t type) {
     if (!k || !b.drawn[0] || rows == 0) return out;
     b.aliveMask.resize(rows);
     bindColumns(type, b.render, b.renderScratch, b.renderColumns);
-    KernelInputs context;
-    context.dt = static_cast<float>(lastDt_);
-    context.time = static_cast<float>(now_);
-    context.seed = options_.seed;
-    RowBatch batch;
-    batch.mask = b.aliveMask.data();
-    batch.columns = b.renderColumns.data();
-    batch.externs = externs_.data();
-    batch.uniforms = uniforms(type, *k, context);
-    batch.time = now_;
-    batch.dt = static_cast<float>(lastDt_);
-    batch.seed = options_.seed;
-    batch.draw = static_cast<uint32_t>(step_);
+    RowBatch batch = stepBatch(type, *k, b.aliveMask.data(), b.renderColumns, now_, lastDt_);
     forChunks(rows, [&](size_t c) {
         RowBatch part = batch;
         part.begin = c * kRowsPerChunk;
