@@ -28,6 +28,7 @@
 #include "driver/compile.h"
 #include "interp/interpreter.h"
 #include "rt/system.h"
+#include "tests/run_length.h"
 
 using namespace psys;
 
@@ -119,12 +120,12 @@ Comparison compareBackends(const std::string& text, int frames, bool optimize, M
 
 }  // namespace
 
-TEST_CASE("every sample draws the same on the LLVM backend as on the interpreter, for 600 frames") {
+TEST_CASE("every sample draws the same on the LLVM backend as on the interpreter, for 600 frames (200 sanitized)") {
     for (MathMode mode : {MathMode::Exact, MathMode::Fast}) {
         for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
             if (entry.path().extension() != ".psys") continue;
             INFO((entry.path().filename().string() + (mode == MathMode::Exact ? " exact" : " fast")));
-            CHECK(compareBackends(readFile(entry.path()), 600, true, mode).points > 0);
+            CHECK(compareBackends(readFile(entry.path()), test::kLongRun, true, mode).points > 0);
         }
     }
 }
