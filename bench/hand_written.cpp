@@ -75,6 +75,32 @@ size_t compact(std::vector<uint8_t>& dead, size_t n, Move move) {
     return n;
 }
 
+// The particles of a hand-written SoA effect: a float column per component, dead flags,
+// a count; removal swaps the last particle in.
+enum Column : size_t { kPx, kPy, kPz, kVx, kVy, kVz, kAge, kR, kG, kB, kA };
+
+class SoAParticles {
+public:
+    SoAParticles(size_t columns, size_t capacity) : columns_(columns, std::vector<float>(capacity)), dead_(capacity) {}
+    float* column(Column c) { return columns_[c].data(); }
+    float& at(Column c, size_t i) { return columns_[c][i]; }
+    uint8_t* dead() { return dead_.data(); }
+    size_t live() const { return n_; }
+    size_t room() const { return dead_.size() - n_; }
+    size_t bytesPerUpdate() const { return 2 * columns_.size() * sizeof(float) + 1; }
+    size_t add() { return n_++; }
+    void removeDead() {
+        n_ = compact(dead_, n_, [this](size_t from, size_t to) {
+            for (auto& c : columns_) c[to] = c[from];
+        });
+    }
+
+private:
+    std::vector<std::vector<float>> columns_;
+    std::vector<uint8_t> dead_;
+    size_t n_ = 0;
+};
+
 // A velocity uniform in the cone of samples/fountain.psys.
 void cone(Random& r, float& x, float& y, float& z) {
     float h = 12 * std::cbrt(r.uniform());
@@ -89,42 +115,36 @@ void cone(Random& r, float& x, float& y, float& z) {
 
 class FountainSoA : public Chunked {
 public:
-    FountainSoA(double population, size_t capacity) : population_(population), capacity_(capacity) {
-        for (auto* c : columns()) c->resize(capacity);
-        dead_.resize(capacity);
-    }
-    size_t live() const override { return n_; }
-    size_t bytesPerUpdate() const override { return 2 * 11 * sizeof(float) + 1; }
+    FountainSoA(double population, size_t capacity) : population_(population), p_(11, capacity) {}
+    size_t live() const override { return p_.live(); }
+    size_t bytesPerUpdate() const override { return p_.bytesPerUpdate(); }
 
     void step(float dt) override {
-        forChunks(n_, [&](size_t begin, size_t end) { update(begin, end, dt); });
-        n_ = compact(dead_, n_, [this](size_t from, size_t to) {
-            for (auto* c : columns()) (*c)[to] = (*c)[from];
-        });
-        size_t born = std::min(due(population_ / 3, dt), capacity_ - n_);
-        for (size_t k = 0; k < born; ++k, ++n_) {
-            px_[n_] = py_[n_] = pz_[n_] = 0;
-            cone(random_, vx_[n_], vy_[n_], vz_[n_]);
-            r_[n_] = 0.6f, g_[n_] = 0.8f, b_[n_] = 1, a_[n_] = 1, age_[n_] = 0;
+        forChunks(p_.live(), [&](size_t begin, size_t end) { update(begin, end, dt); });
+        p_.removeDead();
+        size_t born = std::min(due(population_ / 3, dt), p_.room());
+        for (size_t k = 0; k < born; ++k) {
+            size_t i = p_.add();
+            p_.at(kPx, i) = p_.at(kPy, i) = p_.at(kPz, i) = 0;
+            cone(random_, p_.at(kVx, i), p_.at(kVy, i), p_.at(kVz, i));
+            p_.at(kR, i) = 0.6f, p_.at(kG, i) = 0.8f, p_.at(kB, i) = 1, p_.at(kA, i) = 1, p_.at(kAge, i) = 0;
         }
     }
 
 private:
-    std::vector<std::vector<float>*> columns() { return {&px_, &py_, &pz_, &vx_, &vy_, &vz_, &r_, &g_, &b_, &a_, &age_}; }
-
     void update(size_t begin, size_t end, float dt) {
-        float* __restrict px = px_.data();
-        float* __restrict py = py_.data();
-        float* __restrict pz = pz_.data();
-        float* __restrict vx = vx_.data();
-        float* __restrict vy = vy_.data();
-        float* __restrict vz = vz_.data();
-        float* __restrict r = r_.data();
-        float* __restrict g = g_.data();
-        float* __restrict b = b_.data();
-        float* __restrict a = a_.data();
-        float* __restrict age = age_.data();
-        uint8_t* __restrict dead = dead_.data();
+        float* __restrict px = p_.column(kPx);
+        float* __restrict py = p_.column(kPy);
+        float* __restrict pz = p_.column(kPz);
+        float* __restrict vx = p_.column(kVx);
+        float* __restrict vy = p_.column(kVy);
+        float* __restrict vz = p_.column(kVz);
+        float* __restrict r = p_.column(kR);
+        float* __restrict g = p_.column(kG);
+        float* __restrict b = p_.column(kB);
+        float* __restrict a = p_.column(kA);
+        float* __restrict age = p_.column(kAge);
+        uint8_t* __restrict dead = p_.dead();
         const float fall = -9.8f * dt, fade = 0.5f * dt;
 #pragma omp simd
         for (size_t i = begin; i < end; ++i) {
@@ -146,9 +166,7 @@ private:
     }
 
     double population_;
-    size_t capacity_, n_ = 0;
-    std::vector<float> px_, py_, pz_, vx_, vy_, vz_, r_, g_, b_, a_, age_;
-    std::vector<uint8_t> dead_;
+    SoAParticles p_;
 };
 
 // The tutorials' particle: everything any effect might use, 64 bytes.
@@ -218,38 +236,32 @@ private:
 
 class FireSoA : public Chunked {
 public:
-    FireSoA(double rate, size_t capacity) : rate_(rate), capacity_(capacity) {
-        for (auto* c : columns()) c->resize(capacity);
-        dead_.resize(capacity);
-    }
-    size_t live() const override { return n_; }
-    size_t bytesPerUpdate() const override { return 2 * 7 * sizeof(float) + 1; }
+    FireSoA(double rate, size_t capacity) : rate_(rate), p_(7, capacity) {}
+    size_t live() const override { return p_.live(); }
+    size_t bytesPerUpdate() const override { return p_.bytesPerUpdate(); }
 
     void step(float dt) override {
-        forChunks(n_, [&](size_t begin, size_t end) { update(begin, end, dt); });
-        n_ = compact(dead_, n_, [this](size_t from, size_t to) {
-            for (auto* c : columns()) (*c)[to] = (*c)[from];
-        });
-        size_t born = std::min(due(rate_, dt), capacity_ - n_);
-        for (size_t k = 0; k < born; ++k, ++n_) {
-            px_[n_] = random_.signedUniform(), py_[n_] = 0, pz_[n_] = random_.signedUniform();
-            vx_[n_] = 3 * random_.signedUniform(), vy_[n_] = 3 * random_.signedUniform();
-            vz_[n_] = 3 * random_.signedUniform(), age_[n_] = 0;
+        forChunks(p_.live(), [&](size_t begin, size_t end) { update(begin, end, dt); });
+        p_.removeDead();
+        size_t born = std::min(due(rate_, dt), p_.room());
+        for (size_t k = 0; k < born; ++k) {
+            size_t i = p_.add();
+            p_.at(kPx, i) = random_.signedUniform(), p_.at(kPy, i) = 0, p_.at(kPz, i) = random_.signedUniform();
+            p_.at(kVx, i) = 3 * random_.signedUniform(), p_.at(kVy, i) = 3 * random_.signedUniform();
+            p_.at(kVz, i) = 3 * random_.signedUniform(), p_.at(kAge, i) = 0;
         }
     }
 
 private:
-    std::vector<std::vector<float>*> columns() { return {&px_, &py_, &pz_, &vx_, &vy_, &vz_, &age_}; }
-
     void update(size_t begin, size_t end, float dt) {
-        float* __restrict px = px_.data();
-        float* __restrict py = py_.data();
-        float* __restrict pz = pz_.data();
-        float* __restrict vx = vx_.data();
-        float* __restrict vy = vy_.data();
-        float* __restrict vz = vz_.data();
-        float* __restrict age = age_.data();
-        uint8_t* __restrict dead = dead_.data();
+        float* __restrict px = p_.column(kPx);
+        float* __restrict py = p_.column(kPy);
+        float* __restrict pz = p_.column(kPz);
+        float* __restrict vx = p_.column(kVx);
+        float* __restrict vy = p_.column(kVy);
+        float* __restrict vz = p_.column(kVz);
+        float* __restrict age = p_.column(kAge);
+        uint8_t* __restrict dead = p_.dead();
 #pragma omp simd
         for (size_t i = begin; i < end; ++i) {
             float temp = 100 * std::exp(-0.3f * age[i]);
@@ -267,9 +279,7 @@ private:
     }
 
     double rate_;
-    size_t capacity_, n_ = 0;
-    std::vector<float> px_, py_, pz_, vx_, vy_, vz_, age_;
-    std::vector<uint8_t> dead_;
+    SoAParticles p_;
 };
 
 class FireAoS : public AoS {
@@ -349,38 +359,31 @@ protected:
 
 class FireworksSoA : public FireworksBase {
 public:
-    FireworksSoA(double sparks, size_t capacity) : FireworksBase(sparks), capacity_(capacity) {
-        for (auto* c : columns()) c->resize(capacity);
-        dead_.resize(capacity);
-    }
-    size_t live() const override { return n_; }
-    size_t bytesPerUpdate() const override { return 2 * 7 * sizeof(float) + 1; }
+    FireworksSoA(double sparks, size_t capacity) : FireworksBase(sparks), p_(7, capacity) {}
+    size_t live() const override { return p_.live(); }
+    size_t bytesPerUpdate() const override { return p_.bytesPerUpdate(); }
 
     void step(float dt) override {
-        forChunks(n_, [&](size_t begin, size_t end) { update(begin, end, dt); });
-        n_ = compact(dead_, n_, [this](size_t from, size_t to) {
-            for (auto* c : columns()) (*c)[to] = (*c)[from];
-        });
+        forChunks(p_.live(), [&](size_t begin, size_t end) { update(begin, end, dt); });
+        p_.removeDead();
         rockets(dt, [this](const float* pos) {
-            if (n_ == capacity_) return;
-            px_[n_] = pos[0], py_[n_] = pos[1], pz_[n_] = pos[2];
-            vx_[n_] = vy_[n_] = vz_[n_] = age_[n_] = 0;
-            ++n_;
+            if (p_.room() == 0) return;
+            size_t i = p_.add();
+            p_.at(kPx, i) = pos[0], p_.at(kPy, i) = pos[1], p_.at(kPz, i) = pos[2];
+            p_.at(kVx, i) = p_.at(kVy, i) = p_.at(kVz, i) = p_.at(kAge, i) = 0;
         });
     }
 
 private:
-    std::vector<std::vector<float>*> columns() { return {&px_, &py_, &pz_, &vx_, &vy_, &vz_, &age_}; }
-
     void update(size_t begin, size_t end, float dt) {
-        float* __restrict px = px_.data();
-        float* __restrict py = py_.data();
-        float* __restrict pz = pz_.data();
-        float* __restrict vx = vx_.data();
-        float* __restrict vy = vy_.data();
-        float* __restrict vz = vz_.data();
-        float* __restrict age = age_.data();
-        uint8_t* __restrict dead = dead_.data();
+        float* __restrict px = p_.column(kPx);
+        float* __restrict py = p_.column(kPy);
+        float* __restrict pz = p_.column(kPz);
+        float* __restrict vx = p_.column(kVx);
+        float* __restrict vy = p_.column(kVy);
+        float* __restrict vz = p_.column(kVz);
+        float* __restrict age = p_.column(kAge);
+        uint8_t* __restrict dead = p_.dead();
         const float fall = -9.82f * 0.4f * dt;
 #pragma omp simd
         for (size_t i = begin; i < end; ++i) {
@@ -394,9 +397,7 @@ private:
         }
     }
 
-    size_t capacity_, n_ = 0;
-    std::vector<float> px_, py_, pz_, vx_, vy_, vz_, age_;
-    std::vector<uint8_t> dead_;
+    SoAParticles p_;
 };
 
 class FireworksAoS : public FireworksBase {
