@@ -1,5 +1,5 @@
-// The whole compiler as one call: source → checked AST → IR → passes. Used by psysc,
-// the tests, the benchmarks and (later) the viewer.
+// The whole compiler as one call: source → checked AST → IR → passes. Used by psysc, the
+// host library (and through it the viewer and the benchmarks) and the tests.
 #pragma once
 
 #include <optional>
@@ -12,14 +12,19 @@
 namespace psys {
 
 struct CompileOptions {
+    // The passes, and what they print: with `printAfter` or `printAfterAll` and a `log`,
+    // the IR right after lowering is printed first.
     opt::PipelineOptions pipeline;
 };
 
-// Returns the compiled module, or nullopt with the errors in `diags` (a pass's errors are
-// reported without a location).
+// Returns the compiled module, or nullopt with the errors in `diags`. The passes' errors
+// and warnings are reported at the instructions they concern.
 std::optional<ir::Module> compileFile(const std::string& path, SourceManager& sources, DiagnosticEngine& diags,
                                       const CompileOptions& options = {});
 std::optional<ir::Module> compileText(const std::string& displayPath, std::string text, SourceManager& sources,
                                       DiagnosticEngine& diags, const CompileOptions& options = {});
+
+// An IR location as a source range (for diagnostics).
+SourceRange sourceRange(const SourceManager& sources, ir::Loc loc);
 
 }  // namespace psys

@@ -1,39 +1,43 @@
 #include "frontend/builtins.h"
 
+#include "core/integrators.h"
+
 #include <array>
 
 namespace psys {
 namespace {
 
 using R = BuiltinRule;
+// `op`: the one operation of core/ops.h a function is, where it is exactly one (lowering
+// emits it, constant evaluation computes it through core/lanes.h).
 
 constexpr BuiltinFunction kFunctions[] = {
     // componentwise maths
-    {"sin", 1, 1, R::Componentwise, 0, "sin(x: T) -> T"},
-    {"cos", 1, 1, R::Componentwise, 0, "cos(x: T) -> T"},
-    {"tan", 1, 1, R::Componentwise, 0, "tan(x: T) -> T"},
-    {"asin", 1, 1, R::Componentwise, 0, "asin(x: T) -> T"},
-    {"acos", 1, 1, R::Componentwise, 0, "acos(x: T) -> T"},
-    {"atan", 1, 1, R::Componentwise, 0, "atan(x: T) -> T"},
-    {"atan2", 2, 2, R::Componentwise, 0, "atan2(y: T, x: T) -> T"},
-    {"exp", 1, 1, R::Componentwise, 0, "exp(x: T) -> T"},
-    {"log", 1, 1, R::Componentwise, 0, "log(x: T) -> T"},
-    {"pow", 2, 2, R::Componentwise, 0, "pow(x: T, y: T|float) -> T"},
-    {"sqrt", 1, 1, R::Componentwise, 0, "sqrt(x: T) -> T"},
-    {"abs", 1, 1, R::Componentwise, 0, "abs(x: T) -> T"},
-    {"sign", 1, 1, R::Componentwise, 0, "sign(x: T) -> T"},
-    {"floor", 1, 1, R::Componentwise, 0, "floor(x: T) -> T"},
-    {"ceil", 1, 1, R::Componentwise, 0, "ceil(x: T) -> T"},
-    {"round", 1, 1, R::Componentwise, 0, "round(x: T) -> T"},
-    {"fract", 1, 1, R::Componentwise, 0, "fract(x: T) -> T"},
-    {"mod", 2, 2, R::Componentwise, 0, "mod(x: T, y: T|float) -> T"},
-    {"min", 2, 2, R::Componentwise, 0, "min(a: T, b: T|float) -> T"},
-    {"max", 2, 2, R::Componentwise, 0, "max(a: T, b: T|float) -> T"},
+    {"sin", 1, 1, R::Componentwise, 0, "sin(x: T) -> T", core::Op::Sin},
+    {"cos", 1, 1, R::Componentwise, 0, "cos(x: T) -> T", core::Op::Cos},
+    {"tan", 1, 1, R::Componentwise, 0, "tan(x: T) -> T", core::Op::Tan},
+    {"asin", 1, 1, R::Componentwise, 0, "asin(x: T) -> T", core::Op::Asin},
+    {"acos", 1, 1, R::Componentwise, 0, "acos(x: T) -> T", core::Op::Acos},
+    {"atan", 1, 1, R::Componentwise, 0, "atan(x: T) -> T", core::Op::Atan},
+    {"atan2", 2, 2, R::Componentwise, 0, "atan2(y: T, x: T) -> T", core::Op::Atan2},
+    {"exp", 1, 1, R::Componentwise, 0, "exp(x: T) -> T", core::Op::Exp},
+    {"log", 1, 1, R::Componentwise, 0, "log(x: T) -> T", core::Op::Log},
+    {"pow", 2, 2, R::Componentwise, 0, "pow(x: T, y: T|float) -> T", core::Op::Pow},
+    {"sqrt", 1, 1, R::Componentwise, 0, "sqrt(x: T) -> T", core::Op::Sqrt},
+    {"abs", 1, 1, R::Componentwise, 0, "abs(x: T) -> T", core::Op::Abs},
+    {"sign", 1, 1, R::Componentwise, 0, "sign(x: T) -> T", core::Op::Sign},
+    {"floor", 1, 1, R::Componentwise, 0, "floor(x: T) -> T", core::Op::Floor},
+    {"ceil", 1, 1, R::Componentwise, 0, "ceil(x: T) -> T", core::Op::Ceil},
+    {"round", 1, 1, R::Componentwise, 0, "round(x: T) -> T", core::Op::Round},
+    {"fract", 1, 1, R::Componentwise, 0, "fract(x: T) -> T", core::Op::Fract},
+    {"mod", 2, 2, R::Componentwise, 0, "mod(x: T, y: T|float) -> T", core::Op::Mod},
+    {"min", 2, 2, R::Componentwise, 0, "min(a: T, b: T|float) -> T", core::Op::Min},
+    {"max", 2, 2, R::Componentwise, 0, "max(a: T, b: T|float) -> T", core::Op::Max},
     {"clamp", 1, 3, R::Componentwise, 0, "clamp(x: T, lo: T|float = 0, hi: T|float = 1) -> T"},
     {"saturate", 1, 1, R::Componentwise, 0, "saturate(x: T) -> T"},
     {"mix", 3, 3, R::Componentwise, 0, "mix(a: T, b: T, t: T|float) -> T"},
     {"lerp", 3, 3, R::Componentwise, 0, "lerp(a: T, b: T, t: T|float) -> T"},
-    {"step", 2, 2, R::Componentwise, 0, "step(edge: T|float, x: T) -> T"},
+    {"step", 2, 2, R::Componentwise, 0, "step(edge: T|float, x: T) -> T", core::Op::Step},
     {"smoothstep", 3, 3, R::Componentwise, 0, "smoothstep(e0: T|float, e1: T|float, x: T) -> T"},
     {"radians", 1, 1, R::Componentwise, 0, "radians(degrees: T) -> T"},
     {"degrees", 1, 1, R::Componentwise, 0, "degrees(radians: T) -> T"},
@@ -87,8 +91,6 @@ const BuiltinConstant kConstants[] = {
     {"transparent", Type::vec(4), {0, 0, 0, 0}},
 };
 
-constexpr std::array<std::string_view, 6> kIntegrators = {"euler", "semi_implicit", "midpoint", "rk2", "rk4", "exact"};
-
 }  // namespace
 
 std::span<const BuiltinFunction> builtinFunctions() { return kFunctions; }
@@ -115,6 +117,6 @@ int findBuiltinConstant(std::string_view name) {
 
 bool isBuiltinVariable(std::string_view name) { return name == "age" || name == "time" || name == "dt"; }
 
-std::span<const std::string_view> integratorNames() { return kIntegrators; }
+std::span<const std::string_view> integratorNames() { return core::kIntegratorNames; }
 
 }  // namespace psys

@@ -9,6 +9,7 @@
 #include <span>
 #include <string_view>
 
+#include "core/ops.h"
 #include "frontend/types.h"
 
 namespace psys {
@@ -33,6 +34,7 @@ struct BuiltinFunction {
     BuiltinRule rule;
     int width;                  // Construct and Random: the result's width
     std::string_view signature; // for notes: "clamp(x: T, lo: T|float, hi: T|float) -> T"
+    std::optional<core::Op> op = std::nullopt;  // the operation it is, where it is exactly one
 };
 
 std::span<const BuiltinFunction> builtinFunctions();

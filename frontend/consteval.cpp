@@ -1,7 +1,6 @@
 #include "frontend/consteval.h"
 
-#include <cmath>
-
+#include "core/lanes.h"
 #include "frontend/builtins.h"
 
 namespace psys {
@@ -9,19 +8,25 @@ namespace {
 
 using namespace ast;
 using Value = std::optional<ConstValue>;
+using core::Op;
 
-ConstValue scalar(double x) { return {Type::scalar(), {x, 0, 0, 0}}; }
-ConstValue boolean(bool b) { return {Type::boolean(), {b ? 1.0 : 0.0, 0, 0, 0}}; }
+ConstValue scalar(float x) { return {Type::scalar(), {x, 0, 0, 0}}; }
+ConstValue boolean(bool b) { return {Type::boolean(), {b ? 1.0f : 0.0f, 0, 0, 0}}; }
 
 // Broadcast a float to `width` components.
-double component(const ConstValue& c, int i) { return c.type.width() == 1 ? c.v[0] : c.v[static_cast<size_t>(i)]; }
+float component(const ConstValue& c, int i) { return c.type.width() == 1 ? c.v[0] : c.v[static_cast<size_t>(i)]; }
 
-template <typename F>
-Value zipWith(const ConstValue& a, const ConstValue& b, F f) {
+// A binary componentwise op, a float broadcasting to the other's width.
+ConstValue binary(Op op, const ConstValue& a, const ConstValue& b) {
     int w = std::max(a.type.width(), b.type.width());
-    ConstValue out{Type::vec(w), {}};
-    for (int i = 0; i < w; ++i) out.v[static_cast<size_t>(i)] = f(component(a, i), component(b, i));
+    ConstValue out{w == 1 ? Type::scalar() : Type::vec(w), {}};
+    for (int i = 0; i < w; ++i) out.v[static_cast<size_t>(i)] = core::lane(op, component(a, i), component(b, i));
     return out;
+}
+
+ConstValue unary(Op op, ConstValue x) {
+    for (int i = 0; i < x.type.width(); ++i) x.v[static_cast<size_t>(i)] = core::lane(op, x.v[static_cast<size_t>(i)]);
+    return x;
 }
 
 Value evalCall(const CallExpr& call) {
@@ -44,23 +49,33 @@ Value evalCall(const CallExpr& call) {
             for (int i = 0; i < a.type.width() && n < 4; ++i) out.v[n++] = a.v[static_cast<size_t>(i)];
         return out;
     }
-    auto unary = [&](double (*f)(double)) -> Value {
-        ConstValue out = args[0];
-        for (int i = 0; i < out.type.width(); ++i) out.v[static_cast<size_t>(i)] = f(out.v[static_cast<size_t>(i)]);
-        return out;
-    };
-    std::string_view n = fn.name;
-    if (n == "sin") return unary([](double x) { return std::sin(x); });
-    if (n == "cos") return unary([](double x) { return std::cos(x); });
-    if (n == "sqrt") return unary([](double x) { return std::sqrt(x); });
-    if (n == "abs") return unary([](double x) { return std::fabs(x); });
-    if (n == "exp") return unary([](double x) { return std::exp(x); });
-    if (n == "floor") return unary([](double x) { return std::floor(x); });
-    if (n == "radians") return unary([](double x) { return x * M_PI / 180.0; });
-    if (n == "min") return zipWith(args[0], args[1], [](double a, double b) { return std::min(a, b); });
-    if (n == "max") return zipWith(args[0], args[1], [](double a, double b) { return std::max(a, b); });
-    if (n == "pow") return zipWith(args[0], args[1], [](double a, double b) { return std::pow(a, b); });
+    if (fn.op && core::isComponentwise(*fn.op)) {
+        if (core::opInfo(*fn.op).arity == 1) return unary(*fn.op, args[0]);
+        return binary(*fn.op, args[0], args[1]);
+    }
+    // The two that lowering writes as a multiplication by a constant.
+    if (fn.name == "radians") return binary(Op::Mul, args[0], scalar(core::kRadiansPerDegree));
+    if (fn.name == "degrees") return binary(Op::Mul, args[0], scalar(core::kDegreesPerRadian));
     return std::nullopt;
+}
+
+Op binaryOp(BinaryOp op) {
+    switch (op) {
+        case BinaryOp::Add: return Op::Add;
+        case BinaryOp::Sub: return Op::Sub;
+        case BinaryOp::Mul: return Op::Mul;
+        case BinaryOp::Div: return Op::Div;
+        case BinaryOp::Mod: return Op::Mod;
+        case BinaryOp::Lt: return Op::Lt;
+        case BinaryOp::Le: return Op::Le;
+        case BinaryOp::Gt: return Op::Gt;
+        case BinaryOp::Ge: return Op::Ge;
+        case BinaryOp::Eq: return Op::Eq;
+        case BinaryOp::Ne: return Op::Ne;
+        case BinaryOp::And: return Op::And;
+        case BinaryOp::Or: return Op::Or;
+    }
+    return Op::Add;
 }
 
 }  // namespace
@@ -68,7 +83,7 @@ Value evalCall(const CallExpr& call) {
 std::optional<ConstValue> evaluateConstant(const Expr& expr) {
     if (expr.type.isVague() || expr.type.isTuple()) return std::nullopt;
     switch (expr.kind) {
-        case ExprKind::Number: return scalar(static_cast<const NumberExpr&>(expr).value);
+        case ExprKind::Number: return scalar(static_cast<float>(static_cast<const NumberExpr&>(expr).value));
         case ExprKind::Bool: return boolean(static_cast<const BoolExpr&>(expr).value);
         case ExprKind::Name: {
             auto& name = static_cast<const NameExpr&>(expr);
@@ -87,31 +102,22 @@ std::optional<ConstValue> evaluateConstant(const Expr& expr) {
             Value v = evaluateConstant(*u.operand);
             if (!v) return std::nullopt;
             if (u.op == UnaryOp::Not) return boolean(!v->isTrue());
-            if (u.op == UnaryOp::Neg)
-                for (auto& x : v->v) x = -x;
+            if (u.op == UnaryOp::Neg) return unary(Op::Neg, *v);
             return v;
         }
         case ExprKind::Binary: {
             auto& b = static_cast<const BinaryExpr&>(expr);
             Value l = evaluateConstant(*b.lhs), r = evaluateConstant(*b.rhs);
             if (!l || !r) return std::nullopt;
-            switch (b.op) {
-                case BinaryOp::Add: return zipWith(*l, *r, [](double a, double c) { return a + c; });
-                case BinaryOp::Sub: return zipWith(*l, *r, [](double a, double c) { return a - c; });
-                case BinaryOp::Mul: return zipWith(*l, *r, [](double a, double c) { return a * c; });
-                case BinaryOp::Div: return zipWith(*l, *r, [](double a, double c) { return a / c; });
-                case BinaryOp::Mod:
-                    return zipWith(*l, *r, [](double a, double c) { return a - c * std::floor(a / c); });
-                case BinaryOp::Lt: return boolean(l->v[0] < r->v[0]);
-                case BinaryOp::Le: return boolean(l->v[0] <= r->v[0]);
-                case BinaryOp::Gt: return boolean(l->v[0] > r->v[0]);
-                case BinaryOp::Ge: return boolean(l->v[0] >= r->v[0]);
-                case BinaryOp::Eq: return boolean(l->v == r->v);
-                case BinaryOp::Ne: return boolean(l->v != r->v);
-                case BinaryOp::And: return boolean(l->isTrue() && r->isTrue());
-                case BinaryOp::Or: return boolean(l->isTrue() || r->isTrue());
+            Op op = binaryOp(b.op);
+            switch (op) {
+                case Op::Lt: case Op::Le: case Op::Gt: case Op::Ge: return boolean(core::compare(op, l->v[0], r->v[0]));
+                case Op::Eq: return boolean(l->v == r->v);
+                case Op::Ne: return boolean(l->v != r->v);
+                case Op::And: return boolean(l->isTrue() && r->isTrue());
+                case Op::Or: return boolean(l->isTrue() || r->isTrue());
+                default: return binary(op, *l, *r);
             }
-            return std::nullopt;
         }
         case ExprKind::Conditional: {
             auto& c = static_cast<const ConditionalExpr&>(expr);

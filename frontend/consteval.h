@@ -3,6 +3,9 @@
 // Used where the front end must know a value to check it: extern defaults and ranges,
 // `@step`, `@capacity`, constant emission rates and counts. Returns nullopt for anything
 // that is not a constant (an extern, `age`, `rand()`, a user function call, …).
+//
+// Values are floats computed by core/lanes.h, the arithmetic every backend runs, so a
+// constant checked here is the constant the program computes.
 #pragma once
 
 #include <array>
@@ -14,7 +17,7 @@ namespace psys {
 
 struct ConstValue {
     Type type;                      // bool, float or vecN
-    std::array<double, 4> v{};      // components; a bool is 0 or 1
+    std::array<float, 4> v{};       // components; a bool is 0 or 1
     bool isTrue() const { return v[0] != 0; }
 };
 

@@ -23,6 +23,13 @@ LineColumn SourceFile::lineColumn(uint32_t offset) const {
     return {line, offset - lineStarts_[line - 1] + 1};
 }
 
+uint32_t SourceFile::offset(LineColumn at) const {
+    if (at.line == 0) return 0;
+    if (at.line > lineStarts_.size()) return static_cast<uint32_t>(text_.size());
+    uint32_t start = lineStarts_[at.line - 1];
+    return std::min<uint32_t>(start + (at.column > 0 ? at.column - 1 : 0), static_cast<uint32_t>(text_.size()));
+}
+
 std::string_view SourceFile::lineText(uint32_t line) const {
     if (line == 0 || line > lineStarts_.size()) return {};
     uint32_t begin = lineStarts_[line - 1];

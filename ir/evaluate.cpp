@@ -1,24 +1,11 @@
 #include "ir/evaluate.h"
 
-#include <cmath>
+#include "core/hash.h"
+#include "core/lanes.h"
 
 namespace psys::ir {
 
 namespace {
-
-template <typename F>
-Value map1(const Value& a, int width, F f) {
-    Value r;
-    for (int i = 0; i < width; ++i) r.f[static_cast<size_t>(i)] = f(a.f[static_cast<size_t>(i)]);
-    return r;
-}
-
-template <typename F>
-Value map2(const Value& a, const Value& b, int width, F f) {
-    Value r;
-    for (int i = 0; i < width; ++i) r.f[static_cast<size_t>(i)] = f(a.f[static_cast<size_t>(i)], b.f[static_cast<size_t>(i)]);
-    return r;
-}
 
 bool equal(const Value& a, const Value& b, const Type& t) {
     if (t.kind == Type::Kind::U32) return a.u == b.u;
@@ -30,72 +17,98 @@ bool equal(const Value& a, const Value& b, const Type& t) {
 
 }  // namespace
 
-bool isPure(Op op) { return op >= Op::Add && op <= Op::Dot; }
-
 Value evaluate(const Inst& inst, const Value* operands, const Type* operandTypes) {
-    const int w = inst.type.width;
+    const auto w = static_cast<size_t>(inst.type.width);
     auto a = [&](size_t i) -> const Value& { return operands[i]; };
     Value out;
+    if (isComponentwise(inst.op) && inst.op != Op::Select) {
+        const int arity = opInfo(inst.op).arity;
+        for (size_t l = 0; l < w; ++l)
+            out.f[l] = arity == 1 ? core::lane(inst.op, a(0).f[l]) : core::lane(inst.op, a(0).f[l], a(1).f[l]);
+        return out;
+    }
     switch (inst.op) {
-        case Op::Add: out = map2(a(0), a(1), w, [](float x, float y) { return x + y; }); break;
-        case Op::Sub: out = map2(a(0), a(1), w, [](float x, float y) { return x - y; }); break;
-        case Op::Mul: out = map2(a(0), a(1), w, [](float x, float y) { return x * y; }); break;
-        case Op::Div: out = map2(a(0), a(1), w, [](float x, float y) { return x / y; }); break;
-        case Op::Mod: out = map2(a(0), a(1), w, [](float x, float y) { return x - y * std::floor(x / y); }); break;
-        case Op::Neg: out = map1(a(0), w, [](float x) { return -x; }); break;
-        case Op::Min: out = map2(a(0), a(1), w, [](float x, float y) { return y < x ? y : x; }); break;
-        case Op::Max: out = map2(a(0), a(1), w, [](float x, float y) { return x < y ? y : x; }); break;
-        case Op::Step: out = map2(a(0), a(1), w, [](float edge, float x) { return x < edge ? 0.0f : 1.0f; }); break;
-        case Op::Atan2: out = map2(a(0), a(1), w, [](float y, float x) { return std::atan2(y, x); }); break;
-        case Op::Pow: out = map2(a(0), a(1), w, [](float x, float y) { return std::pow(x, y); }); break;
-        case Op::Sin: out = map1(a(0), w, [](float x) { return std::sin(x); }); break;
-        case Op::Cos: out = map1(a(0), w, [](float x) { return std::cos(x); }); break;
-        case Op::Tan: out = map1(a(0), w, [](float x) { return std::tan(x); }); break;
-        case Op::Asin: out = map1(a(0), w, [](float x) { return std::asin(x); }); break;
-        case Op::Acos: out = map1(a(0), w, [](float x) { return std::acos(x); }); break;
-        case Op::Atan: out = map1(a(0), w, [](float x) { return std::atan(x); }); break;
-        case Op::Exp: out = map1(a(0), w, [](float x) { return std::exp(x); }); break;
-        case Op::Log: out = map1(a(0), w, [](float x) { return std::log(x); }); break;
-        case Op::Sqrt: out = map1(a(0), w, [](float x) { return std::sqrt(x); }); break;
-        case Op::Abs: out = map1(a(0), w, [](float x) { return std::fabs(x); }); break;
-        case Op::Sign: out = map1(a(0), w, [](float x) { return x > 0 ? 1.0f : x < 0 ? -1.0f : 0.0f; }); break;
-        case Op::Floor: out = map1(a(0), w, [](float x) { return std::floor(x); }); break;
-        case Op::Ceil: out = map1(a(0), w, [](float x) { return std::ceil(x); }); break;
-        case Op::Round: out = map1(a(0), w, [](float x) { return std::nearbyint(x); }); break;
-        case Op::Fract: out = map1(a(0), w, [](float x) { return x - std::floor(x); }); break;
-        case Op::Lt: out = Value::boolean(a(0).f[0] < a(1).f[0]); break;
-        case Op::Le: out = Value::boolean(a(0).f[0] <= a(1).f[0]); break;
-        case Op::Gt: out = Value::boolean(a(0).f[0] > a(1).f[0]); break;
-        case Op::Ge: out = Value::boolean(a(0).f[0] >= a(1).f[0]); break;
-        case Op::Eq: out = Value::boolean(equal(a(0), a(1), operandTypes[0])); break;
-        case Op::Ne: out = Value::boolean(!equal(a(0), a(1), operandTypes[0])); break;
-        case Op::And: out = Value::boolean(a(0).truth() && a(1).truth()); break;
-        case Op::Or: out = Value::boolean(a(0).truth() || a(1).truth()); break;
-        case Op::Not: out = Value::boolean(!a(0).truth()); break;
-        case Op::Select: out = a(0).truth() ? a(1) : a(2); break;
-        case Op::Splat: out.f = {a(0).f[0], a(0).f[0], a(0).f[0], a(0).f[0]}; break;
+        case Op::Lt: case Op::Le: case Op::Gt: case Op::Ge:
+            return Value::boolean(core::compare(inst.op, a(0).f[0], a(1).f[0]));
+        case Op::Eq: return Value::boolean(equal(a(0), a(1), operandTypes[0]));
+        case Op::Ne: return Value::boolean(!equal(a(0), a(1), operandTypes[0]));
+        case Op::And: return Value::boolean(a(0).truth() && a(1).truth());
+        case Op::Or: return Value::boolean(a(0).truth() || a(1).truth());
+        case Op::Not: return Value::boolean(!a(0).truth());
+        case Op::Select: return a(0).truth() ? a(1) : a(2);
+        case Op::Splat: out.f = {a(0).f[0], a(0).f[0], a(0).f[0], a(0).f[0]}; return out;
         case Op::Compose: {
             size_t n = 0;
-            for (size_t i = 0; i < inst.operands.size(); ++i) {
-                int cw = operandTypes[i].width;
-                for (int c = 0; c < cw && n < 4; ++c) out.f[n++] = a(i).f[static_cast<size_t>(c)];
-            }
-            break;
+            for (size_t i = 0; i < inst.operands.size(); ++i)
+                for (int c = 0; c < operandTypes[i].width && n < 4; ++c) out.f[n++] = a(i).f[static_cast<size_t>(c)];
+            return out;
         }
-        case Op::Extract: out = Value::scalar(a(0).f[static_cast<size_t>(inst.attr)]); break;
+        case Op::Extract: return Value::scalar(a(0).f[static_cast<size_t>(inst.attr)]);
         case Op::Shuffle:
             for (size_t i = 0; i < inst.lanes.size(); ++i) out.f[i] = a(0).f[inst.lanes[i]];
-            break;
-        case Op::Dot: {
+            return out;
+        case Op::Dot: {  // ((0 + x0·y0) + x1·y1) + …
             float s = 0;
             for (int i = 0; i < operandTypes[0].width; ++i)
                 s += a(0).f[static_cast<size_t>(i)] * a(1).f[static_cast<size_t>(i)];
-            out = Value::scalar(s);
-            break;
+            return Value::scalar(s);
         }
-        default: break;
+        default: return out;
     }
-    return out;
+}
+
+void Evaluator::run(const Kernel& kernel, const KernelInputs& in, std::vector<Value>& yields) {
+    registers_.resize(kernel.size());
+    std::vector<Value>& r = registers_;
+    size_t parent = 0;
+    core::HostAlgebra host;
+    for (ValueId v = 0; v < kernel.size(); ++v) {
+        const Inst& inst = kernel.at(v);
+        Value out;
+        switch (inst.op) {
+            case Op::Const: out.f = inst.constant; break;
+            case Op::Param: case Op::TriggerParam: out = in.params[inst.attr]; break;
+            case Op::StateRead: out = in.state[inst.attr]; break;
+            case Op::Extern: out = in.externs[inst.attr]; break;
+            case Op::Uniform: out = in.uniforms[inst.attr]; break;
+            case Op::Age: out = Value::scalar(in.age); break;
+            case Op::Dt: out = Value::scalar(in.dt); break;
+            case Op::Time: out = Value::scalar(in.time); break;
+            case Op::First: out = Value::boolean(in.first); break;
+            case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge: out = in.parents[parent++]; break;
+            case Op::ObjectId: out.u = in.objectId; break;
+            case Op::DrawIndex: out.u = inst.attr == 1 ? in.childDraw : in.draw; break;
+            case Op::Rand: case Op::NRand: {
+                uint32_t object = r[inst.operands[0]].u, draw = r[inst.operands[1]].u;
+                for (int i = 0; i < inst.type.width; ++i)
+                    out.f[static_cast<size_t>(i)] = core::drawLane(host, inst.op, in.seed, object,
+                                                                   static_cast<uint32_t>(inst.attr), draw,
+                                                                   static_cast<uint32_t>(i));
+                break;
+            }
+            default:
+                if (isPure(inst.op)) {
+                    operandValues_.clear();
+                    operandTypes_.clear();
+                    for (ValueId o : inst.operands) {
+                        operandValues_.push_back(r[o]);
+                        operandTypes_.push_back(kernel.at(o).type);
+                    }
+                    out = evaluate(inst, operandValues_.data(), operandTypes_.data());
+                }
+                break;
+        }
+        r[v] = out;
+    }
+    yields.resize(kernel.yields.size());
+    for (size_t i = 0; i < kernel.yields.size(); ++i) yields[i] = r[kernel.yields[i].value];
+}
+
+std::vector<const Inst*> parentReads(const Kernel& kernel) {
+    std::vector<const Inst*> reads;
+    for (const Inst& i : kernel.insts())
+        if (isParentRead(i.op)) reads.push_back(&i);
+    return reads;
 }
 
 }  // namespace psys::ir

@@ -1,7 +1,11 @@
-// What each pure instruction computes: one definition, used by the interpreter and by
-// constant folding, so folding a constant gives exactly what running it would.
+// What an IR kernel computes, as the reference: `evaluate` for one pure instruction (the
+// interpreter and constant folding both use it, so folding a constant gives exactly what
+// running it would), and `Evaluator` for a whole kernel given its inputs (the
+// interpreter's loops, and the run-time's once-per-step kernels: start, triggers, uniform
+// values). Lanes are computed by core/lanes.h, random draws by core/hash.h.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "ir/ir.h"
@@ -9,11 +13,42 @@
 
 namespace psys::ir {
 
-// Whether `evaluate` computes `op` (arithmetic, logic and vector instructions; not inputs,
-// random draws or temporal constructs).
-bool isPure(Op op);
-
 // `operands[i]` is the value of `inst.operands[i]`, whose type is `operandTypes[i]`.
+// For pure instructions only.
 Value evaluate(const Inst& inst, const Value* operands, const Type* operandTypes);
+
+// What a kernel reads when it is evaluated once.
+struct KernelInputs {
+    const Value* params = nullptr;    // param (the object's) or trigger.param (the trigger's)
+    const Value* state = nullptr;     // the slots before this kernel
+    const Value* externs = nullptr;
+    const Value* uniforms = nullptr;  // the values of the kernel's uniform kernel
+    const Value* parents = nullptr;   // the kernel's parent reads, in instruction order
+    float age = 0;
+    float dt = 0;
+    float time = 0;
+    bool first = false;               // true while the object is being created
+    uint32_t seed = 0;
+    uint32_t objectId = 0;
+    uint32_t draw = 0;                // draw.index #0
+    uint32_t childDraw = 0;           // draw.index #1: the id of the object being spawned
+};
+
+// Evaluates kernels instruction by instruction, in float, the way the IR says.
+class Evaluator {
+public:
+    // `yields[i]` receives the value of `kernel.yields[i]`.
+    void run(const Kernel& kernel, const KernelInputs& in, std::vector<Value>& yields);
+
+private:
+    std::vector<Value> registers_;
+    std::vector<Value> operandValues_;
+    std::vector<Type> operandTypes_;
+};
+
+// The parent reads of a kernel (parent.export, parent.alive, parent.age), in instruction
+// order: the order of KernelInputs::parents.
+std::vector<const Inst*> parentReads(const Kernel& kernel);
+inline bool isParentRead(Op op) { return op == Op::ParentExport || op == Op::ParentAlive || op == Op::ParentAge; }
 
 }  // namespace psys::ir

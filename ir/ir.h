@@ -24,12 +24,24 @@
 #include <unordered_map>
 #include <vector>
 
+#include "core/integrators.h"
 #include "ir/ops.h"
 #include "ir/types.h"
 
 namespace psys::ir {
 
 using ValueId = uint32_t;
+
+// Where an instruction came from in the source: a file of Module::files, a line and a
+// column (1-based) and the length of the range on that line. Every instruction is built
+// with one (a pass gives what it builds the location of what it replaces), so a pass can
+// report an error or a warning at the equation it concerns.
+struct Loc {
+    int32_t file = -1;  // -1: unknown
+    uint32_t line = 0, column = 0, length = 0;
+    bool valid() const { return file >= 0; }
+    bool operator==(const Loc&) const = default;
+};
 
 struct Inst {
     Op op = Op::Const;
@@ -40,8 +52,20 @@ struct Inst {
     std::array<float, 4> constant{};  // Const: components (bool: 0 or 1)
     std::vector<uint8_t> lanes;       // Shuffle: component indices
     std::string name;                 // for reading only: the equation it came from
+    Loc loc;                          // not part of its identity: equal instructions merge
 
-    bool sameAs(const Inst& other) const;  // equal but for the name
+    bool sameAs(const Inst& other) const;  // equal but for the name and location
+
+    // An instruction from its parts; built into a kernel it gets the builder's location.
+    static Inst make(Op op, Type type, std::vector<ValueId> operands = {}, int32_t attr = 0, int32_t attr2 = 0) {
+        Inst inst;
+        inst.op = op;
+        inst.type = type;
+        inst.operands = std::move(operands);
+        inst.attr = attr;
+        inst.attr2 = attr2;
+        return inst;
+    }
 };
 
 enum class YieldKind {
@@ -90,8 +114,9 @@ public:
     std::map<std::string, ValueId> equations;
 
     // Adds `inst` unless an equal one exists (hash-consing); returns its value.
-    // Operands of commutative ops are sorted first. Temporal ops are never merged: each
-    // is its own call site.
+    // Operands of commutative ops are sorted first. Temporal ops and random draws are
+    // never merged: each is its own call site. An instruction without a location gets the
+    // builder's (setLoc).
     ValueId add(Inst inst);
     // Appends without merging, for operands not known yet (recursive equations).
     ValueId addUnique(Inst inst);
@@ -108,9 +133,27 @@ public:
     // Rebuilds the hash-consing table after instructions were edited in place.
     void rehash();
 
+    // The location given to instructions built without one (LocScope sets it for a scope).
+    void setLoc(Loc loc) { loc_ = loc; }
+    Loc loc() const { return loc_; }
+
 private:
     std::vector<Inst> insts_;
     std::unordered_map<std::string, ValueId> table_;
+    Loc loc_;
+};
+
+// Builds with `loc` until the end of the scope, then with what was there before.
+class LocScope {
+public:
+    LocScope(Kernel& k, Loc loc) : k_(k), saved_(k.loc()) { k.setLoc(loc); }
+    ~LocScope() { k_.setLoc(saved_); }
+    LocScope(const LocScope&) = delete;
+    LocScope& operator=(const LocScope&) = delete;
+
+private:
+    Kernel& k_;
+    Loc saved_;
 };
 
 // ---------------------------------------------------------------- objects
@@ -149,15 +192,27 @@ struct ParentRead {
     Type type;
 };
 
+using core::Integrator;
+
+// An object's @attributes (the object's own, else the file's, else none).
+struct Attributes {
+    std::optional<Integrator> integrator;  // none: the pipeline's default
+    Loc integratorLoc;
+    float step = 0;                        // @step: the longest update, in seconds; 0: none
+    std::optional<uint64_t> capacity;      // @capacity: most objects alive at once
+    bool operator==(const Attributes&) const = default;
+};
+
 struct Object {
     std::string name;
+    Loc loc;             // its declaration
     std::string parent;  // the enclosing object type; empty at file level
     std::vector<Param> params;
     std::vector<StateSlot> state;
     std::vector<EmitSite> emits;
     std::vector<Export> exports;
     std::vector<ParentRead> parentReads;
-    std::map<std::string, std::string> attributes;  // integrator, step, capacity
+    Attributes attributes;
     std::vector<Kernel> kernels;
 
     const Kernel* kernel(KernelKind kind, int site = -1) const;
@@ -181,6 +236,7 @@ struct Trigger {
 };
 
 struct Module {
+    std::vector<std::string> files;  // the source files locations refer to
     std::vector<Extern> externs;
     std::vector<Object> objects;  // parents before children
     std::vector<Trigger> triggers;

@@ -30,9 +30,10 @@ bool Inst::sameAs(const Inst& other) const {
 }
 
 ValueId Kernel::add(Inst inst) {
+    if (!inst.loc.valid()) inst.loc = loc_;
     if (isCommutative(inst.op) && inst.operands.size() == 2 && inst.operands[0] > inst.operands[1])
         std::swap(inst.operands[0], inst.operands[1]);
-    if (isTemporal(inst.op)) return addUnique(std::move(inst));
+    if (hasOwnSite(inst.op)) return addUnique(std::move(inst));
     std::string key = keyOf(inst);
     if (auto it = table_.find(key); it != table_.end()) {
         if (insts_[it->second].name.empty()) insts_[it->second].name = inst.name;
@@ -45,6 +46,7 @@ ValueId Kernel::add(Inst inst) {
 }
 
 ValueId Kernel::addUnique(Inst inst) {
+    if (!inst.loc.valid()) inst.loc = loc_;
     auto id = static_cast<ValueId>(insts_.size());
     insts_.push_back(std::move(inst));
     return id;
@@ -84,7 +86,7 @@ const Yield* Kernel::findOne(YieldKind kind, int index, int sub) const {
 void Kernel::rehash() {
     table_.clear();
     for (ValueId v = 0; v < insts_.size(); ++v)
-        if (!isTemporal(insts_[v].op)) table_.emplace(keyOf(insts_[v]), v);
+        if (!hasOwnSite(insts_[v].op)) table_.emplace(keyOf(insts_[v]), v);
 }
 
 const Kernel* Object::kernel(KernelKind kind, int site) const {

@@ -33,6 +33,7 @@ namespace {
 
 using namespace ast;
 using detail::irType;
+using detail::Locator;
 using detail::ObjectLowering;
 using detail::Values;
 
@@ -47,6 +48,7 @@ struct CommandLowering {
 
     void run(const std::vector<CommandPtr>& commands, std::vector<ValueId> conditions, ValueId& kill) {
         for (auto& cmd : commands) {
+            LocScope at(k, lowering.locate(cmd->range));
             switch (cmd->kind) {
                 case CommandKind::Point: {
                     k.yields.push_back({YieldKind::Position, 0, 0, lowering.lowerOne(*cmd->args[0])});
@@ -103,8 +105,10 @@ std::array<float, 4> constantValue(const Expr* e, Type t) {
 
 }  // namespace
 
-Module lower(const ast::Program& program) {
+Module lower(const ast::Program& program, const SourceManager& sources) {
     Module m;
+    for (int f = 0; f < sources.count(); ++f) m.files.push_back(sources.file(f).path());
+    Locator locate(sources);
     // Externs first: kernels refer to them by index.
     for (auto& module : program.modules)
         for (auto& d : module->decls)
@@ -125,27 +129,27 @@ Module lower(const ast::Program& program) {
         if (auto it = names.find(o); it != names.end()) return it->second;
         return names[o] = o->parent ? qualified(o->parent) + "." + o->name : o->name;
     };
-    std::vector<std::pair<const ObjectDecl*, std::map<std::string, std::string>>> decls;
-    std::function<void(const ObjectDecl&, std::map<std::string, std::string>)> collect =
-        [&](const ObjectDecl& o, std::map<std::string, std::string> attributes) {
-            for (auto& a : o.attributes)
-                if (!a.args.empty()) {
-                    if (a.args[0]->kind == ExprKind::Name) attributes[a.name] = static_cast<const NameExpr&>(*a.args[0]).name;
-                    else if (auto v = evaluateConstant(*a.args[0])) attributes[a.name] = fmt::format("{}", v->v[0]);
-                }
-            decls.push_back({&o, attributes});
-            for (auto& child : o.children) collect(*child, attributes);
-        };
+    // Attributes: the file's, then each enclosing object's, then the object's own.
+    auto apply = [&](const ast::Attribute& a, Attributes& attributes) {
+        if (a.args.empty()) return;
+        if (a.name == "integrator" && a.args[0]->kind == ExprKind::Name) {
+            attributes.integrator = core::integratorFromName(static_cast<const NameExpr&>(*a.args[0]).name);
+            attributes.integratorLoc = locate(a.args[0]->range);
+        } else if (auto v = evaluateConstant(*a.args[0])) {
+            if (a.name == "step") attributes.step = v->v[0];
+            if (a.name == "capacity") attributes.capacity = static_cast<uint64_t>(v->v[0]);
+        }
+    };
+    std::vector<std::pair<const ObjectDecl*, Attributes>> decls;
+    std::function<void(const ObjectDecl&, Attributes)> collect = [&](const ObjectDecl& o, Attributes attributes) {
+        for (auto& a : o.attributes) apply(a, attributes);
+        decls.push_back({&o, attributes});
+        for (auto& child : o.children) collect(*child, attributes);
+    };
     for (auto& module : program.modules) {
-        std::map<std::string, std::string> fileAttributes;
+        Attributes fileAttributes;
         for (auto& d : module->decls)
-            if (d->kind == DeclKind::Attribute) {
-                auto& a = static_cast<const FileAttributeDecl&>(*d).attribute;
-                if (!a.args.empty() && a.args[0]->kind == ExprKind::Name)
-                    fileAttributes[a.name] = static_cast<const NameExpr&>(*a.args[0]).name;
-                else if (!a.args.empty())
-                    if (auto v = evaluateConstant(*a.args[0])) fileAttributes[a.name] = fmt::format("{}", v->v[0]);
-            }
+            if (d->kind == DeclKind::Attribute) apply(static_cast<const FileAttributeDecl&>(*d).attribute, fileAttributes);
         for (auto& d : module->decls)
             if (d->kind == DeclKind::Object) collect(static_cast<const ObjectDecl&>(*d), fileAttributes);
     }
@@ -153,6 +157,7 @@ Module lower(const ast::Program& program) {
     for (auto& [decl, attributes] : decls) {
         Object o;
         o.name = qualified(decl);
+        o.loc = locate(decl->nameRange);
         o.parent = qualified(decl->parent);
         o.attributes = attributes;
         for (auto& p : decl->params) o.params.push_back({p.name, irType(p.type.type)});
@@ -164,7 +169,7 @@ Module lower(const ast::Program& program) {
         Kernel k;
         k.kind = KernelKind::Behaviour;
         int sites = 0;
-        ObjectLowering lowering(m, k, &o, decl, nullptr, sites);
+        ObjectLowering lowering(m, locate, k, &o, decl, nullptr, sites);
         lowering.lowerEquations();
         ValueId kill = k.boolean(false);
         CommandLowering commands{lowering, k, o.emits, program, qualified};
@@ -184,7 +189,7 @@ Module lower(const ast::Program& program) {
                 for (auto& p : t.params) trigger.params.push_back({p.name, irType(p.type.type)});
                 trigger.kernel.kind = KernelKind::Trigger;
                 int sites = 0;
-                ObjectLowering lowering(m, trigger.kernel, nullptr, nullptr, &t, sites);
+                ObjectLowering lowering(m, locate, trigger.kernel, nullptr, nullptr, &t, sites);
                 ValueId kill = trigger.kernel.boolean(false);
                 CommandLowering commands{lowering, trigger.kernel, trigger.emits, program, qualified};
                 commands.run(t.commands, {}, kill);
@@ -194,7 +199,7 @@ Module lower(const ast::Program& program) {
     m.start.name = "start";
     m.start.kernel.kind = KernelKind::Start;
     int startSites = 0;
-    ObjectLowering startLowering(m, m.start.kernel, nullptr, nullptr, nullptr, startSites);
+    ObjectLowering startLowering(m, locate, m.start.kernel, nullptr, nullptr, nullptr, startSites);
     for (auto& module : program.modules)
         for (auto& d : module->decls)
             if (d->kind == DeclKind::Spawn) {

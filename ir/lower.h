@@ -2,11 +2,13 @@
 #pragma once
 
 #include "frontend/ast.h"
+#include "frontend/source.h"
 #include "ir/ir.h"
 
 namespace psys::ir {
 
-// `program` must have passed the front end without errors.
-Module lower(const ast::Program& program);
+// `program` must have passed the front end without errors; `sources` holds its files
+// (instructions get their locations from it).
+Module lower(const ast::Program& program, const SourceManager& sources);
 
 }  // namespace psys::ir

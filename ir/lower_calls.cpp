@@ -1,7 +1,6 @@
 // Lowering calls: user functions are inlined (each inlined `rand` is a call site of its
 // own), and the library's functions become arithmetic the passes can see through.
-#include <cmath>
-
+#include "core/lanes.h"
 #include "frontend/builtins.h"
 #include "ir/object_lowering.h"
 
@@ -41,29 +40,9 @@ Values ObjectLowering::lowerCall(const CallExpr& c) {
     std::string_view n = fn.name;
     switch (fn.rule) {
         case BuiltinRule::Componentwise:
-            if (n == "sin") return unary(Op::Sin);
-            if (n == "cos") return unary(Op::Cos);
-            if (n == "tan") return unary(Op::Tan);
-            if (n == "asin") return unary(Op::Asin);
-            if (n == "acos") return unary(Op::Acos);
-            if (n == "atan") return unary(Op::Atan);
-            if (n == "exp") return unary(Op::Exp);
-            if (n == "log") return unary(Op::Log);
-            if (n == "sqrt") return unary(Op::Sqrt);
-            if (n == "abs") return unary(Op::Abs);
-            if (n == "sign") return unary(Op::Sign);
-            if (n == "floor") return unary(Op::Floor);
-            if (n == "ceil") return unary(Op::Ceil);
-            if (n == "round") return unary(Op::Round);
-            if (n == "fract") return unary(Op::Fract);
-            if (n == "atan2") return binary(Op::Atan2);
-            if (n == "pow") return binary(Op::Pow);
-            if (n == "mod") return binary(Op::Mod);
-            if (n == "min") return binary(Op::Min);
-            if (n == "max") return binary(Op::Max);
-            if (n == "step") return binary(Op::Step);
-            if (n == "radians") return {k_.op(Op::Mul, t, {b(0), scalarConst(static_cast<float>(M_PI / 180), t)})};
-            if (n == "degrees") return {k_.op(Op::Mul, t, {b(0), scalarConst(static_cast<float>(180 / M_PI), t)})};
+            if (fn.op) return opInfo(*fn.op).arity == 1 ? unary(*fn.op) : binary(*fn.op);
+            if (n == "radians") return {k_.op(Op::Mul, t, {b(0), scalarConst(core::kRadiansPerDegree, t)})};
+            if (n == "degrees") return {k_.op(Op::Mul, t, {b(0), scalarConst(core::kDegreesPerRadian, t)})};
             if (n == "saturate") return {clamp(b(0), scalarConst(0, t), scalarConst(1, t))};
             if (n == "clamp")
                 return {clamp(b(0), a.size() > 1 ? b(1) : scalarConst(0, t), a.size() > 2 ? b(2) : scalarConst(1, t))};

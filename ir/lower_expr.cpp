@@ -98,6 +98,7 @@ ValueId ObjectLowering::parentRead(const MemberExpr& m) {
 }
 
 Values ObjectLowering::lower(const Expr& e) {
+    LocScope at(k_, locate_(e.range));
     switch (e.kind) {
         case ExprKind::Number: return {k_.scalar(static_cast<float>(static_cast<const NumberExpr&>(e).value))};
         case ExprKind::Bool: return {k_.boolean(static_cast<const BoolExpr&>(e).value)};

@@ -9,11 +9,28 @@
 #include <vector>
 
 #include "frontend/ast.h"
+#include "frontend/source.h"
 #include "ir/ir.h"
 
 namespace psys::ir::detail {
 
 using namespace ast;
+
+// Source ranges as IR locations: file, line, column and the length on that line.
+class Locator {
+public:
+    explicit Locator(const SourceManager& sources) : sources_(sources) {}
+    Loc operator()(SourceRange r) const {
+        if (!r.valid() || r.file >= sources_.count()) return {};
+        const SourceFile& f = sources_.file(r.file);
+        LineColumn start = f.lineColumn(r.begin), end = f.lineColumn(r.end);
+        uint32_t length = end.line == start.line && r.end > r.begin ? r.end - r.begin : 1;
+        return {r.file, start.line, start.column, length};
+    }
+
+private:
+    const SourceManager& sources_;
+};
 
 inline Type irType(const psys::Type& t) {
     if (t.isBool()) return Type::boolean();
@@ -31,17 +48,23 @@ struct FnFrame {
 
 class ObjectLowering {
 public:
-    ObjectLowering(const Module& module, Kernel& kernel, Object* object, const ObjectDecl* decl,
+    ObjectLowering(const Module& module, const Locator& locate, Kernel& kernel, Object* object, const ObjectDecl* decl,
                    const TriggerDecl* trigger, int& siteCounter)
-        : module_(module), k_(kernel), object_(object), decl_(decl), trigger_(trigger), site_(siteCounter) {}
+        : module_(module), locate_(locate), k_(kernel), object_(object), decl_(decl), trigger_(trigger),
+          site_(siteCounter) {}
+
+    Loc locate(SourceRange r) const { return locate_(r); }
 
     // The object's equations, in evaluation order.
     void lowerEquations() {
-        for (size_t i = 0; i < decl_->params.size(); ++i)
+        for (size_t i = 0; i < decl_->params.size(); ++i) {
+            LocScope at(k_, locate_(decl_->params[i].nameRange));
             k_.equations[decl_->params[i].name] = input(Op::Param, irType(decl_->params[i].type.type), static_cast<int>(i));
+        }
         std::vector<const Equation*> order = evaluationOrder();
         for (const Equation* eq : order) {
             current_ = eq;
+            LocScope at(k_, locate_(eq->range));
             Values v = lower(*eq->value);
             for (size_t i = 0; i < eq->names.size() && i < v.size(); ++i) {
                 name(v[i], eq->names[i]);
@@ -85,7 +108,7 @@ public:
 private:
     void name(ValueId v, const std::string& n) {
         Inst& inst = k_.mutableAt(v);
-        if (inst.name.empty() && !isInput(inst.op)) inst.name = n;
+        if (inst.name.empty() && !isLeaf(inst.op)) inst.name = n;
     }
 
     std::vector<const Equation*> evaluationOrder();
@@ -139,6 +162,7 @@ public:
 private:
 
     const Module& module_;
+    const Locator& locate_;
     Kernel& k_;
     Object* object_;
     const ObjectDecl* decl_;

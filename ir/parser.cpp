@@ -164,7 +164,7 @@ private:
             if (w.empty()) continue;
             if (w[0] == "end") return o;
             if (w[0] == "parent") o.parent = w.at(1);
-            else if (w[0] == "attribute") o.attributes[w.at(1)] = w.at(2);
+            else if (w[0] == "attribute") attribute(o.attributes, w);
             else if (w[0] == "state") {
                 if (w.size() != 4 || w[1].back() != ':') throw ParseError("expected `state name: type zero|next`");
                 StateInit init = w[3] == "zero" ? StateInit::Zero : w[3] == "next" ? StateInit::Next
@@ -185,6 +185,20 @@ private:
             }
         }
         throw ParseError("object `" + o.name + "` has no `end`");
+    }
+
+    static void attribute(Attributes& a, const std::vector<std::string>& w) {
+        if (w.size() != 3) throw ParseError("expected `attribute name value`");
+        if (w[1] == "integrator") {
+            a.integrator = core::integratorFromName(w[2]);
+            if (!a.integrator) throw ParseError("unknown integrator `" + w[2] + "`");
+        } else if (w[1] == "step") {
+            a.step = number(w[2]);
+        } else if (w[1] == "capacity") {
+            a.capacity = static_cast<uint64_t>(integer(w[2]));
+        } else {
+            throw ParseError("unknown attribute `" + w[1] + "`");
+        }
     }
 
     static EmitSite emitSite(const std::vector<std::string>& w) {
@@ -255,6 +269,12 @@ private:
             inst.name = trimmed(line.substr(semi + 1));
             line = line.substr(0, semi);
         }
+        if (auto at = line.find("loc("); at != std::string::npos) {
+            auto close = line.find(')', at);
+            if (close == std::string::npos) throw ParseError("expected `)` after a location");
+            inst.loc = location(line.substr(at + 4, close - at - 4));
+            line.erase(at, close - at + 1);
+        }
         if (auto open = line.find('<'); open != std::string::npos) {
             auto close = line.find('>', open);
             if (close == std::string::npos) throw ParseError("expected `>`");
@@ -286,6 +306,23 @@ private:
         k.addUnique(std::move(inst));
     }
 
+    // FILE:LINE:COLUMN; files are numbered in the order they first appear.
+    Loc location(const std::string& text) {
+        auto second = text.rfind(':');
+        auto first = second == std::string::npos || second == 0 ? std::string::npos : text.rfind(':', second - 1);
+        if (first == std::string::npos) throw ParseError("expected a location `file:line:column`");
+        std::string file = text.substr(0, first);
+        size_t index = 0;
+        while (index < files_.size() && files_[index] != file) ++index;
+        if (index == files_.size()) files_.push_back(file);
+        return {static_cast<int32_t>(index), static_cast<uint32_t>(integer(text.substr(first + 1, second - first - 1))),
+                static_cast<uint32_t>(integer(text.substr(second + 1))), 1};
+    }
+
+public:
+    std::vector<std::string> files_;
+
+private:
     std::vector<std::string> lines_;
     size_t pos_ = 0;
 };
@@ -295,7 +332,9 @@ private:
 std::optional<Module> parseModule(const std::string& text, std::string& error) {
     Parser parser(text);
     try {
-        return parser.run();
+        Module m = parser.run();
+        m.files = parser.files_;
+        return m;
     } catch (const std::exception& e) {
         error = fmt::format("line {}: {}", parser.lineNumber(), e.what());
         return std::nullopt;

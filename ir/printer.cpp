@@ -48,7 +48,7 @@ std::string yieldKindName(YieldKind kind) {
     return "?";
 }
 
-std::string print(const Kernel& kernel, int indent) {
+std::string print(const Kernel& kernel, int indent, PrintOptions options) {
     std::string pad(static_cast<size_t>(indent), ' ');
     std::string out = pad + "kernel " + kernelName(kernel.kind);
     if (kernel.kind == KernelKind::Spawn) out += fmt::format(" #{}", kernel.site);
@@ -61,13 +61,19 @@ std::string print(const Kernel& kernel, int indent) {
         bool showAttr = inst.attr != 0 || inst.op == Op::Param || inst.op == Op::StateRead || inst.op == Op::Extern ||
                         inst.op == Op::TriggerParam || inst.op == Op::ParentRead || inst.op == Op::ParentExport ||
                         inst.op == Op::Extract || inst.op == Op::DrawIndex || inst.op == Op::Uniform ||
-                        isTemporal(inst.op);
+                        hasOwnSite(inst.op);
         if (showAttr) line += fmt::format(" #{}", inst.attr);
         if (inst.attr2 != 0) line += fmt::format(" ^{}", inst.attr2);
         if (!inst.lanes.empty()) {
             line += " <";
             for (size_t i = 0; i < inst.lanes.size(); ++i) line += fmt::format("{}{}", i ? " " : "", inst.lanes[i]);
             line += ">";
+        }
+        if (options.locations && inst.loc.valid()) {
+            auto file = static_cast<size_t>(inst.loc.file);
+            std::string path = options.files && file < options.files->size() ? (*options.files)[file]
+                                                                             : fmt::format("#{}", file);
+            line += fmt::format("  loc({}:{}:{})", path, inst.loc.line, inst.loc.column);
         }
         if (!inst.name.empty()) line += "  ; " + inst.name;
         out += line + "\n";
@@ -85,31 +91,35 @@ std::string print(const Kernel& kernel, int indent) {
     return out + pad + "end\n";
 }
 
-std::string print(const Object& o) {
+std::string print(const Object& o, PrintOptions options) {
     std::string out = fmt::format("object {}({})\n", o.name, params(o.params));
     if (!o.parent.empty()) out += "  parent " + o.parent + "\n";
-    for (auto& [key, value] : o.attributes) out += fmt::format("  attribute {} {}\n", key, value);
+    const Attributes& a = o.attributes;
+    if (a.integrator) out += fmt::format("  attribute integrator {}\n", core::integratorName(*a.integrator));
+    if (a.step > 0) out += fmt::format("  attribute step {}\n", number(a.step));
+    if (a.capacity) out += fmt::format("  attribute capacity {}\n", *a.capacity);
     for (auto& s : o.state)
         out += fmt::format("  state {}: {} {}\n", s.name, s.type.str(), s.init == StateInit::Zero ? "zero" : "next");
     for (auto& e : o.emits) out += fmt::format("  emit {} {}\n", e.target, e.rate ? "rate" : "burst");
     for (auto& e : o.exports) out += fmt::format("  export {}: {}\n", e.name, e.type.str());
     for (auto& r : o.parentReads) out += fmt::format("  read {}: {} ^{}\n", r.member, r.type.str(), r.depth);
-    for (auto& k : o.kernels) out += print(k, 2);
+    for (auto& k : o.kernels) out += print(k, 2, options);
     return out + "end\n";
 }
 
-std::string print(const Module& m) {
+std::string print(const Module& m, PrintOptions options) {
+    if (!options.files) options.files = &m.files;
     std::string out;
     for (auto& e : m.externs) {
         out += fmt::format("extern {}: {} = {}", e.name, e.type.str(), values(e.defaultValue, e.type));
         if (e.low) out += fmt::format(" range {} to {}", values(*e.low, e.type), values(*e.high, e.type));
         out += "\n";
     }
-    for (auto& o : m.objects) out += print(o);
+    for (auto& o : m.objects) out += print(o, options);
     auto trigger = [&](const Trigger& t, const std::string& head) {
         out += head + "\n";
         for (auto& e : t.emits) out += fmt::format("  emit {} {}\n", e.target, e.rate ? "rate" : "burst");
-        out += print(t.kernel, 2);
+        out += print(t.kernel, 2, options);
         out += "end\n";
     };
     for (auto& t : m.triggers) trigger(t, fmt::format("trigger {}({})", t.name, params(t.params)));

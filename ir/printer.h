@@ -15,7 +15,8 @@
 //   end
 //
 // `#n` is an instruction's index attribute, `^n` its parent depth, `<a b>` shuffle lanes;
-// a `; name` comment keeps the equation a value came from.
+// a `; name` comment keeps the equation a value came from. With `locations`, each
+// instruction says where it came from: `loc(fire.psys:4:25)` (file, line, column).
 #pragma once
 
 #include <string>
@@ -24,9 +25,14 @@
 
 namespace psys::ir {
 
-std::string print(const Module& module);
-std::string print(const Object& object);
-std::string print(const Kernel& kernel, int indent = 0);
+struct PrintOptions {
+    bool locations = false;
+    const std::vector<std::string>* files = nullptr;  // Module::files, for locations
+};
+
+std::string print(const Module& module, PrintOptions options = {});
+std::string print(const Object& object, PrintOptions options = {});
+std::string print(const Kernel& kernel, int indent = 0, PrintOptions options = {});
 std::string yieldKindName(YieldKind kind);
 
 }  // namespace psys::ir

@@ -29,7 +29,7 @@ private:
         const Inst& i = k.at(v);
         const OpInfo& info = opInfo(i.op);
         bool keyedRandom = (i.op == Op::Rand || i.op == Op::NRand) && (i.operands.size() == 2 || unkeyedDrawsAllowed_);
-        if (isTemporal(i.op) && !behaviour && !keyedRandom) fail(v, fmt::format("`{}` outside a behaviour kernel", info.name));
+        if ((isTemporal(i.op) || (isRandom(i.op) && !keyedRandom)) && !behaviour) fail(v, fmt::format("`{}` outside a behaviour kernel", info.name));
         if (info.arity >= 0 && static_cast<int>(i.operands.size()) != info.arity)
             return fail(v, fmt::format("`{}` takes {} operands, has {}", info.name, info.arity, i.operands.size()));
         for (size_t n = 0; n < i.operands.size(); ++n) {

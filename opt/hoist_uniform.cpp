@@ -41,7 +41,7 @@ void hoist(Object& object, KernelKind kind) {
     std::vector<int> index(k->size(), -1);
     std::function<void(ValueId)> take = [&](ValueId v) {
         const Inst& i = k->at(v);
-        if (isInput(i.op) || i.op == Op::Const || index[v] >= 0) return;
+        if (isLeaf(i.op) || index[v] >= 0) return;
         if (freeLaneOp(i.op)) {
             for (ValueId o : i.operands) take(o);
             return;
@@ -68,7 +68,7 @@ void hoist(Object& object, KernelKind kind) {
     Rewriter rw(*k);
     Kernel rest = rw.run([&](Rewriter& r, ValueId old, const Inst& inst, const std::vector<ValueId>&) -> std::optional<ValueId> {
         if (index[old] < 0) return std::nullopt;
-        return r.emit({Op::Uniform, inst.type, {}, index[old], 0, {}, {}, ""});
+        return r.emit(Inst::make(Op::Uniform, inst.type, {}, index[old]));
     });
     Rewriter clean(rest);  // the inputs only the hoisted values read are now unused
     *k = clean.run(nullptr);

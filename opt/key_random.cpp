@@ -22,8 +22,8 @@ void keyKernel(Kernel& k) {
     Rewriter rewriter(k);
     k = rewriter.run([](Rewriter& rw, ValueId, const Inst& inst, const std::vector<ValueId>&) -> std::optional<ValueId> {
         if ((inst.op != Op::Rand && inst.op != Op::NRand) || !inst.operands.empty()) return std::nullopt;
-        Inst id{Op::ObjectId, Type::u32(), {}, 0, 0, {}, {}, ""};
-        Inst draw{Op::DrawIndex, Type::u32(), {}, inst.attr2 == 1 ? 1 : 0, 0, {}, {}, ""};
+        Inst id = Inst::make(Op::ObjectId, Type::u32(), {});
+        Inst draw = Inst::make(Op::DrawIndex, Type::u32(), {}, inst.attr2 == 1 ? 1 : 0);
         Inst keyed = inst;
         keyed.operands = {rw.emit(id), rw.emit(draw)};
         keyed.attr2 = 0;

@@ -48,9 +48,11 @@ void lowerTemporal(Module& module, const PassOptions& options, PassErrors& error
     for (Object& object : module.objects) {
         Kernel* behaviour = object.kernel(KernelKind::Behaviour);
         if (!behaviour) continue;
-        if (auto it = object.attributes.find("integrator"); it != object.attributes.end() && it->second != "euler") {
-            errors.push_back(fmt::format("object {}: @integrator({}) is not implemented yet; euler is", object.name,
-                                         it->second));
+        Integrator method = object.attributes.integrator.value_or(options.integrator);
+        if (method != Integrator::Euler) {
+            Loc at = object.attributes.integrator ? object.attributes.integratorLoc : object.loc;
+            errors.error(at, fmt::format("object {}: @integrator({}) is not implemented yet; euler is", object.name,
+                                         core::integratorName(method)));
             continue;
         }
         std::vector<std::pair<int, ValueId>> nextOld;  // (slot, old value its next is)
@@ -74,12 +76,12 @@ void lowerTemporal(Module& module, const PassOptions& options, PassErrors& error
                     // Relaxed: the Euler sum of something fixed at creation is c·age, exact
                     // in real arithmetic; no state needed (docs/optimizer.md).
                     if (options.relaxed && creationInvariant(k, ops[0]))
-                        return rw.emit({Op::Mul, t, {ops[0], broadcast(k, input(k, Op::Age, Type::f32()), t)}, 0, 0, {}, {}, ""});
+                        return rw.emit(Inst::make(Op::Mul, t, {ops[0], broadcast(k, input(k, Op::Age, Type::f32()), t)}));
                     int slot = addSlot("integrate", inst, StateInit::Zero);
                     ValueId a = input(k, Op::StateRead, t, slot);
                     ValueId dt = broadcast(k, input(k, Op::Dt, Type::f32()), t);
                     ValueId step = k.op(Op::Add, t, {a, k.op(Op::Mul, t, {ops[0], dt})});
-                    ValueId value = rw.emit({Op::Select, t, {first, zero, step}, 0, 0, {}, {}, ""});
+                    ValueId value = rw.emit(Inst::make(Op::Select, t, {first, zero, step}));
                     nextNew.push_back({slot, value});
                     return value;
                 }
@@ -91,25 +93,25 @@ void lowerTemporal(Module& module, const PassOptions& options, PassErrors& error
                     ValueId slope = k.op(Op::Div, t, {k.op(Op::Sub, t, {ops[0], p}), broadcast(k, dtScalar, t)});
                     ValueId ready = k.op(Op::And, Type::boolean(), {k.op(Op::Not, Type::boolean(), {first}), moving});
                     nextNew.push_back({slot, ops[0]});
-                    return rw.emit({Op::Select, t, {ready, slope, zero}, 0, 0, {}, {}, ""});
+                    return rw.emit(Inst::make(Op::Select, t, {ready, slope, zero}));
                 }
                 case Op::Prev: {
                     int slot = addSlot("prev", inst, StateInit::Next);
                     ValueId p = input(k, Op::StateRead, t, slot);
                     nextOld.push_back({slot, inst.operands[0]});  // may be defined later
-                    return rw.emit({Op::Select, t, {first, zero, p}, 0, 0, {}, {}, ""});
+                    return rw.emit(Inst::make(Op::Select, t, {first, zero, p}));
                 }
                 case Op::Snapshot: {
                     int slot = addSlot("snapshot", inst, StateInit::Next);
                     ValueId s = input(k, Op::StateRead, t, slot);
-                    ValueId value = rw.emit({Op::Select, t, {first, ops[0], s}, 0, 0, {}, {}, ""});
+                    ValueId value = rw.emit(Inst::make(Op::Select, t, {first, ops[0], s}));
                     nextNew.push_back({slot, value});
                     return value;
                 }
                 case Op::FollowedBy:
                     // The next side may refer forward only through a `prev`, which reads
                     // state: by now both operands exist.
-                    return rw.emit({Op::Select, t, {first, ops[0], ops[1]}, 0, 0, {}, {}, ""});
+                    return rw.emit(Inst::make(Op::Select, t, {first, ops[0], ops[1]}));
                 default: return std::nullopt;
             }
         });

@@ -34,21 +34,44 @@
 #include <vector>
 
 #include "ir/ir.h"
+#include "ir/printer.h"
 
 namespace psys::opt {
 
-enum class Integrator { Euler };
-
 struct PassOptions {
-    Integrator integrator = Integrator::Euler;
+    // The method for objects without @integrator.
+    ir::Integrator integrator = ir::Integrator::Euler;
     // Rewrites that may change the last bits of a result (docs/optimizer.md): x+0 → x,
     // x/c → x·(1/c), sums and products put in one canonical order so they share parts,
     // and integrals of what is fixed at creation in closed form (c·age).
     bool relaxed = false;
 };
 
-// Errors a pass reports about the program (not about the compiler).
-using PassErrors = std::vector<std::string>;
+// What a pass reports about the program, at the instruction (or object) it concerns.
+struct PassMessage {
+    ir::Loc loc;
+    std::string text;
+    bool warning = false;
+};
+
+class PassErrors {
+public:
+    void error(ir::Loc loc, std::string text) { all_.push_back({loc, std::move(text), false}); }
+    void warning(ir::Loc loc, std::string text) { all_.push_back({loc, std::move(text), true}); }
+    bool hasErrors() const {
+        for (const PassMessage& m : all_)
+            if (!m.warning) return true;
+        return false;
+    }
+    bool empty() const { return all_.empty(); }
+    size_t size() const { return all_.size(); }
+    const PassMessage& operator[](size_t i) const { return all_[i]; }
+    auto begin() const { return all_.begin(); }
+    auto end() const { return all_.end(); }
+
+private:
+    std::vector<PassMessage> all_;
+};
 
 void resolveCycles(ir::Module& module, PassErrors& errors);
 void scoping(ir::Module& module, PassErrors& errors);
@@ -74,6 +97,7 @@ struct PipelineOptions {
     bool printAfterAll = false;
     bool verifyEach = false;           // run the verifier after every pass
     std::ostream* log = nullptr;       // where --print-after goes
+    ir::PrintOptions print;            // how it is printed there (with locations or not)
 };
 
 // Runs every pass in order. Returns false (with `errors`) when the program is wrong or a

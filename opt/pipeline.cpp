@@ -34,19 +34,19 @@ bool runPipeline(ir::Module& module, const PipelineOptions& options, PassErrors&
     const bool verifyEach = options.verifyEach;
 #endif
     auto after = [&](const char* pass) {
-        if (!errors.empty()) return false;
+        if (errors.hasErrors()) return false;
         if (options.log && (options.printAfterAll || options.printAfter.count(pass)))
-            *options.log << "; IR after " << pass << "\n" << ir::print(module);
+            *options.log << "; IR after " << pass << "\n" << ir::print(module, options.print);
         if (verifyEach) {
             for (const std::string& problem : ir::verify(module))
-                errors.push_back(fmt::format("internal error: the IR after {} is malformed: {}", pass, problem));
+                errors.error({}, fmt::format("internal error: the IR after {} is malformed: {}", pass, problem));
         }
-        return errors.empty();
+        return !errors.hasErrors();
     };
     if (verifyEach)
         for (const std::string& problem : ir::verify(module))
-            errors.push_back("internal error: the lowered IR is malformed: " + problem);
-    if (!errors.empty()) return false;
+            errors.error({}, "internal error: the lowered IR is malformed: " + problem);
+    if (errors.hasErrors()) return false;
 
     resolveCycles(module, errors);
     if (!after("resolve-cycles")) return false;

@@ -45,7 +45,7 @@ void reassociateKernel(Kernel& kernel) {
         for (ValueId l : leaves) mapped.push_back(r.map(l));
         std::sort(mapped.begin(), mapped.end());
         ValueId acc = mapped[0];
-        for (size_t i = 1; i < mapped.size(); ++i) acc = r.emit({inst.op, inst.type, {acc, mapped[i]}, 0, 0, {}, {}, ""});
+        for (size_t i = 1; i < mapped.size(); ++i) acc = r.emit(Inst::make(inst.op, inst.type, {acc, mapped[i]}));
         return acc;
     });
     result.kind = kernel.kind;

@@ -57,7 +57,7 @@ void resolveCycles(Module& module, PassErrors& errors) {
                     const std::string& n = k->at(p).name;
                     path += (path.empty() ? "" : " → ") + (n.empty() ? fmt::format("%{}", p) : n);
                 }
-                errors.push_back(fmt::format("object {}: algebraic loop: {} → {}", object.name,
+                errors.error(k->at(v).loc, fmt::format("object {}: algebraic loop: {} → {}", object.name,
                                              k->at(v).name.empty() ? fmt::format("%{}", v) : k->at(v).name, path));
                 continue;
             }

@@ -24,7 +24,7 @@ ValueId zeroOf(Kernel& k, Type t) {
 bool creationInvariant(const Kernel& k, ValueId v) {
     const Inst& i = k.at(v);
     if (i.op == Op::Param || i.op == Op::Const) return true;
-    if (!(i.op >= Op::Add && i.op <= Op::Dot)) return false;
+    if (!isPure(i.op)) return false;
     for (ValueId o : i.operands)
         if (!creationInvariant(k, o)) return false;
     return true;
@@ -50,7 +50,7 @@ ValueId Rewriter::emit(Inst inst) {
             break;
         default: break;
     }
-    return isTemporal(inst.op) ? to_.addUnique(std::move(inst)) : to_.add(std::move(inst));
+    return hasOwnSite(inst.op) ? to_.addUnique(std::move(inst)) : to_.add(std::move(inst));
 }
 
 Kernel Rewriter::run(const Hook& hook) {
@@ -91,6 +91,8 @@ Kernel Rewriter::run(const Hook& hook, const std::vector<ValueId>& roots) {
                 pending.push_back(i);
             }
         }
+        // What the hook builds stands for `inst`: it gets its location.
+        LocScope at(to_, inst.loc);
         std::optional<ValueId> replaced = hook ? hook(*this, v, inst, operands) : std::nullopt;
         ValueId nv;
         if (replaced) {
@@ -104,7 +106,7 @@ Kernel Rewriter::run(const Hook& hook, const std::vector<ValueId>& roots) {
                 forwardOld.push_back({nv, inst.operands[i]});
             }
         }
-        if (!inst.name.empty() && to_.at(nv).name.empty() && !isInput(to_.at(nv).op)) to_.mutableAt(nv).name = inst.name;
+        if (!inst.name.empty() && to_.at(nv).name.empty() && !isLeaf(to_.at(nv).op)) to_.mutableAt(nv).name = inst.name;
         mapped_[v] = nv;
     }
     for (size_t i = 0; i < forward.size(); ++i)

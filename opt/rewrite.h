@@ -5,7 +5,7 @@
 // has become equal). For each live instruction a pass's hook may build a replacement;
 // otherwise the instruction is copied with its operands mapped. Copies fold the trivial
 // cases that specialisation creates: `select` on a constant, `and`/`or`/`not` of
-// constants.
+// constants. What a hook builds gets the location of the instruction it replaces.
 #pragma once
 
 #include <functional>

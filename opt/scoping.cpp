@@ -17,12 +17,19 @@ void scoping(Module& module, PassErrors& errors) {
         if (child.parentReads.empty()) continue;
         Kernel* k = child.kernel(KernelKind::Behaviour);
         std::vector<std::pair<int, int>> resolved;  // per read: (export index, depth)
-        for (const ParentRead& read : child.parentReads) {
+        // Where read `i` is written (its first parent.read instruction).
+        auto readLoc = [&](size_t i) {
+            for (const Inst& inst : k->insts())
+                if (inst.op == Op::ParentRead && inst.attr == static_cast<int>(i)) return inst.loc;
+            return child.loc;
+        };
+        for (size_t i = 0; i < child.parentReads.size(); ++i) {
+            const ParentRead& read = child.parentReads[i];
             int ancestorIndex = module.objectIndex(child.parent);
             for (int d = 1; d < read.depth && ancestorIndex >= 0; ++d)
                 ancestorIndex = module.objectIndex(module.objects[static_cast<size_t>(ancestorIndex)].parent);
             if (ancestorIndex < 0) {
-                errors.push_back(fmt::format("object {}: no ancestor {} levels up", child.name, read.depth));
+                errors.error(readLoc(i), fmt::format("object {}: no ancestor {} levels up", child.name, read.depth));
                 resolved.push_back({0, read.depth});
                 continue;
             }
@@ -30,7 +37,7 @@ void scoping(Module& module, PassErrors& errors) {
             Kernel* ak = ancestor.kernel(KernelKind::Behaviour);
             bool found = ak && ak->equations.count(read.member);
             if (!found) {
-                errors.push_back(fmt::format("object {}: `{}` has no equation `{}`", child.name, ancestor.name, read.member));
+                errors.error(readLoc(i), fmt::format("object {}: `{}` has no equation `{}`", child.name, ancestor.name, read.member));
                 resolved.push_back({0, read.depth});
                 continue;
             }

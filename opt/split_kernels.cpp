@@ -107,8 +107,7 @@ private:
     }
 
     ValueId read(Kernel& k, int slot) {
-        Inst inst{Op::StateRead, object_.state[static_cast<size_t>(slot)].type, {}, slot, 0, {}, {}, ""};
-        return k.add(std::move(inst));
+        return k.add(Inst::make(Op::StateRead, object_.state[static_cast<size_t>(slot)].type, {}, slot));
     }
 
     int carry(ValueId v) {

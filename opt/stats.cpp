@@ -10,7 +10,7 @@ using namespace ir;
 namespace {
 
 size_t opsOf(const Kernel& kernel, const Inst& i) {
-    if (isInput(i.op)) return 0;
+    if (isLeaf(i.op)) return 0;
     switch (i.op) {
         case Op::Splat: case Op::Compose: case Op::Extract: case Op::Shuffle: return 0;
         case Op::Dot: return 2u * kernel.at(i.operands[0]).type.width - 1;

@@ -22,12 +22,9 @@ using detail::seconds;
 System::System(ir::Module module, Backend& backend, SystemOptions options)
     : module_(std::move(module)), backend_(backend), options_(options) {
     for (const ir::Object& o : module_.objects) {
-        size_t capacity = options_.capacity;
-        if (auto it = o.attributes.find("capacity"); it != o.attributes.end())
-            capacity = static_cast<size_t>(std::strtod(it->second.c_str(), nullptr));
+        size_t capacity = o.attributes.capacity ? static_cast<size_t>(*o.attributes.capacity) : options_.capacity;
         pools_.emplace_back(o, capacity);
-        auto step = o.attributes.find("step");
-        stepLimit_.push_back(step == o.attributes.end() ? 0 : std::strtod(step->second.c_str(), nullptr));
+        stepLimit_.push_back(o.attributes.step);
         parentType_.push_back(o.parent.empty() ? -1 : module_.objectIndex(o.parent));
         typeStats_.push_back({o.name, 0, 0, 0, 0, 0});
     }

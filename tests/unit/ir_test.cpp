@@ -55,18 +55,21 @@ TEST_CASE("every sample's IR prints, parses back and prints the same, before and
         ++count;
         auto c = test::check(test::readFile(entry.path().string()), entry.path().string());
         REQUIRE_MESSAGE(c.ok(), c.output);
-        Module m = lower(*c.program);
+        Module m = lower(*c.program, *c.sources);
         INFO(entry.path().filename().string());
         std::string problems;
         for (auto& e : verify(m)) problems += e + "\n";
         CHECK_MESSAGE(problems.empty(), problems);
         std::string text = print(m);
         CHECK(print(parseOrFail(text)) == text);
+        // With locations too: every instruction has one, and they read back.
+        std::string located = print(m, {.locations = true});
+        CHECK(print(parseOrFail(located), {.locations = true}) == located);
         opt::PassErrors errors;
         opt::PipelineOptions options;
         options.verifyEach = true;
         bool ok = opt::runPipeline(m, options, errors);
-        for (auto& e : errors) problems += e + "\n";
+        for (auto& e : errors) problems += e.text + "\n";
         REQUIRE_MESSAGE(ok, problems);
         text = print(m);
         Module back = parseOrFail(text);

@@ -24,7 +24,7 @@ std::string after(const std::string& text, void (*pass)(Module&, opt::PassErrors
     opt::PassErrors errors;
     pass(m, errors);
     std::string all;
-    for (auto& e : errors) all += "error: " + e + "\n";
+    for (auto& e : errors) all += "error: " + e.text + "\n";
     for (auto& e : verify(m)) all += "malformed: " + e + "\n";
     return all + print(m);
 }

@@ -15,7 +15,6 @@
 
 #include "frontend/frontend.h"
 #include "frontend/loader.h"
-#include "ir/lower.h"
 #include "ir/printer.h"
 #include "opt/passes.h"
 #include "opt/stats.h"
@@ -117,6 +116,8 @@ int main(int argc, char** argv) {
     app.add_option("--print-after", printAfter, "With --emit=ir: print the IR after this pass (repeatable)")
         ->type_name("PASS")->allow_extra_args(false);
     app.add_flag("--print-after-all", printAfterAll, "With --emit=ir: print the IR after every pass");
+    bool locations = false;
+    app.add_flag("--locations", locations, "With --emit=ir: say where each instruction came from (file:line:column)");
     bool relaxedMath = false, noOptimize = false;
     app.add_flag("--relaxed-math", relaxedMath,
                  "Allow rewrites that may change the last bits of a result (docs/optimizer.md)");
@@ -186,21 +187,14 @@ int main(int argc, char** argv) {
             std::cerr << "psysc: --emit=" << emit << " takes exactly one FILE\n";
             return 2;
         }
-        psys::SourceManager sources;
-        bool failed = false;
-        auto program = checkOne(emitFiles[0], sources, colour, false, &failed);
-        if (!program) return 1;
         if (emit == "ast") {
+            psys::SourceManager sources;
+            bool failed = false;
+            auto program = checkOne(emitFiles[0], sources, colour, false, &failed);
+            if (!program) return 1;
             std::cout << psys::printAst(*program, sources);
             return 0;
         }
-        psys::ir::Module module = psys::ir::lower(*program);
-        psys::opt::PipelineOptions options;
-        options.optimize = !noOptimize;
-        options.pass.relaxed = relaxedMath;
-        options.printAfter = {printAfter.begin(), printAfter.end()};
-        options.printAfterAll = printAfterAll;
-        options.log = &std::cout;
         for (const std::string& pass : printAfter) {
             bool known = false;
             for (auto& info : psys::opt::passCatalogue()) known |= pass == info.name;
@@ -210,13 +204,19 @@ int main(int argc, char** argv) {
                 return 2;
             }
         }
-        if (printAfterAll || !printAfter.empty()) std::cout << "; IR after lowering\n" << psys::ir::print(module);
-        psys::opt::PassErrors errors;
-        if (!psys::opt::runPipeline(module, options, errors)) {
-            for (const std::string& e : errors) std::cerr << "psysc: error: " << e << "\n";
-            return 1;
-        }
-        if (!printAfterAll && printAfter.empty()) std::cout << psys::ir::print(module);
+        psys::SourceManager sources;
+        psys::DiagnosticEngine diags(sources);
+        psys::CompileOptions options;
+        options.pipeline.optimize = !noOptimize;
+        options.pipeline.pass.relaxed = relaxedMath;
+        options.pipeline.printAfter = {printAfter.begin(), printAfter.end()};
+        options.pipeline.printAfterAll = printAfterAll;
+        options.pipeline.log = &std::cout;
+        options.pipeline.print.locations = locations;
+        auto module = psys::compileFile(emitFiles[0], sources, diags, options);
+        diags.print(std::cerr, colour);
+        if (!module) return 1;
+        if (!printAfterAll && printAfter.empty()) std::cout << psys::ir::print(*module, options.pipeline.print);
         return 0;
     }
     std::cerr << app.help();

@@ -1,0 +1,77 @@
+// The counter-based random numbers every backend shares, written once.
+//
+// A draw is a pure function of (seed, object id, call site, draw index, component): no
+// generator state, so the interpreter, the JIT on any number of threads and the GPU draw
+// the same numbers. The mixing function is the PCG-based integer hash of Jarzynski and
+// Olano ("Hash Functions for GPU Rendering", 2020): 32-bit integer arithmetic only, so
+// GLSL computes it exactly as C++ does.
+//
+// The definition is generic over an *algebra*: a type that provides the operations the
+// hash is made of on its own kind of values. The host instantiates it with plain integers
+// (HostAlgebra, below; rt/rng.h), the LLVM backend with an IR builder, a GLSL emitter
+// with text. So a backend does not restate the hash; it says how to add, multiply, shift
+// and convert, and emits the hash from this definition.
+//
+// An algebra A provides:
+//   using Int   (32-bit unsigned), using Float (32-bit float)
+//   Int constant(uint32_t); Float floatConstant(float);
+//   Int add(Int, Int), mul(Int, Int), bitXor(Int, Int), shiftRight(Int, Int)  (mod 2^32)
+//   Float toFloat(Int)   (unsigned → float, exact below 2^24)
+//   Float fmul(Float, Float), fsub(Float, Float)
+#pragma once
+
+#include <cstdint>
+
+#include "core/ops.h"
+
+namespace psys::core {
+
+template <class A>
+typename A::Int pcgHash(A& a, typename A::Int v) {
+    auto state = a.add(a.mul(v, a.constant(747796405u)), a.constant(2891336453u));
+    auto shift = a.add(a.shiftRight(state, a.constant(28u)), a.constant(4u));
+    auto word = a.mul(a.bitXor(a.shiftRight(state, shift), state), a.constant(277803737u));
+    return a.bitXor(a.shiftRight(word, a.constant(22u)), word);
+}
+
+// The bits of one component of one draw.
+template <class A>
+typename A::Int drawBits(A& a, typename A::Int seed, typename A::Int object, uint32_t site, typename A::Int draw,
+                         uint32_t component) {
+    auto h = pcgHash(a, a.bitXor(a.constant(component), pcgHash(a, draw)));
+    h = pcgHash(a, a.bitXor(h, a.constant(site * 0x9E3779B9u)));
+    h = pcgHash(a, a.bitXor(h, object));
+    return pcgHash(a, a.bitXor(h, seed));
+}
+
+// Uniform in [0, 1): the top 24 bits, exactly representable in a float.
+template <class A>
+typename A::Float unitInterval(A& a, typename A::Int bits) {
+    return a.fmul(a.toFloat(a.shiftRight(bits, a.constant(8u))), a.floatConstant(1.0f / 16777216.0f));
+}
+
+// One component of `rand` (in [0, 1)) or `nrand` (in [-1, 1)).
+template <class A>
+typename A::Float drawLane(A& a, Op op, typename A::Int seed, typename A::Int object, uint32_t site,
+                           typename A::Int draw, uint32_t component) {
+    auto u = unitInterval(a, drawBits(a, seed, object, site, draw, component));
+    if (op == Op::NRand) return a.fsub(a.fmul(u, a.floatConstant(2.0f)), a.floatConstant(1.0f));
+    return u;
+}
+
+// The algebra of plain host integers and floats.
+struct HostAlgebra {
+    using Int = uint32_t;
+    using Float = float;
+    static constexpr Int constant(uint32_t x) { return x; }
+    static constexpr Float floatConstant(float x) { return x; }
+    static constexpr Int add(Int x, Int y) { return x + y; }
+    static constexpr Int mul(Int x, Int y) { return x * y; }
+    static constexpr Int bitXor(Int x, Int y) { return x ^ y; }
+    static constexpr Int shiftRight(Int x, Int y) { return x >> y; }
+    static constexpr Float toFloat(Int x) { return static_cast<float>(x); }
+    static constexpr Float fmul(Float x, Float y) { return x * y; }
+    static constexpr Float fsub(Float x, Float y) { return x - y; }
+};
+
+}  // namespace psys::core
