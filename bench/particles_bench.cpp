@@ -167,7 +167,7 @@ int main(int argc, char** argv) {
 
     unsigned cores = std::max(1u, std::thread::hardware_concurrency());
     codegen_llvm::LlvmBackend jit;
-    std::cout << fmt::format("# psys_bench on {} ({} cores), {} timed steps per figure (median)\n\n", jit.cpu(), cores,
+    std::cout << fmt::format("# psys_bench on {} ({} cores), {} timed steps per figure (median)\n\n", jit.report().target, cores,
                              frames);
     double bandwidth1 = triad(1, triadElements), bandwidthAll = triad(0, triadElements);
     std::cout << fmt::format("STREAM triad: {:.1f} GB/s on 1 thread, {:.1f} GB/s on {} threads\n\n", bandwidth1 / 1e9,
@@ -292,8 +292,8 @@ int main(int argc, char** argv) {
             auto ready = Clock::now();
             front.push_back(seconds(start, compiled));
             total.push_back(seconds(start, ready));
-            jitTimes.push_back(backend.compileStats().seconds);
-            kernels = backend.compileStats().kernels;
+            jitTimes.push_back(backend.report().compileSeconds);
+            kernels = backend.report().kernels;
         }
         std::cout << fmt::format("| {} | {:.1f} | {:.1f} | {} | {:.1f} |\n", path.filename().string(), median(front) * 1e3,
                                  median(jitTimes) * 1e3, kernels, median(total) * 1e3);

@@ -25,9 +25,9 @@ namespace {
 // Keeps what the loop vectorizer says about each loop; every other diagnostic goes to
 // LLVM's default printing (none is expected).
 struct RemarkCollector : llvm::DiagnosticHandler {
-    std::vector<VectorizeRemark>* out;
+    std::vector<rt::BackendReport::Remark>* out;
     std::mutex* mutex;  // modules are optimized on several threads
-    RemarkCollector(std::vector<VectorizeRemark>* remarks, std::mutex* m) : out(remarks), mutex(m) {}
+    RemarkCollector(std::vector<rt::BackendReport::Remark>* remarks, std::mutex* m) : out(remarks), mutex(m) {}
     bool isPassedOptRemarkEnabled(llvm::StringRef pass) const override { return pass == "loop-vectorize"; }
     bool isMissedOptRemarkEnabled(llvm::StringRef pass) const override { return pass == "loop-vectorize"; }
     bool isAnalysisRemarkEnabled(llvm::StringRef pass) const override { return pass == "loop-vectorize"; }
@@ -51,7 +51,7 @@ struct JitEngine::Impl {
     std::optional<llvm::orc::JITTargetMachineBuilder> host;
     std::string cpu;
     std::mutex remarksMutex;
-    std::vector<VectorizeRemark> remarks;
+    std::vector<rt::BackendReport::Remark> remarks;
 
     // Runs on the JIT's compile threads: a target machine of its own for the cost model.
     void optimize(llvm::Module& module) {
@@ -141,7 +141,7 @@ std::unique_ptr<llvm::Module> JitEngine::newModule(llvm::LLVMContext& context) c
     return module;
 }
 
-std::vector<VectorizeRemark> JitEngine::remarks() const {
+std::vector<rt::BackendReport::Remark> JitEngine::remarks() const {
     std::lock_guard lock(impl_->remarksMutex);
     return impl_->remarks;
 }

@@ -13,6 +13,7 @@
 #include <llvm/IR/Module.h>
 
 #include "codegen_llvm/lane_emitter.h"
+#include "rt/backend.h"
 
 namespace psys::codegen_llvm {
 
@@ -35,7 +36,8 @@ public:
     // address of each one's function. Throws std::runtime_error when LLVM refuses one.
     std::vector<void*> add(std::vector<Unit> units);
 
-    std::vector<VectorizeRemark> remarks() const;
+    // What the loop vectorizer said about every loop compiled so far.
+    std::vector<rt::BackendReport::Remark> remarks() const;
     std::string cpu() const;
     unsigned floatLanes() const;
 

@@ -1,6 +1,6 @@
-// LLVM functions for IR kernels, in the three shapes the run-time calls: one object
-// (`run`), the children an object emits at once (`runChildren`), and a loop over a range
-// of a pool's rows (`runRows`). Each builder adds one function to a module.
+// LLVM functions for IR kernels, in the two launch shapes of rt/backend.h: a loop over a
+// range of rows of a column table (RowsLaunch), and a spawn kernel over the children one
+// object emits at once (ChildrenLaunch). Each builder adds one function to a module.
 #pragma once
 
 #include <cstdint>
@@ -14,29 +14,26 @@
 
 namespace psys::codegen_llvm {
 
-// void kernel(const Value* params, const Value* state, const Value* externs,
-//             const Value* uniforms, const Value* parents, const float* scalars,
-//             const uint32_t* keys, Value* yields)
-// scalars: age, dt, time, first; keys: seed, object id, draw, child draw; parents: the
-// values of the kernel's parent reads, gathered by the caller in instruction order.
-using ObjectFn = void (*)(const rt::Value*, const rt::Value*, const rt::Value*, const rt::Value*, const rt::Value*,
-                          const float*, const uint32_t*, rt::Value*);
+// int64_t rows(void* const* columns, const uint8_t* mask, int64_t begin, int64_t end,
+//              const Value* externs, const Value* uniforms, double now, float dt,
+//              uint32_t first, uint32_t seed, uint32_t draw)
+// `columns`: host addresses by layout position. Returns the rows it killed.
+using RowsFn = int64_t (*)(void* const*, const uint8_t*, int64_t, int64_t, const rt::Value*, const rt::Value*, double,
+                           float, uint32_t, uint32_t, uint32_t);
 
-// The spawn kernel over several children (ObjectFunctionBuilder::buildChildren).
-using ChildrenFn = void (*)(const rt::Value*, const rt::Value*, const rt::Value*, const rt::Value*, const rt::Value*,
-                            const float*, const uint32_t*, rt::Value*, int64_t, int64_t);
+// void children(void* const* columns, int64_t row, const Value* parents, const Value* externs,
+//               double now, float dt, uint32_t first, uint32_t seed, uint32_t draw,
+//               uint32_t firstChild, int64_t count, float* const* args, int64_t argsFirst)
+using ChildrenFn = void (*)(void* const*, int64_t, const rt::Value*, const rt::Value*, double, float, uint32_t,
+                            uint32_t, uint32_t, uint32_t, int64_t, float* const*, int64_t);
 
-// void rows(void* const* columns, const uint8_t* mask, int64_t begin, int64_t end,
-//           const Value* externs, const Value* uniforms, double time, float dt,
-//           uint32_t seed, uint32_t draw)
-using RowsFn = void (*)(void* const*, const uint8_t*, int64_t, int64_t, const rt::Value*, const rt::Value*, double,
-                        float, uint32_t, uint32_t);
-
-
-void buildObjectFunction(llvm::Module& module, MathMode mode, const ir::Kernel& kernel, const std::string& name);
-void buildChildrenFunction(llvm::Module& module, MathMode mode, const ir::Kernel& kernel, const std::string& name);
-// `lanes`: floats per vector register, the width the loop is vectorized to.
+// `lanes`: floats per vector register, the width the loop is vectorized to. `now` and
+// `dt`: where the loop reads each row's clock from (rt/clock.h); when either is per row,
+// the kernel's uniform kernel is evaluated in the loop for each row.
 void buildRowsFunction(llvm::Module& module, MathMode mode, unsigned lanes, const ir::Object& object,
-                       const ir::Kernel& kernel, rt::RowsMode rowsMode, const std::string& name);
+                       const ir::Kernel& kernel, const ir::Kernel* uniformKernel, rt::Clock::Source now,
+                       rt::Clock::Source dt, const std::string& name);
+void buildChildrenFunction(llvm::Module& module, MathMode mode, const ir::Object& object, const ir::Kernel& spawn,
+                           const std::string& name);
 
 }  // namespace psys::codegen_llvm

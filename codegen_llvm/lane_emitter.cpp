@@ -5,6 +5,8 @@
 
 #include <llvm/IR/Intrinsics.h>
 
+#include "core/hash.h"
+
 namespace psys::codegen_llvm {
 
 using namespace ir;
@@ -30,9 +32,9 @@ public:
         values_.resize(kernel_.size());
         for (ValueId v = 0; v < kernel_.size(); ++v) {
             const Inst& i = kernel_.at(v);
-            if (isLeaf(i.op)) {
+            if (isInput(i.op)) {
                 values_[v] = leaf(i, parentOrdinal);
-                if (i.op == Op::ParentExport || i.op == Op::ParentAlive || i.op == Op::ParentAge) ++parentOrdinal;
+                if (readsAncestor(i.op)) ++parentOrdinal;
             } else {
                 values_[v] = emit(i);
             }
@@ -42,17 +44,6 @@ public:
     }
 
 private:
-    static bool isLeaf(Op op) {
-        switch (op) {
-            case Op::Param: case Op::TriggerParam: case Op::StateRead: case Op::Extern: case Op::Uniform:
-            case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge: case Op::Age: case Op::Dt:
-            case Op::Time: case Op::First: case Op::ObjectId: case Op::DrawIndex:
-                return true;
-            default:
-                return false;
-        }
-    }
-
     llvm::Value* f(float x) { return llvm::ConstantFP::get(b_.getFloatTy(), x); }
 
     // One lane through a libm function: a plain call in exact mode (the interpreter's
@@ -72,29 +63,31 @@ private:
         return call;
     }
 
-    llvm::Value* pcg(llvm::Value* v) {  // rt/rng.h's pcgHash
-        llvm::Value* state = b_.CreateAdd(b_.CreateMul(v, b_.getInt32(747796405u)), b_.getInt32(2891336453u));
-        llvm::Value* shift = b_.CreateAdd(b_.CreateLShr(state, b_.getInt32(28)), b_.getInt32(4));
-        llvm::Value* word = b_.CreateMul(b_.CreateXor(b_.CreateLShr(state, shift), state), b_.getInt32(277803737u));
-        return b_.CreateXor(b_.CreateLShr(word, b_.getInt32(22)), word);
-    }
+    // core/hash.h's algebra on LLVM values: the hash is emitted from its one definition.
+    struct Integers {
+        llvm::IRBuilder<>& b;
+        using Int = llvm::Value*;
+        using Float = llvm::Value*;
+        Int constant(uint32_t x) { return b.getInt32(x); }
+        Float floatConstant(float x) { return llvm::ConstantFP::get(b.getFloatTy(), x); }
+        Int add(Int x, Int y) { return b.CreateAdd(x, y); }
+        Int mul(Int x, Int y) { return b.CreateMul(x, y); }
+        Int bitXor(Int x, Int y) { return b.CreateXor(x, y); }
+        Int shiftRight(Int x, Int y) { return b.CreateLShr(x, y); }
+        Float toFloat(Int x) { return b.CreateUIToFP(x, b.getFloatTy()); }
+        Float fmul(Float x, Float y) { return b.CreateFMul(x, y); }
+        Float fsub(Float x, Float y) { return b.CreateFSub(x, y); }
+    };
 
-    // rt/rng.h's drawBits(seed, object, site, draw, component) → uniform01, per lane.
+    // rand / nrand, keyed by (object, draw), lane by lane.
     Lanes random(const Inst& i) {
         llvm::Value* object = values_[i.operands[0]][0];
         llvm::Value* draw = values_[i.operands[1]][0];
-        llvm::Value* drawHash = pcg(draw);
+        Integers algebra{b_};
         Lanes out;
-        for (int l = 0; l < i.type.width; ++l) {
-            llvm::Value* h = pcg(b_.CreateXor(b_.getInt32(static_cast<uint32_t>(l)), drawHash));
-            h = pcg(b_.CreateXor(h, b_.getInt32(static_cast<uint32_t>(i.attr) * 0x9E3779B9u)));
-            h = pcg(b_.CreateXor(h, object));
-            h = pcg(b_.CreateXor(h, seed_));
-            llvm::Value* u = b_.CreateFMul(b_.CreateUIToFP(b_.CreateLShr(h, b_.getInt32(8)), b_.getFloatTy()),
-                                           f(1.0f / 16777216.0f));
-            if (i.op == Op::NRand) u = b_.CreateFSub(b_.CreateFMul(u, f(2.0f)), f(1.0f));
-            out.push_back(u);
-        }
+        for (int l = 0; l < i.type.width; ++l)
+            out.push_back(core::drawLane(algebra, i.op, seed_, object, static_cast<uint32_t>(i.attr), draw,
+                                         static_cast<uint32_t>(l)));
         return out;
     }
 

@@ -27,7 +27,7 @@
 namespace psys::core {
 
 template <class A>
-typename A::Int pcgHash(A& a, typename A::Int v) {
+constexpr typename A::Int pcgHash(A& a, typename A::Int v) {
     auto state = a.add(a.mul(v, a.constant(747796405u)), a.constant(2891336453u));
     auto shift = a.add(a.shiftRight(state, a.constant(28u)), a.constant(4u));
     auto word = a.mul(a.bitXor(a.shiftRight(state, shift), state), a.constant(277803737u));
@@ -36,8 +36,8 @@ typename A::Int pcgHash(A& a, typename A::Int v) {
 
 // The bits of one component of one draw.
 template <class A>
-typename A::Int drawBits(A& a, typename A::Int seed, typename A::Int object, uint32_t site, typename A::Int draw,
-                         uint32_t component) {
+constexpr typename A::Int drawBits(A& a, typename A::Int seed, typename A::Int object, uint32_t site, typename A::Int draw,
+                                   uint32_t component) {
     auto h = pcgHash(a, a.bitXor(a.constant(component), pcgHash(a, draw)));
     h = pcgHash(a, a.bitXor(h, a.constant(site * 0x9E3779B9u)));
     h = pcgHash(a, a.bitXor(h, object));
@@ -46,13 +46,13 @@ typename A::Int drawBits(A& a, typename A::Int seed, typename A::Int object, uin
 
 // Uniform in [0, 1): the top 24 bits, exactly representable in a float.
 template <class A>
-typename A::Float unitInterval(A& a, typename A::Int bits) {
+constexpr typename A::Float unitInterval(A& a, typename A::Int bits) {
     return a.fmul(a.toFloat(a.shiftRight(bits, a.constant(8u))), a.floatConstant(1.0f / 16777216.0f));
 }
 
 // One component of `rand` (in [0, 1)) or `nrand` (in [-1, 1)).
 template <class A>
-typename A::Float drawLane(A& a, Op op, typename A::Int seed, typename A::Int object, uint32_t site,
+constexpr typename A::Float drawLane(A& a, Op op, typename A::Int seed, typename A::Int object, uint32_t site,
                            typename A::Int draw, uint32_t component) {
     auto u = unitInterval(a, drawBits(a, seed, object, site, draw, component));
     if (op == Op::NRand) return a.fsub(a.fmul(u, a.floatConstant(2.0f)), a.floatConstant(1.0f));

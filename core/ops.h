@@ -126,6 +126,8 @@ inline bool isTemporal(Op op) { return kindOf(op) == OpKind::Temporal; }
 inline bool isCommutative(Op op) { return opInfo(op).flags & kCommutative; }
 inline bool isComponentwise(Op op) { return opInfo(op).flags & kComponentwise; }
 inline bool hasOwnSite(Op op) { return opInfo(op).flags & kOwnSite; }
+// The inputs that read an ancestor object (its exports, whether it is alive, its age).
+inline bool readsAncestor(Op op) { return op == Op::ParentExport || op == Op::ParentAlive || op == Op::ParentAge; }
 // Operand `i` of `op` may refer to a value defined later (a recursive equation).
 inline bool mayReferForward(Op op, size_t operand) {
     return operand < 8 && (opInfo(op).delayedOperands >> operand & 1u);

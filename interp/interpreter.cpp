@@ -1,62 +1,169 @@
 #include "interp/interpreter.h"
 
-#include <cmath>
+#include <utility>
 
-#include "ir/evaluate.h"
-#include "rt/rng.h"
+#include "rt/clock.h"
 
 namespace psys::interp {
 
 using namespace ir;
-using ir::Value;
+using rt::Buffer;
+using rt::ColumnLayout;
 
-void Interpreter::run(const Kernel& kernel, const rt::KernelInputs& in, std::vector<Value>& yields) {
-    registers_.resize(kernel.size());
-    std::vector<Value>& r = registers_;
-    for (ValueId v = 0; v < kernel.size(); ++v) {
-        const Inst& inst = kernel.at(v);
-        const int w = inst.type.width;
-        auto a = [&](size_t i) -> const Value& { return r[inst.operands[i]]; };
-        Value out;
-        switch (inst.op) {
-            case Op::Const: out.f = inst.constant; break;
-            case Op::Param: case Op::TriggerParam: out = in.params[inst.attr]; break;
-            case Op::StateRead: out = in.state[inst.attr]; break;
-            case Op::Extern: out = in.externs[inst.attr]; break;
-            case Op::Uniform: out = in.uniforms[inst.attr]; break;
-            case Op::Age: out = Value::scalar(in.age); break;
-            case Op::Dt: out = Value::scalar(in.dt); break;
-            case Op::Time: out = Value::scalar(in.time); break;
-            case Op::First: out = Value::boolean(in.first); break;
-            case Op::ParentExport: out = in.parentExport(inst.attr2, inst.attr); break;
-            case Op::ParentAlive: out = Value::boolean(in.parentAlive(inst.attr2)); break;
-            case Op::ParentAge: out = Value::scalar(in.parentAge(inst.attr2)); break;
-            case Op::ObjectId: out.u = in.objectId; break;
-            case Op::DrawIndex: out.u = inst.attr == 1 ? in.childDraw : in.draw; break;
-            default:
-                if (isPure(inst.op)) {
-                    operandValues_.clear();
-                    operandTypes_.clear();
-                    for (ValueId o : inst.operands) {
-                        operandValues_.push_back(r[o]);
-                        operandTypes_.push_back(kernel.at(o).type);
-                    }
-                    out = evaluate(inst, operandValues_.data(), operandTypes_.data());
-                }
-                break;
-            case Op::Rand: case Op::NRand: {
-                uint32_t object = a(0).u, draw = a(1).u, site = static_cast<uint32_t>(inst.attr);
-                for (int i = 0; i < w; ++i) {
-                    float u = rt::uniform01(rt::drawBits(in.seed, object, site, draw, static_cast<uint32_t>(i)));
-                    out.f[static_cast<size_t>(i)] = inst.op == Op::Rand ? u : u * 2.0f - 1.0f;
-                }
-                break;
+namespace {
+
+// Reads the columns of a launch's table on host memory.
+struct Columns {
+    rt::Memory& memory;
+    std::span<const Buffer> table;
+
+    float* floats(int column) const { return rt::hostData<float>(memory, table[static_cast<size_t>(column)]); }
+    Value gather(int column, int width, size_t row) const {
+        Value v;
+        for (int c = 0; c < width; ++c) v.f[static_cast<size_t>(c)] = floats(column + c)[row];
+        return v;
+    }
+    void scatter(int column, int width, size_t row, const Value& v) const {
+        for (int c = 0; c < width; ++c) floats(column + c)[row] = v.f[static_cast<size_t>(c)];
+    }
+    // Every parameter (a column-less one, not kept by the pool, reads 0) and every slot.
+    void inputs(const Object& o, const ColumnLayout& l, size_t row, std::vector<Value>& params,
+                std::vector<Value>& state) const {
+        params.assign(o.params.size(), Value{});
+        for (size_t p = 0; p < o.params.size(); ++p)
+            if (table[static_cast<size_t>(l.paramOffset[p])].valid())
+                params[p] = gather(l.paramOffset[p], o.params[p].type.width, row);
+        state.resize(o.state.size());
+        for (size_t s = 0; s < o.state.size(); ++s) state[s] = gather(l.stateOffset[s], o.state[s].type.width, row);
+    }
+};
+
+}  // namespace
+
+rt::BackendReport Interpreter::report() const {
+    rt::BackendReport r;
+    r.target = "interpreter";
+    return r;
+}
+
+// Row by row: the reference for what a compiled loop must compute.
+rt::RowsResult Interpreter::run(const rt::RowsLaunch& launch) {
+    const Object& o = *launch.object;
+    const Kernel& kernel = *launch.kernel;
+    const ColumnLayout& l = *launch.layout;
+    Columns columns{memory_, launch.columns};
+    const auto* created = rt::hostData<double>(memory_, launch.columns[ColumnLayout::kCreated]);
+    const auto* ids = rt::hostData<uint32_t>(memory_, launch.columns[ColumnLayout::kIds]);
+    const auto* mask = rt::hostData<uint8_t>(memory_, launch.mask);
+    const rt::Clock& clock = launch.clock;
+    const double* nows = clock.now == rt::Clock::Source::PerRow
+                             ? rt::hostData<double>(memory_, launch.columns[ColumnLayout::kNow])
+                             : nullptr;
+    const float* dts = clock.dt == rt::Clock::Source::PerRow
+                           ? rt::hostData<float>(memory_, launch.columns[ColumnLayout::kDt])
+                           : nullptr;
+    // The kill column is written only by kernels that can kill.
+    uint8_t* kill = nullptr;
+    for (const Yield& y : kernel.yields)
+        if (y.kind == YieldKind::Kill) kill = rt::hostData<uint8_t>(memory_, launch.columns[ColumnLayout::kKill]);
+    rt::RowsResult result;
+    for (size_t row = launch.begin; row < launch.end; ++row) {
+        if (kill) kill[row] = 0;
+        if (!mask[row]) continue;
+        columns.inputs(o, l, row, params_, state_);
+        parents_.clear();
+        for (const auto& p : l.parentColumns) parents_.push_back(columns.gather(p.offset, p.width, row));
+        double now = nows ? nows[row] : clock.nowValue;
+        KernelInputs in;
+        in.params = params_.data();
+        in.state = state_.data();
+        in.externs = launch.externs;
+        in.uniforms = launch.uniforms;
+        in.parents = parents_.data();
+        in.age = rt::ageAt(now, created[row]);
+        in.dt = dts ? dts[row] : clock.dtValue;
+        in.time = static_cast<float>(now);
+        in.first = clock.first;
+        in.seed = launch.seed;
+        in.objectId = ids[row];
+        in.draw = launch.draw;
+        if (clock.perRow() && launch.uniformKernel) {  // this row's own uniform values
+            KernelInputs u;
+            u.externs = launch.externs;
+            u.dt = in.dt;
+            u.time = in.time;
+            u.seed = launch.seed;
+            evaluator_.run(*launch.uniformKernel, u, uniformValues_);
+            uniforms_.assign(uniformValues_.size(), Value{});
+            for (size_t i = 0; i < launch.uniformKernel->yields.size(); ++i)
+                uniforms_.at(static_cast<size_t>(launch.uniformKernel->yields[i].index)) = uniformValues_[i];
+            in.uniforms = uniforms_.data();
+        }
+        evaluator_.run(kernel, in, yields_);
+        for (size_t i = 0; i < kernel.yields.size(); ++i) {
+            const Yield& y = kernel.yields[i];
+            const Value& v = yields_[i];
+            int width = kernel.at(y.value).type.width;
+            switch (y.kind) {
+                case YieldKind::StateNext: columns.scatter(l.stateOffset[static_cast<size_t>(y.index)], width, row, v); break;
+                case YieldKind::Export: columns.scatter(l.exportOffset[static_cast<size_t>(y.index)], width, row, v); break;
+                case YieldKind::Kill:
+                    kill[row] = v.truth() ? 1 : 0;
+                    result.killed += kill[row];
+                    break;
+                case YieldKind::EmitRate: columns.floats(l.emitRate(y.index))[row] = v.f[0]; break;
+                case YieldKind::EmitCount: columns.floats(l.emitCount(y.index))[row] = v.f[0]; break;
+                case YieldKind::Visible: case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:
+                    columns.scatter(l.render + ColumnLayout::renderColumn(y.kind), y.kind == YieldKind::Visible ? 1 : width,
+                                    row, y.kind == YieldKind::Visible ? Value::scalar(v.truth() ? 1.0f : 0.0f) : v);
+                    break;
+                default: break;
             }
         }
-        r[v] = out;
     }
-    yields.resize(kernel.yields.size());
-    for (size_t i = 0; i < kernel.yields.size(); ++i) yields[i] = r[kernel.yields[i].value];
+    return result;
+}
+
+// A spawn kernel once per child: its arguments go to the argument columns, one per
+// component of each parameter, in parameter order.
+void Interpreter::run(const rt::ChildrenLaunch& launch) {
+    const Kernel& spawn = *launch.spawn;
+    Columns columns{memory_, launch.columns};
+    columns.inputs(*launch.object, *launch.layout, launch.row, params_, state_);
+    const auto* created = rt::hostData<double>(memory_, launch.columns[ColumnLayout::kCreated]);
+    const auto* ids = rt::hostData<uint32_t>(memory_, launch.columns[ColumnLayout::kIds]);
+    std::vector<size_t> firstColumn;  // per argument (emit.arg #sub)
+    for (const Yield& y : spawn.yields)
+        if (y.kind == YieldKind::EmitArg) {
+            if (firstColumn.size() <= static_cast<size_t>(y.sub)) firstColumn.resize(static_cast<size_t>(y.sub) + 1, 0);
+            firstColumn[static_cast<size_t>(y.sub)] = static_cast<size_t>(spawn.at(y.value).type.width);
+        }
+    size_t next = 0;
+    for (size_t& c : firstColumn) next += std::exchange(c, next);
+    KernelInputs in;
+    in.params = params_.data();
+    in.state = state_.data();
+    in.externs = launch.externs;
+    in.parents = launch.parents;
+    in.age = rt::ageAt(launch.clock.nowValue, created[launch.row]);
+    in.dt = launch.clock.dtValue;
+    in.time = static_cast<float>(launch.clock.nowValue);
+    in.first = launch.clock.first;
+    in.seed = launch.seed;
+    in.objectId = ids[launch.row];
+    in.draw = launch.draw;
+    for (size_t k = 0; k < launch.count; ++k) {
+        in.childDraw = launch.firstChild + static_cast<uint32_t>(k);
+        evaluator_.run(spawn, in, yields_);
+        for (size_t i = 0; i < spawn.yields.size(); ++i) {
+            const Yield& y = spawn.yields[i];
+            if (y.kind != YieldKind::EmitArg) continue;
+            size_t column = firstColumn[static_cast<size_t>(y.sub)];
+            for (int c = 0; c < spawn.at(y.value).type.width; ++c)
+                rt::hostData<float>(memory_, launch.args[column + static_cast<size_t>(c)])[launch.argsFirst + k] =
+                    yields_[i].f[static_cast<size_t>(c)];
+        }
+    }
 }
 
 }  // namespace psys::interp

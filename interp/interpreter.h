@@ -1,7 +1,11 @@
 // The reference backend: evaluates IR kernels instruction by instruction, in float, the
-// way the IR says. Slow and obviously right; every other backend is tested against it.
+// way the IR says (ir::Evaluator), one row at a time over host memory. Slow and obviously
+// right; every other backend is tested against it.
 #pragma once
 
+#include <vector>
+
+#include "ir/evaluate.h"
 #include "rt/backend.h"
 
 namespace psys::interp {
@@ -9,12 +13,15 @@ namespace psys::interp {
 class Interpreter : public rt::Backend {
 public:
     std::string name() const override { return "interp"; }
-    void run(const ir::Kernel& kernel, const rt::KernelInputs& in, std::vector<rt::Value>& yields) override;
+    rt::Memory& memory() override { return memory_; }
+    rt::RowsResult run(const rt::RowsLaunch& launch) override;
+    void run(const rt::ChildrenLaunch& launch) override;
+    rt::BackendReport report() const override;
 
 private:
-    std::vector<rt::Value> registers_;
-    std::vector<rt::Value> operandValues_;
-    std::vector<ir::Type> operandTypes_;
+    rt::HostMemory memory_;
+    ir::Evaluator evaluator_;
+    std::vector<rt::Value> params_, state_, parents_, uniformValues_, uniforms_, yields_;
 };
 
 }  // namespace psys::interp

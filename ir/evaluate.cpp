@@ -107,7 +107,7 @@ void Evaluator::run(const Kernel& kernel, const KernelInputs& in, std::vector<Va
 std::vector<const Inst*> parentReads(const Kernel& kernel) {
     std::vector<const Inst*> reads;
     for (const Inst& i : kernel.insts())
-        if (isParentRead(i.op)) reads.push_back(&i);
+        if (readsAncestor(i.op)) reads.push_back(&i);
     return reads;
 }
 

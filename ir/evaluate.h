@@ -49,6 +49,5 @@ private:
 // The parent reads of a kernel (parent.export, parent.alive, parent.age), in instruction
 // order: the order of KernelInputs::parents.
 std::vector<const Inst*> parentReads(const Kernel& kernel);
-inline bool isParentRead(Op op) { return op == Op::ParentExport || op == Op::ParentAlive || op == Op::ParentAge; }
 
 }  // namespace psys::ir

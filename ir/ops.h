@@ -22,5 +22,6 @@ using core::isCommutative;
 using core::isComponentwise;
 using core::hasOwnSite;
 using core::mayReferForward;
+using core::readsAncestor;
 
 }  // namespace psys::ir

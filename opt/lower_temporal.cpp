@@ -19,6 +19,9 @@
 // semi-implicit Euler step games use. Other methods (midpoint, RK4) integrate an
 // object's integrals together and will slot in here as further cases of `integrate`.
 // With relaxed maths, the integral of something fixed at creation is c·age, no state.
+#include <map>
+#include <set>
+
 #include <fmt/format.h>
 
 #include "opt/passes.h"
@@ -42,6 +45,45 @@ ValueId broadcast(Kernel& k, ValueId scalar, Type t) {
     return t.width == 1 ? scalar : k.op(Op::Splat, t, {scalar});
 }
 
+// State slot names that say where the state is and survive edits elsewhere in the
+// source (hot reload carries state by slot name): `integrate@vel` for the integral in
+// equation vel, `prev@pos,vel#2` for the second prev of the tuple equation (pos, vel);
+// `integrate#3` (the call site) for one outside every equation.
+std::map<ValueId, std::string> slotNames(const Kernel& k) {
+    // The equations, in evaluation order; a tuple's components share one name.
+    std::map<ValueId, std::string> roots;
+    for (auto& [name, v] : k.equations)
+        if (!isLeaf(k.at(v).op)) roots[v] = roots.count(v) ? roots[v] + "," + name : name;
+    std::map<ValueId, std::string> owner;
+    for (auto& [root, name] : roots) {
+        std::vector<ValueId> work = {root};
+        std::set<ValueId> seen;
+        while (!work.empty()) {
+            ValueId v = work.back();
+            work.pop_back();
+            if (!seen.insert(v).second || (v != root && roots.count(v))) continue;
+            if (isTemporal(k.at(v).op) && !owner.count(v)) owner[v] = name;
+            for (ValueId o : k.at(v).operands) work.push_back(o);
+        }
+    }
+    std::map<ValueId, std::string> names;
+    std::map<std::string, int> seenKinds;
+    for (ValueId v = 0; v < k.size(); ++v) {
+        const Inst& i = k.at(v);
+        if (!isTemporal(i.op)) continue;
+        std::string kind(opInfo(i.op).name);
+        auto it = owner.find(v);
+        if (it == owner.end()) {
+            names[v] = fmt::format("{}#{}", kind, i.attr);
+            continue;
+        }
+        std::string base = kind + "@" + it->second;
+        int n = ++seenKinds[base];
+        names[v] = n == 1 ? base : fmt::format("{}#{}", base, n);
+    }
+    return names;
+}
+
 }  // namespace
 
 void lowerTemporal(Module& module, const PassOptions& options, PassErrors& errors) {
@@ -57,16 +99,19 @@ void lowerTemporal(Module& module, const PassOptions& options, PassErrors& error
         }
         std::vector<std::pair<int, ValueId>> nextOld;  // (slot, old value its next is)
         std::vector<std::pair<int, ValueId>> nextNew;  // (slot, new value)
-        auto addSlot = [&](const char* kind, const Inst& inst, StateInit init) {
-            object.state.push_back({fmt::format("{}#{}", kind, inst.attr), inst.type, init});
+        std::map<ValueId, std::string> names = slotNames(*behaviour);
+        ValueId current = 0;
+        auto addSlot = [&](const Inst& inst, StateInit init) {
+            object.state.push_back({names.at(current), inst.type, init});
             return static_cast<int>(object.state.size() - 1);
         };
         Rewriter rewriter(*behaviour);
-        Kernel lowered = rewriter.run([&](Rewriter& rw, ValueId, const Inst& inst,
+        Kernel lowered = rewriter.run([&](Rewriter& rw, ValueId old, const Inst& inst,
                                           const std::vector<ValueId>& ops) -> std::optional<ValueId> {
             if (inst.op != Op::Integrate && inst.op != Op::Derive && inst.op != Op::Prev &&
                 inst.op != Op::Snapshot && inst.op != Op::FollowedBy)
                 return std::nullopt;
+            current = old;
             Kernel& k = rw.to();
             Type t = inst.type;
             ValueId first = input(k, Op::First, Type::boolean());
@@ -77,7 +122,7 @@ void lowerTemporal(Module& module, const PassOptions& options, PassErrors& error
                     // in real arithmetic; no state needed (docs/optimizer.md).
                     if (options.relaxed && creationInvariant(k, ops[0]))
                         return rw.emit(Inst::make(Op::Mul, t, {ops[0], broadcast(k, input(k, Op::Age, Type::f32()), t)}));
-                    int slot = addSlot("integrate", inst, StateInit::Zero);
+                    int slot = addSlot(inst, StateInit::Zero);
                     ValueId a = input(k, Op::StateRead, t, slot);
                     ValueId dt = broadcast(k, input(k, Op::Dt, Type::f32()), t);
                     ValueId step = k.op(Op::Add, t, {a, k.op(Op::Mul, t, {ops[0], dt})});
@@ -86,7 +131,7 @@ void lowerTemporal(Module& module, const PassOptions& options, PassErrors& error
                     return value;
                 }
                 case Op::Derive: {
-                    int slot = addSlot("derive", inst, StateInit::Next);
+                    int slot = addSlot(inst, StateInit::Next);
                     ValueId p = input(k, Op::StateRead, t, slot);
                     ValueId dtScalar = input(k, Op::Dt, Type::f32());
                     ValueId moving = k.op(Op::Gt, Type::boolean(), {dtScalar, k.scalar(0)});
@@ -96,13 +141,13 @@ void lowerTemporal(Module& module, const PassOptions& options, PassErrors& error
                     return rw.emit(Inst::make(Op::Select, t, {ready, slope, zero}));
                 }
                 case Op::Prev: {
-                    int slot = addSlot("prev", inst, StateInit::Next);
+                    int slot = addSlot(inst, StateInit::Next);
                     ValueId p = input(k, Op::StateRead, t, slot);
                     nextOld.push_back({slot, inst.operands[0]});  // may be defined later
                     return rw.emit(Inst::make(Op::Select, t, {first, zero, p}));
                 }
                 case Op::Snapshot: {
-                    int slot = addSlot("snapshot", inst, StateInit::Next);
+                    int slot = addSlot(inst, StateInit::Next);
                     ValueId s = input(k, Op::StateRead, t, slot);
                     ValueId value = rw.emit(Inst::make(Op::Select, t, {first, ops[0], s}));
                     nextNew.push_back({slot, value});

@@ -1,81 +1,112 @@
-// What the run-time asks of a backend: evaluate a kernel for one object (`run`), or for a
-// range of rows of a pool, column by column (`runRows`, rt/batch.h).
+// What the run-time asks of a backend: a contract a CPU and a GPU can both implement.
 //
-// The run-time (pools, time, spawning, killing, parents, externs, triggers) is the same
-// for every backend; a backend only computes kernels. For `run`, the inputs are gathered
-// from the object's row of its pool and from the system; the yields come back in the
-// kernel's order and the run-time scatters them. `runRows` reads and writes the pool's
-// columns in place; its default runs `run` row by row, so every backend has it.
+// The run-time (rt/system.h) decides everything about a system's objects: which kernels
+// run, over which rows, at what time (rt/clock.h); it evaluates the kernels that run once
+// per step or per trigger itself, on the host (start, triggers, the uniform kernels:
+// ir::Evaluator). A backend is handed the rest as launches:
+//   - RowsLaunch: a kernel (init, update, exports, render) over a range of rows of a
+//     column table — buffers in the backend's memory, by handle (rt/memory.h);
+//   - ChildrenLaunch: a spawn kernel for the children one object emits at once, writing
+//     their arguments into buffers.
+// A launch returns counts (how many rows it killed); every value stays in the buffers.
+// Before the first launch of a system, `prepare` lists every launch shape it will ask for,
+// so a compiling backend compiles them all at once.
 #pragma once
 
-#include <array>
-#include <cstdint>
-#include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "ir/ir.h"
 #include "ir/value.h"
-#include "rt/batch.h"
+#include "rt/clock.h"
+#include "rt/columns.h"
+#include "rt/memory.h"
 
 namespace psys::rt {
 
 using Value = ir::Value;
 
-struct KernelInputs {
-    const Value* params = nullptr;        // the object's (or a trigger's) parameters
-    const Value* state = nullptr;         // its slots before this kernel
+struct RowsLaunch {
+    const ir::Object* object = nullptr;
+    const ir::Kernel* kernel = nullptr;
+    const ColumnLayout* layout = nullptr;
+    std::span<const Buffer> columns;        // by layout position
+    Buffer mask;                            // u8 per row: rows with 0 are left alone
+    size_t begin = 0, end = 0;              // the rows
+    Clock clock;
     const Value* externs = nullptr;
-    const Value* uniforms = nullptr;      // the values of the kernel's uniform kernel
-    float age = 0;
-    float dt = 0;
-    float time = 0;
-    bool first = false;                   // true while the object is being created
+    const Value* uniforms = nullptr;        // uniform clock: the values of the kernel's uniform kernel
+    const ir::Kernel* uniformKernel = nullptr;  // per-row clock: evaluated at each row's clock
     uint32_t seed = 0;
-    uint32_t objectId = 0;
-    uint32_t draw = 0;                    // draw.index #0: the step, or kCreationDraw
-    uint32_t childDraw = 0;               // draw.index #1: the id of the object being spawned
-    // Live reads of an ancestor `depth` levels up (1: the parent).
-    std::function<Value(int depth, int exportIndex)> parentExport;
-    std::function<bool(int depth)> parentAlive;
-    std::function<float(int depth)> parentAge;
+    uint32_t draw = 0;                      // draw.index #0 (the step, or kCreationDraw)
+};
+
+struct RowsResult {
+    size_t killed = 0;  // rows of the range whose kill flag the kernel set
+};
+
+struct ChildrenLaunch {
+    const ir::Object* object = nullptr;     // the emitter's type
+    const ir::Kernel* spawn = nullptr;
+    const ColumnLayout* layout = nullptr;   // of the spawn kernel (its parent reads are `parents`)
+    std::span<const Buffer> columns;        // the emitter's columns, by layout position
+    uint32_t row = 0;                       // the emitter's row
+    const Value* parents = nullptr;         // the spawn kernel's parent reads for the emitter
+    Clock clock;                            // uniform
+    const Value* externs = nullptr;
+    uint32_t seed = 0, draw = 0;
+    uint32_t firstChild = 0;                // child k draws with draw.index #1 = firstChild + k
+    size_t count = 0;
+    std::span<const Buffer> args;           // per component of the created type's parameters
+    size_t argsFirst = 0;                   // child k's arguments at row argsFirst + k
+};
+
+// Every launch shape a system will use, listed before its first step.
+struct Plan {
+    struct Rows {
+        const ir::Object* object;
+        const ir::Kernel* kernel;
+        Clock::Source now, dt;
+    };
+    std::vector<Rows> rows;
+    struct Children {
+        const ir::Object* object;
+        const ir::Kernel* spawn;
+    };
+    std::vector<Children> children;
+};
+
+// What a backend says about itself: for `psysc run --timing --remarks` and the viewer.
+struct BackendReport {
+    std::string target;          // "interpreter", or the CPU the JIT compiles for
+    size_t kernels = 0;          // functions compiled
+    size_t cacheHits = 0;        // kernels found already compiled
+    double compileSeconds = 0;
+    struct Remark {
+        std::string loop;
+        bool vectorized;
+        std::string message;
+    };
+    std::vector<Remark> remarks; // what the compiler said about each loop
 };
 
 class Backend {
 public:
     virtual ~Backend() = default;
     virtual std::string name() const = 0;
-    // Evaluates `kernel` once; `yields[i]` receives the value of `kernel.yields[i]`.
-    virtual void run(const ir::Kernel& kernel, const KernelInputs& in, std::vector<Value>& yields) = 0;
-
-    // The arguments of `count` children that `in`'s object emits at once: a spawn kernel
-    // run with childDraw firstChild, firstChild + 1, …; child k's argument `sub` goes to
-    // args[k·stride + sub]. The default runs `run` once per child.
-    virtual void runChildren(const ir::Kernel& spawn, const KernelInputs& in, uint32_t firstChild, size_t count,
-                             Value* args, size_t stride);
-
-    // What a System will ask of a backend for a module: the kernels it runs one object at
-    // a time, and the loops it runs over rows. Called once, before any kernel of the
-    // module runs, so a compiling backend compiles them all here (and anything else when
-    // it is first asked for).
-    struct Plan {
-        std::vector<const ir::Kernel*> objectKernels;
-        struct Loop {
-            const ir::Object* object;
-            const ir::Kernel* kernel;
-            RowsMode mode;
-        };
-        std::vector<Loop> loops;
-    };
+    // Where the columns of the systems this backend runs live.
+    virtual Memory& memory() = 0;
+    // Called once per system, before any of its launches.
     virtual void prepare(const Plan&) {}
     // The module's kernels are about to be destroyed: a backend that keeps anything by a
     // kernel's address drops it here (a later kernel may get the same address).
     virtual void forget(const ir::Module&) {}
-    // Evaluates an update or exports kernel of `object` on the masked rows of `batch`.
-    virtual void runRows(const ir::Object& object, const ir::Kernel& kernel, const BatchLayout& layout,
-                         const RowBatch& batch);
-    // Whether runRows may run on several threads at once (on disjoint rows).
+    virtual RowsResult run(const RowsLaunch& launch) = 0;
+    virtual void run(const ChildrenLaunch& launch) = 0;
+    // Whether launches on disjoint rows may run on several threads at once.
     virtual bool concurrent() const { return false; }
+    virtual BackendReport report() const { return {}; }
 };
 
 }  // namespace psys::rt

@@ -2,7 +2,7 @@
 
 namespace psys::rt {
 
-void Columns::define(const std::vector<ir::Type>& types) {
+void ValueColumns::define(Memory& memory, const std::vector<ir::Type>& types, size_t rows) {
     types_ = types;
     offset_.clear();
     size_t n = 0;
@@ -10,37 +10,81 @@ void Columns::define(const std::vector<ir::Type>& types) {
         offset_.push_back(n);
         n += static_cast<size_t>(t.width);
     }
-    columns_.assign(n, {});
+    columns_.clear();
+    for (size_t i = 0; i < n; ++i) columns_.push_back(memory.create(Elem::F32, rows));
 }
 
-void Columns::resize(size_t rows) {
-    for (auto& c : columns_) c.resize(rows, 0.0f);
+void ValueColumns::release(Memory& memory) {
+    for (Buffer b : columns_) memory.release(b);
+    columns_.clear();
 }
 
-Value Columns::get(size_t i, size_t row) const {
-    Value v;
-    for (int c = 0; c < types_[i].width; ++c) v.f[static_cast<size_t>(c)] = columns_[offset_[i] + static_cast<size_t>(c)][row];
+void ValueColumns::resize(Memory& memory, size_t rows) {
+    for (Buffer b : columns_) memory.resize(b, rows);
+}
+
+ir::Value ValueColumns::get(const Memory& memory, size_t i, size_t row) const {
+    ir::Value v;
+    for (int c = 0; c < types_[i].width; ++c)
+        memory.read(column(i, static_cast<size_t>(c)), row, 1, &v.f[static_cast<size_t>(c)]);
     return v;
 }
 
-void Columns::set(size_t i, size_t row, const Value& v) {
-    for (int c = 0; c < types_[i].width; ++c) columns_[offset_[i] + static_cast<size_t>(c)][row] = v.f[static_cast<size_t>(c)];
+void ValueColumns::set(Memory& memory, size_t i, size_t row, const ir::Value& v) const {
+    for (int c = 0; c < types_[i].width; ++c)
+        memory.write(column(i, static_cast<size_t>(c)), row, 1, &v.f[static_cast<size_t>(c)]);
 }
 
-Pool::Pool(const ir::Object& object, size_t capacity) : object_(&object), capacity_(capacity) {
+Pool::Pool(const ir::Object& object, size_t capacity, Memory& memory)
+    : object_(&object), capacity_(capacity), memory_(&memory) {
+    created = memory.create(Elem::F64, 0);
+    ids = memory.create(Elem::U32, 0);
+    updatable = memory.create(Elem::U8, 0);
     std::vector<ir::Type> types;
     for (auto& s : object.state) types.push_back(s.type);
-    state.define(types);
+    state.define(memory, types, 0);
     types.clear();
     for (auto& p : object.params) {
         paramColumn.push_back(p.kept ? static_cast<int>(types.size()) : -1);
         if (p.kept) types.push_back(p.type);
     }
-    params.define(types);
+    params.define(memory, types, 0);
     types.clear();
     for (auto& e : object.exports) types.push_back(e.type);
-    exports.define(types);
+    exports.define(memory, types, 0);
     emitted.assign(object.emits.size(), {});
+}
+
+Pool::Pool(Pool&& other) noexcept
+    : created(other.created), ids(other.ids), updatable(other.updatable), state(std::move(other.state)),
+      params(std::move(other.params)), exports(std::move(other.exports)), paramColumn(std::move(other.paramColumn)),
+      parent(std::move(other.parent)), readers(std::move(other.readers)), fresh(std::move(other.fresh)),
+      emitted(std::move(other.emitted)), object_(other.object_), capacity_(other.capacity_), memory_(other.memory_),
+      status_(std::move(other.status_)), generation_(std::move(other.generation_)),
+      freeRows_(std::move(other.freeRows_)), live_(other.live_), frozen_(other.frozen_) {
+    other.memory_ = nullptr;
+}
+
+Pool::~Pool() {
+    if (!memory_) return;  // moved from
+    memory_->release(created);
+    memory_->release(ids);
+    memory_->release(updatable);
+    state.release(*memory_);
+    params.release(*memory_);
+    exports.release(*memory_);
+}
+
+void Pool::grow(size_t n) {
+    status_.resize(n, Status::Free);
+    generation_.resize(n, 0);
+    parent.resize(n);
+    readers.resize(n, 0);
+    for (auto& e : emitted) e.resize(n, 0);
+    for (Buffer b : {created, ids, updatable}) memory_->resize(b, n);
+    state.resize(*memory_, n);
+    params.resize(*memory_, n);
+    exports.resize(*memory_, n);
 }
 
 std::optional<uint32_t> Pool::allocate() {
@@ -51,21 +95,10 @@ std::optional<uint32_t> Pool::allocate() {
     } else {
         if (rows() >= capacity_) return std::nullopt;
         row = static_cast<uint32_t>(rows());
-        size_t n = rows() + 1;
-        status_.resize(n, Status::Free);
-        generation_.resize(n, 0);
-        created.resize(n, 0);
-        id.resize(n, 0);
-        parent.resize(n);
-        readers.resize(n, 0);
-        updatable.resize(n, 0);
-        for (auto& e : emitted) e.resize(n, 0);
-        state.resize(n);
-        params.resize(n);
-        exports.resize(n);
+        grow(rows() + 1);
     }
     status_[row] = Status::Alive;
-    updatable[row] = 0;
+    hostData<uint8_t>(*memory_, updatable)[row] = 0;
     fresh.push_back(row);
     ++live_;
     readers[row] = 0;
@@ -77,7 +110,7 @@ std::optional<uint32_t> Pool::allocate() {
 void Pool::freeze(uint32_t row) {
     if (status_[row] != Status::Alive) return;
     status_[row] = Status::Frozen;
-    updatable[row] = 0;
+    hostData<uint8_t>(*memory_, updatable)[row] = 0;
     --live_;
     ++frozen_;
 }
@@ -87,15 +120,28 @@ void Pool::release(uint32_t row) {
     else if (status_[row] == Status::Frozen) --frozen_;
     else return;
     status_[row] = Status::Free;
-    updatable[row] = 0;
+    hostData<uint8_t>(*memory_, updatable)[row] = 0;
     ++generation_[row];
     freeRows_.push_back(row);
 }
 
 void Pool::beginStep() {
+    uint8_t* mask = hostData<uint8_t>(*memory_, updatable);
     for (uint32_t row : fresh)
-        if (status_[row] == Status::Alive) updatable[row] = 1;
+        if (status_[row] == Status::Alive) mask[row] = 1;
     fresh.clear();
+}
+
+void Pool::restore(std::vector<Status> status, std::vector<uint32_t> generation, std::vector<uint32_t> freeRows) {
+    grow(status.size());
+    status_ = std::move(status);
+    generation_ = std::move(generation);
+    freeRows_ = std::move(freeRows);
+    live_ = frozen_ = 0;
+    for (Status s : status_) {
+        live_ += s == Status::Alive;
+        frozen_ += s == Status::Frozen;
+    }
 }
 
 }  // namespace psys::rt

@@ -1,5 +1,7 @@
-// One pool per object type: structure of arrays, one float column per component of every
-// state slot, parameter and export the IR keeps, plus the bookkeeping every object needs.
+// One pool per object type: structure of arrays, one f32 column per component of every
+// state slot, parameter and export the IR keeps, plus the columns every object has
+// (creation time, id) — all buffers in the backend's memory — and the bookkeeping the
+// run-time keeps on the host (which rows are free, generations, parents, readers).
 //
 // Rows are reused through a free list; a Handle is (row, generation), and a row's
 // generation changes whenever it is freed, so a stale handle never reads a reused row.
@@ -13,7 +15,8 @@
 #include <vector>
 
 #include "ir/ir.h"
-#include "rt/backend.h"
+#include "ir/value.h"
+#include "rt/memory.h"
 
 namespace psys::rt {
 
@@ -25,26 +28,33 @@ struct Handle {
 
 enum class Status : uint8_t { Free, Alive, Frozen };
 
-// Component columns for a list of typed values: column(i, c)[row].
-class Columns {
+// Typed values as component columns: value i's component c is column(i, c).
+class ValueColumns {
 public:
-    void define(const std::vector<ir::Type>& types);
-    void resize(size_t rows);
-    Value get(size_t i, size_t row) const;
-    void set(size_t i, size_t row, const Value& v);
+    void define(Memory& memory, const std::vector<ir::Type>& types, size_t rows);
+    void release(Memory& memory);
+    void resize(Memory& memory, size_t rows);
     size_t count() const { return types_.size(); }
-    const std::vector<float>& column(size_t i, size_t component) const { return columns_[offset_[i] + component]; }
-    float* data(size_t i, size_t component) { return columns_[offset_[i] + component].data(); }
+    const ir::Type& type(size_t i) const { return types_[i]; }
+    Buffer column(size_t i, size_t component) const { return columns_[offset_[i] + component]; }
+    // One value of one row, through explicit transfers.
+    ir::Value get(const Memory& memory, size_t i, size_t row) const;
+    void set(Memory& memory, size_t i, size_t row, const ir::Value& v) const;
 
 private:
     std::vector<ir::Type> types_;
     std::vector<size_t> offset_;
-    std::vector<std::vector<float>> columns_;
+    std::vector<Buffer> columns_;
 };
 
 class Pool {
 public:
-    Pool(const ir::Object& object, size_t capacity);
+    Pool(const ir::Object& object, size_t capacity, Memory& memory);
+    ~Pool();
+    Pool(Pool&&) noexcept;
+    Pool(const Pool&) = delete;
+    Pool& operator=(const Pool&) = delete;
+    Pool& operator=(Pool&&) = delete;
 
     const ir::Object& object() const { return *object_; }
     size_t capacity() const { return capacity_; }
@@ -59,24 +69,33 @@ public:
     void freeze(uint32_t row);
     bool matches(Handle h) const { return h.row < rows() && generation_[h.row] == h.generation && status_[h.row] != Status::Free; }
     Handle handle(uint32_t row) const { return {row, generation_[row]}; }
-
-    Columns state, params, exports;  // params: only the kept ones
-    std::vector<int> paramColumn;     // per parameter: its column in `params`, or -1
-    std::vector<double> created;
-    std::vector<uint32_t> id;
-    std::vector<Handle> parent;
-    std::vector<uint32_t> readers;       // children that read this object live
-    // 1 for rows a step updates: alive and not created during the current step. Rows
-    // created during a step are listed in `fresh` until the next step begins.
-    std::vector<uint8_t> updatable;
-    std::vector<uint32_t> fresh;
-    void beginStep();  // the rows created before this step become updatable
-    std::vector<std::vector<double>> emitted;  // per rate site: events accumulated, in [0, 1)
     Status status(uint32_t row) const { return status_[row]; }
+
+    // Columns in the backend's memory.
+    Buffer created, ids;             // f64, u32
+    Buffer updatable;                // u8: 1 for rows a step updates (alive, not created during it)
+    ValueColumns state, params, exports;  // params: only the kept ones
+    std::vector<int> paramColumn;    // per parameter: its value in `params`, or -1
+
+    // Host bookkeeping.
+    std::vector<Handle> parent;
+    std::vector<uint32_t> readers;   // children that read this object live
+    std::vector<uint32_t> fresh;     // rows created during the current step
+    void beginStep();                // the rows created before this step become updatable
+    std::vector<std::vector<double>> emitted;  // per rate site: events accumulated, in [0, 1)
+
+    Memory& memory() const { return *memory_; }
+    // Rebuilds the host bookkeeping of rows as given (hot reload, rt/reload.cpp).
+    void restore(std::vector<Status> status, std::vector<uint32_t> generation, std::vector<uint32_t> freeRows);
+    const std::vector<uint32_t>& generations() const { return generation_; }
+    const std::vector<uint32_t>& freeRows() const { return freeRows_; }
+    // Grows every column to `rows` rows (new rows free).
+    void grow(size_t rows);
 
 private:
     const ir::Object* object_;
     size_t capacity_;
+    Memory* memory_;
     std::vector<Status> status_;
     std::vector<uint32_t> generation_;
     std::vector<uint32_t> freeRows_;

@@ -1,217 +1,159 @@
-// The System: construction, the host API, a step from end to end, kills and freeing.
-// Updates and drawing are in system_update.cpp, creation in system_create.cpp.
+// The System: the host API and the schedule of a step. The object store and what the
+// parts share are rt/system_state.cpp; updating rt/system_update.cpp; creating
+// rt/system_create.cpp; drawing rt/system_draw.cpp; hot reload rt/reload.cpp.
 #include "rt/system.h"
 
-#include <chrono>
 #include <cmath>
-#include <cstdlib>
 
 #include <fmt/format.h>
 
 #include "rt/rng.h"
+#include "rt/system_create.h"
+#include "rt/system_draw.h"
 #include "rt/system_support.h"
+#include "rt/system_update.h"
 
 namespace psys::rt {
 
-using ir::KernelKind;
-using ir::YieldKind;
-using detail::Clock;
 using detail::finite;
 using detail::seconds;
+using detail::WallClock;
+using ir::KernelKind;
 
-System::System(ir::Module module, Backend& backend, SystemOptions options)
-    : module_(std::move(module)), backend_(backend), options_(options) {
-    for (const ir::Object& o : module_.objects) {
-        size_t capacity = o.attributes.capacity ? static_cast<size_t>(*o.attributes.capacity) : options_.capacity;
-        pools_.emplace_back(o, capacity);
-        stepLimit_.push_back(o.attributes.step);
-        parentType_.push_back(o.parent.empty() ? -1 : module_.objectIndex(o.parent));
-        typeStats_.push_back({o.name, 0, 0, 0, 0, 0});
-    }
-    for (const ir::Extern& e : module_.externs) externs_.push_back({e.defaultValue, 0});
-    render_.resize(pools_.size());
-    renderStale_.assign(pools_.size(), true);
-    queued_.assign(pools_.size(), 0);
-    pending_.assign(pools_.size(), 0);
-    uniformCache_.resize(pools_.size());
-    for (const ir::Object& o : module_.objects) {
-        PoolBatch b;
-        const ir::Kernel* update = o.kernel(KernelKind::Update);
-        b.update = batchLayout(o, *update);
-        if (const ir::Kernel* ek = o.kernel(KernelKind::Exports)) b.exports = batchLayout(o, *ek);
-        b.drawn.assign(4, false);
-        if (const ir::Kernel* rk = o.kernel(KernelKind::Render)) {
-            b.render = batchLayout(o, *rk);
-            for (const ir::Yield& y : rk->yields) {
-                if (y.kind == YieldKind::Visible) b.drawn[0] = true;
-                if (y.kind == YieldKind::Position) b.drawn[1] = true;
-                if (y.kind == YieldKind::Color) b.drawn[2] = true;
-                if (y.kind == YieldKind::Size) b.drawn[3] = true;
-            }
-        }
-        b.counted.assign(o.emits.size(), false);
-        b.rated.assign(o.emits.size(), false);
-        for (const ir::Yield& y : update->yields) {
-            if (y.kind == YieldKind::Kill) b.kills = true;
-            if (y.kind == YieldKind::EmitCount) b.counted[static_cast<size_t>(y.index)] = true;
-            if (y.kind == YieldKind::EmitRate) b.rated[static_cast<size_t>(y.index)] = true;
-        }
-        bool bursts = false;
-        for (const ir::EmitSite& e : o.emits) {
-            b.rateEmits |= e.rate;
-            bursts |= !e.rate;
-        }
-        b.createInBatches = options_.createInBatches && stepLimit_[batches_.size()] <= 0 && !o.kernel(KernelKind::Exports) && !bursts &&
-                            parentType_[batches_.size()] < 0;
-        batches_.push_back(std::move(b));
-    }
-    setThreads(options_.threads);
-    backend_.prepare(plan());
-}
+namespace {
 
-System::~System() { backend_.forget(module_); }
-
-void System::setThreads(unsigned threads) {
-    options_.threads = threads;
-    arena_ = std::make_unique<tbb::task_arena>(threads ? static_cast<int>(threads) : tbb::task_arena::automatic);
-}
-
-// The kernels this system runs object by object and the loops it runs over rows.
-Backend::Plan System::plan() const {
-    Backend::Plan plan;
-    plan.objectKernels.push_back(&module_.start.kernel);
-    for (const ir::Trigger& t : module_.triggers) plan.objectKernels.push_back(&t.kernel);
-    for (size_t type = 0; type < pools_.size(); ++type) {
-        const ir::Object& o = module_.objects[type];
-        bool oneByOne = !batches_[type].createInBatches;
-        bool subSteps = stepLimit_[type] > 0;
+// Every launch shape a system asks for (rt/system_create.cpp, rt/system_update.cpp,
+// rt/system_draw.cpp): steps of existing objects at one clock; creation at each object's
+// creation time (now per row, dt 0); first updates and their exports at per-row clocks.
+Plan planOf(const ir::Module& module) {
+    using S = Clock::Source;
+    Plan plan;
+    for (const ir::Object& o : module.objects)
         for (const ir::Kernel& k : o.kernels) {
             switch (k.kind) {
-                case KernelKind::Spawn: case KernelKind::UniformUpdate: case KernelKind::UniformRender:
-                case KernelKind::UniformExports:
-                    plan.objectKernels.push_back(&k);
-                    break;
-                case KernelKind::Init:
-                    if (oneByOne) plan.objectKernels.push_back(&k);
-                    else plan.loops.push_back({&o, &k, RowsMode::Init});
-                    break;
+                case KernelKind::Init: plan.rows.push_back({&o, &k, S::PerRow, S::Uniform}); break;
                 case KernelKind::Update:
-                    if (oneByOne || subSteps) plan.objectKernels.push_back(&k);
-                    plan.loops.push_back({&o, &k, RowsMode::Step});
-                    if (!oneByOne) plan.loops.push_back({&o, &k, RowsMode::FirstUpdate});
+                    plan.rows.push_back({&o, &k, S::Uniform, S::Uniform});
+                    plan.rows.push_back({&o, &k, S::PerRow, S::PerRow});
                     break;
                 case KernelKind::Exports:
-                    if (oneByOne || subSteps) plan.objectKernels.push_back(&k);
-                    plan.loops.push_back({&o, &k, RowsMode::Step});
+                    plan.rows.push_back({&o, &k, S::Uniform, S::Uniform});
+                    plan.rows.push_back({&o, &k, S::PerRow, S::Uniform});
+                    plan.rows.push_back({&o, &k, S::PerRow, S::PerRow});
                     break;
-                case KernelKind::Render:
-                    plan.loops.push_back({&o, &k, RowsMode::Step});
-                    break;
-                default:
-                    break;
+                case KernelKind::Render: plan.rows.push_back({&o, &k, S::Uniform, S::Uniform}); break;
+                case KernelKind::Spawn: plan.children.push_back({&o, &k}); break;
+                default: break;  // start, triggers and uniform kernels: evaluated on the host
             }
         }
-    }
     return plan;
 }
 
+}  // namespace
+
+System::System(ir::Module module, Backend& backend, SystemOptions options)
+    : state_(std::make_unique<detail::State>(std::move(module), backend, options)),
+      creation_(std::make_unique<detail::Creation>(*state_)),
+      drawing_(std::make_unique<detail::Drawing>(*state_)) {
+    backend.prepare(planOf(state_->module));
+}
+
+System::~System() {
+    drawing_.reset();
+    creation_.reset();
+    state_->backend.forget(state_->module);
+}
+
+void System::setThreads(unsigned threads) {
+    state_->options.threads = threads;
+    state_->parallel = std::make_unique<detail::Parallel>(threads);
+}
+
+double System::time() const { return state_->now; }
+uint64_t System::stepCount() const { return state_->step; }
+const ir::Module& System::module() const { return state_->module; }
+const SystemOptions& System::options() const { return state_->options; }
+const Pool& System::pool(size_t type) const { return state_->pools[type]; }
+size_t System::typeCount() const { return state_->pools.size(); }
+Backend& System::backend() const { return state_->backend; }
+int System::typeIndex(std::string_view name) const { return state_->module.objectIndex(std::string(name)); }
+int System::externHandle(std::string_view name) const { return state_->module.externIndex(std::string(name)); }
+
 // The `spawn`s run when the system is first used, so externs set before that apply.
 void System::start() {
-    if (started_) return;
-    started_ = true;
-    emitFromKernel(module_.start, {}, kStartObject);
-    drain(now_);
-}
-
-int System::typeIndex(std::string_view name) const { return module_.objectIndex(std::string(name)); }
-
-void System::kill(size_t type, uint32_t row) {
-    ++typeStats_[type].killed;
-    pools_[type].freeze(row);  // no longer alive; freed at the end of the step if nobody reads it
-    dying_.push_back({type, row});
-}
-
-// A reader of `parent` is gone; a frozen parent without readers is freed, and so on up.
-void System::releaseReader(size_t childType, Handle parent) {
-    int t = parentType_[childType];
-    while (t >= 0 && parent.valid()) {
-        Pool& pool = pools_[static_cast<size_t>(t)];
-        if (!pool.matches(parent)) return;
-        if (--pool.readers[parent.row] > 0 || pool.status(parent.row) != Status::Frozen) return;
-        Handle up = pool.parent[parent.row];
-        pool.release(parent.row);
-        parent = up;
-        childType = static_cast<size_t>(t);
-        t = parentType_[childType];
-    }
+    detail::State& s = *state_;
+    if (s.started) return;
+    s.started = true;
+    creation_->emitFromKernel(s.module.start, {}, kStartObject);
+    creation_->drain(s.now);
 }
 
 std::optional<std::string> System::step(double dt) {
+    detail::State& s = *state_;
     if (!std::isfinite(dt) || dt < 0) {
-        ++stats_.rejectedSteps;
+        ++s.stats.rejectedSteps;
         return fmt::format("a step must be a finite, non-negative number of seconds, not {}", dt);
     }
     start();
-    ++step_;
-    lastDt_ = dt;
-    double t1 = now_ + dt;
-    for (Pool& pool : pools_) pool.beginStep();
-    for (size_t type = 0; type < pools_.size(); ++type) {
-        Pool& pool = pools_[type];
-        if (stepLimit_[type] > 0 && dt > stepLimit_[type]) {
-            // Sub-steps: object by object, each through all its sub-steps.
-            auto start = Clock::now();
-            for (uint32_t row = 0; row < pool.rows(); ++row)
-                if (pool.updatable[row]) update(type, row, dt, t1);
-            stats_.loopSeconds += seconds(start, Clock::now());
-        } else {
-            updatePool(type, dt, t1);
-        }
-        auto start = Clock::now();
-        drain(t1);
-        stats_.createSeconds += seconds(start, Clock::now());
+    ++s.step;
+    s.lastDt = dt;
+    double t1 = s.now + dt;
+    for (Pool& pool : s.pools) pool.beginStep();
+    // Parents before children: a type's objects, then what they created, advanced to t1.
+    for (size_t type = 0; type < s.pools.size(); ++type) {
+        detail::updateType(s, *creation_, type, dt, t1);
+        auto start = WallClock::now();
+        creation_->drain(t1);
+        s.stats.createSeconds += seconds(start, WallClock::now());
     }
-    now_ = t1;
-    auto releasing = Clock::now();
-    for (auto [type, row] : dying_) {
-        Pool& pool = pools_[type];
+    s.now = t1;
+    auto releasing = WallClock::now();
+    for (auto [type, row] : s.dying) {
+        Pool& pool = s.pools[type];
         if (pool.status(row) != Status::Frozen || pool.readers[row] > 0) continue;
         Handle parent = pool.parent[row];
         pool.release(row);
-        releaseReader(type, parent);
+        s.releaseReader(type, parent);
     }
-    dying_.clear();
-    stats_.emitSeconds += seconds(releasing, Clock::now());
-    renderStale_.assign(pools_.size(), true);
-    ++stats_.steps;
+    s.dying.clear();
+    s.stats.emitSeconds += seconds(releasing, WallClock::now());
+    drawing_->invalidate();
+    ++s.stats.steps;
     return std::nullopt;
 }
 
 std::optional<std::string> System::setExtern(std::string_view name, std::span<const float> value) {
-    int index = module_.externIndex(std::string(name));
+    int index = externHandle(name);
     if (index < 0) return fmt::format("there is no extern `{}`", name);
     return setExtern(index, value);
 }
 
 std::optional<std::string> System::setExtern(int index, std::span<const float> value) {
-    if (index < 0 || static_cast<size_t>(index) >= module_.externs.size())
+    detail::State& s = *state_;
+    if (index < 0 || static_cast<size_t>(index) >= s.module.externs.size())
         return fmt::format("there is no extern with handle {}", index);
-    const ir::Extern& e = module_.externs[static_cast<size_t>(index)];
-    const std::string& name = e.name;
+    const ir::Extern& e = s.module.externs[static_cast<size_t>(index)];
     if (value.size() != static_cast<size_t>(e.type.width))
-        return fmt::format("extern `{}` is {}: it takes {} value{}, not {}", name, e.type.str(), e.type.width,
+        return fmt::format("extern `{}` is {}: it takes {} value{}, not {}", e.name, e.type.str(), e.type.width,
                            e.type.width == 1 ? "" : "s", value.size());
     Value v;
     for (size_t i = 0; i < value.size(); ++i) v.f[i] = value[i];
-    if (!finite(v, e.type.width)) ++stats_.nonFiniteExterns;
-    externs_[static_cast<size_t>(index)] = v;
-    ++externsVersion_;
+    if (!finite(v, e.type.width)) ++s.stats.nonFiniteExterns;
+    s.externs[static_cast<size_t>(index)] = v;
+    ++s.externsVersion;
     return std::nullopt;
 }
 
+std::optional<Value> System::externValue(std::string_view name) const {
+    int index = externHandle(name);
+    if (index < 0) return std::nullopt;
+    return state_->externs[static_cast<size_t>(index)];
+}
+
 std::optional<std::string> System::fire(std::string_view name, std::span<const float> args) {
+    detail::State& s = *state_;
     const ir::Trigger* trigger = nullptr;
-    for (const ir::Trigger& t : module_.triggers)
+    for (const ir::Trigger& t : s.module.triggers)
         if (t.name == name) trigger = &t;
     if (!trigger) return fmt::format("there is no trigger `{}`", name);
     size_t width = 0;
@@ -226,22 +168,31 @@ std::optional<std::string> System::fire(std::string_view name, std::span<const f
         params.push_back(v);
     }
     start();
-    emitFromKernel(*trigger, params, kTriggerObject);
-    drain(now_);
-    renderStale_.assign(pools_.size(), true);
+    creation_->emitFromKernel(*trigger, params, kTriggerObject);
+    creation_->drain(s.now);
+    drawing_->invalidate();
     return std::nullopt;
 }
 
-
-Stats System::stats() const {
-    Stats s = stats_;
-    s.types = typeStats_;
-    for (size_t t = 0; t < pools_.size(); ++t) {
-        s.types[t].live = pools_[t].live();
-        s.types[t].frozen = pools_[t].frozen();
-    }
-    return s;
+const DrawColumns& System::draw(size_t type) {
+    start();
+    return drawing_->draw(type);
 }
 
+std::vector<RenderPoint> System::points(size_t type) {
+    start();
+    return drawing_->points(type);
+}
+
+Stats System::stats() const {
+    const detail::State& s = *state_;
+    Stats out = s.stats;
+    out.types = s.typeStats;
+    for (size_t t = 0; t < s.pools.size(); ++t) {
+        out.types[t].live = s.pools[t].live();
+        out.types[t].frozen = s.pools[t].frozen();
+    }
+    return out;
+}
 
 }  // namespace psys::rt

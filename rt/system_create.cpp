@@ -1,271 +1,493 @@
-// Creating objects: the queue of objects asked for, creation in batches
-// (createBatch) and one by one (create), and what triggers and the start emit.
-#include "rt/system.h"
+// Creating objects: the queue of objects asked for, with their arguments in staging
+// columns, and their creation in batches (rt/system_create.h).
+#include "rt/system_create.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstring>
 
 #include "rt/rng.h"
 #include "rt/system_support.h"
 
-namespace psys::rt {
+namespace psys::rt::detail {
 
 using ir::KernelKind;
 using ir::YieldKind;
-using detail::validCount;
 
-// Queues `count` children of emit site `site`, `perEvent` at a time; the k-th event is at
-// firstTime + k·spacing (spacing 0: all at once). Beyond the target's free capacity the
-// rest are dropped and counted, without work per dropped child.
-void System::queueChildren(size_t type, uint32_t row, int site, uint64_t count, uint64_t perEvent, double firstTime,
-                           double spacing, double evalTime, bool first) {
-    Pool& pool = pools_[type];
-    const ir::EmitSite& emit = pool.object().emits[static_cast<size_t>(site)];
-    size_t target = static_cast<size_t>(module_.objectIndex(emit.target));
-    size_t free = pools_[target].free() + pending_[target];
+// Per type: the arguments of queued objects, one f32 column per component of the type's
+// parameters (kept or not); an entry's row is its place among the type's queued entries.
+struct Creation::Staging {
+    std::vector<Buffer> args;
+    size_t used = 0;
+};
+
+// Per type: the scratch columns a batch is created in, indexed like the staging rows (so
+// the staging columns are the batch's parameters as they are).
+struct Creation::Batch {
+    explicit Batch(Memory& m) : columns(m), initParents(m), updateParents(m), exportsParents(m) {}
+    Scratch columns, initParents, updateParents, exportsParents;
+    ColumnLayout initLayout;
+    std::vector<Buffer> initTable, updateTable, exportsTable;
+    std::vector<std::vector<Buffer>> burstTables;  // per emit site: the state at creation, for bursts
+    size_t first = 0;                  // the batch's first staging row
+    std::vector<uint32_t> poolRows;    // per object of the batch: its pool row, or kSkipRow (dropped)
+    std::vector<uint32_t> subSteps;    // per object: the sub-steps of its first update
+    std::vector<double> spans;         // per object: the length of its first update
+};
+
+namespace {
+
+// Scratch column indices of a batch.
+constexpr size_t kCreated = 0, kIds = 1, kKill = 2, kNow = 3, kDt = 4, kMask = 5, kStepMask = 6, kExportMask = 7,
+                 kFirstValue = 8;
+
+size_t components(const std::vector<ir::StateSlot>& slots) {
+    size_t n = 0;
+    for (const auto& s : slots) n += static_cast<size_t>(s.type.width);
+    return n;
+}
+
+}  // namespace
+
+Creation::Creation(State& state) : s_(state) {
+    queued_.assign(s_.pools.size(), 0);
+    pending_.assign(s_.pools.size(), 0);
+    staging_.resize(s_.pools.size());
+    for (size_t t = 0; t < s_.pools.size(); ++t) {
+        for (const ir::Param& p : s_.module.objects[t].params)
+            for (int c = 0; c < p.type.width; ++c) staging_[t].args.push_back(s_.memory.create(Elem::F32, 0));
+        batches_.emplace_back(s_.memory);
+        const ir::Object& o = s_.module.objects[t];
+        if (s_.types[t].init) batches_[t].initLayout = columnLayout(o, *s_.types[t].init);
+    }
+}
+
+Creation::~Creation() {
+    for (Staging& st : staging_)
+        for (Buffer b : st.args) s_.memory.release(b);
+}
+
+size_t Creation::stage(size_t type, size_t count) {
+    Staging& st = staging_[type];
+    size_t row = st.used;
+    st.used += count;
+    for (Buffer b : st.args)
+        if (s_.memory.rows(b) < st.used) s_.memory.resize(b, std::max(st.used, 2 * s_.memory.rows(b)));
+    return row;
+}
+
+void Creation::queueChildren(const Emitter& e, int site, uint64_t count, uint64_t perEvent, double firstTime,
+                             double spacing) {
+    const TypeInfo& info = s_.types[e.type];
+    size_t target = info.emitTarget[static_cast<size_t>(site)];
+    size_t free = s_.pools[target].free() + pending_[target];
     size_t room = free > queued_[target] ? free - queued_[target] : 0;
     uint64_t kept = std::min<uint64_t>(count, room);
-    typeStats_[target].dropped += count - kept;
+    s_.typeStats[target].dropped += count - kept;
     if (kept == 0) return;
-    const ir::Kernel* spawn = pool.object().kernel(KernelKind::Spawn, site);
-    Handle parent = parentType_[target] == static_cast<int>(type) ? pool.handle(row) : Handle{};
-    size_t params = pools_[target].paramColumn.size();
-    size_t base = queueArgs_.size();
-    queueArgs_.resize(base + static_cast<size_t>(kept) * params);
-    if (spawn) {
-        KernelInputs in = inputs(type, row, evalTime, static_cast<float>(lastDt_), first, params_, state_);
-        in.uniforms = uniforms(type, *spawn, in);
-        backend_.runChildren(*spawn, in, nextId_, static_cast<size_t>(kept), queueArgs_.data() + base, params);
+    Handle parent = s_.types[target].parentType == static_cast<int>(e.type) ? s_.pools[e.type].handle(e.row) : Handle{};
+    size_t base = stage(target, static_cast<size_t>(kept));
+    if (const ir::Kernel* spawn = info.spawn[static_cast<size_t>(site)]) {
+        const ColumnLayout& layout = info.spawnLayout[static_cast<size_t>(site)];
+        s_.parentValues(e.type, e.row, layout, e.at, parents_);
+        ChildrenLaunch launch;
+        launch.object = &s_.pools[e.type].object();
+        launch.spawn = spawn;
+        launch.layout = &layout;
+        launch.columns = e.columns.empty() ? std::span<const Buffer>(s_.work[e.type].spawnTables[static_cast<size_t>(site)])
+                                           : e.columns;
+        launch.row = e.columns.empty() ? e.row : e.columnRow;
+        launch.parents = parents_.data();
+        launch.clock.nowValue = e.at;
+        launch.clock.dtValue = static_cast<float>(s_.lastDt);
+        launch.clock.first = e.first;
+        launch.externs = s_.externs.data();
+        launch.seed = s_.options.seed;
+        launch.draw = e.first ? kCreationDraw : static_cast<uint32_t>(s_.step);
+        launch.firstChild = s_.nextId;
+        launch.count = static_cast<size_t>(kept);
+        launch.args = staging_[target].args;
+        launch.argsFirst = base;
+        s_.backend.run(launch);
     }
     for (uint64_t k = 0; k < kept; ++k) {
-        queue_.push_back({target, base + static_cast<size_t>(k) * params, parent,
-                          firstTime + static_cast<double>(k / perEvent) * spacing, nextId_++});
+        queue_.push_back({target, base + static_cast<size_t>(k), parent,
+                          firstTime + static_cast<double>(k / perEvent) * spacing, s_.nextId++});
         ++queued_[target];
     }
 }
 
-// Creates one object at c.time and advances it to t1: init, its bursts, its exports, and
-// a first update of the rest of the step.
-void System::create(const Creation& c, double t1) {
-    Pool& pool = pools_[c.type];
-    auto allocated = pool.allocate();
-    if (!allocated) {
-        ++typeStats_[c.type].dropped;
-        return;
-    }
-    uint32_t row = *allocated;
+void Creation::emitAtRate(const Emitter& e, std::span<const float> rate, std::span<const float> count, double dt,
+                          double t1) {
+    Pool& pool = s_.pools[e.type];
     const ir::Object& o = pool.object();
-    ++typeStats_[c.type].created;
-    pool.created[row] = c.time;
-    pool.id[row] = c.id;
-    pool.parent[row] = c.parent;
-    if (c.parent.valid()) ++pools_[static_cast<size_t>(parentType_[c.type])].readers[c.parent.row];
-    // A copy: creating may queue more, and move the queue's arguments.
-    std::vector<Value>& args = createArgs_;
-    args.assign(queueArgs_.begin() + static_cast<std::ptrdiff_t>(c.args),
-                queueArgs_.begin() + static_cast<std::ptrdiff_t>(c.args + pool.paramColumn.size()));
-    for (size_t i = 0; i < pool.paramColumn.size(); ++i)
-        if (pool.paramColumn[i] >= 0) pool.params.set(static_cast<size_t>(pool.paramColumn[i]), row, args[i]);
-    for (size_t i = 0; i < pool.state.count(); ++i) pool.state.set(i, row, Value{});
-
-    std::vector<double>& bursts = bursts_;
-    bursts.assign(o.emits.size(), 0);
-    if (const ir::Kernel* init = o.kernel(KernelKind::Init)) {
-        KernelInputs in = inputs(c.type, row, c.time, 0, true, params_, state_);
-        in.params = args.data();  // every parameter, kept or not
-        runKernel(c.type, row, *init, in);
-        for (size_t i = 0; i < init->yields.size(); ++i) {
-            const ir::Yield& y = init->yields[i];
-            if (y.kind == YieldKind::StateNext) pool.state.set(static_cast<size_t>(y.index), row, yields_[i]);
-            if (y.kind == YieldKind::EmitCount)
-                bursts[static_cast<size_t>(y.index)] = std::floor(validCount(yields_[i].f[0], stats_.invalidEmissions));
-        }
+    for (size_t site = 0; site < o.emits.size(); ++site) {
+        if (!o.emits[site].rate) continue;
+        double r = validCount(rate[site], s_.stats.invalidEmissions);
+        double perEvent = std::floor(validCount(count[site], s_.stats.invalidEmissions));
+        double before = pool.emitted[site][e.row];
+        double total = before + r * dt;
+        // A whole number reached by adding up rounded rates (0.25 · 1/60, 240 times) counts as reached.
+        double events = std::floor(total + 1e-9);
+        pool.emitted[site][e.row] = std::max(0.0, total - events);
+        if (events < 1 || perEvent < 1) continue;
+        double firstTime = (t1 - dt) + (1.0 - before) / r;
+        double children = events * perEvent;
+        queueChildren(e, static_cast<int>(site), static_cast<uint64_t>(std::min(children, 1e18)),
+                      static_cast<uint64_t>(perEvent), firstTime, 1.0 / r);
     }
-    if (const ir::Kernel* ek = o.kernel(KernelKind::Exports)) {
-        KernelInputs in = inputs(c.type, row, c.time, 0, true, params_, state_);
-        runKernel(c.type, row, *ek, in);
-        for (size_t i = 0; i < ek->yields.size(); ++i)
-            pool.exports.set(static_cast<size_t>(ek->yields[i].index), row, yields_[i]);
-    }
-    for (size_t s = 0; s < o.emits.size(); ++s)
-        if (!o.emits[s].rate && bursts[s] >= 1)
-            queueChildren(c.type, row, static_cast<int>(s), static_cast<uint64_t>(std::min(bursts[s], 1e18)), 1, c.time,
-                          0, c.time, true);
-    update(c.type, row, t1 - c.time, t1);
 }
 
-// Creates the queued objects in queue order (and those their creation queues). Runs of
-// one type that can be created in batches are; the rest one by one.
-void System::drain(double t1) {
-    for (size_t i = 0; i < queue_.size();) {
-        size_t type = queue_[i].type;
-        if (batches_[type].createInBatches) {
-            size_t end = i + 1;
-            while (end < queue_.size() && queue_[end].type == type) ++end;
-            createBatch(type, i, end, t1);
-            i = end;
-            continue;
-        }
-        Creation c = queue_[i];  // a copy: creating may queue more
-        --queued_[c.type];
-        create(c, t1);
-        ++i;
-    }
-    queue_.clear();
-    queueArgs_.clear();
-}
-
-// Creates queue_[from, to), all of one type, as `create` would one by one: the rows are
-// allocated in order, the init kernel and the first update run over all of them at once
-// (on scratch columns, where every parameter has a column, kept or not), and kills and
-// emissions follow object by object in queue order. While an object emits, the rows
-// allocated for the objects after it count as free, as they still are in `create`.
-void System::createBatch(size_t type, size_t from, size_t to, double t1) {
-    Pool& pool = pools_[type];
-    PoolBatch& b = batches_[type];
-    const ir::Object& o = pool.object();
-    b.newRows.clear();
-    b.newQueueIndex.clear();
-    for (size_t q = from; q < to; ++q) {
-        auto row = pool.allocate();
-        if (!row) {
-            ++typeStats_[type].dropped;
-            continue;
-        }
-        b.newRows.push_back(*row);
-        b.newQueueIndex.push_back(q);
-    }
-    size_t n = b.newRows.size();
-    // The queue entries leave the queue one by one below, as objects are created in order.
-    if (n == 0) {
-        queued_[type] -= to - from;
-        return;
-    }
-    typeStats_[type].created += n;
-
-    // Scratch columns in the layout's positions.
-    const BatchLayout& layout = b.update;
-    b.newColumns.resize(static_cast<size_t>(layout.total));
-    b.newTable.assign(static_cast<size_t>(layout.total), nullptr);
-    for (int column = BatchLayout::kFirstColumn; column < layout.total; ++column) {
-        auto& c = b.newColumns[static_cast<size_t>(column)];
-        c.assign(n, 0.0f);
-        b.newTable[static_cast<size_t>(column)] = c.data();
-    }
-    b.newCreated.resize(n);
-    b.newIds.resize(n);
-    b.newKill.assign(n, 0);
-    b.newMask.assign(n, 1);
-    b.newTable[BatchLayout::kCreated] = b.newCreated.data();
-    b.newTable[BatchLayout::kIds] = b.newIds.data();
-    b.newTable[BatchLayout::kKill] = b.newKill.data();
-    for (size_t r = 0; r < n; ++r) {
-        const Creation& c = queue_[b.newQueueIndex[r]];
-        uint32_t row = b.newRows[r];
-        pool.created[row] = c.time;
-        pool.id[row] = c.id;
-        pool.parent[row] = c.parent;
-        b.newCreated[r] = c.time;
-        b.newIds[r] = c.id;
-        for (size_t p = 0; p < o.params.size(); ++p) {
-            const Value& v = queueArgs_[c.args + p];
-            for (int k = 0; k < o.params[p].type.width; ++k)
-                b.newColumns[static_cast<size_t>(layout.paramOffset[p] + k)][r] = v.f[static_cast<size_t>(k)];
-            if (pool.paramColumn[p] >= 0) pool.params.set(static_cast<size_t>(pool.paramColumn[p]), row, v);
-        }
-    }
-
-    RowBatch batch;
-    batch.mask = b.newMask.data();
-    batch.columns = b.newTable.data();
-    batch.externs = externs_.data();
-    batch.seed = options_.seed;
-    auto runAll = [&](const ir::Kernel& kernel, const RowBatch& all) {
-        forChunks(n, [&](size_t c) {
-            RowBatch part = all;
-            part.begin = c * kRowsPerChunk;
-            part.end = std::min(n, part.begin + kRowsPerChunk);
-            backend_.runRows(o, kernel, layout, part);
-        });
-    };
-    if (const ir::Kernel* init = o.kernel(KernelKind::Init)) {
-        RowBatch in = batch;
-        in.mode = RowsMode::Init;
-        in.draw = kCreationDraw;
-        runAll(*init, in);
-    }
-    RowBatch first = batch;
-    first.mode = RowsMode::FirstUpdate;
-    first.time = t1;
-    first.draw = static_cast<uint32_t>(step_);
-    first.uniformKernel = o.kernel(KernelKind::UniformUpdate);
-    runAll(*o.kernel(KernelKind::Update), first);
-
-    for (size_t s = 0; s < o.state.size(); ++s)
-        for (int k = 0; k < o.state[s].type.width; ++k) {
-            const float* from = b.newColumns[static_cast<size_t>(layout.stateOffset[s] + k)].data();
-            float* to = pool.state.data(s, static_cast<size_t>(k));
-            for (size_t r = 0; r < n; ++r) to[b.newRows[r]] = from[r];
-        }
-    std::vector<float>& rate = rate_;
-    std::vector<float>& count = count_;
-    rate.assign(o.emits.size(), 0);
-    count.assign(o.emits.size(), 1);
-    size_t r = 0;
-    for (size_t q = from; q < to; ++q) {
-        --queued_[type];
-        if (r == n || b.newQueueIndex[r] != q) continue;  // dropped at capacity
-        uint32_t row = b.newRows[r];
-        if (b.kills && b.newKill[r]) {
-            kill(type, row);
-        } else if (b.rateEmits) {
-            for (size_t s = 0; s < o.emits.size(); ++s) {
-                if (b.rated[s]) rate[s] = b.newColumns[static_cast<size_t>(layout.emitRate(static_cast<int>(s)))][r];
-                if (b.counted[s]) count[s] = b.newColumns[static_cast<size_t>(layout.emitCount(static_cast<int>(s)))][r];
-            }
-            pending_[type] = n - 1 - r;
-            emitAtRate(type, row, rate, count, t1 - b.newCreated[r], t1);
-        }
-        ++r;
-    }
-    pending_[type] = 0;
-}
-
-
-// Runs a trigger's (or the start's) kernel: once for the counts, then once per created
-// object for its arguments, so each draws its own random numbers.
-void System::emitFromKernel(const ir::Trigger& trigger, std::span<const Value> params, uint32_t objectId) {
+void Creation::emitFromKernel(const ir::Trigger& trigger, std::span<const Value> params, uint32_t objectId) {
     const ir::Kernel& k = trigger.kernel;
-    KernelInputs in;
+    ir::KernelInputs in;
     in.params = params.data();
-    in.externs = externs_.data();
-    in.time = static_cast<float>(now_);
-    in.seed = options_.seed;
+    in.externs = s_.externs.data();
+    in.time = static_cast<float>(s_.now);
+    in.seed = s_.options.seed;
     in.objectId = objectId;
-    in.draw = static_cast<uint32_t>(step_);
-    backend_.run(k, in, yields_);
+    in.draw = static_cast<uint32_t>(s_.step);
+    s_.evaluator.run(k, in, yields_);
     std::vector<double> counts(trigger.emits.size(), 0);
     for (size_t i = 0; i < k.yields.size(); ++i)
         if (k.yields[i].kind == YieldKind::EmitCount)
-            counts[static_cast<size_t>(k.yields[i].index)] = std::floor(validCount(yields_[i].f[0], stats_.invalidEmissions));
-    for (size_t s = 0; s < trigger.emits.size(); ++s) {
-        size_t target = static_cast<size_t>(module_.objectIndex(trigger.emits[s].target));
-        size_t room = pools_[target].free() > queued_[target] ? pools_[target].free() - queued_[target] : 0;
-        auto kept = static_cast<uint64_t>(std::min(counts[s], static_cast<double>(room)));
-        typeStats_[target].dropped += static_cast<uint64_t>(counts[s]) - kept;
+            counts[static_cast<size_t>(k.yields[i].index)] = std::floor(validCount(yields_[i].f[0], s_.stats.invalidEmissions));
+    for (size_t site = 0; site < trigger.emits.size(); ++site) {
+        auto target = static_cast<size_t>(s_.module.objectIndex(trigger.emits[site].target));
+        Pool& pool = s_.pools[target];
+        size_t room = pool.free() > queued_[target] ? pool.free() - queued_[target] : 0;
+        auto kept = static_cast<uint64_t>(std::min(counts[site], static_cast<double>(room)));
+        s_.typeStats[target].dropped += static_cast<uint64_t>(counts[site]) - kept;
+        // The first column of each parameter among the staging columns.
+        std::vector<size_t> column;
+        size_t next = 0;
+        for (const ir::Param& p : pool.object().params) {
+            column.push_back(next);
+            next += static_cast<size_t>(p.type.width);
+        }
         for (uint64_t n = 0; n < kept; ++n) {
-            Creation c{target, queueArgs_.size(), {}, now_, nextId_++};
-            queueArgs_.resize(queueArgs_.size() + pools_[target].paramColumn.size());
-            in.childDraw = c.id;
-            backend_.run(k, in, yields_);
-            for (size_t i = 0; i < k.yields.size(); ++i)
-                if (k.yields[i].kind == YieldKind::EmitArg && k.yields[i].index == static_cast<int>(s))
-                    queueArgs_.at(c.args + static_cast<size_t>(k.yields[i].sub)) = yields_[i];
+            Entry entry{target, stage(target, 1), {}, s_.now, s_.nextId++};
+            in.childDraw = entry.id;
+            s_.evaluator.run(k, in, yields_);
+            for (size_t i = 0; i < k.yields.size(); ++i) {
+                const ir::Yield& y = k.yields[i];
+                if (y.kind != YieldKind::EmitArg || y.index != static_cast<int>(site)) continue;
+                auto p = static_cast<size_t>(y.sub);
+                for (int c = 0; c < pool.object().params[p].type.width; ++c)
+                    s_.memory.write(staging_[target].args[column[p] + static_cast<size_t>(c)], entry.staging, 1,
+                                    &yields_[i].f[static_cast<size_t>(c)]);
+            }
             ++queued_[target];
-            queue_.push_back(c);
+            queue_.push_back(entry);
         }
     }
 }
 
+void Creation::drain(double t1) {
+    for (size_t i = 0; i < queue_.size();) {
+        size_t type = queue_[i].type;
+        size_t end = i + 1;
+        if (s_.options.createInBatches)
+            while (end < queue_.size() && queue_[end].type == type) ++end;
+        createBatch(type, i, end, t1);
+        i = end;
+    }
+    queue_.clear();
+    for (Staging& st : staging_) st.used = 0;
+}
 
-}  // namespace psys::rt
+// A table over the batch's scratch columns for `layout`: the staging columns as the
+// parameters, the state at creation (bursts) or the state being advanced.
+void Creation::bindBatch(size_t type, Batch& b, const ColumnLayout& layout, Scratch& parents,
+                         std::vector<Buffer>& table, bool atCreation) {
+    const ir::Object& o = s_.module.objects[type];
+    size_t rows = staging_[type].used;
+    size_t stateCount = components(o.state), exportCount = 0;
+    for (const auto& e : o.exports) exportCount += static_cast<size_t>(e.type.width);
+    table.assign(static_cast<size_t>(layout.total), Buffer{});
+    table[ColumnLayout::kCreated] = b.columns.at(kCreated, Elem::F64, rows);
+    table[ColumnLayout::kIds] = b.columns.at(kIds, Elem::U32, rows);
+    table[ColumnLayout::kKill] = b.columns.at(kKill, Elem::U8, rows);
+    table[ColumnLayout::kNow] = b.columns.at(kNow, Elem::F64, rows);
+    table[ColumnLayout::kDt] = b.columns.at(kDt, Elem::F32, rows);
+    size_t component = 0;
+    for (size_t s = 0; s < o.state.size(); ++s)
+        for (int c = 0; c < o.state[s].type.width; ++c, ++component)
+            table[static_cast<size_t>(layout.stateOffset[s] + c)] =
+                b.columns.at(kFirstValue + (atCreation ? stateCount : 0) + component, Elem::F32, rows);
+    component = 0;
+    for (size_t p = 0; p < o.params.size(); ++p)
+        for (int c = 0; c < o.params[p].type.width; ++c)
+            table[static_cast<size_t>(layout.paramOffset[p] + c)] = staging_[type].args[component++];
+    component = 0;
+    for (size_t e = 0; e < o.exports.size(); ++e)
+        for (int c = 0; c < o.exports[e].type.width; ++c, ++component)
+            table[static_cast<size_t>(layout.exportOffset[e] + c)] =
+                b.columns.at(kFirstValue + 2 * stateCount + component, Elem::F32, rows);
+    for (size_t e = 0; e < 2 * o.emits.size(); ++e)
+        table[static_cast<size_t>(layout.emits) + e] =
+            b.columns.at(kFirstValue + 2 * stateCount + exportCount + e, Elem::F32, rows);
+    for (size_t p = 0; p < layout.parentColumns.size(); ++p)
+        for (int c = 0; c < layout.parentColumns[p].width; ++c) {
+            size_t column = static_cast<size_t>(layout.parentColumns[p].offset + c);
+            table[column] = parents.at(column - static_cast<size_t>(layout.parents), Elem::F32, rows);
+        }
+}
+
+// Creates queue_[from, to), all of one type: see rt/system_create.h. Rows are allocated
+// in queue order (what does not fit is dropped and counted); init, exports at creation
+// and the first update run over the whole batch; then object by object, in queue order,
+// its bursts, its death or its emissions. While an object emits, the rows allocated for
+// the objects after it count as free, as they would if each object were created alone.
+void Creation::createBatch(size_t type, size_t from, size_t to, double t1) {
+    Pool& pool = s_.pools[type];
+    const TypeInfo& info = s_.types[type];
+    const ir::Object& o = pool.object();
+    Batch& b = batches_[type];
+    const size_t n = to - from, first = queue_[from].staging, end = first + n;
+    b.first = first;
+    b.poolRows.assign(n, kSkipRow);
+    size_t allocated = 0;
+    for (size_t r = 0; r < n; ++r) {
+        auto row = pool.allocate();
+        if (!row) {
+            ++s_.typeStats[type].dropped;
+            continue;
+        }
+        b.poolRows[r] = *row;
+        ++allocated;
+    }
+    if (allocated == 0) {
+        queued_[type] -= n;
+        return;
+    }
+    s_.typeStats[type].created += allocated;
+    if (info.init) bindBatch(type, b, b.initLayout, b.initParents, b.initTable, false);
+    bindBatch(type, b, info.updateLayout, b.updateParents, b.updateTable, false);
+    if (info.exports) bindBatch(type, b, info.exportsLayout, b.exportsParents, b.exportsTable, false);
+    b.burstTables.resize(o.emits.size());
+    for (size_t site = 0; site < o.emits.size(); ++site)
+        if (!o.emits[site].rate && info.spawn[site])
+            bindBatch(type, b, info.spawnLayout[site], b.initParents, b.burstTables[site], true);
+
+    // The objects' identities, in the batch's columns and their pool rows.
+    const std::vector<Buffer>& table = b.updateTable;
+    auto* mask = s_.host<uint8_t>(b.columns.at(kMask, Elem::U8, end));
+    auto* created = s_.host<double>(table[ColumnLayout::kCreated]);
+    auto* ids = s_.host<uint32_t>(table[ColumnLayout::kIds]);
+    auto* poolCreated = s_.host<double>(pool.created);
+    auto* poolIds = s_.host<uint32_t>(pool.ids);
+    for (size_t r = 0; r < n; ++r) {
+        size_t i = first + r;
+        uint32_t row = b.poolRows[r];
+        mask[i] = row != kSkipRow;
+        if (!mask[i]) continue;
+        const Entry& e = queue_[from + r];
+        created[i] = poolCreated[row] = e.time;
+        ids[i] = poolIds[row] = e.id;
+        pool.parent[row] = e.parent;
+        if (e.parent.valid()) ++s_.pools[static_cast<size_t>(info.parentType)].readers[e.parent.row];
+    }
+    for (size_t p = 0; p < o.params.size(); ++p)
+        if (pool.paramColumn[p] >= 0)
+            for (int c = 0; c < o.params[p].type.width; ++c)
+                s_.memory.scatter(table[static_cast<size_t>(info.updateLayout.paramOffset[p] + c)], first,
+                                  pool.params.column(static_cast<size_t>(pool.paramColumn[p]), static_cast<size_t>(c)),
+                                  b.poolRows);
+    for (size_t s = 0; s < o.state.size(); ++s)
+        for (int c = 0; c < o.state[s].type.width; ++c)
+            std::memset(s_.host<float>(table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)]) + first, 0,
+                        n * sizeof(float));
+
+    // At creation: init (the state, the bursts' sizes) and the exports, at each object's
+    // creation time.
+    auto atCreation = [&](const ir::Kernel& kernel, const ColumnLayout& layout, std::vector<Buffer>& t) {
+        t[ColumnLayout::kNow] = t[ColumnLayout::kCreated];
+        RowsLaunch launch;
+        launch.object = &o;
+        launch.kernel = &kernel;
+        launch.layout = &layout;
+        launch.columns = t;
+        launch.mask = b.columns.at(kMask, Elem::U8, end);
+        launch.clock = {Clock::Source::PerRow, Clock::Source::Uniform, 0, 0, true};
+        launch.externs = s_.externs.data();
+        launch.uniformKernel = s_.uniformKernel(type, kernel);
+        launch.seed = s_.options.seed;
+        launch.draw = kCreationDraw;
+        s_.gatherParents(type, layout, t, mask, first, end, 0, created, b.poolRows.data(), first);
+        runBatch(launch, first, end);
+    };
+    if (info.init) atCreation(*info.init, b.initLayout, b.initTable);
+    if (info.exports) atCreation(*info.exports, info.exportsLayout, b.exportsTable);
+    if (info.bursts)  // bursts read the state at creation, after the first update changed it
+        for (size_t s = 0; s < o.state.size(); ++s)
+            for (int c = 0; c < o.state[s].type.width; ++c) {
+                auto column = static_cast<size_t>(info.updateLayout.stateOffset[s] + c);
+                for (size_t site = 0; site < o.emits.size(); ++site)
+                    if (!b.burstTables[site].empty()) {
+                        s_.memory.copy(table[column], first, b.burstTables[site][column], first, n);
+                        break;
+                    }
+            }
+    firstUpdate(type, b, n, allocated, t1);
+}
+
+// A launch over rows [first, end) of a batch, in chunks (on several threads where the
+// backend allows).
+void Creation::runBatch(const RowsLaunch& launch, size_t first, size_t end) {
+    size_t n = end - first;
+    s_.parallel->forEach((n + kRowsPerChunk - 1) / kRowsPerChunk, s_.backend.concurrent(), [&](size_t c) {
+        RowsLaunch part = launch;
+        part.begin = first + c * kRowsPerChunk;
+        part.end = std::min(end, part.begin + kRowsPerChunk);
+        s_.backend.run(part);
+    });
+}
+
+// The first update of a batch's objects, from their creation to t1, in sub-steps no longer
+// than @step; then each object's bursts, death or emissions, in queue order.
+void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, double t1) {
+    const TypeInfo& info = s_.types[type];
+    const size_t first = b.first, end = first + n;
+    const std::vector<Buffer>& table = b.updateTable;
+    auto* mask = s_.host<uint8_t>(b.columns.at(kMask, Elem::U8, end));
+    auto* created = s_.host<double>(table[ColumnLayout::kCreated]);
+    auto* now = s_.host<double>(table[ColumnLayout::kNow]);
+    auto* dt = s_.host<float>(table[ColumnLayout::kDt]);
+    b.spans.assign(n, 0);
+    b.subSteps.assign(n, 1);
+    uint32_t most = 1;
+    for (size_t r = 0; r < n; ++r) {
+        size_t i = first + r;
+        if (!mask[i]) continue;
+        double span = t1 - created[i], h = info.stepLimit;
+        b.spans[r] = span;
+        b.subSteps[r] = h > 0 && span > h ? static_cast<uint32_t>(std::ceil(span / h)) : 1;
+        most = std::max(most, b.subSteps[r]);
+        now[i] = t1;
+        dt[i] = static_cast<float>(span);
+    }
+    // In queue order: `each(r, ordinal)` for the objects created, with the accounting of
+    // rows allocated for the objects after them.
+    auto inOrder = [&](bool leaveQueue, auto each) {
+        size_t ordinal = 0;
+        for (size_t r = 0; r < n; ++r) {
+            if (leaveQueue) --queued_[type];
+            if (b.poolRows[r] == kSkipRow) continue;
+            pending_[type] = allocated - 1 - ordinal++;
+            each(r);
+        }
+        pending_[type] = 0;
+    };
+    if (most == 1) {
+        advance(type, b, n, kMask);
+        inOrder(true, [&](size_t r) {
+            queueBursts(type, b, r);
+            killOrEmit(type, b, r, b.spans[r], t1);
+        });
+        return;
+    }
+    // Sub-steps: every object through its own, the k-th of each at once.
+    inOrder(true, [&](size_t r) { queueBursts(type, b, r); });
+    auto* stepMask = s_.host<uint8_t>(b.columns.at(kStepMask, Elem::U8, end));
+    const Pool& pool = s_.pools[type];
+    for (uint32_t k = 1; k <= most; ++k) {
+        for (size_t r = 0; r < n; ++r) {
+            size_t i = first + r;
+            uint32_t steps = b.subSteps[r];
+            stepMask[i] = mask[i] && k <= steps && pool.status(b.poolRows[r]) == Status::Alive;
+            if (!stepMask[i]) continue;
+            double span = b.spans[r], t0 = t1 - span;
+            now[i] = k == steps ? t1 : t0 + span * (static_cast<double>(k) / steps);
+            dt[i] = static_cast<float>(span / steps);
+        }
+        advance(type, b, n, kStepMask);
+        inOrder(false, [&](size_t r) {
+            if (stepMask[first + r]) killOrEmit(type, b, r, b.spans[r] / b.subSteps[r], now[first + r]);
+        });
+    }
+}
+
+// One update of the batch rows `maskColumn` selects, at their own clocks, then their
+// exports (those not killed), then the state and exports to their pool rows.
+void Creation::advance(size_t type, Batch& b, size_t n, size_t maskColumn) {
+    const TypeInfo& info = s_.types[type];
+    const ir::Object& o = s_.module.objects[type];
+    const size_t first = b.first, end = first + n;
+    std::vector<Buffer>& table = b.updateTable;
+    Buffer maskBuffer = b.columns.at(maskColumn, Elem::U8, end);
+    auto* mask = s_.host<uint8_t>(maskBuffer);
+    auto* now = s_.host<double>(table[ColumnLayout::kNow]);
+    auto launchOn = [&](const ir::Kernel& kernel, const ColumnLayout& layout, std::vector<Buffer>& t, Buffer m) {
+        t[ColumnLayout::kNow] = table[ColumnLayout::kNow];
+        t[ColumnLayout::kDt] = table[ColumnLayout::kDt];
+        RowsLaunch launch;
+        launch.object = &o;
+        launch.kernel = &kernel;
+        launch.layout = &layout;
+        launch.columns = t;
+        launch.mask = m;
+        launch.clock = {Clock::Source::PerRow, Clock::Source::PerRow, 0, 0, false};
+        launch.externs = s_.externs.data();
+        launch.uniformKernel = s_.uniformKernel(type, kernel);
+        launch.seed = s_.options.seed;
+        launch.draw = static_cast<uint32_t>(s_.step);
+        s_.gatherParents(type, layout, t, s_.host<uint8_t>(m), first, end, 0, now, b.poolRows.data(), first);
+        runBatch(launch, first, end);
+    };
+    launchOn(*info.update, info.updateLayout, table, maskBuffer);
+    if (info.exports) {
+        Buffer exportMask = b.columns.at(kExportMask, Elem::U8, end);
+        auto* alive = s_.host<uint8_t>(exportMask);
+        const auto* kill = s_.host<uint8_t>(table[ColumnLayout::kKill]);
+        for (size_t i = first; i < end; ++i) alive[i] = mask[i] && !(info.kills && kill[i]);
+        launchOn(*info.exports, info.exportsLayout, b.exportsTable, exportMask);
+    }
+    Pool& pool = s_.pools[type];
+    for (size_t s = 0; s < o.state.size(); ++s)
+        for (int c = 0; c < o.state[s].type.width; ++c)
+            s_.memory.scatter(table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)], first,
+                              pool.state.column(s, static_cast<size_t>(c)), b.poolRows);
+    for (size_t e = 0; e < o.exports.size(); ++e)
+        for (int c = 0; c < o.exports[e].type.width; ++c)
+            s_.memory.scatter(b.exportsTable[static_cast<size_t>(info.exportsLayout.exportOffset[e] + c)], first,
+                              pool.exports.column(e, static_cast<size_t>(c)), b.poolRows);
+}
+
+void Creation::queueBursts(size_t type, Batch& b, size_t r) {
+    const ir::Object& o = s_.module.objects[type];
+    size_t i = b.first + r;
+    const auto* created = s_.host<double>(b.updateTable[ColumnLayout::kCreated]);
+    for (size_t site = 0; site < o.emits.size(); ++site) {
+        if (o.emits[site].rate) continue;
+        auto column = static_cast<size_t>(b.initLayout.emitCount(static_cast<int>(site)));
+        float size = b.initTable.empty() ? 0 : s_.host<float>(b.initTable[column])[i];
+        double count = std::floor(validCount(size, s_.stats.invalidEmissions));
+        if (count < 1) continue;
+        Emitter e{type, b.poolRows[r], b.burstTables[site], static_cast<uint32_t>(i), created[i], true};
+        queueChildren(e, static_cast<int>(site), static_cast<uint64_t>(std::min(count, 1e18)), 1, created[i], 0);
+    }
+}
+
+void Creation::killOrEmit(size_t type, Batch& b, size_t r, double dt, double t1) {
+    const TypeInfo& info = s_.types[type];
+    const ir::Object& o = s_.module.objects[type];
+    size_t i = b.first + r;
+    uint32_t row = b.poolRows[r];
+    if (info.kills && s_.host<uint8_t>(b.updateTable[ColumnLayout::kKill])[i]) {
+        s_.kill(type, row);
+        return;
+    }
+    if (!info.rateEmits) return;
+    rate_.assign(o.emits.size(), 0);
+    count_.assign(o.emits.size(), 1);
+    for (size_t s = 0; s < o.emits.size(); ++s) {
+        auto site = static_cast<int>(s);
+        if (info.rated[s]) rate_[s] = s_.host<float>(b.updateTable[static_cast<size_t>(info.updateLayout.emitRate(site))])[i];
+        if (info.counted[s]) count_[s] = s_.host<float>(b.updateTable[static_cast<size_t>(info.updateLayout.emitCount(site))])[i];
+    }
+    emitAtRate({type, row, {}, row, t1, false}, rate_, count_, dt, t1);
+}
+
+}  // namespace psys::rt::detail

@@ -9,8 +9,8 @@
 
 namespace psys::rt::detail {
 
-using Clock = std::chrono::steady_clock;
-inline double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+using WallClock = std::chrono::steady_clock;
+inline double seconds(WallClock::time_point a, WallClock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
 // An emission count or rate from a kernel: NaN, infinite and negative values count as
 // invalid and emit nothing.

@@ -97,8 +97,8 @@ Comparison compareBackends(const std::string& text, int frames, bool optimize, M
         REQUIRE_FALSE(a.step(1.0 / 60));
         REQUIRE_FALSE(b.step(1.0 / 60));
         for (size_t t = 0; t < a.typeCount(); ++t) {
-            const auto& pa = a.render(t);
-            const auto& pb = b.render(t);
+            const auto& pa = a.points(t);
+            const auto& pb = b.points(t);
             REQUIRE(pa.size() == pb.size());
             for (size_t i = 0; i < pa.size(); ++i) {
                 REQUIRE(pa[i].id == pb[i].id);

@@ -41,7 +41,7 @@ struct Run {
         for (int i = 0; i < n; ++i) REQUIRE_FALSE(system->step(dt).has_value());
     }
     size_t type(const std::string& name) const { return static_cast<size_t>(system->typeIndex(name)); }
-    const std::vector<rt::RenderPoint>& points(const std::string& name) { return system->render(type(name)); }
+    std::vector<rt::RenderPoint> points(const std::string& name) { return system->points(type(name)); }
     rt::TypeStats stats(const std::string& name) const { return system->stats().types[type(name)]; }
 };
 
@@ -185,7 +185,7 @@ TEST_CASE("every sample compiles, verifies and runs 600 frames at dt = 1/60") {
         INFO(entry.path().filename().string());
         Run run(test::readFile(entry.path().string()));
         run.steps(600, 1.0 / 60);
-        for (size_t t = 0; t < run.system->typeCount(); ++t) run.system->render(t);
+        for (size_t t = 0; t < run.system->typeCount(); ++t) run.system->points(t);
         CHECK(run.system->stats().nonFiniteRender == 0);
     }
     CHECK(count >= 12);
@@ -334,8 +334,8 @@ size_t compareRuns(Run& a, Run& b, int frames, const std::function<bool(float, f
         a.steps(1, 1.0 / 60);
         b.steps(1, 1.0 / 60);
         for (size_t t = 0; t < a.system->typeCount(); ++t) {
-            const auto& pa = a.system->render(t);
-            const auto& pb = b.system->render(t);
+            const auto& pa = a.system->points(t);
+            const auto& pb = b.system->points(t);
             REQUIRE(pa.size() == pb.size());
             for (size_t i = 0; i < pa.size(); ++i) {
                 ++points;

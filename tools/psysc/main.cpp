@@ -19,6 +19,7 @@
 #include "opt/passes.h"
 #include "opt/stats.h"
 #include "driver/compile.h"
+#include "host/backends.h"
 #include "run_command.h"
 
 namespace {
@@ -146,7 +147,7 @@ int main(int argc, char** argv) {
     run->add_option("--dump-every", runOptions.dumpEvery, "Dump every Nth frame (1)")->check(CLI::PositiveNumber);
     run->add_flag("--quiet", runOptions.quiet, "No line per frame, only the summary");
     run->add_option("--backend", runOptions.backend, "llvm (JIT-compiled, the default) or interp (the reference)")
-        ->check(CLI::IsMember({"interp", "llvm"}));
+        ->check(CLI::IsMember(psys::host::backendNames()));
     run->add_option("--math", runOptions.math,
                     "llvm backend: fast (fused multiply-adds, vector math functions; the default) or exact "
                     "(the interpreter's results bit for bit)")

@@ -1,6 +1,7 @@
-// `psysc run`: compile a system and step it through time, JIT-compiled or interpreted.
+// `psysc run`: compile a system and step it through time (through the host library).
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -19,7 +20,7 @@ struct RunOptions {
     bool quiet = false;
     bool optimize = true;
     bool relaxed = false;
-    std::string backend = "llvm";    // or "interp"
+    std::string backend = "llvm";    // host/backends.h
     std::string math = "fast";       // or "exact" (llvm)
     unsigned threads = 0;            // 0: every core
     bool timing = false;

@@ -1,12 +1,12 @@
-#include "rt/batch.h"
+#include "rt/columns.h"
 
 #include <fmt/format.h>
 
 namespace psys::rt {
 
-BatchLayout batchLayout(const ir::Object& object, const ir::Kernel& kernel) {
-    BatchLayout l;
-    int next = BatchLayout::kFirstColumn;
+ColumnLayout columnLayout(const ir::Object& object, const ir::Kernel& kernel) {
+    ColumnLayout l;
+    int next = ColumnLayout::kFirstColumn;
     auto section = [&next](std::vector<int>& offsets, auto const& items) {
         int start = next;
         for (const auto& item : items) {
@@ -21,10 +21,10 @@ BatchLayout batchLayout(const ir::Object& object, const ir::Kernel& kernel) {
     l.emits = next;
     next += 2 * static_cast<int>(object.emits.size());
     l.render = next;
-    next += BatchLayout::kRenderColumns;
+    next += ColumnLayout::kRenderColumns;
     l.parents = next;
     for (const ir::Inst& i : kernel.insts()) {
-        if (i.op != ir::Op::ParentExport && i.op != ir::Op::ParentAlive && i.op != ir::Op::ParentAge) continue;
+        if (!ir::readsAncestor(i.op)) continue;
         l.parentColumns.push_back({i.op, i.attr2, i.op == ir::Op::ParentExport ? i.attr : -1, i.type.width, next});
         next += i.type.width;
     }
@@ -32,7 +32,16 @@ BatchLayout batchLayout(const ir::Object& object, const ir::Kernel& kernel) {
     return l;
 }
 
-std::string BatchLayout::signature() const {
+int ColumnLayout::renderColumn(ir::YieldKind kind) {
+    switch (kind) {
+        case ir::YieldKind::Visible: return kVisible;
+        case ir::YieldKind::Position: return kPosition;
+        case ir::YieldKind::Color: return kColor;
+        default: return kSize;
+    }
+}
+
+std::string ColumnLayout::signature() const {
     std::string s = fmt::format("state {} params {} exports {} emits {} render {} parents {} total {} |", state,
                                 params, exports, emits, render, parents, total);
     for (int o : stateOffset) s += fmt::format(" s{}", o);

@@ -1,0 +1,25 @@
+// Choosing a backend by name: the one place the tools know which backends exist.
+//   llvm    the LLVM ORC JIT (codegen_llvm/), fast or exact maths
+//   interp  the reference interpreter (interp/)
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "host/settings.h"
+#include "rt/backend.h"
+
+namespace psys::host {
+
+struct BackendChoice {
+    std::string name = "llvm";
+    std::string math = "fast";  // llvm: fast or exact
+};
+
+// The backends this build has, the default first.
+std::vector<std::string> backendNames();
+// A new backend, or the message saying why not (an unknown name or maths mode).
+Parsed<std::shared_ptr<rt::Backend>> makeBackend(const BackendChoice& choice);
+
+}  // namespace psys::host

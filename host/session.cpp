@@ -1,0 +1,93 @@
+#include "host/session.h"
+
+#include <chrono>
+#include <ostream>
+
+namespace psys::host {
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+void CompileResult::print(std::ostream& out, bool colour) const {
+    if (diagnostics) diagnostics->print(out, colour);
+}
+
+std::string CompileResult::text() const { return diagnostics ? diagnostics->render(false) : std::string(); }
+
+CompileResult compile(const std::string& path, const CompileOptions& options, std::optional<ir::Module>& module,
+                      const std::string* text) {
+    CompileResult result;
+    result.sources = std::make_shared<SourceManager>();
+    result.diagnostics = std::make_shared<DiagnosticEngine>(*result.sources);
+    auto start = std::chrono::steady_clock::now();
+    module = text ? compileText(path, *text, *result.sources, *result.diagnostics, options)
+                  : compileFile(path, *result.sources, *result.diagnostics, options);
+    result.seconds = secondsSince(start);
+    result.ok = module.has_value();
+    return result;
+}
+
+std::unique_ptr<Session> Session::open(const std::string& path, const SessionOptions& options, CompileResult& result,
+                                       std::string& error, const std::string* text) {
+    std::optional<ir::Module> module;
+    result = compile(path, options.compile, module, text);
+    if (!module) return nullptr;
+    auto backend = makeBackend(options.backend);
+    if (!backend) {
+        error = backend.error;
+        return nullptr;
+    }
+    std::unique_ptr<Session> s(new Session());
+    s->path_ = path;
+    s->options_ = options;
+    s->backend_ = *backend;
+    s->system_ = std::make_unique<rt::System>(std::move(*module), *s->backend_, options.system);
+    return s;
+}
+
+Session::~Session() = default;
+
+std::optional<std::string> Session::apply(const ExternSetting& setting) {
+    return system_->setExtern(setting.name, setting.values);
+}
+
+std::optional<std::string> Session::fire(const TriggerFiring& firing) { return system_->fire(firing.trigger, firing.args); }
+
+std::optional<std::string> Session::frame(int index, double dt) {
+    for (const TriggerFiring& f : scheduled_)
+        if (f.frame == index)
+            if (auto error = fire(f)) return "--fire " + f.trigger + ": " + *error;
+    auto start = std::chrono::steady_clock::now();
+    auto error = system_->step(dt);
+    stepSeconds_ += secondsSince(start);
+    return error;
+}
+
+Session::Reload Session::reload(const std::string* text) {
+    Reload out;
+    std::optional<ir::Module> module;
+    out.compile = compile(path_, options_.compile, module, text);
+    if (!module) return out;  // the old system keeps running
+    auto next = std::make_unique<rt::System>(std::move(*module), *backend_, system_->options());
+    out.report = next->carryOver(*system_);
+    system_ = std::move(next);
+    return out;
+}
+
+std::optional<std::string> Session::switchBackend(const BackendChoice& choice) {
+    auto backend = makeBackend(choice);
+    if (!backend) return backend.error;
+    auto next = std::make_unique<rt::System>(system_->module(), **backend, system_->options());
+    next->carryOver(*system_);
+    system_ = std::move(next);  // the old system goes before its backend
+    backend_ = *backend;
+    options_.backend = choice;
+    return std::nullopt;
+}
+
+}  // namespace psys::host

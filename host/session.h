@@ -1,0 +1,85 @@
+// A running system as a host holds it: compiled from a file (through driver/), on a
+// backend chosen by name, with the host's settings applied, stepped frame by frame — and
+// hot-reloaded: compile the file again and, if it compiles, a new system takes over the
+// running one's objects (rt::System::carryOver); if it does not, the old one keeps
+// running and the diagnostics say why. psysc run, the viewer and the benchmarks are
+// users of this.
+#pragma once
+
+#include <iosfwd>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "driver/compile.h"
+#include "host/backends.h"
+#include "host/settings.h"
+#include "rt/system.h"
+
+namespace psys::host {
+
+struct SessionOptions {
+    BackendChoice backend;
+    CompileOptions compile;
+    rt::SystemOptions system;
+};
+
+// The outcome of one compilation: its diagnostics (errors and warnings, with their
+// sources), whether it produced a module, and how long it took.
+struct CompileResult {
+    std::shared_ptr<SourceManager> sources;
+    std::shared_ptr<DiagnosticEngine> diagnostics;
+    bool ok = false;
+    double seconds = 0;
+    void print(std::ostream& out, bool colour) const;
+    std::string text() const;  // the diagnostics without colour
+};
+
+// Compiles a file (or a text standing for it) to a module.
+CompileResult compile(const std::string& path, const CompileOptions& options, std::optional<ir::Module>& module,
+                      const std::string* text = nullptr);
+
+class Session {
+public:
+    // Compiles `path` (or `text`, standing for it) and starts a system on the chosen
+    // backend; null when it does not compile or the backend cannot be made (`result`, `error`).
+    static std::unique_ptr<Session> open(const std::string& path, const SessionOptions& options, CompileResult& result,
+                                         std::string& error, const std::string* text = nullptr);
+    ~Session();
+
+    rt::System& system() { return *system_; }
+    const rt::System& system() const { return *system_; }
+    rt::Backend& backend() { return *backend_; }
+    const SessionOptions& options() const { return options_; }
+    const std::string& path() const { return path_; }
+
+    std::optional<std::string> apply(const ExternSetting& setting);
+    std::optional<std::string> fire(const TriggerFiring& firing);
+    // Triggers fired before the frames they name (frame() below).
+    void schedule(std::vector<TriggerFiring> firings) { scheduled_ = std::move(firings); }
+    // Frame `index` (from 1): the triggers scheduled for it, then a step of `dt`.
+    std::optional<std::string> frame(int index, double dt);
+    double stepSeconds() const { return stepSeconds_; }  // in frame(), so far
+
+    struct Reload {
+        CompileResult compile;
+        std::optional<rt::ReloadReport> report;  // when it compiled and took over
+    };
+    // Compiles the file again (or `text`); on success the new system takes over.
+    Reload reload(const std::string* text = nullptr);
+    // The running system's objects on another backend.
+    std::optional<std::string> switchBackend(const BackendChoice& choice);
+
+private:
+    Session() = default;
+
+    std::string path_;
+    SessionOptions options_;
+    std::shared_ptr<rt::Backend> backend_;
+    std::unique_ptr<rt::System> system_;
+    std::vector<TriggerFiring> scheduled_;
+    double stepSeconds_ = 0;
+};
+
+}  // namespace psys::host

@@ -1,0 +1,62 @@
+#include "host/settings.h"
+
+#include <cmath>
+#include <cstdlib>
+
+namespace psys::host {
+
+std::optional<double> parseNumber(const std::string& text) {
+    auto slash = text.find('/');
+    if (slash != std::string::npos) {
+        auto a = parseNumber(text.substr(0, slash)), b = parseNumber(text.substr(slash + 1));
+        if (!a || !b) return std::nullopt;
+        return *a / *b;
+    }
+    char* end = nullptr;
+    double v = std::strtod(text.c_str(), &end);
+    if (text.empty() || *end != '\0') return std::nullopt;
+    return v;
+}
+
+std::optional<std::vector<float>> parseNumbers(const std::string& text) {
+    std::vector<float> out;
+    if (text.empty()) return out;
+    size_t start = 0;
+    while (start <= text.size()) {
+        size_t comma = text.find(',', start);
+        auto v = parseNumber(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+        if (!v) return std::nullopt;
+        out.push_back(static_cast<float>(*v));
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+    }
+    return out;
+}
+
+Parsed<ExternSetting> parseSet(const std::string& text) {
+    auto eq = text.find('=');
+    auto values = eq == std::string::npos ? std::nullopt : parseNumbers(text.substr(eq + 1));
+    if (!values || eq == 0) return Parsed<ExternSetting>::fail("--set takes NAME=VALUE or NAME=X,Y,Z, not `" + text + "`");
+    return {ExternSetting{text.substr(0, eq), *values}, {}};
+}
+
+Parsed<TriggerFiring> parseFire(const std::string& text) {
+    auto at = text.rfind('@');
+    auto colon = text.find(':');
+    double frame = -1;
+    if (at != std::string::npos)
+        if (auto n = parseNumber(text.substr(at + 1))) frame = *n;
+    std::optional<std::vector<float>> args = std::vector<float>{};
+    if (colon != std::string::npos && colon < at) args = parseNumbers(text.substr(colon + 1, at - colon - 1));
+    if (frame < 0 || !args || !std::isfinite(frame) || frame > 2e9)
+        return Parsed<TriggerFiring>::fail("--fire takes TRIGGER@FRAME or TRIGGER:X,Y,Z@FRAME, not `" + text + "`");
+    return {TriggerFiring{text.substr(0, std::min(colon, at)), *args, static_cast<int>(frame)}, {}};
+}
+
+Parsed<double> parseStep(const std::string& text) {
+    auto dt = parseNumber(text);
+    if (!dt) return Parsed<double>::fail("--dt takes a number of seconds (such as 0.016 or 1/60), not `" + text + "`");
+    return {*dt, {}};
+}
+
+}  // namespace psys::host

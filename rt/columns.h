@@ -1,0 +1,56 @@
+// The column table of a launch: where each column a kernel reads or writes sits, fixed by
+// the object's types and the kernel alone, so a backend can compile a kernel's loop once
+// and run it on any pool (or creation scratch) of that object type.
+//
+//   created  f64 per row: the creation time (age = ageAt(now, created), rt/clock.h)
+//   ids      u32 per row
+//   kill     u8 per row, written (0 or 1) for every row of the range by kernels that kill
+//   now, dt  f64 and f32 per row, read when the launch's clock says PerRow
+//   state, params, exports: one f32 column per component, in declaration order; a
+//     parameter the pool does not keep has no column (an invalid buffer)
+//   emits    per emit site, a rate and a count column (f32), written for every row
+//   render   visible (0 or 1), position x y z, colour r g b a, size: f32, written for
+//     every row by render kernels
+//   parents  per parent read of the kernel, in instruction order, one f32 column per
+//     component (gathered by the run-time; `alive` is 0 or 1)
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "ir/ir.h"
+
+namespace psys::rt {
+
+struct ColumnLayout {
+    static constexpr int kCreated = 0, kIds = 1, kKill = 2, kNow = 3, kDt = 4, kFirstColumn = 5;
+    int state = 0, params = 0, exports = 0, emits = 0, render = 0, parents = 0, total = 0;
+    static constexpr int kVisible = 0, kPosition = 1, kColor = 4, kSize = 8, kRenderColumns = 9;
+    std::vector<int> stateOffset, paramOffset, exportOffset;
+    struct ParentColumn {
+        ir::Op op;
+        int depth;
+        int exportIndex;  // ParentExport only
+        int width;
+        int offset;       // its first column
+    };
+    std::vector<ParentColumn> parentColumns;  // in the kernel's instruction order
+
+    int emitRate(int site) const { return emits + 2 * site; }
+    int emitCount(int site) const { return emits + 2 * site + 1; }
+    // The first render column of a render yield.
+    static int renderColumn(ir::YieldKind kind);
+    // Names every column position, so two kernels with the same text and signature can
+    // share compiled code.
+    std::string signature() const;
+};
+
+ColumnLayout columnLayout(const ir::Object& object, const ir::Kernel& kernel);
+
+// Rows per chunk when a launch over a pool is split over threads. Chunks never depend on
+// the number of threads, so every row is computed by the same code path (vector body or
+// remainder) with 1 or N threads, and results are identical.
+constexpr size_t kRowsPerChunk = 8192;
+
+}  // namespace psys::rt

@@ -1,0 +1,106 @@
+#include "rt/memory.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <new>
+#include <stdexcept>
+
+namespace psys::rt {
+
+// One column: a 64-byte aligned array that grows by doubling, so that appending rows one
+// at a time costs amortized O(1).
+struct HostMemory::Column {
+    Elem elem;
+    size_t rows = 0, capacity = 0;
+    std::byte* data = nullptr;
+
+    ~Column() { std::free(data); }
+    size_t size() const { return elemSize(elem); }
+    void reserve(size_t wanted) {
+        if (wanted <= capacity) return;
+        size_t grown = std::max(wanted, capacity * 2);
+        size_t bytes = (grown * size() + 63) / 64 * 64;
+        auto* fresh = static_cast<std::byte*>(std::aligned_alloc(64, std::max<size_t>(bytes, 64)));
+        if (!fresh) throw std::bad_alloc();
+        if (data) std::memcpy(fresh, data, rows * size());
+        std::free(data);
+        data = fresh;
+        capacity = grown;
+    }
+    void resize(size_t n) {
+        reserve(n);
+        if (n > rows) std::memset(data + rows * size(), 0, (n - rows) * size());
+        rows = n;
+    }
+};
+
+HostMemory::HostMemory() = default;
+HostMemory::~HostMemory() = default;
+
+Buffer HostMemory::create(Elem elem, size_t rows) {
+    auto column = std::make_unique<Column>();
+    column->elem = elem;
+    column->resize(rows);
+    if (!free_.empty()) {
+        uint32_t id = free_.back();
+        free_.pop_back();
+        columns_[id] = std::move(column);
+        return {id};
+    }
+    columns_.push_back(std::move(column));
+    return {static_cast<uint32_t>(columns_.size() - 1)};
+}
+
+void HostMemory::resize(Buffer b, size_t rows) { columns_.at(b.id)->resize(rows); }
+
+void HostMemory::release(Buffer b) {
+    if (!b.valid() || b.id >= columns_.size() || !columns_[b.id]) return;
+    columns_[b.id].reset();
+    free_.push_back(b.id);
+}
+
+size_t HostMemory::rows(Buffer b) const { return columns_.at(b.id)->rows; }
+Elem HostMemory::elem(Buffer b) const { return columns_.at(b.id)->elem; }
+
+void HostMemory::read(Buffer b, size_t first, size_t count, void* out) const {
+    const Column& c = *columns_.at(b.id);
+    if (first + count > c.rows) throw std::out_of_range("HostMemory::read past the end of a buffer");
+    std::memcpy(out, c.data + first * c.size(), count * c.size());
+}
+
+void HostMemory::write(Buffer b, size_t first, size_t count, const void* in) {
+    Column& c = *columns_.at(b.id);
+    if (first + count > c.rows) throw std::out_of_range("HostMemory::write past the end of a buffer");
+    std::memcpy(c.data + first * c.size(), in, count * c.size());
+}
+
+void HostMemory::copy(Buffer from, size_t fromFirst, Buffer to, size_t toFirst, size_t count) {
+    Column &f = *columns_.at(from.id), &t = *columns_.at(to.id);
+    if (f.elem != t.elem || fromFirst + count > f.rows || toFirst + count > t.rows)
+        throw std::out_of_range("HostMemory::copy between mismatched buffers");
+    std::memmove(t.data + toFirst * t.size(), f.data + fromFirst * f.size(), count * f.size());
+}
+
+void HostMemory::scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const uint32_t> rows) {
+    Column &f = *columns_.at(from.id), &t = *columns_.at(to.id);
+    if (f.elem != t.elem || fromFirst + rows.size() > f.rows)
+        throw std::out_of_range("HostMemory::scatter between mismatched buffers");
+    size_t n = f.size();
+    for (size_t i = 0; i < rows.size(); ++i) {
+        if (rows[i] == kSkipRow) continue;
+        if (rows[i] >= t.rows) throw std::out_of_range("HostMemory::scatter past the end of a buffer");
+        std::memcpy(t.data + rows[i] * n, f.data + (fromFirst + i) * n, n);
+    }
+}
+
+void* HostMemory::host(Buffer b) { return columns_.at(b.id)->data; }
+
+size_t HostMemory::bytes() const {
+    size_t total = 0;
+    for (const auto& c : columns_)
+        if (c) total += c->capacity * c->size();
+    return total;
+}
+
+}  // namespace psys::rt

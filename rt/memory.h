@@ -1,0 +1,88 @@
+// Where a system's columns live, and the only way the run-time and the backends refer to
+// them: a Buffer is a handle to one column of fixed-size elements on some memory (host
+// RAM here; a GPU's memory for a GPU backend). Kernels are launched on buffers by handle
+// (rt/backend.h); moving values between the host and a buffer is an explicit call
+// (read, write), so where a device's memory is not the host's, every transfer is visible.
+//
+// HostMemory is the memory of the CPU backends (the interpreter and the LLVM JIT): its
+// buffers are host arrays, and `host()` gives their address to the code that runs on the
+// host (the backends' loops and the run-time's own bookkeeping of kills, emissions and
+// creation).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <span>
+#include <vector>
+
+namespace psys::rt {
+
+enum class Elem : uint8_t { F32, F64, U32, U8 };
+constexpr size_t elemSize(Elem e) { return e == Elem::F64 ? 8 : e == Elem::U8 ? 1 : 4; }
+
+// In a scatter's row list: this element is not written.
+constexpr uint32_t kSkipRow = std::numeric_limits<uint32_t>::max();
+
+struct Buffer {
+    uint32_t id = std::numeric_limits<uint32_t>::max();
+    bool valid() const { return id != std::numeric_limits<uint32_t>::max(); }
+    bool operator==(const Buffer&) const = default;
+};
+
+class Memory {
+public:
+    virtual ~Memory() = default;
+    // A column of `rows` elements, zero-filled.
+    virtual Buffer create(Elem elem, size_t rows) = 0;
+    // Keeps the first min(old, rows) elements; new ones are zero.
+    virtual void resize(Buffer buffer, size_t rows) = 0;
+    virtual void release(Buffer buffer) = 0;
+    virtual size_t rows(Buffer buffer) const = 0;
+    virtual Elem elem(Buffer buffer) const = 0;
+
+    // Explicit transfers between the host and a buffer, `count` elements from row `first`.
+    virtual void read(Buffer buffer, size_t first, size_t count, void* out) const = 0;
+    virtual void write(Buffer buffer, size_t first, size_t count, const void* in) = 0;
+    // Between buffers of one element type: to[toFirst + i] = from[fromFirst + i]; and
+    // to[rows[i]] = from[fromFirst + i] (rows[i] == kSkipRow: nothing).
+    virtual void copy(Buffer from, size_t fromFirst, Buffer to, size_t toFirst, size_t count) = 0;
+    virtual void scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const uint32_t> rows) = 0;
+
+    // The address of a buffer's first element where the host can address it, else null.
+    virtual void* host(Buffer buffer) = 0;
+    const void* host(Buffer buffer) const { return const_cast<Memory*>(this)->host(buffer); }
+};
+
+// Host RAM: buffers are arrays the host addresses directly (aligned to 64 bytes).
+class HostMemory final : public Memory {
+public:
+    HostMemory();
+    ~HostMemory() override;
+    Buffer create(Elem elem, size_t rows) override;
+    void resize(Buffer buffer, size_t rows) override;
+    void release(Buffer buffer) override;
+    size_t rows(Buffer buffer) const override;
+    Elem elem(Buffer buffer) const override;
+    void read(Buffer buffer, size_t first, size_t count, void* out) const override;
+    void write(Buffer buffer, size_t first, size_t count, const void* in) override;
+    void copy(Buffer from, size_t fromFirst, Buffer to, size_t toFirst, size_t count) override;
+    void scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const uint32_t> rows) override;
+    void* host(Buffer buffer) override;
+    // Bytes held by every live buffer (their capacity).
+    size_t bytes() const;
+
+private:
+    struct Column;
+    std::vector<std::unique_ptr<Column>> columns_;
+    std::vector<uint32_t> free_;
+};
+
+// Typed access to a host-addressable buffer (null when the memory is not the host's).
+template <typename T>
+T* hostData(Memory& memory, Buffer b) {
+    return static_cast<T*>(memory.host(b));
+}
+
+}  // namespace psys::rt

@@ -1,0 +1,24 @@
+// Internal to rt/: runs chunks of a launch on several threads. The only place the
+// run-time uses TBB, so that no public header carries it.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <memory>
+
+namespace psys::rt::detail {
+
+class Parallel {
+public:
+    explicit Parallel(unsigned threads);  // 0: every core
+    ~Parallel();
+    // chunk(c) for c in [0, chunks): on several threads when `concurrent` and there is more
+    // than one chunk, else in order on this thread.
+    void forEach(size_t chunks, bool concurrent, const std::function<void(size_t)>& chunk);
+
+private:
+    struct Arena;
+    std::unique_ptr<Arena> arena_;
+};
+
+}  // namespace psys::rt::detail

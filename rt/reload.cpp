@@ -1,0 +1,205 @@
+// Hot reload: a new System takes over an old one's objects (System::carryOver).
+//
+// Objects are carried over by type name, keeping their rows, generations and free lists,
+// so an unchanged source continues bit for bit: the same rows are updated in the same
+// order, new objects get the rows they would have got. A state slot, a kept parameter or
+// an export is carried when the new type has one of the same name and type; a slot the
+// new type adds starts as it would have at the object's creation (its init value,
+// evaluated at the creation time with the carried parameters; parameters the old type did
+// not keep read 0); what the new type no longer has is dropped. Parents are kept when the
+// new child type's parent type is the old one's; readers are counted again, and a frozen
+// object nobody reads any more is freed. Time, the step count, ids and externs (by name
+// and type) continue.
+#include <map>
+#include <set>
+
+#include "rt/rng.h"
+#include "rt/system_create.h"
+#include "rt/system_draw.h"
+#include "rt/system_state.h"
+
+namespace psys::rt {
+
+namespace {
+
+// One column from one memory to another, through the host.
+void copyColumn(const Memory& from, Buffer a, Memory& to, Buffer b, size_t rows, size_t elementBytes) {
+    if (rows == 0) return;
+    std::vector<std::byte> bytes(rows * elementBytes);
+    from.read(a, 0, rows, bytes.data());
+    to.write(b, 0, rows, bytes.data());
+}
+
+// The value columns of `to` matched by name and type in `from`: (new index, old index).
+template <typename Items>
+std::vector<std::pair<size_t, int>> matchByName(const Items& to, const Items& from) {
+    std::vector<std::pair<size_t, int>> out;
+    for (size_t i = 0; i < to.size(); ++i) {
+        int found = -1;
+        for (size_t j = 0; j < from.size(); ++j)
+            if (from[j].name == to[i].name && from[j].type == to[i].type) found = static_cast<int>(j);
+        out.push_back({i, found});
+    }
+    return out;
+}
+
+void copyValues(const Memory& from, const ValueColumns& a, size_t i, Memory& to, const ValueColumns& b, size_t j,
+                size_t rows) {
+    for (int c = 0; c < a.type(i).width; ++c)
+        copyColumn(from, a.column(i, static_cast<size_t>(c)), to, b.column(j, static_cast<size_t>(c)), rows, 4);
+}
+
+}  // namespace
+
+ReloadReport System::carryOver(const System& oldSystem) {
+    detail::State& s = *state_;
+    const detail::State& old = *oldSystem.state_;
+    ReloadReport report;
+    s.now = old.now;
+    s.lastDt = old.lastDt;
+    s.step = old.step;
+    s.nextId = old.nextId;
+    s.started = old.started;
+    s.stats = old.stats;
+    for (size_t e = 0; e < s.module.externs.size(); ++e) {
+        int j = old.module.externIndex(s.module.externs[e].name);
+        if (j >= 0 && old.module.externs[static_cast<size_t>(j)].type == s.module.externs[e].type)
+            s.externs[e] = old.externs[static_cast<size_t>(j)];
+    }
+    ++s.externsVersion;
+    std::set<std::string> kept;
+    // Rows first, for every type: children's parents are matched after.
+    std::vector<int> oldTypeOf(s.pools.size(), -1);
+    for (size_t t = 0; t < s.pools.size(); ++t) {
+        const ir::Object& o = s.module.objects[t];
+        int ot = old.module.objectIndex(o.name);
+        oldTypeOf[t] = ot;
+        if (ot < 0) continue;
+        kept.insert(o.name);
+        const Pool& from = old.pools[static_cast<size_t>(ot)];
+        const ir::Object& oo = from.object();
+        Pool& to = s.pools[t];
+        size_t rows = from.rows();
+        std::vector<Status> status(rows);
+        for (uint32_t r = 0; r < rows; ++r) status[r] = from.status(r);
+        to.restore(status, from.generations(), from.freeRows());
+        report.carried += from.live() + from.frozen();
+        copyColumn(old.memory, from.created, s.memory, to.created, rows, 8);
+        copyColumn(old.memory, from.ids, s.memory, to.ids, rows, 4);
+        copyColumn(old.memory, from.updatable, s.memory, to.updatable, rows, 1);
+        to.fresh = from.fresh;
+        for (auto [i, j] : matchByName(o.state, oo.state)) {
+            if (j >= 0) copyValues(old.memory, from.state, static_cast<size_t>(j), s.memory, to.state, i, rows);
+            else report.newSlots.push_back(o.name + "." + o.state[i].name);
+        }
+        for (auto [j, i] : matchByName(oo.state, o.state))
+            if (i < 0) report.lostSlots.push_back(o.name + "." + oo.state[j].name);
+        for (size_t p = 0; p < o.params.size(); ++p) {
+            if (to.paramColumn[p] < 0) continue;
+            for (size_t q = 0; q < oo.params.size(); ++q)
+                if (oo.params[q].name == o.params[p].name && oo.params[q].type == o.params[p].type && from.paramColumn[q] >= 0)
+                    copyValues(old.memory, from.params, static_cast<size_t>(from.paramColumn[q]), s.memory, to.params,
+                               static_cast<size_t>(to.paramColumn[p]), rows);
+        }
+        for (auto [i, j] : matchByName(o.exports, oo.exports))
+            if (j >= 0) copyValues(old.memory, from.exports, static_cast<size_t>(j), s.memory, to.exports, i, rows);
+        for (size_t site = 0; site < o.emits.size() && site < oo.emits.size(); ++site)
+            if (o.emits[site].target == oo.emits[site].target && o.emits[site].rate == oo.emits[site].rate)
+                to.emitted[site] = from.emitted[site];
+        s.typeStats[t] = old.typeStats[static_cast<size_t>(ot)];
+    }
+    for (size_t ot = 0; ot < old.pools.size(); ++ot) {
+        const std::string& name = old.module.objects[ot].name;
+        if (kept.count(name)) continue;
+        report.dropped += old.pools[ot].live() + old.pools[ot].frozen();
+        report.droppedTypes.push_back(name);
+    }
+    // Parents, where the parent type is the same as before; then readers, counted again.
+    for (size_t t = 0; t < s.pools.size(); ++t) {
+        Pool& to = s.pools[t];
+        int ot = oldTypeOf[t];
+        int parentType = s.types[t].parentType;
+        bool sameParent = ot >= 0 && parentType >= 0 &&
+                          old.types[static_cast<size_t>(ot)].parentType >= 0 &&
+                          old.module.objects[static_cast<size_t>(old.types[static_cast<size_t>(ot)].parentType)].name ==
+                              s.module.objects[static_cast<size_t>(parentType)].name;
+        for (uint32_t r = 0; r < to.rows(); ++r) {
+            to.readers[r] = 0;
+            to.parent[r] = sameParent && to.status(r) != Status::Free ? old.pools[static_cast<size_t>(ot)].parent[r] : Handle{};
+        }
+    }
+    for (size_t t = 0; t < s.pools.size(); ++t) {
+        int parentType = s.types[t].parentType;
+        if (parentType < 0) continue;
+        Pool& parents = s.pools[static_cast<size_t>(parentType)];
+        const Pool& to = s.pools[t];
+        for (uint32_t r = 0; r < to.rows(); ++r)
+            if (to.status(r) != Status::Free && parents.matches(to.parent[r])) ++parents.readers[to.parent[r].row];
+    }
+    for (size_t t = 0; t < s.pools.size(); ++t) {
+        Pool& pool = s.pools[t];
+        for (uint32_t r = 0; r < pool.rows(); ++r)
+            if (pool.status(r) == Status::Frozen && pool.readers[r] == 0) {
+                Handle parent = pool.parent[r];
+                pool.release(r);
+                s.releaseReader(t, parent);
+            }
+    }
+    initNewSlots(report);
+    drawing_->invalidate();
+    return report;
+}
+
+}  // namespace psys::rt
+
+namespace psys::rt {
+
+// The state slots a reload added start as at creation: the init kernel over the carried
+// objects, at their creation times, writing only the new slots.
+void System::initNewSlots(const ReloadReport& report) {
+    detail::State& s = *state_;
+    for (size_t t = 0; t < s.pools.size(); ++t) {
+        Pool& pool = s.pools[t];
+        const ir::Object& o = pool.object();
+        const ir::Kernel* init = s.types[t].init;
+        std::set<size_t> fresh;
+        for (size_t i = 0; i < o.state.size(); ++i)
+            for (const std::string& n : report.newSlots)
+                if (n == o.name + "." + o.state[i].name && o.state[i].init == ir::StateInit::Next) fresh.insert(i);
+        size_t rows = pool.rows();
+        if (fresh.empty() || !init || rows == 0) continue;
+        ColumnLayout layout = columnLayout(o, *init);
+        detail::Scratch scratch(s.memory), parents(s.memory);
+        std::vector<Buffer> table;
+        s.bindPool(t, layout, scratch, table);
+        size_t next = 1000;  // scratch columns past bindPool's
+        table[ColumnLayout::kNow] = pool.created;
+        for (size_t p = 0; p < o.params.size(); ++p)
+            if (pool.paramColumn[p] < 0)
+                for (int c = 0; c < o.params[p].type.width; ++c)
+                    table[static_cast<size_t>(layout.paramOffset[p] + c)] = scratch.at(next++, Elem::F32, rows);
+        for (size_t i = 0; i < o.state.size(); ++i)
+            if (!fresh.count(i))
+                for (int c = 0; c < o.state[i].type.width; ++c)
+                    table[static_cast<size_t>(layout.stateOffset[i] + c)] = scratch.at(next++, Elem::F32, rows);
+        Buffer mask = scratch.at(next++, Elem::U8, rows);
+        auto* carried = s.host<uint8_t>(mask);
+        for (uint32_t r = 0; r < rows; ++r) carried[r] = pool.status(r) != Status::Free;
+        RowsLaunch launch;
+        launch.object = &o;
+        launch.kernel = init;
+        launch.layout = &layout;
+        launch.columns = table;
+        launch.mask = mask;
+        launch.clock = {Clock::Source::PerRow, Clock::Source::Uniform, 0, 0, true};
+        launch.externs = s.externs.data();
+        launch.seed = s.options.seed;
+        launch.draw = kCreationDraw;
+        launch.begin = 0;
+        launch.end = rows;
+        s.gatherParents(t, layout, table, carried, 0, rows, 0, s.host<double>(pool.created));
+        s.backend.run(launch);
+    }
+}
+
+}  // namespace psys::rt

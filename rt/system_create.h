@@ -1,0 +1,79 @@
+// Internal to rt/: creating objects. Emissions queue objects (with their exact creation
+// times and their arguments, computed by the emitter's spawn kernel); `drain` creates
+// what is queued, in queue order, a batch of one type at a time: init, exports at
+// creation, bursts, the first partial update to the end of the step (in sub-steps under
+// @step), exports, then kills and emissions object by object in queue order. Every
+// object is created this way, one or many (docs/runtime.md, "Creation").
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "rt/system_state.h"
+
+namespace psys::rt::detail {
+
+// An object emitting children: its row in its pool (for its id, parent and bookkeeping)
+// and where its spawn kernels read it (the pool's columns, or a creation batch's).
+struct Emitter {
+    size_t type = 0;
+    uint32_t row = 0;
+    std::span<const Buffer> columns;  // empty: the pool's
+    uint32_t columnRow = 0;           // its row in `columns`
+    double at = 0;                    // the time its spawn kernels are evaluated at
+    bool first = false;               // it is being created
+};
+
+class Creation {
+public:
+    explicit Creation(State& state);
+    ~Creation();
+
+    // Queues `count` children of emit site `site`, `perEvent` at a time; the k-th event is
+    // at firstTime + k·spacing (spacing 0: all at once). Beyond the target's free capacity
+    // the rest are dropped and counted, without work per dropped child.
+    void queueChildren(const Emitter& emitter, int site, uint64_t count, uint64_t perEvent, double firstTime,
+                       double spacing);
+    // Rate emitters after an update of `dt` ending at t1: events fall where the accumulated
+    // rate crosses a whole number, so a stream is smooth within a step and a rate of
+    // 0.25/s emits at 4 s, 8 s, …
+    void emitAtRate(const Emitter& emitter, std::span<const float> rate, std::span<const float> count, double dt,
+                    double t1);
+    // A trigger's (or the start's) kernel, evaluated on the host: once for the counts,
+    // then once per created object for its arguments, so each draws its own numbers.
+    void emitFromKernel(const ir::Trigger& trigger, std::span<const Value> params, uint32_t objectId);
+    // Creates everything queued (and what that queues), each advanced to t1.
+    void drain(double t1);
+
+private:
+    struct Entry {
+        size_t type;
+        size_t staging;  // its arguments' row in the type's staging columns
+        Handle parent;
+        double time;
+        uint32_t id;
+    };
+    struct Staging;
+    struct Batch;
+
+    size_t stage(size_t type, size_t count);  // staging rows for `count` new entries of `type`
+    void createBatch(size_t type, size_t from, size_t to, double t1);
+    void runBatch(const RowsLaunch& launch, size_t first, size_t end);
+    void firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, double t1);
+    void advance(size_t type, Batch& b, size_t n, size_t maskColumn);
+    void queueBursts(size_t type, Batch& b, size_t r);
+    void killOrEmit(size_t type, Batch& b, size_t r, double dt, double t1);
+    void bindBatch(size_t type, Batch& b, const ColumnLayout& layout, Scratch& parents, std::vector<Buffer>& table,
+                   bool atCreation);
+
+    State& s_;
+    std::vector<Entry> queue_;
+    std::vector<size_t> queued_;   // per type: entries waiting in the queue
+    std::vector<size_t> pending_;  // per type: rows a batch allocated for objects not yet created in order
+    std::vector<Staging> staging_;
+    std::vector<Batch> batches_;
+    std::vector<Value> yields_, parents_;
+    std::vector<float> rate_, count_;
+};
+
+}  // namespace psys::rt::detail

@@ -1,0 +1,117 @@
+#include "rt/system_draw.h"
+
+#include <cmath>
+#include <mutex>
+
+#include "rt/system_support.h"
+
+namespace psys::rt::detail {
+
+Drawing::Drawing(State& state) : s_(state) {
+    for (size_t t = 0; t < s_.pools.size(); ++t) types_.emplace_back(s_.memory);
+}
+
+void Drawing::invalidate() {
+    for (Type& t : types_) t.stale = true;
+}
+
+const DrawColumns& Drawing::draw(size_t type) {
+    Type& d = types_[type];
+    if (!d.stale) return d.columns;
+    d.stale = false;
+    auto start = WallClock::now();
+    const Pool& pool = s_.pools[type];
+    const TypeInfo& info = s_.types[type];
+    size_t rows = pool.rows();
+    DrawColumns& out = d.columns;
+    out = {};
+    out.rows = rows;
+    out.ids = pool.ids;
+    if (!info.render || !info.drawn[0] || rows == 0) {
+        out.rows = 0;
+        return out;
+    }
+    const ColumnLayout& layout = info.renderLayout;
+    s_.bindPool(type, layout, d.scratch, d.table);
+    auto column = [&](int offset) { return d.table[static_cast<size_t>(layout.render + offset)]; };
+    out.visible = column(ColumnLayout::kVisible);
+    for (int c = 0; c < 3; ++c) out.position[c] = column(ColumnLayout::kPosition + c);
+    for (int c = 0; c < 4; ++c) out.color[c] = column(ColumnLayout::kColor + c);
+    out.size = column(ColumnLayout::kSize);
+    Buffer alive = d.scratch.at(static_cast<size_t>(layout.total), Elem::U8, rows);
+    RowsLaunch launch;
+    launch.object = &pool.object();
+    launch.kernel = info.render;
+    launch.layout = &layout;
+    launch.columns = d.table;
+    launch.mask = alive;
+    launch.clock = {Clock::Source::Uniform, Clock::Source::Uniform, s_.now, static_cast<float>(s_.lastDt), false};
+    launch.externs = s_.externs.data();
+    launch.uniforms = s_.uniforms(type, *info.render, static_cast<float>(s_.lastDt), static_cast<float>(s_.now));
+    launch.seed = s_.options.seed;
+    launch.draw = static_cast<uint32_t>(s_.step);
+    auto* mask = s_.host<uint8_t>(alive);
+    auto* visible = s_.host<float>(out.visible);
+    const float* values[8];
+    for (int c = 0; c < 8; ++c) values[c] = s_.host<float>(column(ColumnLayout::kPosition + c));
+    std::mutex counting;
+    size_t drawn = 0;
+    uint64_t nonFinite = 0;
+    s_.forChunks(rows, [&](size_t c) {
+        RowsLaunch part = launch;
+        part.begin = c * kRowsPerChunk;
+        part.end = std::min(rows, part.begin + kRowsPerChunk);
+        for (size_t row = part.begin; row < part.end; ++row)
+            mask[row] = pool.status(static_cast<uint32_t>(row)) == Status::Alive;
+        s_.gatherParents(type, layout, d.table, mask, part.begin, part.end, s_.now);
+        s_.backend.run(part);
+        // Drawn: alive, visible, and position, colour and size all finite.
+        size_t chunkDrawn = 0;
+        uint64_t chunkNonFinite = 0;
+        for (size_t row = part.begin; row < part.end; ++row) {
+            if (!mask[row] || visible[row] == 0) {
+                visible[row] = 0;
+                continue;
+            }
+            bool finite = true;
+            for (const float* v : values) finite &= std::isfinite(v[row]);
+            visible[row] = finite ? 1.0f : 0.0f;
+            chunkDrawn += finite;
+            chunkNonFinite += !finite;
+        }
+        std::lock_guard lock(counting);
+        drawn += chunkDrawn;
+        nonFinite += chunkNonFinite;
+    });
+    out.drawn = drawn;
+    s_.stats.nonFiniteRender += nonFinite;
+    s_.stats.drawSeconds += seconds(start, WallClock::now());
+    return out;
+}
+
+std::vector<RenderPoint> Drawing::points(size_t type) {
+    const DrawColumns& c = draw(type);
+    std::vector<RenderPoint> out;
+    if (c.rows == 0 || c.drawn == 0) return out;
+    out.reserve(c.drawn);
+    std::vector<float> visible(c.rows), values[8];
+    std::vector<uint32_t> ids(c.rows);
+    const Memory& memory = s_.memory;
+    memory.read(c.visible, 0, c.rows, visible.data());
+    memory.read(c.ids, 0, c.rows, ids.data());
+    Buffer columns[8] = {c.position[0], c.position[1], c.position[2], c.color[0], c.color[1], c.color[2], c.color[3], c.size};
+    for (int k = 0; k < 8; ++k) {
+        values[k].resize(c.rows);
+        memory.read(columns[k], 0, c.rows, values[k].data());
+    }
+    for (size_t row = 0; row < c.rows; ++row) {
+        if (visible[row] == 0) continue;
+        out.push_back({ids[row],
+                       {values[0][row], values[1][row], values[2][row]},
+                       {values[3][row], values[4][row], values[5][row], values[6][row]},
+                       values[7][row]});
+    }
+    return out;
+}
+
+}  // namespace psys::rt::detail

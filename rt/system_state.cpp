@@ -1,0 +1,222 @@
+// The parts of a System share this: the object store (pools, parents, deaths), the
+// uniform values, parent gathering and the column tables of launches over pools.
+#include "rt/system_state.h"
+
+#include <stdexcept>
+
+namespace psys::rt::detail {
+
+using ir::KernelKind;
+using ir::YieldKind;
+
+Scratch::~Scratch() {
+    for (Buffer b : buffers_) memory_->release(b);
+}
+
+Buffer Scratch::at(size_t index, Elem elem, size_t rows) {
+    while (buffers_.size() <= index) buffers_.push_back({});
+    Buffer& b = buffers_[index];
+    if (!b.valid() || memory_->elem(b) != elem) {
+        if (b.valid()) memory_->release(b);
+        b = memory_->create(elem, rows);
+    } else if (memory_->rows(b) < rows) {
+        memory_->resize(b, rows);
+    }
+    return b;
+}
+
+namespace {
+
+TypeInfo typeInfo(const ir::Module& module, const ir::Object& o) {
+    TypeInfo t;
+    t.parentType = o.parent.empty() ? -1 : module.objectIndex(o.parent);
+    t.stepLimit = o.attributes.step;
+    t.init = o.kernel(KernelKind::Init);
+    t.update = o.kernel(KernelKind::Update);
+    t.exports = o.kernel(KernelKind::Exports);
+    t.render = o.kernel(KernelKind::Render);
+    if (!t.update) throw std::invalid_argument("object " + o.name + " has no update kernel: the module was not compiled");
+    t.updateLayout = columnLayout(o, *t.update);
+    if (t.exports) t.exportsLayout = columnLayout(o, *t.exports);
+    if (t.render) {
+        t.renderLayout = columnLayout(o, *t.render);
+        for (const ir::Yield& y : t.render->yields) {
+            if (y.kind == YieldKind::Visible) t.drawn[0] = true;
+            if (y.kind == YieldKind::Position) t.drawn[1] = true;
+            if (y.kind == YieldKind::Color) t.drawn[2] = true;
+            if (y.kind == YieldKind::Size) t.drawn[3] = true;
+        }
+    }
+    t.counted.assign(o.emits.size(), false);
+    t.rated.assign(o.emits.size(), false);
+    for (const ir::Yield& y : t.update->yields) {
+        if (y.kind == YieldKind::Kill) t.kills = true;
+        if (y.kind == YieldKind::EmitCount) t.counted[static_cast<size_t>(y.index)] = true;
+        if (y.kind == YieldKind::EmitRate) t.rated[static_cast<size_t>(y.index)] = true;
+    }
+    for (size_t s = 0; s < o.emits.size(); ++s) {
+        t.rateEmits |= o.emits[s].rate;
+        t.bursts |= !o.emits[s].rate;
+        const ir::Kernel* spawn = o.kernel(KernelKind::Spawn, static_cast<int>(s));
+        t.spawn.push_back(spawn);
+        t.emitTarget.push_back(static_cast<size_t>(module.objectIndex(o.emits[s].target)));
+        t.spawnLayout.push_back(spawn ? columnLayout(o, *spawn) : ColumnLayout{});
+    }
+    return t;
+}
+
+}  // namespace
+
+State::State(ir::Module m, Backend& b, SystemOptions o)
+    : module(std::move(m)), backend(b), memory(b.memory()), options(o), parallel(std::make_unique<Parallel>(o.threads)) {
+    for (const ir::Object& obj : module.objects) {
+        size_t capacity = obj.attributes.capacity ? static_cast<size_t>(*obj.attributes.capacity) : options.capacity;
+        pools.emplace_back(obj, capacity, memory);
+        types.push_back(typeInfo(module, obj));
+        typeStats.push_back({obj.name, 0, 0, 0, 0, 0});
+    }
+    // Spawn kernels read the emitter's own columns, whose buffers never change: their
+    // tables are bound once (the parent values come with each launch).
+    for (size_t t = 0; t < pools.size(); ++t) {
+        work.emplace_back(memory);
+        for (const ColumnLayout& layout : types[t].spawnLayout) {
+            std::vector<Buffer> table;
+            if (layout.total > 0) {
+                bindPool(t, layout, work[t].update, table);
+                for (int column = layout.emits; column < layout.total; ++column) table[static_cast<size_t>(column)] = {};
+                table[ColumnLayout::kKill] = {};
+            }
+            work[t].spawnTables.push_back(std::move(table));
+        }
+    }
+    for (const ir::Extern& e : module.externs) externs.push_back({e.defaultValue, 0});
+    uniformCache.resize(pools.size());
+}
+
+State::~State() = default;
+
+std::pair<int, uint32_t> State::ancestor(size_t type, uint32_t row, int depth) const {
+    int t = static_cast<int>(type);
+    uint32_t r = row;
+    for (int d = 0; d < depth; ++d) {
+        Handle h = pools[static_cast<size_t>(t)].parent[r];
+        t = types[static_cast<size_t>(t)].parentType;
+        if (t < 0 || !h.valid() || !pools[static_cast<size_t>(t)].matches(h)) return {-1, 0};
+        r = h.row;
+    }
+    return {t, r};
+}
+
+void State::kill(size_t type, uint32_t row) {
+    ++typeStats[type].killed;
+    pools[type].freeze(row);  // no longer alive; freed at the end of the step if nobody reads it
+    dying.push_back({type, row});
+}
+
+void State::releaseReader(size_t childType, Handle parent) {
+    int t = types[childType].parentType;
+    while (t >= 0 && parent.valid()) {
+        Pool& pool = pools[static_cast<size_t>(t)];
+        if (!pool.matches(parent)) return;
+        if (--pool.readers[parent.row] > 0 || pool.status(parent.row) != Status::Frozen) return;
+        Handle up = pool.parent[parent.row];
+        pool.release(parent.row);
+        parent = up;
+        childType = static_cast<size_t>(t);
+        t = types[childType].parentType;
+    }
+}
+
+const ir::Kernel* State::uniformKernel(size_t type, const ir::Kernel& kernel) const {
+    auto served = ir::uniformFor(kernel.kind);
+    return served ? module.objects[type].kernel(*served) : nullptr;
+}
+
+const Value* State::uniforms(size_t type, const ir::Kernel& kernel, float dt, float time) {
+    const ir::Kernel* u = uniformKernel(type, kernel);
+    if (!u) return nullptr;
+    size_t slot = kernel.kind == KernelKind::Update ? 0 : kernel.kind == KernelKind::Render ? 1 : 2;
+    UniformCache& cache = uniformCache[type][slot];
+    if (!cache.valid || cache.dt != dt || cache.time != time || cache.externs != externsVersion) {
+        ir::KernelInputs in;
+        in.externs = externs.data();
+        in.dt = dt;
+        in.time = time;
+        in.seed = options.seed;
+        std::vector<Value> values;
+        evaluator.run(*u, in, values);
+        cache.values.assign(values.size(), Value{});
+        for (size_t i = 0; i < u->yields.size(); ++i) cache.values.at(static_cast<size_t>(u->yields[i].index)) = values[i];
+        cache.valid = true;
+        cache.dt = dt;
+        cache.time = time;
+        cache.externs = externsVersion;
+        ++stats.uniformEvaluations;
+    }
+    return cache.values.data();
+}
+
+void State::parentValues(size_t type, uint32_t row, const ColumnLayout& layout, double at, std::vector<Value>& out) const {
+    out.clear();
+    for (const auto& p : layout.parentColumns) {
+        auto [t, r] = ancestor(type, row, p.depth);
+        const Pool* parent = t < 0 ? nullptr : &pools[static_cast<size_t>(t)];
+        Value v;
+        if (p.op == ir::Op::ParentExport && parent) v = parent->exports.get(memory, static_cast<size_t>(p.exportIndex), r);
+        if (p.op == ir::Op::ParentAlive) v = Value::boolean(parent && parent->status(r) == Status::Alive);
+        if (p.op == ir::Op::ParentAge && parent) v = Value::scalar(ageAt(at, host<double>(parent->created)[r]));
+        out.push_back(v);
+    }
+}
+
+void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<const Buffer> table, const uint8_t* mask,
+                          size_t begin, size_t end, double at, const double* atRows, const uint32_t* poolRows,
+                          size_t poolRowsFirst) {
+    for (const auto& p : layout.parentColumns) {
+        for (size_t i = begin; i < end; ++i) {
+            if (!mask[i]) continue;
+            uint32_t row = poolRows ? poolRows[i - poolRowsFirst] : static_cast<uint32_t>(i);
+            auto [t, r] = ancestor(type, row, p.depth);
+            const Pool* parent = t < 0 ? nullptr : &pools[static_cast<size_t>(t)];
+            for (int c = 0; c < p.width; ++c) {
+                float x = 0;
+                if (parent) {
+                    if (p.op == ir::Op::ParentExport)
+                        x = host<float>(parent->exports.column(static_cast<size_t>(p.exportIndex), static_cast<size_t>(c)))[r];
+                    if (p.op == ir::Op::ParentAlive) x = parent->status(r) == Status::Alive ? 1.0f : 0.0f;
+                    if (p.op == ir::Op::ParentAge) x = ageAt(atRows ? atRows[i] : at, host<double>(parent->created)[r]);
+                }
+                host<float>(table[static_cast<size_t>(p.offset + c)])[i] = x;
+            }
+        }
+    }
+}
+
+void State::bindPool(size_t type, const ColumnLayout& layout, Scratch& scratch, std::vector<Buffer>& table) {
+    Pool& pool = pools[type];
+    const ir::Object& o = pool.object();
+    size_t rows = pool.rows();
+    table.assign(static_cast<size_t>(layout.total), Buffer{});
+    table[ColumnLayout::kCreated] = pool.created;
+    table[ColumnLayout::kIds] = pool.ids;
+    table[ColumnLayout::kKill] = scratch.at(0, Elem::U8, rows);
+    for (size_t s = 0; s < o.state.size(); ++s)
+        for (int c = 0; c < o.state[s].type.width; ++c)
+            table[static_cast<size_t>(layout.stateOffset[s] + c)] = pool.state.column(s, static_cast<size_t>(c));
+    for (size_t p = 0; p < o.params.size(); ++p)
+        if (pool.paramColumn[p] >= 0)
+            for (int c = 0; c < o.params[p].type.width; ++c)
+                table[static_cast<size_t>(layout.paramOffset[p] + c)] =
+                    pool.params.column(static_cast<size_t>(pool.paramColumn[p]), static_cast<size_t>(c));
+    for (size_t e = 0; e < o.exports.size(); ++e)
+        for (int c = 0; c < o.exports[e].type.width; ++c)
+            table[static_cast<size_t>(layout.exportOffset[e] + c)] = pool.exports.column(e, static_cast<size_t>(c));
+    for (int column = layout.emits; column < layout.total; ++column)
+        table[static_cast<size_t>(column)] = scratch.at(static_cast<size_t>(1 + column - layout.emits), Elem::F32, rows);
+}
+
+void State::forChunks(size_t rows, const std::function<void(size_t)>& chunk) {
+    parallel->forEach((rows + kRowsPerChunk - 1) / kRowsPerChunk, backend.concurrent(), chunk);
+}
+
+}  // namespace psys::rt::detail

@@ -1,0 +1,126 @@
+// Internal to rt/: what the parts of a System share (rt/system*.cpp) — the module, the
+// backend and its memory, the object store (pools and the bookkeeping of parents and
+// deaths), time, externs, the uniform values, the stats — and the helpers they all use.
+#pragma once
+
+#include <array>
+#include <functional>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "ir/evaluate.h"
+#include "rt/parallel.h"
+#include "rt/system.h"
+
+namespace psys::rt::detail {
+
+// Buffers a part of the run-time reuses from launch to launch (kill flags, emission
+// columns, gathered parent values, masks …), grown on demand.
+class Scratch {
+public:
+    explicit Scratch(Memory& memory) : memory_(&memory) {}
+    ~Scratch();
+    Scratch(Scratch&& other) noexcept : memory_(other.memory_), buffers_(std::move(other.buffers_)) { other.buffers_.clear(); }
+    Scratch(const Scratch&) = delete;
+    Scratch& operator=(const Scratch&) = delete;
+    // Buffer `index`, of `elem`, with at least `rows` rows.
+    Buffer at(size_t index, Elem elem, size_t rows);
+
+private:
+    Memory* memory_;
+    std::vector<Buffer> buffers_;
+};
+
+// What the run-time decided about one object type.
+struct TypeInfo {
+    int parentType = -1;         // the type of its parent, or -1
+    double stepLimit = 0;        // @step: the longest update, or 0
+    const ir::Kernel* init = nullptr;
+    const ir::Kernel* update = nullptr;
+    const ir::Kernel* exports = nullptr;
+    const ir::Kernel* render = nullptr;
+    std::vector<const ir::Kernel*> spawn;  // per emit site (null: no arguments)
+    ColumnLayout updateLayout, exportsLayout, renderLayout;
+    std::vector<ColumnLayout> spawnLayout;
+    std::vector<size_t> emitTarget;    // per emit site: the type it creates
+    bool kills = false, rateEmits = false, bursts = false;
+    std::vector<bool> counted, rated;  // per emit site: whether the update yields its count, its rate
+    std::array<bool, 4> drawn{};       // visible, position, colour, size: whether render yields it
+};
+
+// Per type: the scratch buffers and column tables of its launches over the pool.
+struct TypeWork {
+    explicit TypeWork(Memory& memory) : update(memory), exports(memory), masks(memory) {}
+    Scratch update, exports, masks;
+    std::vector<Buffer> updateTable, exportsTable;
+    std::vector<std::vector<uint32_t>> killed;  // per chunk: the rows that died, in order
+    std::vector<std::vector<Buffer>> spawnTables;  // per emit site: the pool's columns for its spawn kernel
+};
+
+// Per type and served kernel (update, render, exports): the uniform values and the
+// (dt, time, externs) they were computed for.
+struct UniformCache {
+    bool valid = false;
+    float dt = 0, time = 0;
+    uint64_t externs = 0;
+    std::vector<Value> values;
+};
+
+struct State {
+    State(ir::Module module, Backend& backend, SystemOptions options);
+    ~State();
+
+    ir::Module module;
+    Backend& backend;
+    Memory& memory;
+    SystemOptions options;
+    std::vector<Pool> pools;
+    std::vector<TypeInfo> types;
+    std::vector<TypeWork> work;
+    std::vector<Value> externs;
+    uint64_t externsVersion = 0;
+    std::vector<std::array<UniformCache, 3>> uniformCache;
+    std::vector<TypeStats> typeStats;
+    Stats stats;
+    double now = 0;
+    double lastDt = 0;
+    uint64_t step = 0;
+    uint32_t nextId = 0;
+    bool started = false;
+    std::vector<std::pair<size_t, uint32_t>> dying;
+    ir::Evaluator evaluator;  // the kernels the run-time evaluates itself (start, triggers, uniform kernels)
+    std::unique_ptr<Parallel> parallel;
+
+    // The ancestor `depth` levels up of (type, row), or (-1, 0) when there is none.
+    std::pair<int, uint32_t> ancestor(size_t type, uint32_t row, int depth) const;
+    // An object is dead: frozen now, freed at the end of the step unless children read it.
+    void kill(size_t type, uint32_t row);
+    // A reader of `parent` is gone; a frozen parent without readers is freed, and so on up.
+    void releaseReader(size_t childType, Handle parent);
+    // The values of `kernel`'s uniform kernel at (dt, time), evaluated on the host and
+    // cached until dt, time or an extern changes; null when it has none.
+    const Value* uniforms(size_t type, const ir::Kernel& kernel, float dt, float time);
+    // The uniform kernel serving `kernel`, if any.
+    const ir::Kernel* uniformKernel(size_t type, const ir::Kernel& kernel) const;
+    // The values of `layout`'s parent reads for the object in `row` of a pool of `type`,
+    // at time `at`, in instruction order.
+    void parentValues(size_t type, uint32_t row, const ColumnLayout& layout, double at, std::vector<Value>& out) const;
+    // Fills the parent columns of a launch: for i in [begin, end) with mask[i] set, row
+    // i of the table gets the parent values of the object in pool row
+    // poolRows[i - poolRowsFirst] (poolRows null: row i), at time atRows[i] (null: `at`).
+    void gatherParents(size_t type, const ColumnLayout& layout, std::span<const Buffer> table, const uint8_t* mask,
+                       size_t begin, size_t end, double at, const double* atRows = nullptr,
+                       const uint32_t* poolRows = nullptr, size_t poolRowsFirst = 0);
+    // Points `table` at a pool's columns, kill flags and the scratch columns of the rest.
+    void bindPool(size_t type, const ColumnLayout& layout, Scratch& scratch, std::vector<Buffer>& table);
+    // chunk(c) for every chunk of `rows` rows (rt/columns.h kRowsPerChunk).
+    void forChunks(size_t rows, const std::function<void(size_t)>& chunk);
+
+    template <typename T>
+    T* host(Buffer b) const {
+        return hostData<T>(memory, b);
+    }
+};
+
+}  // namespace psys::rt::detail
