@@ -1,5 +1,8 @@
 #include <doctest/doctest.h>
 
+#include <cmath>
+
+#include "core/lanes.h"
 #include "frontend/consteval.h"
 #include "test_support.h"
 
@@ -32,4 +35,12 @@ TEST_CASE("constant folding of arithmetic, constructors, swizzles and constants"
 
 TEST_CASE("what is not constant is not folded") {
     CHECK_FALSE(valueOf("f(2)", "fn f(x: float) -> float = x; ").has_value());
+}
+
+TEST_CASE("constants are computed in float, by the arithmetic the program runs (core/lanes.h)") {
+    volatile float tenThousand = 10000, ninety = 90, one = 1, three = 3;
+    CHECK(valueOf("sin(10000)")->v[0] == std::sin(static_cast<float>(tenThousand)));
+    CHECK(valueOf("1 / 3")->v[0] == static_cast<float>(one) / static_cast<float>(three));
+    CHECK(valueOf("radians(90)")->v[0] == static_cast<float>(ninety) * core::kRadiansPerDegree);
+    CHECK(valueOf("min(vec2(1, 5), 3)")->v[1] == 3);
 }

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "ir/hash.h"
 #include "ir/lower.h"
 #include "ir/parser.h"
 #include "ir/printer.h"
@@ -107,4 +108,66 @@ TEST_CASE("the verifier finds broken invariants") {
     CHECK(verifyText("object a()\n  emit nothing rate\nend\n").find("emits unknown `nothing`") != std::string::npos);
     // Forward references are allowed through delaying operands of a behaviour kernel.
     CHECK(verifyText("object a()\n  kernel behaviour\n    %0 = prev.f32 %1 #0\n    %1 = age.f32\n  end\nend\n").empty());
+}
+
+TEST_CASE("the op table: every op is named, found by its name, and has the properties its kind implies") {
+    for (int i = 0; i <= static_cast<int>(Op::Recur); ++i) {
+        auto op = static_cast<Op>(i);
+        const OpInfo& info = opInfo(op);
+        INFO(info.name);
+        CHECK(opFromName(info.name) == op);
+        if (isLeaf(op)) CHECK(info.arity == 0);
+        if (isComponentwise(op)) CHECK(isPure(op));
+        if (isCommutative(op)) CHECK(info.arity == 2);
+        CHECK(hasOwnSite(op) == (isRandom(op) || isTemporal(op)));
+        if (info.delayedOperands) CHECK(isTemporal(op));
+    }
+    CHECK(mayReferForward(Op::FollowedBy, 1));
+    CHECK_FALSE(mayReferForward(Op::FollowedBy, 0));
+    CHECK_FALSE(isInput(Op::Const));
+    CHECK(isLeaf(Op::Const));
+}
+
+TEST_CASE("the structural hash: equal structure hashes alike; names and locations do not count") {
+    auto build = [](const char* name, uint32_t line, float constant) {
+        Kernel k;
+        k.setLoc({0, line, 1, 1});
+        ValueId a = k.op(Op::Age, Type::f32(), {});
+        ValueId c = k.scalar(constant);
+        ValueId s = k.op(Op::Mul, Type::f32(), {a, c});
+        k.mutableAt(s).name = name;
+        k.yields.push_back({YieldKind::Size, 0, 0, s});
+        return k;
+    };
+    CHECK(structuralHash(build("x", 1, 2)) == structuralHash(build("y", 7, 2)));
+    CHECK_FALSE(structuralHash(build("x", 1, 0.0f)) == structuralHash(build("x", 1, -0.0f)));
+    Kernel a = build("x", 1, 2), b = a;
+    b.yields[0].kind = YieldKind::Visible;
+    CHECK_FALSE(structuralHash(a) == structuralHash(b));
+    b = a;
+    b.kind = KernelKind::Render;
+    CHECK_FALSE(structuralHash(a) == structuralHash(b));
+}
+
+TEST_CASE("instructions carry the location of the source they come from, through every pass") {
+    auto c = test::check("object p {\n  v = integrate(vec3(0, -9.8, 0));\n  point(v * 2, white, age);\n}\nspawn p;",
+                         "loc.psys");
+    REQUIRE(c.ok());
+    Module m = lower(*c.program, *c.sources);
+    opt::PassErrors errors;
+    REQUIRE(opt::runPipeline(m, {}, errors));
+    const Kernel* update = m.objects[0].kernel(KernelKind::Update);
+    REQUIRE(update);
+    for (const Inst& i : update->insts()) CHECK(i.loc.valid());
+    const Kernel* render = m.objects[0].kernel(KernelKind::Render);
+    bool found = false;
+    for (const Inst& i : render->insts())
+        if (i.op == Op::Mul && i.type == Type::vec(3)) {  // v * 2
+            CHECK(i.loc.line == 3);
+            CHECK(i.loc.column == 9);
+            found = true;
+        }
+    CHECK(found);
+    CHECK(m.files == std::vector<std::string>{"loc.psys"});
+    CHECK(print(m, {.locations = true}).find("loc(loc.psys:2:7)") != std::string::npos);
 }

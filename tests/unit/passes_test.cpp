@@ -5,6 +5,7 @@
 #include "ir/printer.h"
 #include "ir/verifier.h"
 #include "opt/passes.h"
+#include "opt/pattern.h"
 
 using namespace psys;
 using namespace psys::ir;
@@ -554,4 +555,43 @@ end
   end
 end
 )");
+}
+
+TEST_CASE("rewrite rules: commutative operands match either way, a variable twice is one value, literals by bits") {
+    Kernel empty;
+    opt::Rewriter rw(empty);
+    Kernel& k = rw.to();
+    ValueId age = k.op(Op::Age, Type::f32(), {}), dt = k.op(Op::Dt, Type::f32(), {});
+    opt::Pat x = opt::var(0);
+    opt::Rules rules;
+    rules.add(opt::rewrite("x * 1 → x", x * opt::lit(1.0f), x));
+    rules.add(opt::rewrite("min(x, x) → x", opt::min(x, x), x));
+    rules.add(opt::rewrite("x + -0 → x", x + opt::lit(-0.0f), x));
+    const std::string* fired = nullptr;
+    auto apply = [&](Op op, ValueId a, ValueId b) { return rules.apply(rw, Inst::make(op, Type::f32(), {a, b}), false, &fired); };
+    CHECK(apply(Op::Mul, k.scalar(1), age) == age);  // 1 * x: the commutative match
+    CHECK(*fired == "x * 1 → x");
+    CHECK(apply(Op::Mul, age, k.scalar(1)) == age);
+    CHECK_FALSE(apply(Op::Mul, age, k.scalar(2)));
+    CHECK(apply(Op::Min, dt, dt) == dt);
+    CHECK_FALSE(apply(Op::Min, dt, age));        // x twice must be one value
+    CHECK(apply(Op::Add, age, k.scalar(-0.0f)) == age);
+    CHECK_FALSE(apply(Op::Add, age, k.scalar(0.0f)));  // +0 is not −0: −0 + 0 is +0
+}
+
+TEST_CASE("rewrite rules build their replacement, folding constants: x / 4 → x * 0.25") {
+    Kernel empty;
+    opt::Rewriter rw(empty);
+    Kernel& k = rw.to();
+    ValueId age = k.op(Op::Age, Type::f32(), {});
+    opt::Pat x = opt::var(0), c = opt::constant(1);
+    opt::Rules rules;
+    rules.add(opt::rewrite("x / c → x * (1/c)", x / c, x * (opt::lit(1.0f) / c)));
+    auto v = rules.apply(rw, Inst::make(Op::Div, Type::f32(), {age, k.scalar(4)}), false, nullptr);
+    REQUIRE(v);
+    const Inst& mul = k.at(*v);
+    CHECK(mul.op == Op::Mul);
+    CHECK(mul.operands[0] == age);
+    CHECK(k.at(mul.operands[1]).op == Op::Const);
+    CHECK(k.at(mul.operands[1]).constant[0] == 0.25f);
 }

@@ -1,6 +1,6 @@
 // The run-time and the interpreter, checked against exact answers: the Euler recurrence,
 // emission counts and times, kill frames, live parent reads, determinism, and the
-// extremes of docs/quality.md.
+// extremes (docs/runtime.md, "The extremes, and what happens").
 #include <doctest/doctest.h>
 
 #include <cmath>

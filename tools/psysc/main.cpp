@@ -1,9 +1,11 @@
 // psysc: the psys compiler driver.
 //
-//   psysc check FILE…            type-check; exit 0 when clean, 1 on errors
-//   psysc --emit=ast FILE        print the checked AST
+//   psysc check FILE…                   type-check; exit 0 when clean, 1 on errors
+//   psysc run FILE [options]            compile and run a system (host/: the host library)
+//   psysc --emit=ast|ir FILE            print the checked AST, or the IR after the passes
+//   psysc --stats FILE                  the cost of each object type, without and with the optimizer
 //
-// Exit status: 0 success, 1 errors in the input, 2 bad usage.
+// Exit status: 0 success, 1 errors in the input, 2 bad usage. README.md lists the options.
 #include <unistd.h>
 
 #include <chrono>

@@ -1,0 +1,120 @@
+// The host library: settings as people write them, backends by name, sessions that run a
+// file, reload it on request (a broken edit keeps the old system running) and move to
+// another backend without losing an object.
+#include <doctest/doctest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "host/session.h"
+
+using namespace psys;
+
+namespace {
+
+std::string drawn(rt::System& system, int frames) {
+    std::string out;
+    for (int f = 0; f < frames; ++f) {
+        REQUIRE_FALSE(system.step(1.0 / 60));
+        for (size_t t = 0; t < system.typeCount(); ++t)
+            for (const rt::RenderPoint& p : system.points(t)) out.append(reinterpret_cast<const char*>(&p), sizeof p);
+    }
+    return out;
+}
+
+struct TempFile {
+    std::filesystem::path path;
+    explicit TempFile(const std::string& name) : path(std::filesystem::temp_directory_path() / name) {}
+    ~TempFile() { std::filesystem::remove(path); }
+    void write(const std::string& text) const { std::ofstream(path) << text; }
+};
+
+}  // namespace
+
+TEST_CASE("host settings: numbers, extern settings and trigger firings, and what is wrong with bad ones") {
+    CHECK(*host::parseNumber("1/60") == doctest::Approx(1.0 / 60));
+    CHECK(*host::parseNumber("1e-3") == 1e-3);
+    CHECK_FALSE(host::parseNumber("fast"));
+    CHECK_FALSE(host::parseNumber(""));
+    auto set = host::parseSet("wind=1,2,3");
+    REQUIRE(set);
+    CHECK(set->name == "wind");
+    CHECK(set->values == std::vector<float>{1, 2, 3});
+    CHECK(host::parseSet("wind").error == "--set takes NAME=VALUE or NAME=X,Y,Z, not `wind`");
+    CHECK_FALSE(host::parseSet("=3"));
+    CHECK_FALSE(host::parseSet("w=1,,2"));
+    auto fire = host::parseFire("explosion:0,5,0@12");
+    REQUIRE(fire);
+    CHECK(fire->trigger == "explosion");
+    CHECK(fire->args == std::vector<float>{0, 5, 0});
+    CHECK(fire->frame == 12);
+    CHECK(host::parseFire("go@3")->args.empty());
+    CHECK(host::parseFire("go").error == "--fire takes TRIGGER@FRAME or TRIGGER:X,Y,Z@FRAME, not `go`");
+    CHECK_FALSE(host::parseFire("go@-1"));
+    CHECK(host::parseStep("x").error.find("--dt takes a number of seconds") == 0);
+}
+
+TEST_CASE("backends by name") {
+    CHECK(host::backendNames().front() == "llvm");
+    for (const std::string& name : host::backendNames()) {
+        auto backend = host::makeBackend({name, "fast"});
+        REQUIRE(backend);
+        CHECK((*backend)->name() == name);
+    }
+    CHECK(host::makeBackend({"vulkan", "fast"}).error == "there is no backend `vulkan`; the backends are llvm, interp");
+    CHECK(host::makeBackend({"llvm", "sloppy"}).error == "the maths is fast or exact, not `sloppy`");
+}
+
+TEST_CASE("a session runs a file, and a broken edit keeps the old system running") {
+    TempFile file("psys_host_reload.psys");
+    file.write("object p { pos = integrate(vec3(1, 0, 0)); point(pos, white, 1); }\nspawn p;\n");
+    host::SessionOptions options;
+    host::CompileResult compiled;
+    std::string error;
+    auto session = host::Session::open(file.path.string(), options, compiled, error);
+    REQUIRE_MESSAGE(session != nullptr, compiled.text(), error);
+    for (int frame = 1; frame <= 60; ++frame) REQUIRE_FALSE(session->frame(frame, 1.0 / 60));
+
+    file.write("object p { pos = integrate(vec3(1, 0, 0)) + nope; point(pos, white, 1); }\nspawn p;\n");
+    auto broken = session->reload();
+    CHECK_FALSE(broken.compile.ok);
+    CHECK_FALSE(broken.report);
+    CHECK(broken.compile.text().find("error: unknown name `nope`") != std::string::npos);
+    REQUIRE_FALSE(session->frame(61, 1.0 / 60));  // still running the old system
+    CHECK(session->system().points(0).at(0).position[0] == doctest::Approx(61.0 / 60).epsilon(1e-4));
+
+    file.write("object p { pos = integrate(vec3(1, 0, 0)); point(pos + vec3(0, 5, 0), white, 2); }\nspawn p;\n");
+    auto good = session->reload();
+    REQUIRE(good.compile.ok);
+    REQUIRE(good.report);
+    CHECK(good.report->carried == 1);
+    REQUIRE_FALSE(session->frame(62, 1.0 / 60));
+    auto p = session->system().points(0).at(0);
+    CHECK(p.position[0] == doctest::Approx(62.0 / 60).epsilon(1e-4));  // the integral went on
+    CHECK(p.position[1] == 5);                                         // the new equation
+    CHECK(p.size == 2);
+}
+
+TEST_CASE("a session moves to another backend without losing a step: llvm (exact) to the interpreter") {
+    std::string text;
+    {
+        std::ifstream in(std::string(PSYS_SAMPLES_DIR) + "/fireworks.psys");
+        text.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    host::SessionOptions exact;
+    exact.backend = {"llvm", "exact"};
+    host::SessionOptions reference;
+    reference.backend = {"interp", "fast"};
+    host::CompileResult compiled;
+    std::string error;
+    auto moving = host::Session::open("fireworks.psys", exact, compiled, error, &text);
+    auto straight = host::Session::open("fireworks.psys", reference, compiled, error, &text);
+    REQUIRE(moving);
+    REQUIRE(straight);
+    CHECK(drawn(moving->system(), 120) == drawn(straight->system(), 120));
+    REQUIRE_FALSE(moving->switchBackend({"interp", "fast"}));
+    CHECK(moving->backend().name() == "interp");
+    CHECK(drawn(moving->system(), 120) == drawn(straight->system(), 120));
+    CHECK(moving->switchBackend({"nope", "fast"}).value().find("there is no backend") == 0);
+}

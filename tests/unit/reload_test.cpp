@@ -1,0 +1,222 @@
+// Hot reload (rt::System::carryOver): a new system takes over a running one's objects.
+// Each documented outcome (docs/runtime.md, "Hot reload") is a case here.
+#include <doctest/doctest.h>
+
+#include <cstring>
+#include <filesystem>
+
+#include "driver/compile.h"
+#include "interp/interpreter.h"
+#include "rt/system.h"
+#include "test_support.h"
+
+using namespace psys;
+
+namespace {
+
+ir::Module compile(const std::string& text) {
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    auto module = compileText("test.psys", text, sources, diags);
+    INFO(diags.render());
+    REQUIRE(module.has_value());
+    return std::move(*module);
+}
+
+// Everything drawn, and every type's counts, after each of `frames` steps, as bytes.
+std::string run(rt::System& system, int frames) {
+    std::string out;
+    for (int f = 0; f < frames; ++f) {
+        REQUIRE_FALSE(system.step(1.0 / 60));
+        for (size_t t = 0; t < system.typeCount(); ++t)
+            for (const rt::RenderPoint& p : system.points(t)) out.append(reinterpret_cast<const char*>(&p), sizeof p);
+        for (const rt::TypeStats& t : system.stats().types)
+            out += std::to_string(t.live) + "/" + std::to_string(t.created) + "/" + std::to_string(t.killed) + "/" +
+                   std::to_string(t.frozen) + ";";
+    }
+    return out;
+}
+
+void fireAll(rt::System& system) {
+    for (const ir::Trigger& t : system.module().triggers) {
+        size_t width = 0;
+        for (auto& p : t.params) width += static_cast<size_t>(p.type.width);
+        std::vector<float> args(width, 1.5f);
+        REQUIRE_FALSE(system.fire(t.name, args));
+    }
+}
+
+const rt::RenderPoint* pointOf(const std::vector<rt::RenderPoint>& points, uint32_t id) {
+    for (const auto& p : points)
+        if (p.id == id) return &p;
+    return nullptr;
+}
+
+}  // namespace
+
+TEST_CASE("reloading an unchanged source continues every sample bit for bit") {
+    for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
+        if (entry.path().extension() != ".psys") continue;
+        INFO(entry.path().filename().string());
+        std::string text = test::readFile(entry.path().string());
+        interp::Interpreter a, b;
+        rt::System straight(compile(text), a), before(compile(text), a);
+        fireAll(straight);
+        fireAll(before);
+        std::string first = run(straight, 150), second = run(straight, 150);
+        CHECK(run(before, 150) == first);
+        // The reloaded system runs on another backend (another memory), as after a switch.
+        rt::System after(compile(text), b);
+        rt::ReloadReport report = after.carryOver(before);
+        CHECK(report.dropped == 0);
+        CHECK(report.newSlots.empty());
+        CHECK(report.lostSlots.empty());
+        CHECK(run(after, 150) == second);
+        CHECK(after.time() == straight.time());
+        CHECK(after.stats().types.size() == straight.stats().types.size());
+    }
+}
+
+TEST_CASE("a reload that adds an equation starts its state as at each object's creation") {
+    std::string old = "object p(k: float) { pos = integrate(vec3(1, 0, 0)); point(pos, white, k); }\n"
+                      "object e { emit p(rand() + 1) at 10 per second; }\nspawn e;";
+    std::string added = "object p(k: float) { pos = integrate(vec3(1, 0, 0)); h = snapshot(k * 10 + age);\n"
+                        "  point(pos + vec3(0, h, 0), white, k); }\n"
+                        "object e { emit p(rand() + 1) at 10 per second; }\nspawn e;";
+    interp::Interpreter backend;
+    rt::System before(compile(old), backend);
+    run(before, 60);
+    auto was = before.points(0);
+    REQUIRE(was.size() >= 9);
+    rt::System after(compile(added), backend);
+    rt::ReloadReport report = after.carryOver(before);
+    CHECK(report.newSlots == std::vector<std::string>{"p.snapshot@h"});
+    CHECK(report.lostSlots.empty());
+    CHECK(report.carried == before.stats().types[0].live + before.stats().types[1].live);
+    REQUIRE_FALSE(after.step(0));  // a step of length 0: nothing moves
+    auto now = after.points(0);
+    REQUIRE(now.size() == was.size());
+    for (const rt::RenderPoint& p : now) {
+        const rt::RenderPoint* q = pointOf(was, p.id);
+        REQUIRE(q);
+        CHECK(p.position[0] == q->position[0]);          // the integral carried over
+        CHECK(p.position[1] == q->size * 10);            // h: k · 10 + age at creation, age 0
+        CHECK(p.size == q->size);                        // k carried over
+    }
+}
+
+TEST_CASE("a reload that removes an equation drops its state; the rest carries on") {
+    std::string old = "object p { a = integrate(vec3(1, 0, 0)); b = integrate(vec3(0, 2, 0));\n"
+                      "  point(a + b, white, 1); }\nspawn p;";
+    std::string removed = "object p { a = integrate(vec3(1, 0, 0)); point(a, white, 1); }\nspawn p;";
+    interp::Interpreter backend;
+    rt::System before(compile(old), backend);
+    run(before, 60);
+    rt::System after(compile(removed), backend);
+    rt::ReloadReport report = after.carryOver(before);
+    CHECK(report.newSlots.empty());
+    CHECK(report.lostSlots == std::vector<std::string>{"p.integrate@b"});
+    run(after, 60);
+    REQUIRE(after.points(0).size() == 1);
+    CHECK(after.points(0)[0].position[0] == doctest::Approx(2.0).epsilon(1e-4));  // 120 frames of 1/60
+    CHECK(after.points(0)[0].position[1] == 0);
+}
+
+TEST_CASE("a reload that changes an equation's type starts it afresh") {
+    std::string old = "object p { v = integrate(1.0); point(vec3(v), white, 1); }\nspawn p;";
+    std::string changed = "object p { v = integrate(vec3(1, 2, 3)); point(v, white, 1); }\nspawn p;";
+    interp::Interpreter backend;
+    rt::System before(compile(old), backend);
+    run(before, 60);
+    rt::System after(compile(changed), backend);
+    rt::ReloadReport report = after.carryOver(before);
+    CHECK(report.newSlots == std::vector<std::string>{"p.integrate@v"});
+    CHECK(report.lostSlots == std::vector<std::string>{"p.integrate@v"});
+    run(after, 30);
+    auto p = after.points(0);
+    REQUIRE(p.size() == 1);
+    CHECK(p[0].position[0] == doctest::Approx(0.5).epsilon(1e-4));  // from zero, 30 frames
+    CHECK(p[0].position[2] == doctest::Approx(1.5).epsilon(1e-4));
+}
+
+TEST_CASE("a reload that removes an object type drops its objects and keeps the others") {
+    std::string old = "object a { point(vec3(age), white, 1); }\nobject b { point(vec3(-age), white, 1); }\n"
+                      "spawn a; spawn b; spawn b;";
+    std::string removed = "object a { point(vec3(age), white, 1); }\nspawn a;";
+    interp::Interpreter backend;
+    rt::System before(compile(old), backend);
+    run(before, 30);
+    rt::System after(compile(removed), backend);
+    rt::ReloadReport report = after.carryOver(before);
+    CHECK(report.dropped == 2);
+    CHECK(report.droppedTypes == std::vector<std::string>{"b"});
+    CHECK(report.carried == 1);
+    run(after, 30);
+    auto p = after.points(0);
+    REQUIRE(p.size() == 1);  // the start does not run again
+    CHECK(p[0].position[0] == doctest::Approx(1.0).epsilon(1e-4));  // its age carried on
+}
+
+TEST_CASE("a reload keeps parents and children, frozen parents included") {
+    // The comet dies at 20 s; its tail reads it frozen until the last tail particle dies.
+    std::string text = test::readFile(std::string(PSYS_SAMPLES_DIR) + "/follow_parent.psys");
+    interp::Interpreter backend;
+    rt::System straight(compile(text), backend), before(compile(text), backend);
+    run(straight, 1205);
+    run(before, 1205);
+    REQUIRE(before.stats().types[0].frozen == 1);
+    std::string expected = run(straight, 120);
+    rt::System after(compile(text), backend);
+    after.carryOver(before);
+    CHECK(after.stats().types[0].frozen == 1);
+    CHECK(run(after, 120) == expected);
+    CHECK(after.stats().types[0].frozen == 0);  // freed with its last reader
+}
+
+TEST_CASE("a reload that removes a child type frees the frozen parents only it read") {
+    std::string text = test::readFile(std::string(PSYS_SAMPLES_DIR) + "/follow_parent.psys");
+    std::string childless = "object comet { pos = vec3(cos(age) * 5, 3 + sin(age * 2), sin(age) * 5);\n"
+                            "  point(pos, white, 4); kill when age > 20; }\nspawn comet;";
+    interp::Interpreter backend;
+    rt::System before(compile(text), backend);
+    run(before, 1205);
+    REQUIRE(before.stats().types[0].frozen == 1);
+    rt::System after(compile(childless), backend);
+    rt::ReloadReport report = after.carryOver(before);
+    CHECK(report.droppedTypes == std::vector<std::string>{"comet.tail"});
+    CHECK(after.stats().types[0].frozen == 0);
+    CHECK(after.stats().types[0].live == 0);
+}
+
+TEST_CASE("a reload under another parent type leaves children without a parent") {
+    std::string old = "object a { x = age; emit c count 1;\n"
+                      "  object c { point(vec3(a.x, a.alive ? 1 : 0, 0), white, 1); } }\nspawn a;";
+    std::string moved = "object b { x = age; emit c count 1;\n"
+                        "  object c { point(vec3(b.x, b.alive ? 1 : 0, 0), white, 1); } }\nspawn b;";
+    interp::Interpreter backend;
+    rt::System before(compile(old), backend);
+    run(before, 30);
+    REQUIRE(before.points(1).size() == 1);
+    CHECK(before.points(1)[0].position[1] == 1);
+    rt::System after(compile(moved), backend);
+    rt::ReloadReport report = after.carryOver(before);
+    CHECK(report.droppedTypes == std::vector<std::string>{"a", "a.c"});
+    CHECK(after.stats().types[0].live == 0);  // b: no objects (a's are not b's)
+}
+
+TEST_CASE("a reload keeps the externs' values where name and type match") {
+    std::string old = "extern w: vec3 = 0; extern s: float = 1;\nobject p { point(w * s, white, 1); }\nspawn p;";
+    std::string changed = "extern w: vec3 = 0; extern s: vec2 = 1;\nobject p { point(w * s.x, white, 1); }\nspawn p;";
+    interp::Interpreter backend;
+    rt::System before(compile(old), backend);
+    float w[3] = {1, 2, 3}, s = 5;
+    REQUIRE_FALSE(before.setExtern("w", w));
+    REQUIRE_FALSE(before.setExtern("s", {&s, 1}));
+    run(before, 2);
+    rt::System after(compile(changed), backend);
+    after.carryOver(before);
+    CHECK(after.externValue("w")->f == std::array<float, 4>{1, 2, 3, 0});
+    auto v = after.externValue("s")->f;  // its type changed: its default
+    CHECK(v[0] == 1);
+    CHECK(v[1] == 1);
+}
