@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include <llvm/IR/IRBuilder.h>
+#include <llvm/IR/MDBuilder.h>
 
 #include "codegen_llvm/lane_emitter.h"
 
@@ -298,55 +299,61 @@ public:
         llvm::BasicBlock* body = llvm::BasicBlock::Create(ctx_, "child", fn_);
         llvm::BasicBlock* exit = llvm::BasicBlock::Create(ctx_, "exit", fn_);
         b_.SetInsertPoint(entry);
-        llvm::Value* count = fn_->getArg(kCount);
-        b_.CreateCondBr(b_.CreateICmpSGT(count, b_.getInt64(0)), body, exit);
-        b_.SetInsertPoint(body);
-        llvm::PHINode* k = b_.CreatePHI(i64, 2, "k");
-        k->addIncoming(b_.getInt64(0), entry);
-        llvm::Value* childDraw = b_.CreateAdd(fn_->getArg(kFirstChild), b_.CreateTrunc(k, i32));
-        auto leaf = [&](const Inst& i, int parent) -> Lanes {
-            auto lanes = [&](int first) {
-                Lanes out;
-                for (int l = 0; l < i.type.width; ++l)
-                    out.push_back(fromFloat(load(b_.getFloatTy(), first + l, fn_->getArg(kRow)), i.type));
-                return out;
-            };
-            switch (i.op) {
-                case Op::Param: return lanes(layout.paramOffset.at(static_cast<size_t>(i.attr)));
-                case Op::StateRead: return lanes(layout.stateOffset.at(static_cast<size_t>(i.attr)));
-                case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge:
-                    return loadValue(fn_->getArg(kParents), parent, i.type);
-                case Op::Extern: return loadValue(fn_->getArg(kExterns), i.attr, i.type);
-                case Op::Age:
-                    return {age(fn_->getArg(kNow), load(b_.getDoubleTy(), ColumnLayout::kCreated, fn_->getArg(kRow)))};
-                case Op::Dt: return {fn_->getArg(kDt)};
-                case Op::Time: return {b_.CreateFPTrunc(fn_->getArg(kNow), b_.getFloatTy())};
-                case Op::First: return {b_.CreateICmpNE(fn_->getArg(kFirst), b_.getInt32(0))};
-                case Op::ObjectId: return {load(b_.getInt32Ty(), ColumnLayout::kIds, fn_->getArg(kRow))};
-                case Op::DrawIndex: return {i.attr == 1 ? childDraw : static_cast<llvm::Value*>(fn_->getArg(kDraw))};
-                default: throw std::runtime_error("a spawn kernel cannot read `" + std::string(opInfo(i.op).name) + "`");
-            }
-        };
-        auto values = emitKernelBody(b_, module_, spawn, mode_, fn_->getArg(kSeed), leaf);
+        // Everything the kernel reads of the emitter, read once before the loop: inside it
+        // only the children's arguments are written, so nothing stops vectorizing it.
+        std::map<const Inst*, Lanes> emitter;
+        int parentOrdinal = 0;
+        for (const Inst& i : spawn.insts()) {
+            if (!isInput(i.op) || (i.op == Op::DrawIndex && i.attr == 1)) continue;
+            emitter[&i] = read(layout, i, readsAncestor(i.op) ? parentOrdinal++ : 0);
+        }
         // Each argument's first column: the arguments' widths in order.
         std::map<int, int> width;
         for (const Yield& y : spawn.yields)
             if (y.kind == YieldKind::EmitArg) width[y.sub] = spawn.at(y.value).type.width;
+        std::vector<llvm::Value*> argColumns;
+        for (auto [sub, w] : width)
+            for (int l = 0; l < w; ++l)
+                argColumns.push_back(b_.CreateAlignedLoad(
+                    ptr, b_.CreateConstGEP1_32(ptr, fn_->getArg(kArgs), static_cast<unsigned>(argColumns.size())),
+                    llvm::Align(8)));
         std::map<int, int> firstColumn;
         int next = 0;
         for (auto [sub, w] : width) {
             firstColumn[sub] = next;
             next += w;
         }
+        llvm::Value* count = fn_->getArg(kCount);
+        b_.CreateCondBr(b_.CreateICmpSGT(count, b_.getInt64(0)), body, exit);
+        b_.SetInsertPoint(body);
+        llvm::PHINode* k = b_.CreatePHI(i64, 2, "k");
+        k->addIncoming(b_.getInt64(0), entry);
+        llvm::Value* childDraw = b_.CreateAdd(fn_->getArg(kFirstChild), b_.CreateTrunc(k, i32));
+        auto leaf = [&](const Inst& i, int) -> Lanes {
+            if (i.op == Op::DrawIndex && i.attr == 1) return {childDraw};
+            return emitter.at(&i);
+        };
+        auto values = emitKernelBody(b_, module_, spawn, mode_, fn_->getArg(kSeed), leaf);
         llvm::Value* target = b_.CreateAdd(fn_->getArg(kArgsFirst), k);
+        // The argument columns are distinct arrays: each store in a scope of its own,
+        // declared not to alias the others', so the stores need no run-time overlap checks.
+        llvm::MDBuilder md(ctx_);
+        llvm::MDNode* domain = md.createAnonymousAliasScopeDomain("psys.args");
+        std::vector<llvm::Metadata*> scopes;
+        for (size_t c = 0; c < argColumns.size(); ++c) scopes.push_back(md.createAnonymousAliasScope(domain));
         for (const Yield& y : spawn.yields) {
             if (y.kind != YieldKind::EmitArg) continue;
             Type t = spawn.at(y.value).type;
             for (int l = 0; l < t.width; ++l) {
-                llvm::Value* slot = b_.CreateConstGEP1_32(ptr, fn_->getArg(kArgs), static_cast<unsigned>(firstColumn[y.sub] + l));
-                llvm::Value* column = b_.CreateAlignedLoad(ptr, slot, llvm::Align(8));
-                b_.CreateAlignedStore(toFloat(values[y.value][static_cast<size_t>(l)], t),
-                                      b_.CreateInBoundsGEP(b_.getFloatTy(), column, target), llvm::Align(4));
+                auto c = static_cast<size_t>(firstColumn[y.sub] + l);
+                llvm::StoreInst* store = b_.CreateAlignedStore(toFloat(values[y.value][static_cast<size_t>(l)], t),
+                                                               b_.CreateInBoundsGEP(b_.getFloatTy(), argColumns[c], target),
+                                                               llvm::Align(4));
+                std::vector<llvm::Metadata*> others;
+                for (size_t o = 0; o < scopes.size(); ++o)
+                    if (o != c) others.push_back(scopes[o]);
+                store->setMetadata(llvm::LLVMContext::MD_alias_scope, llvm::MDNode::get(ctx_, {scopes[c]}));
+                store->setMetadata(llvm::LLVMContext::MD_noalias, llvm::MDNode::get(ctx_, others));
             }
         }
         llvm::Value* nextChild = b_.CreateAdd(k, b_.getInt64(1), "", true, true);
@@ -359,6 +366,30 @@ public:
 private:
     static constexpr unsigned kTable = 0, kRow = 1, kParents = 2, kExterns = 3, kNow = 4, kDt = 5, kFirst = 6, kSeed = 7,
                               kDraw = 8, kFirstChild = 9, kCount = 10, kArgs = 11, kArgsFirst = 12;
+
+    // The lanes of an input that does not depend on the child.
+    Lanes read(const ColumnLayout& layout, const Inst& i, int parent) {
+        auto lanes = [&](int first) {
+            Lanes out;
+            for (int l = 0; l < i.type.width; ++l)
+                out.push_back(fromFloat(load(b_.getFloatTy(), first + l, fn_->getArg(kRow)), i.type));
+            return out;
+        };
+        switch (i.op) {
+            case Op::Param: return lanes(layout.paramOffset.at(static_cast<size_t>(i.attr)));
+            case Op::StateRead: return lanes(layout.stateOffset.at(static_cast<size_t>(i.attr)));
+            case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge:
+                return loadValue(fn_->getArg(kParents), parent, i.type);
+            case Op::Extern: return loadValue(fn_->getArg(kExterns), i.attr, i.type);
+            case Op::Age: return {age(fn_->getArg(kNow), load(b_.getDoubleTy(), ColumnLayout::kCreated, fn_->getArg(kRow)))};
+            case Op::Dt: return {fn_->getArg(kDt)};
+            case Op::Time: return {b_.CreateFPTrunc(fn_->getArg(kNow), b_.getFloatTy())};
+            case Op::First: return {b_.CreateICmpNE(fn_->getArg(kFirst), b_.getInt32(0))};
+            case Op::ObjectId: return {load(b_.getInt32Ty(), ColumnLayout::kIds, fn_->getArg(kRow))};
+            case Op::DrawIndex: return {fn_->getArg(kDraw)};
+            default: throw std::runtime_error("a spawn kernel cannot read `" + std::string(opInfo(i.op).name) + "`");
+        }
+    }
 
     // Element `row` of the table's column `column`.
     llvm::Value* load(llvm::Type* type, int column, llvm::Value* row) {

@@ -84,10 +84,11 @@ private:
         llvm::Value* object = values_[i.operands[0]][0];
         llvm::Value* draw = values_[i.operands[1]][0];
         Integers algebra{b_};
+        llvm::Value* drawHash = core::pcgHash(algebra, draw);
         Lanes out;
         for (int l = 0; l < i.type.width; ++l)
-            out.push_back(core::drawLane(algebra, i.op, seed_, object, static_cast<uint32_t>(i.attr), draw,
-                                         static_cast<uint32_t>(l)));
+            out.push_back(core::drawLaneFromDraw(algebra, i.op, seed_, object, static_cast<uint32_t>(i.attr), drawHash,
+                                                 static_cast<uint32_t>(l)));
         return out;
     }
 

@@ -34,14 +34,22 @@ constexpr typename A::Int pcgHash(A& a, typename A::Int v) {
     return a.bitXor(a.shiftRight(word, a.constant(22u)), word);
 }
 
-// The bits of one component of one draw.
+// The bits of one component of one draw, from the hash of the draw index (the same for
+// every component, so a backend computes it once per draw).
 template <class A>
-constexpr typename A::Int drawBits(A& a, typename A::Int seed, typename A::Int object, uint32_t site, typename A::Int draw,
-                                   uint32_t component) {
-    auto h = pcgHash(a, a.bitXor(a.constant(component), pcgHash(a, draw)));
+constexpr typename A::Int drawBitsFromDraw(A& a, typename A::Int seed, typename A::Int object, uint32_t site,
+                                           typename A::Int drawHash, uint32_t component) {
+    auto h = pcgHash(a, a.bitXor(a.constant(component), drawHash));
     h = pcgHash(a, a.bitXor(h, a.constant(site * 0x9E3779B9u)));
     h = pcgHash(a, a.bitXor(h, object));
     return pcgHash(a, a.bitXor(h, seed));
+}
+
+// The bits of one component of one draw.
+template <class A>
+constexpr typename A::Int drawBits(A& a, typename A::Int seed, typename A::Int object, uint32_t site,
+                                   typename A::Int draw, uint32_t component) {
+    return drawBitsFromDraw(a, seed, object, site, pcgHash(a, draw), component);
 }
 
 // Uniform in [0, 1): the top 24 bits, exactly representable in a float.
@@ -50,13 +58,19 @@ constexpr typename A::Float unitInterval(A& a, typename A::Int bits) {
     return a.fmul(a.toFloat(a.shiftRight(bits, a.constant(8u))), a.floatConstant(1.0f / 16777216.0f));
 }
 
-// One component of `rand` (in [0, 1)) or `nrand` (in [-1, 1)).
+// One component of `rand` (in [0, 1)) or `nrand` (in [-1, 1)), from the draw's hash.
 template <class A>
-constexpr typename A::Float drawLane(A& a, Op op, typename A::Int seed, typename A::Int object, uint32_t site,
-                           typename A::Int draw, uint32_t component) {
-    auto u = unitInterval(a, drawBits(a, seed, object, site, draw, component));
+constexpr typename A::Float drawLaneFromDraw(A& a, Op op, typename A::Int seed, typename A::Int object, uint32_t site,
+                                             typename A::Int drawHash, uint32_t component) {
+    auto u = unitInterval(a, drawBitsFromDraw(a, seed, object, site, drawHash, component));
     if (op == Op::NRand) return a.fsub(a.fmul(u, a.floatConstant(2.0f)), a.floatConstant(1.0f));
     return u;
+}
+
+template <class A>
+constexpr typename A::Float drawLane(A& a, Op op, typename A::Int seed, typename A::Int object, uint32_t site,
+                                     typename A::Int draw, uint32_t component) {
+    return drawLaneFromDraw(a, op, seed, object, site, pcgHash(a, draw), component);
 }
 
 // The algebra of plain host integers and floats.

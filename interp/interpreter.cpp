@@ -12,12 +12,15 @@ using rt::ColumnLayout;
 
 namespace {
 
-// Reads the columns of a launch's table on host memory.
+// The columns of a launch's table on host memory, their addresses looked up once.
 struct Columns {
-    rt::Memory& memory;
-    std::span<const Buffer> table;
+    std::vector<void*> address;
 
-    float* floats(int column) const { return rt::hostData<float>(memory, table[static_cast<size_t>(column)]); }
+    Columns(rt::Memory& memory, std::span<const Buffer> table) : address(table.size(), nullptr) {
+        for (size_t i = 0; i < table.size(); ++i)
+            if (table[i].valid()) address[i] = memory.host(table[i]);
+    }
+    float* floats(int column) const { return static_cast<float*>(address[static_cast<size_t>(column)]); }
     Value gather(int column, int width, size_t row) const {
         Value v;
         for (int c = 0; c < width; ++c) v.f[static_cast<size_t>(c)] = floats(column + c)[row];
@@ -31,8 +34,7 @@ struct Columns {
                 std::vector<Value>& state) const {
         params.assign(o.params.size(), Value{});
         for (size_t p = 0; p < o.params.size(); ++p)
-            if (table[static_cast<size_t>(l.paramOffset[p])].valid())
-                params[p] = gather(l.paramOffset[p], o.params[p].type.width, row);
+            if (address[static_cast<size_t>(l.paramOffset[p])]) params[p] = gather(l.paramOffset[p], o.params[p].type.width, row);
         state.resize(o.state.size());
         for (size_t s = 0; s < o.state.size(); ++s) state[s] = gather(l.stateOffset[s], o.state[s].type.width, row);
     }
@@ -51,7 +53,7 @@ rt::RowsResult Interpreter::run(const rt::RowsLaunch& launch) {
     const Object& o = *launch.object;
     const Kernel& kernel = *launch.kernel;
     const ColumnLayout& l = *launch.layout;
-    Columns columns{memory_, launch.columns};
+    Columns columns(memory_, launch.columns);
     const auto* created = rt::hostData<double>(memory_, launch.columns[ColumnLayout::kCreated]);
     const auto* ids = rt::hostData<uint32_t>(memory_, launch.columns[ColumnLayout::kIds]);
     const auto* mask = rt::hostData<uint8_t>(memory_, launch.mask);
@@ -128,7 +130,7 @@ rt::RowsResult Interpreter::run(const rt::RowsLaunch& launch) {
 // component of each parameter, in parameter order.
 void Interpreter::run(const rt::ChildrenLaunch& launch) {
     const Kernel& spawn = *launch.spawn;
-    Columns columns{memory_, launch.columns};
+    Columns columns(memory_, launch.columns);
     columns.inputs(*launch.object, *launch.layout, launch.row, params_, state_);
     const auto* created = rt::hostData<double>(memory_, launch.columns[ColumnLayout::kCreated]);
     const auto* ids = rt::hostData<uint32_t>(memory_, launch.columns[ColumnLayout::kIds]);

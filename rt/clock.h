@@ -6,7 +6,7 @@
 // come from: one value for every row, or a column with a value per row:
 //   a step of existing objects      now = the step's end, dt = its length (both uniform)
 //   objects being created (init)    now = each one's creation time (the created column),
-//                                   dt = 0, first = true
+//                                   dt = 0 (a column of zeros), first = true
 //   their first, partial update     now = the step's end, dt = now − created, per row
 //                                   (filled by the run-time: rt/system_create.cpp)
 //   sub-steps of new objects        now and dt per row

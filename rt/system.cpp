@@ -23,22 +23,22 @@ using ir::KernelKind;
 namespace {
 
 // Every launch shape a system asks for (rt/system_create.cpp, rt/system_update.cpp,
-// rt/system_draw.cpp): steps of existing objects at one clock; creation at each object's
-// creation time (now per row, dt 0); first updates and their exports at per-row clocks.
+// rt/system_draw.cpp): steps of existing objects at one clock; everything about objects
+// being created (init and exports at their creation times, first updates and their
+// exports) at per-row clocks.
 Plan planOf(const ir::Module& module) {
     using S = Clock::Source;
     Plan plan;
     for (const ir::Object& o : module.objects)
         for (const ir::Kernel& k : o.kernels) {
             switch (k.kind) {
-                case KernelKind::Init: plan.rows.push_back({&o, &k, S::PerRow, S::Uniform}); break;
+                case KernelKind::Init: plan.rows.push_back({&o, &k, S::PerRow, S::PerRow}); break;
                 case KernelKind::Update:
                     plan.rows.push_back({&o, &k, S::Uniform, S::Uniform});
                     plan.rows.push_back({&o, &k, S::PerRow, S::PerRow});
                     break;
                 case KernelKind::Exports:
                     plan.rows.push_back({&o, &k, S::Uniform, S::Uniform});
-                    plan.rows.push_back({&o, &k, S::PerRow, S::Uniform});
                     plan.rows.push_back({&o, &k, S::PerRow, S::PerRow});
                     break;
                 case KernelKind::Render: plan.rows.push_back({&o, &k, S::Uniform, S::Uniform}); break;

@@ -40,7 +40,7 @@ namespace {
 
 // Scratch column indices of a batch.
 constexpr size_t kCreated = 0, kIds = 1, kKill = 2, kNow = 3, kDt = 4, kMask = 5, kStepMask = 6, kExportMask = 7,
-                 kFirstValue = 8;
+                 kZero = 8, kFirstValue = 9;
 
 size_t components(const std::vector<ir::StateSlot>& slots) {
     size_t n = 0;
@@ -301,16 +301,19 @@ void Creation::createBatch(size_t type, size_t from, size_t to, double t1) {
                         n * sizeof(float));
 
     // At creation: init (the state, the bursts' sizes) and the exports, at each object's
-    // creation time.
+    // creation time with dt 0 (a per-row clock, the shape of the first update's).
+    Buffer zero = b.columns.at(kZero, Elem::F32, end);
+    std::memset(s_.host<float>(zero) + first, 0, n * sizeof(float));
     auto atCreation = [&](const ir::Kernel& kernel, const ColumnLayout& layout, std::vector<Buffer>& t) {
         t[ColumnLayout::kNow] = t[ColumnLayout::kCreated];
+        t[ColumnLayout::kDt] = zero;
         RowsLaunch launch;
         launch.object = &o;
         launch.kernel = &kernel;
         launch.layout = &layout;
         launch.columns = t;
         launch.mask = b.columns.at(kMask, Elem::U8, end);
-        launch.clock = {Clock::Source::PerRow, Clock::Source::Uniform, 0, 0, true};
+        launch.clock = {Clock::Source::PerRow, Clock::Source::PerRow, 0, 0, true};
         launch.externs = s_.externs.data();
         launch.uniformKernel = s_.uniformKernel(type, kernel);
         launch.seed = s_.options.seed;

@@ -220,3 +220,20 @@ TEST_CASE("a reload keeps the externs' values where name and type match") {
     CHECK(v[0] == 1);
     CHECK(v[1] == 1);
 }
+
+TEST_CASE("a reload that adds an object type starts it empty, and the spawns do not run again") {
+    std::string old = "object a { point(vec3(age), white, 1); }\nspawn a;";
+    std::string added = "object a { point(vec3(age), white, 1); emit b at 60 per second; }\n"
+                        "object b { point(vec3(-age), white, 1); }\nspawn a; spawn b;";
+    interp::Interpreter backend;
+    rt::System before(compile(old), backend);
+    run(before, 30);
+    rt::System after(compile(added), backend);
+    rt::ReloadReport report = after.carryOver(before);
+    CHECK(report.carried == 1);
+    CHECK(report.dropped == 0);
+    CHECK(after.stats().types[1].live == 0);
+    run(after, 60);
+    CHECK(after.stats().types[0].live == 1);
+    CHECK(after.stats().types[1].created == 60);  // from the carried emitter; no `spawn b`
+}
