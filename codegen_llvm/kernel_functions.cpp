@@ -209,48 +209,7 @@ private:
         }
         auto values = emitKernelBody(b_, module_, kernel, mode_, seed, leaf);
 
-        // Stores: masked rows keep their state and exports, and never die.
-        llvm::Value* mask = b_.CreateICmpNE(
-            b_.CreateAlignedLoad(b_.getInt8Ty(), b_.CreateInBoundsGEP(b_.getInt8Ty(), loop_->getArg(kMask), row_), llvm::Align(1)),
-            b_.getInt8(0));
-        auto maskedStore = [&](int column, llvm::Value* value) {
-            llvm::Value* old = loadFloat(column);
-            b_.CreateAlignedStore(b_.CreateSelect(mask, value, old), columnAt(argOf, column, f32), llvm::Align(4));
-        };
-        llvm::Value* killedNow = killedSoFar;
-        for (const Yield& y : kernel.yields) {
-            Type t = kernel.at(y.value).type;
-            const Lanes& v = values[y.value];
-            switch (y.kind) {
-                case YieldKind::StateNext:
-                    for (int l = 0; l < t.width; ++l)
-                        maskedStore(layout.stateOffset.at(static_cast<size_t>(y.index)) + l, toFloat(v[static_cast<size_t>(l)], t));
-                    break;
-                case YieldKind::Export:
-                    for (int l = 0; l < t.width; ++l)
-                        maskedStore(layout.exportOffset.at(static_cast<size_t>(y.index)) + l, toFloat(v[static_cast<size_t>(l)], t));
-                    break;
-                case YieldKind::Kill: {
-                    llvm::Value* dies = b_.CreateAnd(mask, v[0]);
-                    b_.CreateAlignedStore(b_.CreateZExt(dies, b_.getInt8Ty()),
-                                          columnAt(argOf, ColumnLayout::kKill, b_.getInt8Ty()), llvm::Align(1));
-                    killedNow = b_.CreateAdd(killedNow, b_.CreateZExt(dies, b_.getInt64Ty()));
-                    break;
-                }
-                case YieldKind::EmitRate: case YieldKind::EmitCount: {
-                    int column = y.kind == YieldKind::EmitRate ? layout.emitRate(y.index) : layout.emitCount(y.index);
-                    b_.CreateAlignedStore(toFloat(v[0], t), columnAt(argOf, column, f32), llvm::Align(4));
-                    break;
-                }
-                case YieldKind::Visible: case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:
-                    for (int l = 0; l < t.width; ++l)
-                        b_.CreateAlignedStore(toFloat(v[static_cast<size_t>(l)], t),
-                                              columnAt(argOf, layout.render + ColumnLayout::renderColumn(y.kind) + l, f32),
-                                              llvm::Align(4));
-                    break;
-                default: break;
-            }
-        }
+        llvm::Value* killedNow = storeYields(kernel, layout, argOf, values, killedSoFar);
         llvm::Value* next = b_.CreateAdd(row_, b_.getInt64(1), "", true, true);
         row->addIncoming(next, b_.GetInsertBlock());
         killedSoFar->addIncoming(killedNow, b_.GetInsertBlock());
@@ -270,6 +229,55 @@ private:
         total->addIncoming(b_.getInt64(0), entry);
         total->addIncoming(killedNow, latch->getParent());
         b_.CreateRet(total);
+    }
+
+    // The yields of a row: masked rows keep their state and exports, and never die.
+    // Returns the count of rows killed so far, this one included.
+    llvm::Value* storeYields(const Kernel& kernel, const ColumnLayout& layout, const std::map<int, unsigned>& argOf,
+                             const std::vector<Lanes>& values, llvm::Value* killedSoFar) {
+        llvm::Type* f32 = b_.getFloatTy();
+        llvm::Value* mask = b_.CreateICmpNE(
+            b_.CreateAlignedLoad(b_.getInt8Ty(), b_.CreateInBoundsGEP(b_.getInt8Ty(), loop_->getArg(kMask), row_), llvm::Align(1)),
+            b_.getInt8(0));
+        auto maskedStore = [&](int column, llvm::Value* value) {
+            llvm::Value* old = b_.CreateAlignedLoad(f32, columnAt(argOf, column, f32), llvm::Align(4));
+            b_.CreateAlignedStore(b_.CreateSelect(mask, value, old), columnAt(argOf, column, f32), llvm::Align(4));
+        };
+        llvm::Value* killed = killedSoFar;
+        for (const Yield& y : kernel.yields) {
+            Type t = kernel.at(y.value).type;
+            const Lanes& v = values[y.value];
+            switch (y.kind) {
+                case YieldKind::StateNext:
+                    for (int l = 0; l < t.width; ++l)
+                        maskedStore(layout.stateOffset.at(static_cast<size_t>(y.index)) + l, toFloat(v[static_cast<size_t>(l)], t));
+                    break;
+                case YieldKind::Export:
+                    for (int l = 0; l < t.width; ++l)
+                        maskedStore(layout.exportOffset.at(static_cast<size_t>(y.index)) + l, toFloat(v[static_cast<size_t>(l)], t));
+                    break;
+                case YieldKind::Kill: {
+                    llvm::Value* dies = b_.CreateAnd(mask, v[0]);
+                    b_.CreateAlignedStore(b_.CreateZExt(dies, b_.getInt8Ty()),
+                                          columnAt(argOf, ColumnLayout::kKill, b_.getInt8Ty()), llvm::Align(1));
+                    killed = b_.CreateAdd(killed, b_.CreateZExt(dies, b_.getInt64Ty()));
+                    break;
+                }
+                case YieldKind::EmitRate: case YieldKind::EmitCount: {
+                    int column = y.kind == YieldKind::EmitRate ? layout.emitRate(y.index) : layout.emitCount(y.index);
+                    b_.CreateAlignedStore(toFloat(v[0], t), columnAt(argOf, column, f32), llvm::Align(4));
+                    break;
+                }
+                case YieldKind::Visible: case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:
+                    for (int l = 0; l < t.width; ++l)
+                        b_.CreateAlignedStore(toFloat(v[static_cast<size_t>(l)], t),
+                                              columnAt(argOf, layout.render + ColumnLayout::renderColumn(y.kind) + l, f32),
+                                              llvm::Align(4));
+                    break;
+                default: break;
+            }
+        }
+        return killed;
     }
 
     llvm::Function* loop_ = nullptr;

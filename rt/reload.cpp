@@ -49,80 +49,54 @@ void copyValues(const Memory& from, const ValueColumns& a, size_t i, Memory& to,
         copyColumn(from, a.column(i, static_cast<size_t>(c)), to, b.column(j, static_cast<size_t>(c)), rows, 4);
 }
 
-}  // namespace
+// One type's rows, columns and accumulators, from `old`'s type `ot` to `s`'s type `t`.
+void carryType(const detail::State& old, size_t ot, detail::State& s, size_t t, ReloadReport& report) {
+    const ir::Object& o = s.module.objects[t];
+    const Pool& from = old.pools[ot];
+    const ir::Object& oo = from.object();
+    Pool& to = s.pools[t];
+    size_t rows = from.rows();
+    std::vector<Status> status(rows);
+    for (uint32_t r = 0; r < rows; ++r) status[r] = from.status(r);
+    to.restore(status, from.generations(), from.freeRows());
+    report.carried += from.live() + from.frozen();
+    copyColumn(old.memory, from.created, s.memory, to.created, rows, 8);
+    copyColumn(old.memory, from.ids, s.memory, to.ids, rows, 4);
+    copyColumn(old.memory, from.updatable, s.memory, to.updatable, rows, 1);
+    to.fresh = from.fresh;
+    for (auto [i, j] : matchByName(o.state, oo.state)) {
+        if (j >= 0) copyValues(old.memory, from.state, static_cast<size_t>(j), s.memory, to.state, i, rows);
+        else report.newSlots.push_back(o.name + "." + o.state[i].name);
+    }
+    for (auto [j, i] : matchByName(oo.state, o.state))
+        if (i < 0) report.lostSlots.push_back(o.name + "." + oo.state[j].name);
+    for (size_t p = 0; p < o.params.size(); ++p) {
+        if (to.paramColumn[p] < 0) continue;
+        for (size_t q = 0; q < oo.params.size(); ++q)
+            if (oo.params[q].name == o.params[p].name && oo.params[q].type == o.params[p].type && from.paramColumn[q] >= 0)
+                copyValues(old.memory, from.params, static_cast<size_t>(from.paramColumn[q]), s.memory, to.params,
+                           static_cast<size_t>(to.paramColumn[p]), rows);
+    }
+    for (auto [i, j] : matchByName(o.exports, oo.exports))
+        if (j >= 0) copyValues(old.memory, from.exports, static_cast<size_t>(j), s.memory, to.exports, i, rows);
+    for (size_t site = 0; site < o.emits.size() && site < oo.emits.size(); ++site)
+        if (o.emits[site].target == oo.emits[site].target && o.emits[site].rate == oo.emits[site].rate)
+            to.emitted[site] = from.emitted[site];
+    s.typeStats[t] = old.typeStats[ot];
+}
 
-ReloadReport System::carryOver(const System& oldSystem) {
-    detail::State& s = *state_;
-    const detail::State& old = *oldSystem.state_;
-    ReloadReport report;
-    s.now = old.now;
-    s.lastDt = old.lastDt;
-    s.step = old.step;
-    s.nextId = old.nextId;
-    s.started = old.started;
-    s.stats = old.stats;
-    for (size_t e = 0; e < s.module.externs.size(); ++e) {
-        int j = old.module.externIndex(s.module.externs[e].name);
-        if (j >= 0 && old.module.externs[static_cast<size_t>(j)].type == s.module.externs[e].type)
-            s.externs[e] = old.externs[static_cast<size_t>(j)];
-    }
-    ++s.externsVersion;
-    std::set<std::string> kept;
-    // Rows first, for every type: children's parents are matched after.
-    std::vector<int> oldTypeOf(s.pools.size(), -1);
-    for (size_t t = 0; t < s.pools.size(); ++t) {
-        const ir::Object& o = s.module.objects[t];
-        int ot = old.module.objectIndex(o.name);
-        oldTypeOf[t] = ot;
-        if (ot < 0) continue;
-        kept.insert(o.name);
-        const Pool& from = old.pools[static_cast<size_t>(ot)];
-        const ir::Object& oo = from.object();
-        Pool& to = s.pools[t];
-        size_t rows = from.rows();
-        std::vector<Status> status(rows);
-        for (uint32_t r = 0; r < rows; ++r) status[r] = from.status(r);
-        to.restore(status, from.generations(), from.freeRows());
-        report.carried += from.live() + from.frozen();
-        copyColumn(old.memory, from.created, s.memory, to.created, rows, 8);
-        copyColumn(old.memory, from.ids, s.memory, to.ids, rows, 4);
-        copyColumn(old.memory, from.updatable, s.memory, to.updatable, rows, 1);
-        to.fresh = from.fresh;
-        for (auto [i, j] : matchByName(o.state, oo.state)) {
-            if (j >= 0) copyValues(old.memory, from.state, static_cast<size_t>(j), s.memory, to.state, i, rows);
-            else report.newSlots.push_back(o.name + "." + o.state[i].name);
-        }
-        for (auto [j, i] : matchByName(oo.state, o.state))
-            if (i < 0) report.lostSlots.push_back(o.name + "." + oo.state[j].name);
-        for (size_t p = 0; p < o.params.size(); ++p) {
-            if (to.paramColumn[p] < 0) continue;
-            for (size_t q = 0; q < oo.params.size(); ++q)
-                if (oo.params[q].name == o.params[p].name && oo.params[q].type == o.params[p].type && from.paramColumn[q] >= 0)
-                    copyValues(old.memory, from.params, static_cast<size_t>(from.paramColumn[q]), s.memory, to.params,
-                               static_cast<size_t>(to.paramColumn[p]), rows);
-        }
-        for (auto [i, j] : matchByName(o.exports, oo.exports))
-            if (j >= 0) copyValues(old.memory, from.exports, static_cast<size_t>(j), s.memory, to.exports, i, rows);
-        for (size_t site = 0; site < o.emits.size() && site < oo.emits.size(); ++site)
-            if (o.emits[site].target == oo.emits[site].target && o.emits[site].rate == oo.emits[site].rate)
-                to.emitted[site] = from.emitted[site];
-        s.typeStats[t] = old.typeStats[static_cast<size_t>(ot)];
-    }
-    for (size_t ot = 0; ot < old.pools.size(); ++ot) {
-        const std::string& name = old.module.objects[ot].name;
-        if (kept.count(name)) continue;
-        report.dropped += old.pools[ot].live() + old.pools[ot].frozen();
-        report.droppedTypes.push_back(name);
-    }
-    // Parents, where the parent type is the same as before; then readers, counted again.
+// Parents where the parent type is the one it was; readers counted again; frozen objects
+// nobody reads any more freed.
+void reconnect(const detail::State& old, detail::State& s, const std::vector<int>& oldTypeOf) {
+    auto name = [](const detail::State& state, int type) {
+        return type < 0 ? std::string() : state.module.objects[static_cast<size_t>(type)].name;
+    };
     for (size_t t = 0; t < s.pools.size(); ++t) {
         Pool& to = s.pools[t];
         int ot = oldTypeOf[t];
         int parentType = s.types[t].parentType;
         bool sameParent = ot >= 0 && parentType >= 0 &&
-                          old.types[static_cast<size_t>(ot)].parentType >= 0 &&
-                          old.module.objects[static_cast<size_t>(old.types[static_cast<size_t>(ot)].parentType)].name ==
-                              s.module.objects[static_cast<size_t>(parentType)].name;
+                          name(old, old.types[static_cast<size_t>(ot)].parentType) == name(s, parentType);
         for (uint32_t r = 0; r < to.rows(); ++r) {
             to.readers[r] = 0;
             to.parent[r] = sameParent && to.status(r) != Status::Free ? old.pools[static_cast<size_t>(ot)].parent[r] : Handle{};
@@ -145,14 +119,46 @@ ReloadReport System::carryOver(const System& oldSystem) {
                 s.releaseReader(t, parent);
             }
     }
+}
+
+}  // namespace
+
+ReloadReport System::carryOver(const System& oldSystem) {
+    detail::State& s = *state_;
+    const detail::State& old = *oldSystem.state_;
+    ReloadReport report;
+    s.now = old.now;
+    s.lastDt = old.lastDt;
+    s.step = old.step;
+    s.nextId = old.nextId;
+    s.started = old.started;
+    s.stats = old.stats;
+    for (size_t e = 0; e < s.module.externs.size(); ++e) {
+        int j = old.module.externIndex(s.module.externs[e].name);
+        if (j >= 0 && old.module.externs[static_cast<size_t>(j)].type == s.module.externs[e].type)
+            s.externs[e] = old.externs[static_cast<size_t>(j)];
+    }
+    ++s.externsVersion;
+    std::vector<int> oldTypeOf(s.pools.size(), -1);
+    std::vector<bool> kept(old.pools.size(), false);
+    for (size_t t = 0; t < s.pools.size(); ++t) {
+        oldTypeOf[t] = old.module.objectIndex(s.module.objects[t].name);
+        if (oldTypeOf[t] < 0) continue;
+        kept[static_cast<size_t>(oldTypeOf[t])] = true;
+        carryType(old, static_cast<size_t>(oldTypeOf[t]), s, t, report);
+    }
+    for (size_t ot = 0; ot < old.pools.size(); ++ot) {
+        if (kept[ot]) continue;
+        report.dropped += old.pools[ot].live() + old.pools[ot].frozen();
+        report.droppedTypes.push_back(old.module.objects[ot].name);
+    }
+    reconnect(old, s, oldTypeOf);
     initNewSlots(report);
     drawing_->invalidate();
     return report;
 }
 
-}  // namespace psys::rt
 
-namespace psys::rt {
 
 // The state slots a reload added start as at creation: the init kernel over the carried
 // objects, at their creation times, writing only the new slots.

@@ -245,8 +245,8 @@ void Creation::createBatch(size_t type, size_t from, size_t to, double t1) {
     const TypeInfo& info = s_.types[type];
     const ir::Object& o = pool.object();
     Batch& b = batches_[type];
-    const size_t n = to - from, first = queue_[from].staging, end = first + n;
-    b.first = first;
+    const size_t n = to - from;
+    b.first = queue_[from].staging;
     b.poolRows.assign(n, kSkipRow);
     size_t allocated = 0;
     for (size_t r = 0; r < n; ++r) {
@@ -270,8 +270,18 @@ void Creation::createBatch(size_t type, size_t from, size_t to, double t1) {
     for (size_t site = 0; site < o.emits.size(); ++site)
         if (!o.emits[site].rate && info.spawn[site])
             bindBatch(type, b, info.spawnLayout[site], b.initParents, b.burstTables[site], true);
+    identify(type, b, from, n);
+    atCreation(type, b, n);
+    firstUpdate(type, b, n, allocated, t1);
+}
 
-    // The objects' identities, in the batch's columns and their pool rows.
+// The batch's objects in its columns and their pool rows: creation times, ids, parents
+// (and their readers), kept parameters; the state zeroed for init.
+void Creation::identify(size_t type, Batch& b, size_t from, size_t n) {
+    Pool& pool = s_.pools[type];
+    const TypeInfo& info = s_.types[type];
+    const ir::Object& o = pool.object();
+    const size_t first = b.first, end = first + n;
     const std::vector<Buffer>& table = b.updateTable;
     auto* mask = s_.host<uint8_t>(b.columns.at(kMask, Elem::U8, end));
     auto* created = s_.host<double>(table[ColumnLayout::kCreated]);
@@ -299,9 +309,18 @@ void Creation::createBatch(size_t type, size_t from, size_t to, double t1) {
         for (int c = 0; c < o.state[s].type.width; ++c)
             std::memset(s_.host<float>(table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)]) + first, 0,
                         n * sizeof(float));
+}
 
-    // At creation: init (the state, the bursts' sizes) and the exports, at each object's
-    // creation time with dt 0 (a per-row clock, the shape of the first update's).
+// At creation: init (the state, the bursts' sizes) and the exports, at each object's
+// creation time with dt 0 (a per-row clock, the shape of the first update's); the state
+// at creation kept for the bursts.
+void Creation::atCreation(size_t type, Batch& b, size_t n) {
+    const TypeInfo& info = s_.types[type];
+    const ir::Object& o = s_.module.objects[type];
+    const size_t first = b.first, end = first + n;
+    const std::vector<Buffer>& table = b.updateTable;
+    auto* mask = s_.host<uint8_t>(b.columns.at(kMask, Elem::U8, end));
+    auto* created = s_.host<double>(table[ColumnLayout::kCreated]);
     Buffer zero = b.columns.at(kZero, Elem::F32, end);
     std::memset(s_.host<float>(zero) + first, 0, n * sizeof(float));
     auto atCreation = [&](const ir::Kernel& kernel, const ColumnLayout& layout, std::vector<Buffer>& t) {
@@ -333,7 +352,6 @@ void Creation::createBatch(size_t type, size_t from, size_t to, double t1) {
                         break;
                     }
             }
-    firstUpdate(type, b, n, allocated, t1);
 }
 
 // A launch over rows [first, end) of a batch, in chunks (on several threads where the

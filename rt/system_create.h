@@ -58,6 +58,8 @@ private:
 
     size_t stage(size_t type, size_t count);  // staging rows for `count` new entries of `type`
     void createBatch(size_t type, size_t from, size_t to, double t1);
+    void identify(size_t type, Batch& b, size_t from, size_t n);
+    void atCreation(size_t type, Batch& b, size_t n);
     void runBatch(const RowsLaunch& launch, size_t first, size_t end);
     void firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, double t1);
     void advance(size_t type, Batch& b, size_t n, size_t maskColumn);

@@ -13,6 +13,52 @@ namespace psys::rt::detail {
 
 namespace {
 
+// The rows of [begin, end) whose kill flag is set, in order (most objects live: eight
+// flags are tested at a time).
+void listKilled(const uint8_t* kill, size_t begin, size_t end, std::vector<uint32_t>& out) {
+    out.clear();
+    size_t row = begin;
+    for (; row + 8 <= end; row += 8) {
+        uint64_t flags;
+        std::memcpy(&flags, kill + row, sizeof flags);
+        if (!flags) continue;
+        for (size_t r = row; r < row + 8; ++r)
+            if (kill[r]) out.push_back(static_cast<uint32_t>(r));
+    }
+    for (; row < end; ++row)
+        if (kill[row]) out.push_back(static_cast<uint32_t>(row));
+}
+
+// After an update of `type`: in row order, each updated object dies or emits.
+void killAndEmit(State& s, Creation& creation, size_t type, double dt, double t1) {
+    const Pool& pool = s.pools[type];
+    const TypeInfo& info = s.types[type];
+    const TypeWork& work = s.work[type];
+    const ir::Object& o = pool.object();
+    const auto* updatable = s.host<uint8_t>(pool.updatable);
+    const auto* kill = s.host<uint8_t>(work.updateTable[ColumnLayout::kKill]);
+    std::vector<float> rate(o.emits.size(), 0), count(o.emits.size(), 1);
+    std::vector<const float*> rates(o.emits.size()), counts(o.emits.size());
+    for (size_t site = 0; site < o.emits.size(); ++site) {
+        auto i = static_cast<int>(site);
+        rates[site] = s.host<float>(work.updateTable[static_cast<size_t>(info.updateLayout.emitRate(i))]);
+        counts[site] = s.host<float>(work.updateTable[static_cast<size_t>(info.updateLayout.emitCount(i))]);
+    }
+    for (uint32_t row = 0; row < pool.rows(); ++row) {
+        if (!updatable[row]) continue;
+        if (info.kills && kill[row]) {
+            s.kill(type, row);
+            continue;
+        }
+        if (!info.rateEmits) continue;
+        for (size_t site = 0; site < o.emits.size(); ++site) {
+            if (info.rated[site]) rate[site] = rates[site][row];
+            if (info.counted[site]) count[site] = counts[site][row];
+        }
+        creation.emitAtRate({type, row, {}, row, t1, false}, rate, count, dt, t1);
+    }
+}
+
 // One update of every updatable object of `type` over (t1 − dt, t1]: the update kernel
 // and the exports kernel over chunks of rows (on several threads where the backend
 // allows), then kills and emissions in row order, so that ids, the queue and the free
@@ -60,17 +106,8 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1)
         s.gatherParents(type, info.updateLayout, work.updateTable, updatable, part.begin, part.end, t1);
         size_t killed = s.backend.run(part).killed;
         if (listKills) {
-            work.killed[c].clear();
-            size_t row = part.begin;
-            for (; killed && row + 8 <= part.end; row += 8) {  // most objects live: eight flags at a time
-                uint64_t flags;
-                std::memcpy(&flags, kill + row, sizeof flags);
-                if (!flags) continue;
-                for (size_t r = row; r < row + 8; ++r)
-                    if (kill[r]) work.killed[c].push_back(static_cast<uint32_t>(r));
-            }
-            for (; killed && row < part.end; ++row)
-                if (kill[row]) work.killed[c].push_back(static_cast<uint32_t>(row));
+            if (killed) listKilled(kill, part.begin, part.end, work.killed[c]);
+            else work.killed[c].clear();
         }
         if (!info.exports) return;
         auto* alive = s.host<uint8_t>(exportMask);
@@ -96,26 +133,7 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1)
             for (uint32_t row : work.killed[c]) s.kill(type, row);
         return;
     }
-    std::vector<float> rate(o.emits.size(), 0), count(o.emits.size(), 1);
-    std::vector<const float*> rates(o.emits.size()), counts(o.emits.size());
-    for (size_t site = 0; site < o.emits.size(); ++site) {
-        auto i = static_cast<int>(site);
-        rates[site] = s.host<float>(work.updateTable[static_cast<size_t>(info.updateLayout.emitRate(i))]);
-        counts[site] = s.host<float>(work.updateTable[static_cast<size_t>(info.updateLayout.emitCount(i))]);
-    }
-    for (uint32_t row = 0; row < rows; ++row) {
-        if (!updatable[row]) continue;
-        if (info.kills && kill[row]) {
-            s.kill(type, row);
-            continue;
-        }
-        if (!info.rateEmits) continue;
-        for (size_t site = 0; site < o.emits.size(); ++site) {
-            if (info.rated[site]) rate[site] = rates[site][row];
-            if (info.counted[site]) count[site] = counts[site][row];
-        }
-        creation.emitAtRate({type, row, {}, row, t1, false}, rate, count, dt, t1);
-    }
+    killAndEmit(s, creation, type, dt, t1);
 }
 
 }  // namespace

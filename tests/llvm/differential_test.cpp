@@ -29,6 +29,7 @@
 #include "interp/interpreter.h"
 #include "rt/system.h"
 #include "tests/run_length.h"
+#include "tests/system_support.h"
 
 using namespace psys;
 
@@ -41,16 +42,7 @@ std::string readFile(const std::filesystem::path& p) {
     return s.str();
 }
 
-ir::Module compile(const std::string& text, bool optimize) {
-    SourceManager sources;
-    DiagnosticEngine diags(sources);
-    CompileOptions options;
-    options.pipeline.optimize = optimize;
-    auto module = compileText("test.psys", text, sources, diags, options);
-    INFO(diags.render());
-    REQUIRE(module.has_value());
-    return *module;
-}
+ir::Module compile(const std::string& text, bool optimize) { return test::compileModule(text, optimize); }
 
 using codegen_llvm::MathMode;
 

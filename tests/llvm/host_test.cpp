@@ -8,20 +8,11 @@
 #include <fstream>
 
 #include "host/session.h"
+#include "tests/system_support.h"
 
 using namespace psys;
 
 namespace {
-
-std::string drawn(rt::System& system, int frames) {
-    std::string out;
-    for (int f = 0; f < frames; ++f) {
-        REQUIRE_FALSE(system.step(1.0 / 60));
-        for (size_t t = 0; t < system.typeCount(); ++t)
-            for (const rt::RenderPoint& p : system.points(t)) out.append(reinterpret_cast<const char*>(&p), sizeof p);
-    }
-    return out;
-}
 
 struct TempFile {
     std::filesystem::path path;
@@ -112,9 +103,9 @@ TEST_CASE("a session moves to another backend without losing a step: llvm (exact
     auto straight = host::Session::open("fireworks.psys", reference, compiled, error, &text);
     REQUIRE(moving);
     REQUIRE(straight);
-    CHECK(drawn(moving->system(), 120) == drawn(straight->system(), 120));
+    CHECK(test::drawnBytes(moving->system(), 120) == test::drawnBytes(straight->system(), 120));
     REQUIRE_FALSE(moving->switchBackend({"interp", "fast"}));
     CHECK(moving->backend().name() == "interp");
-    CHECK(drawn(moving->system(), 120) == drawn(straight->system(), 120));
+    CHECK(test::drawnBytes(moving->system(), 120) == test::drawnBytes(straight->system(), 120));
     CHECK(moving->switchBackend({"nope", "fast"}).value().find("there is no backend") == 0);
 }

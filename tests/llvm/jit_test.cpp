@@ -12,6 +12,7 @@
 #include "driver/compile.h"
 #include "interp/interpreter.h"
 #include "rt/system.h"
+#include "tests/system_support.h"
 
 using namespace psys;
 
@@ -24,26 +25,9 @@ std::string sample(const std::string& name) {
     return s.str();
 }
 
-ir::Module compile(const std::string& text) {
-    SourceManager sources;
-    DiagnosticEngine diags(sources);
-    auto module = compileText("test.psys", text, sources, diags, {});
-    INFO(diags.render());
-    REQUIRE(module.has_value());
-    return std::move(*module);
-}
+using test::drawnBytes;
 
-// Everything drawn after each of `frames` steps, as bytes.
-std::string drawn(rt::System& system, int frames) {
-    std::string out;
-    for (int f = 0; f < frames; ++f) {
-        REQUIRE_FALSE(system.step(1.0 / 60));
-        for (size_t t = 0; t < system.typeCount(); ++t)
-            for (const rt::RenderPoint& p : system.points(t))
-                out.append(reinterpret_cast<const char*>(&p), sizeof p);
-    }
-    return out;
-}
+ir::Module compile(const std::string& text) { return test::compileModule(text); }
 
 }  // namespace
 
@@ -74,7 +58,7 @@ TEST_CASE("kernels are cached by their structure: compiling a system again compi
     rt::System again(compile(text), jit);
     CHECK(jit.report().kernels == before.kernels);
     CHECK(jit.report().cacheHits > before.cacheHits);
-    drawn(again, 60);
+    drawnBytes(again, 60);
 }
 
 TEST_CASE("one backend runs system after system, each as a fresh interpreter would") {
@@ -86,7 +70,7 @@ TEST_CASE("one backend runs system after system, each as a fresh interpreter wou
             INFO((name + " round " + std::to_string(round)));
             interp::Interpreter interpreter;
             rt::System a(compile(sample(name)), interpreter), b(compile(sample(name)), jit);
-            CHECK(drawn(a, 90) == drawn(b, 90));
+            CHECK(drawnBytes(a, 90) == drawnBytes(b, 90));
         }
 }
 
@@ -102,7 +86,7 @@ TEST_CASE("the number of threads never changes a result") {
         rt::System system(compile(text), jit, options);
         float population = 30000;
         REQUIRE_FALSE(system.setExtern("population", {&population, 1}));
-        std::string out = drawn(system, 200);
+        std::string out = drawnBytes(system, 200);
         CHECK(system.pool(static_cast<size_t>(system.typeIndex("drop"))).live() > 25000);
         if (reference.empty()) reference = out;
         CHECK(out == reference);

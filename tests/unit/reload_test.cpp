@@ -9,19 +9,13 @@
 #include "interp/interpreter.h"
 #include "rt/system.h"
 #include "test_support.h"
+#include "tests/system_support.h"
 
 using namespace psys;
 
 namespace {
 
-ir::Module compile(const std::string& text) {
-    SourceManager sources;
-    DiagnosticEngine diags(sources);
-    auto module = compileText("test.psys", text, sources, diags);
-    INFO(diags.render());
-    REQUIRE(module.has_value());
-    return std::move(*module);
-}
+ir::Module compile(const std::string& text) { return test::compileModule(text); }
 
 // Everything drawn, and every type's counts, after each of `frames` steps, as bytes.
 std::string run(rt::System& system, int frames) {

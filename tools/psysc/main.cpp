@@ -101,6 +101,63 @@ int printStats(const std::string& file, bool colour) {
     return 0;
 }
 
+// The options of `psysc run`.
+void addRunOptions(CLI::App& run, psys::tools::RunOptions& o) {
+    run.add_option("file", o.file, "The system to run")->required()->type_name("FILE");
+    run.add_option("--frames", o.frames, "Frames to run (600)")->check(CLI::NonNegativeNumber);
+    run.add_option("--dt", o.dt, "Seconds per frame (1/60)");
+    run.add_option("--seed", o.seed, "Random seed (1)");
+    run.add_option("--capacity", o.capacity, "Most live objects per type, unless @capacity says (1048576)");
+    run.add_option("--set", o.sets, "Set an extern: NAME=VALUE or NAME=X,Y,Z (repeatable)")
+        ->allow_extra_args(false);
+    run.add_option("--fire", o.fires, "Fire a trigger before a frame: TRIGGER[:X,Y,Z]@FRAME (repeatable)")->allow_extra_args(false);
+    run.add_option("--dump", o.dump, "Write every drawn point per frame to FILE.csv or FILE.json");
+    run.add_option("--dump-every", o.dumpEvery, "Dump every Nth frame (1)")->check(CLI::PositiveNumber);
+    run.add_flag("--quiet", o.quiet, "No line per frame, only the summary");
+    run.add_option("--backend", o.backend, "llvm (JIT-compiled, the default) or interp (the reference)")
+        ->check(CLI::IsMember(psys::host::backendNames()));
+    run.add_option("--math", o.math,
+                    "llvm backend: fast (fused multiply-adds, vector math functions; the default) or exact "
+                    "(the interpreter's results bit for bit)")
+        ->check(CLI::IsMember({"fast", "exact"}));
+    run.add_option("--threads", o.threads, "Threads for pool updates: 0 for every core (0)")
+        ->check(CLI::NonNegativeNumber);
+    run.add_flag("--timing", o.timing, "Print compile time and the time spent stepping and drawing");
+    run.add_flag("--remarks", o.remarks, "llvm backend: print whether each update loop vectorized");
+}
+
+// `psysc --emit=ast FILE`
+int printAst(const std::string& file, bool colour) {
+    psys::SourceManager sources;
+    bool failed = false;
+    auto program = checkOne(file, sources, colour, false, &failed);
+    if (!program) return 1;
+    std::cout << psys::printAst(*program, sources);
+    return 0;
+}
+
+// `psysc --emit=ir FILE [--print-after=PASS…] [--locations]`
+int printIr(const std::string& file, psys::CompileOptions options, bool colour) {
+    for (const std::string& pass : options.pipeline.printAfter) {
+        bool known = false;
+        for (auto& info : psys::opt::passCatalogue()) known |= pass == info.name;
+        if (!known) {
+            std::cerr << "psysc: error: unknown pass `" << pass << "` for --print-after; the passes are:\n";
+            for (auto& info : psys::opt::passCatalogue()) std::cerr << "  " << info.name << ": " << info.summary << "\n";
+            return 2;
+        }
+    }
+    psys::SourceManager sources;
+    psys::DiagnosticEngine diags(sources);
+    options.pipeline.log = &std::cout;
+    auto module = psys::compileFile(file, sources, diags, options);
+    diags.print(std::cerr, colour);
+    if (!module) return 1;
+    if (!options.pipeline.printAfterAll && options.pipeline.printAfter.empty())
+        std::cout << psys::ir::print(*module, options.pipeline.print);
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -137,27 +194,7 @@ int main(int argc, char** argv) {
 
     auto* run = app.add_subcommand("run", "Compile FILE and run the system (JIT-compiled with LLVM, or interpreted)");
     psys::tools::RunOptions runOptions;
-    run->add_option("file", runOptions.file, "The system to run")->required()->type_name("FILE");
-    run->add_option("--frames", runOptions.frames, "Frames to run (600)")->check(CLI::NonNegativeNumber);
-    run->add_option("--dt", runOptions.dt, "Seconds per frame (1/60)");
-    run->add_option("--seed", runOptions.seed, "Random seed (1)");
-    run->add_option("--capacity", runOptions.capacity, "Most live objects per type, unless @capacity says (1048576)");
-    run->add_option("--set", runOptions.sets, "Set an extern: NAME=VALUE or NAME=X,Y,Z (repeatable)")
-        ->allow_extra_args(false);
-    run->add_option("--fire", runOptions.fires, "Fire a trigger before a frame: TRIGGER[:X,Y,Z]@FRAME (repeatable)")->allow_extra_args(false);
-    run->add_option("--dump", runOptions.dump, "Write every drawn point per frame to FILE.csv or FILE.json");
-    run->add_option("--dump-every", runOptions.dumpEvery, "Dump every Nth frame (1)")->check(CLI::PositiveNumber);
-    run->add_flag("--quiet", runOptions.quiet, "No line per frame, only the summary");
-    run->add_option("--backend", runOptions.backend, "llvm (JIT-compiled, the default) or interp (the reference)")
-        ->check(CLI::IsMember(psys::host::backendNames()));
-    run->add_option("--math", runOptions.math,
-                    "llvm backend: fast (fused multiply-adds, vector math functions; the default) or exact "
-                    "(the interpreter's results bit for bit)")
-        ->check(CLI::IsMember({"fast", "exact"}));
-    run->add_option("--threads", runOptions.threads, "Threads for pool updates: 0 for every core (0)")
-        ->check(CLI::NonNegativeNumber);
-    run->add_flag("--timing", runOptions.timing, "Print compile time and the time spent stepping and drawing");
-    run->add_flag("--remarks", runOptions.remarks, "llvm backend: print whether each update loop vectorized");
+    addRunOptions(*run, runOptions);
     run->fallthrough();
 
     app.require_subcommand(0, 1);
@@ -190,37 +227,14 @@ int main(int argc, char** argv) {
             std::cerr << "psysc: --emit=" << emit << " takes exactly one FILE\n";
             return 2;
         }
-        if (emit == "ast") {
-            psys::SourceManager sources;
-            bool failed = false;
-            auto program = checkOne(emitFiles[0], sources, colour, false, &failed);
-            if (!program) return 1;
-            std::cout << psys::printAst(*program, sources);
-            return 0;
-        }
-        for (const std::string& pass : printAfter) {
-            bool known = false;
-            for (auto& info : psys::opt::passCatalogue()) known |= pass == info.name;
-            if (!known) {
-                std::cerr << "psysc: error: unknown pass `" << pass << "` for --print-after; the passes are:\n";
-                for (auto& info : psys::opt::passCatalogue()) std::cerr << "  " << info.name << ": " << info.summary << "\n";
-                return 2;
-            }
-        }
-        psys::SourceManager sources;
-        psys::DiagnosticEngine diags(sources);
+        if (emit == "ast") return printAst(emitFiles[0], colour);
         psys::CompileOptions options;
         options.pipeline.optimize = !noOptimize;
         options.pipeline.pass.relaxed = relaxedMath;
         options.pipeline.printAfter = {printAfter.begin(), printAfter.end()};
         options.pipeline.printAfterAll = printAfterAll;
-        options.pipeline.log = &std::cout;
         options.pipeline.print.locations = locations;
-        auto module = psys::compileFile(emitFiles[0], sources, diags, options);
-        diags.print(std::cerr, colour);
-        if (!module) return 1;
-        if (!printAfterAll && printAfter.empty()) std::cout << psys::ir::print(*module, options.pipeline.print);
-        return 0;
+        return printIr(emitFiles[0], options, colour);
     }
     std::cerr << app.help();
     return 2;
