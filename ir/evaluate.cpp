@@ -15,19 +15,40 @@ bool equal(const Value& a, const Value& b, const Type& t) {
     return true;
 }
 
+// A componentwise op over the lanes, with the op known at compile time so that
+// core::lane's dispatch folds away (this is the interpreter's inner loop).
+template <Op op>
+Value unary(const Value& a, size_t width) {
+    Value out;
+    for (size_t l = 0; l < width; ++l) out.f[l] = core::lane(op, a.f[l]);
+    return out;
+}
+
+template <Op op>
+Value binary(const Value& a, const Value& b, size_t width) {
+    Value out;
+    for (size_t l = 0; l < width; ++l) out.f[l] = core::lane(op, a.f[l], b.f[l]);
+    return out;
+}
+
 }  // namespace
 
 Value evaluate(const Inst& inst, const Value* operands, const Type* operandTypes) {
     const auto w = static_cast<size_t>(inst.type.width);
     auto a = [&](size_t i) -> const Value& { return operands[i]; };
     Value out;
-    if (isComponentwise(inst.op) && inst.op != Op::Select) {
-        const int arity = opInfo(inst.op).arity;
-        for (size_t l = 0; l < w; ++l)
-            out.f[l] = arity == 1 ? core::lane(inst.op, a(0).f[l]) : core::lane(inst.op, a(0).f[l], a(1).f[l]);
-        return out;
-    }
     switch (inst.op) {
+#define PSYS_UNARY(op) \
+    case Op::op: return unary<Op::op>(a(0), w);
+#define PSYS_BINARY(op) \
+    case Op::op: return binary<Op::op>(a(0), a(1), w);
+        PSYS_BINARY(Add) PSYS_BINARY(Sub) PSYS_BINARY(Mul) PSYS_BINARY(Div) PSYS_BINARY(Mod) PSYS_BINARY(Min)
+        PSYS_BINARY(Max) PSYS_BINARY(Step) PSYS_BINARY(Atan2) PSYS_BINARY(Pow)
+        PSYS_UNARY(Neg) PSYS_UNARY(Sin) PSYS_UNARY(Cos) PSYS_UNARY(Tan) PSYS_UNARY(Asin) PSYS_UNARY(Acos)
+        PSYS_UNARY(Atan) PSYS_UNARY(Exp) PSYS_UNARY(Log) PSYS_UNARY(Sqrt) PSYS_UNARY(Abs) PSYS_UNARY(Sign)
+        PSYS_UNARY(Floor) PSYS_UNARY(Ceil) PSYS_UNARY(Round) PSYS_UNARY(Fract)
+#undef PSYS_UNARY
+#undef PSYS_BINARY
         case Op::Lt: case Op::Le: case Op::Gt: case Op::Ge:
             return Value::boolean(core::compare(inst.op, a(0).f[0], a(1).f[0]));
         case Op::Eq: return Value::boolean(equal(a(0), a(1), operandTypes[0]));

@@ -5,6 +5,10 @@
 #include <fstream>
 #include <sstream>
 
+#include <cmath>
+
+#include "core/lanes.h"
+#include "ir/evaluate.h"
 #include "ir/hash.h"
 #include "ir/lower.h"
 #include "ir/parser.h"
@@ -170,4 +174,23 @@ TEST_CASE("instructions carry the location of the source they come from, through
     CHECK(found);
     CHECK(m.files == std::vector<std::string>{"loc.psys"});
     CHECK(print(m, {.locations = true}).find("loc(loc.psys:2:7)") != std::string::npos);
+}
+
+TEST_CASE("evaluate computes every componentwise op through core/lanes.h, on every lane") {
+    for (int i = 0; i <= static_cast<int>(Op::Recur); ++i) {
+        auto op = static_cast<Op>(i);
+        if (!isComponentwise(op) || op == Op::Select) continue;
+        INFO(opInfo(op).name);
+        Inst inst = Inst::make(op, Type::vec(3), {0, 1});
+        if (opInfo(op).arity == 1) inst.operands = {0};
+        Value x{{0.3f, -2.5f, 7.0f, 0}, 0}, y{{1.5f, 0.25f, -3.0f, 0}, 0};
+        Value operands[2] = {x, y};
+        Type types[2] = {Type::vec(3), Type::vec(3)};
+        Value out = evaluate(inst, operands, types);
+        for (size_t l = 0; l < 3; ++l) {
+            float expected = opInfo(op).arity == 1 ? psys::core::lane(op, x.f[l]) : psys::core::lane(op, x.f[l], y.f[l]);
+            CHECK((out.f[l] == expected || (std::isnan(out.f[l]) && std::isnan(expected))));
+        }
+        CHECK(out.f[3] == 0);
+    }
 }
