@@ -27,9 +27,9 @@ using RowsFn = int64_t (*)(void* const*, const uint8_t*, int64_t, int64_t, const
 using ChildrenFn = void (*)(void* const*, int64_t, const rt::Value*, const rt::Value*, double, float, uint32_t,
                             uint32_t, uint32_t, uint32_t, int64_t, float* const*, int64_t);
 
-// `lanes`: floats per vector register, the width the loop is vectorized to. `now` and
-// `dt`: where the loop reads each row's clock from (rt/clock.h); when either is per row,
-// the kernel's uniform kernel is evaluated in the loop for each row.
+// `lanes`: floats per vector register, the width the loop is vectorized to (0: not
+// vectorized). `now` and `dt`: where the loop reads each row's clock from (rt/clock.h);
+// when either is per row, the kernel's uniform kernel is evaluated in the loop for each row.
 void buildRowsFunction(llvm::Module& module, MathMode mode, unsigned lanes, const ir::Object& object,
                        const ir::Kernel& kernel, const ir::Kernel* uniformKernel, rt::Clock::Source now,
                        rt::Clock::Source dt, const std::string& name);

@@ -46,18 +46,20 @@ struct LlvmBackend::Impl {
         const Object* object;
         Shape shape;
         const Kernel* uniformKernel;  // rows with a per-row clock: evaluated per row
+        bool vectorize;
         Hash128 key;
     };
 
-    Request request(const Object& o, const Kernel& k, bool children, Clock::Source now, Clock::Source dt) {
+    Request request(const Object& o, const Kernel& k, bool children, Clock::Source now, Clock::Source dt,
+                    bool many = true) {
         const Kernel* uniform = nullptr;
         if (!children && (now == Clock::Source::PerRow || dt == Clock::Source::PerRow))
             if (auto served = uniformFor(k.kind)) uniform = o.kernel(*served);
         Hasher h;
         h.add(mode == MathMode::Exact).add(children).add(static_cast<uint64_t>(now)).add(static_cast<uint64_t>(dt));
-        h.add(structuralHash(k)).add(rt::columnLayout(o, k).signature());
+        h.add(many).add(structuralHash(k)).add(rt::columnLayout(o, k).signature());
         if (uniform) h.add(structuralHash(*uniform));
-        return {&o, {&k, children, now, dt}, uniform, h.finish()};
+        return {&o, {&k, children, now, dt}, uniform, many, h.finish()};
     }
 
     // Compiles what is not compiled yet (one module per function, compiled concurrently).
@@ -81,8 +83,8 @@ struct LlvmBackend::Impl {
             if (r.shape.children)
                 buildChildrenFunction(*unit.module, mode, *r.object, *r.shape.kernel, name);
             else
-                buildRowsFunction(*unit.module, mode, lanes, *r.object, *r.shape.kernel, r.uniformKernel, r.shape.now,
-                                  r.shape.dt, name);
+                buildRowsFunction(*unit.module, mode, r.vectorize ? lanes : 0, *r.object, *r.shape.kernel,
+                                  r.uniformKernel, r.shape.now, r.shape.dt, name);
             inThisBatch[r.key] = units.size();
             units.push_back(std::move(unit));
             built.push_back(&r);
@@ -132,7 +134,8 @@ rt::BackendReport LlvmBackend::report() const {
 void LlvmBackend::prepare(const rt::Plan& plan) {
     std::lock_guard lock(impl_->mutex);
     std::vector<Impl::Request> requests;
-    for (const rt::Plan::Rows& r : plan.rows) requests.push_back(impl_->request(*r.object, *r.kernel, false, r.now, r.dt));
+    for (const rt::Plan::Rows& r : plan.rows)
+        requests.push_back(impl_->request(*r.object, *r.kernel, false, r.now, r.dt, r.many));
     for (const rt::Plan::Children& c : plan.children)
         requests.push_back(impl_->request(*c.object, *c.spawn, true, Clock::Source::Uniform, Clock::Source::Uniform));
     impl_->compile(requests);

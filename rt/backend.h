@@ -68,6 +68,9 @@ struct Plan {
         const ir::Object* object;
         const ir::Kernel* kernel;
         Clock::Source now, dt;
+        // Whether its launches usually cover many rows (a pool; the objects a stream
+        // creates every step): a compiler may spend less on the others (not vectorize).
+        bool many = true;
     };
     std::vector<Rows> rows;
     struct Children {

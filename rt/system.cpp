@@ -4,6 +4,7 @@
 #include "rt/system.h"
 
 #include <cmath>
+#include <set>
 
 #include <fmt/format.h>
 
@@ -28,24 +29,32 @@ namespace {
 // exports) at per-row clocks.
 Plan planOf(const ir::Module& module) {
     using S = Clock::Source;
-    Plan plan;
+    // Types created at a rate are created many at a time, step after step; the others (by
+    // the start, bursts and triggers) now and then.
+    std::set<std::string> streams;
     for (const ir::Object& o : module.objects)
+        for (const ir::EmitSite& e : o.emits)
+            if (e.rate) streams.insert(e.target);
+    Plan plan;
+    for (const ir::Object& o : module.objects) {
+        bool stream = streams.count(o.name) > 0;
         for (const ir::Kernel& k : o.kernels) {
             switch (k.kind) {
-                case KernelKind::Init: plan.rows.push_back({&o, &k, S::PerRow, S::PerRow}); break;
+                case KernelKind::Init: plan.rows.push_back({&o, &k, S::PerRow, S::PerRow, stream}); break;
                 case KernelKind::Update:
                     plan.rows.push_back({&o, &k, S::Uniform, S::Uniform});
-                    plan.rows.push_back({&o, &k, S::PerRow, S::PerRow});
+                    plan.rows.push_back({&o, &k, S::PerRow, S::PerRow, stream});
                     break;
                 case KernelKind::Exports:
                     plan.rows.push_back({&o, &k, S::Uniform, S::Uniform});
-                    plan.rows.push_back({&o, &k, S::PerRow, S::PerRow});
+                    plan.rows.push_back({&o, &k, S::PerRow, S::PerRow, stream});
                     break;
                 case KernelKind::Render: plan.rows.push_back({&o, &k, S::Uniform, S::Uniform}); break;
                 case KernelKind::Spawn: plan.children.push_back({&o, &k}); break;
                 default: break;  // start, triggers and uniform kernels: evaluated on the host
             }
         }
+    }
     return plan;
 }
 
