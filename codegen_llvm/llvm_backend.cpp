@@ -62,50 +62,59 @@ struct LlvmBackend::Impl {
         return {&o, {&k, children, now, dt}, uniform, many, h.finish()};
     }
 
-    // Compiles what is not compiled yet (one module per function, compiled concurrently).
+    // Compiles what is not compiled yet (one module per function, compiled concurrently)
+    // and maps the launch shapes to their code. The lock is held only around the maps, so
+    // a system keeps running on this backend while another's kernels compile (a viewer
+    // reloading a file).
     void compile(const std::vector<Request>& requests) {
         auto start = std::chrono::steady_clock::now();
-        std::vector<JitEngine::Unit> units;
-        std::vector<const Request*> built;
-        std::unordered_map<Hash128, size_t, Hash128Hasher> inThisBatch;
-        for (const Request& r : requests) {
-            if (byHash.count(r.key) || inThisBatch.count(r.key)) {
-                ++stats.cacheHits;
-                continue;
+        std::vector<std::pair<const Request*, std::string>> missing;  // with the function's name
+        {
+            std::lock_guard lock(mutex);
+            std::unordered_map<Hash128, bool, Hash128Hasher> inThisBatch;
+            for (const Request& r : requests) {
+                if (byHash.count(r.key) || inThisBatch.count(r.key)) {
+                    ++stats.cacheHits;
+                    continue;
+                }
+                inThisBatch[r.key] = true;
+                // Names say what a function is, for remarks and profiles: drop.update.created.7
+                std::string name = r.object->name + "." + kernelName(r.shape.kernel->kind);
+                if (r.shape.children) name += ".children";
+                else if (r.shape.now == Clock::Source::PerRow || r.shape.dt == Clock::Source::PerRow) name += ".created";
+                missing.push_back({&r, name + "." + std::to_string(counter++)});
             }
-            // Names say what a function is, for remarks and profiles: drop.update.rows.7
-            std::string name = r.object->name + "." + kernelName(r.shape.kernel->kind);
-            if (r.shape.children) name += ".children";
-            else if (r.shape.now == Clock::Source::PerRow || r.shape.dt == Clock::Source::PerRow) name += ".created";
-            name += "." + std::to_string(counter++);
+        }
+        std::vector<JitEngine::Unit> units;
+        for (auto& [r, name] : missing) {
             JitEngine::Unit unit{engine.newContext(), nullptr, name};
             unit.module = engine.newModule(*unit.context);
-            if (r.shape.children)
-                buildChildrenFunction(*unit.module, mode, *r.object, *r.shape.kernel, name);
+            if (r->shape.children)
+                buildChildrenFunction(*unit.module, mode, *r->object, *r->shape.kernel, name);
             else
-                buildRowsFunction(*unit.module, mode, r.vectorize ? lanes : 0, *r.object, *r.shape.kernel,
-                                  r.uniformKernel, r.shape.now, r.shape.dt, name);
-            inThisBatch[r.key] = units.size();
+                buildRowsFunction(*unit.module, mode, r->vectorize ? lanes : 0, *r->object, *r->shape.kernel,
+                                  r->uniformKernel, r->shape.now, r->shape.dt, name);
             units.push_back(std::move(unit));
-            built.push_back(&r);
         }
-        if (!units.empty()) {
-            size_t count = units.size();
-            auto addresses = engine.add(std::move(units));
-            for (size_t n = 0; n < count; ++n) byHash[built[n]->key] = addresses[n];
-            stats.kernels += count;
-        }
+        std::vector<void*> addresses;
+        if (!units.empty()) addresses = engine.add(std::move(units));
+        std::lock_guard lock(mutex);
+        for (size_t n = 0; n < missing.size(); ++n) byHash[missing[n].first->key] = addresses[n];
+        stats.kernels += missing.size();
         for (const Request& r : requests) functions[r.shape] = byHash.at(r.key);
         stats.compileSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
 
     // The compiled function for a launch shape (compiled now if `prepare` did not list it).
     void* function(const Object& o, const Kernel& k, bool children, Clock::Source now, Clock::Source dt) {
-        std::lock_guard lock(mutex);
         Shape shape{&k, children, now, dt};
-        auto it = functions.find(shape);
-        if (it != functions.end()) return it->second;
+        {
+            std::lock_guard lock(mutex);
+            auto it = functions.find(shape);
+            if (it != functions.end()) return it->second;
+        }
         compile({request(o, k, children, now, dt)});
+        std::lock_guard lock(mutex);
         return functions.at(shape);
     }
 
@@ -132,7 +141,6 @@ rt::BackendReport LlvmBackend::report() const {
 }
 
 void LlvmBackend::prepare(const rt::Plan& plan) {
-    std::lock_guard lock(impl_->mutex);
     std::vector<Impl::Request> requests;
     for (const rt::Plan::Rows& r : plan.rows)
         requests.push_back(impl_->request(*r.object, *r.kernel, false, r.now, r.dt, r.many));

@@ -151,6 +151,7 @@ struct FollowedByExpr : Expr {
 struct TypeAnnotation {
     Type type;
     SourceRange range;
+    std::string spelling;  // a named type as written: `color` and `vec4` are one type
 };
 
 struct Param {

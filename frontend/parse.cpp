@@ -121,9 +121,10 @@ private:
     }
 
     TypeAnnotation typeRef(PsysParser::TypeRefContext* ctx) {
-        TypeAnnotation t{Type::error(), range(ctx)};
+        TypeAnnotation t{Type::error(), range(ctx), {}};
         if (auto* named = dynamic_cast<PsysParser::NamedTypeContext*>(ctx)) {
             std::string spelled = named->getText();
+            t.spelling = spelled;
             if (auto known = Type::fromName(spelled)) t.type = *known;
             else
                 diags_.error(t.range, fmt::format("unknown type `{}`", spelled))

@@ -68,16 +68,31 @@ std::optional<std::string> Session::frame(int index, double dt) {
     return error;
 }
 
-Session::Reload Session::reload(const std::string* text) {
+Session::Candidate Session::compileCandidate(const std::string* text) const {
+    Candidate c;
+    c.compile = compile(path_, options_.compile, c.module, text);
+    c.backend = backend_;
+    if (c.module) {
+        auto start = std::chrono::steady_clock::now();
+        c.backend->prepare(rt::launchPlan(*c.module));
+        c.prepareSeconds = secondsSince(start);
+    }
+    return c;
+}
+
+Session::Reload Session::adopt(Candidate candidate) {
     Reload out;
-    std::optional<ir::Module> module;
-    out.compile = compile(path_, options_.compile, module, text);
-    if (!module) return out;  // the old system keeps running
-    auto next = std::make_unique<rt::System>(std::move(*module), *backend_, system_->options());
+    out.compile = std::move(candidate.compile);
+    if (!candidate.module) return out;  // the old system keeps running
+    std::shared_ptr<rt::Backend> backend = candidate.backend ? candidate.backend : backend_;
+    auto next = std::make_unique<rt::System>(std::move(*candidate.module), *backend, system_->options());
     out.report = next->carryOver(*system_);
-    system_ = std::move(next);
+    system_ = std::move(next);  // the old system goes before its backend
+    backend_ = std::move(backend);
     return out;
 }
+
+Session::Reload Session::reload(const std::string* text) { return adopt(compileCandidate(text)); }
 
 std::optional<std::string> Session::switchBackend(const BackendChoice& choice) {
     auto backend = makeBackend(choice);

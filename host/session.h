@@ -68,6 +68,19 @@ public:
     };
     // Compiles the file again (or `text`); on success the new system takes over.
     Reload reload(const std::string* text = nullptr);
+
+    // The same in two halves, for a host that keeps running while it compiles: a candidate
+    // is compiled, and the backend prepared for it (its kernels compiled), on any thread;
+    // `adopt` makes it take over, on its backend, on the thread that runs the session.
+    struct Candidate {
+        CompileResult compile;
+        std::optional<ir::Module> module;
+        std::shared_ptr<rt::Backend> backend;  // the backend it was prepared for
+        double prepareSeconds = 0;             // compiling its kernels
+    };
+    Candidate compileCandidate(const std::string* text = nullptr) const;
+    Reload adopt(Candidate candidate);
+    std::shared_ptr<rt::Backend> backendHandle() const { return backend_; }
     // The running system's objects on another backend.
     std::optional<std::string> switchBackend(const BackendChoice& choice);
 

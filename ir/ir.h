@@ -222,6 +222,7 @@ struct Object {
 struct Extern {
     std::string name;
     Type type;
+    std::string spelling;  // its type as declared where that says more (`color`, `point`): for hosts' controls
     std::array<float, 4> defaultValue{};
     std::optional<std::array<float, 4>> low, high;
 };

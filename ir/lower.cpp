@@ -114,7 +114,8 @@ Module lower(const ast::Program& program, const SourceManager& sources) {
         for (auto& d : module->decls)
             if (d->kind == DeclKind::Extern) {
                 auto& e = static_cast<const ExternDecl&>(*d);
-                Extern x{e.name, irType(e.type.type), constantValue(e.defaultValue.get(), irType(e.type.type)), {}, {}};
+                Extern x{e.name, irType(e.type.type), {}, constantValue(e.defaultValue.get(), irType(e.type.type)), {}, {}};
+                if (e.type.spelling == "color" || e.type.spelling == "point") x.spelling = e.type.spelling;
                 if (e.rangeLow) {
                     x.low = constantValue(e.rangeLow.get(), x.type);
                     x.high = constantValue(e.rangeHigh.get(), x.type);

@@ -142,6 +142,10 @@ private:
         e.type = type(w[2]);
         size_t i = 4;
         for (int c = 0; c < e.type.width; ++c) e.defaultValue[static_cast<size_t>(c)] = number(w.at(i++));
+        if (i + 1 < w.size() && w[w.size() - 2] == "as") {
+            e.spelling = w.back();
+            w.resize(w.size() - 2);
+        }
         if (i < w.size()) {
             if (w[i] != "range") throw ParseError("expected `range`");
             ++i;

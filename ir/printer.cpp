@@ -113,6 +113,7 @@ std::string print(const Module& m, PrintOptions options) {
     for (auto& e : m.externs) {
         out += fmt::format("extern {}: {} = {}", e.name, e.type.str(), values(e.defaultValue, e.type));
         if (e.low) out += fmt::format(" range {} to {}", values(*e.low, e.type), values(*e.high, e.type));
+        if (!e.spelling.empty()) out += " as " + e.spelling;
         out += "\n";
     }
     for (auto& o : m.objects) out += print(o, options);

@@ -21,13 +21,11 @@ using detail::seconds;
 using detail::WallClock;
 using ir::KernelKind;
 
-namespace {
-
 // Every launch shape a system asks for (rt/system_create.cpp, rt/system_update.cpp,
 // rt/system_draw.cpp): steps of existing objects at one clock; everything about objects
 // being created (init and exports at their creation times, first updates and their
 // exports) at per-row clocks.
-Plan planOf(const ir::Module& module) {
+Plan launchPlan(const ir::Module& module) {
     using S = Clock::Source;
     // Types created at a rate are created many at a time, step after step; the others (by
     // the start, bursts and triggers) now and then.
@@ -58,13 +56,11 @@ Plan planOf(const ir::Module& module) {
     return plan;
 }
 
-}  // namespace
-
 System::System(ir::Module module, Backend& backend, SystemOptions options)
     : state_(std::make_unique<detail::State>(std::move(module), backend, options)),
       creation_(std::make_unique<detail::Creation>(*state_)),
       drawing_(std::make_unique<detail::Drawing>(*state_)) {
-    backend.prepare(planOf(state_->module));
+    backend.prepare(launchPlan(state_->module));
 }
 
 System::~System() {

@@ -95,6 +95,11 @@ struct ReloadReport {
     std::vector<std::string> lostSlots;    // "type.slot": state the new module no longer has (or with another type)
 };
 
+// Every launch shape a System of `module` uses: what its constructor hands
+// Backend::prepare. A host may prepare a backend with it ahead of time, on another thread
+// (the constructor then finds everything compiled).
+Plan launchPlan(const ir::Module& module);
+
 namespace detail {
 struct State;
 class Creation;

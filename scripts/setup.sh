@@ -7,7 +7,7 @@ packages=(
   cmake ninja-build pkg-config g++ git
   antlr4 libantlr4-runtime-dev
   llvm-19-dev libzstd-dev
-  libglm-dev libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri
+  libglm-dev libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libimgui-dev
   doctest-dev libcli11-dev libfmt-dev nlohmann-json3-dev libstb-dev libtbb-dev
   glslang-tools xvfb xauth libbenchmark-dev
 )

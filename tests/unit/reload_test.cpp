@@ -231,3 +231,55 @@ TEST_CASE("a reload that adds an object type starts it empty, and the spawns do 
     CHECK(after.stats().types[0].live == 1);
     CHECK(after.stats().types[1].created == 60);  // from the carried emitter; no `spawn b`
 }
+
+TEST_CASE("a renamed object type is a removed type and a new one") {
+    std::string old = "object spark { point(vec3(age), white, 1); }\nobject e { emit spark at 30 per second; }\nspawn e;";
+    std::string renamed = "object ember { point(vec3(age), white, 1); }\nobject e { emit ember at 30 per second; }\nspawn e;";
+    interp::Interpreter backend;
+    rt::System before(compile(old), backend);
+    run(before, 30);
+    size_t sparks = before.stats().types[0].live;
+    REQUIRE(sparks > 10);
+    rt::System after(compile(renamed), backend);
+    rt::ReloadReport report = after.carryOver(before);
+    CHECK(report.droppedTypes == std::vector<std::string>{"spark"});
+    CHECK(report.dropped == sparks);
+    CHECK(after.stats().types[0].live == 0);
+    CHECK(after.stats().types[1].live == 1);  // the emitter carries on, and emits embers
+    run(after, 30);
+    CHECK(after.stats().types[0].created == 15);
+}
+
+TEST_CASE("a reload that adds a parameter carries the objects; the new parameter reads 0") {
+    std::string old = "object p(a: float) { point(vec3(a, 0, 0), white, 1); }\nspawn p(2);";
+    std::string added = "object p(a: float, b: float) { point(vec3(a, b + 7, 0), white, 1); }\nspawn p(2, 3);";
+    interp::Interpreter backend;
+    rt::System before(compile(old), backend);
+    run(before, 5);
+    rt::System after(compile(added), backend);
+    rt::ReloadReport report = after.carryOver(before);
+    CHECK(report.carried == 1);
+    run(after, 1);
+    auto p = after.points(0);
+    REQUIRE(p.size() == 1);
+    CHECK(p[0].position[0] == 2);  // a carried over
+    CHECK(p[0].position[1] == 7);  // b: the old objects never had one
+}
+
+TEST_CASE("a reload right after a burst carries every object of it, as if nothing happened") {
+    // A trigger creates 200 objects at once; the reload comes before the next step.
+    std::string text = test::readFile(std::string(PSYS_SAMPLES_DIR) + "/swamp.psys");
+    interp::Interpreter backend;
+    rt::System straight(compile(text), backend), before(compile(text), backend);
+    run(straight, 10);
+    run(before, 10);
+    float at[3] = {1, 0, 1};
+    REQUIRE_FALSE(straight.fire("explosion", at));
+    REQUIRE_FALSE(before.fire("explosion", at));
+    size_t debris = static_cast<size_t>(before.typeIndex("debris"));
+    REQUIRE(before.stats().types[debris].live == 200);
+    rt::System after(compile(text), backend);
+    after.carryOver(before);
+    CHECK(after.stats().types[debris].live == 200);
+    CHECK(run(after, 60) == run(straight, 60));
+}

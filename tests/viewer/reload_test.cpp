@@ -1,0 +1,157 @@
+// Hot reload as the viewer does it: a file is saved, the watcher sees it, the reloader
+// compiles it off the frame loop, and the new system takes over with the particles still
+// there; a broken edit — in the file or in a file it imports — keeps the old one running.
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "reloader.h"
+#include "watcher.h"
+
+using namespace psys;
+using namespace psys::viewer;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Folder {
+    fs::path path;
+    Folder() : path(fs::temp_directory_path() / ("psys_reload_" + std::to_string(::getpid()))) {
+        fs::create_directories(path);
+    }
+    ~Folder() { fs::remove_all(path); }
+    // Saves as editors do: a new file renamed over the old one.
+    void save(const std::string& name, const std::string& text) const {
+        fs::path temporary = path / (name + ".tmp");
+        std::ofstream(temporary) << text;
+        fs::rename(temporary, path / name);
+    }
+};
+
+// Waits until the watcher sees a save (the frame loop polls it like this).
+void waitForSave(Watcher& watcher) {
+    for (int i = 0; i < 500; ++i) {
+        if (watcher.changed()) return;
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    FAIL("the watcher did not see the save");
+}
+
+// Frames go on until the reloader says what became of the save (the JIT's system, or
+// the errors).
+Reloader::Outcome waitForReload(Reloader& reloader, host::Session& session, int& frame) {
+    for (int i = 0; i < 1000; ++i) {
+        REQUIRE_FALSE(session.frame(++frame, 1.0 / 60));
+        if (auto outcome = reloader.poll(); outcome && outcome->kind != Reloader::Outcome::Kind::Interim) return *outcome;
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    FAIL("the reload did not finish");
+    return {};
+}
+
+const char* kLib = "fn lift() -> vec3 = vec3(0, 1, 0);\n";
+const char* kMain = "import \"lib.psys\";\n"
+                    "object p { pos = integrate(lift()); point(pos, white, 1); }\n"
+                    "object e { emit p at 60 per second; }\nspawn e;\n";
+
+}  // namespace
+
+TEST_CASE("a save is seen, compiled off the frame loop, and the particles stay") {
+    Folder folder;
+    folder.save("lib.psys", kLib);
+    folder.save("main.psys", kMain);
+    host::SessionOptions options;
+    host::CompileResult compiled;
+    std::string error;
+    auto session = host::Session::open((folder.path / "main.psys").string(), options, compiled, error);
+    REQUIRE_MESSAGE(session != nullptr, compiled.text(), error);
+    Watcher watcher;
+    REQUIRE(watcher.ok());
+    std::vector<std::string> files;
+    for (int f = 0; f < compiled.sources->count(); ++f) files.push_back(compiled.sources->file(f).path());
+    watcher.watch(files);
+    Reloader reloader(*session);
+    int frame = 0;
+    for (; frame < 60;) REQUIRE_FALSE(session->frame(++frame, 1.0 / 60));
+    size_t live = session->system().stats().types[0].live;
+    REQUIRE(live > 50);
+
+    SUBCASE("an edit of the file") {
+        std::string edited = kMain;
+        edited.replace(edited.find("point(pos, white, 1)"), 20, "point(pos, red, 3)");
+        folder.save("main.psys", edited);
+        waitForSave(watcher);
+        reloader.saved(Clock::now());
+        Reloader::Outcome outcome = waitForReload(reloader, *session, frame);
+        REQUIRE(outcome.kind == Reloader::Outcome::Kind::Adopted);
+        CHECK(outcome.report->carried >= live + 1);  // the particles and their emitter
+        auto points = session->system().points(0);
+        REQUIRE(points.size() >= live);
+        CHECK(points[0].size == 3);
+        CHECK(points[0].color[1] == 0);
+        CHECK(points[0].position[1] > 0.5f);  // the integral carried on from before the reload
+    }
+    SUBCASE("a broken edit keeps the old system running, until the next good save") {
+        folder.save("main.psys", std::string(kMain) + "broken\n");
+        waitForSave(watcher);
+        reloader.saved(Clock::now());
+        Reloader::Outcome outcome = waitForReload(reloader, *session, frame);
+        CHECK(outcome.kind == Reloader::Outcome::Kind::Failed);
+        CHECK(outcome.compile.text().find("main.psys:5:1: error:") != std::string::npos);
+        CHECK(session->system().stats().types[0].live >= live);
+        REQUIRE_FALSE(session->frame(++frame, 1.0 / 60));
+        folder.save("main.psys", kMain);
+        waitForSave(watcher);
+        reloader.saved(Clock::now());
+        CHECK(waitForReload(reloader, *session, frame).kind == Reloader::Outcome::Kind::Adopted);
+    }
+    SUBCASE("an edit that breaks an import keeps the old system running") {
+        folder.save("lib.psys", "fn lift() -> vec3 = vec3(0, 1);\n");
+        waitForSave(watcher);
+        reloader.saved(Clock::now());
+        Reloader::Outcome outcome = waitForReload(reloader, *session, frame);
+        CHECK(outcome.kind == Reloader::Outcome::Kind::Failed);
+        CHECK(outcome.compile.text().find("lib.psys:1:") != std::string::npos);
+        CHECK(session->system().stats().types[0].live >= live);
+        folder.save("lib.psys", "fn lift() -> vec3 = vec3(0, 2, 0);\n");
+        waitForSave(watcher);
+        reloader.saved(Clock::now());
+        CHECK(waitForReload(reloader, *session, frame).kind == Reloader::Outcome::Kind::Adopted);
+    }
+}
+
+TEST_CASE("a reload that waits too long for the JIT runs on the interpreter meanwhile, then moves to the JIT") {
+    Folder folder;
+    folder.save("lib.psys", kLib);
+    folder.save("main.psys", kMain);
+    host::SessionOptions options;
+    host::CompileResult compiled;
+    std::string error;
+    auto session = host::Session::open((folder.path / "main.psys").string(), options, compiled, error);
+    REQUIRE(session);
+    Reloader reloader(*session);
+    reloader.interimAfterSeconds = 0;  // no waiting at all
+    int frame = 0;
+    for (; frame < 30;) REQUIRE_FALSE(session->frame(++frame, 1.0 / 60));
+    std::string edited = kMain;
+    edited.replace(edited.find("white"), 5, "green");
+    folder.save("main.psys", edited);
+    reloader.saved(Clock::now());
+    bool interim = false;
+    for (int i = 0; i < 2000; ++i) {
+        REQUIRE_FALSE(session->frame(++frame, 1.0 / 60));
+        auto outcome = reloader.poll();
+        if (outcome && outcome->kind == Reloader::Outcome::Kind::Interim) {
+            interim = true;
+            CHECK(session->backend().name() == "interp");
+            CHECK(session->system().points(0).at(0).color[1] == 1);  // green, on the interpreter
+        }
+        if (outcome && outcome->kind == Reloader::Outcome::Kind::Adopted) break;
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    CHECK(session->backend().name() == "llvm");
+    CHECK(session->system().points(0).at(0).color[1] == 1);
+    (void)interim;  // the JIT may win the race on a fast machine: both orders are right
+}

@@ -1,0 +1,133 @@
+// psys-view: see a system, edit it, and watch it change on save (docs/viewer.md).
+//
+//   psys-view FILE                         a window (Xvfb or a desktop), the JIT, hot reload
+//   psys-view --headless FILE --frames N --screenshot out.png
+//                                          no display: EGL surfaceless, PNGs
+//
+// Exit status: 0, 1 (the file does not compile, or a frame failed), 2 (bad usage or no
+// way to draw).
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+
+#include "viewer.h"
+
+using namespace psys;
+using namespace psys::viewer;
+
+namespace {
+
+const char* kKeys = R"(
+Mouse: drag to orbit, right-drag or shift-drag to pan, the wheel to zoom.
+Keys:  F frame what is alive    R reset the camera    B additive / alpha blending
+       G the ground grid and axes   H hide the panel   SPACE pause    S one step
+       T fixed 1/60 s or real time   + and - time scale   1-9 fire trigger N
+       Q or ESC quit
+Hot reload: saving FILE (or a file it imports) compiles it in the background; the new
+system takes over with the particles still flying. An edit that does not compile leaves
+the old one running and shows why.)";
+
+int fail(const std::string& message) {
+    std::cerr << "psys-view: error: " << message << "\n";
+    return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"psys-view: run a .psys system in real time, edit it live"};
+    app.footer(kKeys);
+    ViewerOptions o;
+    std::vector<std::string> sets, fires;
+    std::string camera, dt = "1/60", script, size = "1280x720", blend = "additive";
+    bool noUi = false, ui = false, noWatch = false, noGrid = false;
+    app.add_option("file", o.file, "The system to view")->required()->type_name("FILE");
+    app.add_flag("--headless", o.headless, "No window: render offscreen (EGL surfaceless) and write PNGs");
+    app.add_option("--frames", o.frames, "Frames to run, then exit (0: until the window closes; headless: 1)")
+        ->check(CLI::NonNegativeNumber);
+    app.add_option("--screenshot", o.screenshot, "Write the last frame to this PNG");
+    app.add_option("--record", o.record, "Write a PNG every --every frames into this folder");
+    app.add_option("--every", o.every, "With --record: every Nth frame (1)")->check(CLI::PositiveNumber);
+    app.add_option("--camera", camera, "yaw,pitch,distance[,x,y,z]: degrees and units, looking at (x, y, z)");
+    app.add_option("--set", sets, "Set an extern: NAME=VALUE or NAME=X,Y,Z (repeatable)")->allow_extra_args(false);
+    app.add_option("--fire", fires, "Fire a trigger before a frame: TRIGGER[:X,Y,Z]@FRAME (repeatable)")->allow_extra_args(false);
+    app.add_option("--backend", o.session.backend.name, "llvm (the default) or interp")
+        ->check(CLI::IsMember(host::backendNames()));
+    app.add_option("--math", o.session.backend.math, "llvm: fast (the default) or exact")->check(CLI::IsMember({"fast", "exact"}));
+    app.add_option("--seed", o.session.system.seed, "Random seed (1)");
+    app.add_option("--threads", o.session.system.threads, "Threads for the simulation: 0 for every core (0)");
+    app.add_option("--dt", dt, "Seconds per frame with a fixed step (1/60)");
+    app.add_flag("--real-time", o.realTime, "Step by the time each frame really took (T switches)");
+    app.add_option("--size", size, "Width x height of the window or image (1280x720)");
+    app.add_option("--blend", blend, "additive (the default) or alpha (B switches)")->check(CLI::IsMember({"additive", "alpha"}));
+    app.add_flag("--no-grid", noGrid, "No ground grid and axes (G switches)");
+    app.add_flag("--no-ui", noUi, "No panel");
+    app.add_flag("--ui", ui, "The panel in --headless images too");
+    app.add_flag("--no-watch", noWatch, "Do not reload the file when it is saved");
+    app.add_option("--script", script, "Scripted input, an action a line (docs/viewer.md)")->type_name("FILE");
+    app.add_option("--fps", o.fps, "At most this many frames a second (0: as many as it can)")->check(CLI::NonNegativeNumber);
+    app.add_option("--interim-after", o.interimAfter,
+                   "Seconds a reload waits for the JIT before the new system runs on the interpreter meanwhile (0.05)")
+        ->check(CLI::NonNegativeNumber);
+    app.add_option("--warmup", o.warmup, "Frames left out of the timing summary --log prints (0)")->check(CLI::NonNegativeNumber);
+    app.add_flag("--log", o.log, "Say on stdout what happens: reloads and their latency, images written");
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        int code = app.exit(e);
+        return e.get_exit_code() == 0 ? 0 : (code == 0 ? 0 : 2);
+    }
+
+    for (const std::string& s : sets) {
+        auto setting = host::parseSet(s);
+        if (!setting) return fail(setting.error);
+        o.sets.push_back(*setting);
+    }
+    for (const std::string& f : fires) {
+        auto firing = host::parseFire(f);
+        if (!firing) return fail(firing.error);
+        o.fires.push_back(*firing);
+    }
+    auto step = host::parseStep(dt);
+    if (!step || *step <= 0) return fail("--dt takes a positive number of seconds, not `" + dt + "`");
+    o.dt = *step;
+    if (!camera.empty()) {
+        o.camera = Camera::parse(camera);
+        if (!o.camera) return fail("--camera takes yaw,pitch,distance or yaw,pitch,distance,x,y,z, not `" + camera + "`");
+    }
+    if (std::sscanf(size.c_str(), "%dx%d", &o.width, &o.height) != 2 || o.width < 16 || o.height < 16 ||
+        o.width > 16384 || o.height > 16384)
+        return fail("--size takes WIDTHxHEIGHT, such as 1280x720, not `" + size + "`");
+    if (!script.empty()) {
+        std::ifstream in(script);
+        if (!in) return fail("cannot read `" + script + "`");
+        std::stringstream text;
+        text << in.rdbuf();
+        std::string error;
+        auto parsed = Script::parse(text.str(), error);
+        if (!parsed) return fail(script + ": " + error);
+        o.script = *parsed;
+    }
+    o.blend = blend == "alpha" ? Blend::Alpha : Blend::Additive;
+    o.grid = !noGrid;
+    o.ui = o.headless ? ui : !noUi;
+    o.watch = !noWatch;
+
+    std::string error;
+    std::unique_ptr<Surface> surface = o.headless ? openOffscreen(o.width, o.height, error)
+                                                  : openWindow(o.width, o.height, "psys-view: " + o.file, error);
+    if (!surface) return fail(error);
+    host::CompileResult compiled;
+    auto session = host::Session::open(o.file, o.session, compiled, error);
+    compiled.print(std::cerr, false);
+    if (!compiled.ok) return 1;
+    if (!session) return fail(error);
+    for (const host::ExternSetting& s : o.sets)
+        if (auto e = session->apply(s)) return fail("--set " + s.name + ": " + *e);
+    if (o.log) std::cout << "psys-view: " << o.file << " on " << session->backend().name() << ", " << surface->renderer() << std::endl;
+    Viewer viewer(std::move(o), *surface, std::move(session), compiled);
+    return viewer.run();
+}

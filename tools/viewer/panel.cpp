@@ -1,0 +1,228 @@
+#include "panel.h"
+
+#include <epoxy/gl.h>
+
+#include <GLFW/glfw3.h>
+#include <fmt/format.h>
+#include <imgui.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+
+#include "viewer.h"
+
+namespace psys::viewer {
+
+Panel::Panel(Viewer& viewer, Surface& surface) : viewer_(viewer), surface_(surface) {
+    IMGUI_CHECKVERSION();
+    context_ = ImGui::CreateContext();
+    ImGuiIO& io = ImGui::GetIO();
+    io.IniFilename = nullptr;  // no imgui.ini next to the user's files
+    ImGui::StyleColorsDark();
+    ImGui::GetStyle().Alpha = 0.94f;
+    // The window's input callbacks are installed first (tools/viewer/main.cpp): ImGui's
+    // chain to them.
+    if (surface_.window()) ImGui_ImplGlfw_InitForOpenGL(surface_.window(), true);
+    ImGui_ImplOpenGL3_Init("#version 450");
+    seed_ = static_cast<int>(viewer_.session().options().system.seed);
+}
+
+Panel::~Panel() {
+    ImGui_ImplOpenGL3_Shutdown();
+    if (surface_.window()) ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext(context_);
+}
+
+bool Panel::wantsMouse() const { return ImGui::GetIO().WantCaptureMouse; }
+bool Panel::wantsKeyboard() const { return ImGui::GetIO().WantCaptureKeyboard; }
+
+std::vector<float> Panel::triggerArgs(size_t index) const {
+    const auto& triggers = viewer_.session_->system().module().triggers;
+    if (index >= triggers.size()) return {};
+    auto it = args_.find(triggers[index].name);
+    return it == args_.end() ? std::vector<float>{} : it->second;
+}
+
+void Panel::draw() {
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGuiIO& io = ImGui::GetIO();
+    if (surface_.window()) {
+        ImGui_ImplGlfw_NewFrame();
+    } else {  // offscreen: the frame's size, a frame's time
+        io.DisplaySize = ImVec2(static_cast<float>(surface_.width()), static_cast<float>(surface_.height()));
+        io.DeltaTime = 1.0f / 60;
+    }
+    ImGui::NewFrame();
+    if (visible) {
+        controls();
+        stats();
+    }
+    diagnostics();
+    ImGui::Render();
+    surface_.bind();
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+}
+
+void Panel::controls() {
+    ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
+    ImGui::Begin("psys");
+    host::Session& session = viewer_.session();
+    ImGui::TextUnformatted(session.path().c_str());
+    // Time.
+    ImGui::Checkbox("pause (space)", &viewer_.paused_);
+    ImGui::SameLine();
+    if (ImGui::Button("step (S)")) viewer_.stepOnce_ = true;
+    float scale = static_cast<float>(viewer_.timeScale_);
+    if (ImGui::SliderFloat("time scale", &scale, 1.0f / 64, 16, "%.3g", ImGuiSliderFlags_Logarithmic))
+        viewer_.timeScale_ = scale;
+    ImGui::Checkbox("fixed dt of 1/60 s (T: real time)", &viewer_.fixedDt_);
+    ImGui::InputInt("seed", &seed_);
+    ImGui::SameLine();
+    if (ImGui::Button("restart")) viewer_.restart(static_cast<uint32_t>(seed_));
+    // Backend and drawing.
+    std::string current = session.backend().name();
+    if (ImGui::BeginCombo("backend", current.c_str())) {
+        for (const std::string& name : host::backendNames())
+            if (ImGui::Selectable(name.c_str(), name == current) && name != current) {
+                host::BackendChoice choice = session.options().backend;
+                choice.name = name;
+                if (auto error = session.switchBackend(choice)) viewer_.diagnostics_ = *error;
+            }
+        ImGui::EndCombo();
+    }
+    bool additive = viewer_.options_.blend == Blend::Additive;
+    if (ImGui::RadioButton("additive", additive)) viewer_.options_.blend = Blend::Additive;
+    ImGui::SameLine();
+    if (ImGui::RadioButton("alpha (B)", !additive)) viewer_.options_.blend = Blend::Alpha;
+    ImGui::SameLine();
+    ImGui::Checkbox("grid (G)", &viewer_.options_.grid);
+    if (ImGui::Button("frame what is alive (F)")) viewer_.frameAlive();
+    ImGui::SameLine();
+    if (ImGui::Button("reset camera (R)")) viewer_.camera_.reset();
+    externs();
+    triggers();
+    ImGui::End();
+}
+
+void Panel::externs() {
+    rt::System& system = viewer_.session().system();
+    const auto& list = system.module().externs;
+    if (list.empty() || !ImGui::CollapsingHeader("externs", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    for (const ir::Extern& e : list) {
+        ImGui::PushID(e.name.c_str());
+        std::array<float, 4> v = system.externValue(e.name)->f;
+        float low = e.low ? (*e.low)[0] : -10, high = e.high ? (*e.high)[0] : 10;
+        bool changed = false;
+        const char* label = e.name.c_str();
+        if (e.type.isBool()) {
+            bool on = v[0] != 0;
+            changed = ImGui::Checkbox(label, &on);
+            v[0] = on ? 1.0f : 0.0f;
+        } else if (e.spelling == "color" && e.type.width >= 3) {
+            changed = e.type.width == 4 ? ImGui::ColorEdit4(label, v.data()) : ImGui::ColorEdit3(label, v.data());
+        } else if (e.type.width == 1) {
+            changed = e.low ? ImGui::SliderFloat(label, v.data(), low, high) : ImGui::DragFloat(label, v.data(), 0.05f);
+        } else if (e.low) {
+            switch (e.type.width) {
+                case 2: changed = ImGui::SliderFloat2(label, v.data(), low, high); break;
+                case 3: changed = ImGui::SliderFloat3(label, v.data(), low, high); break;
+                default: changed = ImGui::SliderFloat4(label, v.data(), low, high); break;
+            }
+        } else {
+            switch (e.type.width) {
+                case 2: changed = ImGui::DragFloat2(label, v.data(), 0.05f); break;
+                case 3: changed = ImGui::DragFloat3(label, v.data(), 0.05f); break;
+                default: changed = ImGui::DragFloat4(label, v.data(), 0.05f); break;
+            }
+        }
+        ImGui::SameLine();
+        if (ImGui::SmallButton("reset")) {
+            v = e.defaultValue;
+            changed = true;
+        }
+        if (changed) system.setExtern(e.name, std::span<const float>(v.data(), static_cast<size_t>(e.type.width)));
+        ImGui::PopID();
+    }
+}
+
+void Panel::triggers() {
+    const auto& list = viewer_.session().system().module().triggers;
+    if (list.empty() || !ImGui::CollapsingHeader("triggers", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    for (size_t i = 0; i < list.size(); ++i) {
+        const ir::Trigger& t = list[i];
+        ImGui::PushID(t.name.c_str());
+        std::vector<float>& args = args_[t.name];
+        size_t width = 0;
+        for (const ir::Param& p : t.params) width += static_cast<size_t>(p.type.width);
+        args.resize(width, 0);
+        size_t at = 0;
+        for (const ir::Param& p : t.params) {
+            float* x = args.data() + at;
+            switch (p.type.width) {
+                case 1: ImGui::DragFloat(p.name.c_str(), x, 0.05f); break;
+                case 2: ImGui::DragFloat2(p.name.c_str(), x, 0.05f); break;
+                case 3: ImGui::DragFloat3(p.name.c_str(), x, 0.05f); break;
+                default: ImGui::DragFloat4(p.name.c_str(), x, 0.05f); break;
+            }
+            at += static_cast<size_t>(p.type.width);
+        }
+        std::string label = i < 9 ? fmt::format("fire {} ({})", t.name, i + 1) : "fire " + t.name;
+        if (ImGui::Button(label.c_str())) viewer_.fire(t.name, args);
+        ImGui::PopID();
+    }
+}
+
+void Panel::stats() {
+    const Viewer::FrameStats& f = viewer_.stats_;
+    ImGuiIO& io = ImGui::GetIO();
+    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - 10, 10), ImGuiCond_Always, ImVec2(1, 0));
+    ImGui::SetNextWindowBgAlpha(0.6f);
+    ImGui::Begin("stats", nullptr, ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_AlwaysAutoResize |
+                                        ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing);
+    host::Session& session = viewer_.session();
+    ImGui::Text("%.0f fps, frame %.2f ms (%s)", viewer_.fps_, f.frameSeconds * 1e3, session.backend().name().c_str());
+    const rt::Stats &a = f.before, &b = f.after;
+    ImGui::Text("step %.2f ms: loops %.2f, kills/emissions %.2f, creation %.2f", f.stepSeconds * 1e3,
+                (b.loopSeconds - a.loopSeconds) * 1e3, (b.emitSeconds - a.emitSeconds) * 1e3,
+                (b.createSeconds - a.createSeconds) * 1e3);
+    ImGui::Text("drawing %.2f ms (render kernels %.2f)", f.glSeconds * 1e3, (b.drawSeconds - a.drawSeconds) * 1e3);
+    ImGui::Text("last build %.1f ms", viewer_.lastCompileSeconds_ * 1e3);
+    if (viewer_.lastReloadSeconds_) ImGui::Text("last reload: %.1f ms from save", *viewer_.lastReloadSeconds_ * 1e3);
+    if (!viewer_.reloadNote_.empty()) ImGui::TextWrapped("%s", viewer_.reloadNote_.c_str());
+    if (ImGui::BeginTable("types", 5, ImGuiTableFlags_SizingFixedFit)) {
+        for (const char* h : {"type", "live", "created", "killed", "dropped"}) ImGui::TableSetupColumn(h);
+        ImGui::TableHeadersRow();
+        for (const rt::TypeStats& t : b.types) {
+            ImGui::TableNextRow();
+            ImGui::TableNextColumn();
+            ImGui::TextUnformatted(t.name.c_str());
+            for (uint64_t n : {static_cast<uint64_t>(t.live), t.created, t.killed, t.dropped}) {
+                ImGui::TableNextColumn();
+                ImGui::Text("%llu", static_cast<unsigned long long>(n));
+            }
+        }
+        ImGui::EndTable();
+    }
+    if (b.rejectedSteps || b.nonFiniteExterns || b.invalidEmissions || b.nonFiniteRender)
+        ImGui::TextColored(ImVec4(1, 0.7f, 0.3f, 1), "rejected steps %llu, non-finite externs %llu, invalid emissions %llu, "
+                           "points not drawn (non-finite) %llu",
+                           static_cast<unsigned long long>(b.rejectedSteps), static_cast<unsigned long long>(b.nonFiniteExterns),
+                           static_cast<unsigned long long>(b.invalidEmissions), static_cast<unsigned long long>(b.nonFiniteRender));
+    ImGui::End();
+}
+
+// An edit that does not compile: its errors, as psysc check prints them, until a good save.
+void Panel::diagnostics() {
+    if (viewer_.diagnostics_.empty()) return;
+    ImGuiIO& io = ImGui::GetIO();
+    ImGui::SetNextWindowPos(ImVec2(10, io.DisplaySize.y - 10), ImGuiCond_Always, ImVec2(0, 1));
+    ImGui::SetNextWindowSize(ImVec2(io.DisplaySize.x - 20, 0), ImGuiCond_Always);
+    ImGui::PushStyleColor(ImGuiCol_WindowBg, ImVec4(0.25f, 0.05f, 0.05f, 0.92f));
+    ImGui::Begin("the edit does not compile; the system keeps running", nullptr,
+                 ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_AlwaysAutoResize);
+    ImGui::TextUnformatted(viewer_.diagnostics_.c_str());
+    ImGui::End();
+    ImGui::PopStyleColor();
+}
+
+}  // namespace psys::viewer

@@ -1,0 +1,95 @@
+#include "reloader.h"
+
+namespace psys::viewer {
+
+namespace {
+
+double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+}  // namespace
+
+Reloader::~Reloader() {
+    if (worker_.joinable()) worker_.join();
+}
+
+void Reloader::saved(Clock::time_point when) {
+    if (busy()) {
+        if (!pending_) pending_ = when;
+        return;
+    }
+    start(when);
+}
+
+void Reloader::start(Clock::time_point when) {
+    savedAt_ = when;
+    compiled_ = prepared_ = interim_ = false;
+    std::string path = session_.path();
+    host::SessionOptions options = session_.options();
+    std::shared_ptr<rt::Backend> backend = session_.backendHandle();
+    worker_ = std::thread([this, path, options, backend] {
+        host::Session::Candidate candidate;
+        candidate.compile = host::compile(path, options.compile, candidate.module);
+        candidate.backend = backend;
+        {
+            std::lock_guard lock(mutex_);
+            compile_ = candidate.compile;
+            if (candidate.module) interimModule_ = *candidate.module;
+            compiled_ = true;
+        }
+        if (candidate.module) {
+            auto start = Clock::now();
+            backend->prepare(rt::launchPlan(*candidate.module));
+            candidate.prepareSeconds = secondsSince(start);
+        }
+        std::lock_guard lock(mutex_);
+        candidate_ = std::move(candidate);
+        prepared_ = true;
+    });
+}
+
+void Reloader::finish() {
+    worker_.join();
+    if (pending_) {
+        Clock::time_point when = *pending_;
+        pending_.reset();
+        start(when);
+    }
+}
+
+std::optional<Reloader::Outcome> Reloader::poll() {
+    if (!busy()) return std::nullopt;
+    std::unique_lock lock(mutex_);
+    if (prepared_) {
+        host::Session::Candidate candidate = std::move(candidate_);
+        lock.unlock();
+        finish();
+        Outcome out{candidate.module ? Outcome::Kind::Adopted : Outcome::Kind::Failed, {}, std::nullopt, 0,
+                    candidate.prepareSeconds};
+        host::Session::Reload r = session_.adopt(std::move(candidate));
+        out.compile = std::move(r.compile);
+        out.report = std::move(r.report);
+        out.latencySeconds = secondsSince(savedAt_);
+        return out;
+    }
+    // The JIT is still compiling: after a while, the new system runs on the interpreter.
+    bool jit = session_.backend().name() == "llvm";
+    if (!compiled_ || !interimModule_ || interim_ || !jit || secondsSince(savedAt_) < interimAfterSeconds)
+        return std::nullopt;
+    host::Session::Candidate interim;
+    interim.compile = compile_;
+    interim.module = std::move(interimModule_);
+    interimModule_.reset();
+    lock.unlock();
+    auto interpreter = host::makeBackend({"interp", "fast"});
+    if (!interpreter) return std::nullopt;
+    interim.backend = *interpreter;
+    interim_ = true;
+    Outcome out{Outcome::Kind::Interim, {}, std::nullopt, 0, 0};
+    host::Session::Reload r = session_.adopt(std::move(interim));
+    out.compile = std::move(r.compile);
+    out.report = std::move(r.report);
+    out.latencySeconds = secondsSince(savedAt_);
+    return out;
+}
+
+}  // namespace psys::viewer

@@ -1,0 +1,60 @@
+// Hot reload off the frame loop. On save, a worker thread compiles the file and prepares
+// the JIT for it (compiles its kernels) while the old system keeps running; the frame loop
+// adopts the result at a frame boundary (host::Session::adopt: the objects carry over). If
+// the JIT is still compiling a while after the module is ready, the new system runs on the
+// interpreter meanwhile and moves to the JIT when its kernels are ready: the objects carry
+// over both times. A file that does not compile leaves the old system running.
+#pragma once
+
+#include <chrono>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include "host/session.h"
+
+namespace psys::viewer {
+
+using Clock = std::chrono::steady_clock;
+
+class Reloader {
+public:
+    explicit Reloader(host::Session& session) : session_(session) {}
+    ~Reloader();
+    Reloader(const Reloader&) = delete;
+    Reloader& operator=(const Reloader&) = delete;
+
+    // A watched file was saved (at `when`): compile it now, or after the compile under way.
+    void saved(Clock::time_point when);
+    bool busy() const { return worker_.joinable(); }
+
+    struct Outcome {
+        enum class Kind { Adopted, Interim, Failed } kind;
+        host::CompileResult compile;
+        std::optional<rt::ReloadReport> report;
+        double latencySeconds = 0;  // from the save to the new system taking over
+        double prepareSeconds = 0;  // compiling its kernels
+    };
+    // Once per frame, on the frame loop's thread: what changed, if anything.
+    std::optional<Outcome> poll();
+    // How long a module may wait for the JIT before it runs on the interpreter meanwhile.
+    double interimAfterSeconds = 0.05;
+
+private:
+    void start(Clock::time_point when);
+    void finish();
+
+    host::Session& session_;
+    std::thread worker_;
+    std::mutex mutex_;
+    // What the worker produced, under mutex_.
+    bool compiled_ = false, prepared_ = false;
+    host::CompileResult compile_;
+    std::optional<ir::Module> interimModule_;
+    host::Session::Candidate candidate_;
+    Clock::time_point savedAt_;
+    bool interim_ = false;                      // the new system runs on the interpreter meanwhile
+    std::optional<Clock::time_point> pending_;  // a save during the compile
+};
+
+}  // namespace psys::viewer

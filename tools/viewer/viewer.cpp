@@ -1,0 +1,285 @@
+#include "viewer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <thread>
+
+#include <GLFW/glfw3.h>
+#include <fmt/format.h>
+#include <stb_image_write.h>
+
+#include "input.h"
+#include "panel.h"
+
+namespace psys::viewer {
+
+namespace {
+
+double secondsBetween(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+
+// The longest step a real-time frame takes: a stall (a breakpoint, a dragged window) is not
+// a 10 s hitch for the particles.
+constexpr double kLongestRealStep = 0.1;
+
+}  // namespace
+
+Viewer::Viewer(ViewerOptions options, Surface& surface, std::unique_ptr<host::Session> session,
+               host::CompileResult compiled)
+    : options_(std::move(options)), surface_(surface), session_(std::move(session)) {
+    camera_ = options_.camera.value_or(Camera{});
+    points_ = std::make_unique<PointRenderer>();
+    scene_ = std::make_unique<SceneRenderer>();
+    reloader_ = std::make_unique<Reloader>(*session_);
+    reloader_->interimAfterSeconds = options_.interimAfter;
+    fixedDt_ = !options_.realTime;
+    lastCompileSeconds_ = compiled.seconds + session_->backend().report().compileSeconds;
+    if (options_.watch) watchSources(compiled);
+    if (surface_.window()) connectInput(surface_.window(), *this);  // before the panel's, which chain to them
+    if (options_.ui) panel_ = std::make_unique<Panel>(*this, surface_);
+    session_->schedule(options_.fires);
+}
+
+Viewer::~Viewer() = default;
+
+void Viewer::say(const std::string& line) const {
+    if (options_.log) std::cout << line << std::endl;
+}
+
+void Viewer::watchSources(const host::CompileResult& compiled) {
+    std::vector<std::string> files = {session_->path()};
+    if (compiled.sources)
+        for (int f = 0; f < compiled.sources->count(); ++f) files.push_back(compiled.sources->file(f).path());
+    watcher_.watch(files);
+}
+
+int Viewer::run() {
+    int last = options_.frames > 0 ? options_.frames : (options_.headless ? 1 : 0);
+    lastFrame_ = Clock::now();
+    while (!quit_ && !surface_.closed() && (last == 0 || frame_ < last)) frame();
+    if (!options_.screenshot.empty() && !screenshot(options_.screenshot)) status_ = 1;
+    if (totals_.frames > 0) {
+        size_t live = 0;
+        for (const rt::TypeStats& t : session_->system().stats().types) live += t.live;
+        double n = totals_.frames;
+        say(fmt::format("{} frames drawn, {} objects live at the end: {:.2f} ms a frame (simulation {:.2f}, drawing {:.2f})",
+                        totals_.frames, live, totals_.frame * 1e3 / n, totals_.step * 1e3 / n, totals_.draw * 1e3 / n));
+    }
+    return status_;
+}
+
+void Viewer::frame() {
+    ++frame_;
+    Clock::time_point start = Clock::now();
+    if (surface_.window()) glfwPollEvents();
+    if (options_.watch && watcher_.changed()) reloader_->saved(Clock::now());
+    handleReload();
+    runScript();
+    double real = std::min(secondsBetween(lastFrame_, start), kLongestRealStep);
+    lastFrame_ = start;
+    stats_.before = session_->system().stats();
+    auto stepStart = Clock::now();
+    if (!paused_ || stepOnce_) {
+        step(fixedDt_ ? options_.dt : real * timeScale_);
+        stepOnce_ = false;
+    }
+    stats_.stepSeconds = secondsBetween(stepStart, Clock::now());
+    stats_.after = session_->system().stats();
+    // Offscreen, only the frames that are written are drawn (and, with the panel, every
+    // frame: it lays itself out over a few).
+    bool shown = surface_.window() || panel_ || frame_ == options_.frames || options_.frames <= 0 ||
+                 (!options_.record.empty() && frame_ % std::max(options_.every, 1) == 0);
+    if (shown) {
+        draw();
+        if (panel_) panel_->draw();
+        surface_.present();
+    }
+    if (!options_.record.empty() && frame_ % std::max(options_.every, 1) == 0)
+        screenshot(fmt::format("{}/frame_{:06}.png", options_.record, frame_));
+    if (reloadSaved_) {  // the first frame of a reloaded system is out
+        lastReloadSeconds_ = secondsBetween(*reloadSaved_, Clock::now());
+        say(fmt::format("first frame of the new system {:.1f} ms after the save", *lastReloadSeconds_ * 1e3));
+        reloadSaved_.reset();
+    }
+    stats_.frameSeconds = secondsBetween(start, Clock::now());
+    if (shown && frame_ > options_.warmup) {
+        ++totals_.frames;
+        totals_.frame += stats_.frameSeconds;
+        totals_.step += stats_.stepSeconds;
+        totals_.draw += stats_.glSeconds;
+    }
+    if (options_.fps > 0) {
+        double rest = 1 / options_.fps - stats_.frameSeconds;
+        if (rest > 0) std::this_thread::sleep_for(std::chrono::duration<double>(rest));
+    }
+    fps_ = fps_ == 0 ? 1 / std::max(stats_.frameSeconds, 1e-6) : 0.9 * fps_ + 0.1 / std::max(stats_.frameSeconds, 1e-6);
+}
+
+void Viewer::step(double seconds) {
+    if (fixedDt_) seconds *= timeScale_;
+    if (auto error = session_->frame(frame_, seconds)) {
+        say("psys-view: " + *error);
+        status_ = 1;
+    }
+}
+
+// What the reloader finished this frame, if anything: the new system, or the errors.
+void Viewer::handleReload() {
+    auto outcome = reloader_->poll();
+    if (!outcome) return;
+    using Kind = Reloader::Outcome::Kind;
+    auto saved = Clock::now() - std::chrono::duration_cast<Clock::duration>(
+                                    std::chrono::duration<double>(outcome->latencySeconds));
+    watchSources(outcome->compile);
+    if (outcome->kind == Kind::Failed) {
+        diagnostics_ = outcome->compile.text();
+        reloadNote_ = "the edit does not compile: the system keeps running";
+        say(fmt::format("reload failed {:.1f} ms after the save:\n{}", outcome->latencySeconds * 1e3, diagnostics_));
+        return;
+    }
+    diagnostics_.clear();
+    const rt::ReloadReport& r = *outcome->report;
+    std::string what = fmt::format("{} objects carried over", r.carried);
+    if (r.dropped) what += fmt::format(", {} dropped", r.dropped);
+    if (!r.newSlots.empty()) what += fmt::format(", {} new slots", r.newSlots.size());
+    if (!r.lostSlots.empty()) what += fmt::format(", {} slots lost", r.lostSlots.size());
+    if (outcome->kind == Kind::Interim) {
+        reloadNote_ = what + "; on the interpreter until the JIT is ready";
+        say(fmt::format("reload: the new system {:.1f} ms after the save, on the interpreter until the JIT is ready: {}",
+                        outcome->latencySeconds * 1e3, what));
+        reloadSaved_ = saved;
+        interim_ = true;
+        return;
+    }
+    lastCompileSeconds_ = outcome->compile.seconds + outcome->prepareSeconds;
+    reloadNote_ = what;
+    say(fmt::format("reload: the new system {:.1f} ms after the save (front end {:.1f} ms, kernels {:.1f} ms){}: {}",
+                    outcome->latencySeconds * 1e3, outcome->compile.seconds * 1e3, outcome->prepareSeconds * 1e3,
+                    interim_ ? ", now on the JIT" : "", what));
+    if (!interim_) reloadSaved_ = saved;  // after an interim, the new system is already showing
+    interim_ = false;
+}
+
+void Viewer::draw() {
+    auto start = Clock::now();
+    surface_.bind();
+    clearFrame();
+    float aspect = static_cast<float>(surface_.width()) / static_cast<float>(std::max(surface_.height(), 1));
+    glm::mat4 view = camera_.view(), projection = camera_.projection(aspect);
+    scene_->draw(view, projection, options_.grid);
+    rt::System& system = session_->system();
+    for (size_t t = 0; t < system.typeCount(); ++t)
+        points_->draw(system.draw(t), system.backend().memory(), view, projection,
+                      static_cast<float>(surface_.height()), options_.blend);
+    stats_.glSeconds = secondsBetween(start, Clock::now());
+}
+
+void Viewer::key(int key, bool shift) {
+    switch (key) {
+        case GLFW_KEY_F: frameAlive(); break;
+        case GLFW_KEY_R: camera_.reset(); break;
+        case GLFW_KEY_B: options_.blend = options_.blend == Blend::Additive ? Blend::Alpha : Blend::Additive; break;
+        case GLFW_KEY_G: options_.grid = !options_.grid; break;
+        case GLFW_KEY_SPACE: paused_ = !paused_; break;
+        case GLFW_KEY_S: stepOnce_ = true; break;
+        case GLFW_KEY_T: fixedDt_ = !fixedDt_; break;
+        case GLFW_KEY_EQUAL: case GLFW_KEY_KP_ADD: timeScale_ = std::min(timeScale_ * 2, 16.0); break;
+        case GLFW_KEY_MINUS: case GLFW_KEY_KP_SUBTRACT: timeScale_ = std::max(timeScale_ / 2, 1.0 / 64); break;
+        case GLFW_KEY_H: if (panel_) panel_->visible = !panel_->visible; break;
+        case GLFW_KEY_ESCAPE: case GLFW_KEY_Q: quit_ = true; break;
+        default:
+            if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9) {
+                auto index = static_cast<size_t>(key - GLFW_KEY_1);
+                const auto& triggers = session_->system().module().triggers;
+                if (index < triggers.size()) {
+                    std::vector<float> args = panel_ ? panel_->triggerArgs(index) : std::vector<float>{};
+                    if (args.empty())
+                        for (const ir::Param& p : triggers[index].params) args.resize(args.size() + static_cast<size_t>(p.type.width), 0);
+                    fire(triggers[index].name, args);
+                }
+            }
+    }
+    (void)shift;
+}
+
+// Fits what is alive in view: the box of every drawn point.
+void Viewer::frameAlive() {
+    rt::System& system = session_->system();
+    glm::vec3 low(INFINITY), high(-INFINITY);
+    for (size_t t = 0; t < system.typeCount(); ++t)
+        for (const rt::RenderPoint& p : system.points(t)) {
+            glm::vec3 x{p.position[0], p.position[1], p.position[2]};
+            low = glm::min(low, x);
+            high = glm::max(high, x);
+        }
+    if (low.x <= high.x) camera_.frame(low, high);
+}
+
+std::optional<std::string> Viewer::set(const host::ExternSetting& setting) { return session_->apply(setting); }
+
+std::optional<std::string> Viewer::fire(const std::string& trigger, const std::vector<float>& args) {
+    auto error = session_->system().fire(trigger, args);
+    if (error) say("psys-view: " + *error);
+    return error;
+}
+
+bool Viewer::screenshot(const std::string& path) {
+    std::filesystem::path p(path);
+    if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
+    std::vector<uint8_t> pixels = surface_.pixels();
+    bool ok = stbi_write_png(path.c_str(), surface_.width(), surface_.height(), 4, pixels.data(), surface_.width() * 4) != 0;
+    if (!ok) std::cerr << "psys-view: error: cannot write `" << path << "`\n";
+    else say("wrote " + path);
+    return ok;
+}
+
+void Viewer::restart(uint32_t seed) {
+    host::SessionOptions options = session_->options();
+    options.system.seed = seed;
+    host::CompileResult compiled;
+    std::string error;
+    auto fresh = host::Session::open(session_->path(), options, compiled, error);
+    if (!fresh) {
+        diagnostics_ = compiled.ok ? error : compiled.text();
+        return;
+    }
+    // Extern values set in the panel stay.
+    const rt::System& old = session_->system();
+    for (const ir::Extern& e : old.module().externs)
+        if (auto v = old.externValue(e.name))
+            fresh->system().setExtern(e.name, std::span<const float>(v->f.data(), static_cast<size_t>(e.type.width)));
+    reloader_.reset();
+    session_ = std::move(fresh);
+    reloader_ = std::make_unique<Reloader>(*session_);
+    frame_ = 0;
+}
+
+void Viewer::runScript() {
+    for (const ScriptAction& a : options_.script.actions) {
+        if (a.frame != frame_) continue;
+        const auto& w = a.words;
+        if (a.verb == "orbit") orbit(std::stof(w[0]), std::stof(w[1]));
+        else if (a.verb == "pan") pan(std::stof(w[0]), std::stof(w[1]));
+        else if (a.verb == "zoom") zoom(std::stof(w[0]));
+        else if (a.verb == "quit") quit_ = true;
+        else if (a.verb == "screenshot") screenshot(w[0]);
+        else if (a.verb == "key") {
+            const std::string& k = w[0];
+            int code = k == "SPACE" ? GLFW_KEY_SPACE : k.size() == 1 ? static_cast<int>(std::toupper(k[0])) : 0;
+            key(code, false);
+        } else if (a.verb == "set") {
+            auto setting = host::parseSet(w[0]);
+            auto error = setting ? set(*setting) : std::optional<std::string>(setting.error);
+            if (error) {
+                say("psys-view: script: " + *error);
+                status_ = 1;
+            }
+        } else if (a.verb == "fire") {
+            auto firing = host::parseFire(w[0] + "@1");
+            if (!firing || fire(firing->trigger, firing->args)) status_ = 1;
+        }
+    }
+}
+
+}  // namespace psys::viewer
