@@ -63,6 +63,7 @@ int main(int argc, char** argv) {
     app.add_flag("--real-time", o.realTime, "Step by the time each frame really took (T switches)");
     app.add_option("--size", size, "Width x height of the window or image (1280x720)");
     app.add_option("--blend", blend, "additive (the default) or alpha (B switches)")->check(CLI::IsMember({"additive", "alpha"}));
+    app.add_flag("--fit", o.fit, "The camera fits what is alive before each frame (as F does)");
     app.add_flag("--no-grid", noGrid, "No ground grid and axes (G switches)");
     app.add_flag("--no-ui", noUi, "No panel");
     app.add_flag("--ui", ui, "The panel in --headless images too");

@@ -91,6 +91,7 @@ void Viewer::frame() {
     bool shown = surface_.window() || panel_ || frame_ == options_.frames || options_.frames <= 0 ||
                  (!options_.record.empty() && frame_ % std::max(options_.every, 1) == 0);
     if (shown) {
+        if (options_.fit) frameAlive();
         draw();
         if (panel_) panel_->draw();
         surface_.present();
@@ -203,17 +204,25 @@ void Viewer::key(int key, bool shift) {
     (void)shift;
 }
 
-// Fits what is alive in view: the box of every drawn point.
+// Fits what is alive in view: the box of the drawn points, without the farthest 2% on
+// each side of each axis (a few strays do not shrink the rest to a dot).
 void Viewer::frameAlive() {
     rt::System& system = session_->system();
-    glm::vec3 low(INFINITY), high(-INFINITY);
+    std::vector<float> axis[3];
     for (size_t t = 0; t < system.typeCount(); ++t)
-        for (const rt::RenderPoint& p : system.points(t)) {
-            glm::vec3 x{p.position[0], p.position[1], p.position[2]};
-            low = glm::min(low, x);
-            high = glm::max(high, x);
-        }
-    if (low.x <= high.x) camera_.frame(low, high);
+        for (const rt::RenderPoint& p : system.points(t))
+            for (int c = 0; c < 3; ++c) axis[c].push_back(p.position[static_cast<size_t>(c)]);
+    if (axis[0].empty()) return;
+    glm::vec3 low, high;
+    for (int c = 0; c < 3; ++c) {
+        std::vector<float>& v = axis[c];
+        size_t lo = v.size() / 50, hi = v.size() - 1 - v.size() / 50;
+        std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(lo), v.end());
+        low[c] = v[lo];
+        std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(hi), v.end());
+        high[c] = v[hi];
+    }
+    camera_.frame(low, high);
 }
 
 std::optional<std::string> Viewer::set(const host::ExternSetting& setting) { return session_->apply(setting); }

@@ -43,6 +43,7 @@ struct ViewerOptions {
     Blend blend = Blend::Additive;
     bool ui = true;
     bool grid = true;
+    bool fit = false;            // the camera fits what is alive before each frame is drawn
     bool watch = true;
     Script script;
     bool log = false;            // say on stdout what happens (reloads, their latency)
