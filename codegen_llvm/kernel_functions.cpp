@@ -122,14 +122,15 @@ public:
         // The loop: the entry's parameters but the table, then the columns.
         std::vector<llvm::Type*> loopParams(entryParams.begin() + 1, entryParams.end());
         loopParams.resize(kFixedArgs + columns.size(), ptr);
-        auto* loopType = llvm::FunctionType::get(i64, loopParams, false);
+        counts_ = llvm::StructType::get(ctx_, {i64, i64});
+        auto* loopType = llvm::FunctionType::get(counts_, loopParams, false);
         loop_ = llvm::Function::Create(loopType, llvm::Function::InternalLinkage, name + ".loop", module_);
         loop_->addFnAttr(llvm::Attribute::NoInline);
         for (unsigned a = 0; a < loop_->arg_size(); ++a)
             if (loopParams[a]->isPointerTy()) loop_->getArg(a)->addAttr(llvm::Attribute::NoAlias);
         buildLoop(kernel, layout, argOf);
 
-        auto* entryType = llvm::FunctionType::get(i64, entryParams, false);
+        auto* entryType = llvm::FunctionType::get(counts_, entryParams, false);
         auto* entry = llvm::Function::Create(entryType, llvm::Function::ExternalLinkage, name, module_);
         b_.SetInsertPoint(llvm::BasicBlock::Create(ctx_, "entry", entry));
         std::vector<llvm::Value*> args;
@@ -164,6 +165,8 @@ private:
         row->addIncoming(begin, entry);
         llvm::PHINode* killedSoFar = b_.CreatePHI(b_.getInt64Ty(), 2, "killed");
         killedSoFar->addIncoming(b_.getInt64(0), entry);
+        llvm::PHINode* unstableSoFar = b_.CreatePHI(b_.getInt64Ty(), 2, "unstable");
+        unstableSoFar->addIncoming(b_.getInt64(0), entry);
         row_ = row;
         llvm::Type* f32 = b_.getFloatTy();
         llvm::Type* f64 = b_.getDoubleTy();
@@ -209,10 +212,11 @@ private:
         }
         auto values = emitKernelBody(b_, module_, kernel, mode_, seed, leaf);
 
-        llvm::Value* killedNow = storeYields(kernel, layout, argOf, values, killedSoFar);
+        auto [killedNow, unstableNow] = storeYields(kernel, layout, argOf, values, killedSoFar, unstableSoFar);
         llvm::Value* next = b_.CreateAdd(row_, b_.getInt64(1), "", true, true);
         row->addIncoming(next, b_.GetInsertBlock());
         killedSoFar->addIncoming(killedNow, b_.GetInsertBlock());
+        unstableSoFar->addIncoming(unstableNow, b_.GetInsertBlock());
         llvm::BranchInst* latch = b_.CreateCondBr(b_.CreateICmpSLT(next, end), body, exit);
         // A whole register of floats per operation. Left alone, the vectorizer sizes the
         // loop by its widest type (the double creation times: 4 on AVX2) and runs the
@@ -227,16 +231,22 @@ private:
         loopId->replaceOperandWith(0, loopId);
         latch->setMetadata(llvm::LLVMContext::MD_loop, loopId);
         b_.SetInsertPoint(exit);
-        llvm::PHINode* total = b_.CreatePHI(b_.getInt64Ty(), 2, "total");
-        total->addIncoming(b_.getInt64(0), entry);
-        total->addIncoming(killedNow, latch->getParent());
-        b_.CreateRet(total);
+        llvm::PHINode* killed = b_.CreatePHI(b_.getInt64Ty(), 2, "killed.total");
+        killed->addIncoming(b_.getInt64(0), entry);
+        killed->addIncoming(killedNow, latch->getParent());
+        llvm::PHINode* unstable = b_.CreatePHI(b_.getInt64Ty(), 2, "unstable.total");
+        unstable->addIncoming(b_.getInt64(0), entry);
+        unstable->addIncoming(unstableNow, latch->getParent());
+        llvm::Value* counts = b_.CreateInsertValue(llvm::PoisonValue::get(counts_), killed, {0});
+        b_.CreateRet(b_.CreateInsertValue(counts, unstable, {1}));
     }
 
     // The yields of a row: masked rows keep their state and exports, and never die.
-    // Returns the count of rows killed so far, this one included.
-    llvm::Value* storeYields(const Kernel& kernel, const ColumnLayout& layout, const std::map<int, unsigned>& argOf,
-                             const std::vector<Lanes>& values, llvm::Value* killedSoFar) {
+    // Returns the counts of rows killed and of unstable rows so far, this one included.
+    std::pair<llvm::Value*, llvm::Value*> storeYields(const Kernel& kernel, const ColumnLayout& layout,
+                                                      const std::map<int, unsigned>& argOf,
+                                                      const std::vector<Lanes>& values, llvm::Value* killedSoFar,
+                                                      llvm::Value* unstableSoFar) {
         llvm::Type* f32 = b_.getFloatTy();
         llvm::Value* mask = b_.CreateICmpNE(
             b_.CreateAlignedLoad(b_.getInt8Ty(), b_.CreateInBoundsGEP(b_.getInt8Ty(), loop_->getArg(kMask), row_), llvm::Align(1)),
@@ -246,6 +256,7 @@ private:
             b_.CreateAlignedStore(b_.CreateSelect(mask, value, old), columnAt(argOf, column, f32), llvm::Align(4));
         };
         llvm::Value* killed = killedSoFar;
+        llvm::Value* unstable = unstableSoFar;
         for (const Yield& y : kernel.yields) {
             Type t = kernel.at(y.value).type;
             const Lanes& v = values[y.value];
@@ -265,6 +276,9 @@ private:
                     killed = b_.CreateAdd(killed, b_.CreateZExt(dies, b_.getInt64Ty()));
                     break;
                 }
+                case YieldKind::Unstable:
+                    unstable = b_.CreateAdd(unstable, b_.CreateZExt(b_.CreateAnd(mask, v[0]), b_.getInt64Ty()));
+                    break;
                 case YieldKind::EmitRate: case YieldKind::EmitCount: {
                     int column = y.kind == YieldKind::EmitRate ? layout.emitRate(y.index) : layout.emitCount(y.index);
                     b_.CreateAlignedStore(toFloat(v[0], t), columnAt(argOf, column, f32), llvm::Align(4));
@@ -279,10 +293,11 @@ private:
                 default: break;
             }
         }
-        return killed;
+        return {killed, unstable};
     }
 
     llvm::Function* loop_ = nullptr;
+    llvm::StructType* counts_ = nullptr;
     llvm::Value* row_ = nullptr;
     bool perRowNow_ = false, perRowDt_ = false;
     const Kernel* uniformKernel_ = nullptr;

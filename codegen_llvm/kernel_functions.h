@@ -14,12 +14,18 @@
 
 namespace psys::codegen_llvm {
 
-// int64_t rows(void* const* columns, const uint8_t* mask, int64_t begin, int64_t end,
-//              const Value* externs, const Value* uniforms, double now, float dt,
-//              uint32_t first, uint32_t seed, uint32_t draw)
-// `columns`: host addresses by layout position. Returns the rows it killed.
-using RowsFn = int64_t (*)(void* const*, const uint8_t*, int64_t, int64_t, const rt::Value*, const rt::Value*, double,
-                           float, uint32_t, uint32_t, uint32_t);
+// RowCounts rows(void* const* columns, const uint8_t* mask, int64_t begin, int64_t end,
+//                const Value* externs, const Value* uniforms, double now, float dt,
+//                uint32_t first, uint32_t seed, uint32_t draw)
+// `columns`: host addresses by layout position. Returns the rows it killed and the rows
+// it found beyond the integration method's stability limit (an LLVM {i64, i64}: two
+// registers, as the C ABI returns this struct).
+struct RowCounts {
+    int64_t killed;
+    int64_t unstable;
+};
+using RowsFn = RowCounts (*)(void* const*, const uint8_t*, int64_t, int64_t, const rt::Value*, const rt::Value*, double,
+                             float, uint32_t, uint32_t, uint32_t);
 
 // void children(void* const* columns, int64_t row, const Value* parents, const Value* externs,
 //               double now, float dt, uint32_t first, uint32_t seed, uint32_t draw,

@@ -162,9 +162,9 @@ rt::RowsResult LlvmBackend::run(const rt::RowsLaunch& l) {
     auto fn = reinterpret_cast<RowsFn>(impl_->function(*l.object, *l.kernel, false, l.clock.now, l.clock.dt));
     std::vector<void*> columns = impl_->addresses(l.columns);
     const auto* mask = static_cast<const uint8_t*>(impl_->memory.host(l.mask));
-    int64_t killed = fn(columns.data(), mask, static_cast<int64_t>(l.begin), static_cast<int64_t>(l.end), l.externs,
-                        l.uniforms, l.clock.nowValue, l.clock.dtValue, l.clock.first ? 1u : 0u, l.seed, l.draw);
-    return {static_cast<size_t>(killed)};
+    RowCounts counts = fn(columns.data(), mask, static_cast<int64_t>(l.begin), static_cast<int64_t>(l.end), l.externs,
+                          l.uniforms, l.clock.nowValue, l.clock.dtValue, l.clock.first ? 1u : 0u, l.seed, l.draw);
+    return {static_cast<size_t>(counts.killed), static_cast<size_t>(counts.unstable)};
 }
 
 void LlvmBackend::run(const rt::ChildrenLaunch& l) {

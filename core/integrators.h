@@ -1,5 +1,7 @@
 // The integration methods `@integrator(…)` names: the front end checks the name, the IR
-// carries the method as an object attribute, and opt/lower_temporal lowers it.
+// carries the method as an object attribute, and opt/lower_temporal lowers it (the
+// tableaux and closed forms are in opt/integrate_*.cpp; docs/language.md says what each
+// computes, docs/accuracy.md what each costs and how accurate it is).
 #pragma once
 
 #include <array>
@@ -9,9 +11,10 @@
 
 namespace psys::core {
 
-enum class Integrator : uint8_t { Euler, SemiImplicit, Midpoint, Rk2, Rk4, Exact };
+enum class Integrator : uint8_t { Euler, SemiImplicit, Midpoint, Rk2, Rk4, Exponential, Exact };
 
-constexpr std::array<std::string_view, 6> kIntegratorNames = {"euler", "semi_implicit", "midpoint", "rk2", "rk4", "exact"};
+constexpr std::array<std::string_view, 7> kIntegratorNames = {"euler", "semi_implicit", "midpoint", "rk2",
+                                                              "rk4",   "exponential",   "exact"};
 
 constexpr std::string_view integratorName(Integrator i) { return kIntegratorNames[static_cast<size_t>(i)]; }
 
@@ -19,6 +22,21 @@ constexpr std::optional<Integrator> integratorFromName(std::string_view name) {
     for (size_t i = 0; i < kIntegratorNames.size(); ++i)
         if (kIntegratorNames[i] == name) return static_cast<Integrator>(i);
     return std::nullopt;
+}
+
+// The largest k·h for which a method keeps y' = −k·y from growing, h being the update's
+// length: where the method's stability region meets the negative real axis. Euler, the
+// semi-implicit step and both second-order methods stop at 2; the classical RK4 at
+// 2.785293563405… (where its growth factor 1 − z + z²/2 − z³/6 + z⁴/24 comes back to
+// 1). `exponential`
+// and `exact` solve the linear decay exactly: no limit (0).
+constexpr double stabilityLimit(Integrator i) {
+    switch (i) {
+        case Integrator::Euler: case Integrator::SemiImplicit: case Integrator::Midpoint: case Integrator::Rk2: return 2.0;
+        case Integrator::Rk4: return 2.785293563405282;
+        case Integrator::Exponential: case Integrator::Exact: return 0.0;
+    }
+    return 0.0;
 }
 
 }  // namespace psys::core

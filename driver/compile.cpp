@@ -6,7 +6,6 @@
 #include "ir/lower.h"
 
 namespace psys {
-namespace {
 
 std::optional<ir::Module> compileProgram(const ast::Program* program, SourceManager& sources, DiagnosticEngine& diags,
                                          const CompileOptions& options) {
@@ -24,8 +23,6 @@ std::optional<ir::Module> compileProgram(const ast::Program* program, SourceMana
     if (!ok) return std::nullopt;
     return module;
 }
-
-}  // namespace
 
 SourceRange sourceRange(const SourceManager& sources, ir::Loc loc) {
     if (!loc.valid() || loc.file >= sources.count()) return {};

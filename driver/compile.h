@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "frontend/ast.h"
 #include "frontend/diagnostics.h"
 #include "ir/ir.h"
 #include "opt/passes.h"
@@ -23,6 +24,10 @@ std::optional<ir::Module> compileFile(const std::string& path, SourceManager& so
                                       const CompileOptions& options = {});
 std::optional<ir::Module> compileText(const std::string& displayPath, std::string text, SourceManager& sources,
                                       DiagnosticEngine& diags, const CompileOptions& options = {});
+
+// A checked program (null: it had errors) through lowering and the passes.
+std::optional<ir::Module> compileProgram(const ast::Program* program, SourceManager& sources, DiagnosticEngine& diags,
+                                         const CompileOptions& options = {});
 
 // An IR location as a source range (for diagnostics).
 SourceRange sourceRange(const SourceManager& sources, ir::Loc loc);

@@ -113,6 +113,7 @@ rt::RowsResult Interpreter::run(const rt::RowsLaunch& launch) {
                     kill[row] = v.truth() ? 1 : 0;
                     result.killed += kill[row];
                     break;
+                case YieldKind::Unstable: result.unstable += v.truth() ? 1 : 0; break;
                 case YieldKind::EmitRate: columns.floats(l.emitRate(y.index))[row] = v.f[0]; break;
                 case YieldKind::EmitCount: columns.floats(l.emitCount(y.index))[row] = v.f[0]; break;
                 case YieldKind::Visible: case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:

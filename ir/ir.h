@@ -80,6 +80,8 @@ enum class YieldKind {
     EmitArg,    // index: emit site, sub: argument
     Export,     // index: export (a value children read live)
     Uniform,    // index: a value of a uniform kernel, the same for every object of the type
+    Unstable,   // update: whether this step is beyond the integration method's stability
+                // limit for a decay rate the compiler found (counted per type in the stats)
 };
 
 struct Yield {

@@ -74,7 +74,7 @@ std::string nameBeforeParen(const std::string& header, size_t skip) {
 std::optional<YieldKind> yieldKind(const std::string& name) {
     for (YieldKind k : {YieldKind::StateNext, YieldKind::Kill, YieldKind::Visible, YieldKind::Position,
                         YieldKind::Color, YieldKind::Size, YieldKind::EmitRate, YieldKind::EmitCount,
-                        YieldKind::EmitArg, YieldKind::Export, YieldKind::Uniform})
+                        YieldKind::EmitArg, YieldKind::Export, YieldKind::Uniform, YieldKind::Unstable})
         if (yieldKindName(k) == name) return k;
     return std::nullopt;
 }

@@ -44,6 +44,7 @@ std::string yieldKindName(YieldKind kind) {
         case YieldKind::EmitArg: return "emit.arg";
         case YieldKind::Export: return "export";
         case YieldKind::Uniform: return "uniform";
+        case YieldKind::Unstable: return "unstable";
     }
     return "?";
 }

@@ -147,7 +147,7 @@ private:
                            object_->state[static_cast<size_t>(y.index)].type == t,
                        "no state slot of this index and type");
                 break;
-            case YieldKind::Kill: case YieldKind::Visible: expect(t.isBool(), "a bool"); break;
+            case YieldKind::Kill: case YieldKind::Visible: case YieldKind::Unstable: expect(t.isBool(), "a bool"); break;
             case YieldKind::Position: expect(t == Type::vec(3), "a vec3"); break;
             case YieldKind::Color: expect(t == Type::vec(4), "a vec4"); break;
             case YieldKind::Size: case YieldKind::EmitRate: case YieldKind::EmitCount:

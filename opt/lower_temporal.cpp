@@ -1,29 +1,43 @@
 // lower-temporal: the thesis's behaviours become explicit state (thesis §3.3.7, §4.3.6).
 //
 // Each object's behaviour is evaluated at creation (`first` is true) and at every update
-// after (`first` is false, `dt` is the update's length). Every temporal construct gets
-// what it needs:
+// after (`first` is false, `dt` is the update's length). Every temporal construct but the
+// integrals gets what it needs, one instruction at a time:
 //
-//   integrate(e)   slot A, starting at 0:     value = first ? 0 : A + e·dt    next A = value
 //   derive(e)      slot P, starting at e:     value = first || dt <= 0 ? 0 : (e − P)/dt
 //                                                                             next P = e
 //   prev(e)        slot P, starting at e:     value = first ? 0 : P           next P = e
 //   snapshot(e)    slot S, starting at e:     value = first ? e : S           next S = value
 //   a -> b         no state:                  value = first ? a : b
 //
-// `A`, `P` and `S` read the slot as it was before this update. This is Euler's method
-// evaluated in the order lowering chose: an integrand reads this update's values of what
-// was evaluated before it and the previous update's value of what closes a cycle (which
-// resolve-cycles made a `prev`), so a velocity integrated from an acceleration that reads
-// the previous velocity, and a position integrated from that new velocity, is the
-// semi-implicit Euler step games use. Other methods (midpoint, RK4) integrate an
-// object's integrals together and will slot in here as further cases of `integrate`.
+// The integrals form one derivative system per object, lowered as a whole by the
+// object's method (@integrator, else the pipeline's default):
+//
+//   semi_implicit  (the default) integrate(e): slot A, starting at 0,
+//                  value = first ? 0 : A + e·dt, next A = value — Euler's step evaluated
+//                  in the order lowering chose: an integrand reads this update's values
+//                  of what was evaluated before it and the previous update's value of
+//                  what closes a cycle (resolve-cycles made it a `prev`), so a velocity
+//                  integrated from an acceleration that reads the previous velocity, and
+//                  a position integrated from that new velocity, is the semi-implicit
+//                  Euler step games use.
+//   the others     every integral keeps slot A; the method computes all of an object's
+//                  new values together from the start of the step and stages inside it
+//                  (opt/integrate_step.h, opt/integrate_methods.h). A stage sees
+//                  `derive(e)` as its value at the last update (a slot of its own).
+//
+// In both cases, for methods with a stability limit, a decay rate the compiler can see
+// gets a compile-time warning when it is a constant beyond the limit, and an `unstable`
+// yield that counts the updates beyond it (opt/integrate_stability.cpp).
 // With relaxed maths, the integral of something fixed at creation is c·age, no state.
 #include <map>
 #include <set>
 
 #include <fmt/format.h>
 
+#include "opt/integrate_methods.h"
+#include "opt/integrate_step.h"
+#include "opt/linear_part.h"
 #include "opt/passes.h"
 #include "opt/rewrite.h"
 
@@ -84,84 +98,207 @@ std::map<ValueId, std::string> slotNames(const Kernel& k) {
     return names;
 }
 
+
+bool stageMethod(Integrator m) { return m != Integrator::SemiImplicit; }
+
+// The equation an integral's slot name says it is in: `integrate@vel` → `vel`.
+std::string equationOf(const std::string& slot) {
+    size_t at = slot.find('@');
+    if (at == std::string::npos) return slot;
+    return slot.substr(at + 1, slot.find('#', at) - at - 1);
+}
+
+class ObjectLowering {
+public:
+    ObjectLowering(Object& object, const Kernel& behaviour, Integrator method, const PassOptions& options,
+                   PassErrors& errors)
+        : object_(object), from_(behaviour), method_(method), options_(options), errors_(errors),
+          names_(slotNames(behaviour)), rewriter_(behaviour) {}
+
+    Kernel run() {
+        Kernel perUpdate = lowerPerUpdate();
+        std::vector<DecayRate> rates = decayRates();
+        if (!stageMethod(method_)) {
+            addUnstable(perUpdate, rates);
+            return perUpdate;
+        }
+        std::vector<ValueId> integrals;
+        std::vector<int> slots;
+        for (const Integral& i : integrals_) {
+            integrals.push_back(rewriter_.map(i.old));
+            slots.push_back(i.slot);
+        }
+        StepBuilder b(perUpdate, integrals, slots);
+        for (auto& [derived, seen] : stageViews_) b.stageView(derived, seen);
+        b.to().setLoc(object_.loc);
+        leaf_ = [&b, this](ValueId old) { return b.at(b.startPoint(), rewriter_.map(old)); };
+        b.run([&](StepBuilder& builder) { return solve(builder); });
+        addUnstable(b.to(), rates);
+        return b.take();
+    }
+
+private:
+    struct Integral {
+        ValueId old;  // the `integrate` of the behaviour
+        int slot;
+        std::optional<Coefficient> linear;
+    };
+
+    // Every construct becomes state (the table above) but, for the methods other than
+    // the default, the integrals: they stay `integrate` instructions, with their slots.
+    Kernel lowerPerUpdate() {
+        Kernel lowered = rewriter_.run([&](Rewriter& rw, ValueId old, const Inst& inst,
+                                           const std::vector<ValueId>& ops) -> std::optional<ValueId> {
+            if (inst.op != Op::Integrate && inst.op != Op::Derive && inst.op != Op::Prev &&
+                inst.op != Op::Snapshot && inst.op != Op::FollowedBy)
+                return std::nullopt;
+            current_ = old;
+            return lowerOne(rw, old, inst, ops);
+        });
+        for (auto& [slot, value] : nextNew_) lowered.yields.push_back({YieldKind::StateNext, slot, 0, value});
+        for (auto& [slot, old] : nextOld_) lowered.yields.push_back({YieldKind::StateNext, slot, 0, rewriter_.map(old)});
+        if (stageMethod(method_))
+            for (const Integral& i : integrals_)
+                lowered.yields.push_back({YieldKind::StateNext, i.slot, 0, rewriter_.map(i.old)});
+        return lowered;
+    }
+
+    int addSlot(Type type, StateInit init, const std::string& suffix = "") {
+        object_.state.push_back({names_.at(current_) + suffix, type, init});
+        return static_cast<int>(object_.state.size() - 1);
+    }
+
+    std::optional<ValueId> lowerOne(Rewriter& rw, ValueId old, const Inst& inst, const std::vector<ValueId>& ops) {
+        Kernel& k = rw.to();
+        Type t = inst.type;
+        ValueId first = input(k, Op::First, Type::boolean());
+        ValueId zero = zeroOf(k, t);
+        switch (inst.op) {
+            case Op::Integrate: {
+                // Relaxed: the integral of something fixed at creation is c·age, exact in
+                // real arithmetic, whatever the method; no state needed (docs/optimizer.md).
+                if (options_.relaxed && creationInvariant(k, ops[0]))
+                    return rw.emit(Inst::make(Op::Mul, t, {ops[0], broadcast(k, input(k, Op::Age, Type::f32()), t)}));
+                int slot = addSlot(t, StateInit::Zero);
+                integrals_.push_back({old, slot, std::nullopt});
+                if (stageMethod(method_)) return std::nullopt;  // the method lowers it (run)
+                ValueId a = input(k, Op::StateRead, t, slot);
+                ValueId dt = broadcast(k, input(k, Op::Dt, Type::f32()), t);
+                ValueId step = k.op(Op::Add, t, {a, k.op(Op::Mul, t, {ops[0], dt})});
+                ValueId value = rw.emit(Inst::make(Op::Select, t, {first, zero, step}));
+                nextNew_.push_back({slot, value});
+                return value;
+            }
+            case Op::Derive: {
+                int slot = addSlot(t, StateInit::Next);
+                ValueId p = input(k, Op::StateRead, t, slot);
+                ValueId dtScalar = input(k, Op::Dt, Type::f32());
+                ValueId moving = k.op(Op::Gt, Type::boolean(), {dtScalar, k.scalar(0)});
+                ValueId slope = k.op(Op::Div, t, {k.op(Op::Sub, t, {ops[0], p}), broadcast(k, dtScalar, t)});
+                ValueId ready = k.op(Op::And, Type::boolean(), {k.op(Op::Not, Type::boolean(), {first}), moving});
+                nextNew_.push_back({slot, ops[0]});
+                ValueId value = rw.emit(Inst::make(Op::Select, t, {ready, slope, zero}));
+                if (stageMethod(method_)) {
+                    // A stage inside the step sees the derivative as of the last update.
+                    int last = addSlot(t, StateInit::Next, ".last");
+                    nextNew_.push_back({last, value});
+                    stageViews_[value] = rw.emit(Inst::make(Op::Select, t, {first, zero, input(k, Op::StateRead, t, last)}));
+                }
+                return value;
+            }
+            case Op::Prev: {
+                int slot = addSlot(t, StateInit::Next);
+                ValueId p = input(k, Op::StateRead, t, slot);
+                nextOld_.push_back({slot, inst.operands[0]});  // may be defined later
+                return rw.emit(Inst::make(Op::Select, t, {first, zero, p}));
+            }
+            case Op::Snapshot: {
+                int slot = addSlot(t, StateInit::Next);
+                ValueId s = input(k, Op::StateRead, t, slot);
+                ValueId value = rw.emit(Inst::make(Op::Select, t, {first, ops[0], s}));
+                nextNew_.push_back({slot, value});
+                return value;
+            }
+            case Op::FollowedBy:
+                // The next side may refer forward only through a `prev` or a `recur`,
+                // which the rewriter patches: by now both operands exist.
+                return rw.emit(Inst::make(Op::Select, t, {first, ops[0], ops[1]}));
+            default: return std::nullopt;
+        }
+    }
+
+    // The decay rate of each integral whose derivative has a linear part in it.
+    std::vector<DecayRate> decayRates() {
+        std::vector<DecayRate> rates;
+        for (Integral& i : integrals_) {
+            i.linear = linearPart(from_, from_.at(i.old).operands[0], i.old, !stageMethod(method_));
+            if (!i.linear) continue;
+            Coefficient k{Coefficient::Kind::Neg, i.linear->type, 0, {*i.linear}};
+            DecayRate r;
+            r.equation = equationOf(names_.at(i.old));
+            r.loc = from_.at(i.old).loc;
+            r.constant = constantValue(k, from_);
+            r.build = [this, k] { return build(k, *target_, leaf_); };
+            rates.push_back(std::move(r));
+        }
+        return rates;
+    }
+
+    void addUnstable(Kernel& k, std::vector<DecayRate>& rates) {
+        target_ = &k;
+        if (!stageMethod(method_)) leaf_ = [this](ValueId old) { return rewriter_.map(old); };
+        if (auto flag = stabilityCheck(k, object_.name, method_, object_.attributes.step, rates, errors_))
+            k.yields.push_back({YieldKind::Unstable, 0, 0, *flag});
+    }
+
+    std::vector<ValueId> solve(StepBuilder& b) {
+        target_ = &b.to();
+        switch (method_) {
+            case Integrator::Exponential: {
+                std::vector<bool> linear;
+                for (const Integral& i : integrals_) linear.push_back(i.linear.has_value());
+                return exponentialEuler(b, linear, [&](size_t j) { return build(*integrals_[j].linear, b.to(), leaf_); });
+            }
+            case Integrator::Exact: {
+                std::vector<std::string> equations;
+                for (const Integral& i : integrals_) equations.push_back(equationOf(names_.at(i.old)));
+                if (auto values = closedForm(b, object_.name, equations, errors_)) return *values;
+                std::vector<ValueId> unchanged;  // an error was reported; the pipeline stops
+                for (size_t j = 0; j < b.size(); ++j) unchanged.push_back(b.start(j));
+                return unchanged;
+            }
+            default: return rungeKutta(b, method_);
+        }
+    }
+
+    Object& object_;
+    const Kernel& from_;
+    Integrator method_;
+    const PassOptions& options_;
+    PassErrors& errors_;
+    std::map<ValueId, std::string> names_;
+    Rewriter rewriter_;
+    ValueId current_ = 0;
+    std::vector<Integral> integrals_;
+    std::vector<std::pair<int, ValueId>> nextNew_;  // (slot, new value)
+    std::vector<std::pair<int, ValueId>> nextOld_;  // (slot, old value its next is)
+    std::map<ValueId, ValueId> stageViews_;         // (derive, what a stage sees), new values
+    Kernel* target_ = nullptr;                      // where decay rates are built
+    std::function<ValueId(ValueId)> leaf_;          // a behaviour value there
+};
+
 }  // namespace
+
+Integrator methodOf(const Object& object, const PassOptions& options) {
+    return options.everyObject.value_or(object.attributes.integrator.value_or(options.integrator));
+}
 
 void lowerTemporal(Module& module, const PassOptions& options, PassErrors& errors) {
     for (Object& object : module.objects) {
         Kernel* behaviour = object.kernel(KernelKind::Behaviour);
         if (!behaviour) continue;
-        Integrator method = object.attributes.integrator.value_or(options.integrator);
-        if (method != Integrator::Euler) {
-            Loc at = object.attributes.integrator ? object.attributes.integratorLoc : object.loc;
-            errors.error(at, fmt::format("object {}: @integrator({}) is not implemented yet; euler is", object.name,
-                                         core::integratorName(method)));
-            continue;
-        }
-        std::vector<std::pair<int, ValueId>> nextOld;  // (slot, old value its next is)
-        std::vector<std::pair<int, ValueId>> nextNew;  // (slot, new value)
-        std::map<ValueId, std::string> names = slotNames(*behaviour);
-        ValueId current = 0;
-        auto addSlot = [&](const Inst& inst, StateInit init) {
-            object.state.push_back({names.at(current), inst.type, init});
-            return static_cast<int>(object.state.size() - 1);
-        };
-        Rewriter rewriter(*behaviour);
-        Kernel lowered = rewriter.run([&](Rewriter& rw, ValueId old, const Inst& inst,
-                                          const std::vector<ValueId>& ops) -> std::optional<ValueId> {
-            if (inst.op != Op::Integrate && inst.op != Op::Derive && inst.op != Op::Prev &&
-                inst.op != Op::Snapshot && inst.op != Op::FollowedBy)
-                return std::nullopt;
-            current = old;
-            Kernel& k = rw.to();
-            Type t = inst.type;
-            ValueId first = input(k, Op::First, Type::boolean());
-            ValueId zero = zeroOf(k, t);
-            switch (inst.op) {
-                case Op::Integrate: {
-                    // Relaxed: the Euler sum of something fixed at creation is c·age, exact
-                    // in real arithmetic; no state needed (docs/optimizer.md).
-                    if (options.relaxed && creationInvariant(k, ops[0]))
-                        return rw.emit(Inst::make(Op::Mul, t, {ops[0], broadcast(k, input(k, Op::Age, Type::f32()), t)}));
-                    int slot = addSlot(inst, StateInit::Zero);
-                    ValueId a = input(k, Op::StateRead, t, slot);
-                    ValueId dt = broadcast(k, input(k, Op::Dt, Type::f32()), t);
-                    ValueId step = k.op(Op::Add, t, {a, k.op(Op::Mul, t, {ops[0], dt})});
-                    ValueId value = rw.emit(Inst::make(Op::Select, t, {first, zero, step}));
-                    nextNew.push_back({slot, value});
-                    return value;
-                }
-                case Op::Derive: {
-                    int slot = addSlot(inst, StateInit::Next);
-                    ValueId p = input(k, Op::StateRead, t, slot);
-                    ValueId dtScalar = input(k, Op::Dt, Type::f32());
-                    ValueId moving = k.op(Op::Gt, Type::boolean(), {dtScalar, k.scalar(0)});
-                    ValueId slope = k.op(Op::Div, t, {k.op(Op::Sub, t, {ops[0], p}), broadcast(k, dtScalar, t)});
-                    ValueId ready = k.op(Op::And, Type::boolean(), {k.op(Op::Not, Type::boolean(), {first}), moving});
-                    nextNew.push_back({slot, ops[0]});
-                    return rw.emit(Inst::make(Op::Select, t, {ready, slope, zero}));
-                }
-                case Op::Prev: {
-                    int slot = addSlot(inst, StateInit::Next);
-                    ValueId p = input(k, Op::StateRead, t, slot);
-                    nextOld.push_back({slot, inst.operands[0]});  // may be defined later
-                    return rw.emit(Inst::make(Op::Select, t, {first, zero, p}));
-                }
-                case Op::Snapshot: {
-                    int slot = addSlot(inst, StateInit::Next);
-                    ValueId s = input(k, Op::StateRead, t, slot);
-                    ValueId value = rw.emit(Inst::make(Op::Select, t, {first, ops[0], s}));
-                    nextNew.push_back({slot, value});
-                    return value;
-                }
-                case Op::FollowedBy:
-                    // The next side may refer forward only through a `prev`, which reads
-                    // state: by now both operands exist.
-                    return rw.emit(Inst::make(Op::Select, t, {first, ops[0], ops[1]}));
-                default: return std::nullopt;
-            }
-        });
-        for (auto& [slot, value] : nextNew) lowered.yields.push_back({YieldKind::StateNext, slot, 0, value});
-        for (auto& [slot, old] : nextOld) lowered.yields.push_back({YieldKind::StateNext, slot, 0, rewriter.map(old)});
+        Integrator method = methodOf(object, options);
+        Kernel lowered = ObjectLowering(object, *behaviour, method, options, errors).run();
         *behaviour = std::move(lowered);
     }
 }

@@ -7,8 +7,8 @@
 //   scoping          a child's `rocket.pos` becomes a value the parent exports once per
 //                    update; the child reads it through its parent handle (§4.3.5)
 //   lower-temporal   integrate, derive, prev, snapshot and `->` become state slots,
-//                    reads and next values (§4.3.6, §3.3.7); the integration method is a
-//                    parameter (Euler now)
+//                    reads and next values (§4.3.6, §3.3.7); an object's integrals are
+//                    lowered together by its integration method
 //   key-random       every random draw is keyed by (object id, draw index) so that the
 //                    same seed gives the same particles on every backend (§3.1.4)
 //   split-kernels    the behaviour becomes the kernels init, update, render, exports and
@@ -29,6 +29,7 @@
 #pragma once
 
 #include <iosfwd>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -40,12 +41,18 @@ namespace psys::opt {
 
 struct PassOptions {
     // The method for objects without @integrator.
-    ir::Integrator integrator = ir::Integrator::Euler;
+    ir::Integrator integrator = ir::Integrator::SemiImplicit;
+    // A method for every object, whatever its @integrator says (`psysc --integrator`:
+    // trying a method without editing the source).
+    std::optional<ir::Integrator> everyObject;
     // Rewrites that may change the last bits of a result (docs/optimizer.md): x+0 → x,
     // x/c → x·(1/c), sums and products put in one canonical order so they share parts,
     // and integrals of what is fixed at creation in closed form (c·age).
     bool relaxed = false;
 };
+
+// The integration method of an object under these options.
+ir::Integrator methodOf(const ir::Object& object, const PassOptions& options);
 
 // What a pass reports about the program, at the instruction (or object) it concerns.
 struct PassMessage {
@@ -73,7 +80,7 @@ private:
     std::vector<PassMessage> all_;
 };
 
-void resolveCycles(ir::Module& module, PassErrors& errors);
+void resolveCycles(ir::Module& module, const PassOptions& options, PassErrors& errors);
 void scoping(ir::Module& module, PassErrors& errors);
 void lowerTemporal(ir::Module& module, const PassOptions& options, PassErrors& errors);
 void keyRandom(ir::Module& module, PassErrors& errors);

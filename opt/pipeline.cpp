@@ -48,7 +48,7 @@ bool runPipeline(ir::Module& module, const PipelineOptions& options, PassErrors&
             errors.error({}, "internal error: the lowered IR is malformed: " + problem);
     if (errors.hasErrors()) return false;
 
-    resolveCycles(module, errors);
+    resolveCycles(module, options.pass, errors);
     if (!after("resolve-cycles")) return false;
     scoping(module, errors);
     if (!after("scoping")) return false;

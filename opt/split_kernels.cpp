@@ -3,8 +3,9 @@
 //
 //   init       at creation (`first` true): the starting value of every slot that starts
 //              from its next value, and the size of each burst (`emit … count N`)
-//   update     every update (`first` false): every slot's next value, the kill flag, and
-//              the rate and count of each rate emitter
+//   update     every update (`first` false): every slot's next value, the kill flag, the
+//              rate and count of each rate emitter, and whether the step was beyond the
+//              integration method's stability limit
 //   render     after an update: position, colour, size, visible
 //   exports    after an update: the values children read live
 //   spawn.N    per object created by emit site N: its arguments
@@ -164,7 +165,9 @@ void splitKernels(Module& module, PassErrors&) {
             return y.kind == YieldKind::EmitCount && !emits[static_cast<size_t>(y.index)].rate;
         }));
         object.kernels.push_back(specialise(behaviour, KernelKind::Update, false, [&](const Yield& y) {
-            if (y.kind == YieldKind::StateNext || y.kind == YieldKind::Kill || y.kind == YieldKind::EmitRate) return true;
+            if (y.kind == YieldKind::StateNext || y.kind == YieldKind::Kill || y.kind == YieldKind::EmitRate ||
+                y.kind == YieldKind::Unstable)
+                return true;
             return y.kind == YieldKind::EmitCount && emits[static_cast<size_t>(y.index)].rate;
         }));
         for (Kernel& k : postKernels) {

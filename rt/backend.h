@@ -43,7 +43,8 @@ struct RowsLaunch {
 };
 
 struct RowsResult {
-    size_t killed = 0;  // rows of the range whose kill flag the kernel set
+    size_t killed = 0;    // rows of the range whose kill flag the kernel set
+    size_t unstable = 0;  // rows whose `unstable` yield was true (update kernels)
 };
 
 struct ChildrenLaunch {

@@ -50,6 +50,10 @@ struct TypeStats {
     uint64_t created = 0;
     uint64_t killed = 0;
     uint64_t dropped = 0;  // spawns refused at capacity
+    // Object updates whose step was beyond the stability limit of the type's integration
+    // method for a decay rate in its equations (k·dt > 2 for Euler): such an integral
+    // oscillates and grows. @step, or @integrator(exponential), fixes it.
+    uint64_t unstable = 0;
 };
 
 struct Stats {

@@ -3,6 +3,7 @@
 #include "rt/system_create.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -338,7 +339,7 @@ void Creation::atCreation(size_t type, Batch& b, size_t n) {
         launch.seed = s_.options.seed;
         launch.draw = kCreationDraw;
         s_.gatherParents(type, layout, t, mask, first, end, 0, created, b.poolRows.data(), first);
-        runBatch(launch, first, end);
+        runBatch(launch, first, end, type);
     };
     if (info.init) atCreation(*info.init, b.initLayout, b.initTable);
     if (info.exports) atCreation(*info.exports, info.exportsLayout, b.exportsTable);
@@ -356,14 +357,16 @@ void Creation::atCreation(size_t type, Batch& b, size_t n) {
 
 // A launch over rows [first, end) of a batch, in chunks (on several threads where the
 // backend allows).
-void Creation::runBatch(const RowsLaunch& launch, size_t first, size_t end) {
+void Creation::runBatch(const RowsLaunch& launch, size_t first, size_t end, size_t type) {
     size_t n = end - first;
+    std::atomic<uint64_t> unstable = 0;
     s_.parallel->forEach((n + kRowsPerChunk - 1) / kRowsPerChunk, s_.backend.concurrent(), [&](size_t c) {
         RowsLaunch part = launch;
         part.begin = first + c * kRowsPerChunk;
         part.end = std::min(end, part.begin + kRowsPerChunk);
-        s_.backend.run(part);
+        if (size_t u = s_.backend.run(part).unstable) unstable += u;
     });
+    s_.typeStats[type].unstable += unstable;
 }
 
 // The first update of a batch's objects, from their creation to t1, in sub-steps no longer
@@ -455,7 +458,7 @@ void Creation::advance(size_t type, Batch& b, size_t n, size_t maskColumn) {
         launch.seed = s_.options.seed;
         launch.draw = static_cast<uint32_t>(s_.step);
         s_.gatherParents(type, layout, t, s_.host<uint8_t>(m), first, end, 0, now, b.poolRows.data(), first);
-        runBatch(launch, first, end);
+        runBatch(launch, first, end, type);
     };
     launchOn(*info.update, info.updateLayout, table, maskBuffer);
     if (info.exports) {

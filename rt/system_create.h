@@ -60,7 +60,8 @@ private:
     void createBatch(size_t type, size_t from, size_t to, double t1);
     void identify(size_t type, Batch& b, size_t from, size_t n);
     void atCreation(size_t type, Batch& b, size_t n);
-    void runBatch(const RowsLaunch& launch, size_t first, size_t end);
+    // Counts the updates beyond the stability limit in `type`'s stats.
+    void runBatch(const RowsLaunch& launch, size_t first, size_t end, size_t type);
     void firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, double t1);
     void advance(size_t type, Batch& b, size_t n, size_t maskColumn);
     void queueBursts(size_t type, Batch& b, size_t r);

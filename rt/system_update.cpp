@@ -3,6 +3,7 @@
 #include "rt/system_update.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -99,12 +100,15 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1)
     bool listKills = info.kills && !info.rateEmits;
     size_t chunks = (rows + kRowsPerChunk - 1) / kRowsPerChunk;
     if (listKills) work.killed.resize(chunks);
+    std::atomic<uint64_t> unstable = 0;
     auto chunk = [&](size_t c) {
         RowsLaunch part = update;
         part.begin = c * kRowsPerChunk;
         part.end = std::min(rows, part.begin + kRowsPerChunk);
         s.gatherParents(type, info.updateLayout, work.updateTable, updatable, part.begin, part.end, t1);
-        size_t killed = s.backend.run(part).killed;
+        RowsResult result = s.backend.run(part);
+        size_t killed = result.killed;
+        if (result.unstable) unstable += result.unstable;
         if (listKills) {
             if (killed) listKilled(kill, part.begin, part.end, work.killed[c]);
             else work.killed[c].clear();
@@ -120,6 +124,7 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1)
     };
     auto start = WallClock::now();
     s.forChunks(rows, chunk);
+    s.typeStats[type].unstable += unstable;
     auto loopsDone = WallClock::now();
     s.stats.loopSeconds += seconds(start, loopsDone);
     struct Timer {

@@ -4,6 +4,7 @@
 
 #include <doctest/doctest.h>
 
+#include <optional>
 #include <string>
 
 #include "driver/compile.h"
@@ -11,11 +12,13 @@
 
 namespace psys::test {
 
-inline ir::Module compileModule(const std::string& text, bool optimize = true) {
+inline ir::Module compileModule(const std::string& text, bool optimize = true,
+                                std::optional<core::Integrator> integrator = {}) {
     SourceManager sources;
     DiagnosticEngine diags(sources);
     CompileOptions options;
     options.pipeline.optimize = optimize;
+    options.pipeline.pass.everyObject = integrator;
     auto module = compileText("test.psys", text, sources, diags, options);
     INFO(diags.render());
     REQUIRE(module.has_value());

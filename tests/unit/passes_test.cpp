@@ -30,7 +30,8 @@ std::string after(const std::string& text, void (*pass)(Module&, opt::PassErrors
     return all + print(m);
 }
 
-void lowerTemporalEuler(Module& m, opt::PassErrors& e) { opt::lowerTemporal(m, {}, e); }
+void lowerTemporalDefault(Module& m, opt::PassErrors& e) { opt::lowerTemporal(m, {}, e); }
+void resolveCycles(Module& m, opt::PassErrors& e) { opt::resolveCycles(m, {}, e); }
 
 }  // namespace
 
@@ -46,7 +47,7 @@ TEST_CASE("resolve-cycles: a recursive reference through integrate becomes prev"
     yield size = %3
   end
 end
-)", opt::resolveCycles) == R"(object p()
+)", resolveCycles) == R"(object p()
   kernel behaviour
     %0 = const.f32 1
     %1 = prev.f32 %4 #0  ; acc
@@ -68,7 +69,7 @@ TEST_CASE("resolve-cycles: a cycle through no delaying construct is an algebraic
     yield size = %2
   end
 end
-)", opt::resolveCycles);
+)", resolveCycles);
     CHECK(out.find("error: object p: algebraic loop: b → b → a → b") != std::string::npos);
 }
 
@@ -123,7 +124,7 @@ TEST_CASE("lower-temporal: integrate, prev, snapshot, derive and -> become state
     yield size = %7
   end
 end
-)", lowerTemporalEuler) == R"(object p(v: f32)
+)", lowerTemporalDefault) == R"(object p(v: f32)
   state integrate#0: f32 zero
   state prev#1: f32 next
   state snapshot#2: f32 next
@@ -156,6 +157,74 @@ end
     yield state #2 = %11
     yield state #3 = %7
     yield state #1 = %7
+  end
+end
+)");
+}
+
+TEST_CASE("resolve-cycles: under a Runge–Kutta method a cycle through integrate keeps its recur") {
+    // x = integrate(-x): the stages read x at their own instant, not the previous update's.
+    CHECK(after(R"(object p()
+  attribute integrator midpoint
+  kernel behaviour
+    %0 = recur.f32 %2 #0  ; x
+    %1 = neg.f32 %0
+    %2 = integrate.f32 %1 #1  ; x
+    let x = %2
+    yield size = %2
+  end
+end
+)", resolveCycles) == R"(object p()
+  attribute integrator midpoint
+  kernel behaviour
+    %0 = recur.f32 %2 #0  ; x
+    %1 = neg.f32 %0
+    %2 = integrate.f32 %1 #1  ; x
+    let x = %2
+    yield size = %2
+  end
+end
+)");
+}
+
+TEST_CASE("lower-temporal: the midpoint method evaluates the derivative at the start and in the middle of the step") {
+    // x = integrate(-x): k1 = -x0; x1 = x0 + (0.5 dt)·k1; k2 = -x1; x' = x0 + dt·k2; and the
+    // decay rate 1 checked against the limit 2 (k·dt > 2: unstable).
+    CHECK(after(R"(object p()
+  attribute integrator midpoint
+  kernel behaviour
+    %0 = recur.f32 %2 #0  ; x
+    %1 = neg.f32 %0
+    %2 = integrate.f32 %1 #1  ; x
+    let x = %2
+    yield size = %2
+  end
+end
+)", lowerTemporalDefault) == R"(object p()
+  attribute integrator midpoint
+  state integrate@x: f32 zero
+  kernel behaviour
+    %0 = state.f32 #0
+    %1 = neg.f32 %0
+    %2 = const.f32 0.5
+    %3 = dt.f32
+    %4 = mul.f32 %2, %3
+    %5 = mul.f32 %1, %4
+    %6 = add.f32 %0, %5
+    %7 = neg.f32 %6
+    %8 = mul.f32 %3, %7
+    %9 = add.f32 %0, %8
+    %10 = first.bool
+    %11 = const.f32 0
+    %12 = select.f32 %10, %11, %9
+    %13 = const.f32 1
+    %14 = mul.f32 %3, %13
+    %15 = const.f32 2
+    %16 = gt.bool %14, %15
+    let x = %12
+    yield size = %12
+    yield state #0 = %12
+    yield unstable = %16
   end
 end
 )");

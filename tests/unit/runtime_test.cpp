@@ -15,40 +15,15 @@
 #include "interp/interpreter.h"
 #include "rt/system.h"
 #include "tests/run_length.h"
+#include "run.h"
 #include "test_support.h"
 
 using namespace psys;
+using test::bitwise;
+using test::compareRuns;
+using test::Run;
 
-namespace {
-
-struct Run {
-    interp::Interpreter backend;
-    std::unique_ptr<rt::System> system;
-
-    explicit Run(const std::string& source, rt::SystemOptions options = {}, bool optimize = true, bool relaxed = false) {
-        SourceManager sources;
-        DiagnosticEngine diags(sources);
-        CompileOptions compile;
-        compile.pipeline.optimize = optimize;
-        compile.pipeline.pass.relaxed = relaxed;
-        auto module = compileText("test.psys", source, sources, diags, compile);
-        INFO(diags.render());
-        REQUIRE(module.has_value());
-        system = std::make_unique<rt::System>(std::move(*module), backend, options);
-    }
-
-    void steps(int n, double dt) {
-        for (int i = 0; i < n; ++i) REQUIRE_FALSE(system->step(dt).has_value());
-    }
-    size_t type(const std::string& name) const { return static_cast<size_t>(system->typeIndex(name)); }
-    std::vector<rt::RenderPoint> points(const std::string& name) { return system->points(type(name)); }
-    rt::TypeStats stats(const std::string& name) const { return system->stats().types[type(name)]; }
-};
-
-
-}  // namespace
-
-TEST_CASE("a projectile under Euler is the Euler recurrence, bit for bit") {
+TEST_CASE("a projectile under the default method (semi-implicit Euler) is its recurrence, bit for bit") {
     Run run(R"(
         object p {
             pos = integrate(vel);
@@ -307,71 +282,8 @@ TEST_CASE("@step(h) advances an object in sub-steps no longer than h") {
     CHECK(after("@step(0.3)") == doctest::Approx(std::pow(0.75, 4)));  // 4 equal sub-steps of 0.25
 }
 
-TEST_CASE("an integrator that is not implemented is an error, not a silent euler") {
-    SourceManager sources;
-    DiagnosticEngine diags(sources);
-    auto module = compileText("t.psys", "@integrator(rk4) object a { p = integrate(vec3(1)); point(p, white, 1); }",
-                              sources, diags);
-    CHECK_FALSE(module.has_value());
-    // Reported at the attribute's argument.
-    CHECK(diags.render().find("t.psys:1:13: error: object a: @integrator(rk4) is not implemented yet; euler is") !=
-          std::string::npos);
-}
-
-// Runs two systems side by side for `frames` frames, firing every trigger once, and
-// compares what is drawn: the same objects, and values compared by `close`. Returns the
-// number of points compared.
-size_t compareRuns(Run& a, Run& b, int frames, const std::function<bool(float, float)>& close) {
-    for (const ir::Trigger& t : a.system->module().triggers) {
-        size_t width = 0;
-        for (auto& p : t.params) width += static_cast<size_t>(p.type.width);
-        std::vector<float> args(width, 1.5f);
-        REQUIRE_FALSE(a.system->fire(t.name, args));
-        REQUIRE_FALSE(b.system->fire(t.name, args));
-    }
-    size_t points = 0, differences = 0;
-    for (int frame = 0; frame < frames; ++frame) {
-        a.steps(1, 1.0 / 60);
-        b.steps(1, 1.0 / 60);
-        for (size_t t = 0; t < a.system->typeCount(); ++t) {
-            const auto& pa = a.system->points(t);
-            const auto& pb = b.system->points(t);
-            REQUIRE(pa.size() == pb.size());
-            for (size_t i = 0; i < pa.size(); ++i) {
-                ++points;
-                bool same = pa[i].id == pb[i].id && close(pa[i].size, pb[i].size);
-                for (int c = 0; c < 3; ++c) same &= close(pa[i].position[static_cast<size_t>(c)], pb[i].position[static_cast<size_t>(c)]);
-                for (int c = 0; c < 4; ++c) same &= close(pa[i].color[static_cast<size_t>(c)], pb[i].color[static_cast<size_t>(c)]);
-                differences += same ? 0 : 1;
-            }
-        }
-    }
-    CHECK(differences == 0);
-    for (size_t t = 0; t < a.system->typeCount(); ++t) {
-        CHECK(a.system->stats().types[t].created == b.system->stats().types[t].created);
-        CHECK(a.system->stats().types[t].killed == b.system->stats().types[t].killed);
-        CHECK(a.system->stats().types[t].dropped == b.system->stats().types[t].dropped);
-    }
-    return points;
-}
-
-bool bitwise(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
-
-// Every sample for 600 frames without the optimizer against with it.
-size_t compareWithUnoptimized(bool relaxed, const std::function<bool(float, float)>& close) {
-    size_t points = 0;
-    for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
-        if (entry.path().extension() != ".psys") continue;
-        INFO(entry.path().filename().string());
-        std::string text = test::readFile(entry.path().string());
-        Run plain(text, {}, false), optimized(text, {}, true, relaxed);
-        points += compareRuns(plain, optimized, 600, close);
-    }
-    return points;
-}
-
 TEST_CASE("the optimizer leaves every sample's output unchanged, bit for bit, over 600 frames") {
-    size_t points = compareWithUnoptimized(false, bitwise);
+    size_t points = test::compareWithUnoptimized(false, {}, 600, bitwise);
     CHECK(points > 100000);
 }
 
@@ -406,7 +318,7 @@ TEST_CASE("with relaxed maths every sample's output stays within 1e-4 (relative)
     // What differs: the last bits of reassociated sums and of x/c as x·(1/c), and integrals of
     // constants taken as c·age instead of a float sum over 600 steps (the closed form is the
     // more accurate of the two). Measured worst case: 6.3e-5, first_particle's position.
-    size_t points = compareWithUnoptimized(true, [](float a, float b) {
+    size_t points = test::compareWithUnoptimized(true, {}, 600, [](float a, float b) {
         return std::fabs(a - b) <= 1e-4f * std::max(std::fabs(a), 1e-3f);
     });
     CHECK(points > 100000);

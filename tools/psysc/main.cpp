@@ -1,6 +1,6 @@
 // psysc: the psys compiler driver.
 //
-//   psysc check FILE…                   type-check; exit 0 when clean, 1 on errors
+//   psysc check FILE…                   check and compile; exit 0 when clean, 1 on errors
 //   psysc run FILE [options]            compile and run a system (host/: the host library)
 //   psysc --emit=ast|ir FILE            print the checked AST, or the IR after the passes
 //   psysc --stats FILE                  the cost of each object type, without and with the optimizer
@@ -19,7 +19,7 @@
 #include "frontend/loader.h"
 #include "ir/printer.h"
 #include "opt/passes.h"
-#include "opt/stats.h"
+#include "stats_command.h"
 #include "driver/compile.h"
 #include "host/backends.h"
 #include "run_command.h"
@@ -37,10 +37,11 @@ double millisecondsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-// Checks one file; prints its diagnostics (and, with `time`, how long loading and checking
-// took); returns the program when it is clean.
-std::unique_ptr<psys::ast::Program> checkOne(const std::string& path, psys::SourceManager& sources, bool colour,
-                                             bool time, bool* failed) {
+// Checks one file, and compiles it unless `compile` is null; prints its diagnostics (and,
+// with `time`, how long each part took); returns the program when it is clean.
+std::unique_ptr<psys::ast::Program> checkOne(const std::string& path, psys::SourceManager& sources,
+                                             const psys::CompileOptions* compile, bool colour, bool time,
+                                             bool* failed) {
     psys::DiagnosticEngine diags(sources);
     auto start = std::chrono::steady_clock::now();
     auto program = psys::loadProgram(path, sources, diags);
@@ -51,54 +52,18 @@ std::unique_ptr<psys::ast::Program> checkOne(const std::string& path, psys::Sour
         if (diags.errorCount() > 0) program.reset();
     }
     double checkMs = millisecondsSince(start);
+    // The passes report too: an integral without a closed form under @integrator(exact),
+    // a decay beyond the integrator's stability limit.
+    start = std::chrono::steady_clock::now();
+    if (program && compile && !psys::compileProgram(program.get(), sources, diags, *compile)) program.reset();
+    double compileMs = millisecondsSince(start);
     diags.print(std::cerr, colour);
     if (time)
-        std::cerr << path << ": parse " << parseMs << " ms, check " << checkMs << " ms (" << sources.count()
+        std::cerr << path << ": parse " << parseMs << " ms, check " << checkMs << " ms, compile " << compileMs
+                  << " ms (" << sources.count()
                   << " file" << (sources.count() == 1 ? "" : "s") << ")\n";
     if (!program) *failed = true;
     return program;
-}
-
-// `psysc --stats FILE`: the cost of each object type without and with the optimizer.
-int printStats(const std::string& file, bool colour) {
-    // Three compilations: no optimizer, the exact optimizer, and with relaxed maths.
-    std::vector<std::vector<psys::opt::ObjectCost>> costs;
-    for (int level = 0; level < 3; ++level) {
-        psys::SourceManager sources;
-        psys::DiagnosticEngine diags(sources);
-        psys::CompileOptions options;
-        options.pipeline.optimize = level > 0;
-        options.pipeline.pass.relaxed = level == 2;
-        auto module = psys::compileFile(file, sources, diags, options);
-        if (level == 0 || !module) diags.print(std::cerr, colour);
-        if (!module) return 1;
-        costs.push_back(psys::opt::measure(*module));
-    }
-    auto percent = [](size_t a, size_t b) { return b ? fmt::format("{:.0f}%", 100.0 * a / b) : std::string("-"); };
-    std::cout << fmt::format("{:24} {:>10} {:>22} {:>6} {:>6} {:>24} {:>16} {:>14}\n", "object", "tree ops",
-                             "ops/update", "exact", "relax", "state bytes/object", "param bytes", "uniform ops");
-    size_t total[3] = {0, 0, 0}, tree = 0;
-    for (size_t i = 0; i < costs[0].size(); ++i) {
-        const auto &b = costs[0][i], &e = costs[1][i], &r = costs[2][i];
-        tree += b.treeOpsPerUpdate;
-        total[0] += b.opsPerUpdate;
-        total[1] += e.opsPerUpdate;
-        total[2] += r.opsPerUpdate;
-        std::cout << fmt::format("{:24} {:>10} {:>22} {:>6} {:>6} {:>24} {:>16} {:>14}\n", b.name, b.treeOpsPerUpdate,
-                                 fmt::format("{} / {} / {}", b.opsPerUpdate, e.opsPerUpdate, r.opsPerUpdate),
-                                 percent(e.opsPerUpdate, b.opsPerUpdate), percent(r.opsPerUpdate, b.opsPerUpdate),
-                                 fmt::format("{} / {} / {}", b.stateBytes, e.stateBytes, r.stateBytes),
-                                 fmt::format("{} / {} / {}", b.paramBytes, e.paramBytes, r.paramBytes),
-                                 fmt::format("{} / {} / {}", b.uniformOps, e.uniformOps, r.uniformOps));
-    }
-    std::cout << fmt::format("{:24} {:>10} {:>22} {:>6} {:>6}\n", "all", tree,
-                             fmt::format("{} / {} / {}", total[0], total[1], total[2]), percent(total[1], total[0]),
-                             percent(total[2], total[0]));
-    std::cout << fmt::format("optimized / tree ops: {} exact, {} relaxed\n", percent(total[1], tree), percent(total[2], tree));
-    std::cout << "(ops/update: scalar operations per object per frame, without the optimizer / optimized / optimized "
-                 "with --relaxed-math; tree ops: the same expressions evaluated as trees, nothing shared; uniform ops: "
-                 "per type per step)\n";
-    return 0;
 }
 
 // The options of `psysc run`.
@@ -130,7 +95,7 @@ void addRunOptions(CLI::App& run, psys::tools::RunOptions& o) {
 int printAst(const std::string& file, bool colour) {
     psys::SourceManager sources;
     bool failed = false;
-    auto program = checkOne(file, sources, colour, false, &failed);
+    auto program = checkOne(file, sources, nullptr, colour, false, &failed);
     if (!program) return 1;
     std::cout << psys::printAst(*program, sources);
     return 0;
@@ -182,11 +147,17 @@ int main(int argc, char** argv) {
     app.add_flag("--relaxed-math", relaxedMath,
                  "Allow rewrites that may change the last bits of a result (docs/optimizer.md)");
     app.add_flag("--no-optimize", noOptimize, "Only the lowering passes");
+    std::string integrator;
+    std::vector<std::string> methods(psys::core::kIntegratorNames.begin(), psys::core::kIntegratorNames.end());
+    app.add_option("--integrator", integrator,
+                   "Integrate every object with this method, whatever its @integrator says (to try one without "
+                   "editing the source)")
+        ->check(CLI::IsMember(methods))->type_name("METHOD");
     std::string statsFile;
     app.add_option("--stats", statsFile, "Per object type: operations per update before and after optimization, "
                    "state bytes per object")->type_name("FILE");
 
-    auto* check = app.add_subcommand("check", "Type-check .psys files and report every error");
+    auto* check = app.add_subcommand("check", "Check and compile .psys files and report every error and warning");
     std::vector<std::string> checkFiles;
     check->add_option("files", checkFiles, "Files to check")->required()->type_name("FILE");
     bool time = false;
@@ -207,18 +178,23 @@ int main(int argc, char** argv) {
     }
     bool colour = useColour(colourMode);
 
-    if (!statsFile.empty()) return printStats(statsFile, colour);
+    std::optional<psys::core::Integrator> everyObject;
+    if (!integrator.empty()) everyObject = psys::core::integratorFromName(integrator);
+    if (!statsFile.empty()) return psys::tools::printStats(statsFile, everyObject, colour);
     if (run->parsed()) {
         runOptions.colour = colour;
         runOptions.relaxed = relaxedMath;
         runOptions.optimize = !noOptimize;
+        runOptions.integrator = everyObject;
         return psys::tools::runSystem(runOptions);
     }
     if (check->parsed()) {
         bool failed = false;
+        psys::CompileOptions options;
+        options.pipeline.pass.everyObject = everyObject;
         for (const std::string& file : checkFiles) {
             psys::SourceManager sources;
-            checkOne(file, sources, colour, time, &failed);
+            checkOne(file, sources, &options, colour, time, &failed);
         }
         return failed ? 1 : 0;
     }
@@ -231,6 +207,7 @@ int main(int argc, char** argv) {
         psys::CompileOptions options;
         options.pipeline.optimize = !noOptimize;
         options.pipeline.pass.relaxed = relaxedMath;
+        options.pipeline.pass.everyObject = everyObject;
         options.pipeline.printAfter = {printAfter.begin(), printAfter.end()};
         options.pipeline.printAfterAll = printAfterAll;
         options.pipeline.print.locations = locations;

@@ -75,6 +75,12 @@ void printSummary(const RunOptions& options, host::Session& session, double draw
     for (auto& t : stats.types)
         std::cout << fmt::format("  {:24} live {:8}  created {:10}  killed {:10}  frozen {:4}  dropped {}\n", t.name,
                                  t.live, t.created, t.killed, t.frozen, t.dropped);
+    for (auto& t : stats.types)
+        if (t.unstable)
+            std::cout << fmt::format("  {}: {} updates beyond its integration method's stability limit (a decay "
+                                     "rate k with k·dt too large: the integral oscillates and grows); use @step or "
+                                     "@integrator(exponential)\n",
+                                     t.name, t.unstable);
     if (stats.rejectedSteps || stats.nonFiniteExterns || stats.invalidEmissions || stats.nonFiniteRender)
         std::cout << fmt::format("  rejected steps {}, non-finite extern values {}, invalid emissions {}, "
                                  "points not drawn (non-finite) {}\n",
@@ -108,6 +114,7 @@ int runSystem(const RunOptions& options) {
     session.backend = {options.backend, options.math};
     session.compile.pipeline.optimize = options.optimize;
     session.compile.pipeline.pass.relaxed = options.relaxed;
+    session.compile.pipeline.pass.everyObject = options.integrator;
     session.system.seed = options.seed;
     session.system.capacity = options.capacity;
     session.system.threads = options.threads;

@@ -2,8 +2,11 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "core/integrators.h"
 
 namespace psys::tools {
 
@@ -20,6 +23,7 @@ struct RunOptions {
     bool quiet = false;
     bool optimize = true;
     bool relaxed = false;
+    std::optional<core::Integrator> integrator;  // every object's, whatever @integrator says
     std::string backend = "llvm";    // host/backends.h
     std::string math = "fast";       // or "exact" (llvm)
     unsigned threads = 0;            // 0: every core

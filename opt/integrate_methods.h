@@ -1,0 +1,53 @@
+// The integration methods other than the default: each builds, with a StepBuilder, every
+// integral's value at the end of the update (docs/language.md says what each computes).
+//
+//   euler, midpoint, rk2, rk4   explicit Runge–Kutta methods: stages re-evaluate the
+//                               derivatives at instants inside the step (opt/integrate_methods.cpp)
+//   exponential                 Euler's step with each integral's linear decay solved
+//                               exactly over the step (opt/integrate_methods.cpp)
+//   exact                       closed forms over the step (opt/integrate_exact.cpp)
+#pragma once
+
+#include <array>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/integrators.h"
+#include "opt/integrate_step.h"
+#include "opt/linear_part.h"
+#include "opt/passes.h"
+
+namespace psys::opt {
+
+// euler, midpoint, rk2 (Heun's method) or rk4: the classical Butcher tableaux.
+std::vector<ir::ValueId> rungeKutta(StepBuilder& b, core::Integrator method);
+
+// Each integral y' = f with f = c·y + r (c its linear part, when it has one):
+// y + dt·φ1(−c·dt)·f, all at the start of the step; Euler's step where there is no c.
+// `coefficient` builds integral j's c at the start of the step.
+std::vector<ir::ValueId> exponentialEuler(StepBuilder& b, const std::vector<bool>& hasLinearPart,
+                                          const std::function<ir::ValueId(size_t)>& coefficient);
+
+// Closed forms over the step, or an error at the integral that has none. `names`: the
+// equation each integral is in, for the message.
+std::optional<std::vector<ir::ValueId>> closedForm(StepBuilder& b, const std::string& object,
+                                                   const std::vector<std::string>& names, PassErrors& errors);
+
+// A decay rate k the compiler found in an integral's derivative (f = −k·y + …).
+struct DecayRate {
+    std::string equation;  // the equation the integral is in
+    ir::Loc loc;           // the integral
+    std::optional<std::array<double, 4>> constant;  // k, when it is a constant
+    std::function<ir::ValueId()> build;             // k in the lowered kernel
+};
+
+// For a method with a stability limit (core::stabilityLimit): a warning for each constant
+// rate beyond it at the object's step (@step, else 1/60 s), and the value of the
+// `unstable` yield: whether k·dt is beyond the limit for any rate this update (none when
+// no rate can be). `step`: the object's @step (0: none).
+std::optional<ir::ValueId> stabilityCheck(ir::Kernel& to, const std::string& object, core::Integrator method,
+                                          float step, const std::vector<DecayRate>& rates, PassErrors& errors);
+
+}  // namespace psys::opt

@@ -1,0 +1,114 @@
+// Running a system on the interpreter in the unit tests: a program as text, compiled with
+// the options a test names, and two runs compared side by side.
+#pragma once
+
+#include <doctest/doctest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "driver/compile.h"
+#include "interp/interpreter.h"
+#include "rt/system.h"
+#include "test_support.h"
+
+namespace psys::test {
+
+struct Run {
+    interp::Interpreter backend;
+    std::unique_ptr<rt::System> system;
+    std::string diagnostics;  // what compiling printed (warnings)
+
+    explicit Run(const std::string& source, rt::SystemOptions options = {}, bool optimize = true, bool relaxed = false,
+                 std::optional<core::Integrator> integrator = {}) {
+        SourceManager sources;
+        DiagnosticEngine diags(sources);
+        CompileOptions compile;
+        compile.pipeline.optimize = optimize;
+        compile.pipeline.pass.relaxed = relaxed;
+        compile.pipeline.pass.everyObject = integrator;
+        auto module = compileText("test.psys", source, sources, diags, compile);
+        diagnostics = diags.render();
+        INFO(diagnostics);
+        REQUIRE(module.has_value());
+        system = std::make_unique<rt::System>(std::move(*module), backend, options);
+    }
+
+    void steps(int n, double dt) {
+        for (int i = 0; i < n; ++i) REQUIRE_FALSE(system->step(dt).has_value());
+    }
+    size_t type(const std::string& name) const { return static_cast<size_t>(system->typeIndex(name)); }
+    std::vector<rt::RenderPoint> points(const std::string& name) { return system->points(type(name)); }
+    rt::TypeStats stats(const std::string& name) const { return system->stats().types[type(name)]; }
+};
+
+inline bool bitwise(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// Runs two systems side by side for `frames` frames, firing every trigger once, and
+// compares what is drawn: the same objects, and values compared by `close`. Returns the
+// number of points compared.
+inline size_t compareRuns(Run& a, Run& b, int frames, const std::function<bool(float, float)>& close) {
+    for (const ir::Trigger& t : a.system->module().triggers) {
+        size_t width = 0;
+        for (auto& p : t.params) width += static_cast<size_t>(p.type.width);
+        std::vector<float> args(width, 1.5f);
+        REQUIRE_FALSE(a.system->fire(t.name, args));
+        REQUIRE_FALSE(b.system->fire(t.name, args));
+    }
+    size_t points = 0, differences = 0;
+    for (int frame = 0; frame < frames; ++frame) {
+        a.steps(1, 1.0 / 60);
+        b.steps(1, 1.0 / 60);
+        for (size_t t = 0; t < a.system->typeCount(); ++t) {
+            const auto& pa = a.system->points(t);
+            const auto& pb = b.system->points(t);
+            REQUIRE(pa.size() == pb.size());
+            for (size_t i = 0; i < pa.size(); ++i) {
+                ++points;
+                bool same = pa[i].id == pb[i].id && close(pa[i].size, pb[i].size);
+                for (size_t c = 0; c < 3; ++c) same &= close(pa[i].position[c], pb[i].position[c]);
+                for (size_t c = 0; c < 4; ++c) same &= close(pa[i].color[c], pb[i].color[c]);
+                differences += same ? 0 : 1;
+            }
+        }
+    }
+    CHECK(differences == 0);
+    for (size_t t = 0; t < a.system->typeCount(); ++t) {
+        CHECK(a.system->stats().types[t].created == b.system->stats().types[t].created);
+        CHECK(a.system->stats().types[t].killed == b.system->stats().types[t].killed);
+        CHECK(a.system->stats().types[t].dropped == b.system->stats().types[t].dropped);
+        CHECK(a.system->stats().types[t].unstable == b.system->stats().types[t].unstable);
+    }
+    return points;
+}
+
+// Whether a sample has a closed form for every integral (what `exact` needs).
+inline bool compiles(const std::string& text, std::optional<core::Integrator> integrator) {
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    CompileOptions compile;
+    compile.pipeline.pass.everyObject = integrator;
+    return compileText("test.psys", text, sources, diags, compile).has_value();
+}
+
+// Every sample (that compiles under `integrator`) for `frames` frames without the
+// optimizer against with it.
+inline size_t compareWithUnoptimized(bool relaxed, std::optional<core::Integrator> integrator, int frames,
+                                     const std::function<bool(float, float)>& close) {
+    size_t points = 0;
+    for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
+        if (entry.path().extension() != ".psys") continue;
+        INFO(entry.path().filename().string());
+        std::string text = readFile(entry.path().string());
+        if (integrator && !compiles(text, integrator)) continue;
+        Run plain(text, {}, false, false, integrator), optimized(text, {}, true, relaxed, integrator);
+        points += compareRuns(plain, optimized, frames, close);
+    }
+    return points;
+}
+
+}  // namespace psys::test
