@@ -13,9 +13,11 @@
 //   y(t) = y0·φ0(kt) + Σ gp·p!·tᵖ⁺¹·φp+1(kt).
 //
 // The integrals are solved one after another in dependency order; each value at the end
-// of the update is its sum at τ = dt. That covers polynomials in age (projectiles, any
-// constant force), linear drag with constant forcing, and chains of them (the position
-// of a particle under drag). A derivative outside the family — a coupled system such as a
+// of the update is its sum at τ = dt. Where everything the derivatives read is fixed at
+// creation, the same sums are taken over the object's whole life instead (from 0 at
+// creation to τ = age): no state, and no rounding carried from one step to the next.
+// That covers polynomials in age (projectiles, any constant force), linear drag with
+// constant forcing, and chains of them (the position of a particle under drag). A derivative outside the family — a coupled system such as a
 // spring, a decay rate that changes within the step, sin of the age — is an error at the
 // integral, never a quiet fallback to another method.
 #include <fmt/format.h>
@@ -25,6 +27,7 @@
 
 #include "opt/integrate_methods.h"
 #include "opt/phi.h"
+#include "opt/rewrite.h"
 
 namespace psys::opt {
 
@@ -56,12 +59,31 @@ struct Sum {
 struct NoClosedForm {
     std::string why;
 };
+// A derivative reads something that may change after creation: solve step by step.
+struct NotFixedAtCreation {};
 
 class ClosedForm {
 public:
     ClosedForm(StepBuilder& b, const std::vector<std::string>& names) : b_(b), k_(b.to()), names_(names) {}
 
+    // From creation where every value the derivatives read is fixed at creation (constants
+    // and parameters): then each integral is a function of the age alone, with no state
+    // and no rounding carried from step to step. Otherwise over each step, from the state.
     std::vector<ValueId> solve() {
+        try {
+            fromCreation_ = true;
+            return solveAll();
+        } catch (const NotFixedAtCreation&) {
+            fromCreation_ = false;
+            solved_.clear();
+            return solveAll();
+        }
+    }
+
+    size_t failedAt() const { return current_; }
+
+private:
+    std::vector<ValueId> solveAll() {
         for (size_t j : order()) {
             current_ = j;
             memo_.clear();  // `self` meant the previous integral
@@ -75,9 +97,10 @@ public:
         return out;
     }
 
-    size_t failedAt() const { return current_; }
-
-private:
+    // τ at the end of the update: the step's length, or from creation the age.
+    ValueId span() { return fromCreation_ ? k_.add(Inst::make(Op::Age, Type::f32())) : b_.dt(); }
+    // Integral j at τ = 0.
+    ValueId start(size_t j) { return fromCreation_ ? k_.constant(b_.type(j), {0, 0, 0, 0}) : b_.start(j); }
     // The integrals in an order where each derivative reads only integrals before it.
     std::vector<size_t> order() {
         size_t n = b_.size();
@@ -125,7 +148,10 @@ private:
 
     // `old` over the step.
     Sum of(ValueId old) {
-        if (!b_.dependent(old)) return fixed(b_.final(old));
+        if (!b_.dependent(old)) {
+            if (fromCreation_ && !b_.fixedAtCreation(old)) throw NotFixedAtCreation{};
+            return fixed(b_.final(old));
+        }
         if (auto it = memo_.find(old); it != memo_.end()) return it->second;
         Sum s = compute(old);
         return memo_[old] = s;
@@ -143,7 +169,8 @@ private:
                 }
                 break;
             case Op::Age: case Op::Time: {
-                ValueId start = b_.clockAt(i.op, 0);
+                if (fromCreation_ && i.op == Op::Time) throw NotFixedAtCreation{};
+                ValueId start = fromCreation_ ? k_.scalar(0) : b_.clockAt(i.op, 0);
                 return {i.type, {{start, 0, std::nullopt}, {one(i.type), 1, std::nullopt}}, std::nullopt};
             }
             case Op::Recur: return op(0);
@@ -252,7 +279,7 @@ private:
         Type t = b_.type(j);
         Sum out{t, {}, std::nullopt};
         if (!derivative.self) {
-            out.terms.push_back({b_.start(j), 0, std::nullopt});
+            out.terms.push_back({start(j), 0, std::nullopt});
             for (const Term& d : derivative.terms) {
                 // ∫ c·τᵖ = c/(p+1)·τᵖ⁺¹;  ∫ c·τᵖ·φp(kτ) = c·τᵖ⁺¹·φp+1(kτ).
                 ValueId c = d.coef;
@@ -266,7 +293,7 @@ private:
             if (d.rate)
                 throw NoClosedForm{"it decays while driven by another decaying value"};
         ValueId rate = k_.op(Op::Neg, t, {*derivative.self});
-        out.terms.push_back({b_.start(j), 0, rate});
+        out.terms.push_back({start(j), 0, rate});
         for (const Term& d : derivative.terms) {
             double f = 1;
             for (int p = 2; p <= d.power; ++p) f *= p;
@@ -278,13 +305,13 @@ private:
 
     ValueId uniformConst(Type t, float x) { return k_.constant(t, {x, x, x, x}); }
 
-    // Σ coef·dtᵖ(·φp(rate·dt)).
+    // Σ coef·τᵖ(·φp(rate·τ)) at the end of the update.
     ValueId valueAtEnd(const Sum& s) {
         ValueId total = 0;
         bool any = false;
         for (const Term& t : s.terms) {
             ValueId v = t.coef;
-            if (t.rate) v = b_.mul(v, phi(k_, t.power, b_.mul(*t.rate, b_.dt())));
+            if (t.rate) v = b_.mul(v, phi(k_, t.power, b_.mul(*t.rate, span())));
             if (t.power > 0) v = b_.mul(power(t.power), v);
             total = any ? b_.add(total, v) : v;
             any = true;
@@ -293,8 +320,8 @@ private:
     }
 
     ValueId power(int p) {
-        ValueId v = b_.dt();
-        for (int i = 1; i < p; ++i) v = k_.op(Op::Mul, Type::f32(), {v, b_.dt()});
+        ValueId v = span();
+        for (int i = 1; i < p; ++i) v = k_.op(Op::Mul, Type::f32(), {v, span()});
         return v;
     }
 
@@ -302,6 +329,7 @@ private:
     Kernel& k_;
     const std::vector<std::string>& names_;
     size_t current_ = 0;
+    bool fromCreation_ = false;
     std::map<size_t, Sum> solved_;
     std::map<ValueId, Sum> memo_;
 };

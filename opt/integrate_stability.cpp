@@ -20,6 +20,12 @@ constexpr float kAssumedFrame = 1.0f / 60;
 
 std::string number(double x) { return fmt::format("{:.4g}", x); }
 
+// A step as the source would write it: 1/120 rather than 0.008333.
+std::string stepText(double h) {
+    double n = std::round(1 / h);
+    return n >= 1 && std::fabs(1 / n - h) <= 1e-6 * h ? fmt::format("1/{}", n) : number(h);
+}
+
 void warnIfConstant(const std::string& object, core::Integrator method, float step, const DecayRate& r,
                     PassErrors& errors) {
     if (!r.constant) return;
@@ -28,7 +34,7 @@ void warnIfConstant(const std::string& object, core::Integrator method, float st
     double limit = core::stabilityLimit(method);
     double h = step > 0 ? step : kAssumedFrame;
     if (k * h <= limit) return;
-    std::string at = step > 0 ? fmt::format("at @step({}) k·dt = {}", number(step), number(k * h))
+    std::string at = step > 0 ? fmt::format("at @step({}) k·dt = {}", stepText(step), number(k * h))
                               : fmt::format("at 60 updates a second k·dt = {}", number(k * h));
     errors.warning(r.loc, fmt::format("object {}: `{}` decays at k = {}/s, and {} is stable only while k·dt < {} "
                                       "(updates shorter than {} ms); {}, so it oscillates and grows. Use "

@@ -30,6 +30,15 @@ ValueId StepBuilder::resolve(ValueId old) const {
     return old;
 }
 
+bool StepBuilder::fixedAtCreation(ValueId old) const {
+    const Inst& i = from_.at(old);
+    if (i.op == Op::Param || i.op == Op::Const || snapshotsOfFixed_.count(old)) return true;
+    if (!isPure(i.op)) return false;
+    for (ValueId o : i.operands)
+        if (!fixedAtCreation(o)) return false;
+    return true;
+}
+
 ValueId StepBuilder::dt() { return to_.add(Inst::make(Op::Dt, Type::f32())); }
 
 ValueId StepBuilder::start(size_t j) { return to_.add(Inst::make(Op::StateRead, type(j), {}, slots_[j])); }

@@ -20,6 +20,7 @@
 
 #include <functional>
 #include <map>
+#include <set>
 #include <vector>
 
 #include "ir/ir.h"
@@ -67,6 +68,11 @@ public:
     // Stages see `old` as `seen` instead of re-evaluating it (a `derive`: its value at the
     // last update).
     void stageView(ir::ValueId old, ir::ValueId seen) { stageViews_[old] = seen; }
+    // Whether `old` is fixed when the object is created: built from constants and
+    // parameters, or a `snapshot` of such (lowered to a state read, whose value is the
+    // same bits: with or without the optimizer, which folds it away, the same answer).
+    void snapshotOfFixed(ir::ValueId old) { snapshotsOfFixed_.insert(old); }
+    bool fixedAtCreation(ir::ValueId old) const;
 
     // Builds the kernel: every yield and equation at its final value; `solve` gives each
     // integral's value at the end of the update (called once, when first needed).
@@ -88,6 +94,7 @@ private:
     std::map<ir::ValueId, size_t> integralIndex_;
     std::vector<bool> dependent_;
     std::map<ir::ValueId, ir::ValueId> stageViews_;
+    std::set<ir::ValueId> snapshotsOfFixed_;
     ir::Kernel to_;
     std::map<ir::ValueId, ir::ValueId> final_;
     std::vector<ir::ValueId> solved_;

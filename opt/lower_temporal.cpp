@@ -130,6 +130,7 @@ public:
         }
         StepBuilder b(perUpdate, integrals, slots);
         for (auto& [derived, seen] : stageViews_) b.stageView(derived, seen);
+        for (ValueId v : snapshotsOfFixed_) b.snapshotOfFixed(v);
         b.to().setLoc(object_.loc);
         leaf_ = [&b, this](ValueId old) { return b.at(b.startPoint(), rewriter_.map(old)); };
         b.run([&](StepBuilder& builder) { return solve(builder); });
@@ -217,6 +218,7 @@ private:
                 ValueId s = input(k, Op::StateRead, t, slot);
                 ValueId value = rw.emit(Inst::make(Op::Select, t, {first, ops[0], s}));
                 nextNew_.push_back({slot, value});
+                if (creationInvariant(k, ops[0])) snapshotsOfFixed_.push_back(value);
                 return value;
             }
             case Op::FollowedBy:
@@ -283,6 +285,7 @@ private:
     std::vector<std::pair<int, ValueId>> nextNew_;  // (slot, new value)
     std::vector<std::pair<int, ValueId>> nextOld_;  // (slot, old value its next is)
     std::map<ValueId, ValueId> stageViews_;         // (derive, what a stage sees), new values
+    std::vector<ValueId> snapshotsOfFixed_;         // snapshots of what is fixed at creation
     Kernel* target_ = nullptr;                      // where decay rates are built
     std::function<ValueId(ValueId)> leaf_;          // a behaviour value there
 };

@@ -9,7 +9,7 @@ packages=(
   llvm-19-dev libzstd-dev
   libglm-dev libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libimgui-dev
   doctest-dev libcli11-dev libfmt-dev nlohmann-json3-dev libstb-dev libtbb-dev
-  glslang-tools xvfb xauth libbenchmark-dev
+  glslang-tools xvfb xauth libbenchmark-dev python3-matplotlib
 )
 
 missing=()

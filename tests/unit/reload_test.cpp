@@ -2,6 +2,7 @@
 // Each documented outcome (docs/runtime.md, "Hot reload") is a case here.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 
@@ -282,4 +283,43 @@ TEST_CASE("a reload right after a burst carries every object of it, as if nothin
     after.carryOver(before);
     CHECK(after.stats().types[debris].live == 200);
     CHECK(run(after, 60) == run(straight, 60));
+}
+
+TEST_CASE("a reload that changes the integrator carries the integrals; the new method takes over") {
+    // A ball thrown up under drag: its integrals keep their slots (integrate@vel,
+    // integrate@pos) whatever the method, so switching carries them and the ball goes on
+    // from where it was, now integrated by rk4. (The default method also kept the
+    // previous velocity that the drag read, prev@vel: rk4 reads the stage's.)
+    auto ball = [](const std::string& method) {
+        return "@integrator(" + method + ") object b { vel = vec3(0, 10, 0) + integrate(vec3(0, -9.8, 0) - 0.5 * vel);\n"
+               "  pos = integrate(vel); point(pos, vec4(vel, 1), 1); }\nspawn b;";
+    };
+    interp::Interpreter backend;
+    rt::System before(compile(ball("semi_implicit")), backend), stayed(compile(ball("semi_implicit")), backend);
+    run(before, 60);
+    run(stayed, 60);
+    double p1 = before.points(0).at(0).position[1], v1 = before.points(0).at(0).color[1];
+    rt::System after(compile(ball("rk4")), backend);
+    rt::ReloadReport report = after.carryOver(before);
+    CHECK(report.newSlots.empty());
+    CHECK(report.lostSlots == std::vector<std::string>{"b.prev@vel"});
+    // From the carried (p1, v1), the exact solution one second on; rk4 follows it to its
+    // own error (1e-7 m at this step), the default method to its own (centimetres).
+    run(after, 60);
+    run(stayed, 60);
+    const double terminal = -19.6;
+    double exact = p1 + terminal * 1.0 + (v1 - terminal) * (1 - std::exp(-0.5)) / 0.5;
+    CHECK(std::fabs(after.points(0).at(0).position[1] - exact) < 1e-4);
+    CHECK(std::fabs(stayed.points(0).at(0).position[1] - exact) > 1e-2);
+    // exact from creation reads no state: its slots stay only as what render reads (the
+    // velocity in the colour, the position), rewritten each update from the age. The
+    // closed form takes over unchanged by the switch: the ball is where an exact run
+    // from the start has it.
+    rt::System exactAfter(compile(ball("exact")), backend);
+    rt::ReloadReport toExact = exactAfter.carryOver(after);
+    CHECK(toExact.lostSlots.empty());
+    run(exactAfter, 1);
+    rt::System fresh(compile(ball("exact")), backend);
+    run(fresh, 121);
+    CHECK(exactAfter.points(0).at(0).position[1] == fresh.points(0).at(0).position[1]);
 }

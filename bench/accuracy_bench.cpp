@@ -1,0 +1,355 @@
+// accuracy_bench: the speed ↔ accuracy trade of the integration methods, measured
+// (docs/accuracy.md is its output).
+//
+// Each reference problem in bench/accuracy/ has an exact solution. For every method and
+// step (1/15 … 1/240 s, and frames of 1/60 s in @step(1/240) sub-steps) one object is
+// stepped on the LLVM JIT (the default, fast maths) and compared with the solution after
+// every step: the largest and the last error. The cost of an update is measured in the
+// same run: the same problem with 100 000 copies, on one thread, ns per object update.
+// A stiff decay is run at k·dt from 0.1 to 100 to see which methods stay bounded, and
+// the fountain with integrals gives the cost of each method on a real effect.
+//
+//   psys_accuracy [--csv FILE] [--copies N] [--quick]
+//
+// The CSV is what bench/plot_accuracy.py draws (docs/images/accuracy.png).
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <algorithm>
+#include <functional>
+#include <iostream>
+#include <map>
+#include <numbers>
+#include <optional>
+
+#include "codegen_llvm/llvm_backend.h"
+#include "driver/compile.h"
+#include "frontend/source.h"
+#include "rt/system.h"
+
+using namespace psys;
+using core::Integrator;
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+struct Problem {
+    std::string file, type;
+    double seconds;
+    // The error of a drawn point at time t against the exact solution.
+    std::function<double(const rt::RenderPoint&, double)> error;
+};
+
+double norm3(double x, double y, double z) { return std::sqrt(x * x + y * y + z * z); }
+
+// Position error of a point against an exact position.
+double positionError(const rt::RenderPoint& p, double x, double y, double z) {
+    return norm3(p.position[0] - x, p.position[1] - y, p.position[2] - z);
+}
+
+std::vector<Problem> problems() {
+    const double g = -9.8;
+    return {
+        {"projectile", "ball", 2,
+         [=](const rt::RenderPoint& p, double t) { return positionError(p, 2 * t, 10 * t + g * t * t / 2, 0); }},
+        {"drag", "ball", 4,
+         [=](const rt::RenderPoint& p, double t) {
+             // vel = v∞ + (v0 − v∞)e^(−kt), pos = v∞·t + (v0 − v∞)(1 − e^(−kt))/k per component.
+             const double k = 0.5, decay = (1 - std::exp(-k * t)) / k;
+             double x = 2 * decay, y = (g / k) * t + (10 - g / k) * decay;
+             return positionError(p, x, y, 0);
+         }},
+        {"spring", "mass", 10,
+         [](const rt::RenderPoint& p, double t) { return std::fabs(p.position[0] - std::cos(2 * kPi * t)); }},
+        {"damped_spring", "mass", 10,
+         [](const rt::RenderPoint& p, double t) {
+             const double w = 2 * kPi, zeta = 0.1, wd = w * std::sqrt(1 - zeta * zeta);
+             double x = std::exp(-zeta * w * t) * (std::cos(wd * t) + zeta * w / wd * std::sin(wd * t));
+             return std::fabs(p.position[0] - x);
+         }},
+        {"orbit", "planet", 200 * kPi,  // 100 periods
+         [](const rt::RenderPoint& p, double t) { return positionError(p, std::cos(t), std::sin(t), 0); }},
+    };
+}
+
+// The orbit's energy v²/2 − 1/r (velocity in the colour), relative to its exact −1/2.
+double energyDrift(const rt::RenderPoint& p) {
+    double v = norm3(p.color[0], p.color[1], p.color[2]);
+    double r = norm3(p.position[0], p.position[1], p.position[2]);
+    return std::fabs((v * v / 2 - 1 / r) + 0.5) / 0.5;
+}
+
+struct Step {
+    std::string label;
+    double frame;    // the host's step
+    bool subSteps;   // the program says @step(1/240)
+    double h() const { return subSteps ? 1.0 / 240 : frame; }
+};
+
+const std::vector<Step> kSteps = {{"1/15", 1.0 / 15, false},   {"1/30", 1.0 / 30, false},
+                                  {"1/60", 1.0 / 60, false},   {"1/120", 1.0 / 120, false},
+                                  {"1/240", 1.0 / 240, false}, {"1/60 @step(1/240)", 1.0 / 60, true}};
+
+std::string readFile(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) {
+        std::cerr << "psys_accuracy: cannot read " << path << "\n";
+        std::exit(1);
+    }
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::optional<ir::Module> compile(const std::string& text, Integrator method) {
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    CompileOptions options;
+    options.pipeline.pass.everyObject = method;
+    return compileText("problem.psys", text, sources, diags, options);
+}
+
+struct Measured {
+    bool closedForm = true;  // false: `exact` has none for this problem
+    double maxError = 0, finalError = 0, drift = 0;
+    double nsPerUpdate = 0;  // per object per frame
+};
+
+class Bench {
+public:
+    Bench(size_t copies, bool quick) : copies_(copies), quick_(quick) {}
+
+    // Steps one object through the problem, comparing after every step.
+    Measured accuracy(const Problem& problem, const std::string& text, Integrator method, const Step& step) {
+        Measured m;
+        std::string source = step.subSteps ? "@step(1/240);\n" + text : text;
+        auto module = compile(source, method);
+        if (!module) {
+            m.closedForm = false;
+            return m;
+        }
+        rt::SystemOptions options;
+        options.threads = 1;
+        rt::System system(std::move(*module), jit_, options);
+        double seconds = quick_ ? std::min(problem.seconds, 1.0) : problem.seconds;
+        auto frames = static_cast<long>(std::lround(seconds / step.frame));
+        size_t type = static_cast<size_t>(system.typeIndex(problem.type));
+        rt::RenderPoint last{};
+        for (long f = 1; f <= frames; ++f) {
+            if (system.step(step.frame)) std::exit(1);
+            auto points = system.points(type);
+            if (points.size() != 1) {
+                std::cerr << "psys_accuracy: " << problem.file << " has " << points.size() << " objects\n";
+                std::exit(1);
+            }
+            last = points[0];
+            double e = problem.error(last, f * step.frame);
+            m.maxError = std::isfinite(e) ? std::max(m.maxError, e) : INFINITY;
+            m.finalError = e;
+        }
+        if (problem.file == "orbit") m.drift = energyDrift(last);
+        return m;
+    }
+
+    // ns per object per frame: `copies` objects of the problem's type, on one thread.
+    double cost(const std::string& text, const std::string& type, Integrator method, const Step& step) {
+        std::string source = (step.subSteps ? "@step(1/240);\n" : "") + text +
+                             fmt::format("\nobject copies {{ emit {} count {}; }}\nspawn copies;\n", type, copies_);
+        auto module = compile(source, method);
+        if (!module) return NAN;
+        rt::SystemOptions options;
+        options.threads = 1;
+        options.capacity = copies_ + 16;
+        rt::System system(std::move(*module), jit_, options);
+        for (int f = 0; f < 3; ++f)
+            if (system.step(step.frame)) std::exit(1);
+        double before = system.stats().loopSeconds;
+        int frames = quick_ ? 3 : 30;
+        for (int f = 0; f < frames; ++f)
+            if (system.step(step.frame)) std::exit(1);
+        size_t live = system.stats().types[static_cast<size_t>(system.typeIndex(type))].live;
+        return (system.stats().loopSeconds - before) * 1e9 / (static_cast<double>(live) * frames);
+    }
+
+    codegen_llvm::LlvmBackend& jit() { return jit_; }
+
+private:
+    codegen_llvm::LlvmBackend jit_;
+    size_t copies_;
+    bool quick_;
+};
+
+std::vector<Integrator> methods() {
+    std::vector<Integrator> all;
+    for (size_t i = 0; i < core::kIntegratorNames.size(); ++i) all.push_back(static_cast<Integrator>(i));
+    return all;
+}
+
+std::string sci(double x) {
+    if (std::isnan(x)) return "—";
+    if (std::isinf(x)) return "∞";
+    return fmt::format("{:.1e}", x);
+}
+
+// The order of convergence between two step sizes, from the largest errors; none where
+// the finer error is down at float's rounding (the state's own precision).
+std::string order(double coarse, double fine) {
+    if (!(coarse > 0) || !(fine > 2e-5) || !std::isfinite(coarse) || !std::isfinite(fine)) return "—";
+    return fmt::format("{:.2f}", std::log2(coarse / fine));
+}
+
+void accuracyTables(Bench& bench, const std::string& dir, std::ofstream* csv) {
+    for (const Problem& p : problems()) {
+        std::string text = readFile(dir + "/" + p.file + ".psys");
+        std::cout << fmt::format("\n### {} ({} s)\n\n", p.file, fmt::format("{:.4g}", p.seconds));
+        std::cout << "| method | ns/update |";
+        for (const Step& s : kSteps) std::cout << " " << s.label << " |";
+        std::cout << " order (1/30→1/60→1/120) |" << (p.file == "orbit" ? " energy drift at 1/60 |" : "") << "\n|---|---|";
+        for (size_t i = 0; i < kSteps.size() + 1 + (p.file == "orbit"); ++i) std::cout << "---|";
+        std::cout << "\n";
+        for (Integrator m : methods()) {
+            std::string name(core::integratorName(m));
+            double cost = bench.cost(text, p.type, m, kSteps[2]);
+            double subCost = bench.cost(text, p.type, m, kSteps[5]);
+            std::cout << "| " << name << " | " << (std::isnan(cost) ? "—" : fmt::format("{:.2f}", cost)) << " |";
+            std::vector<Measured> row;
+            for (const Step& s : kSteps) {
+                Measured r = bench.accuracy(p, text, m, s);
+                r.nsPerUpdate = s.subSteps ? subCost : cost;
+                row.push_back(r);
+                std::cout << " " << (r.closedForm ? fmt::format("{} / {}", sci(r.maxError), sci(r.finalError))
+                                                  : std::string("no closed form"))
+                          << " |";
+                if (csv && r.closedForm)
+                    *csv << fmt::format("{},{},{},{},{},{},{},{},{}\n", p.file, name, s.label, s.frame, s.h(),
+                                        r.maxError, r.finalError, r.nsPerUpdate, r.drift);
+            }
+            std::cout << " " << order(row[1].maxError, row[2].maxError) << ", " << order(row[2].maxError, row[3].maxError)
+                      << " |";
+            if (p.file == "orbit") std::cout << " " << (row[2].closedForm ? sci(row[2].drift) : "—") << " |";
+            std::cout << "\n";
+        }
+    }
+    std::cout << "\n(max / final error against the exact solution: position, in metres; ns/update: one object's "
+                 "update at 1/60 s on the JIT, one thread; the @step column costs four updates a frame)\n";
+}
+
+// rate·dt from 0.1 to 100 at 60 frames a second for one second.
+void stiffTable(Bench& bench, const std::string& dir, std::ofstream* csv) {
+    std::string text = readFile(dir + "/stiff.psys");
+    const double dt = 1.0 / 60;
+    std::cout << "\n### stiff decay v' = −k·v, 1 s at 60 frames a second\n\n| k·dt |";
+    for (Integrator m : methods()) std::cout << " " << core::integratorName(m) << " |";
+    std::cout << "\n|---|";
+    for (size_t i = 0; i < methods().size(); ++i) std::cout << "---|";
+    std::cout << "\n";
+    for (double kdt : {0.1, 0.5, 1.0, 1.9, 2.5, 2.8, 3.0, 10.0, 100.0}) {
+        std::cout << "| " << kdt << " |";
+        for (Integrator m : methods()) {
+            auto module = compile(text, m);
+            rt::System system(std::move(*module), bench.jit());
+            float rate[] = {static_cast<float>(kdt / dt)};
+            if (system.setExtern("rate", rate)) std::exit(1);
+            double worst = 0, last = 0;
+            bool bounded = true, oscillates = false;
+            float previous = 1;
+            for (int f = 1; f <= 60; ++f) {
+                if (system.step(dt)) std::exit(1);
+                auto points = system.points(0);  // a non-finite point is not drawn
+                float v = points.empty() ? INFINITY : points[0].position[0];
+                worst = std::max(worst, std::fabs(v - std::exp(-kdt * f)));
+                bounded &= std::fabs(v) <= 1;
+                oscillates |= (v < 0) != (previous < 0);
+                previous = v;
+                last = v;
+            }
+            uint64_t unstable = system.stats().types[0].unstable;
+            std::string outcome = !bounded ? "grows" : oscillates ? "oscillates" : "decays";
+            std::cout << fmt::format(" {} {}{} |", outcome, sci(worst), unstable ? " ⚑" : "");
+            if (csv)
+                *csv << fmt::format("stiff,{},k·dt={},{},{},{},{},{},{}\n", core::integratorName(m), kdt, dt, dt,
+                                    worst, last, 0, unstable);
+        }
+        std::cout << "\n";
+    }
+    std::cout << "\n(decays / oscillates / grows, then the largest error against e^(−k·t); ⚑: the run-time counted "
+                 "its updates as beyond the method's stability limit)\n";
+}
+
+// The fountain with integrals: ns per drop update under each method, at 100 000 drops on
+// one thread (the state stays in the caches: the arithmetic shows) and at a million on
+// every core (memory-bound, as docs/performance.md's fountain).
+void fountainTable(Bench& bench, const std::string& dir, bool quick) {
+    std::string text = readFile(dir + "/fountain.psys");
+    struct Setting {
+        float population;
+        unsigned threads;
+    };
+    const std::vector<Setting> settings = {{100000, 1}, {quick ? 100000.0f : 1000000.0f, 0}};
+    std::cout << "\n### the fountain (bench/accuracy/fountain.psys)\n\n| method | 100 000 drops, one thread: ns per "
+                 "drop update | relative to euler | 1 000 000 drops, every core: ns per drop update | relative to "
+                 "euler |\n|---|---|---|---|---|\n";
+    std::vector<double> euler(settings.size(), 0);
+    for (Integrator m : methods()) {
+        std::cout << "| " << core::integratorName(m) << " |";
+        for (size_t s = 0; s < settings.size(); ++s) {
+            auto module = compile(text, m);
+            if (!module) {
+                std::cout << " no closed form | — |";
+                continue;
+            }
+            rt::SystemOptions options;
+            options.threads = settings[s].threads;
+            options.capacity = 1200000;
+            rt::System system(std::move(*module), bench.jit(), options);
+            float population[] = {settings[s].population};
+            if (system.setExtern("population", population)) std::exit(1);
+            for (int f = 0; f < 200; ++f)
+                if (system.step(1.0 / 60)) std::exit(1);
+            // Median of rounds of 20 frames: the machine drifts.
+            std::vector<double> rounds;
+            for (int r = 0; r < (quick ? 1 : 5); ++r) {
+                double before = system.stats().loopSeconds;
+                for (int f = 0; f < 20; ++f)
+                    if (system.step(1.0 / 60)) std::exit(1);
+                size_t live = system.stats().types[static_cast<size_t>(system.typeIndex("drop"))].live;
+                rounds.push_back((system.stats().loopSeconds - before) * 1e9 / (static_cast<double>(live) * 20));
+            }
+            std::sort(rounds.begin(), rounds.end());
+            double ns = rounds[rounds.size() / 2];
+            if (m == Integrator::Euler) euler[s] = ns;
+            std::cout << fmt::format(" {:.2f} | {:.2f} |", ns, ns / euler[s]);
+        }
+        std::cout << "\n";
+    }
+    std::cout << "\n(ns of the update loops per live drop per frame, median of 5 rounds of 20 frames)\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app("psys_accuracy: error against cost for every integration method");
+    std::string csvPath, dir = PSYS_ACCURACY_DIR;
+    size_t copies = 100000;
+    bool quick = false;
+    app.add_option("--csv", csvPath, "Write every measurement to FILE (for bench/plot_accuracy.py)");
+    app.add_option("--copies", copies, "Objects per cost measurement (100000)");
+    app.add_option("--problems", dir, "The folder of problem files (bench/accuracy)");
+    app.add_flag("--quick", quick, "A smoke test: a second of each problem, few timed frames (the figures mean nothing)");
+    CLI11_PARSE(app, argc, argv);
+    std::ofstream csvFile;
+    std::ofstream* csv = nullptr;
+    if (!csvPath.empty()) {
+        csvFile.open(csvPath);
+        csvFile << "problem,method,step,frame,h,max_error,final_error,ns_per_update,extra\n";
+        csv = &csvFile;
+    }
+    Bench bench(copies, quick);
+    std::cout << fmt::format("# psys_accuracy on {}\n", bench.jit().report().target.empty() ? "this CPU"
+                                                                                          : bench.jit().report().target);
+    accuracyTables(bench, dir, csv);
+    stiffTable(bench, dir, csv);
+    fountainTable(bench, dir, quick);
+    return 0;
+}
