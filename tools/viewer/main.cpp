@@ -57,6 +57,11 @@ int main(int argc, char** argv) {
     app.add_option("--backend", o.session.backend.name, "llvm (the default) or interp")
         ->check(CLI::IsMember(host::backendNames()));
     app.add_option("--math", o.session.backend.math, "llvm: fast (the default) or exact")->check(CLI::IsMember({"fast", "exact"}));
+    std::string integrator;
+    std::vector<std::string> methods(core::kIntegratorNames.begin(), core::kIntegratorNames.end());
+    app.add_option("--integrator", integrator,
+                   "Integrate every object with this method, whatever its @integrator says (docs/accuracy.md)")
+        ->check(CLI::IsMember(methods))->type_name("METHOD");
     app.add_option("--seed", o.session.system.seed, "Random seed (1)");
     app.add_option("--threads", o.session.system.threads, "Threads for the simulation: 0 for every core (0)");
     app.add_option("--dt", dt, "Seconds per frame with a fixed step (1/60)");
@@ -82,6 +87,7 @@ int main(int argc, char** argv) {
         return e.get_exit_code() == 0 ? 0 : (code == 0 ? 0 : 2);
     }
 
+    if (!integrator.empty()) o.session.compile.pipeline.pass.everyObject = core::integratorFromName(integrator);
     for (const std::string& s : sets) {
         auto setting = host::parseSet(s);
         if (!setting) return fail(setting.error);
