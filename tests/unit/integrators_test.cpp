@@ -161,6 +161,12 @@ double springError(Integrator m, double h, double seconds) {
     return worst;
 }
 
+// v′ = −k·v from 1: object `d`, drawn at (v, 0, 0).
+std::string decayAt(int k) {
+    return "object d {\n    v = 1 + integrate(-" + std::to_string(k) + " * v);\n"
+           "    point(vec3(v, 0, 0), white, 1);\n}\nspawn d;";
+}
+
 }  // namespace
 
 TEST_CASE("the φ functions are within a few ulp of their definition, for small and large arguments") {
@@ -260,12 +266,7 @@ TEST_CASE("exact and exponential match the analytic solutions of their cases wit
 }
 
 TEST_CASE("a stiff decay at k·dt = 100 stays bounded and decays under exponential and exact, and is flagged under euler") {
-    const char* stiff = R"(
-        object d {
-            v = 1 + integrate(-6000 * v);
-            point(vec3(v, 0, 0), white, 1);
-        }
-        spawn d;)";
+    std::string stiff = decayAt(6000);
     for (Integrator m : {Integrator::Exponential, Integrator::Exact}) {
         CAPTURE(core::integratorName(m));
         Run run(stiff, {}, true, false, m);
@@ -287,12 +288,7 @@ TEST_CASE("a stiff decay at k·dt = 100 stays bounded and decays under exponenti
 }
 
 TEST_CASE("the stability limit is the method's: k·dt = 2.5 is beyond euler's 2, within rk4's 2.785") {
-    const char* decay = R"(
-        object d {
-            v = 1 + integrate(-150 * v);
-            point(vec3(v, 0, 0), white, 1);
-        }
-        spawn d;)";
+    std::string decay = decayAt(150);
     Run euler(decay, {}, true, false, Integrator::Euler), rk4(decay, {}, true, false, Integrator::Rk4);
     CHECK(euler.diagnostics.find("warning") != std::string::npos);
     CHECK(rk4.diagnostics.find("warning") == std::string::npos);

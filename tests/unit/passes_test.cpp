@@ -162,45 +162,28 @@ end
 )");
 }
 
+// x = integrate(-x) under the midpoint method.
+const char* kMidpointDecay = R"(object p()
+  attribute integrator midpoint
+  kernel behaviour
+    %0 = recur.f32 %2 #0  ; x
+    %1 = neg.f32 %0
+    %2 = integrate.f32 %1 #1  ; x
+    let x = %2
+    yield size = %2
+  end
+end
+)";
+
 TEST_CASE("resolve-cycles: under a Runge–Kutta method a cycle through integrate keeps its recur") {
-    // x = integrate(-x): the stages read x at their own instant, not the previous update's.
-    CHECK(after(R"(object p()
-  attribute integrator midpoint
-  kernel behaviour
-    %0 = recur.f32 %2 #0  ; x
-    %1 = neg.f32 %0
-    %2 = integrate.f32 %1 #1  ; x
-    let x = %2
-    yield size = %2
-  end
-end
-)", resolveCycles) == R"(object p()
-  attribute integrator midpoint
-  kernel behaviour
-    %0 = recur.f32 %2 #0  ; x
-    %1 = neg.f32 %0
-    %2 = integrate.f32 %1 #1  ; x
-    let x = %2
-    yield size = %2
-  end
-end
-)");
+    // The stages read x at their own instant, not the previous update's: unchanged.
+    CHECK(after(kMidpointDecay, resolveCycles) == kMidpointDecay);
 }
 
 TEST_CASE("lower-temporal: the midpoint method evaluates the derivative at the start and in the middle of the step") {
     // x = integrate(-x): k1 = -x0; x1 = x0 + (0.5 dt)·k1; k2 = -x1; x' = x0 + dt·k2; and the
     // decay rate 1 checked against the limit 2 (k·dt > 2: unstable).
-    CHECK(after(R"(object p()
-  attribute integrator midpoint
-  kernel behaviour
-    %0 = recur.f32 %2 #0  ; x
-    %1 = neg.f32 %0
-    %2 = integrate.f32 %1 #1  ; x
-    let x = %2
-    yield size = %2
-  end
-end
-)", lowerTemporalDefault) == R"(object p()
+    CHECK(after(kMidpointDecay, lowerTemporalDefault) == R"(object p()
   attribute integrator midpoint
   state integrate@x: f32 zero
   kernel behaviour
