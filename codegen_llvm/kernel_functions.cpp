@@ -332,22 +332,11 @@ public:
             if (!isInput(i.op) || (i.op == Op::DrawIndex && i.attr == 1)) continue;
             emitter[&i] = read(layout, i, readsAncestor(i.op) ? parentOrdinal++ : 0);
         }
-        // Each argument's first column: the arguments' widths in order.
-        std::map<int, int> width;
-        for (const Yield& y : spawn.yields)
-            if (y.kind == YieldKind::EmitArg) width[y.sub] = spawn.at(y.value).type.width;
+        const rt::ArgumentColumns arguments = rt::argumentColumns(spawn);
         std::vector<llvm::Value*> argColumns;
-        for (auto [sub, w] : width)
-            for (int l = 0; l < w; ++l)
-                argColumns.push_back(b_.CreateAlignedLoad(
-                    ptr, b_.CreateConstGEP1_32(ptr, fn_->getArg(kArgs), static_cast<unsigned>(argColumns.size())),
-                    llvm::Align(8)));
-        std::map<int, int> firstColumn;
-        int next = 0;
-        for (auto [sub, w] : width) {
-            firstColumn[sub] = next;
-            next += w;
-        }
+        for (size_t c = 0; c < arguments.total; ++c)
+            argColumns.push_back(b_.CreateAlignedLoad(
+                ptr, b_.CreateConstGEP1_32(ptr, fn_->getArg(kArgs), static_cast<unsigned>(c)), llvm::Align(8)));
         llvm::Value* count = fn_->getArg(kCount);
         b_.CreateCondBr(b_.CreateICmpSGT(count, b_.getInt64(0)), body, exit);
         b_.SetInsertPoint(body);
@@ -370,7 +359,7 @@ public:
             if (y.kind != YieldKind::EmitArg) continue;
             Type t = spawn.at(y.value).type;
             for (int l = 0; l < t.width; ++l) {
-                auto c = static_cast<size_t>(firstColumn[y.sub] + l);
+                size_t c = arguments.first[static_cast<size_t>(y.sub)] + static_cast<size_t>(l);
                 llvm::StoreInst* store = b_.CreateAlignedStore(toFloat(values[y.value][static_cast<size_t>(l)], t),
                                                                b_.CreateInBoundsGEP(b_.getFloatTy(), argColumns[c], target),
                                                                llvm::Align(4));

@@ -1,11 +1,12 @@
 #include "host/backends.h"
 
 #include "codegen_llvm/llvm_backend.h"
+#include "gpu/glsl_backend.h"
 #include "interp/interpreter.h"
 
 namespace psys::host {
 
-std::vector<std::string> backendNames() { return {"llvm", "interp"}; }
+std::vector<std::string> backendNames() { return {"llvm", "interp", "glsl"}; }
 
 Parsed<std::shared_ptr<rt::Backend>> makeBackend(const BackendChoice& choice) {
     using Result = Parsed<std::shared_ptr<rt::Backend>>;
@@ -16,6 +17,12 @@ Parsed<std::shared_ptr<rt::Backend>> makeBackend(const BackendChoice& choice) {
         return {std::make_shared<codegen_llvm::LlvmBackend>(mode), {}};
     }
     if (choice.name == "interp") return {std::make_shared<interp::Interpreter>(), {}};
+    if (choice.name == "glsl") {
+        std::string error;
+        std::shared_ptr<rt::Backend> gpu = gpu::GlslBackend::create(error);
+        if (!gpu) return Result::fail("the glsl backend cannot start: " + error);
+        return {gpu, {}};
+    }
     std::string names;
     for (const std::string& n : backendNames()) names += (names.empty() ? "" : ", ") + n;
     return Result::fail("there is no backend `" + choice.name + "`; the backends are " + names);

@@ -1,6 +1,7 @@
 // Choosing a backend by name: the one place the tools know which backends exist.
 //   llvm    the LLVM ORC JIT (codegen_llvm/), fast or exact maths
 //   interp  the reference interpreter (interp/)
+//   glsl    GLSL compute shaders on OpenGL 4.5 (codegen_glsl/, gpu/): a GPU, or llvmpipe
 #pragma once
 
 #include <memory>

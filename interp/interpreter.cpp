@@ -1,7 +1,5 @@
 #include "interp/interpreter.h"
 
-#include <utility>
-
 #include "rt/clock.h"
 
 namespace psys::interp {
@@ -135,14 +133,7 @@ void Interpreter::run(const rt::ChildrenLaunch& launch) {
     columns.inputs(*launch.object, *launch.layout, launch.row, params_, state_);
     const auto* created = rt::hostData<double>(memory_, launch.columns[ColumnLayout::kCreated]);
     const auto* ids = rt::hostData<uint32_t>(memory_, launch.columns[ColumnLayout::kIds]);
-    std::vector<size_t> firstColumn;  // per argument (emit.arg #sub)
-    for (const Yield& y : spawn.yields)
-        if (y.kind == YieldKind::EmitArg) {
-            if (firstColumn.size() <= static_cast<size_t>(y.sub)) firstColumn.resize(static_cast<size_t>(y.sub) + 1, 0);
-            firstColumn[static_cast<size_t>(y.sub)] = static_cast<size_t>(spawn.at(y.value).type.width);
-        }
-    size_t next = 0;
-    for (size_t& c : firstColumn) next += std::exchange(c, next);
+    const std::vector<size_t> firstColumn = rt::argumentColumns(spawn).first;
     KernelInputs in;
     in.params = params_.data();
     in.state = state_.data();

@@ -32,6 +32,22 @@ ColumnLayout columnLayout(const ir::Object& object, const ir::Kernel& kernel) {
     return l;
 }
 
+ArgumentColumns argumentColumns(const ir::Kernel& spawn) {
+    ArgumentColumns a;
+    for (const ir::Yield& y : spawn.yields)
+        if (y.kind == ir::YieldKind::EmitArg) {
+            auto sub = static_cast<size_t>(y.sub);
+            if (a.first.size() <= sub) a.first.resize(sub + 1, 0);
+            a.first[sub] = static_cast<size_t>(spawn.at(y.value).type.width);  // its width, for now
+        }
+    for (size_t& c : a.first) {
+        size_t width = c;
+        c = a.total;
+        a.total += width;
+    }
+    return a;
+}
+
 int ColumnLayout::renderColumn(ir::YieldKind kind) {
     switch (kind) {
         case ir::YieldKind::Visible: return kVisible;

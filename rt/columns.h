@@ -48,6 +48,14 @@ struct ColumnLayout {
 
 ColumnLayout columnLayout(const ir::Object& object, const ir::Kernel& kernel);
 
+// The argument columns of a spawn kernel (ChildrenLaunch::args): one per component of each
+// argument (emit.arg #sub), arguments in order. `first[sub]` is where argument sub starts.
+struct ArgumentColumns {
+    std::vector<size_t> first;
+    size_t total = 0;
+};
+ArgumentColumns argumentColumns(const ir::Kernel& spawn);
+
 // Rows per chunk when a launch over a pool is split over threads. Chunks never depend on
 // the number of threads, so every row is computed by the same code path (vector body or
 // remainder) with 1 or N threads, and results are identical.

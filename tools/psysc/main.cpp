@@ -3,6 +3,7 @@
 //   psysc check FILE…                   check and compile; exit 0 when clean, 1 on errors
 //   psysc run FILE [options]            compile and run a system (host/: the host library)
 //   psysc --emit=ast|ir FILE            print the checked AST, or the IR after the passes
+//   psysc --emit=glsl FILE              print the GLSL shaders the GPU backend runs
 //   psysc --stats FILE                  the cost of each object type, without and with the optimizer
 //
 // Exit status: 0 success, 1 errors in the input, 2 bad usage. README.md lists the options.
@@ -15,6 +16,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "codegen_glsl/glsl_shaders.h"
 #include "frontend/frontend.h"
 #include "frontend/loader.h"
 #include "ir/printer.h"
@@ -22,6 +24,7 @@
 #include "stats_command.h"
 #include "driver/compile.h"
 #include "host/backends.h"
+#include "rt/system.h"
 #include "run_command.h"
 
 namespace {
@@ -123,6 +126,18 @@ int printIr(const std::string& file, psys::CompileOptions options, bool colour) 
     return 0;
 }
 
+// `psysc --emit=glsl FILE`: every shader of the module, each after a line naming it.
+int printGlsl(const std::string& file, const psys::CompileOptions& options, bool colour) {
+    psys::SourceManager sources;
+    psys::DiagnosticEngine diags(sources);
+    auto module = psys::compileFile(file, sources, diags, options);
+    diags.print(std::cerr, colour);
+    if (!module) return 1;
+    for (const auto& shader : psys::codegen_glsl::moduleShaders(psys::rt::launchPlan(*module)))
+        std::cout << "//// " << shader.name << "\n" << shader.source << "\n";
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -134,7 +149,7 @@ int main(int argc, char** argv) {
 
     std::string emit;
     std::vector<std::string> emitFiles;
-    app.add_option("--emit", emit, "Print an intermediate form of FILE")->check(CLI::IsMember({"ast", "ir"}));
+    app.add_option("--emit", emit, "Print an intermediate form of FILE")->check(CLI::IsMember({"ast", "ir", "glsl"}));
     app.add_option("files", emitFiles, "Source file for --emit")->type_name("FILE");
     std::vector<std::string> printAfter;
     bool printAfterAll = false;
@@ -211,6 +226,7 @@ int main(int argc, char** argv) {
         options.pipeline.printAfter = {printAfter.begin(), printAfter.end()};
         options.pipeline.printAfterAll = printAfterAll;
         options.pipeline.print.locations = locations;
+        if (emit == "glsl") return printGlsl(emitFiles[0], options, colour);
         return printIr(emitFiles[0], options, colour);
     }
     std::cerr << app.help();

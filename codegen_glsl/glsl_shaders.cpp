@@ -1,0 +1,348 @@
+#include "codegen_glsl/glsl_shaders.h"
+
+#include <fmt/format.h>
+
+#include "codegen_glsl/glsl_body.h"
+
+namespace psys::codegen_glsl {
+
+using namespace ir;
+using rt::ColumnLayout;
+
+namespace {
+
+uint32_t align4(uint32_t words) { return (words + 3u) & ~3u; }
+
+// Values after the columns, 4 words each.
+LaunchBlock valuesAfterColumns(LaunchBlock b, uint32_t externs, uint32_t uniforms, uint32_t params, uint32_t state,
+                               uint32_t parents) {
+    b.externCount = externs;
+    b.uniformCount = uniforms;
+    b.externs = align4(LaunchBlock::kColumns + b.columns);
+    b.uniforms = b.externs + 4 * externs;
+    b.params = b.uniforms + 4 * uniforms;
+    b.state = b.params + 4 * params;
+    b.parents = b.state + 4 * state;
+    b.words = b.parents + 4 * parents;
+    return b;
+}
+
+// How many of the values `op` reads (externs, uniforms) the kernel needs: up to the last it reads.
+uint32_t valuesRead(const Kernel* kernel, Op op) {
+    uint32_t n = 0;
+    if (kernel)
+        for (const Inst& i : kernel->insts())
+            if (i.op == op) n = std::max(n, static_cast<uint32_t>(i.attr) + 1);
+    return n;
+}
+uint32_t uniformValues(const Kernel& kernel) { return valuesRead(&kernel, Op::Uniform); }
+
+// What every compute shader starts with: the bindings, the accessors and the helpers
+// that give GLSL built-ins core/lanes.h's results where GLSL leaves them undefined.
+std::string preamble(const std::string& comment, uint32_t blockWords) {
+    return fmt::format(R"(#version 450
+// {0}
+layout(local_size_x = {1}) in;
+layout(std430, binding = 0) buffer Words {{ uint w[]; }};
+layout(std430, binding = 1) buffer Counts {{ uint counts[]; }};
+layout(std140, binding = 0) uniform Launch {{ uvec4 L[{2}]; }};
+
+uint lw(uint k) {{ return L[k >> 2u][k & 3u]; }}
+float lf(uint k) {{ return uintBitsToFloat(lw(k)); }}
+double ld(uint k) {{ return packDouble2x32(uvec2(lw(k), lw(k + 1u))); }}
+vec4 lv(uint k) {{ return uintBitsToFloat(L[k >> 2u]); }}
+uint col(uint c) {{ return lw({3}u + c); }}
+float cf(uint c, uint i) {{ return uintBitsToFloat(w[col(c) + i]); }}
+uint cu(uint c, uint i) {{ return w[col(c) + i]; }}
+double cd(uint c, uint i) {{ uint o = col(c) + 2u * i; return packDouble2x32(uvec2(w[o], w[o + 1u])); }}
+void sf(uint c, uint i, float x) {{ w[col(c) + i] = floatBitsToUint(x); }}
+void su(uint c, uint i, uint x) {{ w[col(c) + i] = x; }}
+
+#define psys_nan uintBitsToFloat(0x7fc00000u)
+#define psys_inf uintBitsToFloat(0x7f800000u)
+float psys_sign(float x) {{ return x > 0.0 ? 1.0 : x < 0.0 ? -1.0 : 0.0; }}
+float psys_sqrt(float x) {{ return x < 0.0 ? psys_nan : sqrt(x); }}
+float psys_log(float x) {{ return x < 0.0 ? psys_nan : x == 0.0 ? -psys_inf : log(x); }}
+float psys_asin(float x) {{ return abs(x) > 1.0 ? psys_nan : asin(x); }}
+float psys_acos(float x) {{ return abs(x) > 1.0 ? psys_nan : acos(x); }}
+float psys_atan2(float y, float x) {{
+    if (x == 0.0 && y == 0.0)  // C's atan2 of zeros: ±0, or ±π when x is −0
+        return (floatBitsToUint(x) >> 31) != 0u ? ((floatBitsToUint(y) >> 31) != 0u ? -3.14159265 : 3.14159265) : y;
+    return atan(y, x);
+}}
+float psys_pow(float x, float y) {{  // C's pow: defined for every base
+    if (y == 0.0 || x == 1.0) return 1.0;
+    if (isnan(x) || isnan(y)) return psys_nan;
+    bool integer = floor(y) == y;
+    bool odd = integer && abs(y) < 16777216.0 && mod(abs(y), 2.0) == 1.0;
+    if (x == 0.0) return y < 0.0 ? (odd ? 1.0 / x : psys_inf) : (odd ? x : 0.0);
+    if (isinf(y)) return abs(x) == 1.0 ? 1.0 : (abs(x) > 1.0) == (y > 0.0) ? psys_inf : 0.0;
+    if (x < 0.0) {{
+        if (!integer) return psys_nan;
+        float r = isinf(x) ? (y < 0.0 ? 0.0 : psys_inf) : pow(-x, y);
+        return odd ? -r : r;
+    }}
+    if (isinf(x)) return y < 0.0 ? 0.0 : psys_inf;
+    return pow(x, y);
+}}
+
+)",
+                       comment, kWorkGroupSize, align4(blockWords) / 4, LaunchBlock::kColumns);
+}
+
+const char* kIndex =
+    "    uint i = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + "
+    "gl_LocalInvocationID.x;\n"
+    "    if (i >= lw(0u)) return;\n";
+
+// A value of `width` floats at block word `word`.
+std::string blockValue(uint32_t word, Type type) {
+    std::string v = fmt::format("lv({}u)", word);
+    if (type.isBool()) return v + ".x != 0.0";
+    if (type.width == 1) return v + ".x";
+    return type.width == 4 ? v : v + "." + std::string("xyzw").substr(0, type.width);
+}
+
+// A value of `width` float columns from `column` on, at row `row`.
+std::string columnsValue(int column, Type type, const std::string& row) {
+    if (type.isBool()) return fmt::format("cf({}u, {}) != 0.0", column, row);
+    if (type.width == 1) return fmt::format("cf({}u, {})", column, row);
+    std::string s = fmt::format("vec{}(", type.width);
+    for (int c = 0; c < type.width; ++c) s += fmt::format("{}cf({}u, {})", c ? ", " : "", column + c, row);
+    return s + ")";
+}
+
+std::string lane(const std::string& value, int width, int c) {
+    return width == 1 ? value : value + "." + "xyzw"[c];
+}
+
+void storeColumns(Statements& out, int column, int width, const std::string& value) {
+    for (int c = 0; c < width; ++c) out.line(fmt::format("sf({}u, i, {});", column + c, lane(value, width, c)));
+}
+
+// The shader's clock: now, dt, time, first and the row's age.
+struct ClockNames {
+    std::string now, dt, time, first, age;
+};
+
+ClockNames emitClock(Statements& out, rt::Clock::Source now, rt::Clock::Source dt, bool perRowCreated) {
+    using S = rt::Clock::Source;
+    ClockNames c;
+    c.now = out.define("now", "double", now == S::PerRow ? fmt::format("cd({}u, i)", ColumnLayout::kNow)
+                                                : fmt::format("ld({}u)", LaunchBlock::kNow));
+    c.dt = out.define("dt", "float", dt == S::PerRow ? fmt::format("cf({}u, i)", ColumnLayout::kDt)
+                                             : fmt::format("lf({}u)", LaunchBlock::kDt), true);
+    c.time = out.define("time", "float", "float(" + c.now + ")", true);
+    c.first = out.define("first", "bool", fmt::format("lw({}u) != 0u", LaunchBlock::kFirst));
+    std::string created = perRowCreated ? fmt::format("cd({}u, i)", ColumnLayout::kCreated)
+                                        : fmt::format("ld({}u)", LaunchBlock::kCreated);
+    c.age = out.define("age", "float", emitAge(out, c.now, created), true);
+    return c;
+}
+
+// The rows kernel's uniform kernel, evaluated in the shader for this row's clock.
+std::vector<std::string> inlineUniforms(Statements& out, const Kernel& uniform,
+                                        const ClockNames& clock, const LaunchBlock& block) {
+    Statements body("ut");
+    auto leaf = [&](const Inst& inst, int) -> std::string {
+        switch (inst.op) {
+            case Op::Dt: return clock.dt;
+            case Op::Time: return clock.time;
+            case Op::Extern: return blockValue(block.externs + 4 * static_cast<uint32_t>(inst.attr), inst.type);
+            case Op::DrawIndex: case Op::ObjectId: return "0u";
+            case Op::First: return "false";
+            default: return inst.type.isBool() ? "false" : inst.type.kind == Type::Kind::U32 ? "0u" : glslType(inst.type) + "(0.0)";
+        }
+    };
+    std::vector<std::string> names = emitBody(body, uniform, fmt::format("lw({}u)", LaunchBlock::kSeed), leaf, "u");
+    out.line("// the uniform kernel, at this row's clock");
+    out.append(body.text());
+    std::vector<std::string> values(uniformValues(uniform));
+    for (const Yield& y : uniform.yields) {
+        if (values.size() <= static_cast<size_t>(y.index)) values.resize(static_cast<size_t>(y.index) + 1);
+        values[static_cast<size_t>(y.index)] = names[y.value];
+    }
+    return values;
+}
+
+void storeRowsYields(Statements& out, const Kernel& kernel, const ColumnLayout& l, const std::vector<std::string>& v) {
+    for (const Yield& y : kernel.yields) {
+        const std::string& value = v[y.value];
+        int width = kernel.at(y.value).type.width;
+        switch (y.kind) {
+            case YieldKind::StateNext: storeColumns(out, l.stateOffset[static_cast<size_t>(y.index)], width, value); break;
+            case YieldKind::Export: storeColumns(out, l.exportOffset[static_cast<size_t>(y.index)], width, value); break;
+            case YieldKind::Kill:
+                out.line(fmt::format("su({}u, i, {} ? 1u : 0u);", ColumnLayout::kKill, value));
+                out.line(fmt::format("if ({}) atomicAdd(counts[0], 1u);", value));
+                break;
+            case YieldKind::Unstable: out.line(fmt::format("if ({}) atomicAdd(counts[1], 1u);", value)); break;
+            case YieldKind::EmitRate: storeColumns(out, l.emitRate(y.index), 1, value); break;
+            case YieldKind::EmitCount: storeColumns(out, l.emitCount(y.index), 1, value); break;
+            case YieldKind::Visible:
+                storeColumns(out, l.render + ColumnLayout::kVisible, 1, value + " ? 1.0 : 0.0");
+                break;
+            case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:
+                storeColumns(out, l.render + ColumnLayout::renderColumn(y.kind), width, value);
+                break;
+            default: break;
+        }
+    }
+}
+
+const char* clockName(rt::Clock::Source s) { return s == rt::Clock::Source::PerRow ? "per row" : "uniform"; }
+
+}  // namespace
+
+LaunchBlock rowsBlock(const Kernel& kernel, const Kernel* uniform, const ColumnLayout& layout) {
+    LaunchBlock b;
+    b.columns = static_cast<uint32_t>(layout.total) + 1;  // the mask last
+    uint32_t externs = std::max(valuesRead(&kernel, Op::Extern), valuesRead(uniform, Op::Extern));
+    return valuesAfterColumns(b, externs, uniformValues(kernel), 0, 0, 0);
+}
+
+LaunchBlock childrenBlock(const Object& object, const Kernel& spawn, const ColumnLayout& layout) {
+    LaunchBlock b;
+    b.columns = static_cast<uint32_t>(rt::argumentColumns(spawn).total);
+    return valuesAfterColumns(b, valuesRead(&spawn, Op::Extern), 0, static_cast<uint32_t>(object.params.size()),
+                              static_cast<uint32_t>(object.state.size()),
+                              static_cast<uint32_t>(layout.parentColumns.size()));
+}
+
+std::string rowsShader(const Object& object, const Kernel& kernel, rt::Clock::Source now, rt::Clock::Source dt,
+                       const Kernel* uniform) {
+    ColumnLayout l = rt::columnLayout(object, kernel);
+    LaunchBlock block = rowsBlock(kernel, uniform, l);
+    std::string text = preamble(fmt::format("object `{}`, kernel `{}`, clock: now {}, dt {}", object.name,
+                                            kernelName(kernel.kind), clockName(now), clockName(dt)),
+                                block.words);
+    Statements out("t");
+    bool kills = kernel.findOne(YieldKind::Kill) != nullptr;
+    if (kills) out.line(fmt::format("su({}u, i, 0u);", ColumnLayout::kKill));
+    out.line(fmt::format("if (cu({}u, i) == 0u) return;  // masked out", l.total));
+    ClockNames clock = emitClock(out, now, dt, true);
+    bool perRow = now == rt::Clock::Source::PerRow || dt == rt::Clock::Source::PerRow;
+    std::vector<std::string> uniforms;
+    if (perRow && uniform) uniforms = inlineUniforms(out, *uniform, clock, block);
+    const Kernel& k = kernel;
+    auto leaf = [&](const Inst& inst, int parentOrdinal) -> std::string {
+        switch (inst.op) {
+            case Op::Param: return columnsValue(l.paramOffset[static_cast<size_t>(inst.attr)], inst.type, "i");
+            case Op::StateRead: return columnsValue(l.stateOffset[static_cast<size_t>(inst.attr)], inst.type, "i");
+            case Op::Extern: return blockValue(block.externs + 4 * static_cast<uint32_t>(inst.attr), inst.type);
+            case Op::Uniform:
+                if (!uniforms.empty()) return uniforms.at(static_cast<size_t>(inst.attr));
+                return blockValue(block.uniforms + 4 * static_cast<uint32_t>(inst.attr), inst.type);
+            case Op::Age: return clock.age;
+            case Op::Dt: return clock.dt;
+            case Op::Time: return clock.time;
+            case Op::First: return clock.first;
+            case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge:
+                return columnsValue(l.parentColumns.at(static_cast<size_t>(parentOrdinal)).offset, inst.type, "i");
+            case Op::ObjectId: return fmt::format("cu({}u, i)", ColumnLayout::kIds);
+            case Op::DrawIndex: return fmt::format("lw({}u)", LaunchBlock::kDraw);
+            default: return glslType(inst.type) + "(0)";
+        }
+    };
+    std::vector<std::string> values = emitBody(out, k, fmt::format("lw({}u)", LaunchBlock::kSeed), leaf);
+    storeRowsYields(out, k, l, values);
+    return text + "void main() {\n" + kIndex + out.text() + "}\n";
+}
+
+std::string childrenShader(const Object& object, const Kernel& spawn) {
+    ColumnLayout l = rt::columnLayout(object, spawn);
+    LaunchBlock block = childrenBlock(object, spawn, l);
+    std::string text = preamble(fmt::format("object `{}`, kernel `spawn.{}` (creates `{}`): one invocation per child",
+                                            object.name, spawn.site,
+                                            object.emits.at(static_cast<size_t>(spawn.site)).target),
+                                block.words);
+    Statements out("t");
+    using S = rt::Clock::Source;
+    ClockNames clock = emitClock(out, S::Uniform, S::Uniform, false);
+    auto leaf = [&](const Inst& inst, int parentOrdinal) -> std::string {
+        switch (inst.op) {
+            case Op::Param: return blockValue(block.params + 4 * static_cast<uint32_t>(inst.attr), inst.type);
+            case Op::StateRead: return blockValue(block.state + 4 * static_cast<uint32_t>(inst.attr), inst.type);
+            case Op::Extern: return blockValue(block.externs + 4 * static_cast<uint32_t>(inst.attr), inst.type);
+            case Op::Age: return clock.age;
+            case Op::Dt: return clock.dt;
+            case Op::Time: return clock.time;
+            case Op::First: return clock.first;
+            case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge:
+                return blockValue(block.parents + 4 * static_cast<uint32_t>(parentOrdinal), inst.type);
+            case Op::ObjectId: return fmt::format("lw({}u)", LaunchBlock::kObjectId);
+            case Op::DrawIndex:
+                return inst.attr == 1 ? fmt::format("lw({}u) + i", LaunchBlock::kFirstChild)
+                                      : fmt::format("lw({}u)", LaunchBlock::kDraw);
+            default: return glslType(inst.type) + "(0)";
+        }
+    };
+    std::vector<std::string> values = emitBody(out, spawn, fmt::format("lw({}u)", LaunchBlock::kSeed), leaf);
+    std::vector<size_t> first = rt::argumentColumns(spawn).first;
+    for (const Yield& y : spawn.yields)
+        if (y.kind == YieldKind::EmitArg)
+            storeColumns(out, static_cast<int>(first[static_cast<size_t>(y.sub)]), spawn.at(y.value).type.width,
+                         values[y.value]);
+    return text + "void main() {\n" + kIndex + out.text() + "}\n";
+}
+
+std::string drawVertexShader() {
+    return R"(#version 450
+// draw: one point per row of a type's render columns (DrawColumns), read straight from
+// the words of the columns; rows that are not visible give no pixels.
+layout(std430, binding = 0) readonly buffer Words { uint w[]; };
+uniform uint columns[9];  // first words of visible, x, y, z, r, g, b, a, size
+uniform mat4 view;
+uniform mat4 projection;
+uniform float reference;  // pixels per unit of size at depth 1
+out vec4 colour;
+float column(int c) { return uintBitsToFloat(w[columns[c] + uint(gl_VertexID)]); }
+void main() {
+    if (column(0) == 0.0) {
+        gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
+        gl_PointSize = 0.0;
+        colour = vec4(0.0);
+        return;
+    }
+    vec4 eye = view * vec4(column(1), column(2), column(3), 1.0);
+    gl_Position = projection * eye;
+    gl_PointSize = clamp(column(8) * reference / max(-eye.z, 1e-3), 1.0, 256.0);
+    colour = vec4(column(4), column(5), column(6), column(7));
+}
+)";
+}
+
+std::string drawFragmentShader() {
+    return R"(#version 450
+// draw: a round point with a soft rim
+in vec4 colour;
+out vec4 fragment;
+void main() {
+    vec2 d = gl_PointCoord * 2.0 - 1.0;
+    float r2 = dot(d, d);
+    if (r2 > 1.0) discard;
+    float edge = 1.0 - smoothstep(0.4, 1.0, r2);
+    fragment = vec4(colour.rgb, colour.a * edge);
+}
+)";
+}
+
+std::vector<NamedShader> moduleShaders(const rt::Plan& plan) {
+    std::vector<NamedShader> shaders;
+    using S = rt::Clock::Source;
+    for (const rt::Plan::Rows& r : plan.rows) {
+        auto served = uniformFor(r.kernel->kind);
+        const Kernel* uniform = served ? r.object->kernel(*served) : nullptr;
+        std::string clock = r.now == S::PerRow ? "per_row" : "uniform";
+        shaders.push_back({fmt::format("{}.{}.{}.comp", r.object->name, kernelName(r.kernel->kind), clock),
+                           rowsShader(*r.object, *r.kernel, r.now, r.dt, uniform)});
+    }
+    for (const rt::Plan::Children& c : plan.children)
+        shaders.push_back({fmt::format("{}.spawn{}.comp", c.object->name, c.spawn->site),
+                           childrenShader(*c.object, *c.spawn)});
+    shaders.push_back({"draw.vert", drawVertexShader()});
+    shaders.push_back({"draw.frag", drawFragmentShader()});
+    return shaders;
+}
+
+}  // namespace psys::codegen_glsl

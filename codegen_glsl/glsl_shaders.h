@@ -1,0 +1,75 @@
+// GLSL 4.50 shaders for a system's launches (rt/backend.h), from the same optimized IR
+// kernels the CPU backends get.
+//
+// Interface of every compute shader (what a GPU backend binds):
+//   binding 0, SSBO `Words`   uint w[]: every column of the launch, 32-bit words; a column
+//                             holds one word per row (f32 as bits; u32; u8 widened to a
+//                             word) or two (f64, low word first). Where column c's rows
+//                             start is a word of the launch block.
+//   binding 1, SSBO `Counts`  uint counts[2]: rows killed, rows unstable (atomic adds of
+//                             one per row: a sum, the same whatever the order).
+//   binding 0, UBO  `Launch`  uvec4 L[]: the launch block (LaunchBlock): row count, clock,
+//                             seed, draw, column offsets, externs and uniform values.
+// One invocation per row, 64 to a work group, work groups in x then y (a grid of up to
+// 65535 × 65535 groups).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "ir/ir.h"
+#include "rt/backend.h"
+#include "rt/columns.h"
+
+namespace psys::codegen_glsl {
+
+// Where each input sits in the launch block, in 32-bit words. Values (externs, uniforms,
+// the emitter's parameters, state and parent reads) take 4 words each, 16-byte aligned.
+struct LaunchBlock {
+    static constexpr uint32_t kCount = 0;       // rows (children) in the launch
+    static constexpr uint32_t kNow = 2;         // f64: now, for a uniform clock
+    static constexpr uint32_t kDt = 4;          // f32: dt, for a uniform clock
+    static constexpr uint32_t kFirst = 5;       // 1 while the rows are being created
+    static constexpr uint32_t kSeed = 6;
+    static constexpr uint32_t kDraw = 7;        // draw.index #0
+    static constexpr uint32_t kFirstChild = 8;  // children: draw.index #1 of the first child
+    static constexpr uint32_t kCreated = 10;    // children: f64, the emitter's creation time
+    static constexpr uint32_t kObjectId = 12;   // children: the emitter's id
+    static constexpr uint32_t kColumns = 16;    // the columns' first words
+    uint32_t columns = 0;  // how many: rows launches, the layout's columns and then the mask;
+                           // children launches, one per component of the arguments
+    uint32_t externs = 0, uniforms = 0, params = 0, state = 0, parents = 0;  // first words
+    uint32_t externCount = 0, uniformCount = 0;
+    uint32_t words = 0;                                                      // in all
+};
+
+constexpr uint32_t kWorkGroupSize = 64;
+constexpr uint32_t kMaxGroupsX = 65535;
+
+// The blocks hold the externs the kernels read (the first `externs` of the module's).
+LaunchBlock rowsBlock(const ir::Kernel& kernel, const ir::Kernel* uniform, const rt::ColumnLayout& layout);
+LaunchBlock childrenBlock(const ir::Object& object, const ir::Kernel& spawn, const rt::ColumnLayout& layout);
+
+// A compute shader running `kernel` over rows (init, update, exports, render), for the
+// clock sources a launch plan names. `uniform` is the kernel's uniform kernel, evaluated
+// in the shader for each row where the clock is per row (else its values come in the block).
+std::string rowsShader(const ir::Object& object, const ir::Kernel& kernel, rt::Clock::Source now,
+                       rt::Clock::Source dt, const ir::Kernel* uniform);
+// A compute shader running a spawn kernel once per child of one emitter.
+std::string childrenShader(const ir::Object& object, const ir::Kernel& spawn);
+
+// The vertex and fragment shaders that draw points straight from render columns
+// (visible, x y z, r g b a, size: DrawColumns), one vertex per row.
+std::string drawVertexShader();
+std::string drawFragmentShader();
+
+// Every shader of a module, named and commented (`psysc --emit=glsl`): one per launch
+// shape of its plan (rt::launchPlan), then the draw pair.
+struct NamedShader {
+    std::string name;   // "fountain.update.uniform.comp", …: the extension is the stage
+    std::string source;
+};
+std::vector<NamedShader> moduleShaders(const rt::Plan& plan);
+
+}  // namespace psys::codegen_glsl

@@ -1,0 +1,34 @@
+// An OpenGL 4.5 core context without a window: EGL's surfaceless platform (Mesa's
+// llvmpipe renders it on the CPU where there is no GPU; the NVIDIA driver's EGL on a GPU
+// machine). The GPU backend computes in one when no context is current; the viewer draws
+// offscreen into one.
+#pragma once
+
+#include <memory>
+#include <string>
+
+namespace psys::gpu {
+
+class HeadlessContext {
+public:
+    // Null, and `error` set, when no such context can be made.
+    static std::unique_ptr<HeadlessContext> open(std::string& error);
+    ~HeadlessContext();
+    HeadlessContext(const HeadlessContext&) = delete;
+    HeadlessContext& operator=(const HeadlessContext&) = delete;
+    // Makes it the calling thread's current context.
+    bool makeCurrent();
+
+private:
+    HeadlessContext() = default;
+    void* display_ = nullptr;
+    void* context_ = nullptr;
+};
+
+// Whether the calling thread has a current EGL context (the viewer's, for one).
+bool contextCurrent();
+
+// "llvmpipe (LLVM 15.0.6, 256 bits), OpenGL 4.5 (Core Profile) Mesa 22.3.6", …
+std::string rendererName();
+
+}  // namespace psys::gpu

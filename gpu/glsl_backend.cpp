@@ -1,0 +1,373 @@
+#include "gpu/glsl_backend.h"
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cstring>
+#include <stdexcept>
+
+#include <epoxy/gl.h>
+#include <fmt/format.h>
+
+#include "codegen_glsl/glsl_shaders.h"
+#include "gpu/gl_context.h"
+
+namespace psys::gpu {
+
+using codegen_glsl::LaunchBlock;
+using rt::Buffer;
+using rt::ColumnLayout;
+using rt::Elem;
+
+struct GlslBackend::Program {
+    GLuint program = 0;
+    LaunchBlock block;
+    ColumnLayout layout;
+    std::vector<int> written;  // the table columns the kernel writes
+    std::string pass;          // "update", "spawn", …: what timer queries add up under
+};
+
+namespace {
+
+uint32_t bits(float x) { return std::bit_cast<uint32_t>(x); }
+
+void putDouble(std::vector<uint32_t>& block, uint32_t word, double x) {
+    auto b = std::bit_cast<uint64_t>(x);
+    block[word] = static_cast<uint32_t>(b);
+    block[word + 1] = static_cast<uint32_t>(b >> 32);
+}
+
+void putValue(std::vector<uint32_t>& block, uint32_t word, const rt::Value& v) {
+    for (size_t c = 0; c < 4; ++c) block[word + c] = bits(v.f[c]);
+}
+
+uint32_t wordsPerRow(Elem e) { return e == Elem::F64 ? 2 : 1; }
+
+// Host rows to words (u8 widened to a word) and back.
+void toWords(const void* from, Elem e, size_t rows, uint32_t* to) {
+    if (e == Elem::U8) {
+        const auto* b = static_cast<const uint8_t*>(from);
+        for (size_t r = 0; r < rows; ++r) to[r] = b[r];
+    } else {
+        std::memcpy(to, from, rows * rt::elemSize(e));
+    }
+}
+
+void fromWords(const uint32_t* from, Elem e, size_t rows, void* to) {
+    if (e == Elem::U8) {
+        auto* b = static_cast<uint8_t*>(to);
+        for (size_t r = 0; r < rows; ++r) b[r] = static_cast<uint8_t>(from[r]);
+    } else {
+        std::memcpy(to, from, rows * rt::elemSize(e));
+    }
+}
+
+std::vector<int> writtenColumns(const ir::Kernel& kernel, const ColumnLayout& l) {
+    std::vector<int> cols;
+    auto range = [&cols](int first, int width) {
+        for (int c = 0; c < width; ++c) cols.push_back(first + c);
+    };
+    for (const ir::Yield& y : kernel.yields) {
+        int width = kernel.at(y.value).type.width;
+        switch (y.kind) {
+            case ir::YieldKind::StateNext: range(l.stateOffset[static_cast<size_t>(y.index)], width); break;
+            case ir::YieldKind::Export: range(l.exportOffset[static_cast<size_t>(y.index)], width); break;
+            case ir::YieldKind::Kill: cols.push_back(ColumnLayout::kKill); break;
+            case ir::YieldKind::EmitRate: cols.push_back(l.emitRate(y.index)); break;
+            case ir::YieldKind::EmitCount: cols.push_back(l.emitCount(y.index)); break;
+            case ir::YieldKind::Visible: cols.push_back(l.render + ColumnLayout::kVisible); break;
+            case ir::YieldKind::Position: case ir::YieldKind::Color: case ir::YieldKind::Size:
+                range(l.render + ColumnLayout::renderColumn(y.kind), width);
+                break;
+            default: break;
+        }
+    }
+    std::sort(cols.begin(), cols.end());
+    cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
+    return cols;
+}
+
+const ir::Kernel* uniformKernelOf(const ir::Object& object, const ir::Kernel& kernel) {
+    auto served = ir::uniformFor(kernel.kind);
+    return served ? object.kernel(*served) : nullptr;
+}
+
+}  // namespace
+
+std::unique_ptr<GlslBackend> GlslBackend::create(std::string& error) {
+    std::unique_ptr<GlslBackend> b(new GlslBackend);
+    if (!contextCurrent()) {
+        b->context_ = HeadlessContext::open(error);
+        if (!b->context_) return nullptr;
+    }
+    if (epoxy_gl_version() < 45) {
+        error = "the GLSL backend needs OpenGL 4.5; this context has " + rendererName();
+        return nullptr;
+    }
+    GLint64 maxBlock = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBlock);
+    b->maxWords_ = static_cast<size_t>(std::min<GLint64>(maxBlock, GLint64{1} << 31)) / 4;
+    b->renderer_ = rendererName();
+    glCreateBuffers(1, &b->words_);
+    glCreateBuffers(1, &b->counts_);
+    glCreateBuffers(1, &b->block_);
+    glNamedBufferData(b->counts_, 2 * sizeof(uint32_t), nullptr, GL_DYNAMIC_READ);
+    glCreateQueries(GL_TIME_ELAPSED, 1, &b->query_);
+    return b;
+}
+
+GlslBackend::~GlslBackend() {
+    if (context_) context_->makeCurrent();
+    for (auto& [key, p] : rows_) glDeleteProgram(p->program);
+    for (auto& [key, p] : children_) glDeleteProgram(p->program);
+    GLuint buffers[] = {words_, counts_, block_};
+    glDeleteBuffers(3, buffers);
+    glDeleteQueries(1, &query_);
+}
+
+GlslBackend::Program GlslBackend::compile(const std::string& source, const std::string& what) {
+    auto start = std::chrono::steady_clock::now();
+    GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
+    const char* text = source.c_str();
+    glShaderSource(shader, 1, &text, nullptr);
+    glCompileShader(shader);
+    GLint ok = 0;
+    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    auto log = [](GLuint object, bool isProgram) {
+        GLint length = 0;
+        isProgram ? glGetProgramiv(object, GL_INFO_LOG_LENGTH, &length) : glGetShaderiv(object, GL_INFO_LOG_LENGTH, &length);
+        std::string text(static_cast<size_t>(std::max(length, 1)), '\0');
+        isProgram ? glGetProgramInfoLog(object, length, nullptr, text.data())
+                  : glGetShaderInfoLog(object, length, nullptr, text.data());
+        return text;
+    };
+    if (!ok) {
+        std::string message = log(shader, false);
+        glDeleteShader(shader);
+        throw std::runtime_error("the GL did not compile the shader of " + what + ":\n" + message);
+    }
+    Program p;
+    p.program = glCreateProgram();
+    glAttachShader(p.program, shader);
+    glLinkProgram(p.program);
+    glDeleteShader(shader);
+    glGetProgramiv(p.program, GL_LINK_STATUS, &ok);
+    if (!ok) throw std::runtime_error("the GL did not link the shader of " + what + ":\n" + log(p.program, true));
+    ++kernels_;
+    compileSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return p;
+}
+
+GlslBackend::Program& GlslBackend::rowsProgram(const ir::Object& object, const ir::Kernel& kernel,
+                                               rt::Clock::Source now, rt::Clock::Source dt) {
+    auto& slot = rows_[{&kernel, now, dt}];
+    if (!slot) {
+        const ir::Kernel* uniform = uniformKernelOf(object, kernel);
+        auto p = std::make_unique<Program>(compile(codegen_glsl::rowsShader(object, kernel, now, dt, uniform),
+                                                   object.name + "." + ir::kernelName(kernel.kind)));
+        p->layout = rt::columnLayout(object, kernel);
+        p->block = codegen_glsl::rowsBlock(kernel, uniform, p->layout);
+        p->written = writtenColumns(kernel, p->layout);
+        p->pass = ir::kernelName(kernel.kind);
+        slot = std::move(p);
+    }
+    return *slot;
+}
+
+GlslBackend::Program& GlslBackend::childrenProgram(const ir::Object& object, const ir::Kernel& spawn) {
+    auto& slot = children_[&spawn];
+    if (!slot) {
+        auto p = std::make_unique<Program>(
+            compile(codegen_glsl::childrenShader(object, spawn), object.name + ".spawn" + std::to_string(spawn.site)));
+        p->layout = rt::columnLayout(object, spawn);
+        p->block = codegen_glsl::childrenBlock(object, spawn, p->layout);
+        p->pass = "spawn";
+        slot = std::move(p);
+    }
+    return *slot;
+}
+
+void GlslBackend::prepare(const rt::Plan& plan) {
+    if (context_) context_->makeCurrent();
+    for (const auto& r : plan.rows) rowsProgram(*r.object, *r.kernel, r.now, r.dt);
+    for (const auto& c : plan.children) childrenProgram(*c.object, *c.spawn);
+}
+
+void GlslBackend::forget(const ir::Module& module) {
+    for (const ir::Object& o : module.objects)
+        for (const ir::Kernel& k : o.kernels) {
+            for (auto it = rows_.begin(); it != rows_.end();)
+                if (std::get<0>(it->first) == &k) {
+                    glDeleteProgram(it->second->program);
+                    it = rows_.erase(it);
+                } else {
+                    ++it;
+                }
+            if (auto it = children_.find(&k); it != children_.end()) {
+                glDeleteProgram(it->second->program);
+                children_.erase(it);
+            }
+        }
+}
+
+void GlslBackend::ensureWords(size_t words) {
+    if (words <= wordsCapacity_) return;
+    wordsCapacity_ = std::max(words, wordsCapacity_ * 2);
+    glNamedBufferData(words_, static_cast<GLsizeiptr>(wordsCapacity_ * 4), nullptr, GL_DYNAMIC_COPY);
+}
+
+std::pair<uint32_t, uint32_t> GlslBackend::dispatch(Program& program, const std::vector<uint32_t>& block, size_t count,
+                                                    const std::string& pass) {
+    uint32_t zero[2] = {0, 0};
+    glNamedBufferSubData(counts_, 0, sizeof zero, zero);
+    glNamedBufferData(block_, static_cast<GLsizeiptr>(block.size() * 4), block.data(), GL_STREAM_DRAW);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, words_);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, counts_);
+    glBindBufferBase(GL_UNIFORM_BUFFER, 0, block_);
+    glUseProgram(program.program);
+    size_t groups = (count + codegen_glsl::kWorkGroupSize - 1) / codegen_glsl::kWorkGroupSize;
+    size_t x = std::min<size_t>(groups, codegen_glsl::kMaxGroupsX);
+    size_t y = (groups + x - 1) / x;
+    if (timing_) glBeginQuery(GL_TIME_ELAPSED, query_);
+    glDispatchCompute(static_cast<GLuint>(x), static_cast<GLuint>(y), 1);
+    if (timing_) {
+        glEndQuery(GL_TIME_ELAPSED);
+        GLuint64 ns = 0;
+        glGetQueryObjectui64v(query_, GL_QUERY_RESULT, &ns);
+        PassTime& t = passTimes_[pass];
+        t.milliseconds += static_cast<double>(ns) * 1e-6;
+        t.launches += 1;
+        t.rows += count;
+    }
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    uint32_t counts[2] = {0, 0};
+    glGetNamedBufferSubData(counts_, 0, sizeof counts, counts);
+    return {counts[0], counts[1]};
+}
+
+rt::RowsResult GlslBackend::run(const rt::RowsLaunch& launch) {
+    if (context_) context_->makeCurrent();
+    Program& p = rowsProgram(*launch.object, *launch.kernel, launch.clock.now, launch.clock.dt);
+    // Rows per dispatch: as many as the largest storage block the GL binds holds.
+    size_t perRow = 0;
+    for (int c = 0; c < p.layout.total; ++c) {
+        Buffer b = launch.columns[static_cast<size_t>(c)];
+        perRow += b.valid() ? wordsPerRow(memory_.elem(b)) : 1;
+    }
+    size_t rows = std::max<size_t>(1, maxWords_ / (perRow + 1));
+    rt::RowsResult result;
+    for (size_t begin = launch.begin; begin < launch.end; begin += rows) {
+        rt::RowsResult r = runRows(launch, p, begin, std::min(launch.end, begin + rows));
+        result.killed += r.killed;
+        result.unstable += r.unstable;
+    }
+    return result;
+}
+
+rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, size_t begin, size_t end) {
+    size_t n = end - begin;
+    if (n == 0) return {};
+    // Each distinct buffer of the table once (the mask last), a column of zeros for the
+    // columns the table has no buffer for (parameters the pool does not keep).
+    struct Slot {
+        Buffer buffer;
+        size_t word;
+    };
+    std::vector<Slot> slots;
+    std::vector<uint32_t> block(p.block.words + 4, 0);
+    size_t words = n;  // the zeros first
+    auto place = [&](Buffer b) -> size_t {
+        if (!b.valid()) return 0;
+        for (const Slot& s : slots)
+            if (s.buffer == b) return s.word;
+        slots.push_back({b, words});
+        words += n * wordsPerRow(memory_.elem(b));
+        return slots.back().word;
+    };
+    for (int c = 0; c < p.layout.total; ++c)
+        block[LaunchBlock::kColumns + static_cast<size_t>(c)] = static_cast<uint32_t>(place(launch.columns[static_cast<size_t>(c)]));
+    block[LaunchBlock::kColumns + static_cast<size_t>(p.layout.total)] = static_cast<uint32_t>(place(launch.mask));
+    staging_.assign(words, 0);
+    for (const Slot& s : slots) {
+        Elem e = memory_.elem(s.buffer);
+        toWords(static_cast<const char*>(memory_.host(s.buffer)) + begin * rt::elemSize(e), e, n, &staging_[s.word]);
+    }
+    ensureWords(words);
+    glNamedBufferSubData(words_, 0, static_cast<GLsizeiptr>(words * 4), staging_.data());
+
+    block[LaunchBlock::kCount] = static_cast<uint32_t>(n);
+    putDouble(block, LaunchBlock::kNow, launch.clock.nowValue);
+    block[LaunchBlock::kDt] = bits(launch.clock.dtValue);
+    block[LaunchBlock::kFirst] = launch.clock.first ? 1 : 0;
+    block[LaunchBlock::kSeed] = launch.seed;
+    block[LaunchBlock::kDraw] = launch.draw;
+    for (uint32_t e = 0; e < p.block.externCount; ++e) putValue(block, p.block.externs + 4 * e, launch.externs[e]);
+    if (launch.uniforms)
+        for (uint32_t u = 0; u < p.block.uniformCount; ++u) putValue(block, p.block.uniforms + 4 * u, launch.uniforms[u]);
+    auto [killed, unstable] = dispatch(p, block, n, p.pass);
+
+    for (int c : p.written) {
+        Buffer b = launch.columns[static_cast<size_t>(c)];
+        if (!b.valid()) continue;
+        size_t word = block[LaunchBlock::kColumns + static_cast<size_t>(c)];
+        Elem e = memory_.elem(b);
+        glGetNamedBufferSubData(words_, static_cast<GLintptr>(word * 4), static_cast<GLsizeiptr>(n * wordsPerRow(e) * 4),
+                                &staging_[word]);
+        fromWords(&staging_[word], e, n, static_cast<char*>(memory_.host(b)) + begin * rt::elemSize(e));
+    }
+    return {killed, unstable};
+}
+
+void GlslBackend::run(const rt::ChildrenLaunch& launch) {
+    if (launch.count == 0) return;
+    if (context_) context_->makeCurrent();
+    Program& p = childrenProgram(*launch.object, *launch.spawn);
+    const ir::Object& o = *launch.object;
+    const ColumnLayout& l = *launch.layout;
+    size_t n = launch.count, columns = launch.args.size();
+    std::vector<uint32_t> block(p.block.words + 4, 0);
+    block[LaunchBlock::kCount] = static_cast<uint32_t>(n);
+    putDouble(block, LaunchBlock::kNow, launch.clock.nowValue);
+    block[LaunchBlock::kDt] = bits(launch.clock.dtValue);
+    block[LaunchBlock::kFirst] = launch.clock.first ? 1 : 0;
+    block[LaunchBlock::kSeed] = launch.seed;
+    block[LaunchBlock::kDraw] = launch.draw;
+    block[LaunchBlock::kFirstChild] = launch.firstChild;
+    putDouble(block, LaunchBlock::kCreated,
+              static_cast<const double*>(memory_.host(launch.columns[ColumnLayout::kCreated]))[launch.row]);
+    block[LaunchBlock::kObjectId] = static_cast<const uint32_t*>(memory_.host(launch.columns[ColumnLayout::kIds]))[launch.row];
+    for (size_t c = 0; c < columns; ++c) block[LaunchBlock::kColumns + c] = static_cast<uint32_t>(c * n);
+    for (uint32_t e = 0; e < p.block.externCount; ++e) putValue(block, p.block.externs + 4 * e, launch.externs[e]);
+    // The emitter's parameters and state, read from its row (a parameter the pool does
+    // not keep reads 0, as on every backend).
+    auto rowValue = [&](int column, int width) {
+        rt::Value v;
+        for (int c = 0; c < width; ++c) {
+            Buffer b = launch.columns[static_cast<size_t>(column + c)];
+            if (b.valid()) v.f[static_cast<size_t>(c)] = static_cast<const float*>(memory_.host(b))[launch.row];
+        }
+        return v;
+    };
+    for (size_t i = 0; i < o.params.size(); ++i)
+        putValue(block, p.block.params + 4 * static_cast<uint32_t>(i), rowValue(l.paramOffset[i], o.params[i].type.width));
+    for (size_t i = 0; i < o.state.size(); ++i)
+        putValue(block, p.block.state + 4 * static_cast<uint32_t>(i), rowValue(l.stateOffset[i], o.state[i].type.width));
+    for (size_t i = 0; i < l.parentColumns.size(); ++i)
+        putValue(block, p.block.parents + 4 * static_cast<uint32_t>(i), launch.parents[i]);
+    ensureWords(columns * n);
+    dispatch(p, block, n, p.pass);
+    staging_.resize(columns * n);
+    glGetNamedBufferSubData(words_, 0, static_cast<GLsizeiptr>(columns * n * 4), staging_.data());
+    for (size_t c = 0; c < columns; ++c)
+        std::memcpy(static_cast<float*>(memory_.host(launch.args[c])) + launch.argsFirst, &staging_[c * n], n * 4);
+}
+
+rt::BackendReport GlslBackend::report() const {
+    rt::BackendReport r;
+    r.target = renderer_;
+    r.kernels = kernels_;
+    r.compileSeconds = compileSeconds_;
+    return r;
+}
+
+}  // namespace psys::gpu

@@ -1,0 +1,77 @@
+// The GLSL backend: runs a system's launches (rt/backend.h) as OpenGL 4.5 compute
+// shaders emitted by codegen_glsl/, on whatever GL the machine has (a GPU's driver, or
+// Mesa's llvmpipe on the CPU), headless through EGL unless a context is current.
+//
+// Where the columns live: the run-time's bookkeeping (kills, emissions, creation, parents)
+// runs on the host over host columns (rt::HostMemory), and each launch carries the rows it
+// covers to the GPU, runs the kernel there and brings back the columns the kernel writes
+// (docs/gpu.md). The shaders address columns through the launch block, so the same
+// shaders run over columns that stay on the GPU.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "rt/backend.h"
+
+namespace psys::gpu {
+
+class HeadlessContext;
+
+class GlslBackend final : public rt::Backend {
+public:
+    // Null, and `error` set, when there is no OpenGL 4.5 to run on.
+    static std::unique_ptr<GlslBackend> create(std::string& error);
+    ~GlslBackend() override;
+
+    std::string name() const override { return "glsl"; }
+    rt::Memory& memory() override { return memory_; }
+    void prepare(const rt::Plan& plan) override;
+    void forget(const ir::Module& module) override;
+    rt::RowsResult run(const rt::RowsLaunch& launch) override;
+    void run(const rt::ChildrenLaunch& launch) override;
+    rt::BackendReport report() const override;
+
+    // GPU time of the launches so far (GL timer queries), by kernel kind name.
+    struct PassTime {
+        double milliseconds = 0;
+        size_t launches = 0;
+        size_t rows = 0;
+    };
+    const std::map<std::string, PassTime>& passTimes() const { return passTimes_; }
+    void timePasses(bool on) { timing_ = on; }
+
+private:
+    GlslBackend() = default;
+    struct Program;
+    using RowsKey = std::tuple<const ir::Kernel*, rt::Clock::Source, rt::Clock::Source>;
+    Program& rowsProgram(const ir::Object& object, const ir::Kernel& kernel, rt::Clock::Source now,
+                         rt::Clock::Source dt);
+    Program& childrenProgram(const ir::Object& object, const ir::Kernel& spawn);
+    Program compile(const std::string& source, const std::string& what);
+    rt::RowsResult runRows(const rt::RowsLaunch& launch, Program& program, size_t begin, size_t end);
+    // Uploads the block and the words, runs `program` over `count` invocations, and
+    // returns the counts (killed, unstable).
+    std::pair<uint32_t, uint32_t> dispatch(Program& program, const std::vector<uint32_t>& block, size_t count,
+                                           const std::string& pass);
+    void ensureWords(size_t words);
+
+    std::unique_ptr<HeadlessContext> context_;
+    rt::HostMemory memory_;
+    std::map<RowsKey, std::unique_ptr<Program>> rows_;
+    std::map<const ir::Kernel*, std::unique_ptr<Program>> children_;
+    unsigned words_ = 0, counts_ = 0, block_ = 0, query_ = 0;
+    size_t wordsCapacity_ = 0;
+    size_t maxWords_ = 0;  // the largest storage block the GL allows, in words
+    std::vector<uint32_t> staging_;
+    size_t kernels_ = 0;
+    double compileSeconds_ = 0;
+    std::string renderer_;
+    bool timing_ = false;
+    std::map<std::string, PassTime> passTimes_;
+};
+
+}  // namespace psys::gpu

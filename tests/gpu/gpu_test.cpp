@@ -1,0 +1,240 @@
+// The GLSL backend against the interpreter, on whatever OpenGL 4.5 the machine has (Mesa's
+// llvmpipe in CI): every sample and the every-operation program for 600 frames (triggers
+// fired), and the extremes of docs/runtime.md. Both must create, kill and draw the same
+// objects with the same ids.
+//
+// The tolerances. The shaders compute + − × ÷, comparisons, floor, mod, min, max, the
+// random draws and the ages as the interpreter does, bit for bit (`precise`: no fused
+// multiply-add, no reordering; the hash in 32-bit integers; ages from doubles). What
+// differs is the GL's own sin, cos, tan, asin, acos, atan, exp, log, pow and sqrt, which
+// GLSL 4.50 asks little of (§4.7.1: atan, and asin and acos with it, within 4096 ulp, a
+// relative 4.9e-4; exp and log within 3 + 2·|x| ulp; pow as exp2(y·log2 x)); llvmpipe
+// computes them with its own polynomials (its asin is good to about 1e-4).
+//   - The samples use sin, cos, exp, pow and sqrt gently: measured 7.1e-6 at worst
+//     (relative to max(1, |value|)) after 600 frames. Tolerance 1e-4.
+//   - The every-operation program feeds asin, acos and atan (their 4.9e-4) into pow as a
+//     base with exponents up to about 10, which multiplies a relative error by the
+//     exponent: measured 2.5e-3. Tolerance 1e-2.
+// A wrong operation, lane, column or draw is off by the size of the value itself, far
+// beyond both.
+#define DOCTEST_CONFIG_IMPLEMENT_WITH_MAIN
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include "gpu/glsl_backend.h"
+#include "interp/interpreter.h"
+#include "tests/differential.h"
+#include "tests/run_length.h"
+#include "tests/system_support.h"
+
+using namespace psys;
+
+namespace {
+
+constexpr double kSamplesTolerance = 1e-4, kEveryOperationTolerance = 1e-2;
+
+std::string readFile(const std::filesystem::path& p) {
+    std::ifstream in(p);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+std::unique_ptr<gpu::GlslBackend> gpuBackend() {
+    std::string error;
+    auto b = gpu::GlslBackend::create(error);
+    INFO(error);
+    REQUIRE(b);
+    return b;
+}
+
+// A program on the interpreter and on the GPU, stepped together.
+struct Pair {
+    interp::Interpreter interpreter;
+    std::unique_ptr<gpu::GlslBackend> gpu = gpuBackend();
+    std::unique_ptr<rt::System> cpu, gl;
+
+    explicit Pair(const std::string& text, bool optimize = true) {
+        cpu = std::make_unique<rt::System>(test::compileModule(text, optimize), interpreter);
+        gl = std::make_unique<rt::System>(test::compileModule(text, optimize), *gpu);
+    }
+    void steps(int n, double dt) {
+        for (int i = 0; i < n; ++i) {
+            REQUIRE_FALSE(cpu->step(dt));
+            REQUIRE_FALSE(gl->step(dt));
+        }
+    }
+    void setExtern(const char* name, std::span<const float> v) {
+        REQUIRE_FALSE(cpu->setExtern(name, v));
+        REQUIRE_FALSE(gl->setExtern(name, v));
+    }
+    void fire(const char* name) {
+        REQUIRE_FALSE(cpu->fire(name, {}));
+        REQUIRE_FALSE(gl->fire(name, {}));
+    }
+    rt::TypeStats stats(const char* type) const { return gl->stats().types.at(static_cast<size_t>(gl->typeIndex(type))); }
+    // What both draw now, and every count: the same.
+    double compare() {
+        double worst = 0;
+        for (size_t t = 0; t < cpu->typeCount(); ++t) {
+            auto a = cpu->points(t), b = gl->points(t);
+            REQUIRE(a.size() == b.size());
+            for (size_t i = 0; i < a.size(); ++i) {
+                REQUIRE(a[i].id == b[i].id);
+                worst = std::max(worst, test::pointDifference(a[i], b[i]));
+            }
+            const auto& sa = cpu->stats().types[t];
+            const auto& sb = gl->stats().types[t];
+            CHECK(sa.live == sb.live);
+            CHECK(sa.created == sb.created);
+            CHECK(sa.killed == sb.killed);
+            CHECK(sa.dropped == sb.dropped);
+            CHECK(sa.frozen == sb.frozen);
+        }
+        CHECK(cpu->stats().nonFiniteRender == gl->stats().nonFiniteRender);
+        CHECK(cpu->stats().nonFiniteExterns == gl->stats().nonFiniteExterns);
+        CHECK(cpu->stats().invalidEmissions == gl->stats().invalidEmissions);
+        CHECK(worst <= kSamplesTolerance);
+        return worst;
+    }
+};
+
+test::Comparison compareProgram(const std::string& text, int frames, bool optimize, double tolerance) {
+    interp::Interpreter interpreter;
+    auto gpu = gpuBackend();
+    rt::System a(test::compileModule(text, optimize), interpreter), b(test::compileModule(text, optimize), *gpu);
+    test::Comparison result = test::compareSystems(a, b, frames);
+    CHECK(result.worst <= tolerance);
+    return result;
+}
+
+}  // namespace
+
+TEST_CASE("every sample draws the same on the GPU as on the interpreter, for 600 frames (200 sanitized)") {
+    double worst = 0;
+    for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
+        if (entry.path().extension() != ".psys") continue;
+        INFO(entry.path().filename().string());
+        test::Comparison c = compareProgram(readFile(entry.path()), test::kLongRun, true, kSamplesTolerance);
+        CHECK(c.points > 0);
+        MESSAGE(entry.path().filename().string() << ": " << c.points << " points, " << c.differences
+                                                 << " not bit for bit, worst " << c.worst);
+        worst = std::max(worst, c.worst);
+    }
+    MESSAGE("the samples' worst difference: " << worst);
+}
+
+TEST_CASE("every operation computes on the GPU what the interpreter computes") {
+    std::string text = readFile(PSYS_EVERY_OPERATION);
+    for (bool optimize : {false, true}) {
+        test::Comparison c = compareProgram(text, 300, optimize, kEveryOperationTolerance);
+        CHECK(c.points > 1000);
+        MESSAGE(std::string(optimize ? "every operation (optimized): " : "every operation: ") << c.points << " points, worst "
+                                                                                    << c.worst);
+    }
+}
+
+TEST_CASE("the GPU at the extremes of docs/runtime.md") {
+    SUBCASE("capacity overflow: the pool stays full and the spawns beyond it are counted") {
+        Pair p("@capacity(1000) object s { point(origin, white, age); kill when age > 2; }\n"
+               "object e { emit s at 1e6 per second; }\nspawn e;");
+        for (int f = 0; f < 180; ++f) {
+            p.steps(1, 1.0 / 60);
+            p.compare();
+        }
+        CHECK(p.stats("s").live == 1000);
+        CHECK(p.stats("s").dropped > 1'000'000);
+    }
+    SUBCASE("every object killed in one frame") {
+        Pair p("object s(k: float) { point(vec3(k, 0, 0), white, 1); kill when age > 1; }\n"
+               "object e { emit s(rand()) count 5000; kill; }\nspawn e;");
+        p.steps(59, 1.0 / 60);
+        p.compare();
+        CHECK(p.stats("s").live == 5000);
+        p.steps(2, 1.0 / 60);
+        p.compare();
+        CHECK(p.stats("s").live == 0);
+        CHECK(p.stats("s").killed == 5000);
+    }
+    SUBCASE("a burst of 100k in one frame") {
+        Pair p("object s { v = nrand3(); pos = integrate(v); point(pos, white, age); }\n"
+               "trigger boom { emit s count 100000; }");
+        p.steps(1, 1.0 / 60);
+        p.fire("boom");
+        p.steps(3, 1.0 / 60);
+        p.compare();
+        CHECK(p.stats("s").live == 100000);
+    }
+    SUBCASE("a rate of 0.25 per second emits at 4 s, 8 s, 12 s") {
+        Pair p("object s { point(origin, white, age); }\nobject e { emit s at 0.25 per second; }\nspawn e;");
+        for (int frame = 1; frame <= 60 * 12; ++frame) {
+            p.steps(1, 1.0 / 60);
+            REQUIRE_MESSAGE(p.stats("s").created == static_cast<uint64_t>(frame / 240), "frame " << frame);
+        }
+        p.compare();
+    }
+    SUBCASE("dt = 0 changes nothing, and a 10 s hitch") {
+        Pair p("object s { pos = integrate(vec3(1, 2, 3)); point(pos, white, age); kill when age > 3; }\n"
+               "object e { emit s at 100 per second; }\nspawn e;");
+        p.steps(30, 1.0 / 60);
+        auto before = p.gl->points(0);
+        p.steps(10, 0.0);
+        CHECK(p.gl->points(0).size() == before.size());
+        p.compare();
+        p.steps(1, 10.0);
+        p.compare();
+        CHECK(p.stats("s").live == doctest::Approx(300).epsilon(0.01));
+    }
+    SUBCASE("after 10^7 s ages are exact to a millisecond") {
+        Pair p("object a { point(origin, white, age); }\ntrigger go { emit a count 1; }");
+        p.steps(1, 1e7);
+        p.fire("go");
+        p.steps(1, 0.001);
+        p.compare();
+        auto points = p.gl->points(0);
+        REQUIRE(points.size() == 1);
+        CHECK(points[0].size == doctest::Approx(0.001).epsilon(1e-3));
+    }
+    SUBCASE("NaN in an extern: counted, and what it reaches is not drawn") {
+        Pair p("extern w: vec3 = 0;\nobject a(k: float) { point(vec3(k) + w * k, white, 1); }\n"
+               "spawn a(0); spawn a(1);");
+        float bad[3] = {std::nanf(""), 0, INFINITY};
+        p.setExtern("w", bad);
+        p.steps(1, 1.0 / 60);
+        p.compare();
+        CHECK(p.gl->points(0).empty());
+        CHECK(p.gl->stats().nonFiniteRender == 2);
+        float good[3] = {1, 2, 3};
+        p.setExtern("w", good);
+        p.steps(1, 1.0 / 60);
+        p.compare();
+        CHECK(p.gl->points(0).size() == 2);
+    }
+}
+
+TEST_CASE("a parent's children read it live on the GPU, then frozen after it dies") {
+    Pair p(R"(
+        object rocket {
+            pos = integrate(vec3(0, 10, 0));
+            point(pos, white, 1);
+            emit spark at 50 per second;
+            kill when age > 1;
+            object spark {
+                p = rocket.pos + vec3(age, 0, 0);
+                point(p, rocket.alive ? red : blue, 1);
+                kill when age > 2;
+            }
+        }
+        spawn rocket;)");
+    for (int f = 0; f < 150; ++f) {
+        p.steps(1, 1.0 / 60);
+        p.compare();
+    }
+    CHECK(p.gl->stats().types.at(1).created > 40);
+}
+
