@@ -11,6 +11,7 @@
 
 #include "codegen_glsl/glsl_shaders.h"
 #include "gpu/gl_context.h"
+#include "gpu/gl_memory.h"
 
 namespace psys::gpu {
 
@@ -23,7 +24,8 @@ struct GlslBackend::Program {
     GLuint program = 0;
     LaunchBlock block;
     ColumnLayout layout;
-    std::vector<int> written;  // the table columns the kernel writes
+    std::vector<int> resident, returned;  // the table columns the kernel writes (writtenColumns)
+    std::vector<bool> needed;             // the table columns a launch carries (the others are not touched)
     std::string pass;          // "update", "spawn", …: what timer queries add up under
 };
 
@@ -41,50 +43,59 @@ void putValue(std::vector<uint32_t>& block, uint32_t word, const rt::Value& v) {
     for (size_t c = 0; c < 4; ++c) block[word + c] = bits(v.f[c]);
 }
 
-uint32_t wordsPerRow(Elem e) { return e == Elem::F64 ? 2 : 1; }
-
-// Host rows to words (u8 widened to a word) and back.
-void toWords(const void* from, Elem e, size_t rows, uint32_t* to) {
-    if (e == Elem::U8) {
-        const auto* b = static_cast<const uint8_t*>(from);
-        for (size_t r = 0; r < rows; ++r) to[r] = b[r];
-    } else {
-        std::memcpy(to, from, rows * rt::elemSize(e));
-    }
-}
-
-void fromWords(const uint32_t* from, Elem e, size_t rows, void* to) {
-    if (e == Elem::U8) {
-        auto* b = static_cast<uint8_t*>(to);
-        for (size_t r = 0; r < rows; ++r) b[r] = static_cast<uint8_t>(from[r]);
-    } else {
-        std::memcpy(to, from, rows * rt::elemSize(e));
-    }
-}
-
-std::vector<int> writtenColumns(const ir::Kernel& kernel, const ColumnLayout& l) {
-    std::vector<int> cols;
-    auto range = [&cols](int first, int width) {
+// The table columns a kernel writes: what stays on the GPU (state, exports) and what the
+// host reads right after the launch (kill flags, emissions, what is drawn).
+void writtenColumns(const ir::Kernel& kernel, const ColumnLayout& l, std::vector<int>& resident,
+                    std::vector<int>& returned) {
+    auto range = [](std::vector<int>& cols, int first, int width) {
         for (int c = 0; c < width; ++c) cols.push_back(first + c);
     };
+    std::vector<int>& cols = returned;
     for (const ir::Yield& y : kernel.yields) {
         int width = kernel.at(y.value).type.width;
         switch (y.kind) {
-            case ir::YieldKind::StateNext: range(l.stateOffset[static_cast<size_t>(y.index)], width); break;
-            case ir::YieldKind::Export: range(l.exportOffset[static_cast<size_t>(y.index)], width); break;
+            case ir::YieldKind::StateNext: range(resident, l.stateOffset[static_cast<size_t>(y.index)], width); break;
+            case ir::YieldKind::Export: range(resident, l.exportOffset[static_cast<size_t>(y.index)], width); break;
             case ir::YieldKind::Kill: cols.push_back(ColumnLayout::kKill); break;
             case ir::YieldKind::EmitRate: cols.push_back(l.emitRate(y.index)); break;
             case ir::YieldKind::EmitCount: cols.push_back(l.emitCount(y.index)); break;
             case ir::YieldKind::Visible: cols.push_back(l.render + ColumnLayout::kVisible); break;
             case ir::YieldKind::Position: case ir::YieldKind::Color: case ir::YieldKind::Size:
-                range(l.render + ColumnLayout::renderColumn(y.kind), width);
+                range(cols, l.render + ColumnLayout::renderColumn(y.kind), width);
                 break;
             default: break;
         }
     }
-    std::sort(cols.begin(), cols.end());
-    cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
-    return cols;
+    for (std::vector<int>* list : {&resident, &returned}) {
+        std::sort(list->begin(), list->end());
+        list->erase(std::unique(list->begin(), list->end()), list->end());
+    }
+}
+
+// The table columns a launch of `kernel` carries to the GPU: what its shader reads (the
+// clock's columns and the creation times are always read), and what it writes where
+// rows keep their values (all but the kill flags, written for every row).
+std::vector<bool> neededColumns(const ir::Kernel& kernel, const ColumnLayout& l, bool perRowClock,
+                                const std::vector<int>& resident, const std::vector<int>& returned) {
+    std::vector<bool> needed(static_cast<size_t>(l.total), false);
+    auto mark = [&needed](int first, int width) {
+        for (int c = 0; c < width; ++c) needed[static_cast<size_t>(first + c)] = true;
+    };
+    mark(ColumnLayout::kCreated, 1);
+    if (perRowClock) mark(ColumnLayout::kNow, 2);
+    for (const ir::Inst& i : kernel.insts()) {
+        switch (i.op) {
+            case ir::Op::Param: mark(l.paramOffset[static_cast<size_t>(i.attr)], i.type.width); break;
+            case ir::Op::StateRead: mark(l.stateOffset[static_cast<size_t>(i.attr)], i.type.width); break;
+            case ir::Op::ObjectId: mark(ColumnLayout::kIds, 1); break;
+            default: break;
+        }
+    }
+    for (const auto& p : l.parentColumns) mark(p.offset, p.width);
+    for (int c : resident) mark(c, 1);
+    for (int c : returned)
+        if (c != ColumnLayout::kKill) mark(c, 1);
+    return needed;
 }
 
 const ir::Kernel* uniformKernelOf(const ir::Object& object, const ir::Kernel& kernel) {
@@ -167,7 +178,9 @@ GlslBackend::Program& GlslBackend::rowsProgram(const ir::Object& object, const i
                                                    object.name + "." + ir::kernelName(kernel.kind)));
         p->layout = rt::columnLayout(object, kernel);
         p->block = codegen_glsl::rowsBlock(kernel, uniform, p->layout);
-        p->written = writtenColumns(kernel, p->layout);
+        writtenColumns(kernel, p->layout, p->resident, p->returned);
+        p->needed = neededColumns(kernel, p->layout, now == rt::Clock::Source::PerRow || dt == rt::Clock::Source::PerRow,
+                                  p->resident, p->returned);
         p->pass = ir::kernelName(kernel.kind);
         slot = std::move(p);
     }
@@ -252,7 +265,7 @@ rt::RowsResult GlslBackend::run(const rt::RowsLaunch& launch) {
     size_t perRow = 0;
     for (int c = 0; c < p.layout.total; ++c) {
         Buffer b = launch.columns[static_cast<size_t>(c)];
-        perRow += b.valid() ? wordsPerRow(memory_.elem(b)) : 1;
+        perRow += b.valid() ? GlMemory::wordsPerRow(memory_.elem(b)) : 1;  // at most
     }
     size_t rows = std::max<size_t>(1, maxWords_ / (perRow + 1));
     rt::RowsResult result;
@@ -281,19 +294,37 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
         for (const Slot& s : slots)
             if (s.buffer == b) return s.word;
         slots.push_back({b, words});
-        words += n * wordsPerRow(memory_.elem(b));
+        words += n * GlMemory::wordsPerRow(memory_.elem(b));
         return slots.back().word;
     };
     for (int c = 0; c < p.layout.total; ++c)
-        block[LaunchBlock::kColumns + static_cast<size_t>(c)] = static_cast<uint32_t>(place(launch.columns[static_cast<size_t>(c)]));
+        if (p.needed[static_cast<size_t>(c)])
+            block[LaunchBlock::kColumns + static_cast<size_t>(c)] = static_cast<uint32_t>(place(launch.columns[static_cast<size_t>(c)]));
+    // The kill flags: written for every row, carried only from the GPU.
+    Buffer killBuffer = launch.columns[ColumnLayout::kKill];
+    bool kills = std::find(p.returned.begin(), p.returned.end(), ColumnLayout::kKill) != p.returned.end();
+    if (kills && killBuffer.valid()) {
+        block[LaunchBlock::kColumns + ColumnLayout::kKill] = static_cast<uint32_t>(words);
+        words += n;
+    }
     block[LaunchBlock::kColumns + static_cast<size_t>(p.layout.total)] = static_cast<uint32_t>(place(launch.mask));
-    staging_.assign(words, 0);
+    ensureWords(words);
+    // Columns on the GPU are copied there; the others come from the host.
+    uint32_t zero = 0;
+    glClearNamedBufferSubData(words_, GL_R32UI, 0, static_cast<GLsizeiptr>(n * 4), GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     for (const Slot& s : slots) {
         Elem e = memory_.elem(s.buffer);
-        toWords(static_cast<const char*>(memory_.host(s.buffer)) + begin * rt::elemSize(e), e, n, &staging_[s.word]);
+        size_t w = GlMemory::wordsPerRow(e);
+        if (memory_.onDevice(s.buffer)) {
+            glCopyNamedBufferSubData(memory_.deviceBuffer(s.buffer), words_, static_cast<GLintptr>(begin * w * 4),
+                                     static_cast<GLintptr>(s.word * 4), static_cast<GLsizeiptr>(n * w * 4));
+            continue;
+        }
+        staging_.resize(n * w);
+        toWords(static_cast<const char*>(memory_.view(s.buffer)) + begin * rt::elemSize(e), e, n, staging_.data());
+        glNamedBufferSubData(words_, static_cast<GLintptr>(s.word * 4), static_cast<GLsizeiptr>(n * w * 4), staging_.data());
+        memory_.transferred += n * w * 4;
     }
-    ensureWords(words);
-    glNamedBufferSubData(words_, 0, static_cast<GLsizeiptr>(words * 4), staging_.data());
 
     block[LaunchBlock::kCount] = static_cast<uint32_t>(n);
     putDouble(block, LaunchBlock::kNow, launch.clock.nowValue);
@@ -306,14 +337,20 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
         for (uint32_t u = 0; u < p.block.uniformCount; ++u) putValue(block, p.block.uniforms + 4 * u, launch.uniforms[u]);
     auto [killed, unstable] = dispatch(p, block, n, p.pass);
 
-    for (int c : p.written) {
+    for (int c : p.resident) {
+        Buffer b = launch.columns[static_cast<size_t>(c)];
+        if (b.valid()) memory_.adopt(b, begin, n, words_, block[LaunchBlock::kColumns + static_cast<size_t>(c)]);
+    }
+    for (int c : p.returned) {
         Buffer b = launch.columns[static_cast<size_t>(c)];
         if (!b.valid()) continue;
         size_t word = block[LaunchBlock::kColumns + static_cast<size_t>(c)];
         Elem e = memory_.elem(b);
-        glGetNamedBufferSubData(words_, static_cast<GLintptr>(word * 4), static_cast<GLsizeiptr>(n * wordsPerRow(e) * 4),
-                                &staging_[word]);
-        fromWords(&staging_[word], e, n, static_cast<char*>(memory_.host(b)) + begin * rt::elemSize(e));
+        staging_.resize(n * GlMemory::wordsPerRow(e));
+        glGetNamedBufferSubData(words_, static_cast<GLintptr>(word * 4), static_cast<GLsizeiptr>(staging_.size() * 4),
+                                staging_.data());
+        memory_.transferred += staging_.size() * 4;
+        fromWords(staging_.data(), e, n, static_cast<char*>(memory_.host(b)) + begin * rt::elemSize(e));
     }
     return {killed, unstable};
 }
@@ -333,9 +370,10 @@ void GlslBackend::run(const rt::ChildrenLaunch& launch) {
     block[LaunchBlock::kSeed] = launch.seed;
     block[LaunchBlock::kDraw] = launch.draw;
     block[LaunchBlock::kFirstChild] = launch.firstChild;
-    putDouble(block, LaunchBlock::kCreated,
-              static_cast<const double*>(memory_.host(launch.columns[ColumnLayout::kCreated]))[launch.row]);
-    block[LaunchBlock::kObjectId] = static_cast<const uint32_t*>(memory_.host(launch.columns[ColumnLayout::kIds]))[launch.row];
+    double created = 0;
+    memory_.read(launch.columns[ColumnLayout::kCreated], launch.row, 1, &created);
+    putDouble(block, LaunchBlock::kCreated, created);
+    memory_.read(launch.columns[ColumnLayout::kIds], launch.row, 1, &block[LaunchBlock::kObjectId]);
     for (size_t c = 0; c < columns; ++c) block[LaunchBlock::kColumns + c] = static_cast<uint32_t>(c * n);
     for (uint32_t e = 0; e < p.block.externCount; ++e) putValue(block, p.block.externs + 4 * e, launch.externs[e]);
     // The emitter's parameters and state, read from its row (a parameter the pool does
@@ -344,7 +382,7 @@ void GlslBackend::run(const rt::ChildrenLaunch& launch) {
         rt::Value v;
         for (int c = 0; c < width; ++c) {
             Buffer b = launch.columns[static_cast<size_t>(column + c)];
-            if (b.valid()) v.f[static_cast<size_t>(c)] = static_cast<const float*>(memory_.host(b))[launch.row];
+            if (b.valid()) memory_.read(b, launch.row, 1, &v.f[static_cast<size_t>(c)]);
         }
         return v;
     };
@@ -358,8 +396,8 @@ void GlslBackend::run(const rt::ChildrenLaunch& launch) {
     dispatch(p, block, n, p.pass);
     staging_.resize(columns * n);
     glGetNamedBufferSubData(words_, 0, static_cast<GLsizeiptr>(columns * n * 4), staging_.data());
-    for (size_t c = 0; c < columns; ++c)
-        std::memcpy(static_cast<float*>(memory_.host(launch.args[c])) + launch.argsFirst, &staging_[c * n], n * 4);
+    memory_.transferred += columns * n * 4;
+    for (size_t c = 0; c < columns; ++c) memory_.write(launch.args[c], launch.argsFirst, n, &staging_[c * n]);
 }
 
 rt::BackendReport GlslBackend::report() const {

@@ -2,11 +2,10 @@
 // shaders emitted by codegen_glsl/, on whatever GL the machine has (a GPU's driver, or
 // Mesa's llvmpipe on the CPU), headless through EGL unless a context is current.
 //
-// Where the columns live: the run-time's bookkeeping (kills, emissions, creation, parents)
-// runs on the host over host columns (rt::HostMemory), and each launch carries the rows it
-// covers to the GPU, runs the kernel there and brings back the columns the kernel writes
-// (docs/gpu.md). The shaders address columns through the launch block, so the same
-// shaders run over columns that stay on the GPU.
+// Where the columns live (gpu/gl_memory.h): an object's state and exports stay on the GPU
+// from step to step; the run-time's bookkeeping (kills, emissions, creation, parents) runs
+// on the host, so a launch takes the masks, ids and creation times from the host and
+// gives back the kill flags, emissions and what is drawn (docs/gpu.md).
 #pragma once
 
 #include <map>
@@ -15,6 +14,7 @@
 #include <tuple>
 #include <vector>
 
+#include "gpu/gl_memory.h"
 #include "rt/backend.h"
 
 namespace psys::gpu {
@@ -43,6 +43,8 @@ public:
     };
     const std::map<std::string, PassTime>& passTimes() const { return passTimes_; }
     void timePasses(bool on) { timing_ = on; }
+    // Bytes moved between the host and the GPU so far, either way.
+    uint64_t transferredBytes() const { return memory_.transferred; }
 
 private:
     GlslBackend() = default;
@@ -60,7 +62,7 @@ private:
     void ensureWords(size_t words);
 
     std::unique_ptr<HeadlessContext> context_;
-    rt::HostMemory memory_;
+    GlMemory memory_;
     std::map<RowsKey, std::unique_ptr<Program>> rows_;
     std::map<const ir::Kernel*, std::unique_ptr<Program>> children_;
     unsigned words_ = 0, counts_ = 0, block_ = 0, query_ = 0;

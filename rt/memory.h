@@ -50,9 +50,12 @@ public:
     virtual void copy(Buffer from, size_t fromFirst, Buffer to, size_t toFirst, size_t count) = 0;
     virtual void scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const uint32_t> rows) = 0;
 
-    // The address of a buffer's first element where the host can address it, else null.
+    // The address of a buffer's first element where the host can address it, else null:
+    // `host` for reading and writing, `view` for reading only (a memory that keeps
+    // columns on a device brings the values to the host for either, and takes them as
+    // changed after `host`).
     virtual void* host(Buffer buffer) = 0;
-    const void* host(Buffer buffer) const { return const_cast<Memory*>(this)->host(buffer); }
+    virtual const void* view(Buffer buffer) const { return const_cast<Memory*>(this)->host(buffer); }
 };
 
 // Host RAM: buffers are arrays the host addresses directly (aligned to 64 bytes).
@@ -83,6 +86,10 @@ private:
 template <typename T>
 T* hostData(Memory& memory, Buffer b) {
     return static_cast<T*>(memory.host(b));
+}
+template <typename T>
+const T* viewData(const Memory& memory, Buffer b) {
+    return static_cast<const T*>(memory.view(b));
 }
 
 }  // namespace psys::rt

@@ -464,7 +464,7 @@ void Creation::advance(size_t type, Batch& b, size_t n, size_t maskColumn) {
     if (info.exports) {
         Buffer exportMask = b.columns.at(kExportMask, Elem::U8, end);
         auto* alive = s_.host<uint8_t>(exportMask);
-        const auto* kill = s_.host<uint8_t>(table[ColumnLayout::kKill]);
+        const auto* kill = s_.view<uint8_t>(table[ColumnLayout::kKill]);
         for (size_t i = first; i < end; ++i) alive[i] = mask[i] && !(info.kills && kill[i]);
         launchOn(*info.exports, info.exportsLayout, b.exportsTable, exportMask);
     }
@@ -482,11 +482,11 @@ void Creation::advance(size_t type, Batch& b, size_t n, size_t maskColumn) {
 void Creation::queueBursts(size_t type, Batch& b, size_t r) {
     const ir::Object& o = s_.module.objects[type];
     size_t i = b.first + r;
-    const auto* created = s_.host<double>(b.updateTable[ColumnLayout::kCreated]);
+    const auto* created = s_.view<double>(b.updateTable[ColumnLayout::kCreated]);
     for (size_t site = 0; site < o.emits.size(); ++site) {
         if (o.emits[site].rate) continue;
         auto column = static_cast<size_t>(b.initLayout.emitCount(static_cast<int>(site)));
-        float size = b.initTable.empty() ? 0 : s_.host<float>(b.initTable[column])[i];
+        float size = b.initTable.empty() ? 0 : s_.view<float>(b.initTable[column])[i];
         double count = std::floor(validCount(size, s_.stats.invalidEmissions));
         if (count < 1) continue;
         Emitter e{type, b.poolRows[r], b.burstTables[site], static_cast<uint32_t>(i), created[i], true};
@@ -499,7 +499,7 @@ void Creation::killOrEmit(size_t type, Batch& b, size_t r, double dt, double t1)
     const ir::Object& o = s_.module.objects[type];
     size_t i = b.first + r;
     uint32_t row = b.poolRows[r];
-    if (info.kills && s_.host<uint8_t>(b.updateTable[ColumnLayout::kKill])[i]) {
+    if (info.kills && s_.view<uint8_t>(b.updateTable[ColumnLayout::kKill])[i]) {
         s_.kill(type, row);
         return;
     }
@@ -508,8 +508,8 @@ void Creation::killOrEmit(size_t type, Batch& b, size_t r, double dt, double t1)
     count_.assign(o.emits.size(), 1);
     for (size_t s = 0; s < o.emits.size(); ++s) {
         auto site = static_cast<int>(s);
-        if (info.rated[s]) rate_[s] = s_.host<float>(b.updateTable[static_cast<size_t>(info.updateLayout.emitRate(site))])[i];
-        if (info.counted[s]) count_[s] = s_.host<float>(b.updateTable[static_cast<size_t>(info.updateLayout.emitCount(site))])[i];
+        if (info.rated[s]) rate_[s] = s_.view<float>(b.updateTable[static_cast<size_t>(info.updateLayout.emitRate(site))])[i];
+        if (info.counted[s]) count_[s] = s_.view<float>(b.updateTable[static_cast<size_t>(info.updateLayout.emitCount(site))])[i];
     }
     emitAtRate({type, row, {}, row, t1, false}, rate_, count_, dt, t1);
 }

@@ -164,7 +164,7 @@ void State::parentValues(size_t type, uint32_t row, const ColumnLayout& layout, 
         Value v;
         if (p.op == ir::Op::ParentExport && parent) v = parent->exports.get(memory, static_cast<size_t>(p.exportIndex), r);
         if (p.op == ir::Op::ParentAlive) v = Value::boolean(parent && parent->status(r) == Status::Alive);
-        if (p.op == ir::Op::ParentAge && parent) v = Value::scalar(ageAt(at, host<double>(parent->created)[r]));
+        if (p.op == ir::Op::ParentAge && parent) v = Value::scalar(ageAt(at, view<double>(parent->created)[r]));
         out.push_back(v);
     }
 }
@@ -182,9 +182,9 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
                 float x = 0;
                 if (parent) {
                     if (p.op == ir::Op::ParentExport)
-                        x = host<float>(parent->exports.column(static_cast<size_t>(p.exportIndex), static_cast<size_t>(c)))[r];
+                        x = view<float>(parent->exports.column(static_cast<size_t>(p.exportIndex), static_cast<size_t>(c)))[r];
                     if (p.op == ir::Op::ParentAlive) x = parent->status(r) == Status::Alive ? 1.0f : 0.0f;
-                    if (p.op == ir::Op::ParentAge) x = ageAt(atRows ? atRows[i] : at, host<double>(parent->created)[r]);
+                    if (p.op == ir::Op::ParentAge) x = ageAt(atRows ? atRows[i] : at, view<double>(parent->created)[r]);
                 }
                 host<float>(table[static_cast<size_t>(p.offset + c)])[i] = x;
             }

@@ -117,9 +117,14 @@ struct State {
     // chunk(c) for every chunk of `rows` rows (rt/columns.h kRowsPerChunk).
     void forChunks(size_t rows, const std::function<void(size_t)>& chunk);
 
+    // A column's values on the host: to change (host) or to read (view).
     template <typename T>
     T* host(Buffer b) const {
         return hostData<T>(memory, b);
+    }
+    template <typename T>
+    const T* view(Buffer b) const {
+        return viewData<T>(memory, b);
     }
 };
 

@@ -36,14 +36,14 @@ void killAndEmit(State& s, Creation& creation, size_t type, double dt, double t1
     const TypeInfo& info = s.types[type];
     const TypeWork& work = s.work[type];
     const ir::Object& o = pool.object();
-    const auto* updatable = s.host<uint8_t>(pool.updatable);
-    const auto* kill = s.host<uint8_t>(work.updateTable[ColumnLayout::kKill]);
+    const auto* updatable = s.view<uint8_t>(pool.updatable);
+    const auto* kill = s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]);
     std::vector<float> rate(o.emits.size(), 0), count(o.emits.size(), 1);
     std::vector<const float*> rates(o.emits.size()), counts(o.emits.size());
     for (size_t site = 0; site < o.emits.size(); ++site) {
         auto i = static_cast<int>(site);
-        rates[site] = s.host<float>(work.updateTable[static_cast<size_t>(info.updateLayout.emitRate(i))]);
-        counts[site] = s.host<float>(work.updateTable[static_cast<size_t>(info.updateLayout.emitCount(i))]);
+        rates[site] = s.view<float>(work.updateTable[static_cast<size_t>(info.updateLayout.emitRate(i))]);
+        counts[site] = s.view<float>(work.updateTable[static_cast<size_t>(info.updateLayout.emitCount(i))]);
     }
     for (uint32_t row = 0; row < pool.rows(); ++row) {
         if (!updatable[row]) continue;
@@ -94,8 +94,8 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1)
         exports.mask = exportMask;
         exports.uniforms = s.uniforms(type, *info.exports, static_cast<float>(dt), static_cast<float>(t1));
     }
-    const auto* updatable = s.host<uint8_t>(pool.updatable);
-    const auto* kill = s.host<uint8_t>(work.updateTable[ColumnLayout::kKill]);
+    const auto* updatable = s.view<uint8_t>(pool.updatable);
+    const auto* kill = s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]);
     // Objects that only die (no rate emits) are found while their chunk is in cache.
     bool listKills = info.kills && !info.rateEmits;
     size_t chunks = (rows + kRowsPerChunk - 1) / kRowsPerChunk;

@@ -238,3 +238,20 @@ TEST_CASE("a parent's children read it live on the GPU, then frozen after it die
     CHECK(p.gl->stats().types.at(1).created > 40);
 }
 
+
+TEST_CASE("an object's state stays on the GPU from step to step") {
+    // The fountain's drops: 24 bytes of state each (position and velocity), read and
+    // written every step. A step moves the update mask and the creation times up and the
+    // kill flags down (16 bytes a drop), and what creating the step's new drops needs;
+    // the state stays on the GPU.
+    auto gpu = gpuBackend();
+    rt::System system(test::compileModule(readFile(std::string(PSYS_SAMPLES_DIR) + "/fountain.psys")), *gpu);
+    for (int f = 0; f < 120; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
+    size_t live = system.pool(static_cast<size_t>(system.typeIndex("drop"))).live();
+    uint64_t before = gpu->transferredBytes();
+    for (int f = 0; f < 10; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
+    double perDrop = static_cast<double>(gpu->transferredBytes() - before) / 10 / static_cast<double>(live);
+    MESSAGE("bytes between host and GPU per drop per step: " << perDrop);
+    CHECK(perDrop < 24);
+    CHECK(perDrop > 0);
+}

@@ -6,6 +6,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <filesystem>
 #include <fstream>
@@ -40,7 +41,8 @@ bool background(Pixel p) {
 
 // Runs `text` for `frames` frames offscreen, no grid, and returns the last frame; `check`
 // sees the viewer (its system and camera) before it goes.
-Frame render(const std::string& text, int frames, Blend blend, const std::function<void(Viewer&)>& check = {}) {
+Frame render(const std::string& text, int frames, Blend blend, const std::function<void(Viewer&)>& check = {},
+             const std::string& backend = "llvm") {
     std::string error;
     auto surface = openOffscreen(kWidth, kHeight, error);
     REQUIRE_MESSAGE(surface, error);
@@ -53,6 +55,7 @@ Frame render(const std::string& text, int frames, Blend blend, const std::functi
     options.watch = false;
     options.blend = blend;
     options.camera = Camera::parse("0,0,10,0,2,0");  // from +z, level, looking at (0, 2, 0)
+    options.session.backend.name = backend;
     host::CompileResult compiled;
     auto session = host::Session::open("test.psys", options.session, compiled, error, &text);
     REQUIRE_MESSAGE(session, compiled.text(), error);
@@ -128,4 +131,23 @@ TEST_CASE("a sample's particles are drawn where they project") {
     size_t lit = 0;
     for (auto [x, y] : where) lit += !background(f.at(x, y));
     CHECK(lit >= where.size() * 95 / 100);
+}
+
+TEST_CASE("the GLSL backend computes in the viewer's own GL context and draws what the JIT draws") {
+    std::ifstream in(std::string(PSYS_SAMPLES_DIR) + "/fountain.psys");
+    std::string text((std::istreambuf_iterator<char>(in)), {});
+    size_t drawn = 0;
+    Frame gpu = render(text, 90, Blend::Additive, [&](Viewer& viewer) {
+        CHECK(viewer.session().backend().name() == "glsl");
+        drawn = viewer.session().system().points(0).size();
+    }, "glsl");
+    Frame jit = render(text, 90, Blend::Additive, {}, "llvm");
+    CHECK(drawn > 500);
+    // The fountain's values agree to a few ulp (tests/gpu): at most a pixel here and there
+    // differs, where a point's edge falls on a pixel's edge.
+    REQUIRE(gpu.rgba.size() == jit.rgba.size());
+    size_t differ = 0;
+    for (size_t i = 0; i < gpu.rgba.size(); i += 4) differ += std::memcmp(&gpu.rgba[i], &jit.rgba[i], 4) != 0;
+    MESSAGE(differ << " of " << gpu.rgba.size() / 4 << " pixels differ");
+    CHECK(differ <= gpu.rgba.size() / 4 / 1000);
 }

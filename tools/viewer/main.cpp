@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
     app.add_option("--camera", camera, "yaw,pitch,distance[,x,y,z]: degrees and units, looking at (x, y, z)");
     app.add_option("--set", sets, "Set an extern: NAME=VALUE or NAME=X,Y,Z (repeatable)")->allow_extra_args(false);
     app.add_option("--fire", fires, "Fire a trigger before a frame: TRIGGER[:X,Y,Z]@FRAME (repeatable)")->allow_extra_args(false);
-    app.add_option("--backend", o.session.backend.name, "llvm (the default) or interp")
+    app.add_option("--backend", o.session.backend.name, "llvm (the default), interp or glsl (compute shaders on the GL the viewer draws with)")
         ->check(CLI::IsMember(host::backendNames()));
     app.add_option("--math", o.session.backend.math, "llvm: fast (the default) or exact")->check(CLI::IsMember({"fast", "exact"}));
     std::string integrator;

@@ -133,7 +133,7 @@ void PointRenderer::draw(const rt::DrawColumns& c, const rt::Memory& memory, con
                                           c.color[1], c.color[2], c.color[3], c.size};
     for (int i = 0; i < kColumns; ++i) {
         // The column itself where the host can address it; else read back (a device's memory).
-        const void* data = memory.host(columns[i]);
+        const void* data = memory.view(columns[i]);
         if (!data) {
             staging_.resize(c.rows);
             memory.read(columns[i], 0, c.rows, staging_.data());

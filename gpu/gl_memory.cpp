@@ -1,0 +1,270 @@
+#include "gpu/gl_memory.h"
+
+#include <algorithm>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include <epoxy/gl.h>
+
+namespace psys::gpu {
+
+using rt::Buffer;
+using rt::Elem;
+
+void toWords(const void* from, Elem e, size_t rows, uint32_t* to) {
+    if (e == Elem::U8) {
+        const auto* b = static_cast<const uint8_t*>(from);
+        for (size_t r = 0; r < rows; ++r) to[r] = b[r];
+    } else {
+        std::memcpy(to, from, rows * rt::elemSize(e));
+    }
+}
+
+void fromWords(const uint32_t* from, Elem e, size_t rows, void* to) {
+    if (e == Elem::U8) {
+        auto* b = static_cast<uint8_t*>(to);
+        for (size_t r = 0; r < rows; ++r) b[r] = static_cast<uint8_t>(from[r]);
+    } else {
+        std::memcpy(to, from, rows * rt::elemSize(e));
+    }
+}
+
+struct GlMemory::Column {
+    Elem elem = Elem::F32;
+    size_t rows = 0;
+    std::vector<uint8_t> hostCopy;
+    GLuint gl = 0;
+    size_t glRows = 0;    // rows the GL buffer holds
+    bool device = false;  // the value is the GL buffer's (the host copy is stale)
+    bool live = false;
+    size_t words() const { return rows * wordsPerRow(elem); }
+};
+
+namespace {
+
+// to[rows[i]] = from[first + i], a row of `w` words at a time (kSkipRow: nothing).
+const char* kScatter = R"(#version 450
+layout(local_size_x = 64) in;
+layout(std430, binding = 0) readonly buffer From { uint from[]; };
+layout(std430, binding = 1) buffer To { uint to[]; };
+layout(std430, binding = 2) readonly buffer Rows { uint rows[]; };
+uniform uint count, first, w;
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= count || rows[i] == 0xFFFFFFFFu) return;
+    for (uint k = 0u; k < w; ++k) to[rows[i] * w + k] = from[(first + i) * w + k];
+}
+)";
+
+GLuint scatterProgram() {
+    GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
+    glShaderSource(shader, 1, &kScatter, nullptr);
+    glCompileShader(shader);
+    GLint ok = 0;
+    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    if (!ok) throw std::runtime_error("the GL did not compile the scatter shader");
+    GLuint program = glCreateProgram();
+    glAttachShader(program, shader);
+    glLinkProgram(program);
+    glDeleteShader(shader);
+    return program;
+}
+
+}  // namespace
+
+GlMemory::GlMemory() = default;
+
+GlMemory::~GlMemory() {
+    for (auto& c : columns_)
+        if (c && c->gl) glDeleteBuffers(1, &c->gl);
+    if (scatterProgram_) glDeleteProgram(scatterProgram_);
+    if (rowsBuffer_) glDeleteBuffers(1, &rowsBuffer_);
+}
+
+GlMemory::Column& GlMemory::at(Buffer b) const { return *columns_.at(b.id); }
+
+Buffer GlMemory::create(Elem elem, size_t rows) {
+    uint32_t id;
+    if (!free_.empty()) {
+        id = free_.back();
+        free_.pop_back();
+    } else {
+        id = static_cast<uint32_t>(columns_.size());
+        columns_.push_back(std::make_unique<Column>());
+    }
+    Column& c = *columns_[id];
+    c.elem = elem;
+    c.rows = rows;
+    c.hostCopy.assign(rows * rt::elemSize(elem), 0);
+    c.device = false;
+    c.live = true;
+    return Buffer{id};
+}
+
+void GlMemory::resize(Buffer b, size_t rows) {
+    Column& c = at(b);
+    if (c.device) {  // grown or shrunk on the GPU: the column stays there
+        size_t w = wordsPerRow(c.elem);
+        GLuint grown = 0;
+        glCreateBuffers(1, &grown);
+        glNamedBufferData(grown, static_cast<GLsizeiptr>(std::max<size_t>(rows * w, 1) * 4), nullptr, GL_DYNAMIC_COPY);
+        uint32_t zero = 0;
+        glClearNamedBufferData(grown, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+        size_t kept = std::min(rows, c.rows) * w * 4;
+        if (kept) glCopyNamedBufferSubData(c.gl, grown, 0, 0, static_cast<GLsizeiptr>(kept));
+        glDeleteBuffers(1, &c.gl);
+        c.gl = grown;
+        c.glRows = rows;
+    }
+    c.hostCopy.resize(rows * rt::elemSize(c.elem), 0);
+    c.rows = rows;
+}
+
+void GlMemory::release(Buffer b) {
+    if (!b.valid() || b.id >= columns_.size() || !columns_[b.id]->live) return;
+    Column& c = at(b);
+    c.live = false;
+    c.device = false;
+    c.rows = 0;
+    c.hostCopy.clear();
+    c.hostCopy.shrink_to_fit();
+    free_.push_back(b.id);
+}
+
+size_t GlMemory::rows(Buffer b) const { return at(b).rows; }
+Elem GlMemory::elem(Buffer b) const { return at(b).elem; }
+
+void GlMemory::toHost(Column& c) const {
+    if (!c.device) return;
+    std::vector<uint32_t> words(c.words());
+    if (!words.empty()) glGetNamedBufferSubData(c.gl, 0, static_cast<GLsizeiptr>(words.size() * 4), words.data());
+    transferred += words.size() * 4;
+    fromWords(words.data(), c.elem, c.rows, c.hostCopy.data());
+    c.device = false;
+}
+
+void GlMemory::upload(Column& c) const {
+    if (c.device) return;
+    size_t words = std::max<size_t>(c.words(), 1);
+    if (!c.gl) glCreateBuffers(1, &c.gl);
+    if (c.glRows != c.rows || c.glRows == 0) {
+        glNamedBufferData(c.gl, static_cast<GLsizeiptr>(words * 4), nullptr, GL_DYNAMIC_COPY);
+        c.glRows = c.rows;
+    }
+    if (c.rows == 0) return;
+    std::vector<uint32_t> staging(c.words());
+    toWords(c.hostCopy.data(), c.elem, c.rows, staging.data());
+    glNamedBufferSubData(c.gl, 0, static_cast<GLsizeiptr>(staging.size() * 4), staging.data());
+    transferred += staging.size() * 4;
+}
+
+void GlMemory::read(Buffer b, size_t first, size_t count, void* out) const {
+    Column& c = at(b);
+    if (!c.device) {
+        std::memcpy(out, c.hostCopy.data() + first * rt::elemSize(c.elem), count * rt::elemSize(c.elem));
+        return;
+    }
+    size_t w = wordsPerRow(c.elem);
+    std::vector<uint32_t> words(count * w);
+    if (count)
+        glGetNamedBufferSubData(c.gl, static_cast<GLintptr>(first * w * 4), static_cast<GLsizeiptr>(words.size() * 4),
+                                words.data());
+    transferred += words.size() * 4;
+    fromWords(words.data(), c.elem, count, out);
+}
+
+void GlMemory::write(Buffer b, size_t first, size_t count, const void* in) {
+    Column& c = at(b);
+    if (!c.device) {
+        std::memcpy(c.hostCopy.data() + first * rt::elemSize(c.elem), in, count * rt::elemSize(c.elem));
+        return;
+    }
+    size_t w = wordsPerRow(c.elem);
+    std::vector<uint32_t> words(count * w);
+    toWords(in, c.elem, count, words.data());
+    if (count)
+        glNamedBufferSubData(c.gl, static_cast<GLintptr>(first * w * 4), static_cast<GLsizeiptr>(words.size() * 4),
+                             words.data());
+    transferred += words.size() * 4;
+}
+
+void GlMemory::copy(Buffer from, size_t fromFirst, Buffer to, size_t toFirst, size_t count) {
+    Column &f = at(from), &t = at(to);
+    if (!f.device && !t.device) {
+        size_t e = rt::elemSize(f.elem);
+        std::memmove(t.hostCopy.data() + toFirst * e, f.hostCopy.data() + fromFirst * e, count * e);
+        return;
+    }
+    upload(f);
+    upload(t);
+    size_t w = wordsPerRow(f.elem) * 4;
+    if (count)
+        glCopyNamedBufferSubData(f.gl, t.gl, static_cast<GLintptr>(fromFirst * w), static_cast<GLintptr>(toFirst * w),
+                                 static_cast<GLsizeiptr>(count * w));
+    t.device = true;
+}
+
+// On the GPU, always: scatters fill pools' columns with what creation computed (state,
+// exports, parameters), which then stay on the GPU.
+void GlMemory::scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const uint32_t> rows) {
+    Column &f = at(from), &t = at(to);
+    if (rows.empty()) return;
+    upload(f);
+    upload(t);
+    if (!scatterProgram_) {
+        scatterProgram_ = scatterProgram();
+        glCreateBuffers(1, &rowsBuffer_);
+    }
+    glNamedBufferData(rowsBuffer_, static_cast<GLsizeiptr>(rows.size() * 4), rows.data(), GL_STREAM_DRAW);
+    transferred += rows.size() * 4;
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.gl);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, t.gl);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, rowsBuffer_);
+    glUseProgram(scatterProgram_);
+    glProgramUniform1ui(scatterProgram_, glGetUniformLocation(scatterProgram_, "count"), static_cast<GLuint>(rows.size()));
+    glProgramUniform1ui(scatterProgram_, glGetUniformLocation(scatterProgram_, "first"), static_cast<GLuint>(fromFirst));
+    glProgramUniform1ui(scatterProgram_, glGetUniformLocation(scatterProgram_, "w"),
+                        static_cast<GLuint>(wordsPerRow(f.elem)));
+    glDispatchCompute(static_cast<GLuint>((rows.size() + 63) / 64), 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    t.device = true;
+}
+
+void* GlMemory::host(Buffer b) {
+    Column& c = at(b);
+    toHost(c);
+    return c.hostCopy.data();
+}
+
+const void* GlMemory::view(Buffer b) const {
+    Column& c = at(b);
+    toHost(c);
+    return c.hostCopy.data();
+}
+
+bool GlMemory::onDevice(Buffer b) const { return at(b).device; }
+
+unsigned GlMemory::deviceBuffer(Buffer b) {
+    Column& c = at(b);
+    upload(c);
+    return c.gl;
+}
+
+void GlMemory::adopt(Buffer b, size_t first, size_t count, unsigned words, size_t word) {
+    Column& c = at(b);
+    upload(c);
+    size_t w = wordsPerRow(c.elem) * 4;
+    glCopyNamedBufferSubData(words, c.gl, static_cast<GLintptr>(word * 4), static_cast<GLintptr>(first * w),
+                             static_cast<GLsizeiptr>(count * w));
+    c.device = true;
+}
+
+size_t GlMemory::deviceBytes() const {
+    size_t bytes = 0;
+    for (const auto& c : columns_)
+        if (c && c->gl) bytes += std::max<size_t>(c->glRows * wordsPerRow(c->elem), 1) * 4;
+    return bytes;
+}
+
+}  // namespace psys::gpu

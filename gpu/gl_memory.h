@@ -1,0 +1,66 @@
+// The GLSL backend's memory: every column has a host copy and a GL buffer, and one of
+// them is the column's true value.
+//
+// A column starts on the host. It moves to the GPU when a kernel writes it there (an
+// object's state and exports: GlslBackend adopts them) or when a copy or scatter between
+// columns runs on the GPU; from then on steps leave it there. It comes back to the host
+// only when the host asks for its address (`host`, `view`), so the run-time's bookkeeping
+// reads what it needs and an object's state stays on the GPU from step to step. `read`
+// and `write` of a column on the GPU move only the rows they name.
+//
+// On the GPU a column is 32-bit words: one per row (f32, u32, u8 widened) or two (f64).
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "rt/memory.h"
+
+namespace psys::gpu {
+
+class GlMemory final : public rt::Memory {
+public:
+    GlMemory();
+    ~GlMemory() override;
+    rt::Buffer create(rt::Elem elem, size_t rows) override;
+    void resize(rt::Buffer buffer, size_t rows) override;
+    void release(rt::Buffer buffer) override;
+    size_t rows(rt::Buffer buffer) const override;
+    rt::Elem elem(rt::Buffer buffer) const override;
+    void read(rt::Buffer buffer, size_t first, size_t count, void* out) const override;
+    void write(rt::Buffer buffer, size_t first, size_t count, const void* in) override;
+    void copy(rt::Buffer from, size_t fromFirst, rt::Buffer to, size_t toFirst, size_t count) override;
+    void scatter(rt::Buffer from, size_t fromFirst, rt::Buffer to, std::span<const uint32_t> rows) override;
+    void* host(rt::Buffer buffer) override;
+    const void* view(rt::Buffer buffer) const override;
+
+    // For the backend's launches. Whether the column's value is on the GPU.
+    bool onDevice(rt::Buffer buffer) const;
+    // Its GL buffer, holding the column's value (uploaded first when it is on the host).
+    unsigned deviceBuffer(rt::Buffer buffer);
+    // The GPU wrote `count` rows from `first` into `words` (a GL buffer) at word `word`:
+    // they become the column's, and the column's value is on the GPU from now on.
+    void adopt(rt::Buffer buffer, size_t first, size_t count, unsigned words, size_t word);
+    // Bytes of GL buffers held.
+    size_t deviceBytes() const;
+    // Bytes moved between the host and the GPU so far, either way (the backend adds its
+    // launches' transfers).
+    mutable uint64_t transferred = 0;
+
+    static size_t wordsPerRow(rt::Elem e) { return e == rt::Elem::F64 ? 2 : 1; }
+
+private:
+    struct Column;
+    Column& at(rt::Buffer b) const;
+    void toHost(Column& c) const;      // the column's value to the host copy
+    void upload(Column& c) const;      // the host copy into the GL buffer (sized to the rows)
+    std::vector<std::unique_ptr<Column>> columns_;
+    std::vector<uint32_t> free_;
+    unsigned scatterProgram_ = 0, rowsBuffer_ = 0;
+};
+
+// Host rows to GPU words (u8 widened to a word) and back.
+void toWords(const void* from, rt::Elem e, size_t rows, uint32_t* to);
+void fromWords(const uint32_t* from, rt::Elem e, size_t rows, void* to);
+
+}  // namespace psys::gpu
