@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <iostream>
 #include <string>
 #include <thread>
@@ -25,47 +26,20 @@
 
 #include "codegen_llvm/llvm_backend.h"
 #include "driver/compile.h"
+#include "effects.h"
+#include "gpu_figures.h"
 #include "hand_written.h"
 #include "interp/interpreter.h"
 #include "rt/system.h"
 
 using namespace psys;
-using Clock = std::chrono::steady_clock;
+using bench::Clock;
+using bench::Effect;
+using bench::median;
+using bench::seconds;
+using bench::stateBytes;
 
 namespace {
-
-double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.empty() ? 0 : v[v.size() / 2];
-}
-
-// What an effect is: its sample, the extern that sets its size, the object type that
-// holds its particles, and how long it takes to reach its steady population.
-struct Effect {
-    std::string name;
-    std::string knob;
-    std::string particles;
-    int warmFrames;
-};
-
-const std::vector<Effect> kEffects = {
-    {"fountain", "population", "drop", 200},
-    {"fire", "rate", "part", 540},
-    {"fireworks", "sparks", "spark", 420},
-};
-
-ir::Module compile(const std::string& name) {
-    SourceManager sources;
-    DiagnosticEngine diags(sources);
-    auto module = compileFile(std::string(PSYS_SAMPLES_DIR) + "/" + name + ".psys", sources, diags, {});
-    if (!module) {
-        diags.print(std::cerr, false);
-        std::exit(1);
-    }
-    return std::move(*module);
-}
 
 // STREAM's triad, a[i] = b[i] + s·c[i] over arrays far larger than the caches: the
 // bandwidth a streaming loop can reach, in bytes per second (3 floats per element).
@@ -122,29 +96,6 @@ std::vector<Rate> timeInterleaved(const std::vector<std::function<size_t()>>& st
     return rates;
 }
 
-// The extern value that keeps about `particles` alive: populations are proportional to
-// it, so one short run at a small value tells.
-double calibrate(const Effect& e, codegen_llvm::LlvmBackend& jit, double particles) {
-    if (e.name == "fountain") return particles;
-    double probe = e.name == "fire" ? 2000 : 200;
-    rt::System system(compile(e.name), jit);
-    float value = static_cast<float>(probe);
-    system.setExtern(e.knob, {&value, 1});
-    for (int f = 0; f < e.warmFrames; ++f) system.step(1.0 / 60);
-    double live = static_cast<double>(system.pool(static_cast<size_t>(system.typeIndex(e.particles))).live());
-    return probe * particles / std::max(live, 1.0);
-}
-
-// Bytes the pool's update loop must read and write per particle: every state slot read
-// and written, every kept parameter read.
-double stateBytes(const ir::Object& o) {
-    double bytes = 0;
-    for (const auto& s : o.state) bytes += 2 * 4 * s.type.width;
-    for (const auto& p : o.params)
-        if (p.kept) bytes += 4 * p.type.width;
-    return bytes;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -155,6 +106,7 @@ int main(int argc, char** argv) {
     double interpParticles = 1e5;
     size_t triadElements = size_t{1} << 26;
     bool skipCompile = false;
+    bool gpuToo = false;
     int compileRuns = 5;
     app.add_option("--particles", sizes, "Live particles per effect (1e6 1e7)");
     app.add_option("--frames", frames, "Timed steps per measurement; the median counts (15)")->check(CLI::Range(5, 100000));
@@ -162,6 +114,7 @@ int main(int argc, char** argv) {
     app.add_option("--interp-particles", interpParticles, "Live particles for the interpreter (1e5)");
     app.add_option("--triad-elements", triadElements, "Floats per STREAM array (2^26)");
     app.add_flag("--skip-compile", skipCompile, "Leave out the compile times");
+    app.add_flag("--gpu", gpuToo, "Also run the GLSL backend on each effect and size, beside the JIT");
     app.add_option("--compile-runs", compileRuns, "Compiles per sample; the median counts (5)")->check(CLI::PositiveNumber);
     CLI11_PARSE(app, argc, argv);
 
@@ -174,20 +127,21 @@ int main(int argc, char** argv) {
                              bandwidthAll / 1e9, cores);
 
     std::string breakdown;
+    std::map<std::pair<std::string, double>, Rate> jitAllCores;  // for --gpu
     std::cout << "| effect | live | threads | psys JIT | hand SoA | hand AoS | JIT / SoA | JIT / AoS | bound | JIT / bound |\n";
     std::cout << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const std::string& name : effects) {
-        auto effect = std::find_if(kEffects.begin(), kEffects.end(), [&](const Effect& e) { return e.name == name; });
-        if (effect == kEffects.end()) {
+        const Effect* effect = bench::findEffect(name);
+        if (!effect) {
             std::cerr << "psys_bench: no effect `" << name << "`\n";
             return 2;
         }
         for (double particles : sizes) {
-            double knob = calibrate(*effect, jit, particles);
+            double knob = bench::calibrate(*effect, jit, particles);
             auto capacity = static_cast<size_t>(particles * 1.5) + 1024;
             rt::SystemOptions options;
             options.capacity = capacity;
-            rt::System system(compile(name), jit, options);
+            rt::System system(bench::compileEffect(name), jit, options);
             float value = static_cast<float>(knob);
             system.setExtern(effect->knob, {&value, 1});
             auto type = static_cast<size_t>(system.typeIndex(effect->particles));
@@ -220,6 +174,7 @@ int main(int argc, char** argv) {
                     frames);
                 rt::Stats after = system.stats();
                 Rate j = rates[0], s = rates[1], a = rates[2];
+                if (threads == cores) jitAllCores[{name, particles}] = j;
                 double steps = static_cast<double>(after.steps - before.steps);
                 breakdown += fmt::format("| {} | {:.2g} | {} | {:.2f} | {:.2f} | {:.2f} | {:.2g} / {:.2g} |\n", name, j.live,
                                          threads, (after.loopSeconds - before.loopSeconds) * 1e3 / steps,
@@ -241,15 +196,39 @@ int main(int argc, char** argv) {
                  "|---|---:|---:|---:|---:|---:|---:|\n"
               << breakdown << "\n";
 
+    if (gpuToo) {
+        std::string error;
+        auto gpu = gpu::GlslBackend::create(error);
+        if (!gpu) {
+            std::cerr << "psys_bench: --gpu: " << error << "\n";
+            return 1;
+        }
+        std::cout << fmt::format("The GLSL backend on {} beside the JIT on {} cores (psys_gpu_bench has the passes):\n\n",
+                                 gpu->report().target, cores)
+                  << "| effect | live | JIT (M/s) | GLSL (M/s) | GLSL / JIT | GLSL update pass (ms) |\n|---|---:|---:|---:|---:|---:|\n";
+        for (const std::string& name : effects)
+            for (double particles : sizes) {
+                bench::GpuFigures g = bench::measureGpu(*bench::findEffect(name), particles, frames, *gpu);
+                Rate j = jitAllCores[{name, particles}];
+                std::cout << fmt::format("| {} | {:.2g} | {:.0f} | {:.1f} | {:.3f} | {:.2f}{} |\n", name, g.live,
+                                         j.perSecond / 1e6, g.perSecond / 1e6, g.perSecond / j.perSecond,
+                                         g.updateMilliseconds, g.wallPasses ? " (wall)" : "");
+                std::cout.flush();
+            }
+        if (gpu->report().target.find("llvmpipe") != std::string::npos)
+            std::cout << "\n(llvmpipe runs the shaders on the CPU: its figures say the backend works, not how fast a GPU runs it)\n";
+        std::cout << "\n";
+    }
+
     // The interpreter, on fewer particles (its rate hardly depends on how many).
     std::cout << "| effect | live | interpreter (1 thread) | JIT (1 thread) | JIT / interpreter |\n|---|---:|---:|---:|---:|\n";
     for (const std::string& name : effects) {
-        const Effect& effect = *std::find_if(kEffects.begin(), kEffects.end(), [&](const Effect& e) { return e.name == name; });
-        double knob = calibrate(effect, jit, interpParticles);
+        const Effect& effect = *bench::findEffect(name);
+        double knob = bench::calibrate(effect, jit, interpParticles);
         interp::Interpreter interpreter;
         rt::SystemOptions options;
         options.threads = 1;
-        rt::System slow(compile(name), interpreter, options), fast(compile(name), jit, options);
+        rt::System slow(bench::compileEffect(name), interpreter, options), fast(bench::compileEffect(name), jit, options);
         float value = static_cast<float>(knob);
         slow.setExtern(effect.knob, {&value, 1});
         fast.setExtern(effect.knob, {&value, 1});
@@ -285,7 +264,7 @@ int main(int argc, char** argv) {
         size_t kernels = 0;
         for (int run = 0; run < compileRuns; ++run) {
             auto start = Clock::now();
-            ir::Module module = compile(path.stem().string());
+            ir::Module module = bench::compileEffect(path.stem().string());
             auto compiled = Clock::now();
             codegen_llvm::LlvmBackend backend;
             rt::System system(std::move(module), backend);

@@ -35,7 +35,7 @@ struct GlMemory::Column {
     size_t rows = 0;
     std::vector<uint8_t> hostCopy;
     GLuint gl = 0;
-    size_t glRows = 0;    // rows the GL buffer holds
+    size_t glRows = 0;    // rows the GL buffer has room for (pools grow a row at a time: doubled)
     bool device = false;  // the value is the GL buffer's (the host copy is stale)
     bool live = false;
     size_t words() const { return rows * wordsPerRow(elem); }
@@ -106,16 +106,22 @@ void GlMemory::resize(Buffer b, size_t rows) {
     Column& c = at(b);
     if (c.device) {  // grown or shrunk on the GPU: the column stays there
         size_t w = wordsPerRow(c.elem);
-        GLuint grown = 0;
-        glCreateBuffers(1, &grown);
-        glNamedBufferData(grown, static_cast<GLsizeiptr>(std::max<size_t>(rows * w, 1) * 4), nullptr, GL_DYNAMIC_COPY);
-        uint32_t zero = 0;
-        glClearNamedBufferData(grown, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
-        size_t kept = std::min(rows, c.rows) * w * 4;
-        if (kept) glCopyNamedBufferSubData(c.gl, grown, 0, 0, static_cast<GLsizeiptr>(kept));
-        glDeleteBuffers(1, &c.gl);
-        c.gl = grown;
-        c.glRows = rows;
+        if (rows > c.glRows) {
+            size_t room = std::max(rows, 2 * c.glRows);
+            GLuint grown = 0;
+            glCreateBuffers(1, &grown);
+            glNamedBufferData(grown, static_cast<GLsizeiptr>(room * w * 4), nullptr, GL_DYNAMIC_COPY);
+            if (c.rows) glCopyNamedBufferSubData(c.gl, grown, 0, 0, static_cast<GLsizeiptr>(c.rows * w * 4));
+            glDeleteBuffers(1, &c.gl);
+            c.gl = grown;
+            c.glRows = room;
+        }
+        if (rows > c.rows) {  // new rows are zero
+            uint32_t zero = 0;
+            glClearNamedBufferSubData(c.gl, GL_R32UI, static_cast<GLintptr>(c.rows * w * 4),
+                                      static_cast<GLsizeiptr>((rows - c.rows) * w * 4), GL_RED_INTEGER, GL_UNSIGNED_INT,
+                                      &zero);
+        }
     }
     c.hostCopy.resize(rows * rt::elemSize(c.elem), 0);
     c.rows = rows;
@@ -148,9 +154,11 @@ void GlMemory::upload(Column& c) const {
     if (c.device) return;
     size_t words = std::max<size_t>(c.words(), 1);
     if (!c.gl) glCreateBuffers(1, &c.gl);
-    if (c.glRows != c.rows || c.glRows == 0) {
+    if (c.glRows < c.rows || c.glRows == 0) {
+        size_t room = std::max(c.rows, 2 * c.glRows);
+        words = std::max<size_t>(room * wordsPerRow(c.elem), 1);
         glNamedBufferData(c.gl, static_cast<GLsizeiptr>(words * 4), nullptr, GL_DYNAMIC_COPY);
-        c.glRows = c.rows;
+        c.glRows = std::max<size_t>(room, 1);
     }
     if (c.rows == 0) return;
     std::vector<uint32_t> staging(c.words());

@@ -241,14 +241,22 @@ std::pair<uint32_t, uint32_t> GlslBackend::dispatch(Program& program, const std:
     size_t groups = (count + codegen_glsl::kWorkGroupSize - 1) / codegen_glsl::kWorkGroupSize;
     size_t x = std::min<size_t>(groups, codegen_glsl::kMaxGroupsX);
     size_t y = (groups + x - 1) / x;
-    if (timing_) glBeginQuery(GL_TIME_ELAPSED, query_);
+    auto start = std::chrono::steady_clock::now();
+    if (timing_) {
+        glFinish();
+        start = std::chrono::steady_clock::now();
+        glBeginQuery(GL_TIME_ELAPSED, query_);
+    }
     glDispatchCompute(static_cast<GLuint>(x), static_cast<GLuint>(y), 1);
     if (timing_) {
         glEndQuery(GL_TIME_ELAPSED);
+        glFinish();
+        double wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         GLuint64 ns = 0;
         glGetQueryObjectui64v(query_, GL_QUERY_RESULT, &ns);
         PassTime& t = passTimes_[pass];
         t.milliseconds += static_cast<double>(ns) * 1e-6;
+        t.wallMilliseconds += wall;
         t.launches += 1;
         t.rows += count;
     }

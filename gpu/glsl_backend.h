@@ -35,9 +35,12 @@ public:
     void run(const rt::ChildrenLaunch& launch) override;
     rt::BackendReport report() const override;
 
-    // GPU time of the launches so far (GL timer queries), by kernel kind name.
+    // Time of the launches so far while timePasses is on, by kernel kind name: on the GPU
+    // (GL timer queries), and on the wall from a glFinish before the dispatch to one after
+    // (what a GL whose timer does not see its compute work, as llvmpipe's, can give).
     struct PassTime {
         double milliseconds = 0;
+        double wallMilliseconds = 0;
         size_t launches = 0;
         size_t rows = 0;
     };

@@ -53,7 +53,7 @@ TEST_CASE("backends by name") {
         REQUIRE(backend);
         CHECK((*backend)->name() == name);
     }
-    CHECK(host::makeBackend({"vulkan", "fast"}).error == "there is no backend `vulkan`; the backends are llvm, interp");
+    CHECK(host::makeBackend({"vulkan", "fast"}).error == "there is no backend `vulkan`; the backends are llvm, interp, glsl");
     CHECK(host::makeBackend({"llvm", "sloppy"}).error == "the maths is fast or exact, not `sloppy`");
 }
 
@@ -108,4 +108,27 @@ TEST_CASE("a session moves to another backend without losing a step: llvm (exact
     CHECK(moving->backend().name() == "interp");
     CHECK(test::drawnBytes(moving->system(), 120) == test::drawnBytes(straight->system(), 120));
     CHECK(moving->switchBackend({"nope", "fast"}).value().find("there is no backend") == 0);
+}
+
+TEST_CASE("a session moves onto the GPU backend and back without losing a step") {
+    // The fireworks compute only + − × ÷ and draws: bit for bit on the GPU (docs/gpu.md).
+    std::string text;
+    {
+        std::ifstream in(std::string(PSYS_SAMPLES_DIR) + "/fireworks.psys");
+        text.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    host::SessionOptions reference;
+    reference.backend = {"interp", "fast"};
+    host::CompileResult compiled;
+    std::string error;
+    auto moving = host::Session::open("fireworks.psys", reference, compiled, error, &text);
+    auto straight = host::Session::open("fireworks.psys", reference, compiled, error, &text);
+    REQUIRE(moving);
+    REQUIRE(straight);
+    CHECK(test::drawnBytes(moving->system(), 60) == test::drawnBytes(straight->system(), 60));
+    REQUIRE_FALSE(moving->switchBackend({"glsl", "fast"}));
+    CHECK(moving->backend().name() == "glsl");
+    CHECK(test::drawnBytes(moving->system(), 120) == test::drawnBytes(straight->system(), 120));
+    REQUIRE_FALSE(moving->switchBackend({"interp", "fast"}));
+    CHECK(test::drawnBytes(moving->system(), 60) == test::drawnBytes(straight->system(), 60));
 }

@@ -1,0 +1,65 @@
+// psys_gpu_bench: the GLSL backend alone, on the GPU of the machine it runs on (or Mesa's
+// llvmpipe where there is none): million particle updates per second for the fountain,
+// the fire and the fireworks, the GPU time of each pass (GL timer queries), and the
+// update pass's bytes per particle ÷ its time, to hold against the card's bandwidth.
+//
+// It links no LLVM: it is built to be copied, with the few shared libraries `ldd` lists,
+// to a GPU machine that has none of this build (docs/gpu.md).
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "gpu_figures.h"
+
+using namespace psys;
+
+int main(int argc, char** argv) {
+    CLI::App app("psys_gpu_bench: the GLSL backend's particle updates per second");
+    std::vector<double> sizes = {1e6, 1e7};
+    int frames = 15;
+    std::vector<std::string> effects = {"fountain", "fire", "fireworks"};
+    app.add_option("--particles", sizes, "Live particles per effect (1e6 1e7)");
+    app.add_option("--frames", frames, "Timed steps per figure; the median counts (15)")->check(CLI::Range(3, 100000));
+    app.add_option("--effects", effects, "fountain fire fireworks");
+    CLI11_PARSE(app, argc, argv);
+
+    std::string error;
+    auto gpu = gpu::GlslBackend::create(error);
+    if (!gpu) {
+        std::cerr << "psys_gpu_bench: " << error << "\n";
+        return 1;
+    }
+    std::string renderer = gpu->report().target;
+    std::cout << fmt::format("# psys_gpu_bench on {}, {} timed steps per figure (median)\n", renderer, frames);
+    if (renderer.find("llvmpipe") != std::string::npos)
+        std::cout << "# llvmpipe computes the shaders on the CPU: these figures say the backend works, not how fast a "
+                     "GPU runs it\n";
+    std::cout << "\n| effect | live | step (ms) | M updates/s | update pass (ms) | other passes (ms) | state B/particle | "
+                 "update pass GB/s | host↔GPU B/particle/step |\n|---|---:|---:|---:|---:|---|---:|---:|---:|\n";
+    for (const std::string& name : effects) {
+        const bench::Effect* effect = bench::findEffect(name);
+        if (!effect) {
+            std::cerr << "psys_gpu_bench: no effect `" << name << "`\n";
+            return 2;
+        }
+        for (double particles : sizes) {
+            bench::GpuFigures f = bench::measureGpu(*effect, particles, frames, *gpu);
+            std::string others;
+            for (const auto& [pass, ms] : f.passMilliseconds)
+                if (pass != "update") others += fmt::format("{}{} {:.2f}", others.empty() ? "" : ", ", pass, ms);
+            double gbs = f.updateMilliseconds > 0 ? f.stateBytes * f.live / (f.updateMilliseconds * 1e-3) / 1e9 : 0;
+            std::cout << fmt::format("| {} | {:.2g} | {:.2f} | {:.1f} | {:.2f}{} | {} | {:.0f} | {:.1f} | {:.1f} |\n", name,
+                                     f.live, f.stepSeconds * 1e3, f.perSecond / 1e6, f.updateMilliseconds,
+                                     f.wallPasses ? " (wall)" : "", others,
+                                     f.stateBytes, gbs, f.transferBytes);
+            std::cout.flush();
+        }
+    }
+    std::cout << "\n(passes: GPU time from GL timer queries, or \"wall\": from a glFinish before the pass to one after, "
+                 "where the GL's timer does not see compute work; state B/particle: what the update pass must read and "
+                 "write; update pass GB/s: that ÷ the pass's time)\n";
+    return 0;
+}

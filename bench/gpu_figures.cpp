@@ -1,0 +1,53 @@
+#include "gpu_figures.h"
+
+#include "rt/system.h"
+
+namespace psys::bench {
+
+GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::GlslBackend& gpu) {
+    double knob = calibrate(effect, gpu, particles);
+    rt::SystemOptions options;
+    options.capacity = static_cast<size_t>(particles * 1.5) + 1024;
+    rt::System system(compileEffect(effect.name), gpu, options);
+    float value = static_cast<float>(knob);
+    system.setExtern(effect.knob, {&value, 1});
+    auto type = static_cast<size_t>(system.typeIndex(effect.particles));
+    for (int f = 0; f < effect.warmFrames; ++f) system.step(1.0 / 60);
+    GpuFigures out;
+    out.stateBytes = stateBytes(system.module().objects[type]);
+    // Wall times with the GPU untimed (a timer query waits for its pass), then the passes.
+    std::vector<double> times;
+    double live = 0;
+    uint64_t transferred = gpu.transferredBytes();
+    for (int f = 0; f < frames; ++f) {
+        auto start = Clock::now();
+        system.step(1.0 / 60);
+        times.push_back(seconds(start, Clock::now()));
+        live += static_cast<double>(system.pool(type).live());
+    }
+    out.live = live / frames;
+    out.transferBytes = static_cast<double>(gpu.transferredBytes() - transferred) / frames / std::max(out.live, 1.0);
+    out.stepSeconds = median(times);
+    out.perSecond = out.live / out.stepSeconds;
+    auto before = gpu.passTimes();
+    gpu.timePasses(true);
+    int timed = std::max(1, frames / 3);
+    for (int f = 0; f < timed; ++f) system.step(1.0 / 60);
+    gpu.timePasses(false);
+    double gpuTotal = 0, wallTotal = 0;
+    for (const auto& [pass, t] : gpu.passTimes()) {
+        gpuTotal += t.milliseconds - (before.count(pass) ? before.at(pass).milliseconds : 0);
+        wallTotal += t.wallMilliseconds - (before.count(pass) ? before.at(pass).wallMilliseconds : 0);
+    }
+    // Where the GL's timer sees (almost) nothing of the compute work, the wall times.
+    out.wallPasses = gpuTotal < 0.01 * wallTotal;
+    for (const auto& [pass, t] : gpu.passTimes()) {
+        const auto* b = before.count(pass) ? &before.at(pass) : nullptr;
+        double ms = out.wallPasses ? t.wallMilliseconds - (b ? b->wallMilliseconds : 0) : t.milliseconds - (b ? b->milliseconds : 0);
+        out.passMilliseconds[pass] = ms / timed;
+    }
+    out.updateMilliseconds = out.passMilliseconds.count("update") ? out.passMilliseconds["update"] : 0;
+    return out;
+}
+
+}  // namespace psys::bench

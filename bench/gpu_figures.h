@@ -1,0 +1,27 @@
+// The GLSL backend on one effect at one size: what psys_gpu_bench prints and psys_bench
+// --gpu sets beside the JIT.
+#pragma once
+
+#include <map>
+#include <string>
+
+#include "effects.h"
+#include "gpu/glsl_backend.h"
+
+namespace psys::bench {
+
+struct GpuFigures {
+    double live = 0;
+    double stepSeconds = 0;        // median wall time of a step (everything, host included)
+    double perSecond = 0;          // particle updates per second: live ÷ stepSeconds
+    double updateMilliseconds = 0; // GPU time of the update pass per step (timer queries)
+    std::map<std::string, double> passMilliseconds;  // every pass, per step
+    bool wallPasses = false;       // the passes' times are wall times (the GL's timer saw nothing)
+    double stateBytes = 0;         // per particle, what the update pass must read and write
+    double transferBytes = 0;      // per particle per step, between the host and the GPU
+};
+
+// Runs `effect` to its steady population of about `particles` on `gpu`, then times `frames` steps.
+GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::GlslBackend& gpu);
+
+}  // namespace psys::bench
