@@ -11,6 +11,7 @@
 
 #include "codegen_glsl/glsl_shaders.h"
 #include "gpu/gl_context.h"
+#include "gpu/compact.h"
 #include "gpu/gl_memory.h"
 
 namespace psys::gpu {
@@ -275,7 +276,7 @@ rt::RowsResult GlslBackend::run(const rt::RowsLaunch& launch) {
         Buffer b = launch.columns[static_cast<size_t>(c)];
         perRow += b.valid() ? GlMemory::wordsPerRow(memory_.elem(b)) : 1;  // at most
     }
-    size_t rows = std::max<size_t>(1, maxWords_ / (perRow + 1));
+    size_t rows = std::clamp<size_t>(maxWords_ / (perRow + 1), 1, size_t{codegen_glsl::kMaxGroupsX} * kCompactGroup);
     rt::RowsResult result;
     for (size_t begin = launch.begin; begin < launch.end; begin += rows) {
         rt::RowsResult r = runRows(launch, p, begin, std::min(launch.end, begin + rows));
@@ -352,6 +353,15 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
     for (int c : p.returned) {
         Buffer b = launch.columns[static_cast<size_t>(c)];
         if (!b.valid()) continue;
+        if (c == ColumnLayout::kKill) {  // the rows killed, compacted on the GPU
+            size_t word = block[LaunchBlock::kColumns + ColumnLayout::kKill];
+            std::vector<uint32_t> rows = compactor_.flagged(words_, word, n, killed);
+            memory_.transferred += rows.size() * 4;
+            auto* kill = static_cast<uint8_t*>(memory_.host(b)) + begin;
+            std::memset(kill, 0, n);
+            for (uint32_t r : rows) kill[r] = 1;
+            continue;
+        }
         size_t word = block[LaunchBlock::kColumns + static_cast<size_t>(c)];
         Elem e = memory_.elem(b);
         staging_.resize(n * GlMemory::wordsPerRow(e));

@@ -5,7 +5,8 @@
 // Where the columns live (gpu/gl_memory.h): an object's state and exports stay on the GPU
 // from step to step; the run-time's bookkeeping (kills, emissions, creation, parents) runs
 // on the host, so a launch takes the masks, ids and creation times from the host and
-// gives back the kill flags, emissions and what is drawn (docs/gpu.md).
+// gives back the rows killed (compacted on the GPU: gpu/compact.h), emissions and what
+// is drawn (docs/gpu.md).
 #pragma once
 
 #include <map>
@@ -14,6 +15,7 @@
 #include <tuple>
 #include <vector>
 
+#include "gpu/compact.h"
 #include "gpu/gl_memory.h"
 #include "rt/backend.h"
 
@@ -66,6 +68,7 @@ private:
 
     std::unique_ptr<HeadlessContext> context_;
     GlMemory memory_;
+    Compactor compactor_;
     std::map<RowsKey, std::unique_ptr<Program>> rows_;
     std::map<const ir::Kernel*, std::unique_ptr<Program>> children_;
     unsigned words_ = 0, counts_ = 0, block_ = 0, query_ = 0;

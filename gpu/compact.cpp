@@ -1,0 +1,167 @@
+#include "gpu/compact.h"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include <epoxy/gl.h>
+
+namespace psys::gpu {
+
+namespace {
+
+// The flags at words[first + i]; per group, its count.
+const char* kCount = R"(#version 450
+layout(local_size_x = 256) in;
+layout(std430, binding = 0) readonly buffer Words { uint w[]; };
+layout(std430, binding = 1) buffer Groups { uint groups[]; };
+uniform uint first, n;
+shared uint total;
+void main() {
+    if (gl_LocalInvocationID.x == 0u) total = 0u;
+    barrier();
+    uint i = gl_GlobalInvocationID.x;
+    if (i < n && w[first + i] != 0u) atomicAdd(total, 1u);
+    barrier();
+    if (gl_LocalInvocationID.x == 0u) groups[gl_WorkGroupID.x] = total;
+}
+)";
+
+// Exclusive prefix sums of the groups' counts, in place: invocation t sums a run of
+// groups, a scan of the 256 runs in shared memory, then each run is rewritten.
+const char* kScan = R"(#version 450
+layout(local_size_x = 256) in;
+layout(std430, binding = 1) buffer Groups { uint groups[]; };
+uniform uint count;
+shared uint runs[256];
+void main() {
+    uint t = gl_LocalInvocationID.x;
+    uint per = (count + 255u) / 256u;
+    uint begin = min(t * per, count), end = min(begin + per, count);
+    uint sum = 0u;
+    for (uint g = begin; g < end; ++g) sum += groups[g];
+    runs[t] = sum;
+    barrier();
+    for (uint step = 1u; step < 256u; step *= 2u) {  // inclusive scan (Hillis and Steele)
+        uint add = t >= step ? runs[t - step] : 0u;
+        barrier();
+        runs[t] += add;
+        barrier();
+    }
+    uint offset = runs[t] - sum;
+    for (uint g = begin; g < end; ++g) {
+        uint c = groups[g];
+        groups[g] = offset;
+        offset += c;
+    }
+}
+)";
+
+// Each group's set rows at its offset, in order.
+const char* kWrite = R"(#version 450
+layout(local_size_x = 256) in;
+layout(std430, binding = 0) readonly buffer Words { uint w[]; };
+layout(std430, binding = 1) readonly buffer Groups { uint groups[]; };
+layout(std430, binding = 2) writeonly buffer List { uint list[]; };
+uniform uint first, n;
+shared uint prefix[256];
+void main() {
+    uint t = gl_LocalInvocationID.x, i = gl_GlobalInvocationID.x;
+    uint flag = i < n && w[first + i] != 0u ? 1u : 0u;
+    prefix[t] = flag;
+    barrier();
+    for (uint step = 1u; step < 256u; step *= 2u) {
+        uint add = t >= step ? prefix[t - step] : 0u;
+        barrier();
+        prefix[t] += add;
+        barrier();
+    }
+    if (flag != 0u) list[groups[gl_WorkGroupID.x] + prefix[t] - 1u] = i;
+}
+)";
+
+GLuint program(const char* source) {
+    GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
+    glShaderSource(shader, 1, &source, nullptr);
+    glCompileShader(shader);
+    GLint ok = 0;
+    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    if (!ok) throw std::runtime_error("the GL did not compile a compaction shader");
+    GLuint p = glCreateProgram();
+    glAttachShader(p, shader);
+    glLinkProgram(p);
+    glDeleteShader(shader);
+    return p;
+}
+
+void setUint(GLuint p, const char* name, size_t value) {
+    glProgramUniform1ui(p, glGetUniformLocation(p, name), static_cast<GLuint>(value));
+}
+
+void grow(GLuint buffer, size_t& capacity, size_t words) {
+    if (words <= capacity) return;
+    capacity = std::max(words, 2 * capacity);
+    glNamedBufferData(buffer, static_cast<GLsizeiptr>(capacity * 4), nullptr, GL_DYNAMIC_COPY);
+}
+
+}  // namespace
+
+Compactor::Compactor() = default;
+
+Compactor::~Compactor() {
+    for (GLuint p : {count_, scan_, write_})
+        if (p) glDeleteProgram(p);
+    GLuint buffers[] = {groups_, list_};
+    if (groups_) glDeleteBuffers(2, buffers);
+}
+
+std::vector<uint32_t> Compactor::flagged(unsigned words, size_t word, size_t n, size_t set) {
+    std::vector<uint32_t> rows(set);
+    if (set == 0 || n == 0) return rows;
+    if (!count_) {
+        count_ = program(kCount);
+        scan_ = program(kScan);
+        write_ = program(kWrite);
+        glCreateBuffers(1, &groups_);
+        glCreateBuffers(1, &list_);
+    }
+    size_t groups = (n + kCompactGroup - 1) / kCompactGroup;
+    grow(groups_, groupsCapacity_, groups);
+    grow(list_, listCapacity_, set);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, words);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, groups_);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, list_);
+    for (GLuint p : {count_, write_}) {
+        setUint(p, "first", word);
+        setUint(p, "n", n);
+    }
+    setUint(scan_, "count", groups);
+    glUseProgram(count_);
+    glDispatchCompute(static_cast<GLuint>(groups), 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glUseProgram(scan_);
+    glDispatchCompute(1, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glUseProgram(write_);
+    glDispatchCompute(static_cast<GLuint>(groups), 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glGetNamedBufferSubData(list_, 0, static_cast<GLsizeiptr>(set * 4), rows.data());
+    return rows;
+}
+
+}  // namespace psys::gpu
+
+namespace psys::gpu {
+
+std::vector<uint32_t> Compactor::flagged(std::span<const uint32_t> flags) {
+    size_t set = 0;
+    for (uint32_t f : flags) set += f != 0;
+    GLuint buffer = 0;
+    glCreateBuffers(1, &buffer);
+    glNamedBufferData(buffer, static_cast<GLsizeiptr>(std::max<size_t>(flags.size(), 1) * 4), flags.data(), GL_STATIC_DRAW);
+    std::vector<uint32_t> rows = flagged(buffer, 0, flags.size(), set);
+    glDeleteBuffers(1, &buffer);
+    return rows;
+}
+
+}  // namespace psys::gpu
