@@ -1,5 +1,7 @@
 #include "gpu/compact.h"
 
+#include "gpu/gl_context.h"
+
 #include <algorithm>
 #include <stdexcept>
 #include <string>
@@ -80,20 +82,6 @@ void main() {
 }
 )";
 
-GLuint program(const char* source) {
-    GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
-    glShaderSource(shader, 1, &source, nullptr);
-    glCompileShader(shader);
-    GLint ok = 0;
-    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-    if (!ok) throw std::runtime_error("the GL did not compile a compaction shader");
-    GLuint p = glCreateProgram();
-    glAttachShader(p, shader);
-    glLinkProgram(p);
-    glDeleteShader(shader);
-    return p;
-}
-
 void setUint(GLuint p, const char* name, size_t value) {
     glProgramUniform1ui(p, glGetUniformLocation(p, name), static_cast<GLuint>(value));
 }
@@ -119,9 +107,9 @@ std::vector<uint32_t> Compactor::flagged(unsigned words, size_t word, size_t n, 
     std::vector<uint32_t> rows(set);
     if (set == 0 || n == 0) return rows;
     if (!count_) {
-        count_ = program(kCount);
-        scan_ = program(kScan);
-        write_ = program(kWrite);
+        count_ = computeProgram(kCount, "compaction (counts)");
+        scan_ = computeProgram(kScan, "compaction (scan)");
+        write_ = computeProgram(kWrite, "compaction (rows)");
         glCreateBuffers(1, &groups_);
         glCreateBuffers(1, &list_);
     }

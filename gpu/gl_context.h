@@ -28,6 +28,10 @@ private:
 // Whether the calling thread has a current EGL context (the viewer's, for one).
 bool contextCurrent();
 
+// A linked program of one compute shader; throws std::runtime_error with the GL's log,
+// naming `what`, when the GL does not compile or link it (a fault of ours, not the user's).
+unsigned computeProgram(const std::string& source, const std::string& what);
+
 // "llvmpipe (LLVM 15.0.6, 256 bits), OpenGL 4.5 (Core Profile) Mesa 22.3.6", …
 std::string rendererName();
 

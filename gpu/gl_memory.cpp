@@ -1,5 +1,7 @@
 #include "gpu/gl_memory.h"
 
+#include "gpu/gl_context.h"
+
 #include <algorithm>
 #include <cstring>
 #include <stdexcept>
@@ -56,20 +58,6 @@ void main() {
     for (uint k = 0u; k < w; ++k) to[rows[i] * w + k] = from[(first + i) * w + k];
 }
 )";
-
-GLuint scatterProgram() {
-    GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
-    glShaderSource(shader, 1, &kScatter, nullptr);
-    glCompileShader(shader);
-    GLint ok = 0;
-    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-    if (!ok) throw std::runtime_error("the GL did not compile the scatter shader");
-    GLuint program = glCreateProgram();
-    glAttachShader(program, shader);
-    glLinkProgram(program);
-    glDeleteShader(shader);
-    return program;
-}
 
 }  // namespace
 
@@ -221,7 +209,7 @@ void GlMemory::scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const
     upload(f);
     upload(t);
     if (!scatterProgram_) {
-        scatterProgram_ = scatterProgram();
+        scatterProgram_ = computeProgram(kScatter, "scatter");
         glCreateBuffers(1, &rowsBuffer_);
     }
     glNamedBufferData(rowsBuffer_, static_cast<GLsizeiptr>(rows.size() * 4), rows.data(), GL_STREAM_DRAW);

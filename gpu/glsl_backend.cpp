@@ -40,6 +40,19 @@ void putDouble(std::vector<uint32_t>& block, uint32_t word, double x) {
     block[word + 1] = static_cast<uint32_t>(b >> 32);
 }
 
+// The words every launch block starts with.
+std::vector<uint32_t> blockHeader(const LaunchBlock& layout, size_t count, const rt::Clock& clock, uint32_t seed,
+                                  uint32_t draw) {
+    std::vector<uint32_t> block(layout.words + 4, 0);
+    block[LaunchBlock::kCount] = static_cast<uint32_t>(count);
+    putDouble(block, LaunchBlock::kNow, clock.nowValue);
+    block[LaunchBlock::kDt] = bits(clock.dtValue);
+    block[LaunchBlock::kFirst] = clock.first ? 1 : 0;
+    block[LaunchBlock::kSeed] = seed;
+    block[LaunchBlock::kDraw] = draw;
+    return block;
+}
+
 void putValue(std::vector<uint32_t>& block, uint32_t word, const rt::Value& v) {
     for (size_t c = 0; c < 4; ++c) block[word + c] = bits(v.f[c]);
 }
@@ -139,32 +152,8 @@ GlslBackend::~GlslBackend() {
 
 GlslBackend::Program GlslBackend::compile(const std::string& source, const std::string& what) {
     auto start = std::chrono::steady_clock::now();
-    GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
-    const char* text = source.c_str();
-    glShaderSource(shader, 1, &text, nullptr);
-    glCompileShader(shader);
-    GLint ok = 0;
-    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-    auto log = [](GLuint object, bool isProgram) {
-        GLint length = 0;
-        isProgram ? glGetProgramiv(object, GL_INFO_LOG_LENGTH, &length) : glGetShaderiv(object, GL_INFO_LOG_LENGTH, &length);
-        std::string text(static_cast<size_t>(std::max(length, 1)), '\0');
-        isProgram ? glGetProgramInfoLog(object, length, nullptr, text.data())
-                  : glGetShaderInfoLog(object, length, nullptr, text.data());
-        return text;
-    };
-    if (!ok) {
-        std::string message = log(shader, false);
-        glDeleteShader(shader);
-        throw std::runtime_error("the GL did not compile the shader of " + what + ":\n" + message);
-    }
     Program p;
-    p.program = glCreateProgram();
-    glAttachShader(p.program, shader);
-    glLinkProgram(p.program);
-    glDeleteShader(shader);
-    glGetProgramiv(p.program, GL_LINK_STATUS, &ok);
-    if (!ok) throw std::runtime_error("the GL did not link the shader of " + what + ":\n" + log(p.program, true));
+    p.program = computeProgram(source, what);
     ++kernels_;
     compileSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return p;
@@ -296,7 +285,7 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
         size_t word;
     };
     std::vector<Slot> slots;
-    std::vector<uint32_t> block(p.block.words + 4, 0);
+    std::vector<uint32_t> block = blockHeader(p.block, n, launch.clock, launch.seed, launch.draw);
     size_t words = n;  // the zeros first
     auto place = [&](Buffer b) -> size_t {
         if (!b.valid()) return 0;
@@ -335,12 +324,6 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
         memory_.transferred += n * w * 4;
     }
 
-    block[LaunchBlock::kCount] = static_cast<uint32_t>(n);
-    putDouble(block, LaunchBlock::kNow, launch.clock.nowValue);
-    block[LaunchBlock::kDt] = bits(launch.clock.dtValue);
-    block[LaunchBlock::kFirst] = launch.clock.first ? 1 : 0;
-    block[LaunchBlock::kSeed] = launch.seed;
-    block[LaunchBlock::kDraw] = launch.draw;
     for (uint32_t e = 0; e < p.block.externCount; ++e) putValue(block, p.block.externs + 4 * e, launch.externs[e]);
     if (launch.uniforms)
         for (uint32_t u = 0; u < p.block.uniformCount; ++u) putValue(block, p.block.uniforms + 4 * u, launch.uniforms[u]);
@@ -380,13 +363,7 @@ void GlslBackend::run(const rt::ChildrenLaunch& launch) {
     const ir::Object& o = *launch.object;
     const ColumnLayout& l = *launch.layout;
     size_t n = launch.count, columns = launch.args.size();
-    std::vector<uint32_t> block(p.block.words + 4, 0);
-    block[LaunchBlock::kCount] = static_cast<uint32_t>(n);
-    putDouble(block, LaunchBlock::kNow, launch.clock.nowValue);
-    block[LaunchBlock::kDt] = bits(launch.clock.dtValue);
-    block[LaunchBlock::kFirst] = launch.clock.first ? 1 : 0;
-    block[LaunchBlock::kSeed] = launch.seed;
-    block[LaunchBlock::kDraw] = launch.draw;
+    std::vector<uint32_t> block = blockHeader(p.block, n, launch.clock, launch.seed, launch.draw);
     block[LaunchBlock::kFirstChild] = launch.firstChild;
     double created = 0;
     memory_.read(launch.columns[ColumnLayout::kCreated], launch.row, 1, &created);

@@ -87,22 +87,34 @@ TEST_CASE("a session runs a file, and a broken edit keeps the old system running
     CHECK(p.size == 2);
 }
 
-TEST_CASE("a session moves to another backend without losing a step: llvm (exact) to the interpreter") {
-    std::string text;
-    {
-        std::ifstream in(std::string(PSYS_SAMPLES_DIR) + "/fireworks.psys");
-        text.assign(std::istreambuf_iterator<char>(in), {});
-    }
-    host::SessionOptions exact;
-    exact.backend = {"llvm", "exact"};
-    host::SessionOptions reference;
-    reference.backend = {"interp", "fast"};
+namespace {
+
+std::string sampleText(const std::string& name) {
+    std::ifstream in(std::string(PSYS_SAMPLES_DIR) + "/" + name + ".psys");
+    return {std::istreambuf_iterator<char>(in), {}};
+}
+
+// Two sessions of one text: one to move between backends, one to stay on `backend`.
+std::pair<std::unique_ptr<host::Session>, std::unique_ptr<host::Session>> twoSessions(const std::string& text,
+                                                                                      host::BackendChoice moving,
+                                                                                      host::BackendChoice backend) {
+    host::SessionOptions a, b;
+    a.backend = moving;
+    b.backend = backend;
     host::CompileResult compiled;
     std::string error;
-    auto moving = host::Session::open("fireworks.psys", exact, compiled, error, &text);
-    auto straight = host::Session::open("fireworks.psys", reference, compiled, error, &text);
-    REQUIRE(moving);
-    REQUIRE(straight);
+    auto first = host::Session::open("sample.psys", a, compiled, error, &text);
+    auto second = host::Session::open("sample.psys", b, compiled, error, &text);
+    REQUIRE(first);
+    REQUIRE(second);
+    return {std::move(first), std::move(second)};
+}
+
+}  // namespace
+
+TEST_CASE("a session moves to another backend without losing a step: llvm (exact) to the interpreter") {
+    std::string text = sampleText("fireworks");
+    auto [moving, straight] = twoSessions(text, {"llvm", "exact"}, {"interp", "fast"});
     CHECK(test::drawnBytes(moving->system(), 120) == test::drawnBytes(straight->system(), 120));
     REQUIRE_FALSE(moving->switchBackend({"interp", "fast"}));
     CHECK(moving->backend().name() == "interp");
@@ -112,19 +124,8 @@ TEST_CASE("a session moves to another backend without losing a step: llvm (exact
 
 TEST_CASE("a session moves onto the GPU backend and back without losing a step") {
     // The fireworks compute only + − × ÷ and draws: bit for bit on the GPU (docs/gpu.md).
-    std::string text;
-    {
-        std::ifstream in(std::string(PSYS_SAMPLES_DIR) + "/fireworks.psys");
-        text.assign(std::istreambuf_iterator<char>(in), {});
-    }
-    host::SessionOptions reference;
-    reference.backend = {"interp", "fast"};
-    host::CompileResult compiled;
-    std::string error;
-    auto moving = host::Session::open("fireworks.psys", reference, compiled, error, &text);
-    auto straight = host::Session::open("fireworks.psys", reference, compiled, error, &text);
-    REQUIRE(moving);
-    REQUIRE(straight);
+    std::string text = sampleText("fireworks");
+    auto [moving, straight] = twoSessions(text, {"interp", "fast"}, {"interp", "fast"});
     CHECK(test::drawnBytes(moving->system(), 60) == test::drawnBytes(straight->system(), 60));
     REQUIRE_FALSE(moving->switchBackend({"glsl", "fast"}));
     CHECK(moving->backend().name() == "glsl");

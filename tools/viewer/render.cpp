@@ -6,6 +6,8 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "codegen_glsl/glsl_shaders.h"
+
 namespace psys::viewer {
 
 namespace {
@@ -38,17 +40,6 @@ void main() {
 }
 )";
 
-const char* kPointFragment = R"(#version 450 core
-in vec4 colour;
-out vec4 fragment;
-void main() {
-    vec2 d = gl_PointCoord * 2.0 - 1.0;
-    float r2 = dot(d, d);
-    if (r2 > 1.0) discard;
-    float edge = 1.0 - smoothstep(0.4, 1.0, r2);  // round, with a soft rim
-    fragment = vec4(colour.rgb, colour.a * edge);
-}
-)";
 
 const char* kLineVertex = R"(#version 450 core
 layout(location = 0) in vec3 position;
@@ -109,7 +100,7 @@ void clearFrame() {
 }
 
 PointRenderer::PointRenderer() {
-    program_ = linkProgram(kPointVertex, kPointFragment);
+    program_ = linkProgram(kPointVertex, codegen_glsl::drawFragmentShader().c_str());
     glCreateVertexArrays(1, &vao_);
     glCreateBuffers(kColumns, buffers_);
     for (GLuint i = 0; i < kColumns; ++i) {

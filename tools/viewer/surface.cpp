@@ -2,10 +2,11 @@
 
 #include <algorithm>
 
-#include <epoxy/egl.h>
 #include <epoxy/gl.h>
 
 #include <GLFW/glfw3.h>
+
+#include "gpu/gl_context.h"
 
 namespace psys::viewer {
 
@@ -23,54 +24,25 @@ std::vector<uint8_t> Surface::pixels() {
     return out;
 }
 
-std::string Surface::renderer() const {
-    auto text = [](GLenum e) {
-        const auto* s = reinterpret_cast<const char*>(glGetString(e));
-        return std::string(s ? s : "?");
-    };
-    return text(GL_RENDERER) + ", OpenGL " + text(GL_VERSION);
-}
+std::string Surface::renderer() const { return gpu::rendererName(); }
 
 namespace {
 
-// An EGL surfaceless context drawing into a framebuffer object.
+// An EGL surfaceless context (gpu/gl_context.h) drawing into a framebuffer object.
 class Offscreen : public Surface {
 public:
     ~Offscreen() override {
-        if (display_ == EGL_NO_DISPLAY) return;
-        if (context_ != EGL_NO_CONTEXT) {
-            glDeleteFramebuffers(1, &framebuffer_);
-            glDeleteRenderbuffers(2, renderbuffers_);
-            eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-            eglDestroyContext(display_, context_);
-        }
-        // No eglTerminate: the display is shared by every context of the process (and
-        // terminating it unloads the driver, whose allocations then show as leaks of an
-        // unknown module under LeakSanitizer).
+        if (!context_) return;
+        context_->makeCurrent();
+        glDeleteFramebuffers(1, &framebuffer_);
+        glDeleteRenderbuffers(2, renderbuffers_);
     }
 
     bool open(int width, int height, std::string& error) {
         width_ = width;
         height_ = height;
-        // eglGetPlatformDisplay (without EXT) aborts in libepoxy before a display exists.
-        display_ = eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-        EGLint major = 0, minor = 0;
-        if (display_ == EGL_NO_DISPLAY || !eglInitialize(display_, &major, &minor)) {
-            error = "no EGL surfaceless display (Mesa's EGL is needed for --headless)";
-            return false;
-        }
-        eglBindAPI(EGL_OPENGL_API);
-        EGLint configAttributes[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
-        EGLConfig config = nullptr;
-        EGLint configs = 0;
-        eglChooseConfig(display_, configAttributes, &config, 1, &configs);
-        EGLint contextAttributes[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
-                                      EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
-        context_ = eglCreateContext(display_, configs ? config : EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, contextAttributes);
-        if (context_ == EGL_NO_CONTEXT || !eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_)) {
-            error = "cannot make an OpenGL 4.5 core context on the EGL surfaceless display";
-            return false;
-        }
+        context_ = gpu::HeadlessContext::open(error);
+        if (!context_) return false;
         glGenRenderbuffers(2, renderbuffers_);
         glBindRenderbuffer(GL_RENDERBUFFER, renderbuffers_[0]);
         glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
@@ -96,8 +68,7 @@ public:
     void present() override { glFinish(); }
 
 private:
-    EGLDisplay display_ = EGL_NO_DISPLAY;
-    EGLContext context_ = EGL_NO_CONTEXT;
+    std::unique_ptr<gpu::HeadlessContext> context_;
     GLuint framebuffer_ = 0, renderbuffers_[2] = {0, 0};
     int width_ = 0, height_ = 0;
 };
