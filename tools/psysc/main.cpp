@@ -11,6 +11,7 @@
 
 #include <chrono>
 #include <cstdlib>
+#include <exception>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
@@ -201,7 +202,12 @@ int main(int argc, char** argv) {
         runOptions.relaxed = relaxedMath;
         runOptions.optimize = !noOptimize;
         runOptions.integrator = everyObject;
-        return psys::tools::runSystem(runOptions);
+        try {
+            return psys::tools::runSystem(runOptions);
+        } catch (const std::exception& e) {  // a backend that cannot go on (a GL that refuses a shader, …)
+            std::cerr << "psysc: error: " << e.what() << "\n";
+            return 1;
+        }
     }
     if (check->parsed()) {
         bool failed = false;
