@@ -190,6 +190,20 @@ void storeRowsYields(Statements& out, const Kernel& kernel, const ColumnLayout& 
     }
 }
 
+// A render shader marks its row drawn (the rule of rt/system_draw.cpp, which the GLSL
+// backend leaves to it: Backend::marksDrawn): visible, and every value finite; and counts.
+void markDrawn(Statements& out, const ColumnLayout& l) {
+    out.line("// drawn: visible, with a finite position, colour and size (counted)");
+    std::string finite = "true";
+    for (int c = ColumnLayout::kPosition; c < ColumnLayout::kRenderColumns; ++c)
+        finite += fmt::format(" && (floatBitsToUint(cf({}u, i)) & 0x7f800000u) != 0x7f800000u", l.render + c);
+    std::string visible = out.define("shown", "bool", fmt::format("cf({}u, i) != 0.0", l.render + ColumnLayout::kVisible));
+    std::string ok = out.define("finite", "bool", finite);
+    out.line(fmt::format("sf({}u, i, {} && {} ? 1.0 : 0.0);", l.render + ColumnLayout::kVisible, visible, ok));
+    out.line(fmt::format("if ({} && {}) atomicAdd(counts[2], 1u);", visible, ok));
+    out.line(fmt::format("if ({} && !{}) atomicAdd(counts[3], 1u);", visible, ok));
+}
+
 const char* clockName(rt::Clock::Source s) { return s == rt::Clock::Source::PerRow ? "per row" : "uniform"; }
 
 }  // namespace
@@ -218,8 +232,13 @@ std::string rowsShader(const Object& object, const Kernel& kernel, rt::Clock::So
                                 block.words);
     Statements out("t");
     bool kills = kernel.findOne(YieldKind::Kill) != nullptr;
+    bool render = kernel.kind == KernelKind::Render;
     if (kills) out.line(fmt::format("su({}u, i, 0u);", ColumnLayout::kKill));
-    out.line(fmt::format("if (cu({}u, i) == 0u) return;  // masked out", l.total));
+    if (render)
+        out.line(fmt::format("if (cu({}u, i) == 0u) {{ sf({}u, i, 0.0); return; }}  // masked out: not drawn", l.total,
+                             l.render + ColumnLayout::kVisible));
+    else
+        out.line(fmt::format("if (cu({}u, i) == 0u) return;  // masked out", l.total));
     ClockNames clock = emitClock(out, now, dt, true);
     bool perRow = now == rt::Clock::Source::PerRow || dt == rt::Clock::Source::PerRow;
     std::vector<std::string> uniforms;
@@ -246,6 +265,7 @@ std::string rowsShader(const Object& object, const Kernel& kernel, rt::Clock::So
     };
     std::vector<std::string> values = emitBody(out, k, fmt::format("lw({}u)", LaunchBlock::kSeed), leaf);
     storeRowsYields(out, k, l, values);
+    if (render) markDrawn(out, l);
     return text + "void main() {\n" + kIndex + out.text() + "}\n";
 }
 

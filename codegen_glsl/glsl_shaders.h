@@ -6,8 +6,9 @@
 //                             holds one word per row (f32 as bits; u32; u8 widened to a
 //                             word) or two (f64, low word first). Where column c's rows
 //                             start is a word of the launch block.
-//   binding 1, SSBO `Counts`  uint counts[2]: rows killed, rows unstable (atomic adds of
-//                             one per row: a sum, the same whatever the order).
+//   binding 1, SSBO `Counts`  uint counts[4]: rows killed, rows unstable, rows drawn, rows
+//                             visible but not finite (atomic adds of one per row: sums, the
+//                             same whatever the order). A render shader marks its rows drawn.
 //   binding 0, UBO  `Launch`  uvec4 L[]: the launch block (LaunchBlock): row count, clock,
 //                             seed, draw, column offsets, externs and uniform values.
 // One invocation per row, 64 to a work group, work groups in x then y (a grid of up to

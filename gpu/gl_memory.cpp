@@ -241,6 +241,12 @@ const void* GlMemory::view(Buffer b) const {
 
 bool GlMemory::onDevice(Buffer b) const { return at(b).device; }
 
+unsigned GlMemory::glBuffer(Buffer b) const {
+    Column& c = at(b);
+    upload(c);
+    return c.gl;
+}
+
 unsigned GlMemory::deviceBuffer(Buffer b) {
     Column& c = at(b);
     upload(c);

@@ -33,6 +33,7 @@ public:
     void scatter(rt::Buffer from, size_t fromFirst, rt::Buffer to, std::span<const uint32_t> rows) override;
     void* host(rt::Buffer buffer) override;
     const void* view(rt::Buffer buffer) const override;
+    unsigned glBuffer(rt::Buffer buffer) const override;
 
     // For the backend's launches. Whether the column's value is on the GPU.
     bool onDevice(rt::Buffer buffer) const;

@@ -136,7 +136,7 @@ std::unique_ptr<GlslBackend> GlslBackend::create(std::string& error) {
     glCreateBuffers(1, &b->words_);
     glCreateBuffers(1, &b->counts_);
     glCreateBuffers(1, &b->block_);
-    glNamedBufferData(b->counts_, 2 * sizeof(uint32_t), nullptr, GL_DYNAMIC_READ);
+    glNamedBufferData(b->counts_, sizeof(Counts::n), nullptr, GL_DYNAMIC_READ);
     glCreateQueries(GL_TIME_ELAPSED, 1, &b->query_);
     return b;
 }
@@ -169,6 +169,10 @@ GlslBackend::Program& GlslBackend::rowsProgram(const ir::Object& object, const i
         p->layout = rt::columnLayout(object, kernel);
         p->block = codegen_glsl::rowsBlock(kernel, uniform, p->layout);
         writtenColumns(kernel, p->layout, p->resident, p->returned);
+        if (kernel.kind == ir::KernelKind::Render) {  // what is drawn stays on the GPU (the viewer draws from it)
+            p->returned.clear();
+            for (int c = 0; c < ColumnLayout::kRenderColumns; ++c) p->resident.push_back(p->layout.render + c);
+        }
         p->needed = neededColumns(kernel, p->layout, now == rt::Clock::Source::PerRow || dt == rt::Clock::Source::PerRow,
                                   p->resident, p->returned);
         p->pass = ir::kernelName(kernel.kind);
@@ -219,9 +223,9 @@ void GlslBackend::ensureWords(size_t words) {
     glNamedBufferData(words_, static_cast<GLsizeiptr>(wordsCapacity_ * 4), nullptr, GL_DYNAMIC_COPY);
 }
 
-std::pair<uint32_t, uint32_t> GlslBackend::dispatch(Program& program, const std::vector<uint32_t>& block, size_t count,
+GlslBackend::Counts GlslBackend::dispatch(Program& program, const std::vector<uint32_t>& block, size_t count,
                                                     const std::string& pass) {
-    uint32_t zero[2] = {0, 0};
+    uint32_t zero[4] = {0, 0, 0, 0};
     glNamedBufferSubData(counts_, 0, sizeof zero, zero);
     glNamedBufferData(block_, static_cast<GLsizeiptr>(block.size() * 4), block.data(), GL_STREAM_DRAW);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, words_);
@@ -251,9 +255,9 @@ std::pair<uint32_t, uint32_t> GlslBackend::dispatch(Program& program, const std:
         t.rows += count;
     }
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    uint32_t counts[2] = {0, 0};
-    glGetNamedBufferSubData(counts_, 0, sizeof counts, counts);
-    return {counts[0], counts[1]};
+    Counts counts;
+    glGetNamedBufferSubData(counts_, 0, sizeof counts.n, counts.n);
+    return counts;
 }
 
 rt::RowsResult GlslBackend::run(const rt::RowsLaunch& launch) {
@@ -271,6 +275,8 @@ rt::RowsResult GlslBackend::run(const rt::RowsLaunch& launch) {
         rt::RowsResult r = runRows(launch, p, begin, std::min(launch.end, begin + rows));
         result.killed += r.killed;
         result.unstable += r.unstable;
+        result.drawn += r.drawn;
+        result.nonFinite += r.nonFinite;
     }
     return result;
 }
@@ -327,7 +333,8 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
     for (uint32_t e = 0; e < p.block.externCount; ++e) putValue(block, p.block.externs + 4 * e, launch.externs[e]);
     if (launch.uniforms)
         for (uint32_t u = 0; u < p.block.uniformCount; ++u) putValue(block, p.block.uniforms + 4 * u, launch.uniforms[u]);
-    auto [killed, unstable] = dispatch(p, block, n, p.pass);
+    Counts counts = dispatch(p, block, n, p.pass);
+    size_t killed = counts.n[0];
 
     for (int c : p.resident) {
         Buffer b = launch.columns[static_cast<size_t>(c)];
@@ -353,7 +360,7 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
         memory_.transferred += staging_.size() * 4;
         fromWords(staging_.data(), e, n, static_cast<char*>(memory_.host(b)) + begin * rt::elemSize(e));
     }
-    return {killed, unstable};
+    return {killed, counts.n[1], counts.n[2], counts.n[3]};
 }
 
 void GlslBackend::run(const rt::ChildrenLaunch& launch) {

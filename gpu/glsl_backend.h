@@ -36,6 +36,7 @@ public:
     rt::RowsResult run(const rt::RowsLaunch& launch) override;
     void run(const rt::ChildrenLaunch& launch) override;
     rt::BackendReport report() const override;
+    bool marksDrawn() const override { return true; }
 
     // Time of the launches so far while timePasses is on, by kernel kind name: on the GPU
     // (GL timer queries), and on the wall from a glFinish before the dispatch to one after
@@ -60,9 +61,12 @@ private:
     Program& childrenProgram(const ir::Object& object, const ir::Kernel& spawn);
     Program compile(const std::string& source, const std::string& what);
     rt::RowsResult runRows(const rt::RowsLaunch& launch, Program& program, size_t begin, size_t end);
-    // Uploads the block and the words, runs `program` over `count` invocations, and
-    // returns the counts (killed, unstable).
-    std::pair<uint32_t, uint32_t> dispatch(Program& program, const std::vector<uint32_t>& block, size_t count,
+    // Uploads the block, runs `program` over `count` invocations, and returns the counts
+    // (killed, unstable, drawn, not finite).
+    struct Counts {
+        uint32_t n[4] = {0, 0, 0, 0};
+    };
+    Counts dispatch(Program& program, const std::vector<uint32_t>& block, size_t count,
                                            const std::string& pass);
     void ensureWords(size_t words);
 

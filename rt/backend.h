@@ -45,6 +45,9 @@ struct RowsLaunch {
 struct RowsResult {
     size_t killed = 0;    // rows of the range whose kill flag the kernel set
     size_t unstable = 0;  // rows whose `unstable` yield was true (update kernels)
+    // Render launches of a backend that marksDrawn(): rows drawn, and rows visible but
+    // with a NaN or infinite position, colour or size (not drawn).
+    size_t drawn = 0, nonFinite = 0;
 };
 
 struct ChildrenLaunch {
@@ -110,6 +113,10 @@ public:
     virtual void run(const ChildrenLaunch& launch) = 0;
     // Whether launches on disjoint rows may run on several threads at once.
     virtual bool concurrent() const { return false; }
+    // Whether render launches mark the rows drawn themselves: visible = 1 where the row is
+    // in the mask, its point visible and every render value finite, else 0; counted in
+    // RowsResult. Else the run-time does it on the host after the launch.
+    virtual bool marksDrawn() const { return false; }
     virtual BackendReport report() const { return {}; }
 };
 

@@ -56,6 +56,9 @@ public:
     // changed after `host`).
     virtual void* host(Buffer buffer) = 0;
     virtual const void* view(Buffer buffer) const { return const_cast<Memory*>(this)->host(buffer); }
+    // The OpenGL buffer object holding the column's value, on a memory that keeps columns
+    // in GL buffers (a viewer draws straight from it); 0 on any other.
+    virtual unsigned glBuffer(Buffer) const { return 0; }
 };
 
 // Host RAM: buffers are arrays the host addresses directly (aligned to 64 bytes).

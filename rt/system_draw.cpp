@@ -51,9 +51,13 @@ const DrawColumns& Drawing::draw(size_t type) {
     launch.seed = s_.options.seed;
     launch.draw = static_cast<uint32_t>(s_.step);
     auto* mask = s_.host<uint8_t>(alive);
-    auto* visible = s_.host<float>(out.visible);
-    const float* values[8];
-    for (int c = 0; c < 8; ++c) values[c] = s_.host<float>(column(ColumnLayout::kPosition + c));
+    // The rows drawn: marked by the render launch itself on a backend that does so (its
+    // render columns stay where it computed them), else here.
+    const bool marked = s_.backend.marksDrawn();
+    float* visible = marked ? nullptr : s_.host<float>(out.visible);
+    const float* values[8] = {};
+    if (!marked)
+        for (int c = 0; c < 8; ++c) values[c] = s_.view<float>(column(ColumnLayout::kPosition + c));
     std::mutex counting;
     size_t drawn = 0;
     uint64_t nonFinite = 0;
@@ -64,11 +68,11 @@ const DrawColumns& Drawing::draw(size_t type) {
         for (size_t row = part.begin; row < part.end; ++row)
             mask[row] = pool.status(static_cast<uint32_t>(row)) == Status::Alive;
         s_.gatherParents(type, layout, d.table, mask, part.begin, part.end, s_.now);
-        s_.backend.run(part);
+        RowsResult result = s_.backend.run(part);
+        size_t chunkDrawn = result.drawn;
+        uint64_t chunkNonFinite = result.nonFinite;
         // Drawn: alive, visible, and position, colour and size all finite.
-        size_t chunkDrawn = 0;
-        uint64_t chunkNonFinite = 0;
-        for (size_t row = part.begin; row < part.end; ++row) {
+        for (size_t row = part.begin; !marked && row < part.end; ++row) {
             if (!mask[row] || visible[row] == 0) {
                 visible[row] = 0;
                 continue;

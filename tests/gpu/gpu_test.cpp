@@ -275,3 +275,22 @@ TEST_CASE("the rows killed are compacted on the GPU in row order, across work gr
         }
     }
 }
+
+TEST_CASE("what is drawn is computed and marked on the GPU, and stays there") {
+    // A render pass reads the update mask and the creation times from the host (12 bytes
+    // a row) and marks the drawn rows itself; its 36 bytes of render columns a row stay on
+    // the GPU, where the viewer draws from them.
+    auto gpu = gpuBackend();
+    rt::System system(test::compileModule(readFile(std::string(PSYS_SAMPLES_DIR) + "/fountain.psys")), *gpu);
+    for (int f = 0; f < 60; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
+    auto drop = static_cast<size_t>(system.typeIndex("drop"));
+    system.draw(drop);  // the first draw puts the render columns on the GPU
+    REQUIRE_FALSE(system.step(1.0 / 60));
+    uint64_t before = gpu->transferredBytes();
+    const rt::DrawColumns& drawn = system.draw(drop);
+    double perRow = static_cast<double>(gpu->transferredBytes() - before) / static_cast<double>(drawn.rows);
+    MESSAGE("bytes between host and GPU per row drawn: " << perRow);
+    CHECK(perRow <= 12.5);
+    CHECK(drawn.drawn == system.pool(drop).live());
+    CHECK(system.backend().memory().glBuffer(drawn.position[0]) != 0);
+}

@@ -123,7 +123,13 @@ void PointRenderer::draw(const rt::DrawColumns& c, const rt::Memory& memory, con
     const rt::Buffer columns[kColumns] = {c.visible, c.position[0], c.position[1], c.position[2], c.color[0],
                                           c.color[1], c.color[2], c.color[3], c.size};
     for (int i = 0; i < kColumns; ++i) {
-        // The column itself where the host can address it; else read back (a device's memory).
+        // Straight from the column's GL buffer where the backend computes in GL (the GLSL
+        // backend, in this context); else uploaded from the host.
+        if (unsigned gl = memory.glBuffer(columns[i])) {
+            glVertexArrayVertexBuffer(vao_, static_cast<GLuint>(i), gl, 0, sizeof(float));
+            continue;
+        }
+        glVertexArrayVertexBuffer(vao_, static_cast<GLuint>(i), buffers_[i], 0, sizeof(float));
         const void* data = memory.view(columns[i]);
         if (!data) {
             staging_.resize(c.rows);
