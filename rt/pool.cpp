@@ -40,6 +40,7 @@ Pool::Pool(const ir::Object& object, size_t capacity, Memory& memory)
     created = memory.create(Elem::F64, 0);
     ids = memory.create(Elem::U32, 0);
     updatable = memory.create(Elem::U8, 0);
+    maskStaging_ = memory.create(Elem::U8, 0);
     std::vector<ir::Type> types;
     for (auto& s : object.state) types.push_back(s.type);
     state.define(memory, types, 0);
@@ -61,7 +62,8 @@ Pool::Pool(Pool&& other) noexcept
       parent(std::move(other.parent)), readers(std::move(other.readers)), fresh(std::move(other.fresh)),
       emitted(std::move(other.emitted)), object_(other.object_), capacity_(other.capacity_), memory_(other.memory_),
       status_(std::move(other.status_)), generation_(std::move(other.generation_)),
-      freeRows_(std::move(other.freeRows_)), live_(other.live_), frozen_(other.frozen_) {
+      freeRows_(std::move(other.freeRows_)), live_(other.live_), frozen_(other.frozen_), mask_(std::move(other.mask_)),
+      maskRows_(std::move(other.maskRows_)), maskStaging_(other.maskStaging_) {
     other.memory_ = nullptr;
 }
 
@@ -70,6 +72,7 @@ Pool::~Pool() {
     memory_->release(created);
     memory_->release(ids);
     memory_->release(updatable);
+    memory_->release(maskStaging_);
     state.release(*memory_);
     params.release(*memory_);
     exports.release(*memory_);
@@ -82,6 +85,7 @@ void Pool::grow(size_t n) {
     readers.resize(n, 0);
     for (auto& e : emitted) e.resize(n, 0);
     for (Buffer b : {created, ids, updatable}) memory_->resize(b, n);
+    mask_.resize(n, 0);
     state.resize(*memory_, n);
     params.resize(*memory_, n);
     exports.resize(*memory_, n);
@@ -98,7 +102,7 @@ std::optional<uint32_t> Pool::allocate() {
         grow(rows() + 1);
     }
     status_[row] = Status::Alive;
-    hostData<uint8_t>(*memory_, updatable)[row] = 0;
+    setMask(row, 0);
     fresh.push_back(row);
     ++live_;
     readers[row] = 0;
@@ -110,7 +114,7 @@ std::optional<uint32_t> Pool::allocate() {
 void Pool::freeze(uint32_t row) {
     if (status_[row] != Status::Alive) return;
     status_[row] = Status::Frozen;
-    hostData<uint8_t>(*memory_, updatable)[row] = 0;
+    setMask(row, 0);
     --live_;
     ++frozen_;
 }
@@ -120,16 +124,40 @@ void Pool::release(uint32_t row) {
     else if (status_[row] == Status::Frozen) --frozen_;
     else return;
     status_[row] = Status::Free;
-    hostData<uint8_t>(*memory_, updatable)[row] = 0;
+    setMask(row, 0);
     ++generation_[row];
     freeRows_.push_back(row);
 }
 
 void Pool::beginStep() {
-    uint8_t* mask = hostData<uint8_t>(*memory_, updatable);
     for (uint32_t row : fresh)
-        if (status_[row] == Status::Alive) mask[row] = 1;
+        if (status_[row] == Status::Alive) setMask(row, 1);
     fresh.clear();
+}
+
+void Pool::setMask(uint32_t row, uint8_t value) {
+    if (mask_[row] == value) return;
+    mask_[row] = value;
+    maskRows_.push_back(row);
+}
+
+void Pool::syncMask() {
+    if (maskRows_.empty()) return;
+    // A row changed twice is listed twice, with its one current value: the order of the
+    // scatter's writes does not matter.
+    std::vector<uint8_t> values(maskRows_.size());
+    for (size_t i = 0; i < maskRows_.size(); ++i) values[i] = mask_[maskRows_[i]];
+    if (memory_->rows(maskStaging_) < values.size()) memory_->resize(maskStaging_, values.size());
+    memory_->write(maskStaging_, 0, values.size(), values.data());
+    memory_->scatter(maskStaging_, 0, updatable, maskRows_);
+    maskRows_.clear();
+}
+
+void Pool::restoreMask(std::vector<uint8_t> mask) {
+    mask.resize(rows(), 0);
+    mask_ = std::move(mask);
+    maskRows_.clear();
+    memory_->write(updatable, 0, mask_.size(), mask_.data());
 }
 
 void Pool::restore(std::vector<Status> status, std::vector<uint32_t> generation, std::vector<uint32_t> freeRows) {

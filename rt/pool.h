@@ -74,6 +74,12 @@ public:
     // Columns in the backend's memory.
     Buffer created, ids;             // f64, u32
     Buffer updatable;                // u8: 1 for rows a step updates (alive, not created during it)
+    // `updatable` as the host keeps it: the host reads this, and the rows it changes reach
+    // the column (a scatter of those rows, so the column may live on a device) when
+    // syncMask is called, before a launch over the pool.
+    const uint8_t* mask() const { return mask_.data(); }
+    void syncMask();
+    void restoreMask(std::vector<uint8_t> mask);  // hot reload: the whole mask
     ValueColumns state, params, exports;  // params: only the kept ones
     std::vector<int> paramColumn;    // per parameter: its value in `params`, or -1
 
@@ -100,6 +106,10 @@ private:
     std::vector<uint32_t> generation_;
     std::vector<uint32_t> freeRows_;
     size_t live_ = 0, frozen_ = 0;
+    std::vector<uint8_t> mask_;
+    std::vector<uint32_t> maskRows_;  // rows changed since the last syncMask
+    Buffer maskStaging_;              // their values, for the scatter
+    void setMask(uint32_t row, uint8_t value);
 };
 
 }  // namespace psys::rt

@@ -62,7 +62,7 @@ void carryType(const detail::State& old, size_t ot, detail::State& s, size_t t, 
     report.carried += from.live() + from.frozen();
     copyColumn(old.memory, from.created, s.memory, to.created, rows, 8);
     copyColumn(old.memory, from.ids, s.memory, to.ids, rows, 4);
-    copyColumn(old.memory, from.updatable, s.memory, to.updatable, rows, 1);
+    to.restoreMask({from.mask(), from.mask() + rows});
     to.fresh = from.fresh;
     for (auto [i, j] : matchByName(o.state, oo.state)) {
         if (j >= 0) copyValues(old.memory, from.state, static_cast<size_t>(j), s.memory, to.state, i, rows);

@@ -287,19 +287,20 @@ void Creation::identify(size_t type, Batch& b, size_t from, size_t n) {
     auto* mask = s_.host<uint8_t>(b.columns.at(kMask, Elem::U8, end));
     auto* created = s_.host<double>(table[ColumnLayout::kCreated]);
     auto* ids = s_.host<uint32_t>(table[ColumnLayout::kIds]);
-    auto* poolCreated = s_.host<double>(pool.created);
-    auto* poolIds = s_.host<uint32_t>(pool.ids);
     for (size_t r = 0; r < n; ++r) {
         size_t i = first + r;
         uint32_t row = b.poolRows[r];
         mask[i] = row != kSkipRow;
         if (!mask[i]) continue;
         const Entry& e = queue_[from + r];
-        created[i] = poolCreated[row] = e.time;
-        ids[i] = poolIds[row] = e.id;
+        created[i] = e.time;
+        ids[i] = e.id;
         pool.parent[row] = e.parent;
         if (e.parent.valid()) ++s_.pools[static_cast<size_t>(info.parentType)].readers[e.parent.row];
     }
+    // Into the pool rows through the memory (the pool's columns may live on a device).
+    s_.memory.scatter(table[ColumnLayout::kCreated], first, pool.created, b.poolRows);
+    s_.memory.scatter(table[ColumnLayout::kIds], first, pool.ids, b.poolRows);
     for (size_t p = 0; p < o.params.size(); ++p)
         if (pool.paramColumn[p] >= 0)
             for (int c = 0; c < o.params[p].type.width; ++c)

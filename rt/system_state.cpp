@@ -194,6 +194,7 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
 
 void State::bindPool(size_t type, const ColumnLayout& layout, Scratch& scratch, std::vector<Buffer>& table) {
     Pool& pool = pools[type];
+    pool.syncMask();
     const ir::Object& o = pool.object();
     size_t rows = pool.rows();
     table.assign(static_cast<size_t>(layout.total), Buffer{});

@@ -36,7 +36,7 @@ void killAndEmit(State& s, Creation& creation, size_t type, double dt, double t1
     const TypeInfo& info = s.types[type];
     const TypeWork& work = s.work[type];
     const ir::Object& o = pool.object();
-    const auto* updatable = s.view<uint8_t>(pool.updatable);
+    const uint8_t* updatable = pool.mask();
     const auto* kill = s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]);
     std::vector<float> rate(o.emits.size(), 0), count(o.emits.size(), 1);
     std::vector<const float*> rates(o.emits.size()), counts(o.emits.size());
@@ -94,7 +94,7 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1)
         exports.mask = exportMask;
         exports.uniforms = s.uniforms(type, *info.exports, static_cast<float>(dt), static_cast<float>(t1));
     }
-    const auto* updatable = s.view<uint8_t>(pool.updatable);
+    const uint8_t* updatable = pool.mask();
     const auto* kill = s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]);
     // Objects that only die (no rate emits) are found while their chunk is in cache.
     bool listKills = info.kills && !info.rateEmits;
