@@ -66,12 +66,14 @@ Elem HostMemory::elem(Buffer b) const { return columns_.at(b.id)->elem; }
 void HostMemory::read(Buffer b, size_t first, size_t count, void* out) const {
     const Column& c = *columns_.at(b.id);
     if (first + count > c.rows) throw std::out_of_range("HostMemory::read past the end of a buffer");
+    if (count == 0) return;  // an empty buffer has no address
     std::memcpy(out, c.data + first * c.size(), count * c.size());
 }
 
 void HostMemory::write(Buffer b, size_t first, size_t count, const void* in) {
     Column& c = *columns_.at(b.id);
     if (first + count > c.rows) throw std::out_of_range("HostMemory::write past the end of a buffer");
+    if (count == 0) return;
     std::memcpy(c.data + first * c.size(), in, count * c.size());
 }
 
@@ -79,6 +81,7 @@ void HostMemory::copy(Buffer from, size_t fromFirst, Buffer to, size_t toFirst, 
     Column &f = *columns_.at(from.id), &t = *columns_.at(to.id);
     if (f.elem != t.elem || fromFirst + count > f.rows || toFirst + count > t.rows)
         throw std::out_of_range("HostMemory::copy between mismatched buffers");
+    if (count == 0) return;
     std::memmove(t.data + toFirst * t.size(), f.data + fromFirst * f.size(), count * f.size());
 }
 
