@@ -138,20 +138,22 @@ void GlMemory::toHost(Column& c) const {
     c.device = false;
 }
 
-void GlMemory::upload(Column& c) const {
+void GlMemory::upload(Column& c) const { uploadRows(c, 0, c.rows); }
+
+void GlMemory::uploadRows(Column& c, size_t first, size_t count) const {
     if (c.device) return;
-    size_t words = std::max<size_t>(c.words(), 1);
     if (!c.gl) glCreateBuffers(1, &c.gl);
     if (c.glRows < c.rows || c.glRows == 0) {
-        size_t room = std::max(c.rows, 2 * c.glRows);
-        words = std::max<size_t>(room * wordsPerRow(c.elem), 1);
-        glNamedBufferData(c.gl, static_cast<GLsizeiptr>(words * 4), nullptr, GL_DYNAMIC_COPY);
-        c.glRows = std::max<size_t>(room, 1);
+        size_t room = std::max<size_t>({c.rows, 2 * c.glRows, 1});
+        glNamedBufferData(c.gl, static_cast<GLsizeiptr>(room * wordsPerRow(c.elem) * 4), nullptr, GL_DYNAMIC_COPY);
+        c.glRows = room;
     }
-    if (c.rows == 0) return;
-    std::vector<uint32_t> staging(c.words());
-    toWords(c.hostCopy.data(), c.elem, c.rows, staging.data());
-    glNamedBufferSubData(c.gl, 0, static_cast<GLsizeiptr>(staging.size() * 4), staging.data());
+    if (count == 0) return;
+    size_t w = wordsPerRow(c.elem);
+    std::vector<uint32_t> staging(count * w);
+    toWords(c.hostCopy.data() + first * rt::elemSize(c.elem), c.elem, count, staging.data());
+    glNamedBufferSubData(c.gl, static_cast<GLintptr>(first * w * 4), static_cast<GLsizeiptr>(staging.size() * 4),
+                         staging.data());
     transferred += staging.size() * 4;
 }
 
@@ -195,7 +197,7 @@ void GlMemory::copy(Buffer from, size_t fromFirst, Buffer to, size_t toFirst, si
         std::memmove(t.hostCopy.data() + toFirst * e, f.hostCopy.data() + fromFirst * e, count * e);
         return;
     }
-    upload(f);
+    uploadRows(f, fromFirst, count);  // only the rows copied: the source stays on the host
     upload(t);
     size_t w = wordsPerRow(f.elem) * 4;
     if (count)
@@ -209,7 +211,7 @@ void GlMemory::copy(Buffer from, size_t fromFirst, Buffer to, size_t toFirst, si
 void GlMemory::scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const uint32_t> rows) {
     Column &f = at(from), &t = at(to);
     if (rows.empty()) return;
-    upload(f);
+    uploadRows(f, fromFirst, rows.size());  // only the rows scattered: the source stays on the host
     upload(t);
     if (!scatterProgram_) {
         scatterProgram_ = computeProgram(kScatter, "scatter");

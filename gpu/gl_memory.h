@@ -55,6 +55,9 @@ private:
     Column& at(rt::Buffer b) const;
     void toHost(Column& c) const;      // the column's value to the host copy
     void upload(Column& c) const;      // the host copy into the GL buffer (sized to the rows)
+    // Rows of the host copy into the GL buffer, which may hold stale values elsewhere: for
+    // a column read once on the GPU that stays the host's (a copy's or scatter's source).
+    void uploadRows(Column& c, size_t first, size_t count) const;
     std::vector<std::unique_ptr<Column>> columns_;
     std::vector<uint32_t> free_;
     unsigned scatterProgram_ = 0, rowsBuffer_ = 0;

@@ -57,14 +57,17 @@ void putValue(std::vector<uint32_t>& block, uint32_t word, const rt::Value& v) {
     for (size_t c = 0; c < 4; ++c) block[word + c] = bits(v.f[c]);
 }
 
-// The table columns a kernel writes: what stays on the GPU (state, exports) and what the
-// host reads right after the launch (kill flags, emissions, what is drawn).
+// The table columns a kernel writes: what stays on the GPU (state, exports, what is drawn)
+// and what the host reads right after the launch (kill flags, emissions).
 void writtenColumns(const ir::Kernel& kernel, const ColumnLayout& l, std::vector<int>& resident,
                     std::vector<int>& returned) {
     auto range = [](std::vector<int>& cols, int first, int width) {
         for (int c = 0; c < width; ++c) cols.push_back(first + c);
     };
     std::vector<int>& cols = returned;
+    // What is drawn stays on the GPU (the viewer draws from it): the render shader writes
+    // `visible` for every row and reads every render column to mark the drawn rows.
+    if (kernel.kind == ir::KernelKind::Render) range(resident, l.render, ColumnLayout::kRenderColumns);
     for (const ir::Yield& y : kernel.yields) {
         int width = kernel.at(y.value).type.width;
         switch (y.kind) {
@@ -73,10 +76,6 @@ void writtenColumns(const ir::Kernel& kernel, const ColumnLayout& l, std::vector
             case ir::YieldKind::Kill: cols.push_back(ColumnLayout::kKill); break;
             case ir::YieldKind::EmitRate: cols.push_back(l.emitRate(y.index)); break;
             case ir::YieldKind::EmitCount: cols.push_back(l.emitCount(y.index)); break;
-            case ir::YieldKind::Visible: cols.push_back(l.render + ColumnLayout::kVisible); break;
-            case ir::YieldKind::Position: case ir::YieldKind::Color: case ir::YieldKind::Size:
-                range(cols, l.render + ColumnLayout::renderColumn(y.kind), width);
-                break;
             default: break;
         }
     }
@@ -169,10 +168,6 @@ GlslBackend::Program& GlslBackend::rowsProgram(const ir::Object& object, const i
         p->layout = rt::columnLayout(object, kernel);
         p->block = codegen_glsl::rowsBlock(kernel, uniform, p->layout);
         writtenColumns(kernel, p->layout, p->resident, p->returned);
-        if (kernel.kind == ir::KernelKind::Render) {  // what is drawn stays on the GPU (the viewer draws from it)
-            p->returned.clear();
-            for (int c = 0; c < ColumnLayout::kRenderColumns; ++c) p->resident.push_back(p->layout.render + c);
-        }
         p->needed = neededColumns(kernel, p->layout, now == rt::Clock::Source::PerRow || dt == rt::Clock::Source::PerRow,
                                   p->resident, p->returned);
         p->pass = ir::kernelName(kernel.kind);

@@ -12,14 +12,18 @@
 
 namespace psys::test {
 
+// `diagnostics`, when given, receives what compiling printed (warnings).
 inline ir::Module compileModule(const std::string& text, bool optimize = true,
-                                std::optional<core::Integrator> integrator = {}) {
+                                std::optional<core::Integrator> integrator = {}, bool relaxed = false,
+                                std::string* diagnostics = nullptr) {
     SourceManager sources;
     DiagnosticEngine diags(sources);
     CompileOptions options;
     options.pipeline.optimize = optimize;
+    options.pipeline.pass.relaxed = relaxed;
     options.pipeline.pass.everyObject = integrator;
     auto module = compileText("test.psys", text, sources, diags, options);
+    if (diagnostics) *diagnostics = diags.render();
     INFO(diags.render());
     REQUIRE(module.has_value());
     return std::move(*module);

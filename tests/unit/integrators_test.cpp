@@ -234,18 +234,12 @@ TEST_CASE("exact and exponential match the analytic solutions of their cases wit
         }
     }
     SUBCASE("a projectile: the polynomial in age, under exact") {
-        Run run(R"(
-            object b {
-                pos = integrate(vel);
-                vel = vec3(1, 10, 0) + integrate(vec3(0, -9.8, 0));
-                point(pos, white, 1);
-            }
-            spawn b;)", {}, true, false, Integrator::Exact);
+        Run run(test::kProjectile, {}, true, false, Integrator::Exact);
         for (int frame = 1; frame <= 300; ++frame) {
             run.steps(1, kFrame);
             double t = frame * kFrame;
-            CHECK(std::fabs(only(run, "b").position[0] - t) <= bound(frame, 5));
-            CHECK(std::fabs(only(run, "b").position[1] - (10 * t - 4.9 * t * t)) <= bound(frame, 75));
+            CHECK(std::fabs(only(run, "p").position[0] - t) <= bound(frame, 5));
+            CHECK(std::fabs(only(run, "p").position[1] - (10 * t - 4.9 * t * t)) <= bound(frame, 75));
         }
     }
     SUBCASE("powers of age and a decay driven by age, under exact") {

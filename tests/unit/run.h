@@ -15,8 +15,19 @@
 #include "interp/interpreter.h"
 #include "rt/system.h"
 #include "test_support.h"
+#include "tests/system_support.h"
 
 namespace psys::test {
+
+// A projectile thrown at (1, 10, 0) under gravity, drawn where it is: a program with
+// closed forms that several tests run.
+constexpr const char* kProjectile = R"(
+    object p {
+        pos = integrate(vel);
+        vel = vec3(1, 10, 0) + integrate(vec3(0, -9.8, 0));
+        point(pos, white, 1);
+    }
+    spawn p;)";
 
 struct Run {
     interp::Interpreter backend;
@@ -25,17 +36,8 @@ struct Run {
 
     explicit Run(const std::string& source, rt::SystemOptions options = {}, bool optimize = true, bool relaxed = false,
                  std::optional<core::Integrator> integrator = {}) {
-        SourceManager sources;
-        DiagnosticEngine diags(sources);
-        CompileOptions compile;
-        compile.pipeline.optimize = optimize;
-        compile.pipeline.pass.relaxed = relaxed;
-        compile.pipeline.pass.everyObject = integrator;
-        auto module = compileText("test.psys", source, sources, diags, compile);
-        diagnostics = diags.render();
-        INFO(diagnostics);
-        REQUIRE(module.has_value());
-        system = std::make_unique<rt::System>(std::move(*module), backend, options);
+        system = std::make_unique<rt::System>(compileModule(source, optimize, integrator, relaxed, &diagnostics), backend,
+                                              options);
     }
 
     void steps(int n, double dt) {

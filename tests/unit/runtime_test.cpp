@@ -24,13 +24,7 @@ using test::compareRuns;
 using test::Run;
 
 TEST_CASE("a projectile under the default method (semi-implicit Euler) is its recurrence, bit for bit") {
-    Run run(R"(
-        object p {
-            pos = integrate(vel);
-            vel = vec3(1, 10, 0) + integrate(vec3(0, -9.8, 0));
-            point(pos, white, 1);
-        }
-        spawn p;)");
+    Run run(test::kProjectile);
     const float dt = 1.0f / 60.0f;
     float av = 0, apx = 0, apy = 0;  // the integrals of gravity (y) and of velocity
     for (int frame = 1; frame <= 300; ++frame) {
