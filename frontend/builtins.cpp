@@ -91,7 +91,27 @@ const BuiltinConstant kConstants[] = {
     {"transparent", Type::vec(4), {0, 0, 0, 0}},
 };
 
+constexpr BuiltinAttribute kAttributes[] = {
+    {"integrator", "@integrator(method)", "how `integrate` advances this object's equations (docs/accuracy.md)"},
+    {"step", "@step(seconds)", "a fixed sub-step: updates run in steps of at most this many seconds"},
+    {"capacity", "@capacity(count)", "the most objects of this type alive at once; emissions beyond it are dropped"},
+};
+
+constexpr std::string_view kKeywords[] = {"import", "const", "fn", "let", "extern", "range", "trigger", "object",
+                                          "spawn", "point", "kill", "when", "emit", "at", "per", "second", "count",
+                                          "if", "then", "else", "true", "false"};
+
 }  // namespace
+
+std::span<const BuiltinAttribute> builtinAttributes() { return kAttributes; }
+
+std::string_view attributeDoc(std::string_view name) {
+    for (const BuiltinAttribute& a : kAttributes)
+        if (a.name == name) return a.doc;
+    return {};
+}
+
+std::span<const std::string_view> keywords() { return kKeywords; }
 
 std::span<const BuiltinFunction> builtinFunctions() { return kFunctions; }
 

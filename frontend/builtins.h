@@ -56,6 +56,18 @@ int findBuiltinConstant(std::string_view name);  // -1 when none
 // `age`, `time`, `dt`: names that always mean the same thing inside an object.
 bool isBuiltinVariable(std::string_view name);
 
+// The attributes of objects and files: `@integrator(rk4)`, `@step(1/240)`, `@capacity(N)`.
+struct BuiltinAttribute {
+    std::string_view name;
+    std::string_view signature;  // "@step(seconds)"
+    std::string_view doc;
+};
+std::span<const BuiltinAttribute> builtinAttributes();
+std::string_view attributeDoc(std::string_view name);  // "" for an unknown attribute
+
+// The words of grammar/Psys.g4 (a test keeps the two in step).
+std::span<const std::string_view> keywords();
+
 // The integrators `@integrator(…)` accepts.
 std::span<const std::string_view> integratorNames();
 

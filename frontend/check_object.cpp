@@ -17,6 +17,19 @@ namespace psys::detail {
 
 using namespace ast;
 
+namespace {
+
+// "@integrator(method), @step(seconds) and @capacity(count)"
+std::string attributeList() {
+    std::string list;
+    auto all = builtinAttributes();
+    for (size_t i = 0; i < all.size(); ++i)
+        list += (i == 0 ? "" : i + 1 == all.size() ? " and " : ", ") + std::string(all[i].signature);
+    return list;
+}
+
+}  // namespace
+
 void Checker::declareObjectNames(ObjectDecl& object) {
     ObjectScope& scope = objectScopes_[&object];
     auto declare = [&](const std::string& name, SourceRange range, Ref ref, const char* what) {
@@ -279,8 +292,7 @@ void Checker::checkAttributes(const std::vector<Attribute*>& attributes) {
                 diags_.error(a.args[0]->range, "the capacity must be a positive constant whole number");
         } else {
             diags_.error(a.nameRange, fmt::format("unknown attribute `@{}`", a.name))
-                .notes.push_back({a.nameRange, "the attributes are @integrator(method), @step(seconds) and "
-                                               "@capacity(count)"});
+                .notes.push_back({a.nameRange, "the attributes are " + attributeList()});
         }
     }
 }

@@ -349,6 +349,13 @@ private:
 
 std::unique_ptr<Module> parseModule(int file, const SourceManager& sources, DiagnosticEngine& diags) {
     const std::string& text = sources.file(file).text();
+    // The lexer reads code points: a file must be UTF-8 (ASCII is), and one that is not is
+    // reported at its first bad byte rather than read wrongly.
+    if (auto bad = firstInvalidUtf8(text)) {
+        diags.error({file, *bad, *bad + 1}, fmt::format("this file is not valid UTF-8: byte 0x{:02X} cannot be here; "
+                                                        "save it as UTF-8", static_cast<unsigned char>(text[*bad])));
+        return nullptr;
+    }
     antlr4::ANTLRInputStream input(text);
     grammar::PsysLexer lexer(&input);
     lexer.removeErrorListeners();

@@ -39,6 +39,24 @@ std::string_view SourceFile::lineText(uint32_t line) const {
     return view;
 }
 
+std::optional<uint32_t> firstInvalidUtf8(std::string_view text) {
+    auto byte = [&](size_t i) { return i < text.size() ? static_cast<unsigned char>(text[i]) : 0u; };
+    for (size_t i = 0; i < text.size();) {
+        unsigned c = byte(i);
+        size_t length = c < 0x80 ? 1 : c >= 0xC2 && c <= 0xDF ? 2 : c >= 0xE0 && c <= 0xEF ? 3 : c >= 0xF0 && c <= 0xF4 ? 4 : 0;
+        if (length == 0) return static_cast<uint32_t>(i);
+        // The second byte's range excludes overlong forms, surrogates and what lies past U+10FFFF.
+        unsigned lo = c == 0xE0 ? 0xA0 : c == 0xF0 ? 0x90 : 0x80;
+        unsigned hi = c == 0xED ? 0x9F : c == 0xF4 ? 0x8F : 0xBF;
+        for (size_t k = 1; k < length; ++k) {
+            unsigned b = byte(i + k);
+            if (k == 1 ? (b < lo || b > hi) : (b & 0xC0) != 0x80) return static_cast<uint32_t>(i);
+        }
+        i += length;
+    }
+    return std::nullopt;
+}
+
 int SourceManager::add(std::string displayPath, std::string text) {
     files_.push_back(std::make_unique<SourceFile>(std::move(displayPath), std::move(text)));
     return count() - 1;

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -41,6 +42,10 @@ private:
     std::string text_;
     std::vector<uint32_t> lineStarts_;
 };
+
+// The offset of the first byte that does not begin a well-formed UTF-8 sequence (overlong
+// forms, surrogates and code points past U+10FFFF are not well-formed), or nullopt.
+std::optional<uint32_t> firstInvalidUtf8(std::string_view text);
 
 class SourceManager {
 public:

@@ -46,13 +46,27 @@ std::string Type::str() const {
     return "<error>";
 }
 
+namespace {
+
+struct NamedType {
+    std::string_view name;
+    int width;  // 0: bool
+};
+constexpr NamedType kNamedTypes[] = {{"bool", 0}, {"float", 1}, {"scalar", 1}, {"vec2", 2}, {"vec3", 3},
+                                     {"point", 3}, {"vector", 3}, {"vec4", 4}, {"color", 4}};
+
+}  // namespace
+
 std::optional<Type> Type::fromName(std::string_view name) {
-    if (name == "bool") return boolean();
-    if (name == "float" || name == "scalar") return scalar();
-    if (name == "vec2") return vec(2);
-    if (name == "vec3" || name == "point" || name == "vector") return vec(3);
-    if (name == "vec4" || name == "color") return vec(4);
+    for (const NamedType& t : kNamedTypes)
+        if (t.name == name) return t.width == 0 ? boolean() : vec(t.width);
     return std::nullopt;
+}
+
+std::vector<std::string_view> Type::names() {
+    std::vector<std::string_view> all;
+    for (const NamedType& t : kNamedTypes) all.push_back(t.name);
+    return all;
 }
 
 }  // namespace psys

@@ -41,6 +41,8 @@ public:
 
     // `float`, `vec3`, `color`, … ; nullopt for an unknown name.
     static std::optional<Type> fromName(std::string_view name);
+    // Every name fromName knows.
+    static std::vector<std::string_view> names();
 
 private:
     explicit Type(Kind kind) : kind_(kind) {}

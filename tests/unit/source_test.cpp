@@ -32,3 +32,16 @@ TEST_CASE("joining ranges spans both and ignores invalid ones") {
     CHECK(SourceRange::join(none, b).begin == 10);
     CHECK(SourceRange::join(a, none).end == 6);
 }
+
+TEST_CASE("UTF-8: the first byte that does not begin a well-formed sequence") {
+    using psys::firstInvalidUtf8;
+    CHECK_FALSE(firstInvalidUtf8("plain ASCII").has_value());
+    CHECK_FALSE(firstInvalidUtf8("caf\xC3\xA9 \xE2\x98\x95 \xF0\x9D\x84\x9E").has_value());  // é ☕ 𝄞
+    CHECK(firstInvalidUtf8("caf\xE9!") == 3u);             // Latin-1 é
+    CHECK(firstInvalidUtf8("a\xC0\x80") == 1u);            // an overlong NUL
+    CHECK(firstInvalidUtf8("ab\xE0\x80\x80") == 2u);       // an overlong three-byte form
+    CHECK(firstInvalidUtf8("\xED\xA0\x80") == 0u);         // a surrogate
+    CHECK(firstInvalidUtf8("x\xF4\x90\x80\x80") == 1u);    // past U+10FFFF
+    CHECK(firstInvalidUtf8("ok\xE2\x98") == 2u);           // cut short at the end
+    CHECK(firstInvalidUtf8("\x80") == 0u);                 // a lone continuation byte
+}

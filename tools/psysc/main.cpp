@@ -5,6 +5,8 @@
 //   psysc --emit=ast|ir FILE            print the checked AST, or the IR after the passes
 //   psysc --emit=glsl FILE              print the GLSL shaders the GPU backend runs
 //   psysc --stats FILE                  the cost of each object type, without and with the optimizer
+//   psysc lsp                           the language server, on stdin and stdout (editor-support/)
+//   psysc builtins                      the language's keywords and built-ins, as JSON
 //
 // Exit status: 0 success, 1 errors in the input, 2 bad usage. README.md lists the options.
 #include <unistd.h>
@@ -25,6 +27,8 @@
 #include "stats_command.h"
 #include "driver/compile.h"
 #include "host/backends.h"
+#include "lsp/features.h"
+#include "lsp/server.h"
 #include "rt/system.h"
 #include "run_command.h"
 
@@ -184,6 +188,14 @@ int main(int argc, char** argv) {
     addRunOptions(*run, runOptions);
     run->fallthrough();
 
+    auto* lsp = app.add_subcommand("lsp", "Serve the Language Server Protocol on stdin and stdout (for editors)");
+    int debounceMs = 150;
+    lsp->add_option("--debounce", debounceMs, "Milliseconds of quiet after an edit before it is checked (150)")
+        ->check(CLI::Range(0, 10000));
+    bool stdio = true;  // what vscode-languageclient passes for its stdio transport
+    lsp->add_flag("--stdio", stdio, "Use stdin and stdout (the default and only transport)");
+    auto* builtins = app.add_subcommand("builtins", "Print the language's keywords, built-ins and attributes as JSON");
+
     app.require_subcommand(0, 1);
     check->fallthrough();
     try {
@@ -196,6 +208,16 @@ int main(int argc, char** argv) {
 
     std::optional<psys::core::Integrator> everyObject;
     if (!integrator.empty()) everyObject = psys::core::integratorFromName(integrator);
+    if (lsp->parsed()) {
+        psys::lsp::ServerOptions options;
+        options.debounce = std::chrono::milliseconds(debounceMs);
+        options.version = PSYS_VERSION;
+        return psys::lsp::serve(STDIN_FILENO, STDOUT_FILENO, options);
+    }
+    if (builtins->parsed()) {
+        std::cout << psys::lsp::vocabulary().dump(2) << "\n";
+        return 0;
+    }
     if (!statsFile.empty()) return psys::tools::printStats(statsFile, everyObject, colour);
     if (run->parsed()) {
         runOptions.colour = colour;

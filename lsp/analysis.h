@@ -1,0 +1,68 @@
+// One document as the front end sees it: its diagnostics, and an index of what every
+// name and expression in it is (for hover, go to definition, symbols and completion).
+// The AST is not kept: the index holds what the features need, so an analysis outlives
+// the text it came from (completion keeps using the last one that parsed while the
+// current text does not).
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "frontend/diagnostics.h"
+#include "frontend/source.h"
+
+namespace psys::lsp {
+
+// The protocol's kinds (SymbolKind and CompletionItemKind), the ones used here.
+enum class SymbolKind { Class = 5, Property = 7, Field = 8, Function = 12, Variable = 13, Constant = 14, Event = 24 };
+enum class CompletionKind { Function = 3, Field = 5, Variable = 6, Class = 7, Property = 10, Keyword = 14,
+                            Snippet = 15, Constant = 21, Struct = 22, Event = 23, TypeParameter = 25 };
+
+// A name or expression in a file: what hover shows and where its declaration is.
+struct Occurrence {
+    SourceRange range;
+    std::string hover;  // Markdown
+    std::optional<SourceRange> definition;
+};
+
+struct Symbol {
+    std::string name, detail;
+    SymbolKind kind;
+    SourceRange range, selection;
+    std::vector<Symbol> children;
+};
+
+struct Name {
+    std::string label, detail, documentation;
+    CompletionKind kind;
+};
+
+// Names visible inside a range of the main file beyond the file scope: an object's
+// parameters, equations, nested objects and enclosing objects; a fn's parameters and lets;
+// a trigger's parameters.
+struct Scope {
+    SourceRange range;
+    std::vector<Name> names;
+};
+
+struct Analysis {
+    std::unique_ptr<SourceManager> sources;
+    int mainFile = -1;
+    bool parsed = false;  // false: syntax errors (or no file); only the diagnostics are meaningful
+    std::vector<Diagnostic> diagnostics;
+    std::vector<Occurrence> occurrences;  // every file's, in the order found
+    std::vector<Symbol> symbols;          // the main file's declarations
+    std::vector<Name> globals;            // the file scope: every module's declarations
+    std::vector<Scope> scopes;
+    std::vector<std::pair<std::string, std::vector<Name>>> members;  // per object: what `object.` reads
+
+    // The innermost occurrence at `offset` of `file` (its end counts: the cursor just after a name).
+    const Occurrence* at(int file, uint32_t offset) const;
+};
+
+// Runs the front end over `text` as the file `path` (imports are read from disk, relative to it).
+Analysis analyze(const std::string& path, std::string text);
+
+}  // namespace psys::lsp

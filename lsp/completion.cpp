@@ -1,0 +1,97 @@
+// Completion: what may be written at the cursor. After `name.`, what an enclosing object
+// offers to be read live; after `@`, the attributes; inside `@integrator(`, the methods;
+// elsewhere the names in scope (the object's, fn's or trigger's own, then the file's),
+// the built-ins and the keywords.
+#include <cctype>
+#include <set>
+
+#include "frontend/builtins.h"
+#include "frontend/types.h"
+#include "lsp/features.h"
+
+namespace psys::lsp {
+
+namespace {
+
+bool identChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+
+nlohmann::json item(const Name& n) {
+    nlohmann::json j = {{"label", n.label}, {"kind", static_cast<int>(n.kind)}};
+    if (!n.detail.empty()) j["detail"] = n.detail;
+    if (!n.documentation.empty()) j["documentation"] = n.documentation;
+    return j;
+}
+
+std::vector<Name> builtinNames() {
+    std::vector<Name> names;
+    for (std::string_view k : keywords()) names.push_back({std::string(k), "", "", CompletionKind::Keyword});
+    for (const BuiltinFunction& f : builtinFunctions())
+        names.push_back({std::string(f.name), std::string(f.signature), "built-in function", CompletionKind::Function});
+    for (const BuiltinConstant& c : builtinConstants())
+        names.push_back({std::string(c.name), c.type.str(), "built-in constant", CompletionKind::Constant});
+    for (const char* v : {"age", "time", "dt"}) names.push_back({v, "float", "built-in variable", CompletionKind::Variable});
+    for (std::string_view t : Type::names()) names.push_back({std::string(t), "type", "", CompletionKind::TypeParameter});
+    return names;
+}
+
+// The text before `offset` without trailing blanks.
+std::string_view before(const std::string& text, size_t offset) {
+    while (offset > 0 && (text[offset - 1] == ' ' || text[offset - 1] == '\t')) --offset;
+    return std::string_view(text).substr(0, offset);
+}
+
+}  // namespace
+
+nlohmann::json vocabulary() {
+    nlohmann::json v;
+    auto list = [](auto&& names) {
+        nlohmann::json out = nlohmann::json::array();
+        for (const auto& n : names) out.push_back(std::string(n));
+        return out;
+    };
+    v["keywords"] = list(keywords());
+    v["functions"] = nlohmann::json::array();
+    for (const BuiltinFunction& f : builtinFunctions()) v["functions"].push_back(std::string(f.name));
+    v["constants"] = nlohmann::json::array();
+    for (const BuiltinConstant& c : builtinConstants()) v["constants"].push_back(std::string(c.name));
+    v["variables"] = {"age", "time", "dt"};
+    v["types"] = list(Type::names());
+    v["attributes"] = nlohmann::json::array();
+    for (const BuiltinAttribute& a : builtinAttributes()) v["attributes"].push_back(std::string(a.name));
+    v["integrators"] = list(integratorNames());
+    return v;
+}
+
+nlohmann::json completion(const Analysis& a, const std::string& text, uint32_t offset) {
+    size_t end = std::min<size_t>(offset, text.size()), start = end;
+    while (start > 0 && identChar(text[start - 1])) --start;
+    std::vector<Name> names;
+    std::string_view lead = before(text, start);
+    if (start > 0 && text[start - 1] == '.') {
+        size_t baseStart = start - 1;
+        while (baseStart > 0 && identChar(text[baseStart - 1])) --baseStart;
+        std::string base = text.substr(baseStart, start - 1 - baseStart);
+        for (const auto& [object, members] : a.members)
+            if (object == base) names = members;
+    } else if (start > 0 && text[start - 1] == '@') {
+        for (const BuiltinAttribute& at : builtinAttributes())
+            names.push_back({std::string(at.name), std::string(at.signature), std::string(at.doc), CompletionKind::Property});
+    } else if (lead.size() >= 1 && lead.back() == '(' && before(text, lead.size() - 1).ends_with("@integrator")) {
+        for (std::string_view m : integratorNames()) names.push_back({std::string(m), "integrator", "", CompletionKind::Constant});
+    } else {
+        if (a.parsed)
+            for (const Scope& s : a.scopes)
+                if (s.range.file == a.mainFile && s.range.begin <= offset && offset <= s.range.end)
+                    names.insert(names.end(), s.names.begin(), s.names.end());
+        names.insert(names.end(), a.globals.begin(), a.globals.end());
+        std::vector<Name> builtins = builtinNames();
+        names.insert(names.end(), builtins.begin(), builtins.end());
+    }
+    nlohmann::json items = nlohmann::json::array();
+    std::set<std::string> seen;  // the innermost declaration of a name wins
+    for (const Name& n : names)
+        if (seen.insert(n.label).second) items.push_back(item(n));
+    return {{"isIncomplete", false}, {"items", items}};
+}
+
+}  // namespace psys::lsp

@@ -1,0 +1,77 @@
+#include "lsp/features.h"
+
+#include "lsp/positions.h"
+
+namespace psys::lsp {
+
+namespace {
+
+nlohmann::json location(const SourceManager& sources, SourceRange r) {
+    const SourceFile& f = sources.file(r.file);
+    return {{"uri", uriFromPath(f.path())}, {"range", range(f, r.begin, r.end)}};
+}
+
+}  // namespace
+
+std::map<std::string, nlohmann::json> diagnosticsByUri(const Analysis& a) {
+    std::map<std::string, nlohmann::json> out;
+    if (a.mainFile >= 0) out[uriFromPath(a.sources->file(a.mainFile).path())] = nlohmann::json::array();
+    for (const Diagnostic& d : a.diagnostics) {
+        // A diagnostic without a place (a file that cannot be read) goes to the top of the main file.
+        SourceRange r = d.range.valid() ? d.range : SourceRange{a.mainFile, 0, 0};
+        if (r.file < 0) continue;
+        const SourceFile& f = a.sources->file(r.file);
+        nlohmann::json related = nlohmann::json::array();
+        for (const DiagnosticNote& n : d.notes)
+            if (n.range.valid()) related.push_back({{"location", location(*a.sources, n.range)}, {"message", n.message}});
+        std::string message = d.message;
+        for (const DiagnosticNote& n : d.notes)
+            if (!n.range.valid()) message += "\nnote: " + n.message;
+        nlohmann::json diag = {{"range", range(f, r.begin, r.end)},
+                               {"severity", d.severity == Severity::Error ? 1 : d.severity == Severity::Warning ? 2 : 3},
+                               {"source", "psysc"},
+                               {"message", message}};
+        if (!related.empty()) diag["relatedInformation"] = related;
+        out[uriFromPath(f.path())].push_back(diag);
+    }
+    return out;
+}
+
+nlohmann::json hover(const Analysis& a, uint32_t offset) {
+    const Occurrence* o = a.parsed ? a.at(a.mainFile, offset) : nullptr;
+    if (!o || o->hover.empty()) return nullptr;
+    const SourceFile& f = a.sources->file(a.mainFile);
+    return {{"contents", {{"kind", "markdown"}, {"value", o->hover}}}, {"range", range(f, o->range.begin, o->range.end)}};
+}
+
+nlohmann::json definition(const Analysis& a, uint32_t offset) {
+    const Occurrence* o = a.parsed ? a.at(a.mainFile, offset) : nullptr;
+    if (!o || !o->definition || !o->definition->valid()) return nullptr;
+    return location(*a.sources, *o->definition);
+}
+
+namespace {
+
+nlohmann::json symbolJson(const SourceFile& f, const Symbol& s) {
+    nlohmann::json children = nlohmann::json::array();
+    for (const Symbol& c : s.children) children.push_back(symbolJson(f, c));
+    nlohmann::json j = {{"name", s.name},
+                        {"kind", static_cast<int>(s.kind)},
+                        {"range", range(f, s.range.begin, s.range.end)},
+                        {"selectionRange", range(f, s.selection.begin, s.selection.end)},
+                        {"children", children}};
+    if (!s.detail.empty()) j["detail"] = s.detail;
+    return j;
+}
+
+}  // namespace
+
+nlohmann::json documentSymbols(const Analysis& a) {
+    nlohmann::json out = nlohmann::json::array();
+    if (!a.parsed) return out;
+    const SourceFile& f = a.sources->file(a.mainFile);
+    for (const Symbol& s : a.symbols) out.push_back(symbolJson(f, s));
+    return out;
+}
+
+}  // namespace psys::lsp

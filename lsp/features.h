@@ -1,0 +1,31 @@
+// The protocol's answers computed from an Analysis: diagnostics to publish, hover, go to
+// definition, document symbols and completion. Pure functions of the analysis and a
+// position, so tests call them without a transport.
+#pragma once
+
+#include <map>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "lsp/analysis.h"
+
+namespace psys::lsp {
+
+// Per file URI, the diagnostics to publish (the main file always has an entry, maybe empty).
+std::map<std::string, nlohmann::json> diagnosticsByUri(const Analysis& a);
+
+// `offset` is a byte offset in the main file. Each returns the protocol's `null` when there is nothing.
+nlohmann::json hover(const Analysis& a, uint32_t offset);
+nlohmann::json definition(const Analysis& a, uint32_t offset);
+nlohmann::json documentSymbols(const Analysis& a);
+
+// `text` is the document as it is now, `offset` the cursor's byte in it; `scopes` come from
+// the latest analysis that parsed (maybe of an older text: ranges are near enough).
+nlohmann::json completion(const Analysis& scopes, const std::string& text, uint32_t offset);
+
+// The language's own words by category (keywords, functions, constants, variables,
+// types, attributes, integrators): `psysc builtins`, which the editor grammars' tests read.
+nlohmann::json vocabulary();
+
+}  // namespace psys::lsp

@@ -1,0 +1,234 @@
+#include "lsp/server.h"
+
+#include <csignal>
+
+#include "lsp/features.h"
+#include "lsp/positions.h"
+#include "lsp/transport.h"
+
+namespace psys::lsp {
+
+using nlohmann::json;
+
+namespace {
+
+// A request's failure the client is told about (the protocol's error code and message).
+struct RequestError {
+    int code;
+    std::string message;
+};
+
+bool isNotification(const json& m) { return !m.contains("id"); }
+
+}  // namespace
+
+void Server::notify(const std::string& method, json params) {
+    send_({{"jsonrpc", "2.0"}, {"method", method}, {"params", std::move(params)}});
+}
+
+void Server::handle(const json& m) {
+    if (!m.is_object() || m.value("jsonrpc", "") != "2.0" ||
+        (m.contains("method") && !m["method"].is_string()) ||
+        (m.contains("id") && !m["id"].is_number_integer() && !m["id"].is_string() && !m["id"].is_null())) {
+        json id = m.is_object() && m.contains("id") && (m["id"].is_number_integer() || m["id"].is_string()) ? m["id"] : json();
+        send_(errorResponse(id, error::kInvalidRequest, "not a JSON-RPC 2.0 request or notification"));
+        return;
+    }
+    if (!m.contains("method")) return;  // a response to something the server never asks
+    std::string method = m["method"];
+    json params = m.value("params", json::object());
+    bool notification = isNotification(m);
+    json id = notification ? json() : m["id"];
+    if (method == "exit") {
+        exitCode_ = shutdown_ ? 0 : 1;
+        return;
+    }
+    try {
+        if (!initialized_ && method != "initialize")
+            throw RequestError{error::kServerNotInitialized, "the server has not been initialised"};
+        if (shutdown_) throw RequestError{error::kInvalidRequest, "the server is shutting down: only `exit` is accepted"};
+        bool found = false;
+        json result = dispatch(method, params, &found);
+        if (!found) {
+            if (notification) return;  // notifications the server does not know are ignored, as the protocol says
+            throw RequestError{error::kMethodNotFound, "no method `" + method + "`"};
+        }
+        if (!notification) send_({{"jsonrpc", "2.0"}, {"id", id}, {"result", result}});
+    } catch (const RequestError& e) {
+        if (!notification) send_(errorResponse(id, e.code, e.message));
+    } catch (const json::exception& e) {
+        if (!notification) send_(errorResponse(id, error::kInvalidParams, std::string("invalid params: ") + e.what()));
+    } catch (const std::exception& e) {
+        if (!notification) send_(errorResponse(id, error::kInternalError, e.what()));
+    }
+}
+
+json Server::dispatch(const std::string& method, const json& params, bool* found) {
+    *found = true;
+    if (method == "initialize") return initialize(params);
+    if (method == "initialized") return nullptr;
+    if (method == "shutdown") {
+        shutdown_ = true;
+        return nullptr;
+    }
+    if (method == "textDocument/didOpen") {
+        didOpen(params);
+        return nullptr;
+    }
+    if (method == "textDocument/didChange") {
+        didChange(params);
+        return nullptr;
+    }
+    if (method == "textDocument/didClose") {
+        didClose(params);
+        return nullptr;
+    }
+    if (method == "textDocument/didSave") {
+        // A saved file may be imported by the others: they are analysed again.
+        for (auto& [uri, doc] : docs_) doc.dirty = true, doc.changedAt = Clock::now() - options_.debounce;
+        return nullptr;
+    }
+    auto offset = [&](Document& doc) { return offsetOf(doc.analysis->sources->file(doc.analysis->mainFile), params.at("position")); };
+    if (method == "textDocument/hover") {
+        Document& doc = document(params);
+        return hover(*doc.analysis, offset(doc));
+    }
+    if (method == "textDocument/definition") {
+        Document& doc = document(params);
+        return definition(*doc.analysis, offset(doc));
+    }
+    if (method == "textDocument/documentSymbol") return documentSymbols(*document(params).analysis);
+    if (method == "textDocument/completion") {
+        Document& doc = document(params);
+        const Analysis& scopes = doc.lastParsed ? *doc.lastParsed : *doc.analysis;
+        return completion(scopes, doc.text, offset(doc));
+    }
+    *found = false;
+    return nullptr;
+}
+
+json Server::initialize(const json& params) {
+    if (initialized_) throw RequestError{error::kInvalidRequest, "the server is already initialised"};
+    initialized_ = true;
+    if (params.contains("initializationOptions") && params["initializationOptions"].is_object()) {
+        const json& o = params["initializationOptions"];
+        if (o.contains("debounceMs")) options_.debounce = std::chrono::milliseconds(o["debounceMs"].get<int64_t>());
+    }
+    return {{"capabilities",
+             {{"textDocumentSync", {{"openClose", true}, {"change", 2}, {"save", true}}},
+              {"hoverProvider", true},
+              {"definitionProvider", true},
+              {"documentSymbolProvider", true},
+              {"completionProvider", {{"triggerCharacters", {".", "@"}}}}}},
+            {"serverInfo", {{"name", "psysc"}, {"version", options_.version}}}};
+}
+
+void Server::didOpen(const json& params) {
+    const json& td = params.at("textDocument");
+    Document doc;
+    doc.uri = td.at("uri").get<std::string>();
+    doc.path = pathFromUri(doc.uri);
+    doc.text = td.at("text").get<std::string>();
+    doc.version = td.value("version", 0);
+    auto [it, _] = docs_.insert_or_assign(doc.uri, std::move(doc));
+    analyse(it->second);
+}
+
+void Server::didChange(const json& params) {
+    std::string uri = params.at("textDocument").at("uri");
+    auto it = docs_.find(uri);
+    if (it == docs_.end()) throw RequestError{error::kInvalidParams, uri + " is not open"};
+    Document& doc = it->second;
+    for (const json& change : params.at("contentChanges")) {
+        if (!change.contains("range")) {
+            doc.text = change.at("text").get<std::string>();
+            continue;
+        }
+        // An incremental change: positions are in the text as it stands before this change.
+        SourceFile current(doc.path, doc.text);
+        uint32_t begin = offsetOf(current, change["range"].at("start"));
+        uint32_t end = std::max(begin, offsetOf(current, change["range"].at("end")));
+        doc.text.replace(begin, end - begin, change.at("text").get<std::string>());
+    }
+    doc.version = params["textDocument"].value("version", doc.version);
+    doc.dirty = true;
+    doc.changedAt = Clock::now();
+}
+
+void Server::didClose(const json& params) {
+    auto it = docs_.find(params.at("textDocument").at("uri").get<std::string>());
+    if (it == docs_.end()) return;
+    for (const std::string& uri : it->second.publishedTo)
+        notify("textDocument/publishDiagnostics", {{"uri", uri}, {"diagnostics", json::array()}});
+    docs_.erase(it);
+}
+
+Server::Document& Server::document(const json& params) {
+    std::string uri = params.at("textDocument").at("uri");
+    auto it = docs_.find(uri);
+    if (it == docs_.end()) throw RequestError{error::kInvalidParams, uri + " is not open"};
+    if (it->second.dirty) analyse(it->second);
+    return it->second;
+}
+
+void Server::analyse(Document& doc) {
+    doc.analysis = std::make_shared<const Analysis>(analyze(doc.path, doc.text));
+    if (doc.analysis->parsed) doc.lastParsed = doc.analysis;
+    doc.dirty = false;
+    publish(doc);
+}
+
+void Server::publish(Document& doc) {
+    std::map<std::string, json> byUri = diagnosticsByUri(*doc.analysis);
+    std::string mainUri = uriFromPath(doc.path);
+    if (mainUri != doc.uri) {  // the editor's spelling of the document's URI is the one it knows
+        byUri[doc.uri] = std::move(byUri[mainUri]);
+        byUri.erase(mainUri);
+    }
+    for (const std::string& uri : doc.publishedTo)
+        if (!byUri.count(uri)) byUri[uri] = json::array();
+    doc.publishedTo.clear();
+    for (auto& [uri, diagnostics] : byUri) {
+        json params = {{"uri", uri}, {"diagnostics", diagnostics}};
+        if (uri == doc.uri) params["version"] = doc.version;
+        if (!diagnostics.empty() || uri == doc.uri) doc.publishedTo.insert(uri);
+        notify("textDocument/publishDiagnostics", std::move(params));
+    }
+}
+
+void Server::idle() {
+    auto now = Clock::now();
+    for (auto& [uri, doc] : docs_)
+        if (doc.dirty && now - doc.changedAt >= options_.debounce) analyse(doc);
+}
+
+std::optional<std::chrono::milliseconds> Server::nextDeadline() const {
+    std::optional<std::chrono::milliseconds> next;
+    auto now = Clock::now();
+    for (const auto& [uri, doc] : docs_) {
+        if (!doc.dirty) continue;
+        auto left = std::chrono::duration_cast<std::chrono::milliseconds>(doc.changedAt + options_.debounce - now);
+        left = std::max(left, std::chrono::milliseconds(0));
+        if (!next || left < *next) next = left;
+    }
+    return next;
+}
+
+int serve(int in, int out, ServerOptions options) {
+    std::signal(SIGPIPE, SIG_IGN);  // a client that goes away is an end of input, not a signal
+    Transport transport(in, out);
+    Server server(std::move(options), [&transport](const json& m) { transport.write(m); });
+    for (;;) {
+        Incoming next = transport.read(server.nextDeadline());
+        switch (next.kind) {
+            case Incoming::Kind::Message: server.handle(next.json); break;
+            case Incoming::Kind::Malformed: transport.write(errorResponse(nullptr, error::kParseError, next.problem)); break;
+            case Incoming::Kind::Timeout: break;
+            case Incoming::Kind::End: return 1;  // the client went away without `exit`
+        }
+        if (server.exitCode()) return *server.exitCode();
+        server.idle();
+    }
+}
+
+}  // namespace psys::lsp

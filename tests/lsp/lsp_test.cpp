@@ -1,0 +1,305 @@
+// The language server's features on real analyses (hover, definition across an import,
+// symbols, completion, diagnostics with their ranges), its positions in UTF-16, and its
+// protocol: every malformed or out-of-order message gets the protocol's error.
+#define DOCTEST_CONFIG_IMPLEMENT_WITH_MAIN
+#include <doctest/doctest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "lsp/analysis.h"
+#include "lsp/features.h"
+#include "lsp/positions.h"
+#include "lsp/server.h"
+#include "lsp/transport.h"
+
+using namespace psys;
+using namespace psys::lsp;
+using nlohmann::json;
+
+namespace {
+
+const char* kFireworks = R"(extern sparks: float = 50;
+fn gravity(m: float) -> vec3 = vec3(0, -9.82 * m, 0);
+object rocket(ivel: vec3) {
+    pos = origin + integrate(vel);
+    vel = snapshot(ivel) + integrate(gravity(0.3));
+    point(pos, white, 2);
+    emit spark(pos) at sparks per second;
+    kill when vel.y < 0;
+    object spark(ipos: vec3) {
+        pos = snapshot(ipos) + integrate(rocket.vel);
+        point(pos, mix(green, black, age), 2);
+        kill when age > 1;
+    }
+}
+spawn rocket(vec3(0, 15, 0));
+)";
+
+// The byte offset of the `n`-th occurrence of `needle` (plus `shift`).
+uint32_t at(const std::string& text, const std::string& needle, int n = 1, int shift = 0) {
+    size_t p = std::string::npos;
+    for (int i = 0; i < n; ++i) p = text.find(needle, p == std::string::npos ? 0 : p + 1);
+    REQUIRE(p != std::string::npos);
+    return static_cast<uint32_t>(p + static_cast<size_t>(shift));
+}
+
+std::string hoverText(const Analysis& a, uint32_t offset) {
+    json h = hover(a, offset);
+    return h.is_null() ? std::string() : h["contents"]["value"].get<std::string>();
+}
+
+std::vector<std::string> labels(const json& completion) {
+    std::vector<std::string> out;
+    for (const json& item : completion["items"]) out.push_back(item["label"]);
+    return out;
+}
+
+bool has(const std::vector<std::string>& list, const std::string& x) {
+    return std::find(list.begin(), list.end(), x) != list.end();
+}
+
+struct TempDir {
+    std::filesystem::path path;
+    TempDir() {
+        char name[] = "/tmp/psys_lsp_XXXXXX";
+        path = mkdtemp(name);
+    }
+    ~TempDir() { std::filesystem::remove_all(path); }
+    std::string write(const std::string& name, const std::string& text) const {
+        std::ofstream(path / name) << text;
+        return (path / name).string();
+    }
+};
+
+}  // namespace
+
+TEST_CASE("hover: an equation, a parameter, a built-in, a swizzle, a live parent read, an extern") {
+    std::string text = kFireworks;
+    Analysis a = analyze("/tmp/fw.psys", text);
+    REQUIRE(a.parsed);
+    CHECK(a.diagnostics.empty());
+    CHECK(hoverText(a, at(text, "pos =")) == "```psys\npos: vec3\n```\n\nequation of `rocket`");
+    CHECK(hoverText(a, at(text, "ivel)", 1, 2)) == "```psys\nivel: vec3\n```\n\nparameter of `rocket`");
+    CHECK(hoverText(a, at(text, "integrate(vel)")).find("integrate(x: T) -> T") != std::string::npos);
+    CHECK(hoverText(a, at(text, "vel.y", 1, 4)) == "```psys\n.y: float\n```\n\nswizzle");
+    CHECK(hoverText(a, at(text, "rocket.vel", 1, 8)).find("vel: vec3") != std::string::npos);
+    CHECK(hoverText(a, at(text, "rocket.vel", 1, 8)).find("read live from `rocket`") != std::string::npos);
+    CHECK(hoverText(a, at(text, "sparks per")) == "```psys\nextern sparks: float\n```\n\nset by the host");
+    CHECK(hoverText(a, at(text, "gravity(0.3)")) == "```psys\nfn gravity(m: float) -> vec3\n```");
+    CHECK(hoverText(a, at(text, "white")).find("built-in constant (1, 1, 1, 1)") != std::string::npos);
+    CHECK(hoverText(a, at(text, "age > 1")).find("age: float") != std::string::npos);
+    // An expression that is not a name shows its type: `vel.y < 0` is a bool.
+    CHECK(hoverText(a, at(text, "< 0")) == "```psys\nbool\n```");
+    CHECK(hoverText(a, at(text, "spawn", 1, 1)).empty());
+}
+
+TEST_CASE("definition: an equation, a parent read, an emitted object, a function") {
+    std::string text = kFireworks;
+    Analysis a = analyze("/tmp/fw.psys", text);
+    auto target = [&](uint32_t offset) {
+        json d = definition(a, offset);
+        REQUIRE(!d.is_null());
+        CHECK(d["uri"] == "file:///tmp/fw.psys");
+        return d["range"]["start"];
+    };
+    CHECK(target(at(text, "integrate(vel)", 1, 10)) == json{{"line", 4}, {"character", 4}});
+    CHECK(target(at(text, "rocket.vel", 1, 8)) == json{{"line", 4}, {"character", 4}});
+    CHECK(target(at(text, "rocket.vel", 1, 1)) == json{{"line", 2}, {"character", 7}});
+    CHECK(target(at(text, "spark(pos)")) == json{{"line", 8}, {"character", 11}});
+    CHECK(target(at(text, "gravity(0.3)")) == json{{"line", 1}, {"character", 3}});
+    CHECK(definition(a, at(text, "age > 1")).is_null());  // built-in: nowhere to go
+}
+
+TEST_CASE("definition across an import, and the imported file's diagnostics go to its own URI") {
+    TempDir dir;
+    dir.write("lib.psys", "// shared\nfn wobble(x: float) -> float = sin(x * 3);\nconst lift = 2;\n");
+    std::string main = "import \"lib.psys\";\nobject o { y = wobble(age) * lift; point(vec3(0, y, 0), white, 1); }\nspawn o;\n";
+    Analysis a = analyze(dir.write("main.psys", main), main);
+    REQUIRE(a.parsed);
+    json d = definition(a, at(main, "wobble"));
+    CHECK(d["uri"] == uriFromPath((dir.path / "lib.psys").string()));
+    CHECK(d["range"]["start"] == json{{"line", 1}, {"character", 3}});
+    CHECK(definition(a, at(main, "lift"))["range"]["start"] == json{{"line", 2}, {"character", 6}});
+    json import = definition(a, at(main, "lib.psys"));
+    CHECK(import["uri"] == uriFromPath((dir.path / "lib.psys").string()));
+
+    dir.write("lib.psys", "fn wobble(x: float) -> float = sin(x * 3) + nope;\nconst lift = 2;\n");
+    Analysis broken = analyze((dir.path / "main.psys").string(), main);
+    auto byUri = diagnosticsByUri(broken);
+    json libDiagnostics = byUri[uriFromPath((dir.path / "lib.psys").string())];
+    REQUIRE(libDiagnostics.size() == 1);
+    CHECK(libDiagnostics[0]["message"].get<std::string>().find("nope") != std::string::npos);
+    CHECK(byUri[uriFromPath((dir.path / "main.psys").string())].empty());
+}
+
+TEST_CASE("document symbols: objects with their parameters, equations and nested objects") {
+    Analysis a = analyze("/tmp/fw.psys", kFireworks);
+    json symbols = documentSymbols(a);
+    std::vector<std::string> top;
+    for (const json& s : symbols) top.push_back(s["name"]);
+    CHECK(top == std::vector<std::string>{"sparks", "gravity", "rocket"});
+    const json& rocket = symbols[2];
+    CHECK(rocket["kind"] == 5);
+    std::vector<std::string> inside;
+    for (const json& c : rocket["children"]) inside.push_back(c["name"]);
+    CHECK(inside == std::vector<std::string>{"ivel", "pos", "vel", "spark"});
+    CHECK(rocket["children"][1]["detail"] == "pos: vec3");
+    CHECK(rocket["children"][3]["children"].size() == 2);  // spark's ipos and pos
+}
+
+TEST_CASE("completion: names in scope inside an object, members after a dot, attributes after @") {
+    std::string text = kFireworks;
+    Analysis a = analyze("/tmp/fw.psys", text);
+    auto inRocket = labels(completion(a, text, at(text, "point(pos, white")));
+    for (const char* n : {"pos", "vel", "ivel", "spark", "sparks", "gravity", "integrate", "age", "white", "emit", "vec3"})
+        CHECK_MESSAGE(has(inRocket, n), n);
+    CHECK_FALSE(has(inRocket, "ipos"));  // spark's parameter is not in rocket's scope
+    auto inSpark = labels(completion(a, text, at(text, "point(pos, mix")));
+    CHECK(has(inSpark, "ipos"));
+    CHECK(has(inSpark, "rocket"));  // an enclosing object, read live
+    std::string dotted = text;
+    uint32_t cursor = at(dotted, "rocket.vel", 1, 7);
+    auto members = labels(completion(a, dotted, cursor));
+    CHECK(members == std::vector<std::string>{"alive", "age", "ivel", "pos", "vel"});
+    std::string attr = "@\n" + text;
+    CHECK(labels(completion(a, attr, 1)) == std::vector<std::string>{"integrator", "step", "capacity"});
+    std::string integrator = "@integrator(\n" + text;
+    CHECK(has(labels(completion(a, integrator, 12)), "rk4"));
+}
+
+TEST_CASE("diagnostics: ranges in UTF-16, notes as related information, warnings, syntax errors") {
+    // é is 2 bytes and 1 UTF-16 unit, 𝄞 4 bytes and 2 units: the error's column in UTF-16 is 3 less than in bytes.
+    std::string text = "object o { /* é𝄞 */ x = vec3(1) + vec2(1); point(vec3(0), white, 1); }\nspawn o;\n";
+    Analysis a = analyze("/tmp/d.psys", text);
+    json diags = diagnosticsByUri(a)["file:///tmp/d.psys"];
+    REQUIRE(diags.size() == 1);
+    CHECK(diags[0]["severity"] == 1);
+    CHECK(diags[0]["message"] == "cannot add vec3 and vec2: vectors of different sizes");
+    uint32_t plus = at(text, "+");
+    CHECK(diags[0]["range"]["start"] == json{{"line", 0}, {"character", plus - 3}});
+    CHECK(diags[0]["range"]["end"] == json{{"line", 0}, {"character", plus - 2}});
+
+    Analysis unused = analyze("/tmp/u.psys", "object o { p = 1; point(vec3(0), white, 1); }\nspawn o;\n");
+    json w = diagnosticsByUri(unused)["file:///tmp/u.psys"];
+    REQUIRE(w.size() == 1);
+    CHECK(w[0]["severity"] == 2);
+    CHECK(w[0]["message"] == "equation `p` is never used");
+
+    Analysis notes = analyze("/tmp/n.psys", "object o { x = 1; x = 2; point(vec3(x), white, 1); }\nspawn o;\n");
+    json n = diagnosticsByUri(notes)["file:///tmp/n.psys"];
+    REQUIRE(n.size() == 1);
+    REQUIRE(n[0].contains("relatedInformation"));
+    CHECK(n[0]["relatedInformation"][0]["location"]["range"]["start"] == json{{"line", 0}, {"character", 11}});
+
+    Analysis syntax = analyze("/tmp/s.psys", "object o { x = ; }\n");
+    CHECK_FALSE(syntax.parsed);
+    json s = diagnosticsByUri(syntax)["file:///tmp/s.psys"];
+    REQUIRE(s.size() == 1);
+    CHECK(s[0]["range"]["start"] == json{{"line", 0}, {"character", 15}});
+    CHECK(hover(syntax, 12).is_null());
+}
+
+TEST_CASE("positions: UTF-16 columns to bytes and back; URIs with spaces") {
+    SourceFile f("x", "a𝄞b\né=1\n");
+    CHECK(position(f, 5) == json{{"line", 0}, {"character", 3}});  // after the 4-byte 𝄞: 2 UTF-16 units
+    CHECK(offsetOf(f, json{{"line", 0}, {"character", 3}}) == 5);
+    CHECK(offsetOf(f, json{{"line", 1}, {"character", 1}}) == 9);   // é is 2 bytes, 1 unit
+    CHECK(offsetOf(f, json{{"line", 1}, {"character", 99}}) == 11);  // clamped to the line
+    CHECK(offsetOf(f, json{{"line", 9}, {"character", 0}}) == f.text().size());
+    CHECK(pathFromUri("file:///a%20b/c.psys") == "/a b/c.psys");
+    CHECK(uriFromPath("/a b/c.psys") == "file:///a%20b/c.psys");
+}
+
+namespace {
+
+struct Session {
+    std::vector<json> out;
+    Server server{ServerOptions{}, [this](const json& m) { out.push_back(m); }};
+    json request(int id, const std::string& method, json params = json::object()) {
+        out.clear();
+        server.handle({{"jsonrpc", "2.0"}, {"id", id}, {"method", method}, {"params", params}});
+        for (const json& m : out)
+            if (m.contains("id") && m["id"] == id) return m;
+        return nullptr;
+    }
+};
+
+}  // namespace
+
+TEST_CASE("protocol: errors for requests before initialize, unknown methods, bad params, after shutdown") {
+    Session s;
+    CHECK(s.request(1, "textDocument/hover")["error"]["code"] == error::kServerNotInitialized);
+    CHECK(s.request(2, "initialize")["result"]["capabilities"]["hoverProvider"] == true);
+    CHECK(s.request(3, "initialize")["error"]["code"] == error::kInvalidRequest);
+    CHECK(s.request(4, "no/such/method")["error"]["code"] == error::kMethodNotFound);
+    CHECK(s.request(5, "textDocument/hover", {{"textDocument", 7}})["error"]["code"] == error::kInvalidParams);
+    CHECK(s.request(6, "textDocument/hover", {{"textDocument", {{"uri", "file:///closed.psys"}}},
+                                               {"position", {{"line", 0}, {"character", 0}}}})["error"]["code"] ==
+          error::kInvalidParams);
+    s.out.clear();
+    s.server.handle(json::array({1, 2}));
+    REQUIRE(s.out.size() == 1);
+    CHECK(s.out[0]["error"]["code"] == error::kInvalidRequest);
+    s.out.clear();
+    s.server.handle({{"jsonrpc", "2.0"}, {"method", "$/unknownNotification"}});
+    CHECK(s.out.empty());  // an unknown notification is ignored
+    CHECK(s.request(7, "shutdown")["result"].is_null());
+    CHECK(s.request(8, "textDocument/documentSymbol")["error"]["code"] == error::kInvalidRequest);
+    s.server.handle({{"jsonrpc", "2.0"}, {"method", "exit"}});
+    CHECK(s.server.exitCode() == 0);
+}
+
+TEST_CASE("documents: edits are debounced, requests see the latest text, closing clears diagnostics") {
+    Session s;
+    s.request(1, "initialize", {{"initializationOptions", {{"debounceMs", 60000}}}});
+    std::string uri = "file:///tmp/doc.psys";
+    s.out.clear();
+    s.server.handle({{"jsonrpc", "2.0"}, {"method", "textDocument/didOpen"},
+                     {"params", {{"textDocument", {{"uri", uri}, {"version", 1}, {"text", "const a = 1 +;\n"}}}}}});
+    REQUIRE(s.out.size() == 1);
+    CHECK(s.out[0]["params"]["diagnostics"].size() == 1);
+    s.out.clear();
+    // An incremental edit: `1 +` becomes `1 + 2`.
+    s.server.handle({{"jsonrpc", "2.0"}, {"method", "textDocument/didChange"},
+                     {"params", {{"textDocument", {{"uri", uri}, {"version", 2}}},
+                                 {"contentChanges", {{{"range", {{"start", {{"line", 0}, {"character", 13}}},
+                                                                 {"end", {{"line", 0}, {"character", 13}}}}},
+                                                      {"text", " 2"}}}}}}});
+    s.server.idle();
+    CHECK(s.out.empty());  // still within the debounce interval
+    CHECK(s.server.nextDeadline().has_value());
+    json h = s.request(2, "textDocument/hover", {{"textDocument", {{"uri", uri}}}, {"position", {{"line", 0}, {"character", 6}}}});
+    CHECK(h["result"]["contents"]["value"] == "```psys\nconst a: float\n```");
+    bool cleared = false;
+    for (const json& m : s.out)
+        if (m.value("method", "") == "textDocument/publishDiagnostics")
+            cleared = m["params"]["diagnostics"].empty() && m["params"]["version"] == 2;
+    CHECK(cleared);
+    CHECK_FALSE(s.server.nextDeadline().has_value());
+    s.out.clear();
+    s.server.handle({{"jsonrpc", "2.0"}, {"method", "textDocument/didClose"}, {"params", {{"textDocument", {{"uri", uri}}}}}});
+    REQUIRE(s.out.size() == 1);
+    CHECK(s.out[0]["params"]["diagnostics"].empty());
+}
+
+TEST_CASE("transport: framing, a header without a length, text that is not JSON, the end of input") {
+    int fds[2];
+    REQUIRE(pipe(fds) == 0);
+    std::string body = R"({"jsonrpc":"2.0","method":"x"})";
+    std::string input = "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body +
+                        "Content-Type: x\r\n\r\n" + "content-length: 5\r\n\r\n{nope";
+    REQUIRE(write(fds[1], input.data(), input.size()) == static_cast<ssize_t>(input.size()));
+    close(fds[1]);
+    Transport t(fds[0], -1);
+    Incoming m = t.read(std::nullopt);
+    CHECK(m.kind == Incoming::Kind::Message);
+    CHECK(m.json["method"] == "x");
+    CHECK(t.read(std::nullopt).kind == Incoming::Kind::Malformed);
+    Incoming bad = t.read(std::nullopt);
+    CHECK(bad.kind == Incoming::Kind::Malformed);
+    CHECK(bad.problem == "the message is not JSON");
+    CHECK(t.read(std::nullopt).kind == Incoming::Kind::End);
+    close(fds[0]);
+}
