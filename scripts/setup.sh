@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs every Debian package psys needs to build, test and run.
+# Installs every Debian package psys needs to build, test and run, and the editor
+# extension's npm packages (editor-support/vscode, versions pinned in package-lock.json).
 # Non-interactive and idempotent: running it again changes nothing.
 set -euo pipefail
 
@@ -9,8 +10,11 @@ packages=(
   llvm-19-dev libzstd-dev
   libglm-dev libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libimgui-dev
   doctest-dev libcli11-dev libfmt-dev nlohmann-json3-dev libstb-dev libtbb-dev
-  glslang-tools xvfb xauth libbenchmark-dev python3-matplotlib
+  glslang-tools xvfb xauth libbenchmark-dev python3-matplotlib vim
 )
+# Node.js 20 and npm (the editor extension's tests and package) come with the machine;
+# where they do not, Debian's are installed.
+command -v node >/dev/null && command -v npm >/dev/null || packages+=(nodejs npm)
 
 missing=()
 for p in "${packages[@]}"; do
@@ -19,11 +23,20 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "setup: all ${#packages[@]} packages already installed"
-  exit 0
+else
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -q
+  $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
-SUDO=""
-[ "$(id -u)" -eq 0 ] || SUDO="sudo"
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -q
-$SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
+# npm ci installs exactly what package-lock.json pins; it runs again only when the lock changed.
+vscode="$(cd "$(dirname "$0")/.." && pwd)/editor-support/vscode"
+if [ ! -f "$vscode/node_modules/.package-lock.json" ] || [ "$vscode/package-lock.json" -nt "$vscode/node_modules/.package-lock.json" ]; then
+  major=$(node -p 'process.versions.node.split(".")[0]')
+  [ "$major" -ge 20 ] || echo "setup: warning: Node.js $major is older than 20, which @vscode/vsce needs to package the extension" >&2
+  (cd "$vscode" && npm ci --no-audit --no-fund --loglevel=error)
+else
+  echo "setup: editor-support/vscode/node_modules up to date"
+fi

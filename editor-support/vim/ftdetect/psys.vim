@@ -1,0 +1,2 @@
+" .psys files are psys programs.
+autocmd BufRead,BufNewFile *.psys setfiletype psys

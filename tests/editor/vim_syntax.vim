@@ -1,0 +1,72 @@
+" Checks the syntax groups vim gives known places of a sample and of the showcase file.
+" Run: vim -Nu NONE -i NONE -es -S tests/editor/vim_syntax.vim -c 'qa!' (from the repository root);
+" it writes what it found to $PSYS_VIM_OUT and exits with an error if any place is wrong.
+set runtimepath^=editor-support/vim
+filetype plugin on
+syntax on
+let s:failures = []
+let s:report = []
+
+" The syntax group at the `nth` match of `needle` (very nomagic) on the line that matches `line`.
+function! s:Check(line, needle, group) abort
+  call cursor(1, 1)
+  let l = search('\V' . a:line, 'cW')
+  if l == 0
+    call add(s:failures, 'no line ' . a:line)
+    return
+  endif
+  let c = stridx(getline(l), a:needle) + 1
+  let got = synIDattr(synID(l, c, 1), 'name')
+  call add(s:report, printf('%s:%d:%d %s -> %s', expand('%:t'), l, c, a:needle, got))
+  if got !=# a:group
+    call add(s:failures, printf('%s line %d `%s`: expected %s, got %s', expand('%:t'), l, a:needle, a:group, got))
+  endif
+endfunction
+
+edit samples/fireworks.psys
+if &filetype !=# 'psys'
+  call add(s:failures, 'ftdetect: filetype is "' . &filetype . '"')
+endif
+call s:Check('// Thesis', 'Thesis', 'psysLineComment')
+call s:Check('extern sparks', 'extern', 'psysStorage')
+call s:Check('extern sparks', 'float', 'psysType')
+call s:Check('extern sparks', '50', 'psysNumber')
+call s:Check('fn gravity', 'gravity', 'psysDeclName')
+call s:Check('fn gravity', '->', 'psysArrow')
+call s:Check('fn gravity', 'vec3 =', 'psysType')
+call s:Check('fn gravity', 'vec3(', 'psysBuiltin')
+call s:Check('fn gravity', '9.82', 'psysNumber')
+call s:Check('object spark', 'spark', 'psysDeclName')
+call s:Check('pos = snapshot(ipos)', 'snapshot', 'psysTemporal')
+call s:Check('vel = origin', 'origin', 'psysConstant')
+call s:Check('point(pos, mix', 'point', 'psysKeyword')
+call s:Check('point(pos, mix', 'mix', 'psysBuiltin')
+call s:Check('point(pos, mix', 'green', 'psysConstant')
+call s:Check('point(pos, mix', 'age', 'psysVariable')
+call s:Check('kill when age', 'kill', 'psysKeyword')
+call s:Check('emit spark(pos)', 'spark', 'psysObjectRef')
+call s:Check('emit spark(pos)', 'per', 'psysKeyword')
+call s:Check('kill when vel.y', 'y <', 'psysSwizzle')
+call s:Check('nrand() * 2', 'nrand', 'psysBuiltin')
+call s:Check('spawn launcher', 'spawn', 'psysKeyword')
+
+edit editor-support/vscode/test/showcase.psys
+call s:Check('/* Every kind', 'Every', 'psysBlockComment')
+call s:Check('import "', '"', 'psysString')
+call s:Check('@integrator(rk4)', '@integrator', 'psysAttribute')
+call s:Check('@integrator(rk4)', 'rk4', 'psysIntegrator')
+call s:Check('const numbers', '.5 +', 'psysNumber')
+call s:Check('const numbers', '1.5e-3', 'psysNumber')
+call s:Check('const numbers', '.5E+2', 'psysNumber')
+call s:Check('trigger burst', 'burst', 'psysDeclName')
+call s:Check('trigger burst', 'point', 'psysType')
+call s:Check('heat = 1 ->', '->', 'psysArrow')
+call s:Check('when age > 1 &&', '&&', 'psysOperator')
+call s:Check('c = if shell.alive', 'if', 'psysConditional')
+call s:Check('kill when age > 0.5', 'true', 'psysBoolean')
+
+call writefile(s:report + map(copy(s:failures), '"FAIL: " . v:val'), $PSYS_VIM_OUT)
+if empty(s:failures)
+  qall!
+endif
+cquit!
