@@ -62,7 +62,8 @@ struct Analysis {
     const Occurrence* at(int file, uint32_t offset) const;
 };
 
-// Runs the front end over `text` as the file `path` (imports are read from disk, relative to it).
+// Runs the front end over `text` as the file `path` (imports are read from disk, relative
+// to it), and the compiler's passes when it is clean, for their warnings.
 Analysis analyze(const std::string& path, std::string text);
 
 }  // namespace psys::lsp

@@ -3,7 +3,7 @@
 #   cmake -DROOT=<source dir> -P tests/check_layers.cmake
 set(allowed_core "")
 set(allowed_frontend "core;grammar")
-set(allowed_lsp "core;frontend")
+set(allowed_lsp "core;frontend;ir;opt;driver")
 set(allowed_ir "core;frontend")
 set(allowed_opt "core;ir")
 set(allowed_driver "core;frontend;ir;opt")
@@ -15,7 +15,7 @@ set(allowed_gpu "core;ir;rt;codegen_glsl")
 set(allowed_host "core;frontend;ir;opt;driver;rt;interp;codegen_llvm;codegen_glsl;gpu")
 set(allowed_tools "core;frontend;lsp;ir;opt;driver;rt;interp;codegen_llvm;codegen_glsl;gpu;host")
 set(allowed_bench "core;frontend;ir;opt;driver;rt;interp;codegen_llvm;codegen_glsl;gpu;host")
-set(layers core frontend lsp ir opt driver rt interp codegen_llvm codegen_glsl gpu host tools bench)
+set(layers core frontend ir opt driver lsp rt interp codegen_llvm codegen_glsl gpu host tools bench)
 
 set(problems "")
 foreach(layer ${layers})

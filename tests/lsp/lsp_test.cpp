@@ -303,3 +303,14 @@ TEST_CASE("transport: framing, a header without a length, text that is not JSON,
     CHECK(t.read(std::nullopt).kind == Incoming::Kind::End);
     close(fds[0]);
 }
+
+TEST_CASE("diagnostics: the passes' warnings, as psysc check reports them") {
+    std::string text = "object drag {\n    vel = vec3(0, 10, 0) + integrate(vec3(0, -9.8, 0) - 180 * vel);\n"
+                       "    point(vel, white, 1);\n}\nspawn drag;\n";
+    Analysis a = analyze("/tmp/w.psys", text);
+    json d = diagnosticsByUri(a)["file:///tmp/w.psys"];
+    REQUIRE(d.size() == 1);
+    CHECK(d[0]["severity"] == 2);
+    CHECK(d[0]["message"].get<std::string>().find("is stable only while") != std::string::npos);
+    CHECK(d[0]["range"]["start"] == json{{"line", 1}, {"character", 27}});
+}
