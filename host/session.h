@@ -57,7 +57,10 @@ public:
     std::optional<std::string> apply(const ExternSetting& setting);
     std::optional<std::string> fire(const TriggerFiring& firing);
     // Triggers fired before the frames they name (frame() below).
-    void schedule(std::vector<TriggerFiring> firings) { scheduled_ = std::move(firings); }
+    // Triggers to fire before given frames. Each must name a trigger of the system with
+    // its number of values, at a frame from 1 to `lastFrame` (0: no last frame); else an
+    // error names the first that does not, and nothing is scheduled.
+    std::optional<std::string> schedule(std::vector<TriggerFiring> firings, int lastFrame = 0);
     // Frame `index` (from 1): the triggers scheduled for it, then a step of `dt`.
     std::optional<std::string> frame(int index, double dt);
     double stepSeconds() const { return stepSeconds_; }  // in frame(), so far

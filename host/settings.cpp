@@ -24,7 +24,9 @@ std::optional<std::vector<float>> parseNumbers(const std::string& text) {
     size_t start = 0;
     while (start <= text.size()) {
         size_t comma = text.find(',', start);
-        auto v = parseNumber(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+        std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+        // A bool extern's values: true and false (or 1 and 0).
+        auto v = item == "true" ? 1.0 : item == "false" ? 0.0 : parseNumber(item);
         if (!v) return std::nullopt;
         out.push_back(static_cast<float>(*v));
         if (comma == std::string::npos) break;
@@ -48,8 +50,9 @@ Parsed<TriggerFiring> parseFire(const std::string& text) {
         if (auto n = parseNumber(text.substr(at + 1))) frame = *n;
     std::optional<std::vector<float>> args = std::vector<float>{};
     if (colon != std::string::npos && colon < at) args = parseNumbers(text.substr(colon + 1, at - colon - 1));
-    if (frame < 0 || !args || !std::isfinite(frame) || frame > 2e9)
-        return Parsed<TriggerFiring>::fail("--fire takes TRIGGER@FRAME or TRIGGER:X,Y,Z@FRAME, not `" + text + "`");
+    if (frame < 1 || !args || !std::isfinite(frame) || frame > 2e9 || frame != std::floor(frame))
+        return Parsed<TriggerFiring>::fail("--fire takes TRIGGER@FRAME or TRIGGER:X,Y,Z@FRAME with FRAME a whole number "
+                                           "from 1, not `" + text + "`");
     return {TriggerFiring{text.substr(0, std::min(colon, at)), *args, static_cast<int>(frame)}, {}};
 }
 

@@ -143,7 +143,21 @@ std::optional<std::string> System::setExtern(int index, std::span<const float> v
                            e.type.width == 1 ? "" : "s", value.size());
     Value v;
     for (size_t i = 0; i < value.size(); ++i) v.f[i] = value[i];
-    if (!finite(v, e.type.width)) ++s.stats.nonFiniteExterns;
+    // One bad value from the host must not poison every particle that reads it: it is
+    // refused and counted, and the extern keeps its last good value.
+    if (!finite(v, e.type.width)) {
+        ++s.stats.nonFiniteExterns;
+        return fmt::format("extern `{}` takes finite values only; it keeps its value", e.name);
+    }
+    for (int c = 0; c < e.type.width; ++c) {
+        auto i = static_cast<size_t>(c);
+        bool below = e.low && v.f[i] < (*e.low)[i], above = e.high && v.f[i] > (*e.high)[i];
+        if (below || above) {
+            ++s.stats.outOfRangeExterns;
+            return fmt::format("extern `{}`: {} is outside its range [{}, {}]; it keeps its value", e.name, v.f[i],
+                               e.low ? (*e.low)[i] : -INFINITY, e.high ? (*e.high)[i] : INFINITY);
+        }
+    }
     s.externs[static_cast<size_t>(index)] = v;
     ++s.externsVersion;
     return std::nullopt;

@@ -49,7 +49,7 @@ struct TypeStats {
     size_t frozen = 0;
     uint64_t created = 0;
     uint64_t killed = 0;
-    uint64_t dropped = 0;  // spawns refused at capacity
+    uint64_t dropped = 0;  // spawns refused at capacity (stops at 2^64 - 1 rather than wrapping)
     // Object updates whose step was beyond the stability limit of the type's integration
     // method for a decay rate in its equations (k·dt > 2 for Euler): such an integral
     // oscillates and grows. @step, or @integrator(exponential), fixes it.
@@ -60,8 +60,10 @@ struct Stats {
     std::vector<TypeStats> types;
     uint64_t steps = 0;
     uint64_t rejectedSteps = 0;        // NaN, infinite or negative dt
-    uint64_t nonFiniteExterns = 0;     // NaN or infinite values set on an extern
+    uint64_t nonFiniteExterns = 0;     // NaN or infinite values set on an extern (refused)
+    uint64_t outOfRangeExterns = 0;    // values outside an extern's declared range (refused)
     uint64_t invalidEmissions = 0;     // NaN or negative rates and counts (taken as 0)
+    uint64_t clampedEmissions = 0;     // counts and rates asking for more than 1e18 objects (taken as 1e18)
     uint64_t nonFiniteRender = 0;      // points not drawn because a value was NaN or infinite
     uint64_t uniformEvaluations = 0;   // runs of uniform kernels (once per step per type, mostly)
     // Where the time went: the update loops over pools, kills and emissions (with the

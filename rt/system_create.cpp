@@ -85,7 +85,7 @@ void Creation::queueChildren(const Emitter& e, int site, uint64_t count, uint64_
     size_t free = s_.pools[target].free() + pending_[target];
     size_t room = free > queued_[target] ? free - queued_[target] : 0;
     uint64_t kept = std::min<uint64_t>(count, room);
-    s_.typeStats[target].dropped += count - kept;
+    addSaturating(s_.typeStats[target].dropped, count - kept);
     if (kept == 0) return;
     Handle parent = s_.types[target].parentType == static_cast<int>(e.type) ? s_.pools[e.type].handle(e.row) : Handle{};
     size_t base = stage(target, static_cast<size_t>(kept));
@@ -126,17 +126,17 @@ void Creation::emitAtRate(const Emitter& e, std::span<const float> rate, std::sp
     for (size_t site = 0; site < o.emits.size(); ++site) {
         if (!o.emits[site].rate) continue;
         double r = validCount(rate[site], s_.stats.invalidEmissions);
-        double perEvent = std::floor(validCount(count[site], s_.stats.invalidEmissions));
+        double size = validCount(count[site], s_.stats.invalidEmissions);
         double before = pool.emitted[site][e.row];
         double total = before + r * dt;
         // A whole number reached by adding up rounded rates (0.25 · 1/60, 240 times) counts as reached.
         double events = std::floor(total + 1e-9);
         pool.emitted[site][e.row] = std::max(0.0, total - events);
-        if (events < 1 || perEvent < 1) continue;
+        if (events < 1 || size < 1) continue;
+        uint64_t perEvent = wholeCount(size, s_.stats.clampedEmissions);  // counted when it is asked for
         double firstTime = (t1 - dt) + (1.0 - before) / r;
-        double children = events * perEvent;
-        queueChildren(e, static_cast<int>(site), static_cast<uint64_t>(std::min(children, 1e18)),
-                      static_cast<uint64_t>(perEvent), firstTime, 1.0 / r);
+        uint64_t children = wholeCount(events * static_cast<double>(perEvent), s_.stats.clampedEmissions);
+        queueChildren(e, static_cast<int>(site), children, perEvent, firstTime, 1.0 / r);
     }
 }
 
@@ -150,16 +150,17 @@ void Creation::emitFromKernel(const ir::Trigger& trigger, std::span<const Value>
     in.objectId = objectId;
     in.draw = static_cast<uint32_t>(s_.step);
     s_.evaluator.run(k, in, yields_);
-    std::vector<double> counts(trigger.emits.size(), 0);
+    std::vector<uint64_t> counts(trigger.emits.size(), 0);
     for (size_t i = 0; i < k.yields.size(); ++i)
         if (k.yields[i].kind == YieldKind::EmitCount)
-            counts[static_cast<size_t>(k.yields[i].index)] = std::floor(validCount(yields_[i].f[0], s_.stats.invalidEmissions));
+            counts[static_cast<size_t>(k.yields[i].index)] =
+                wholeCount(validCount(yields_[i].f[0], s_.stats.invalidEmissions), s_.stats.clampedEmissions);
     for (size_t site = 0; site < trigger.emits.size(); ++site) {
         auto target = static_cast<size_t>(s_.module.objectIndex(trigger.emits[site].target));
         Pool& pool = s_.pools[target];
         size_t room = pool.free() > queued_[target] ? pool.free() - queued_[target] : 0;
-        auto kept = static_cast<uint64_t>(std::min(counts[site], static_cast<double>(room)));
-        s_.typeStats[target].dropped += static_cast<uint64_t>(counts[site]) - kept;
+        uint64_t kept = std::min<uint64_t>(counts[site], room);
+        addSaturating(s_.typeStats[target].dropped, counts[site] - kept);
         // The first column of each parameter among the staging columns.
         std::vector<size_t> column;
         size_t next = 0;
@@ -488,10 +489,10 @@ void Creation::queueBursts(size_t type, Batch& b, size_t r) {
         if (o.emits[site].rate) continue;
         auto column = static_cast<size_t>(b.initLayout.emitCount(static_cast<int>(site)));
         float size = b.initTable.empty() ? 0 : s_.view<float>(b.initTable[column])[i];
-        double count = std::floor(validCount(size, s_.stats.invalidEmissions));
+        uint64_t count = wholeCount(validCount(size, s_.stats.invalidEmissions), s_.stats.clampedEmissions);
         if (count < 1) continue;
         Emitter e{type, b.poolRows[r], b.burstTables[site], static_cast<uint32_t>(i), created[i], true};
-        queueChildren(e, static_cast<int>(site), static_cast<uint64_t>(std::min(count, 1e18)), 1, created[i], 0);
+        queueChildren(e, static_cast<int>(site), count, 1, created[i], 0);
     }
 }
 

@@ -22,6 +22,23 @@ inline double validCount(float x, uint64_t& invalid) {
     return x;
 }
 
+// The most objects one emission may ask for: counts and rates beyond it (1e30 from a
+// kernel, a trigger's argument) are taken as this many and counted, so no count overflows.
+constexpr double kMaxCount = 1e18;
+
+// A valid count as a whole number of objects, at most kMaxCount (a clamp is counted).
+inline uint64_t wholeCount(double x, uint64_t& clamped) {
+    x = std::floor(x);
+    if (x > kMaxCount) {
+        ++clamped;
+        return static_cast<uint64_t>(kMaxCount);
+    }
+    return static_cast<uint64_t>(x);
+}
+
+// a += b, stopping at the largest uint64 rather than wrapping around.
+inline void addSaturating(uint64_t& a, uint64_t b) { a = b > UINT64_MAX - a ? UINT64_MAX : a + b; }
+
 inline bool finite(const ir::Value& v, int width) {
     for (int i = 0; i < width; ++i)
         if (!std::isfinite(v.f[static_cast<size_t>(i)])) return false;

@@ -230,20 +230,43 @@ TEST_CASE("after 10^7 s ages are still exact to a millisecond") {
     CHECK(run.points("a")[0].size == doctest::Approx(0.001).epsilon(1e-3));
 }
 
-TEST_CASE("NaN and infinity in an extern never crash, are counted and are not drawn") {
+TEST_CASE("NaN and infinity set on an extern are refused and counted; it keeps its last good value") {
     Run run("extern w: vec3 = 0;\nobject a(k: float) { point(vec3(k) + w * k, white, 1); }\n"
             "spawn a(0); spawn a(1);");
-    float bad[3] = {std::nanf(""), 0, INFINITY};
-    REQUIRE_FALSE(run.system->setExtern("w", bad));
-    run.steps(1, 1.0 / 60);
-    // a(0): 0 · NaN is NaN too; both points have non-finite positions and are not drawn
-    CHECK(run.points("a").size() == 0);
-    CHECK(run.system->stats().nonFiniteExterns == 1);
-    CHECK(run.system->stats().nonFiniteRender == 2);
     float good[3] = {1, 2, 3};
     REQUIRE_FALSE(run.system->setExtern("w", good));
+    float bad[3] = {std::nanf(""), 0, INFINITY};
+    auto error = run.system->setExtern("w", bad);
+    REQUIRE(error.has_value());
+    CHECK(*error == "extern `w` takes finite values only; it keeps its value");
+    CHECK(run.system->externValue("w")->f[0] == 1);
     run.steps(1, 1.0 / 60);
     CHECK(run.points("a").size() == 2);
+    CHECK(run.system->stats().nonFiniteExterns == 1);
+    CHECK(run.system->stats().nonFiniteRender == 0);
+}
+
+TEST_CASE("a value outside an extern's range is refused and counted; it keeps its value") {
+    Run run("extern k: float = 1 range(0, 2);\nextern v: vec3 = 0 range(-1, 1);\n"
+            "object a { point(v, white, k); }\nspawn a;");
+    float five = 5, two = 2;
+    auto error = run.system->setExtern("k", {&five, 1});
+    REQUIRE(error.has_value());
+    CHECK(*error == "extern `k`: 5 is outside its range [0, 2]; it keeps its value");
+    CHECK(run.system->externValue("k")->f[0] == 1);
+    CHECK_FALSE(run.system->setExtern("k", {&two, 1}));  // the bounds are inside
+    float v[3] = {0, -1.5f, 0};
+    CHECK(run.system->setExtern("v", v).has_value());
+    CHECK(run.system->stats().outOfRangeExterns == 2);
+    run.steps(1, 1.0 / 60);
+    CHECK(run.points("a")[0].size == 2);
+}
+
+TEST_CASE("a point that is not finite is not drawn, and is counted") {
+    Run run("object a(k: float) { point(vec3(k) / k, white, 1); }\nspawn a(0); spawn a(1);");
+    run.steps(1, 1.0 / 60);
+    CHECK(run.points("a").size() == 1);
+    CHECK(run.system->stats().nonFiniteRender == 1);
 }
 
 TEST_CASE("host API misuse is an error value") {

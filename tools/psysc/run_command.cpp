@@ -86,6 +86,9 @@ void printSummary(const RunOptions& options, host::Session& session, double draw
                                  "points not drawn (non-finite) {}\n",
                                  stats.rejectedSteps, stats.nonFiniteExterns, stats.invalidEmissions,
                                  stats.nonFiniteRender);
+    if (stats.clampedEmissions)
+        std::cout << fmt::format("  emissions asking for more than 1e18 objects (taken as 1e18): {}\n",
+                                 stats.clampedEmissions);
 }
 
 }  // namespace
@@ -129,7 +132,7 @@ int runSystem(const RunOptions& options) {
             std::cout << fmt::format("{}: {}: {}\n", r.loop, r.vectorized ? "vectorized" : "not vectorized", r.message);
     for (const host::ExternSetting& set : sets)
         if (auto e = s->apply(set)) return fail("--set " + set.name + ": " + *e);
-    s->schedule(fires);
+    if (auto e = s->schedule(fires, options.frames)) return fail(*e);
     Dump dump(options.dump);
     if (!dump.ok()) return fail("cannot write `" + options.dump + "`");
     rt::System& system = s->system();

@@ -134,6 +134,8 @@ int main(int argc, char** argv) {
     if (!session) return fail(error);
     for (const host::ExternSetting& s : o.sets)
         if (auto e = session->apply(s)) return fail("--set " + s.name + ": " + *e);
+    int lastFrame = o.headless ? std::max(o.frames, 1) : o.frames;
+    if (auto e = session->schedule(o.fires, lastFrame)) return fail(*e);
     if (o.log) std::cout << "psys-view: " << o.file << " on " << session->backend().name() << ", " << surface->renderer() << std::endl;
     Viewer viewer(std::move(o), *surface, std::move(session), compiled);
     return viewer.run();

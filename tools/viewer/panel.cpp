@@ -214,6 +214,9 @@ void Panel::stats() {
                            "points not drawn (non-finite) %llu",
                            static_cast<unsigned long long>(b.rejectedSteps), static_cast<unsigned long long>(b.nonFiniteExterns),
                            static_cast<unsigned long long>(b.invalidEmissions), static_cast<unsigned long long>(b.nonFiniteRender));
+    if (b.clampedEmissions)
+        ImGui::TextColored(ImVec4(1, 0.7f, 0.3f, 1), "emissions asking for more than 1e18 objects (taken as 1e18): %llu",
+                           static_cast<unsigned long long>(b.clampedEmissions));
     ImGui::End();
 }
 

@@ -38,7 +38,7 @@ Viewer::Viewer(ViewerOptions options, Surface& surface, std::unique_ptr<host::Se
     if (options_.watch) watchSources(compiled);
     if (surface_.window()) connectInput(surface_.window(), *this);  // before the panel's, which chain to them
     if (options_.ui) panel_ = std::make_unique<Panel>(*this, surface_);
-    session_->schedule(options_.fires);
+    session_->schedule(options_.fires);  // checked by the caller (main.cpp) against this session
 }
 
 Viewer::~Viewer() = default;

@@ -1,0 +1,48 @@
+// Inputs at and past the limits a user or a generated program can reach: each ends in a
+// documented outcome (a clamp that is counted, an error value, correct behaviour), never
+// a crash, a hang, an overflow or a silent wrong value.
+#include <doctest/doctest.h>
+
+#include <cstdint>
+
+#include "run.h"
+
+using namespace psys;
+using test::Run;
+
+TEST_CASE("counts and rates past 1e18 are taken as 1e18 and counted; dropped stops at 2^64 - 1") {
+    SUBCASE("a count of 1e30 per event") {
+        Run run("@capacity(100) object b { point(origin, white, 1); }\n"
+                "object e { emit b at 1 per second count 1e30; }\nspawn e;");
+        run.steps(90, 1.0 / 60);
+        CHECK(run.stats("b").live == 100);
+        CHECK(run.system->stats().clampedEmissions == 1);
+        CHECK(run.stats("b").dropped == 1'000'000'000'000'000'000ull - 100);
+    }
+    SUBCASE("a trigger's count from its argument") {
+        Run run("@capacity(10) object b { point(origin, white, 1); }\ntrigger t(n: float) { emit b count n; }");
+        float n = 1e30f;
+        REQUIRE_FALSE(run.system->fire("t", {&n, 1}));
+        run.steps(1, 1.0 / 60);
+        CHECK(run.stats("b").live == 10);
+        CHECK(run.system->stats().clampedEmissions == 1);
+        CHECK(run.stats("b").dropped == 1'000'000'000'000'000'000ull - 10);
+    }
+    SUBCASE("a rate of 1e30 for 120 frames") {
+        Run run("@capacity(10) object b { point(origin, white, 1); }\nobject e { emit b at 1e30 per second; }\nspawn e;");
+        uint64_t last = 0;
+        for (int f = 0; f < 120; ++f) {
+            run.steps(1, 1.0 / 60);
+            CHECK(run.stats("b").dropped >= last);  // never wraps around
+            last = run.stats("b").dropped;
+        }
+        CHECK(last == UINT64_MAX);
+        CHECK(run.system->stats().clampedEmissions >= 120);
+    }
+    SUBCASE("a burst at creation of 1e30") {
+        Run run("@capacity(5) object b { point(origin, white, 1); }\nobject e { emit b count 1e30; }\nspawn e;");
+        run.steps(1, 1.0 / 60);
+        CHECK(run.stats("b").live == 5);
+        CHECK(run.system->stats().clampedEmissions == 1);
+    }
+}
