@@ -67,6 +67,15 @@ void Checker::checkConst(ConstDecl& decl) {
         t = decl.annotation->type;
     }
     if (decl.type.isUnknown()) decl.type = t;
+    // As for an extern's default: a constant is a number a reader can rely on.
+    if (!t.isVague() && !t.isBool())
+        if (auto v = evaluateConstant(*decl.value))
+            for (int i = 0; i < std::max(1, t.width()); ++i)
+                if (!std::isfinite(v->v[static_cast<size_t>(i)])) {
+                    diags_.error(decl.value->range, fmt::format("constant `{}` is not a finite number ({})", decl.name,
+                                                                numberText(v->v[static_cast<size_t>(i)])));
+                    break;
+                }
     checking_.pop_back();
     progress_[&decl] = 2;
 }
@@ -87,9 +96,15 @@ void Checker::checkFn(const FnDecl& constDecl) {
     Context ctx;
     ctx.where = Where::Fn;
     ctx.fn = &decl;
+    // One scope: the parameters and the lets; nothing in it is declared twice.
+    std::map<std::string, SourceRange> declared;
+    for (const Param& p : decl.params) declared.emplace(p.name, p.nameRange);
     for (size_t i = 0; i < decl.lets.size(); ++i) {
         LetStmt& let = *decl.lets[i];
         ctx.letsVisible = i;
+        if (auto [it, fresh] = declared.emplace(let.name, let.nameRange); !fresh)
+            diags_.error(let.nameRange, fmt::format("`{}` is already declared in function `{}`", let.name, decl.name))
+                .notes.push_back({it->second, "first declared here"});
         Type t = check(*let.value, ctx);
         if (let.annotation) {
             if (!t.isVague() && t != let.annotation->type)

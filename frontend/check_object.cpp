@@ -177,22 +177,22 @@ void Checker::checkEmit(Command& emit, const Context& ctx) {
     } else {
         for (auto& a : emit.args) check(*a, ctx);
     }
+    // A constant rate or count must be a number of objects: not negative, not NaN, not infinite.
+    auto checkAmount = [&](Expr& e, const char* what, const char* type) {
+        check(e, ctx);
+        if (!expectType(e, Type::scalar(), type)) return;
+        auto v = evaluateConstant(e);
+        if (!v) return;
+        if (!std::isfinite(v->v[0])) diags_.error(e.range, fmt::format("the emission {} is not a finite number ({})", what, numberText(v->v[0])));
+        else if (v->v[0] < 0) diags_.error(e.range, fmt::format("the emission {} is negative ({})", what, v->v[0]));
+    };
     if (emit.rate) {
-        if (ctx.where == Where::Trigger) {
+        if (ctx.where == Where::Trigger)
             diags_.error(emit.rate->range, "a trigger runs once when fired: it cannot emit at a rate; use `count N`");
-        } else {
-            check(*emit.rate, ctx);
-            if (expectType(*emit.rate, Type::scalar(), "an emission rate (per second)"))
-                if (auto v = evaluateConstant(*emit.rate); v && v->v[0] < 0)
-                    diags_.error(emit.rate->range, fmt::format("the emission rate is negative ({})", v->v[0]));
-        }
+        else
+            checkAmount(*emit.rate, "rate", "an emission rate (per second)");
     }
-    if (emit.count) {
-        check(*emit.count, ctx);
-        if (expectType(*emit.count, Type::scalar(), "an emission count"))
-            if (auto v = evaluateConstant(*emit.count); v && v->v[0] < 0)
-                diags_.error(emit.count->range, fmt::format("the emission count is negative ({})", v->v[0]));
-    }
+    if (emit.count) checkAmount(*emit.count, "count", "an emission count");
 }
 
 void Checker::checkCommands(std::vector<CommandPtr>& commands, const Context& ctx, const Command** point) {
@@ -288,8 +288,10 @@ void Checker::checkAttributes(const std::vector<Attribute*>& attributes) {
             check(*a.args[0], ctx);
             if (!expectType(*a.args[0], Type::scalar(), "the capacity")) continue;
             auto v = evaluateConstant(*a.args[0]);
-            if (!a.args[0]->type.isError() && (!v || !(v->v[0] >= 1) || v->v[0] != std::floor(v->v[0])))
-                diags_.error(a.args[0]->range, "the capacity must be a positive constant whole number");
+            // Rows are numbered with 32 bits.
+            if (!a.args[0]->type.isError() &&
+                (!v || !(v->v[0] >= 1 && v->v[0] <= 4294967295.0) || v->v[0] != std::floor(v->v[0])))
+                diags_.error(a.args[0]->range, "the capacity must be a constant whole number from 1 to 4294967295");
         } else {
             diags_.error(a.nameRange, fmt::format("unknown attribute `@{}`", a.name))
                 .notes.push_back({a.nameRange, "the attributes are " + attributeList()});

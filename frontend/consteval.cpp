@@ -1,5 +1,9 @@
 #include "frontend/consteval.h"
 
+#include <cmath>
+
+#include <fmt/format.h>
+
 #include "core/lanes.h"
 #include "frontend/builtins.h"
 
@@ -138,5 +142,7 @@ std::optional<ConstValue> evaluateConstant(const Expr& expr) {
         default: return std::nullopt;
     }
 }
+
+std::string numberText(double v) { return std::isnan(v) ? "NaN" : fmt::format("{}", v); }
 
 }  // namespace psys

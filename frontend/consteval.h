@@ -8,6 +8,8 @@
 // constant checked here is the constant the program computes.
 #pragma once
 
+#include <string>
+
 #include <array>
 #include <optional>
 
@@ -22,5 +24,8 @@ struct ConstValue {
 };
 
 std::optional<ConstValue> evaluateConstant(const ast::Expr& expr);
+
+// A constant's value as a message shows it: `inf`, `-inf`, `NaN` (of any sign), or the number.
+std::string numberText(double v);
 
 }  // namespace psys

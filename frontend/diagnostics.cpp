@@ -9,6 +9,28 @@
 namespace psys {
 namespace {
 
+// A source line as a terminal can show it, byte for byte in place (so the caret lines up):
+// control characters become spaces, bytes that are not UTF-8 become '?'.
+std::string printable(std::string_view line) {
+    std::string out(line);
+    for (size_t i = 0; i < out.size();) {
+        auto c = static_cast<unsigned char>(out[i]);
+        if ((c < 0x20 && c != '\t') || c == 0x7F) out[i] = ' ';
+        if (c < 0x80) {
+            ++i;
+            continue;
+        }
+        auto bad = firstInvalidUtf8(std::string_view(out).substr(i));
+        if (bad && *bad == 0) {
+            out[i++] = '?';
+            continue;
+        }
+        ++i;
+        while (i < out.size() && (static_cast<unsigned char>(out[i]) & 0xC0) == 0x80) ++i;
+    }
+    return out;
+}
+
 constexpr const char* kReset = "\x1b[0m";
 constexpr const char* kBold = "\x1b[1m";
 constexpr const char* kRed = "\x1b[1;31m";
@@ -51,7 +73,7 @@ void printOne(std::ostream& out, const SourceManager& sources, Severity severity
         << paint(kReset) << paint(severityColour(severity)) << severityWord(severity) << ": "
         << paint(kReset) << paint(kBold) << message << paint(kReset) << '\n';
 
-    std::string_view line = file.lineText(at.line);
+    std::string line = printable(file.lineText(at.line));
     std::string number = std::to_string(at.line);
     std::string gutter(number.size(), ' ');
     out << ' ' << number << " | " << line << '\n';

@@ -1,6 +1,9 @@
 #include "frontend/parse.h"
 
 #include <cstdlib>
+#include <limits>
+#include <optional>
+#include <string_view>
 
 #include <antlr4-runtime.h>
 #include <fmt/format.h>
@@ -318,7 +321,11 @@ private:
         SourceRange r = range(ctx);
         if (auto* n = dynamic_cast<PsysParser::NumberLitContext*>(ctx)) {
             std::string text = n->NUMBER()->getText();
-            return std::make_unique<NumberExpr>(r, std::strtod(text.c_str(), nullptr), text);
+            double value = std::strtod(text.c_str(), nullptr);
+            // Numbers are floats: one past the largest float would silently be infinite.
+            if (value > std::numeric_limits<float>::max())
+                diags_.error(r, fmt::format("the number {} is too large for a float (the largest is 3.4028235e38)", text));
+            return std::make_unique<NumberExpr>(r, value, text);
         }
         if (auto* b = dynamic_cast<PsysParser::BoolLitContext*>(ctx))
             return std::make_unique<BoolExpr>(r, b->getText() == "true");
@@ -347,6 +354,29 @@ private:
 
 }  // namespace
 
+namespace {
+
+// Where a `/*` opens that no `*/` closes (outside line comments and strings), if one does.
+// The lexer would read it as `/` and `*`, and the parser report a cascade somewhere else.
+std::optional<uint32_t> unterminatedComment(std::string_view text) {
+    for (size_t i = 0; i + 1 < text.size(); ++i) {
+        if (text[i] == '"') {  // a string ends at its quote or the end of its line
+            for (++i; i < text.size() && text[i] != '"' && text[i] != '\n'; ++i)
+                if (text[i] == '\\') ++i;
+        } else if (text[i] == '/' && text[i + 1] == '/') {
+            i = text.find('\n', i);
+            if (i == std::string_view::npos) return std::nullopt;
+        } else if (text[i] == '/' && text[i + 1] == '*') {
+            size_t close = text.find("*/", i + 2);
+            if (close == std::string_view::npos) return static_cast<uint32_t>(i);
+            i = close + 1;
+        }
+    }
+    return std::nullopt;
+}
+
+}  // namespace
+
 std::unique_ptr<Module> parseModule(int file, const SourceManager& sources, DiagnosticEngine& diags) {
     const std::string& text = sources.file(file).text();
     // The lexer reads code points: a file must be UTF-8 (ASCII is), and one that is not is
@@ -354,6 +384,10 @@ std::unique_ptr<Module> parseModule(int file, const SourceManager& sources, Diag
     if (auto bad = firstInvalidUtf8(text)) {
         diags.error({file, *bad, *bad + 1}, fmt::format("this file is not valid UTF-8: byte 0x{:02X} cannot be here; "
                                                         "save it as UTF-8", static_cast<unsigned char>(text[*bad])));
+        return nullptr;
+    }
+    if (auto open = unterminatedComment(text)) {
+        diags.error({file, *open, *open + 2}, "unterminated comment: this `/*` has no `*/`");
         return nullptr;
     }
     antlr4::ANTLRInputStream input(text);

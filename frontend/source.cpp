@@ -12,9 +12,11 @@ SourceRange SourceRange::join(SourceRange a, SourceRange b) {
 
 SourceFile::SourceFile(std::string displayPath, std::string text)
     : path_(std::move(displayPath)), text_(std::move(text)) {
+    // A line ends at \n, \r\n or a lone \r (old Mac files): every diagnostic on its own line.
     lineStarts_.push_back(0);
     for (uint32_t i = 0; i < text_.size(); ++i)
-        if (text_[i] == '\n') lineStarts_.push_back(i + 1);
+        if (text_[i] == '\n' || (text_[i] == '\r' && (i + 1 == text_.size() || text_[i + 1] != '\n')))
+            lineStarts_.push_back(i + 1);
 }
 
 LineColumn SourceFile::lineColumn(uint32_t offset) const {

@@ -35,7 +35,7 @@ public:
     const std::string& text() const { return text_; }
     LineColumn lineColumn(uint32_t offset) const;
     uint32_t offset(LineColumn at) const;  // the byte offset of a line and column (clamped to the text)
-    std::string_view lineText(uint32_t line) const;  // without the newline
+    std::string_view lineText(uint32_t line) const;  // without the line ending
 
 private:
     std::string path_;

@@ -9,6 +9,21 @@
 namespace psys {
 namespace {
 
+// `'#'`, or for what a terminal would not show, its code point: `U+0000`, `'→' (U+2192)`.
+std::string describeCharacter(const std::string& utf8) {
+    auto lead = static_cast<unsigned char>(utf8.empty() ? 0 : utf8[0]);
+    uint32_t cp = lead;
+    if (lead >= 0xC0 && utf8.size() > 1) {
+        int extra = lead >= 0xF0 ? 3 : lead >= 0xE0 ? 2 : 1;
+        cp = lead & (0x3F >> extra);
+        for (int k = 1; k <= extra && static_cast<size_t>(k) < utf8.size(); ++k)
+            cp = (cp << 6) | (static_cast<unsigned char>(utf8[static_cast<size_t>(k)]) & 0x3F);
+    }
+    if (cp < 0x20 || cp == 0x7F) return fmt::format("U+{:04X}", cp);
+    if (cp < 0x80) return "'" + utf8 + "'";
+    return fmt::format("'{}' (U+{:04X})", utf8, cp);
+}
+
 using grammar::PsysParser;
 
 std::string literal(antlr4::Parser* parser, size_t type) {
@@ -150,7 +165,7 @@ void SyntaxErrorReporter::report(antlr4::Parser* parser, antlr4::Token* found,
     if (found->getType() == PsysParser::UNKNOWN_CHAR) {
         std::string text = found->getText();
         if (text == "\"") diags_.error(where, "unterminated string: a file name needs a closing '\"' on the same line");
-        else diags_.error(where, fmt::format("unexpected character '{}'", text));
+        else diags_.error(where, fmt::format("unexpected character {}", describeCharacter(text)));
         return;
     }
     std::string context = ruleWords(parser->getContext());

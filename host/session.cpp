@@ -60,20 +60,7 @@ std::optional<std::string> Session::apply(const ExternSetting& setting) {
 
 std::optional<std::string> Session::schedule(std::vector<TriggerFiring> firings, int lastFrame) {
     for (const TriggerFiring& f : firings) {
-        const ir::Trigger* trigger = nullptr;
-        std::string names;
-        for (const ir::Trigger& t : system_->module().triggers) {
-            if (t.name == f.trigger) trigger = &t;
-            names += (names.empty() ? "`" : ", `") + t.name + "`";
-        }
-        if (!trigger)
-            return fmt::format("--fire {}: there is no trigger `{}`{}", f.trigger, f.trigger,
-                               names.empty() ? " (the system has none)" : " (the triggers are " + names + ")");
-        size_t width = 0;
-        for (const ir::Param& p : trigger->params) width += static_cast<size_t>(p.type.width);
-        if (f.args.size() != width)
-            return fmt::format("--fire {}: it takes {} value{}, not {}", f.trigger, width, width == 1 ? "" : "s",
-                               f.args.size());
+        if (auto error = system_->checkFiring(f.trigger, f.args.size())) return "--fire " + f.trigger + ": " + *error;
         if (lastFrame > 0 && f.frame > lastFrame)
             return fmt::format("--fire {}@{}: the run ends after frame {}", f.trigger, f.frame, lastFrame);
     }

@@ -169,16 +169,29 @@ std::optional<Value> System::externValue(std::string_view name) const {
     return state_->externs[static_cast<size_t>(index)];
 }
 
+std::optional<std::string> System::checkFiring(std::string_view name, size_t values) const {
+    const ir::Trigger* trigger = nullptr;
+    std::string names;
+    for (const ir::Trigger& t : state_->module.triggers) {
+        if (t.name == name) trigger = &t;
+        names += (names.empty() ? "`" : ", `") + t.name + "`";
+    }
+    if (!trigger)
+        return fmt::format("there is no trigger `{}`{}", name,
+                           names.empty() ? " (the system has none)" : " (the triggers are " + names + ")");
+    size_t width = 0;
+    for (auto& p : trigger->params) width += static_cast<size_t>(p.type.width);
+    if (values != width)
+        return fmt::format("trigger `{}` takes {} number{}, not {}", name, width, width == 1 ? "" : "s", values);
+    return std::nullopt;
+}
+
 std::optional<std::string> System::fire(std::string_view name, std::span<const float> args) {
     detail::State& s = *state_;
+    if (auto error = checkFiring(name, args.size())) return error;
     const ir::Trigger* trigger = nullptr;
     for (const ir::Trigger& t : s.module.triggers)
         if (t.name == name) trigger = &t;
-    if (!trigger) return fmt::format("there is no trigger `{}`", name);
-    size_t width = 0;
-    for (auto& p : trigger->params) width += static_cast<size_t>(p.type.width);
-    if (args.size() != width)
-        return fmt::format("trigger `{}` takes {} number{}, not {}", name, width, width == 1 ? "" : "s", args.size());
     std::vector<Value> params;
     size_t at = 0;
     for (auto& p : trigger->params) {

@@ -127,6 +127,8 @@ public:
     // The current value of an extern (its default until set).
     std::optional<Value> externValue(std::string_view name) const;
     std::optional<std::string> fire(std::string_view trigger, std::span<const float> args);
+    // Whether fire(trigger, `values` numbers) would be accepted: nullopt, or why not.
+    std::optional<std::string> checkFiring(std::string_view trigger, size_t values) const;
     std::optional<std::string> step(double dt);
     // Threads for launches over pools from now on: 0 for every core. Results do not change.
     void setThreads(unsigned threads);

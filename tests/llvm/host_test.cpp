@@ -41,7 +41,13 @@ TEST_CASE("host settings: numbers, extern settings and trigger firings, and what
     CHECK(fire->args == std::vector<float>{0, 5, 0});
     CHECK(fire->frame == 12);
     CHECK(host::parseFire("go@3")->args.empty());
-    CHECK(host::parseFire("go").error == "--fire takes TRIGGER@FRAME or TRIGGER:X,Y,Z@FRAME, not `go`");
+    CHECK(host::parseFire("go").error ==
+          "--fire takes TRIGGER@FRAME or TRIGGER:X,Y,Z@FRAME with FRAME a whole number from 1, not `go`");
+    CHECK_FALSE(host::parseFire("go@0"));
+    CHECK_FALSE(host::parseFire("go@1.5"));
+    CHECK_FALSE(host::parseFire("go@1e20"));
+    CHECK(host::parseSet("lit=true")->values == std::vector<float>{1});
+    CHECK(host::parseSet("lit=false")->values == std::vector<float>{0});
     CHECK_FALSE(host::parseFire("go@-1"));
     CHECK(host::parseStep("x").error.find("--dt takes a number of seconds") == 0);
 }

@@ -210,14 +210,13 @@ TEST_CASE("emission rates at the extremes") {
         CHECK(run.system->pool(run.type("s")).rows() == 1000);  // memory bounded
     }
     SUBCASE("negative and NaN rates emit nothing and are counted") {
-        Run run("extern r: float = 0;\nobject s { point(origin, white, 1); }\nobject e { emit s at r per second; }\nspawn e;");
-        float negative = -5, nan = std::nanf("");
+        Run run("extern r: float = 0;\nobject s { point(origin, white, 1); }\n"
+                "object e { emit s at r per second; emit s at sqrt(r) per second; }\nspawn e;");
+        float negative = -5;  // the first rate is -5, the second sqrt(-5): NaN
         REQUIRE_FALSE(run.system->setExtern("r", {&negative, 1}));
         run.steps(10, 1.0 / 60);
-        REQUIRE_FALSE(run.system->setExtern("r", {&nan, 1}));
-        run.steps(10, 1.0 / 60);
         CHECK(run.stats("s").created == 0);
-        CHECK(run.system->stats().invalidEmissions == 21);  // 20 steps and the emitter's update at creation
+        CHECK(run.system->stats().invalidEmissions == 22);  // two sites: 10 steps and the emitter's update at creation
     }
 }
 
@@ -278,7 +277,7 @@ TEST_CASE("host API misuse is an error value") {
     CHECK(run.system->externHandle("nope") == -1);
     float wind[3] = {4, 5, 6};
     CHECK_FALSE(run.system->setExtern(run.system->externHandle("w"), wind).has_value());
-    CHECK(run.system->fire("boom", {}).value() == "there is no trigger `boom`");
+    CHECK(run.system->fire("boom", {}).value() == "there is no trigger `boom` (the triggers are `go`)");
     CHECK(run.system->fire("go", {&one, 1}).value() == "trigger `go` takes 3 numbers, not 1");
     float at[3] = {1, 2, 3};
     REQUIRE_FALSE(run.system->fire("go", at));

@@ -77,15 +77,16 @@ std::unique_ptr<psys::ast::Program> checkOne(const std::string& path, psys::Sour
 // The options of `psysc run`.
 void addRunOptions(CLI::App& run, psys::tools::RunOptions& o) {
     run.add_option("file", o.file, "The system to run")->required()->type_name("FILE");
-    run.add_option("--frames", o.frames, "Frames to run (600)")->check(CLI::NonNegativeNumber);
+    run.add_option("--frames", o.frames, "Frames to run (600)")->check(CLI::Range(0, 1000000000));
     run.add_option("--dt", o.dt, "Seconds per frame (1/60)");
     run.add_option("--seed", o.seed, "Random seed (1)");
-    run.add_option("--capacity", o.capacity, "Most live objects per type, unless @capacity says (1048576)");
+    run.add_option("--capacity", o.capacity, "Most live objects per type, unless @capacity says (1048576)")
+        ->check(CLI::Range(1.0, 4294967295.0));
     run.add_option("--set", o.sets, "Set an extern: NAME=VALUE or NAME=X,Y,Z (repeatable)")
         ->allow_extra_args(false);
     run.add_option("--fire", o.fires, "Fire a trigger before a frame: TRIGGER[:X,Y,Z]@FRAME (repeatable)")->allow_extra_args(false);
     run.add_option("--dump", o.dump, "Write every drawn point per frame to FILE.csv or FILE.json");
-    run.add_option("--dump-every", o.dumpEvery, "Dump every Nth frame (1)")->check(CLI::PositiveNumber);
+    run.add_option("--dump-every", o.dumpEvery, "Dump every Nth frame (1)")->check(CLI::Range(1, 1000000000));
     run.add_flag("--quiet", o.quiet, "No line per frame, only the summary");
     run.add_option("--backend", o.backend, "llvm (JIT-compiled, the default), interp (the reference) or glsl (compute shaders on OpenGL 4.5: a GPU, or llvmpipe)")
         ->check(CLI::IsMember(psys::host::backendNames()));
@@ -94,7 +95,7 @@ void addRunOptions(CLI::App& run, psys::tools::RunOptions& o) {
                     "(the interpreter's results bit for bit)")
         ->check(CLI::IsMember({"fast", "exact"}));
     run.add_option("--threads", o.threads, "Threads for pool updates: 0 for every core (0)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(CLI::Range(0, 256));  // TBB's own limit
     run.add_flag("--timing", o.timing, "Print compile time and the time spent stepping and drawing");
     run.add_flag("--remarks", o.remarks, "llvm backend: print whether each update loop vectorized");
 }

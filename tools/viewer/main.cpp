@@ -47,10 +47,10 @@ int main(int argc, char** argv) {
     app.add_option("file", o.file, "The system to view")->required()->type_name("FILE");
     app.add_flag("--headless", o.headless, "No window: render offscreen (EGL surfaceless) and write PNGs");
     app.add_option("--frames", o.frames, "Frames to run, then exit (0: until the window closes; headless: 1)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(CLI::Range(0, 1000000000));
     app.add_option("--screenshot", o.screenshot, "Write the last frame to this PNG");
     app.add_option("--record", o.record, "Write a PNG every --every frames into this folder");
-    app.add_option("--every", o.every, "With --record: every Nth frame (1)")->check(CLI::PositiveNumber);
+    app.add_option("--every", o.every, "With --record: every Nth frame (1)")->check(CLI::Range(1, 1000000000));
     app.add_option("--camera", camera, "yaw,pitch,distance[,x,y,z]: degrees and units, looking at (x, y, z)");
     app.add_option("--set", sets, "Set an extern: NAME=VALUE or NAME=X,Y,Z (repeatable)")->allow_extra_args(false);
     app.add_option("--fire", fires, "Fire a trigger before a frame: TRIGGER[:X,Y,Z]@FRAME (repeatable)")->allow_extra_args(false);
@@ -74,11 +74,11 @@ int main(int argc, char** argv) {
     app.add_flag("--ui", ui, "The panel in --headless images too");
     app.add_flag("--no-watch", noWatch, "Do not reload the file when it is saved");
     app.add_option("--script", script, "Scripted input, an action a line (docs/viewer.md)")->type_name("FILE");
-    app.add_option("--fps", o.fps, "At most this many frames a second (0: as many as it can)")->check(CLI::NonNegativeNumber);
+    app.add_option("--fps", o.fps, "At most this many frames a second (0: as many as it can)")->check(CLI::Range(0.0, 10000.0));
     app.add_option("--interim-after", o.interimAfter,
                    "Seconds a reload waits for the JIT before the new system runs on the interpreter meanwhile (0.05)")
-        ->check(CLI::NonNegativeNumber);
-    app.add_option("--warmup", o.warmup, "Frames left out of the timing summary --log prints (0)")->check(CLI::NonNegativeNumber);
+        ->check(CLI::Range(0.0, 3600.0));
+    app.add_option("--warmup", o.warmup, "Frames left out of the timing summary --log prints (0)")->check(CLI::Range(0, 1000000000));
     app.add_flag("--log", o.log, "Say on stdout what happens: reloads and their latency, images written");
     try {
         app.parse(argc, argv);
