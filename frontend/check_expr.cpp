@@ -295,11 +295,13 @@ Type Checker::checkCall(CallExpr& call, const Context& ctx) {
     }
     call.builtin = findBuiltinFunction(call.callee);
     if (call.builtin < 0) {
-        std::vector<std::string> candidates;
-        for (auto& f : builtinFunctions()) candidates.emplace_back(f.name);
-        for (auto& [n, d] : globals_)
-            if (d->kind == DeclKind::Fn) candidates.push_back(n);
-        reportUnknown("function", call.callee, call.calleeRange, candidates);
+        reportUnknown("function", call.callee, call.calleeRange, [&] {
+            std::vector<std::string> candidates;
+            for (auto& f : builtinFunctions()) candidates.emplace_back(f.name);
+            for (auto& [n, d] : globals_)
+                if (d->kind == DeclKind::Fn) candidates.push_back(n);
+            return candidates;
+        });
         return Type::error();
     }
     return checkBuiltinCall(call, args, ctx);

@@ -8,6 +8,7 @@
 // (algebraic loops among an object's equations).
 #pragma once
 
+#include <functional>
 #include <map>
 #include <set>
 #include <string>
@@ -48,7 +49,7 @@ private:
     ast::Ref lookupName(const std::string& name, SourceRange range, const Context& ctx);
     const ast::ObjectDecl* findEmitTarget(const std::string& name, SourceRange range, const Context& ctx);
     void reportUnknown(const std::string& what, const std::string& name, SourceRange range,
-                       const std::vector<std::string>& candidates);
+                       const std::function<std::vector<std::string>()>& candidates);
     std::vector<std::string> namesInScope(const Context& ctx) const;
     const ast::ObjectDecl* enclosingObject(const std::string& name, const Context& ctx, int* depth) const;
 

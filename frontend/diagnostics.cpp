@@ -100,8 +100,14 @@ Diagnostic& DiagnosticEngine::add(Severity severity, SourceRange range, std::str
         discarded_ = {};
         return discarded_;
     }
-    if (severity == Severity::Error) ++errors_;
-    if (severity == Severity::Warning) ++warnings_;
+    int& count = severity == Severity::Error ? errors_ : warnings_;
+    ++count;
+    // Past the limit they are counted, not kept: 50,000 errors of a broken generated file
+    // would bury the first, which is the one to fix.
+    if (count > kMaxShown) {
+        discarded_ = {};
+        return discarded_;
+    }
     diagnostics_.push_back({severity, range, std::move(message), {}});
     return diagnostics_.back();
 }
@@ -120,6 +126,10 @@ void DiagnosticEngine::print(std::ostream& out, bool colour) const {
         for (const DiagnosticNote& n : d.notes)
             printOne(out, sources_, Severity::Note, n.range, n.message, colour);
     }
+    int hiddenErrors = std::max(0, errors_ - kMaxShown), hiddenWarnings = std::max(0, warnings_ - kMaxShown);
+    if (hiddenErrors > 0 || hiddenWarnings > 0)
+        out << fmt::format("(the first {} errors and {} warnings are shown; {} more errors and {} more warnings are not)\n",
+                           std::min(errors_, kMaxShown), std::min(warnings_, kMaxShown), hiddenErrors, hiddenWarnings);
     if (errors_ > 0 || warnings_ > 0) {
         std::vector<std::string> parts;
         if (errors_ > 0) parts.push_back(fmt::format("{} error{}", errors_, errors_ == 1 ? "" : "s"));

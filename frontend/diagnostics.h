@@ -38,6 +38,9 @@ public:
     Diagnostic& error(SourceRange range, std::string message);
     Diagnostic& warning(SourceRange range, std::string message);
 
+    // At most this many errors and this many warnings are kept and printed; the rest are counted.
+    static constexpr int kMaxShown = 50;
+
     int errorCount() const { return errors_; }
     int warningCount() const { return warnings_; }
     const std::vector<Diagnostic>& all() const { return diagnostics_; }

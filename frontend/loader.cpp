@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <sstream>
 
 #include <fmt/format.h>
 
@@ -22,14 +21,24 @@ std::optional<std::string> readFile(const fs::path& path, std::string& error) {
         error = "it is a directory";
         return std::nullopt;
     }
+    // Only a regular file has an end: a device or a pipe (`/dev/zero`) is not read.
+    if (fs::exists(path, ec) && !fs::is_regular_file(path, ec)) {
+        error = "it is not a regular file";
+        return std::nullopt;
+    }
     std::ifstream in(path, std::ios::binary);
     if (!in) {
         error = std::strerror(errno);
         return std::nullopt;
     }
-    std::ostringstream text;
-    text << in.rdbuf();
-    return text.str();
+    std::string text(kMaxSourceBytes + 1, '\0');
+    in.read(text.data(), static_cast<std::streamsize>(text.size()));
+    text.resize(static_cast<size_t>(in.gcount()));
+    if (text.size() > kMaxSourceBytes) {
+        error = fmt::format("it is larger than {} bytes, the most a source file may be", kMaxSourceBytes);
+        return std::nullopt;
+    }
+    return text;
 }
 
 class Loader {

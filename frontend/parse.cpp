@@ -379,6 +379,11 @@ std::optional<uint32_t> unterminatedComment(std::string_view text) {
 
 std::unique_ptr<Module> parseModule(int file, const SourceManager& sources, DiagnosticEngine& diags) {
     const std::string& text = sources.file(file).text();
+    if (text.size() > kMaxSourceBytes) {
+        diags.error({file, 0, 0}, fmt::format("this file is {} bytes, more than the {} a source file may be",
+                                              text.size(), kMaxSourceBytes));
+        return nullptr;
+    }
     // The lexer reads code points: a file must be UTF-8 (ASCII is), and one that is not is
     // reported at its first bad byte rather than read wrongly.
     if (auto bad = firstInvalidUtf8(text)) {

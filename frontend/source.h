@@ -43,6 +43,10 @@ private:
     std::vector<uint32_t> lineStarts_;
 };
 
+// The largest source file read or parsed (a limit in docs/language.md): a program is
+// text a person or a program writes, not a data file.
+constexpr size_t kMaxSourceBytes = 1 << 20;
+
 // The offset of the first byte that does not begin a well-formed UTF-8 sequence (overlong
 // forms, surrogates and code points past U+10FFFF are not well-formed), or nullopt.
 std::optional<uint32_t> firstInvalidUtf8(std::string_view text);

@@ -51,6 +51,10 @@ std::string closestName(const std::string& name, const std::vector<std::string>&
     std::string best;
     size_t bestDistance = std::max<size_t>(1, name.size() / 3) + 1;
     for (const std::string& c : candidates) {
+        // The lengths' difference is a lower bound of the distance: a name far longer or
+        // shorter than every candidate (a million characters) costs nothing to reject.
+        size_t apart = name.size() > c.size() ? name.size() - c.size() : c.size() - name.size();
+        if (apart >= bestDistance) continue;
         size_t d = editDistance(name, c);
         if (d < bestDistance) {
             bestDistance = d;
@@ -155,8 +159,10 @@ std::vector<std::string> Checker::namesInScope(const Context& ctx) const {
 }
 
 void Checker::reportUnknown(const std::string& what, const std::string& name, SourceRange range,
-                            const std::vector<std::string>& candidates) {
-    std::string suggestion = closestName(name, candidates);
+                            const std::function<std::vector<std::string>()>& candidates) {
+    // A suggestion costs a search of the names in scope: none for errors no one will see.
+    bool shown = diags_.errorCount() < DiagnosticEngine::kMaxShown && !diags_.suppressed();
+    std::string suggestion = shown ? closestName(name, candidates()) : std::string();
     diags_.error(range, suggestion.empty() ? fmt::format("unknown {} `{}`", what, name)
                                            : fmt::format("unknown {} `{}`; did you mean `{}`?", what, name, suggestion));
 }
@@ -264,7 +270,7 @@ Ref Checker::lookupName(const std::string& name, SourceRange range, const Contex
         diags_.error(range, fmt::format("`{}` is a built-in function; call it with arguments: `{}(…)`", name, name));
         return ref;
     }
-    reportUnknown("name", name, range, namesInScope(ctx));
+    reportUnknown("name", name, range, [&] { return namesInScope(ctx); });
     return ref;
 }
 
@@ -286,12 +292,14 @@ const ObjectDecl* Checker::findEmitTarget(const std::string& name, SourceRange r
             .notes.push_back({nested->second->nameRange, "declared here"});
         return nullptr;
     }
-    std::vector<std::string> candidates;
-    for (auto& [n, d] : globals_)
-        if (d->kind == DeclKind::Object) candidates.push_back(n);
-    if (ctx.where == Where::Object && ctx.object)
-        for (auto& child : ctx.object->children) candidates.push_back(child->name);
-    reportUnknown("object", name, range, candidates);
+    reportUnknown("object", name, range, [&] {
+        std::vector<std::string> candidates;
+        for (auto& [n, d] : globals_)
+            if (d->kind == DeclKind::Object) candidates.push_back(n);
+        if (ctx.where == Where::Object && ctx.object)
+            for (auto& child : ctx.object->children) candidates.push_back(child->name);
+        return candidates;
+    });
     return nullptr;
 }
 

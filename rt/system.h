@@ -54,6 +54,9 @@ struct TypeStats {
     // method for a decay rate in its equations (k·dt > 2 for Euler): such an integral
     // oscillates and grows. @step, or @integrator(exponential), fixes it.
     uint64_t unstable = 0;
+    // Updates whose @step sub-steps were capped at 10,000 (so each was longer than @step):
+    // `@step(1e-30)`, or a step of 1e30 s.
+    uint64_t cappedSubSteps = 0;
 };
 
 struct Stats {

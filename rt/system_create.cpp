@@ -389,7 +389,7 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
         if (!mask[i]) continue;
         double span = t1 - created[i], h = info.stepLimit;
         b.spans[r] = span;
-        b.subSteps[r] = h > 0 && span > h ? static_cast<uint32_t>(std::ceil(span / h)) : 1;
+        b.subSteps[r] = subStepCount(span, h, s_.typeStats[type].cappedSubSteps);
         most = std::max(most, b.subSteps[r]);
         now[i] = t1;
         dt[i] = static_cast<float>(span);

@@ -39,6 +39,22 @@ inline uint64_t wholeCount(double x, uint64_t& clamped) {
 // a += b, stopping at the largest uint64 rather than wrapping around.
 inline void addSaturating(uint64_t& a, uint64_t b) { a = b > UINT64_MAX - a ? UINT64_MAX : a + b; }
 
+// The most sub-steps one update of an object takes under @step(h): a 10 s hitch at
+// @step(1/240) is 2,400; `@step(1e-30)` or a step of 1e30 s would never end. Past it the
+// update takes kMaxSubSteps longer sub-steps, and the type's stats count it.
+constexpr uint32_t kMaxSubSteps = 10000;
+
+// Sub-steps of at most `h` seconds covering `span` (h <= 0: one), capped and counted.
+inline uint32_t subStepCount(double span, double h, uint64_t& capped) {
+    if (!(h > 0) || !(span > h)) return 1;
+    double n = std::ceil(span / h);
+    if (n > kMaxSubSteps) {
+        ++capped;
+        return kMaxSubSteps;
+    }
+    return static_cast<uint32_t>(n);
+}
+
 inline bool finite(const ir::Value& v, int width) {
     for (int i = 0; i < width; ++i)
         if (!std::isfinite(v.f[static_cast<size_t>(i)])) return false;

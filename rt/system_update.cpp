@@ -144,16 +144,16 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1)
 }  // namespace
 
 void updateType(State& s, Creation& creation, size_t type, double dt, double t1) {
-    double h = s.types[type].stepLimit;
-    if (h <= 0 || dt <= h) {
+    uint32_t n = subStepCount(dt, s.types[type].stepLimit, s.typeStats[type].cappedSubSteps);
+    if (n == 1) {
         updatePool(s, creation, type, dt, t1);
         return;
     }
     // Sub-steps of equal length, each a pass over the pool: an object killed in one takes
     // no more, and what it emits in each is queued in (sub-step, row) order.
-    double n = std::ceil(dt / h);
     double t0 = t1 - dt;
-    for (double i = 1; i <= n; ++i) updatePool(s, creation, type, dt / n, i == n ? t1 : t0 + dt * (i / n));
+    for (uint32_t i = 1; i <= n; ++i)
+        updatePool(s, creation, type, dt / n, i == n ? t1 : t0 + dt * (static_cast<double>(i) / n));
 }
 
 }  // namespace psys::rt::detail

@@ -75,3 +75,28 @@ TEST_CASE("suppressed reports are dropped and not counted") {
     CHECK(diags.errorCount() == 0);
     CHECK(diags.all().empty());
 }
+
+TEST_CASE("past 50 errors and 50 warnings, the rest are counted and not kept") {
+    SourceManager sources;
+    int f = sources.add("x.psys", "x\n");
+    DiagnosticEngine diags(sources);
+    for (int i = 0; i < 70; ++i) diags.error({f, 0, 1}, "bad").notes.push_back({{f, 0, 1}, "a note"});
+    for (int i = 0; i < 3; ++i) diags.warning({f, 0, 1}, "odd");
+    CHECK(diags.errorCount() == 70);
+    CHECK(diags.warningCount() == 3);
+    CHECK(diags.all().size() == 53);
+    std::string text = diags.render();
+    CHECK(text.find("(the first 50 errors and 3 warnings are shown; 20 more errors and 0 more warnings are not)\n"
+                    "70 errors and 3 warnings generated.\n") != std::string::npos);
+}
+
+TEST_CASE("a line with control characters or bytes that are not UTF-8 prints as spaces and '?'") {
+    SourceManager sources;
+    int f = sources.add("x.psys", std::string("a\0b\x01 caf\xE9 \xE2\x86\x92 x\n", 15));
+    DiagnosticEngine diags(sources);
+    diags.error({f, 13, 14}, "here");
+    CHECK(diags.render() == "x.psys:1:14: error: here\n"
+                            " 1 | a b  caf? \xE2\x86\x92 x\n"
+                            "   |              ^\n"
+                            "1 error generated.\n");
+}

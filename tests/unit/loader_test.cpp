@@ -88,3 +88,25 @@ TEST_CASE("a directory or a missing main file is an error without a location") {
     CHECK(checkFile(t.root.string(), sources, diags) == nullptr);
     CHECK(diags.render().find("it is a directory") != std::string::npos);
 }
+
+TEST_CASE("only regular files are read, and none past 1 MiB") {
+    TempTree t;
+    t.write("main.psys", "import \"/dev/zero\";\n");
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    CHECK(checkFile((t.root / "main.psys").string(), sources, diags) == nullptr);
+    CHECK(diags.render().find("cannot open imported file `/dev/zero`: it is not a regular file") != std::string::npos);
+
+    t.write("big.psys", std::string(kMaxSourceBytes + 1, ' '));
+    t.write("uses_big.psys", "import \"big.psys\";\n");
+    SourceManager sources2;
+    DiagnosticEngine diags2(sources2);
+    CHECK(checkFile((t.root / "uses_big.psys").string(), sources2, diags2) == nullptr);
+    CHECK(diags2.render().find("it is larger than 1048576 bytes, the most a source file may be") != std::string::npos);
+
+    // Text handed over directly (an editor's buffer) meets the same limit.
+    SourceManager sources3;
+    DiagnosticEngine diags3(sources3);
+    CHECK(checkText("x.psys", std::string(kMaxSourceBytes + 1, ' '), sources3, diags3) == nullptr);
+    CHECK(diags3.render().find("this file is 1048577 bytes, more than the 1048576") != std::string::npos);
+}

@@ -46,3 +46,24 @@ TEST_CASE("counts and rates past 1e18 are taken as 1e18 and counted; dropped sto
         CHECK(run.system->stats().clampedEmissions == 1);
     }
 }
+
+TEST_CASE("@step sub-steps are capped at 10,000 an update, and counted") {
+    SUBCASE("@step(1e-30)") {
+        Run run("@step(1e-30) object a { pos = integrate(vec3(1)); point(pos, white, 1); }\nspawn a;");
+        run.steps(2, 1.0 / 60);
+        CHECK(run.stats("a").cappedSubSteps == 2);  // the first update at creation, then one step
+        CHECK(run.points("a")[0].position[0] == doctest::Approx(2.0 / 60));
+    }
+    SUBCASE("@step(1/240) and a step of 1e30 s") {
+        Run run("@step(1/240) object a { pos = integrate(vec3(1)); point(pos, white, 1); }\nspawn a;");
+        run.steps(1, 1.0 / 60);
+        run.steps(1, 1e30);
+        CHECK(run.stats("a").cappedSubSteps == 1);
+        CHECK(run.stats("a").live == 1);
+    }
+    SUBCASE("a 10 s hitch at @step(1/240) is 2,400 sub-steps: not capped") {
+        Run run("@step(1/240) object a { pos = integrate(vec3(1)); point(pos, white, 1); }\nspawn a;");
+        run.steps(1, 10.0);
+        CHECK(run.stats("a").cappedSubSteps == 0);
+    }
+}

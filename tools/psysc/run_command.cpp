@@ -81,6 +81,10 @@ void printSummary(const RunOptions& options, host::Session& session, double draw
                                      "rate k with k·dt too large: the integral oscillates and grows); use @step or "
                                      "@integrator(exponential)\n",
                                      t.name, t.unstable);
+    for (auto& t : stats.types)
+        if (t.cappedSubSteps)
+            std::cout << fmt::format("  {}: {} updates needed more than 10000 @step sub-steps and took 10000 longer "
+                                     "ones\n", t.name, t.cappedSubSteps);
     if (stats.rejectedSteps || stats.nonFiniteExterns || stats.invalidEmissions || stats.nonFiniteRender)
         std::cout << fmt::format("  rejected steps {}, non-finite extern values {}, invalid emissions {}, "
                                  "points not drawn (non-finite) {}\n",
