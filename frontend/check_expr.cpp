@@ -15,6 +15,25 @@ using namespace ast;
 
 namespace {
 
+// The one type two expressions of the same value have, where what is known of each (a
+// tuple may be known element by element: `(vec3(1), 2) -> prev((p, q))` while p and q are
+// being inferred) agrees; nullopt where it does not.
+std::optional<Type> unify(const Type& a, const Type& b) {
+    if (a.isUnknown()) return b;
+    if (b.isUnknown()) return a;
+    if (a.isTuple() && b.isTuple() && a.elements().size() == b.elements().size()) {
+        std::vector<Type> elements;
+        for (size_t i = 0; i < a.elements().size(); ++i) {
+            auto e = unify(a.elements()[i], b.elements()[i]);
+            if (!e) return std::nullopt;
+            elements.push_back(*e);
+        }
+        return Type::tuple(std::move(elements));
+    }
+    if (a == b) return a;
+    return std::nullopt;
+}
+
 const char* verb(BinaryOp op) {
     switch (op) {
         case BinaryOp::Add: return "add";
@@ -131,8 +150,7 @@ Type Checker::check(Expr& expr, const Context& ctx) {
                                                      "equations have a history", placeWords(ctx.where)));
                 t = Type::error();
             } else if (init.isError() || next.isError()) t = Type::error();
-            else if (init.isUnknown()) t = next;
-            else if (next.isUnknown() || init == next) t = init;
+            else if (auto both = unify(init, next)) t = *both;
             else {
                 diags_.error(expr.range, fmt::format("the initial value is {} but the next value is {}", init.str(), next.str()))
                     .notes.push_back({f.init->range, fmt::format("initial value: {}", init.str())});

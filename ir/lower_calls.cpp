@@ -21,10 +21,18 @@ Values ObjectLowering::lowerCall(const CallExpr& c) {
     }
     const BuiltinFunction& fn = builtinFunction(c.builtin);
     Type t = irType(c.type);
+    // State of a tuple (`prev((p, q))`, `snapshot(two(age))`) is one slot per element.
     if (fn.rule == BuiltinRule::Prev) {
-        ValueId prev = temporal(Op::Prev, t, {0});
-        deferred_.push_back({prev, c.args[0].get(), frames_});
-        return {prev};
+        Values prevs;
+        for (const psys::Type& element : c.type.isTuple() ? c.type.elements() : std::vector<psys::Type>{c.type})
+            prevs.push_back(temporal(Op::Prev, irType(element), {0}));
+        deferred_.push_back({prevs, c.args[0].get(), frames_});
+        return prevs;
+    }
+    if (fn.rule == BuiltinRule::Snapshot) {
+        Values out;
+        for (ValueId v : lower(*c.args[0])) out.push_back(temporal(Op::Snapshot, k_.at(v).type, {v}));
+        return out;
     }
     std::vector<ValueId> a;
     for (auto& arg : c.args) a.push_back(lowerOne(*arg));
@@ -99,7 +107,7 @@ Values ObjectLowering::lowerCall(const CallExpr& c) {
             return {k_.op(Op::Compose, t, a)};
         case BuiltinRule::Integrate:
             return {temporal(n == "integrate" ? Op::Integrate : Op::Derive, t, {a[0]})};
-        case BuiltinRule::Snapshot: return {temporal(Op::Snapshot, t, {a[0]})};
+        case BuiltinRule::Snapshot:
         case BuiltinRule::Prev: break;  // handled above
         case BuiltinRule::Random:
             return {temporal(n.substr(0, 1) == "n" ? Op::NRand : Op::Rand, t, {})};

@@ -85,13 +85,13 @@ public:
     // last, and what it reads is this update's value even where it refers forward.
     void flushDeferred() {
         while (!deferred_.empty()) {
-            auto [prev, arg, frames] = std::move(deferred_.back());
+            auto [prevs, arg, frames] = std::move(deferred_.back());
             deferred_.pop_back();
             auto saved = std::move(frames_);
             frames_ = std::move(frames);
-            ValueId v = lowerOne(*arg);
+            Values v = lower(*arg);
             frames_ = std::move(saved);
-            k_.mutableAt(prev).operands = {v};
+            for (size_t i = 0; i < prevs.size(); ++i) k_.mutableAt(prevs[i]).operands = {v.at(i)};
         }
     }
 
@@ -172,7 +172,7 @@ private:
     std::vector<std::pair<ValueId, std::pair<const Equation*, size_t>>> pendingRecurs_;
     const Equation* current_ = nullptr;
     std::vector<FnFrame> frames_;
-    std::vector<std::tuple<ValueId, const Expr*, std::vector<FnFrame>>> deferred_;
+    std::vector<std::tuple<Values, const Expr*, std::vector<FnFrame>>> deferred_;  // prev: a slot per element
 };
 
 }  // namespace psys::ir::detail

@@ -67,3 +67,30 @@ TEST_CASE("@step sub-steps are capped at 10,000 an update, and counted") {
         CHECK(run.stats("a").cappedSubSteps == 0);
     }
 }
+
+// A tuple's state is its elements' state: each program below runs bit for bit as the same
+// equations written one element at a time.
+TEST_CASE("tuples through prev, snapshot, -> and ?: are composite state") {
+    struct Case {
+        const char* tuple;
+        const char* elements;
+    };
+    const Case cases[] = {
+        {"object o { (p, q) = prev((age, 2)); point(vec3(p, q, 0), white, 1); }",
+         "object o { p = prev(age); q = prev(2); point(vec3(p, q, 0), white, 1); }"},
+        {"fn two(x: float) -> (float, float) = (x + 1, x * 2);\n"
+         "object o { (p, q) = snapshot(two(age + 0.5)); point(vec3(p, q, age), white, 1); }",
+         "object o { p = snapshot(age + 0.5 + 1); q = snapshot((age + 0.5) * 2); point(vec3(p, q, age), white, 1); }"},
+        {"object o { c = age > 0.05; (p, q) = prev(c ? (1, 2) : (3, 4)); point(vec3(p, q, 0), white, 1); }",
+         "object o { c = age > 0.05; p = prev(c ? 1 : 3); q = prev(c ? 2 : 4); point(vec3(p, q, 0), white, 1); }"},
+        {"object o { (p, q) = (1, 2) -> prev((p + 1, q * 2)); point(vec3(p, q, 0), white, 1); }",
+         "object o { p = 1 -> prev(p + 1); q = 2 -> prev(q * 2); point(vec3(p, q, 0), white, 1); }"},
+        {"object o { (p, q) = (vec3(1), 2) -> prev((p * 2, q + 1)); point(p, white, q); }",
+         "object o { p = vec3(1) -> prev(p * 2); q = 2 -> prev(q + 1); point(p, white, q); }"},
+    };
+    for (const Case& c : cases) {
+        CAPTURE(c.tuple);
+        Run tuple(std::string(c.tuple) + "\nspawn o;"), elements(std::string(c.elements) + "\nspawn o;");
+        CHECK(test::compareRuns(tuple, elements, 30, test::bitwise) == 30);
+    }
+}
