@@ -100,6 +100,12 @@ std::optional<std::string> System::step(double dt) {
         return fmt::format("a step must be a finite, non-negative number of seconds, not {}", dt);
     }
     start();
+    // No time passes: no update runs, so nothing moves, nothing is emitted, and no `prev`
+    // or `->` chain advances (it would count updates, not time).
+    if (dt == 0) {
+        ++s.stats.steps;
+        return std::nullopt;
+    }
     ++s.step;
     s.lastDt = dt;
     double t1 = s.now + dt;

@@ -176,6 +176,13 @@ TEST_CASE("dt = 0 changes nothing; negative, NaN and infinite dt are refused and
     }
     CHECK(run.system->stats().rejectedSteps == 3);
     CHECK(run.system->time() == 0.5);
+
+    // Not even a count of updates: `prev` and `->` do not advance.
+    Run counter("object a { n = 0 -> prev(n) + 1; point(origin, white, n); }\nspawn a;");
+    counter.steps(1, 1.0 / 60);
+    float n = counter.points("a")[0].size;
+    counter.steps(100, 0.0);
+    CHECK(counter.points("a")[0].size == n);
 }
 
 TEST_CASE("tiny steps and a 10 s hitch") {
