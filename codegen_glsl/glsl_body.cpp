@@ -141,8 +141,8 @@ private:
             case Op::Div: return a(0) + " / " + a(1);
             case Op::Mod: return fmt::format("{0} - {1} * floor({0} / {1})", a(0), a(1));
             case Op::Neg: return "-" + a(0);
-            case Op::Min: return choose(inst, a(1), a(0), a(1), a(0));  // y < x ? y : x
-            case Op::Max: return choose(inst, a(0), a(1), a(1), a(0));  // x < y ? y : x
+            case Op::Min: return perLane(inst, "psys_min");
+            case Op::Max: return perLane(inst, "psys_max");
             case Op::Step: return choose(inst, a(1), a(0), vec(inst, "0.0"), vec(inst, "1.0"));  // y < x ? 0 : 1
             case Op::Atan2: return perLane(inst, "psys_atan2");
             case Op::Pow: return perLane(inst, "psys_pow");

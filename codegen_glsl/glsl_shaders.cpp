@@ -61,13 +61,20 @@ void su(uint c, uint i, uint x) {{ w[col(c) + i] = x; }}
 #define psys_nan uintBitsToFloat(0x7fc00000u)
 #define psys_inf uintBitsToFloat(0x7f800000u)
 float psys_sign(float x) {{ return x > 0.0 ? 1.0 : x < 0.0 ? -1.0 : 0.0; }}
+// core/lanes.h's minimumNumber and maximumNumber, from the bits (no driver folds these away).
+bool psys_isnan(float x) {{ return (floatBitsToUint(x) & 0x7fffffffu) > 0x7f800000u; }}
+bool psys_negative(float x) {{ return (floatBitsToUint(x) >> 31) != 0u; }}
+float psys_min(float x, float y) {{ return (psys_isnan(x) || y < x || (y == x && psys_negative(y))) ? y : x; }}
+float psys_max(float x, float y) {{ return (psys_isnan(x) || x < y || (y == x && !psys_negative(y))) ? y : x; }}
 float psys_sqrt(float x) {{ return x < 0.0 ? psys_nan : sqrt(x); }}
 float psys_log(float x) {{ return x < 0.0 ? psys_nan : x == 0.0 ? -psys_inf : log(x); }}
 float psys_asin(float x) {{ return abs(x) > 1.0 ? psys_nan : asin(x); }}
 float psys_acos(float x) {{ return abs(x) > 1.0 ? psys_nan : acos(x); }}
 float psys_atan2(float y, float x) {{
-    if (x == 0.0 && y == 0.0)  // C's atan2 of zeros: ±0, or ±π when x is −0
-        return (floatBitsToUint(x) >> 31) != 0u ? ((floatBitsToUint(y) >> 31) != 0u ? -3.14159265 : 3.14159265) : y;
+    // C's atan2 where y is a zero (GLSL leaves it undefined; llvmpipe's atan(-0, -1) is NaN):
+    // ±0 towards +x, ±π towards −x (−0 counts as −x), the sign of y's zero.
+    if (y == 0.0 && !psys_isnan(x))
+        return (x < 0.0 || (x == 0.0 && psys_negative(x))) ? (psys_negative(y) ? -3.14159265 : 3.14159265) : y;
     return atan(y, x);
 }}
 float psys_pow(float x, float y) {{  // C's pow: defined for every base

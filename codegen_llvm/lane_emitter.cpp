@@ -99,6 +99,16 @@ private:
         return out;
     }
 
+    // core/lanes.h's minimumNumber / maximumNumber: y when x is NaN, when y is beyond x, or
+    // when they are equal and y is the zero of the right sign; else x.
+    llvm::Value* minMax(llvm::Value* x, llvm::Value* y, bool min) {
+        llvm::Value* beyond = min ? b_.CreateFCmpOLT(y, x) : b_.CreateFCmpOLT(x, y);
+        llvm::Value* negative = b_.CreateICmpSLT(b_.CreateBitCast(y, b_.getInt32Ty()), b_.getInt32(0));
+        llvm::Value* zeroSign = b_.CreateAnd(b_.CreateFCmpOEQ(y, x), min ? negative : b_.CreateNot(negative));
+        llvm::Value* pickY = b_.CreateOr(b_.CreateOr(b_.CreateFCmpUNO(x, x), beyond), zeroSign);
+        return b_.CreateSelect(pickY, y, x);
+    }
+
     Lanes emit(const Inst& i) {
         auto x = [&](size_t n, size_t l) { return values_[i.operands[n]][l]; };
         auto width = [&](size_t n) { return kernel_.at(i.operands[n]).type.width; };
@@ -118,8 +128,8 @@ private:
                     return b_.CreateFSub(x(0, l), b_.CreateFMul(x(1, l), q));
                 });
             case Op::Neg: return map(i, [&](size_t l) { return b_.CreateFNeg(x(0, l)); });
-            case Op::Min: return map(i, [&](size_t l) { return b_.CreateSelect(b_.CreateFCmpOLT(x(1, l), x(0, l)), x(1, l), x(0, l)); });
-            case Op::Max: return map(i, [&](size_t l) { return b_.CreateSelect(b_.CreateFCmpOLT(x(0, l), x(1, l)), x(1, l), x(0, l)); });
+            case Op::Min: return map(i, [&](size_t l) { return minMax(x(0, l), x(1, l), true); });
+            case Op::Max: return map(i, [&](size_t l) { return minMax(x(0, l), x(1, l), false); });
             case Op::Step: return map(i, [&](size_t l) { return b_.CreateSelect(b_.CreateFCmpOLT(x(1, l), x(0, l)), f(0), f(1)); });
             case Op::Atan2: return map(i, [&](size_t l) { return math(llvm::Intrinsic::not_intrinsic, "atan2f", x(0, l), x(1, l)); });
             case Op::Pow: return map(i, [&](size_t l) { return math(llvm::Intrinsic::pow, "powf", x(0, l), x(1, l)); });

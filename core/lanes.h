@@ -5,8 +5,10 @@
 // in exact maths).
 //
 // IEEE-754 single precision throughout: x/0 is ±Inf (NaN for 0/0), log(0) is −Inf,
-// sqrt(−1) is NaN; min and max return their first operand when the comparison is false
-// (so a NaN in the second operand is passed over), as GLSL's do.
+// sqrt(−1) is NaN. min and max are IEEE 754-2019's minimumNumber and maximumNumber: a NaN
+// operand gives the other operand, and −0 counts as below +0. Both are symmetric, so the
+// optimizer may order their operands (they are commutative in core/ops.h) without changing
+// a result; clamp and saturate are built from them.
 #pragma once
 
 #include <cmath>
@@ -42,6 +44,11 @@ inline float lane(Op op, float x) {
     }
 }
 
+// IEEE 754-2019 minimumNumber and maximumNumber (see the top of this file): each backend
+// spells out this same choice of operand.
+inline float minimumNumber(float x, float y) { return (std::isnan(x) || y < x || (y == x && std::signbit(y))) ? y : x; }
+inline float maximumNumber(float x, float y) { return (std::isnan(x) || x < y || (y == x && !std::signbit(y))) ? y : x; }
+
 // A binary componentwise op on one lane.
 inline float lane(Op op, float x, float y) {
     switch (op) {
@@ -50,8 +57,8 @@ inline float lane(Op op, float x, float y) {
         case Op::Mul: return x * y;
         case Op::Div: return x / y;
         case Op::Mod: return x - y * std::floor(x / y);  // floored, as GLSL's mod
-        case Op::Min: return y < x ? y : x;
-        case Op::Max: return x < y ? y : x;
+        case Op::Min: return minimumNumber(x, y);
+        case Op::Max: return maximumNumber(x, y);
         case Op::Step: return y < x ? 0.0f : 1.0f;     // step(edge = x, value = y)
         case Op::Atan2: return std::atan2(x, y);
         case Op::Pow: return std::pow(x, y);

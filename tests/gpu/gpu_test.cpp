@@ -140,6 +140,15 @@ TEST_CASE("every operation computes on the GPU what the interpreter computes") {
     }
 }
 
+TEST_CASE("min, max and clamp on NaN and signed zeros: the GPU picks the interpreter's operand") {
+    std::string text = readFile(std::string(PSYS_PROGRAMS_DIR) + "/nan_edges.psys");
+    for (bool optimize : {false, true}) {
+        test::Comparison c = compareProgram(text, 10, optimize, 0);
+        CHECK(c.points == 20);
+        CHECK(c.differences == 0);
+    }
+}
+
 TEST_CASE("the GPU at the extremes of docs/runtime.md") {
     SUBCASE("capacity overflow: the pool stays full and the spawns beyond it are counted") {
         Pair p("@capacity(1000) object s { point(origin, white, age); kill when age > 2; }\n"

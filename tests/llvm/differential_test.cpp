@@ -88,6 +88,16 @@ TEST_CASE("every operation compiles to the interpreter's result") {
     }
 }
 
+TEST_CASE("min, max and clamp on NaN and signed zeros: the JIT picks the interpreter's operand") {
+    std::string text = readFile(std::string(PSYS_PROGRAMS_DIR) + "/nan_edges.psys");
+    for (MathMode mode : {MathMode::Exact, MathMode::Fast})
+        for (bool optimize : {false, true}) {
+            test::Comparison c = compareBackends(text, 10, optimize, mode);
+            CHECK(c.points == 20);
+            CHECK(c.differences == 0);
+        }
+}
+
 TEST_CASE("under every integration method every sample draws the same on both backends (exact maths)") {
     for (size_t m = 0; m < core::kIntegratorNames.size(); ++m) {
         auto method = static_cast<core::Integrator>(m);

@@ -3,6 +3,7 @@
 // a crash, a hang, an overflow or a silent wrong value.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <cstdint>
 
 #include "run.h"
@@ -92,5 +93,24 @@ TEST_CASE("tuples through prev, snapshot, -> and ?: are composite state") {
         CAPTURE(c.tuple);
         Run tuple(std::string(c.tuple) + "\nspawn o;"), elements(std::string(c.elements) + "\nspawn o;");
         CHECK(test::compareRuns(tuple, elements, 30, test::bitwise) == 30);
+    }
+}
+
+TEST_CASE("min, max and clamp on NaN and signed zeros are symmetric, at run time and folded") {
+    std::string text = test::readFile(PSYS_PROGRAMS_DIR "/nan_edges.psys");
+    for (bool optimize : {false, true}) {
+        CAPTURE(optimize);
+        Run run(text, {}, optimize);
+        run.steps(2, 1.0 / 60);
+        auto points = run.points("o");
+        REQUIRE(points.size() == 2);  // nothing is NaN
+        for (const rt::RenderPoint& p : points) {
+            float k = p.size - 1;
+            CHECK(p.position[0] == 4 * k);  // max(NaN, k) + max(k, NaN), run and folded
+            CHECK(p.position[1] == 4 * k);
+            CHECK(p.position[2] == 0);      // clamp(NaN) and saturate(NaN): 0
+            const float pi = std::atan2(0.0f, -1.0f);
+            CHECK(p.color == std::array<float, 4>{-pi, -pi, pi, pi});  // min is -0, max is +0, either order
+        }
     }
 }
