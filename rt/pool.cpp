@@ -83,6 +83,7 @@ void Pool::grow(size_t n) {
     generation_.resize(n, 0);
     parent.resize(n);
     readers.resize(n, 0);
+    diedAt.resize(n, 0);
     for (auto& e : emitted) e.resize(n, 0);
     for (Buffer b : {created, ids, updatable}) memory_->resize(b, n);
     mask_.resize(n, 0);
@@ -111,9 +112,10 @@ std::optional<uint32_t> Pool::allocate() {
     return row;
 }
 
-void Pool::freeze(uint32_t row) {
+void Pool::freeze(uint32_t row, double at) {
     if (status_[row] != Status::Alive) return;
     status_[row] = Status::Frozen;
+    diedAt[row] = at;
     setMask(row, 0);
     --live_;
     ++frozen_;

@@ -66,7 +66,7 @@ public:
     // A new row for an object, or nullopt at capacity.
     std::optional<uint32_t> allocate();
     void release(uint32_t row);  // back to the free list; the generation moves on
-    void freeze(uint32_t row);
+    void freeze(uint32_t row, double at);  // `at`: the time of its last values; its age stays what it was then
     bool matches(Handle h) const { return h.row < rows() && generation_[h.row] == h.generation && status_[h.row] != Status::Free; }
     Handle handle(uint32_t row) const { return {row, generation_[row]}; }
     Status status(uint32_t row) const { return status_[row]; }
@@ -86,6 +86,10 @@ public:
     // Host bookkeeping.
     std::vector<Handle> parent;
     std::vector<uint32_t> readers;   // children that read this object live
+    std::vector<double> diedAt;      // a frozen object's time of its last values
+    // The time a child reading `row`'s age reads it at: `now`, or its death for a frozen
+    // object (frozen with its last values, its age too).
+    double ageClock(uint32_t row, double now) const { return status_[row] == Status::Frozen ? diedAt[row] : now; }
     std::vector<uint32_t> fresh;     // rows created during the current step
     void beginStep();                // the rows created before this step become updatable
     std::vector<std::vector<double>> emitted;  // per rate site: events accumulated, in [0, 1)

@@ -10,6 +10,7 @@
 // new child type's parent type is the old one's; readers are counted again, and a frozen
 // object nobody reads any more is freed. Time, the step count, ids and externs (by name
 // and type) continue.
+#include <algorithm>
 #include <map>
 #include <set>
 
@@ -59,6 +60,7 @@ void carryType(const detail::State& old, size_t ot, detail::State& s, size_t t, 
     std::vector<Status> status(rows);
     for (uint32_t r = 0; r < rows; ++r) status[r] = from.status(r);
     to.restore(status, from.generations(), from.freeRows());
+    std::copy(from.diedAt.begin(), from.diedAt.begin() + static_cast<std::ptrdiff_t>(rows), to.diedAt.begin());
     report.carried += from.live() + from.frozen();
     copyColumn(old.memory, from.created, s.memory, to.created, rows, 8);
     copyColumn(old.memory, from.ids, s.memory, to.ids, rows, 4);

@@ -502,7 +502,7 @@ void Creation::killOrEmit(size_t type, Batch& b, size_t r, double dt, double t1)
     size_t i = b.first + r;
     uint32_t row = b.poolRows[r];
     if (info.kills && s_.view<uint8_t>(b.updateTable[ColumnLayout::kKill])[i]) {
-        s_.kill(type, row);
+        s_.kill(type, row, t1 - dt);
         return;
     }
     if (!info.rateEmits) return;

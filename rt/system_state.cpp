@@ -107,9 +107,9 @@ std::pair<int, uint32_t> State::ancestor(size_t type, uint32_t row, int depth) c
     return {t, r};
 }
 
-void State::kill(size_t type, uint32_t row) {
+void State::kill(size_t type, uint32_t row, double at) {
     ++typeStats[type].killed;
-    pools[type].freeze(row);  // no longer alive; freed at the end of the step if nobody reads it
+    pools[type].freeze(row, at);  // no longer alive; freed at the end of the step if nobody reads it
     dying.push_back({type, row});
 }
 
@@ -164,7 +164,7 @@ void State::parentValues(size_t type, uint32_t row, const ColumnLayout& layout, 
         Value v;
         if (p.op == ir::Op::ParentExport && parent) v = parent->exports.get(memory, static_cast<size_t>(p.exportIndex), r);
         if (p.op == ir::Op::ParentAlive) v = Value::boolean(parent && parent->status(r) == Status::Alive);
-        if (p.op == ir::Op::ParentAge && parent) v = Value::scalar(ageAt(at, view<double>(parent->created)[r]));
+        if (p.op == ir::Op::ParentAge && parent) v = Value::scalar(ageAt(parent->ageClock(r, at), view<double>(parent->created)[r]));
         out.push_back(v);
     }
 }
@@ -184,7 +184,8 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
                     if (p.op == ir::Op::ParentExport)
                         x = view<float>(parent->exports.column(static_cast<size_t>(p.exportIndex), static_cast<size_t>(c)))[r];
                     if (p.op == ir::Op::ParentAlive) x = parent->status(r) == Status::Alive ? 1.0f : 0.0f;
-                    if (p.op == ir::Op::ParentAge) x = ageAt(atRows ? atRows[i] : at, view<double>(parent->created)[r]);
+                    if (p.op == ir::Op::ParentAge)
+                        x = ageAt(parent->ageClock(r, atRows ? atRows[i] : at), view<double>(parent->created)[r]);
                 }
                 host<float>(table[static_cast<size_t>(p.offset + c)])[i] = x;
             }

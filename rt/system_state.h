@@ -95,7 +95,8 @@ struct State {
     // The ancestor `depth` levels up of (type, row), or (-1, 0) when there is none.
     std::pair<int, uint32_t> ancestor(size_t type, uint32_t row, int depth) const;
     // An object is dead: frozen now, freed at the end of the step unless children read it.
-    void kill(size_t type, uint32_t row);
+    // `at`: the time of its last values (those of the update before the one that killed it).
+    void kill(size_t type, uint32_t row, double at);
     // A reader of `parent` is gone; a frozen parent without readers is freed, and so on up.
     void releaseReader(size_t childType, Handle parent);
     // The values of `kernel`'s uniform kernel at (dt, time), evaluated on the host and

@@ -48,7 +48,7 @@ void killAndEmit(State& s, Creation& creation, size_t type, double dt, double t1
     for (uint32_t row = 0; row < pool.rows(); ++row) {
         if (!updatable[row]) continue;
         if (info.kills && kill[row]) {
-            s.kill(type, row);
+            s.kill(type, row, t1 - dt);
             continue;
         }
         if (!info.rateEmits) continue;
@@ -135,7 +135,7 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1)
     if (!info.kills && !info.rateEmits) return;
     if (listKills) {
         for (size_t c = 0; c < chunks; ++c)
-            for (uint32_t row : work.killed[c]) s.kill(type, row);
+            for (uint32_t row : work.killed[c]) s.kill(type, row, t1 - dt);
         return;
     }
     killAndEmit(s, creation, type, dt, t1);

@@ -114,3 +114,22 @@ TEST_CASE("min, max and clamp on NaN and signed zeros are symmetric, at run time
         }
     }
 }
+
+TEST_CASE("a frozen parent's age is frozen with its other values") {
+    Run run(R"(
+        object parent {
+            x = age;
+            emit child count 1;
+            kill when age > 1;
+            object child { point(vec3(parent.x, parent.age, parent.alive ? 1 : 0), white, 1); }
+        }
+        spawn parent;)");
+    run.steps(4, 0.25);
+    CHECK(run.points("parent.child")[0].position[1] == doctest::Approx(1.0));
+    run.steps(5, 0.25);  // dead at the update to 1.25: its last values are those at age 1
+    const auto& c = run.points("parent.child");
+    REQUIRE(c.size() == 1);
+    CHECK(c[0].position[0] == doctest::Approx(1.0));
+    CHECK(c[0].position[1] == doctest::Approx(1.0));  // not 2.25: age does not go on rising
+    CHECK(c[0].position[2] == 0);
+}
