@@ -13,25 +13,30 @@
 namespace psys::tools {
 namespace {
 
-// Every drawn point of the dumped frames, as CSV (streamed) or JSON (written at the end).
+// `--dump`: every drawn point of the frames dumped, written as each frame ends (CSV rows,
+// or a JSON document {"frames": [...]} streamed one frame a line), so memory stays that of
+// one frame however long the run; the file is opened before the run starts.
 class Dump {
 public:
     explicit Dump(const std::string& path) : path_(path), json_(path.ends_with(".json")) {
-        if (!path.empty() && !json_) {
-            out_.open(path);
-            out_ << "frame,time,type,id,x,y,z,r,g,b,a,size\n";
-        }
+        if (path.empty()) return;
+        out_.open(path, std::ios::binary);
+        out_ << (json_ ? "{\"frames\": [" : "frame,time,type,id,x,y,z,r,g,b,a,size\n");
     }
-    bool ok() const { return path_.empty() || json_ || out_.good(); }
+    bool ok() const { return path_.empty() || out_.good(); }
 
     void frame(int frame, rt::System& system) {
         if (path_.empty()) return;
-        nlohmann::json objects = nlohmann::json::array();
+        if (json_) out_ << (frames_++ ? ",\n" : "\n") << fmt::format(R"({{"frame": {}, "time": {}, "objects": [)", frame,
+                                                                     nlohmann::json(system.time()).dump());
+        bool first = true;
         for (size_t t = 0; t < system.typeCount(); ++t) {
             const std::string& type = system.module().objects[t].name;
             for (const rt::RenderPoint& p : system.points(t)) {
                 if (json_) {
-                    objects.push_back({{"type", type}, {"id", p.id}, {"position", p.position}, {"color", p.color}, {"size", p.size}});
+                    nlohmann::json o = {{"type", type}, {"id", p.id}, {"position", p.position}, {"color", p.color}, {"size", p.size}};
+                    out_ << (first ? "" : ", ") << o.dump();
+                    first = false;
                 } else {
                     out_ << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{}\n", frame, system.time(), type, p.id,
                                         p.position[0], p.position[1], p.position[2], p.color[0], p.color[1],
@@ -39,21 +44,22 @@ public:
                 }
             }
         }
-        if (json_) frames_.push_back({{"frame", frame}, {"time", system.time()}, {"objects", objects}});
+        if (json_) out_ << "]}";
+        out_.flush();
     }
 
     bool finish() {
-        if (path_.empty() || !json_) return ok();
-        std::ofstream out(path_);
-        out << nlohmann::json{{"frames", frames_}}.dump(1) << "\n";
-        return out.good();
+        if (path_.empty()) return true;
+        if (json_) out_ << "\n]}\n";
+        out_.close();
+        return !out_.fail();
     }
 
 private:
     std::string path_;
     bool json_;
     std::ofstream out_;
-    nlohmann::json frames_ = nlohmann::json::array();
+    size_t frames_ = 0;
 };
 
 void printSummary(const RunOptions& options, host::Session& session, double drawSeconds) {
@@ -153,7 +159,10 @@ int runSystem(const RunOptions& options) {
         auto start = std::chrono::steady_clock::now();
         for (size_t t = 0; t < system.typeCount(); ++t) system.draw(t);
         drawSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        if (options.dumpEvery > 0 && frame % options.dumpEvery == 0) dump.frame(frame, system);
+        if (options.dumpEvery > 0 && frame % options.dumpEvery == 0) {
+            dump.frame(frame, system);
+            if (!dump.ok()) return fail("cannot write `" + options.dump + "` (at frame " + std::to_string(frame) + ")");
+        }
     }
     if (!dump.finish()) return fail("cannot write `" + options.dump + "`");
     printSummary(options, *s, drawSeconds);
