@@ -272,6 +272,7 @@ void Checker::run() {
             if (decl->kind == DeclKind::Trigger) checkTrigger(static_cast<TriggerDecl&>(*decl));
             if (decl->kind == DeclKind::Spawn) checkSpawn(static_cast<SpawnDecl&>(*decl));
         }
+    if (diags_.errorCount() == 0) checkInlinedSize();
     if (diags_.errorCount() == 0) reportUnused();
 }
 

@@ -5,7 +5,7 @@
 // Split over files by concern: symbols.cpp (scopes and lookup), check_expr.cpp
 // (expressions), check_object.cpp (objects, equations, commands), check_decls.cpp
 // (constants, functions, externs, triggers, spawns, attributes), check_cycles.cpp
-// (algebraic loops among an object's equations).
+// (algebraic loops among an object's equations), check_size.cpp (functions' size once inlined).
 #pragma once
 
 #include <functional>
@@ -78,6 +78,9 @@ private:
 
     // check_cycles.cpp
     void checkAlgebraicLoops(const ast::ObjectDecl& object);
+
+    // check_size.cpp
+    void checkInlinedSize();
 
     // check_decls.cpp
     void checkConst(ast::ConstDecl& decl);
