@@ -19,7 +19,7 @@ using namespace ast;
 
 namespace {
 
-constexpr uint64_t kMaxInlinedOperations = 100'000;
+constexpr uint64_t kMaxInlinedOperations = 1'000'000;
 
 uint64_t add(uint64_t a, uint64_t b) { return b > UINT64_MAX - a ? UINT64_MAX : a + b; }
 

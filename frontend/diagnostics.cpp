@@ -76,9 +76,7 @@ void printOne(std::ostream& out, const SourceManager& sources, Severity severity
     std::string line = printable(file.lineText(at.line));
     std::string number = std::to_string(at.line);
     std::string gutter(number.size(), ' ');
-    out << ' ' << number << " | " << line << '\n';
 
-    // Underline: tabs are copied from the source so the caret lines up.
     uint32_t startCol = at.column - 1;
     uint32_t endCol = startCol + 1;
     if (range.end > range.begin) {
@@ -86,6 +84,24 @@ void printOne(std::ostream& out, const SourceManager& sources, Severity severity
         endCol = last.line == at.line ? last.column : static_cast<uint32_t>(line.size());
     }
     endCol = std::max(endCol, startCol + 1);
+    // A line of a generated file may be 100,000 characters: show a window of it around the
+    // range, marked with `...` where it is cut.
+    constexpr uint32_t kBefore = 60, kWidth = 160;
+    if (line.size() > kBefore + kWidth) {
+        uint32_t from = startCol > kBefore ? startCol - kBefore : 0;
+        while (from > 0 && (static_cast<unsigned char>(line[from]) & 0xC0) == 0x80) --from;  // whole characters
+        uint32_t to = std::min<uint32_t>(static_cast<uint32_t>(line.size()), from + kWidth);
+        while (to < line.size() && (static_cast<unsigned char>(line[to]) & 0xC0) == 0x80) ++to;
+        std::string head = from > 0 ? "..." : "", tail = to < line.size() ? "..." : "";
+        line = head + line.substr(from, to - from) + tail;
+        uint32_t shift = static_cast<uint32_t>(head.size()) - from;
+        startCol += shift;
+        endCol = std::min(endCol + shift, static_cast<uint32_t>(line.size() - tail.size()));
+        endCol = std::max(endCol, startCol + 1);
+    }
+    out << ' ' << number << " | " << line << '\n';
+
+    // Underline: tabs are copied from the source so the caret lines up.
     std::string marks;
     for (uint32_t i = 0; i < startCol; ++i) marks += (i < line.size() && line[i] == '\t') ? '\t' : ' ';
     std::string underline = "^";

@@ -1,5 +1,7 @@
 #include "frontend/parse.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <limits>
 #include <optional>
@@ -375,6 +377,41 @@ std::optional<uint32_t> unterminatedComment(std::string_view text) {
     return std::nullopt;
 }
 
+// The first place brackets nest deeper than kMaxNesting, or more than kMaxNesting prefix
+// operators stand in a row (`- - - x`), outside comments and strings. The parser recurses
+// at each; clang's bracket limit is the model.
+constexpr int kMaxNesting = 256;
+std::optional<uint32_t> tooDeep(std::string_view text) {
+    int depth = 0, prefixes = 0;
+    bool operand = false;  // the last token ends an operand: a `-` after it is binary
+    for (size_t i = 0; i < text.size(); ++i) {
+        char c = text[i];
+        if (c == '"') {
+            for (++i; i < text.size() && text[i] != '"' && text[i] != '\n'; ++i)
+                if (text[i] == '\\') ++i;
+            operand = true;
+            continue;
+        }
+        if (c == '/' && i + 1 < text.size() && (text[i + 1] == '/' || text[i + 1] == '*')) {
+            size_t end = text[i + 1] == '/' ? text.find('\n', i) : text.find("*/", i + 2);
+            if (end == std::string_view::npos) return std::nullopt;
+            i = text[i + 1] == '/' ? end : end + 1;
+            continue;
+        }
+        if (c == ' ' || c == '\t' || c == '\r' || c == '\n') continue;
+        if (c == '(' || c == '{') {
+            if (++depth > kMaxNesting) return static_cast<uint32_t>(i);
+        } else if (c == ')' || c == '}') {
+            depth = std::max(0, depth - 1);
+        }
+        bool prefix = !operand && (c == '-' || c == '+' || c == '!');
+        prefixes = prefix ? prefixes + 1 : 0;
+        if (prefixes > kMaxNesting) return static_cast<uint32_t>(i);
+        operand = std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.' || c == ')' || c == '}';
+    }
+    return std::nullopt;
+}
+
 }  // namespace
 
 std::unique_ptr<Module> parseModule(int file, const SourceManager& sources, DiagnosticEngine& diags) {
@@ -393,6 +430,12 @@ std::unique_ptr<Module> parseModule(int file, const SourceManager& sources, Diag
     }
     if (auto open = unterminatedComment(text)) {
         diags.error({file, *open, *open + 2}, "unterminated comment: this `/*` has no `*/`");
+        return nullptr;
+    }
+    if (auto deep = tooDeep(text)) {
+        diags.error({file, *deep, *deep + 1}, fmt::format("nesting exceeds the maximum of {} levels (brackets, or prefix "
+                                                          "operators in a row); split the expression with a `let` or an "
+                                                          "equation", kMaxNesting));
         return nullptr;
     }
     antlr4::ANTLRInputStream input(text);

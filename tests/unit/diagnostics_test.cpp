@@ -100,3 +100,16 @@ TEST_CASE("a line with control characters or bytes that are not UTF-8 prints as 
                             "   |              ^\n"
                             "1 error generated.\n");
 }
+
+TEST_CASE("a very long line is shown as a window around the range") {
+    SourceManager sources;
+    std::string text = std::string(1000, 'a') + " bad " + std::string(1000, 'b') + "\n";
+    int f = sources.add("x.psys", text);
+    DiagnosticEngine diags(sources);
+    diags.error({f, 1001, 1004}, "here");
+    std::string shown = diags.render();
+    CHECK(shown == "x.psys:1:1002: error: here\n"
+                   " 1 | ..." + std::string(59, 'a') + " bad " + std::string(96, 'b') + "...\n"
+                   "   |    " + std::string(60, ' ') + "^~~\n"
+                   "1 error generated.\n");
+}

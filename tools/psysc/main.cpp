@@ -19,6 +19,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "host/large_stack.h"
 #include "codegen_glsl/glsl_shaders.h"
 #include "frontend/frontend.h"
 #include "frontend/loader.h"
@@ -146,7 +147,9 @@ int printGlsl(const std::string& file, const psys::CompileOptions& options, bool
 
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+
+int realMain(int argc, char** argv) {
     CLI::App app{"psysc: compiler for .psys particle systems"};
     app.set_version_flag("--version", std::string("psysc ") + PSYS_VERSION);
     std::string colourMode = "auto";
@@ -260,4 +263,11 @@ int main(int argc, char** argv) {
     }
     std::cerr << app.help();
     return 2;
+}
+
+}  // namespace
+
+// Everything runs on a thread with a large stack (host/large_stack.h).
+int main(int argc, char** argv) {
+    return psys::host::runWithLargeStack([&] { return realMain(argc, argv); });
 }

@@ -13,6 +13,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "host/large_stack.h"
 #include "viewer.h"
 
 using namespace psys;
@@ -37,7 +38,9 @@ int fail(const std::string& message) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+
+int realMain(int argc, char** argv) {
     CLI::App app{"psys-view: run a .psys system in real time, edit it live"};
     app.footer(kKeys);
     ViewerOptions o;
@@ -139,4 +142,11 @@ int main(int argc, char** argv) {
     if (o.log) std::cout << "psys-view: " << o.file << " on " << session->backend().name() << ", " << surface->renderer() << std::endl;
     Viewer viewer(std::move(o), *surface, std::move(session), compiled);
     return viewer.run();
+}
+
+}  // namespace
+
+// Everything runs on a thread with a large stack (host/large_stack.h).
+int main(int argc, char** argv) {
+    return psys::host::runWithLargeStack([&] { return realMain(argc, argv); });
 }
