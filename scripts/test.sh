@@ -2,6 +2,7 @@
 # Sets up, builds and runs every test: a release build with warnings as errors, then the
 # same tests under AddressSanitizer and UndefinedBehaviorSanitizer.
 #   PSYS_SKIP_SANITIZE=1 bash scripts/test.sh   # only the first build
+#   PSYS_SKIP_FUZZ=1 bash scripts/test.sh       # without the brief fuzzing (scripts/fuzz.sh)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -17,4 +18,10 @@ if [ "${PSYS_SKIP_SANITIZE:-0}" != 1 ]; then
   cmake --build build-asan -j "$jobs"
   ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
     ctest --test-dir build-asan -j "$jobs" --output-on-failure
+fi
+
+# The fuzz targets keep building and, run briefly, keep finding nothing (fuzz_pipeline is
+# built but not run here: docs/robustness.md says why).
+if [ "${PSYS_SKIP_FUZZ:-0}" != 1 ]; then
+  FUZZ_TARGETS="fuzz_frontend fuzz_ir" bash scripts/fuzz.sh 30
 fi
