@@ -44,6 +44,10 @@ std::unique_ptr<Session> Session::open(const std::string& path, const SessionOpt
         error = backend.error;
         return nullptr;
     }
+    if (auto tooLarge = rt::System::checkCapacity(*module, options.system)) {
+        error = *tooLarge;
+        return nullptr;
+    }
     std::unique_ptr<Session> s(new Session());
     s->path_ = path;
     s->options_ = options;

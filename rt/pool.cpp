@@ -56,6 +56,18 @@ Pool::Pool(const ir::Object& object, size_t capacity, Memory& memory)
     emitted.assign(object.emits.size(), {});
 }
 
+size_t Pool::rowBytes(const ir::Object& object) {
+    size_t floats = 0;
+    for (auto& s : object.state) floats += static_cast<size_t>(s.type.width);
+    for (auto& p : object.params)
+        if (p.kept) floats += static_cast<size_t>(p.type.width);
+    for (auto& e : object.exports) floats += static_cast<size_t>(e.type.width);
+    size_t columns = sizeof(double) + sizeof(uint32_t) + 1 + 4 * floats;  // created, id, updatable, values
+    size_t host = sizeof(Status) + sizeof(uint32_t) + sizeof(Handle) + sizeof(uint32_t) + sizeof(double) + 1 +
+                  sizeof(double) * object.emits.size();  // status, generation, parent, readers, diedAt, mask, emitted
+    return columns + host;
+}
+
 Pool::Pool(Pool&& other) noexcept
     : created(other.created), ids(other.ids), updatable(other.updatable), state(std::move(other.state)),
       params(std::move(other.params)), exports(std::move(other.exports)), paramColumn(std::move(other.paramColumn)),

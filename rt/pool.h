@@ -99,6 +99,9 @@ public:
     void restore(std::vector<Status> status, std::vector<uint32_t> generation, std::vector<uint32_t> freeRows);
     const std::vector<uint32_t>& generations() const { return generation_; }
     const std::vector<uint32_t>& freeRows() const { return freeRows_; }
+    // The bytes one row of `object`'s pool takes: its columns (creation time, id, update
+    // mask, kept state, kept parameters, exports) and the host's bookkeeping of it.
+    static size_t rowBytes(const ir::Object& object);
     // Grows every column to `rows` rows (new rows free).
     void grow(size_t rows);
 

@@ -132,6 +132,9 @@ public:
     std::optional<std::string> fire(std::string_view trigger, std::span<const float> args);
     // Whether fire(trigger, `values` numbers) would be accepted: nullopt, or why not.
     std::optional<std::string> checkFiring(std::string_view trigger, size_t values) const;
+    // Whether every type's capacity (its @capacity, else the options') fits in this
+    // machine's memory at the pool's bytes a row: nullopt, or an error that names the bytes.
+    static std::optional<std::string> checkCapacity(const ir::Module& module, const SystemOptions& options);
     std::optional<std::string> step(double dt);
     // Threads for launches over pools from now on: 0 for every core. Results do not change.
     void setThreads(unsigned threads);
