@@ -121,7 +121,9 @@ private:
             }
             case Op::Dot: expect(i.type.isScalarFloat() && t(0) == t(1) && t(0).isFloat(), "f32 of two equal vectors"); break;
             case Op::Rand: case Op::NRand:
-                expect(i.type.isFloat() && (i.operands.empty() || (t(0) == Type::u32() && t(1) == Type::u32())),
+                // No operands (a draw key-random has not keyed yet), or exactly the key's two.
+                expect(i.type.isFloat() &&
+                           (i.operands.empty() || (i.operands.size() == 2 && t(0) == Type::u32() && t(1) == Type::u32())),
                        "floats, keyed by two u32 (object id, draw)");
                 break;
             case Op::Integrate: case Op::Derive: expect(i.type.isFloat() && t(0) == i.type, "T -> T on floats"); break;

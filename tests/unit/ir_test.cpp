@@ -110,6 +110,9 @@ TEST_CASE("the verifier finds broken invariants") {
     CHECK(verifyText("object a()\n  kernel render\n    %0 = age.f32\n    yield position = %0\n  end\nend\n")
               .find("a vec3") != std::string::npos);
     CHECK(verifyText("object a()\n  emit nothing rate\nend\n").find("emits unknown `nothing`") != std::string::npos);
+    // Found by fuzz_ir: a draw with one key operand (it takes none or two) read past its operands.
+    CHECK(verifyText("object a()\n  kernel init\n    %0 = object.id.u32\n    %1 = nrand.vec2 %0 #0\n  end\nend\n")
+              .find("keyed by two u32") != std::string::npos);
     // Forward references are allowed through delaying operands of a behaviour kernel.
     CHECK(verifyText("object a()\n  kernel behaviour\n    %0 = prev.f32 %1 #0\n    %1 = age.f32\n  end\nend\n").empty());
 }
