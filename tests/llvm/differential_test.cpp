@@ -98,6 +98,16 @@ TEST_CASE("min, max and clamp on NaN and signed zeros: the JIT picks the interpr
         }
 }
 
+TEST_CASE("a kernel of thousands of instructions (cut into blocks, fast code generation) computes the same") {
+    std::string sum = "age";
+    for (int i = 0; i < 700; ++i) sum += " + sin(age * " + std::to_string(i) + ".5)";
+    std::string text = "object o { y = " + sum + "; point(vec3(y, age, 0), white, 1); }\nspawn o;";
+    for (MathMode mode : {MathMode::Exact, MathMode::Fast}) {
+        test::Comparison c = compareBackends(text, 3, true, mode);
+        CHECK(c.points == 3);
+    }
+}
+
 TEST_CASE("under every integration method every sample draws the same on both backends (exact maths)") {
     for (size_t m = 0; m < core::kIntegratorNames.size(); ++m) {
         auto method = static_cast<core::Integrator>(m);
