@@ -1,5 +1,7 @@
 #include "reloader.h"
 
+#include "host/large_stack.h"
+
 namespace psys::viewer {
 
 namespace {
@@ -26,7 +28,12 @@ void Reloader::start(Clock::time_point when) {
     std::string path = session_.path();
     host::SessionOptions options = session_.options();
     std::shared_ptr<rt::Backend> backend = session_.backendHandle();
-    worker_ = std::thread([this, path, options, backend] {
+    // The compile recurses as deep as the program nests: on a large stack, as the main thread's work.
+    worker_ = std::thread([this, path, options, backend] { host::runWithLargeStack([&] { return work(path, options, backend); }); });
+}
+
+int Reloader::work(const std::string& path, const host::SessionOptions& options, std::shared_ptr<rt::Backend> backend) {
+    {
         host::Session::Candidate candidate;
         candidate.compile = host::compile(path, options.compile, candidate.module);
         candidate.backend = backend;
@@ -44,7 +51,8 @@ void Reloader::start(Clock::time_point when) {
         std::lock_guard lock(mutex_);
         candidate_ = std::move(candidate);
         prepared_ = true;
-    });
+    }
+    return 0;
 }
 
 void Reloader::finish() {

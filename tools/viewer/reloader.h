@@ -42,6 +42,8 @@ public:
 
 private:
     void start(Clock::time_point when);
+    // The worker's body: compile `path` and prepare the backend; the result for poll().
+    int work(const std::string& path, const host::SessionOptions& options, std::shared_ptr<rt::Backend> backend);
     void finish();
 
     host::Session& session_;
