@@ -5,6 +5,8 @@
 # build-fuzz/crashes/; the corpora grow in build-fuzz/corpus/.
 #   bash scripts/fuzz.sh [SECONDS]     # CI runs it briefly; README names the long run
 #   FUZZ_TARGETS="fuzz_frontend" bash scripts/fuzz.sh 1800   # some of them (all three are built)
+#   FUZZ_RUNS=1 bash scripts/fuzz.sh       # CI: a fixed number of inputs per target from seed 1
+#                                          # in a fresh corpus, so a run is the same every time
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
@@ -24,14 +26,23 @@ if [ -x build/tools/psysc/psysc ]; then
   done
 fi
 
+# Inputs per target for FUZZ_RUNS (about 15 s each here).
+runs_for() { case $1 in fuzz_frontend) echo 12000 ;; fuzz_ir) echo 50000 ;; *) echo 6000 ;; esac; }
+
 status=0
 for target in ${FUZZ_TARGETS:-fuzz_frontend fuzz_ir fuzz_pipeline}; do
   corpus=build-fuzz/corpus/$target
+  limit=(-max_total_time="$seconds")
+  if [ -n "${FUZZ_RUNS:-}" ]; then
+    corpus=build-fuzz/corpus-ci/$target
+    rm -rf "$corpus"
+    limit=(-runs="$(runs_for "$target")" -seed=1)
+  fi
   mkdir -p "$corpus"
   seed=$seeds/psys
   [ "$target" = fuzz_ir ] && seed=$seeds/ir
-  echo "fuzz: $target for ${seconds} s"
-  if ! build-fuzz/fuzz/$target "$corpus" "$seed" -dict=fuzz/psys.dict -max_total_time="$seconds" -timeout=20 \
+  echo "fuzz: $target ${limit[*]}"
+  if ! build-fuzz/fuzz/$target "$corpus" "$seed" -dict=fuzz/psys.dict "${limit[@]}" -timeout=20 \
        -rss_limit_mb=4096 -artifact_prefix="build-fuzz/crashes/$target-" -print_final_stats=1 2>build-fuzz/$target.log; then
     status=1
     echo "fuzz: $target found a failure: build-fuzz/crashes/, build-fuzz/$target.log" >&2
