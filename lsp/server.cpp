@@ -27,7 +27,7 @@ void Server::notify(const std::string& method, json params) {
 }
 
 void Server::handle(const json& m) {
-    if (!m.is_object() || m.value("jsonrpc", "") != "2.0" ||
+    if (!m.is_object() || !m.contains("jsonrpc") || m["jsonrpc"] != "2.0" ||
         (m.contains("method") && !m["method"].is_string()) ||
         (m.contains("id") && !m["id"].is_number_integer() && !m["id"].is_string() && !m["id"].is_null())) {
         json id = m.is_object() && m.contains("id") && (m["id"].is_number_integer() || m["id"].is_string()) ? m["id"] : json();

@@ -243,6 +243,10 @@ TEST_CASE("protocol: errors for requests before initialize, unknown methods, bad
     REQUIRE(s.out.size() == 1);
     CHECK(s.out[0]["error"]["code"] == error::kInvalidRequest);
     s.out.clear();
+    s.server.handle({{"jsonrpc", 2}, {"id", 9}, {"method", "initialize"}});  // not the string "2.0"
+    REQUIRE(s.out.size() == 1);
+    CHECK(s.out[0]["error"]["code"] == error::kInvalidRequest);
+    s.out.clear();
     s.server.handle({{"jsonrpc", "2.0"}, {"method", "$/unknownNotification"}});
     CHECK(s.out.empty());  // an unknown notification is ignored
     CHECK(s.request(7, "shutdown")["result"].is_null());
