@@ -135,7 +135,15 @@ int findBuiltinConstant(std::string_view name) {
     return -1;
 }
 
-bool isBuiltinVariable(std::string_view name) { return name == "age" || name == "time" || name == "dt"; }
+constexpr std::string_view kVariables[] = {"age", "time", "dt"};
+
+std::span<const std::string_view> builtinVariables() { return kVariables; }
+
+bool isBuiltinVariable(std::string_view name) {
+    for (std::string_view v : kVariables)
+        if (v == name) return true;
+    return false;
+}
 
 std::span<const std::string_view> integratorNames() { return core::kIntegratorNames; }
 

@@ -54,6 +54,7 @@ std::span<const BuiltinConstant> builtinConstants();
 int findBuiltinConstant(std::string_view name);  // -1 when none
 
 // `age`, `time`, `dt`: names that always mean the same thing inside an object.
+std::span<const std::string_view> builtinVariables();
 bool isBuiltinVariable(std::string_view name);
 
 // The attributes of objects and files: `@integrator(rk4)`, `@step(1/240)`, `@capacity(N)`.

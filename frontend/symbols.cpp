@@ -144,7 +144,7 @@ std::vector<std::string> Checker::namesInScope(const Context& ctx) const {
         auto it = objectScopes_.find(ctx.object);
         if (it != objectScopes_.end())
             for (auto& [n, _] : it->second.names) names.push_back(n);
-        names.insert(names.end(), {"age", "time", "dt"});
+        for (std::string_view v : builtinVariables()) names.emplace_back(v);
     }
     if (ctx.fn) {
         for (auto& p : ctx.fn->params) names.push_back(p.name);

@@ -29,7 +29,8 @@ std::vector<Name> builtinNames() {
         names.push_back({std::string(f.name), std::string(f.signature), "built-in function", CompletionKind::Function});
     for (const BuiltinConstant& c : builtinConstants())
         names.push_back({std::string(c.name), c.type.str(), "built-in constant", CompletionKind::Constant});
-    for (const char* v : {"age", "time", "dt"}) names.push_back({v, "float", "built-in variable", CompletionKind::Variable});
+    for (std::string_view v : builtinVariables())
+        names.push_back({std::string(v), "float", "built-in variable", CompletionKind::Variable});
     for (std::string_view t : Type::names()) names.push_back({std::string(t), "type", "", CompletionKind::TypeParameter});
     return names;
 }
@@ -54,7 +55,7 @@ nlohmann::json vocabulary() {
     for (const BuiltinFunction& f : builtinFunctions()) v["functions"].push_back(std::string(f.name));
     v["constants"] = nlohmann::json::array();
     for (const BuiltinConstant& c : builtinConstants()) v["constants"].push_back(std::string(c.name));
-    v["variables"] = {"age", "time", "dt"};
+    v["variables"] = list(builtinVariables());
     v["types"] = list(Type::names());
     v["attributes"] = nlohmann::json::array();
     for (const BuiltinAttribute& a : builtinAttributes()) v["attributes"].push_back(std::string(a.name));
