@@ -1,6 +1,7 @@
 #include "codegen_llvm/jit_engine.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <optional>
 #include <stdexcept>
 #include <thread>
@@ -18,6 +19,8 @@
 #include <llvm/Support/TargetSelect.h>
 #include <llvm/Target/TargetMachine.h>
 #include <llvm/TargetParser/Host.h>
+
+#include "codegen_llvm/perf_map.h"
 
 namespace psys::codegen_llvm {
 
@@ -153,6 +156,10 @@ JitEngine::JitEngine(MathMode mode) : impl_(std::make_unique<Impl>()) {
                    .create();
     if (!jit) throw std::runtime_error(llvm::toString(jit.takeError()));
     impl_->jit = std::move(*jit);
+    if (perfMapRequested()) {
+        std::string error;
+        if (!addPerfMap(*impl_->jit, error)) std::fprintf(stderr, "psys: PSYS_PERF_MAP: %s\n", error.c_str());
+    }
     impl_->jit->getIRTransformLayer().setTransform(
         [impl = impl_.get()](llvm::orc::ThreadSafeModule module, llvm::orc::MaterializationResponsibility&)
             -> llvm::Expected<llvm::orc::ThreadSafeModule> {

@@ -4,6 +4,10 @@
 #include <doctest/doctest.h>
 
 #include <cstring>
+#include <cstdlib>
+#include <map>
+
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -91,4 +95,51 @@ TEST_CASE("the number of threads never changes a result") {
         if (reference.empty()) reference = out;
         CHECK(out == reference);
     }
+}
+
+TEST_CASE("with PSYS_PERF_MAP set, every compiled function and its loop are named in perf's map") {
+    std::string path = "/tmp/perf-" + std::to_string(::getpid()) + ".map";
+    std::filesystem::remove(path);
+    ::setenv("PSYS_PERF_MAP", "1", 1);
+    {
+        codegen_llvm::LlvmBackend jit;
+        rt::System system(compile(sample("fountain")), jit);
+        system.step(1.0 / 60);
+    }
+    ::unsetenv("PSYS_PERF_MAP");
+    std::ifstream in(path);
+    REQUIRE(in);
+    std::map<std::string, std::pair<uint64_t, uint64_t>> functions;
+    std::string line;
+    while (std::getline(in, line)) {
+        std::istringstream fields(line);
+        std::string start, size, name;
+        fields >> start >> size >> name;
+        INFO(line);
+        REQUIRE(!name.empty());
+        functions[name] = {std::stoull(start, nullptr, 16), std::stoull(size, nullptr, 16)};
+    }
+    std::filesystem::remove(path);
+    REQUIRE(functions.count("drop.update.1"));
+    REQUIRE(functions.count("drop.update.1.loop"));
+    CHECK(functions["drop.update.1.loop"].second > functions["drop.update.1"].second);  // the loop is the work
+    // No two functions overlap.
+    uint64_t end = 0;
+    std::map<uint64_t, uint64_t> byStart;
+    for (auto& [name, range] : functions) byStart[range.first] = range.second;
+    for (auto& [start, size] : byStart) {
+        CHECK(start >= end);
+        CHECK(size > 0);
+        end = start + size;
+    }
+}
+
+TEST_CASE("without PSYS_PERF_MAP no map is written") {
+    std::string path = "/tmp/perf-" + std::to_string(::getpid()) + ".map";
+    std::filesystem::remove(path);
+    ::unsetenv("PSYS_PERF_MAP");
+    codegen_llvm::LlvmBackend jit;
+    rt::System system(compile(sample("fountain")), jit);
+    system.step(1.0 / 60);
+    CHECK_FALSE(std::filesystem::exists(path));
 }
