@@ -1,5 +1,7 @@
 #include "codegen_llvm/kernel_functions.h"
 
+#include <array>
+
 #include <map>
 #include <stdexcept>
 
@@ -99,6 +101,8 @@ public:
         }
         for (const auto& p : layout.parentColumns)
             for (int l = 0; l < p.width; ++l) use(p.offset + l);
+        if (kernel.kind == KernelKind::Render)  // it marks what it draws (markDrawn): every render column
+            for (int c = 0; c < ColumnLayout::kRenderColumns; ++c) use(layout.render + c);
         for (const Yield& y : kernel.yields) {
             int width = kernel.at(y.value).type.width;
             auto lanes = [&](int first) { for (int l = 0; l < width; ++l) use(first + l); };
@@ -257,6 +261,7 @@ private:
         };
         llvm::Value* killed = killedSoFar;
         llvm::Value* unstable = unstableSoFar;
+        std::array<llvm::Value*, ColumnLayout::kRenderColumns> render{};  // the render values, by render column
         for (const Yield& y : kernel.yields) {
             Type t = kernel.at(y.value).type;
             const Lanes& v = values[y.value];
@@ -285,15 +290,43 @@ private:
                     break;
                 }
                 case YieldKind::Visible: case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:
-                    for (int l = 0; l < t.width; ++l)
-                        b_.CreateAlignedStore(toFloat(v[static_cast<size_t>(l)], t),
-                                              columnAt(argOf, layout.render + ColumnLayout::renderColumn(y.kind) + l, f32),
-                                              llvm::Align(4));
+                    for (int l = 0; l < t.width; ++l) {
+                        int column = ColumnLayout::renderColumn(y.kind) + l;
+                        render[column] = toFloat(v[static_cast<size_t>(l)], t);
+                        b_.CreateAlignedStore(render[column], columnAt(argOf, layout.render + column, f32), llvm::Align(4));
+                    }
                     break;
                 default: break;
             }
         }
+        if (kernel.kind == KernelKind::Render) return markDrawn(layout, argOf, mask, render, killed, unstable);
         return {killed, unstable};
+    }
+
+    // A render loop marks its rows drawn itself (Backend::marksDrawn; the rule of
+    // rt/system_draw.cpp): visible = 1 where the row is in the mask, its point visible and
+    // its position, colour and size all finite, else 0. Returns the counts so far of rows
+    // drawn and of rows visible but not drawn for a NaN or an infinity.
+    std::pair<llvm::Value*, llvm::Value*> markDrawn(const ColumnLayout& layout, const std::map<int, unsigned>& argOf,
+                                                    llvm::Value* mask, std::array<llvm::Value*, ColumnLayout::kRenderColumns>& render,
+                                                    llvm::Value* drawnSoFar, llvm::Value* nonFiniteSoFar) {
+        llvm::Type* f32 = b_.getFloatTy();
+        for (int column = 0; column < ColumnLayout::kRenderColumns; ++column)
+            if (!render[column])
+                render[column] = b_.CreateAlignedLoad(f32, columnAt(argOf, layout.render + column, f32), llvm::Align(4));
+        llvm::Value* finite = b_.getTrue();
+        llvm::Value* infinity = llvm::ConstantFP::getInfinity(f32);
+        for (int column = ColumnLayout::kPosition; column < ColumnLayout::kRenderColumns; ++column) {
+            llvm::Value* magnitude = b_.CreateUnaryIntrinsic(llvm::Intrinsic::fabs, render[column]);
+            finite = b_.CreateAnd(finite, b_.CreateFCmpONE(magnitude, infinity));  // false for NaN too
+        }
+        llvm::Value* shown = b_.CreateAnd(mask, b_.CreateFCmpUNE(render[ColumnLayout::kVisible], llvm::ConstantFP::get(f32, 0.0)));
+        llvm::Value* drawn = b_.CreateAnd(shown, finite);
+        b_.CreateAlignedStore(b_.CreateUIToFP(drawn, f32), columnAt(argOf, layout.render + ColumnLayout::kVisible, f32),
+                              llvm::Align(4));
+        llvm::Type* i64 = b_.getInt64Ty();
+        return {b_.CreateAdd(drawnSoFar, b_.CreateZExt(drawn, i64)),
+                b_.CreateAdd(nonFiniteSoFar, b_.CreateZExt(b_.CreateAnd(shown, b_.CreateNot(finite)), i64))};
     }
 
     llvm::Function* loop_ = nullptr;

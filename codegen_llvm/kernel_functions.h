@@ -18,11 +18,12 @@ namespace psys::codegen_llvm {
 //                const Value* externs, const Value* uniforms, double now, float dt,
 //                uint32_t first, uint32_t seed, uint32_t draw)
 // `columns`: host addresses by layout position. Returns the rows it killed and the rows
-// it found beyond the integration method's stability limit (an LLVM {i64, i64}: two
-// registers, as the C ABI returns this struct).
+// it found beyond the integration method's stability limit — for a render kernel, which
+// marks its rows drawn itself, the rows drawn and the rows visible but not finite (an
+// LLVM {i64, i64}: two registers, as the C ABI returns this struct).
 struct RowCounts {
-    int64_t killed;
-    int64_t unstable;
+    int64_t killed;    // render: drawn
+    int64_t unstable;  // render: not drawn for a NaN or an infinity
 };
 using RowsFn = RowCounts (*)(void* const*, const uint8_t*, int64_t, int64_t, const rt::Value*, const rt::Value*, double,
                              float, uint32_t, uint32_t, uint32_t);

@@ -164,6 +164,12 @@ rt::RowsResult LlvmBackend::run(const rt::RowsLaunch& l) {
     const auto* mask = static_cast<const uint8_t*>(impl_->memory.host(l.mask));
     RowCounts counts = fn(columns.data(), mask, static_cast<int64_t>(l.begin), static_cast<int64_t>(l.end), l.externs,
                           l.uniforms, l.clock.nowValue, l.clock.dtValue, l.clock.first ? 1u : 0u, l.seed, l.draw);
+    if (l.kernel->kind == ir::KernelKind::Render) {  // a render loop counts what it drew instead (marksDrawn)
+        rt::RowsResult drawn;
+        drawn.drawn = static_cast<size_t>(counts.killed);
+        drawn.nonFinite = static_cast<size_t>(counts.unstable);
+        return drawn;
+    }
     return {static_cast<size_t>(counts.killed), static_cast<size_t>(counts.unstable)};
 }
 

@@ -33,6 +33,7 @@ public:
     rt::RowsResult run(const rt::RowsLaunch& launch) override;
     void run(const rt::ChildrenLaunch& launch) override;
     bool concurrent() const override { return true; }
+    bool marksDrawn() const override { return true; }  // render loops mark and count what they draw
     rt::BackendReport report() const override;
 
 private:

@@ -35,12 +35,46 @@ void ValueColumns::set(Memory& memory, size_t i, size_t row, const ir::Value& v)
         memory.write(column(i, static_cast<size_t>(c)), row, 1, &v.f[static_cast<size_t>(c)]);
 }
 
+void SyncedMask::create(Memory& memory) {
+    column = memory.create(Elem::U8, 0);
+    staging_ = memory.create(Elem::U8, 0);
+}
+
+void SyncedMask::release(Memory& memory) {
+    memory.release(column);
+    memory.release(staging_);
+}
+
+void SyncedMask::grow(Memory& memory, size_t rows) {
+    host_.resize(rows, 0);
+    memory.resize(column, rows);
+}
+
+void SyncedMask::sync(Memory& memory) {
+    if (changed_.empty()) return;
+    // A row changed twice is listed twice, with its one current value: the order of the
+    // scatter's writes does not matter.
+    std::vector<uint8_t> values(changed_.size());
+    for (size_t i = 0; i < changed_.size(); ++i) values[i] = host_[changed_[i]];
+    if (memory.rows(staging_) < values.size()) memory.resize(staging_, values.size());
+    memory.write(staging_, 0, values.size(), values.data());
+    memory.scatter(staging_, 0, column, changed_);
+    changed_.clear();
+}
+
+void SyncedMask::restore(Memory& memory, std::vector<uint8_t> values) {
+    values.resize(host_.size(), 0);
+    host_ = std::move(values);
+    changed_.clear();
+    memory.write(column, 0, host_.size(), host_.data());
+}
+
 Pool::Pool(const ir::Object& object, size_t capacity, Memory& memory)
     : object_(&object), capacity_(capacity), memory_(&memory) {
     created = memory.create(Elem::F64, 0);
     ids = memory.create(Elem::U32, 0);
-    updatable = memory.create(Elem::U8, 0);
-    maskStaging_ = memory.create(Elem::U8, 0);
+    updatable.create(memory);
+    alive.create(memory);
     std::vector<ir::Type> types;
     for (auto& s : object.state) types.push_back(s.type);
     state.define(memory, types, 0);
@@ -62,20 +96,19 @@ size_t Pool::rowBytes(const ir::Object& object) {
     for (auto& p : object.params)
         if (p.kept) floats += static_cast<size_t>(p.type.width);
     for (auto& e : object.exports) floats += static_cast<size_t>(e.type.width);
-    size_t columns = sizeof(double) + sizeof(uint32_t) + 1 + 4 * floats;  // created, id, updatable, values
-    size_t host = sizeof(Status) + sizeof(uint32_t) + sizeof(Handle) + sizeof(uint32_t) + sizeof(double) + 1 +
-                  sizeof(double) * object.emits.size();  // status, generation, parent, readers, diedAt, mask, emitted
+    size_t columns = sizeof(double) + sizeof(uint32_t) + 2 + 4 * floats;  // created, id, updatable, alive, values
+    size_t host = sizeof(Status) + sizeof(uint32_t) + sizeof(Handle) + sizeof(uint32_t) + sizeof(double) + 2 +
+                  sizeof(double) * object.emits.size();  // status, generation, parent, readers, diedAt, masks, emitted
     return columns + host;
 }
 
 Pool::Pool(Pool&& other) noexcept
-    : created(other.created), ids(other.ids), updatable(other.updatable), state(std::move(other.state)),
+    : created(other.created), ids(other.ids), updatable(std::move(other.updatable)), alive(std::move(other.alive)), state(std::move(other.state)),
       params(std::move(other.params)), exports(std::move(other.exports)), paramColumn(std::move(other.paramColumn)),
       parent(std::move(other.parent)), readers(std::move(other.readers)), fresh(std::move(other.fresh)),
       emitted(std::move(other.emitted)), object_(other.object_), capacity_(other.capacity_), memory_(other.memory_),
       status_(std::move(other.status_)), generation_(std::move(other.generation_)),
-      freeRows_(std::move(other.freeRows_)), live_(other.live_), frozen_(other.frozen_), mask_(std::move(other.mask_)),
-      maskRows_(std::move(other.maskRows_)), maskStaging_(other.maskStaging_) {
+      freeRows_(std::move(other.freeRows_)), live_(other.live_), frozen_(other.frozen_) {
     other.memory_ = nullptr;
 }
 
@@ -83,8 +116,8 @@ Pool::~Pool() {
     if (!memory_) return;  // moved from
     memory_->release(created);
     memory_->release(ids);
-    memory_->release(updatable);
-    memory_->release(maskStaging_);
+    updatable.release(*memory_);
+    alive.release(*memory_);
     state.release(*memory_);
     params.release(*memory_);
     exports.release(*memory_);
@@ -97,8 +130,9 @@ void Pool::grow(size_t n) {
     readers.resize(n, 0);
     diedAt.resize(n, 0);
     for (auto& e : emitted) e.resize(n, 0);
-    for (Buffer b : {created, ids, updatable}) memory_->resize(b, n);
-    mask_.resize(n, 0);
+    for (Buffer b : {created, ids}) memory_->resize(b, n);
+    updatable.grow(*memory_, n);
+    alive.grow(*memory_, n);
     state.resize(*memory_, n);
     params.resize(*memory_, n);
     exports.resize(*memory_, n);
@@ -115,7 +149,8 @@ std::optional<uint32_t> Pool::allocate() {
         grow(rows() + 1);
     }
     status_[row] = Status::Alive;
-    setMask(row, 0);
+    updatable.set(row, 0);
+    alive.set(row, 1);
     fresh.push_back(row);
     ++live_;
     readers[row] = 0;
@@ -128,7 +163,8 @@ void Pool::freeze(uint32_t row, double at) {
     if (status_[row] != Status::Alive) return;
     status_[row] = Status::Frozen;
     diedAt[row] = at;
-    setMask(row, 0);
+    updatable.set(row, 0);
+    alive.set(row, 0);
     --live_;
     ++frozen_;
 }
@@ -138,41 +174,24 @@ void Pool::release(uint32_t row) {
     else if (status_[row] == Status::Frozen) --frozen_;
     else return;
     status_[row] = Status::Free;
-    setMask(row, 0);
+    updatable.set(row, 0);
+    alive.set(row, 0);
     ++generation_[row];
     freeRows_.push_back(row);
 }
 
 void Pool::beginStep() {
     for (uint32_t row : fresh)
-        if (status_[row] == Status::Alive) setMask(row, 1);
+        if (status_[row] == Status::Alive) updatable.set(row, 1);
     fresh.clear();
 }
 
-void Pool::setMask(uint32_t row, uint8_t value) {
-    if (mask_[row] == value) return;
-    mask_[row] = value;
-    maskRows_.push_back(row);
+void Pool::syncMasks() {
+    updatable.sync(*memory_);
+    alive.sync(*memory_);
 }
 
-void Pool::syncMask() {
-    if (maskRows_.empty()) return;
-    // A row changed twice is listed twice, with its one current value: the order of the
-    // scatter's writes does not matter.
-    std::vector<uint8_t> values(maskRows_.size());
-    for (size_t i = 0; i < maskRows_.size(); ++i) values[i] = mask_[maskRows_[i]];
-    if (memory_->rows(maskStaging_) < values.size()) memory_->resize(maskStaging_, values.size());
-    memory_->write(maskStaging_, 0, values.size(), values.data());
-    memory_->scatter(maskStaging_, 0, updatable, maskRows_);
-    maskRows_.clear();
-}
-
-void Pool::restoreMask(std::vector<uint8_t> mask) {
-    mask.resize(rows(), 0);
-    mask_ = std::move(mask);
-    maskRows_.clear();
-    memory_->write(updatable, 0, mask_.size(), mask_.data());
-}
+void Pool::restoreMask(std::vector<uint8_t> mask) { updatable.restore(*memory_, std::move(mask)); }
 
 void Pool::restore(std::vector<Status> status, std::vector<uint32_t> generation, std::vector<uint32_t> freeRows) {
     grow(status.size());
@@ -180,10 +199,13 @@ void Pool::restore(std::vector<Status> status, std::vector<uint32_t> generation,
     generation_ = std::move(generation);
     freeRows_ = std::move(freeRows);
     live_ = frozen_ = 0;
-    for (Status s : status_) {
-        live_ += s == Status::Alive;
-        frozen_ += s == Status::Frozen;
+    std::vector<uint8_t> isAlive(status_.size());
+    for (size_t row = 0; row < status_.size(); ++row) {
+        live_ += status_[row] == Status::Alive;
+        frozen_ += status_[row] == Status::Frozen;
+        isAlive[row] = status_[row] == Status::Alive;
     }
+    alive.restore(*memory_, std::move(isAlive));
 }
 
 }  // namespace psys::rt

@@ -28,6 +28,30 @@ struct Handle {
 
 enum class Status : uint8_t { Free, Alive, Frozen };
 
+// A u8 column the host keeps and changes row by row, and a backend reads whole: the host's
+// copy is the truth, and the rows changed since the last sync reach the column as one
+// scatter (so the column may live on a device and a step moves only what changed).
+class SyncedMask {
+public:
+    void create(Memory& memory);
+    void release(Memory& memory);
+    void grow(Memory& memory, size_t rows);
+    void set(uint32_t row, uint8_t value) {
+        if (host_[row] == value) return;
+        host_[row] = value;
+        changed_.push_back(row);
+    }
+    const uint8_t* host() const { return host_.data(); }
+    void sync(Memory& memory);
+    void restore(Memory& memory, std::vector<uint8_t> values);  // every row at once
+    Buffer column;
+
+private:
+    std::vector<uint8_t> host_;
+    std::vector<uint32_t> changed_;  // rows changed since the last sync
+    Buffer staging_;                 // their values, for the scatter
+};
+
 // Typed values as component columns: value i's component c is column(i, c).
 class ValueColumns {
 public:
@@ -73,13 +97,13 @@ public:
 
     // Columns in the backend's memory.
     Buffer created, ids;             // f64, u32
-    Buffer updatable;                // u8: 1 for rows a step updates (alive, not created during it)
-    // `updatable` as the host keeps it: the host reads this, and the rows it changes reach
-    // the column (a scatter of those rows, so the column may live on a device) when
-    // syncMask is called, before a launch over the pool.
-    const uint8_t* mask() const { return mask_.data(); }
-    void syncMask();
-    void restoreMask(std::vector<uint8_t> mask);  // hot reload: the whole mask
+    // u8 masks, kept by the host and synced (syncMasks) before a launch over the pool:
+    // `updatable`, the rows a step updates (alive, not created during it); `alive`, the
+    // rows alive (what is drawn is among them).
+    SyncedMask updatable, alive;
+    const uint8_t* mask() const { return updatable.host(); }
+    void syncMasks();
+    void restoreMask(std::vector<uint8_t> mask);  // hot reload: the whole update mask
     ValueColumns state, params, exports;  // params: only the kept ones
     std::vector<int> paramColumn;    // per parameter: its value in `params`, or -1
 
@@ -113,10 +137,6 @@ private:
     std::vector<uint32_t> generation_;
     std::vector<uint32_t> freeRows_;
     size_t live_ = 0, frozen_ = 0;
-    std::vector<uint8_t> mask_;
-    std::vector<uint32_t> maskRows_;  // rows changed since the last syncMask
-    Buffer maskStaging_;              // their values, for the scatter
-    void setMask(uint32_t row, uint8_t value);
 };
 
 }  // namespace psys::rt

@@ -38,19 +38,19 @@ const DrawColumns& Drawing::draw(size_t type) {
     for (int c = 0; c < 3; ++c) out.position[c] = column(ColumnLayout::kPosition + c);
     for (int c = 0; c < 4; ++c) out.color[c] = column(ColumnLayout::kColor + c);
     out.size = column(ColumnLayout::kSize);
-    Buffer alive = d.scratch.at(static_cast<size_t>(layout.total), Elem::U8, rows);
+    // The rows drawn are among the alive ones: the pool keeps that mask (synced by bindPool).
     RowsLaunch launch;
     launch.object = &pool.object();
     launch.kernel = info.render;
     launch.layout = &layout;
     launch.columns = d.table;
-    launch.mask = alive;
+    launch.mask = pool.alive.column;
     launch.clock = {Clock::Source::Uniform, Clock::Source::Uniform, s_.now, static_cast<float>(s_.lastDt), false};
     launch.externs = s_.externs.data();
     launch.uniforms = s_.uniforms(type, *info.render, static_cast<float>(s_.lastDt), static_cast<float>(s_.now));
     launch.seed = s_.options.seed;
     launch.draw = static_cast<uint32_t>(s_.step);
-    auto* mask = s_.host<uint8_t>(alive);
+    const uint8_t* mask = pool.alive.host();
     // The rows drawn: marked by the render launch itself on a backend that does so (its
     // render columns stay where it computed them), else here.
     const bool marked = s_.backend.marksDrawn();
@@ -65,8 +65,6 @@ const DrawColumns& Drawing::draw(size_t type) {
         RowsLaunch part = launch;
         part.begin = c * kRowsPerChunk;
         part.end = std::min(rows, part.begin + kRowsPerChunk);
-        for (size_t row = part.begin; row < part.end; ++row)
-            mask[row] = pool.status(static_cast<uint32_t>(row)) == Status::Alive;
         s_.gatherParents(type, layout, d.table, mask, part.begin, part.end, s_.now);
         RowsResult result = s_.backend.run(part);
         size_t chunkDrawn = result.drawn;

@@ -102,7 +102,7 @@ int printStats(const std::string& file, std::optional<core::Integrator> everyObj
     std::cout << "(ops/update: scalar operations per object per frame, without the optimizer / optimized / optimized "
                  "with --relaxed-math; tree ops: the same expressions evaluated as trees, nothing shared; uniform ops: "
                  "per type per step; row bytes: one object's row in its pool, optimized — kept state, kept parameters, "
-                 "exports, creation time, id, update mask and the run-time's bookkeeping)\n";
+                 "exports, creation time, id, update and alive masks and the run-time's bookkeeping)\n";
     printByMethod(file, objects, own);
     return 0;
 }
