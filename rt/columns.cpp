@@ -23,6 +23,13 @@ ColumnLayout columnLayout(const ir::Object& object, const ir::Kernel& kernel) {
     l.render = next;
     next += ColumnLayout::kRenderColumns;
     l.parents = next;
+    l.writes.assign(static_cast<size_t>(l.parents - l.emits), false);
+    for (const ir::Yield& y : kernel.yields) {
+        if (y.kind == ir::YieldKind::EmitRate) l.writes[static_cast<size_t>(l.emitRate(y.index) - l.emits)] = true;
+        if (y.kind == ir::YieldKind::EmitCount) l.writes[static_cast<size_t>(l.emitCount(y.index) - l.emits)] = true;
+    }
+    if (kernel.kind == ir::KernelKind::Render)  // writes every render column (visible: drawn or not)
+        for (int c = 0; c < ColumnLayout::kRenderColumns; ++c) l.writes[static_cast<size_t>(l.render - l.emits + c)] = true;
     for (const ir::Inst& i : kernel.insts()) {
         if (!ir::readsAncestor(i.op)) continue;
         l.parentColumns.push_back({i.op, i.attr2, i.op == ir::Op::ParentExport ? i.attr : -1, i.type.width, next});

@@ -36,6 +36,10 @@ struct ColumnLayout {
         int offset;       // its first column
     };
     std::vector<ParentColumn> parentColumns;  // in the kernel's instruction order
+    // Per emit and render column: whether the kernel writes it. A table gives scratch
+    // columns only to these (and the parents'): a pool's update needs no render columns.
+    std::vector<bool> writes;
+    bool needs(int column) const { return column >= parents || writes[static_cast<size_t>(column - emits)]; }
 
     int emitRate(int site) const { return emits + 2 * site; }
     int emitCount(int site) const { return emits + 2 * site + 1; }

@@ -195,7 +195,7 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
 
 void State::bindPool(size_t type, const ColumnLayout& layout, Scratch& scratch, std::vector<Buffer>& table) {
     Pool& pool = pools[type];
-    pool.syncMask();
+    pool.syncMasks();
     const ir::Object& o = pool.object();
     size_t rows = pool.rows();
     table.assign(static_cast<size_t>(layout.total), Buffer{});
@@ -214,7 +214,8 @@ void State::bindPool(size_t type, const ColumnLayout& layout, Scratch& scratch, 
         for (int c = 0; c < o.exports[e].type.width; ++c)
             table[static_cast<size_t>(layout.exportOffset[e] + c)] = pool.exports.column(e, static_cast<size_t>(c));
     for (int column = layout.emits; column < layout.total; ++column)
-        table[static_cast<size_t>(column)] = scratch.at(static_cast<size_t>(1 + column - layout.emits), Elem::F32, rows);
+        if (layout.needs(column))
+            table[static_cast<size_t>(column)] = scratch.at(static_cast<size_t>(1 + column - layout.emits), Elem::F32, rows);
 }
 
 void State::forChunks(size_t rows, const std::function<void(size_t)>& chunk) {

@@ -42,8 +42,9 @@ void killAndEmit(State& s, Creation& creation, size_t type, double dt, double t1
     std::vector<const float*> rates(o.emits.size()), counts(o.emits.size());
     for (size_t site = 0; site < o.emits.size(); ++site) {
         auto i = static_cast<int>(site);
-        rates[site] = s.view<float>(work.updateTable[static_cast<size_t>(info.updateLayout.emitRate(i))]);
-        counts[site] = s.view<float>(work.updateTable[static_cast<size_t>(info.updateLayout.emitCount(i))]);
+        if (info.rated[site]) rates[site] = s.view<float>(work.updateTable[static_cast<size_t>(info.updateLayout.emitRate(i))]);
+        if (info.counted[site])
+            counts[site] = s.view<float>(work.updateTable[static_cast<size_t>(info.updateLayout.emitCount(i))]);
     }
     for (uint32_t row = 0; row < pool.rows(); ++row) {
         if (!updatable[row]) continue;
@@ -77,7 +78,7 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1)
     update.kernel = info.update;
     update.layout = &info.updateLayout;
     update.columns = work.updateTable;
-    update.mask = pool.updatable;
+    update.mask = pool.updatable.column;
     update.clock = {Clock::Source::Uniform, Clock::Source::Uniform, t1, static_cast<float>(dt), false};
     update.externs = s.externs.data();
     update.uniforms = s.uniforms(type, *info.update, static_cast<float>(dt), static_cast<float>(t1));
