@@ -6,21 +6,48 @@
 #include <new>
 #include <stdexcept>
 
+#include <sys/mman.h>
+#include <unistd.h>
+
 namespace psys::rt {
 
 // One column: a 64-byte aligned array that grows by doubling, so that appending rows one
-// at a time costs amortized O(1).
+// at a time costs amortized O(1). A large column is its own anonymous mapping, grown with
+// mremap: the kernel moves its pages instead of copying them, pages past the rows in use
+// are never touched (so they take no memory), and no second copy exists while it grows —
+// a pool of 10M rows holds what its rows need, not twice that at its peak.
 struct HostMemory::Column {
+    static constexpr size_t kMapped = size_t{1} << 20;  // bytes from which a column is a mapping
+
     Elem elem;
     size_t rows = 0, capacity = 0;
     std::byte* data = nullptr;
+    size_t mappedBytes = 0;  // 0: data is from aligned_alloc
 
-    ~Column() { std::free(data); }
+    ~Column() {
+        if (mappedBytes) ::munmap(data, mappedBytes);
+        else std::free(data);
+    }
     size_t size() const { return elemSize(elem); }
     void reserve(size_t wanted) {
         if (wanted <= capacity) return;
         size_t grown = std::max(wanted, capacity * 2);
         size_t bytes = (grown * size() + 63) / 64 * 64;
+        if (bytes >= kMapped) {
+            const size_t page = static_cast<size_t>(::sysconf(_SC_PAGESIZE));
+            bytes = (bytes + page - 1) / page * page;
+            void* fresh = mappedBytes ? ::mremap(data, mappedBytes, bytes, MREMAP_MAYMOVE)
+                                      : ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+            if (fresh == MAP_FAILED) throw std::bad_alloc();
+            if (!mappedBytes) {
+                if (data) std::memcpy(fresh, data, rows * size());
+                std::free(data);
+            }
+            data = static_cast<std::byte*>(fresh);
+            mappedBytes = bytes;
+            capacity = bytes / size();
+            return;
+        }
         auto* fresh = static_cast<std::byte*>(std::aligned_alloc(64, std::max<size_t>(bytes, 64)));
         if (!fresh) throw std::bad_alloc();
         if (data) std::memcpy(fresh, data, rows * size());
