@@ -6,7 +6,8 @@
 // Each effect is run to its steady population (its extern scaled so that about N
 // particles are alive), then `--frames` steps are timed one by one; the figure is live
 // particles ÷ the median step time. A step is everything: updates, kills, emissions and
-// creations. Nothing is drawn.
+// creations. Drawing is timed apart, after as many more steps. `--memory` measures the
+// peak memory of each effect alone, in a process of its own, against its pools' rows.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -18,6 +19,10 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -96,6 +101,86 @@ std::vector<Rate> timeInterleaved(const std::vector<std::function<size_t()>>& st
     return rates;
 }
 
+// The resident memory of this process now, in bytes.
+double residentBytes() {
+    std::FILE* f = std::fopen("/proc/self/statm", "r");
+    long pages = 0, resident = 0;
+    if (f) {
+        if (std::fscanf(f, "%ld %ld", &pages, &resident) != 2) resident = 0;
+        std::fclose(f);
+    }
+    return static_cast<double>(resident) * static_cast<double>(sysconf(_SC_PAGESIZE));
+}
+
+// One effect at one size, alone in this (forked) process: the memory before the first
+// step (the program, LLVM, the compiled kernels: the fixed part), the peak after running
+// to the steady population and drawing every step, and what the pools' rows account for.
+std::string measureMemory(const Effect& effect, double particles, int frames) {
+    codegen_llvm::LlvmBackend jit;
+    double knob = bench::calibrate(effect, jit, particles);
+    rt::SystemOptions options;
+    options.capacity = static_cast<size_t>(particles * 1.5) + 1024;
+    rt::System system(bench::compileEffect(effect.name), jit, options);
+    float value = static_cast<float>(knob);
+    system.setExtern(effect.knob, {&value, 1});
+    auto type = static_cast<size_t>(system.typeIndex(effect.particles));
+    double fixed = residentBytes();
+    for (int f = 0; f < effect.warmFrames + frames; ++f) {
+        system.step(1.0 / 60);
+        system.draw(type);
+    }
+    struct rusage usage {};
+    getrusage(RUSAGE_SELF, &usage);
+    double peak = static_cast<double>(usage.ru_maxrss) * 1024;
+    double rows = 0, rowBytes = 0, capacityBytes = 0;
+    for (size_t t = 0; t < system.module().objects.size(); ++t) {
+        double bytes = static_cast<double>(rt::Pool::rowBytes(system.module().objects[t]));
+        rows += static_cast<double>(system.pool(t).rows()) * bytes;
+        capacityBytes += static_cast<double>(system.pool(t).capacity()) * bytes;
+        if (t == type) rowBytes = bytes;
+    }
+    double live = static_cast<double>(system.pool(type).live());
+    return fmt::format("| {} | {:.2g} | {:.0f} | {:.0f} | {:.0f} | {:.0f} | {:.0f} | {:.2f} | {:.2f} |\n", effect.name, live,
+                       rowBytes, capacityBytes / 1e6, rows / 1e6, fixed / 1e6, peak / 1e6, (peak - fixed) / capacityBytes,
+                       (peak - fixed) / live);
+}
+
+// Each measurement in a child process of its own (forked before this process starts any
+// thread), so that one's peak is not another's.
+int memoryTable(const std::vector<std::string>& effects, const std::vector<double>& sizes, int frames) {
+    std::cout << "| effect | live | row bytes | capacity × row bytes (MB) | rows used × row bytes (MB) | fixed (MB) | "
+                 "peak RSS (MB) | (peak − fixed) / (capacity × row bytes) | (peak − fixed) / live (B) |\n"
+                 "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    std::cout.flush();
+    for (const std::string& name : effects)
+        for (double particles : sizes) {
+            const Effect* effect = bench::findEffect(name);
+            if (!effect) return 2;
+            int pipe[2];
+            if (::pipe(pipe) != 0) return 1;
+            pid_t child = fork();
+            if (child == 0) {
+                ::close(pipe[0]);
+                std::string line = measureMemory(*effect, particles, frames);
+                if (::write(pipe[1], line.data(), line.size()) < 0) _exit(1);
+                _exit(0);
+            }
+            ::close(pipe[1]);
+            std::string line;
+            char buffer[512];
+            ssize_t n;
+            while ((n = ::read(pipe[0], buffer, sizeof buffer)) > 0) line.append(buffer, static_cast<size_t>(n));
+            ::close(pipe[0]);
+            int status = 0;
+            waitpid(child, &status, 0);
+            std::cout << line;
+            std::cout.flush();
+        }
+    std::cout << "\n(row bytes: rt::Pool::rowBytes of the particles' type, as psysc --stats prints; fixed: the process "
+                 "before the first step; peak: getrusage's maximum resident set, with the system drawn every step)\n";
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -107,6 +192,7 @@ int main(int argc, char** argv) {
     size_t triadElements = size_t{1} << 26;
     bool skipCompile = false;
     bool gpuToo = false;
+    bool memory = false;
     int compileRuns = 5;
     app.add_option("--particles", sizes, "Live particles per effect (1e6 1e7)");
     app.add_option("--frames", frames, "Timed steps per measurement; the median counts (15)")->check(CLI::Range(5, 100000));
@@ -115,8 +201,10 @@ int main(int argc, char** argv) {
     app.add_option("--triad-elements", triadElements, "Floats per STREAM array (2^26)");
     app.add_flag("--skip-compile", skipCompile, "Leave out the compile times");
     app.add_flag("--gpu", gpuToo, "Also run the GLSL backend on each effect and size, beside the JIT");
+    app.add_flag("--memory", memory, "Only the peak memory of each effect and size, each in a process of its own");
     app.add_option("--compile-runs", compileRuns, "Compiles per sample; the median counts (5)")->check(CLI::PositiveNumber);
     CLI11_PARSE(app, argc, argv);
+    if (memory) return memoryTable(effects, sizes, frames);
 
     unsigned cores = std::max(1u, std::thread::hardware_concurrency());
     codegen_llvm::LlvmBackend jit;
@@ -176,10 +264,26 @@ int main(int argc, char** argv) {
                 Rate j = rates[0], s = rates[1], a = rates[2];
                 if (threads == cores) jitAllCores[{name, particles}] = j;
                 double steps = static_cast<double>(after.steps - before.steps);
-                breakdown += fmt::format("| {} | {:.2g} | {} | {:.2f} | {:.2f} | {:.2f} | {:.2g} / {:.2g} |\n", name, j.live,
-                                         threads, (after.loopSeconds - before.loopSeconds) * 1e3 / steps,
-                                         (after.emitSeconds - before.emitSeconds) * 1e3 / steps,
-                                         (after.createSeconds - before.createSeconds) * 1e3 / steps, s.live, a.live);
+                double created = 0;
+                for (size_t t = 0; t < after.types.size(); ++t)
+                    created += static_cast<double>(after.types[t].created - before.types[t].created);
+                // Drawing, apart from the step (the hand-written code draws nothing): what a
+                // viewer or --dump consumes after each step, the render columns marked.
+                rt::Stats drawBefore = system.stats();
+                for (int f = 0; f < frames; ++f) {
+                    system.step(1.0 / 60);
+                    system.draw(type);
+                }
+                rt::Stats drawAfter = system.stats();
+                double stepMs = 1e3 * j.live / j.perSecond;
+                double drawMs = (drawAfter.drawSeconds - drawBefore.drawSeconds) * 1e3 / frames;
+                breakdown += fmt::format(
+                    "| {} | {:.2g} | {} | {:.2f} | {:.2f} | {:.2f} | {:.0f} | {:.2f} | {:.0f}% | {:.2g} / {:.2g} |\n", name,
+                    j.live, threads, (after.loopSeconds - before.loopSeconds) * 1e3 / steps,
+                    (after.emitSeconds - before.emitSeconds) * 1e3 / steps,
+                    (after.createSeconds - before.createSeconds) * 1e3 / steps,
+                    created > 0 ? (after.createSeconds - before.createSeconds) * 1e9 / created : 0.0, drawMs,
+                    100 * drawMs / stepMs, s.live, a.live);
                 double bound = (threads == 1 ? bandwidth1 : bandwidthAll) / bytes;
                 std::cout << fmt::format("| {} | {:.2g} | {} | {:.0f} | {:.0f} | {:.0f} | {:.2f} | {:.2f} | {:.0f} | {:.0f}% |\n",
                                          name, j.live, threads, j.perSecond / 1e6, s.perSecond / 1e6,
@@ -191,9 +295,10 @@ int main(int argc, char** argv) {
     }
     std::cout << "\n(million particle updates per second; bound: triad bandwidth ÷ the bytes psys's update loop "
                  "must move per particle (state read and written, kept parameters read))\n\n";
-    std::cout << "Where psys's steps went (ms per step), and the hand-written populations:\n\n"
-                 "| effect | live | threads | update loops | kills and emissions | creation | live SoA / AoS |\n"
-                 "|---|---:|---:|---:|---:|---:|---:|\n"
+    std::cout << "Where psys's steps went (ms per step; drawing timed apart, after each of as many more steps), and the hand-written populations:\n\n"
+                 "| effect | live | threads | update loops | kills and emissions | creation | creation (ns/object) | "
+                 "drawing | drawing / step | live SoA / AoS |\n"
+                 "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n"
               << breakdown << "\n";
 
     if (gpuToo) {
