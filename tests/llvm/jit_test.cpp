@@ -143,3 +143,25 @@ TEST_CASE("without PSYS_PERF_MAP no map is written") {
     system.step(1.0 / 60);
     CHECK_FALSE(std::filesystem::exists(path));
 }
+
+TEST_CASE("the JIT's render loops mark what is drawn as the run-time's rule says: visible, every value finite") {
+    // k = 0: a NaN position; 1: drawn; 2: an infinite size; 3: a NaN colour; 4: not visible.
+    const char* text =
+        "object a(k: float) {\n"
+        "    when k != 4 { point(k == 0 ? vec3(k) / k : vec3(k), k == 3 ? vec4(0.0 / 0.0) : white,\n"
+        "                        k == 2 ? 1 / (k - 2) : 1); }\n"
+        "}\n"
+        "spawn a(0); spawn a(1); spawn a(2); spawn a(3); spawn a(4);";
+    interp::Interpreter interpreter;
+    codegen_llvm::LlvmBackend jit;
+    rt::System slow(compile(text), interpreter), fast(compile(text), jit);
+    REQUIRE(jit.marksDrawn());
+    for (rt::System* s : {&slow, &fast}) {
+        s->step(1.0 / 60);
+        auto points = s->points(0);
+        REQUIRE(points.size() == 1);
+        CHECK(points[0].position[0] == 1);
+        CHECK(s->draw(0).drawn == 1);
+        CHECK(s->stats().nonFiniteRender == 3);
+    }
+}
