@@ -190,7 +190,8 @@ void storeRowsYields(Statements& out, const Kernel& kernel, const ColumnLayout& 
                 storeColumns(out, l.render + ColumnLayout::kVisible, 1, value + " ? 1.0 : 0.0");
                 break;
             case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:
-                storeColumns(out, l.render + ColumnLayout::renderColumn(y.kind), width, value);
+                if (!l.fromState(y.kind))  // else drawn from the state column itself
+                    storeColumns(out, l.render + ColumnLayout::renderColumn(y.kind), width, value);
                 break;
             default: break;
         }
@@ -203,7 +204,7 @@ void markDrawn(Statements& out, const ColumnLayout& l) {
     out.line("// drawn: visible, with a finite position, colour and size (counted)");
     std::string finite = "true";
     for (int c = ColumnLayout::kPosition; c < ColumnLayout::kRenderColumns; ++c)
-        finite += fmt::format(" && (floatBitsToUint(cf({}u, i)) & 0x7f800000u) != 0x7f800000u", l.render + c);
+        finite += fmt::format(" && (floatBitsToUint(cf({}u, i)) & 0x7f800000u) != 0x7f800000u", l.drawnFrom(c));
     std::string visible = out.define("shown", "bool", fmt::format("cf({}u, i) != 0.0", l.render + ColumnLayout::kVisible));
     std::string ok = out.define("finite", "bool", finite);
     out.line(fmt::format("sf({}u, i, {} && {} ? 1.0 : 0.0);", l.render + ColumnLayout::kVisible, visible, ok));

@@ -66,8 +66,11 @@ void writtenColumns(const ir::Kernel& kernel, const ColumnLayout& l, std::vector
     };
     std::vector<int>& cols = returned;
     // What is drawn stays on the GPU (the viewer draws from it): the render shader writes
-    // `visible` for every row and reads every render column to mark the drawn rows.
-    if (kernel.kind == ir::KernelKind::Render) range(resident, l.render, ColumnLayout::kRenderColumns);
+    // `visible` for every row and reads every render column to mark the drawn rows (those
+    // drawn from state columns are the state's, resident already).
+    if (kernel.kind == ir::KernelKind::Render)
+        for (int c = 0; c < ColumnLayout::kRenderColumns; ++c)
+            if (l.drawnFrom(c) == l.render + c) resident.push_back(l.render + c);
     for (const ir::Yield& y : kernel.yields) {
         int width = kernel.at(y.value).type.width;
         switch (y.kind) {

@@ -115,6 +115,7 @@ rt::RowsResult Interpreter::run(const rt::RowsLaunch& launch) {
                 case YieldKind::EmitRate: columns.floats(l.emitRate(y.index))[row] = v.f[0]; break;
                 case YieldKind::EmitCount: columns.floats(l.emitCount(y.index))[row] = v.f[0]; break;
                 case YieldKind::Visible: case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:
+                    if (l.fromState(y.kind)) break;  // drawn from the state column itself
                     columns.scatter(l.render + ColumnLayout::renderColumn(y.kind), y.kind == YieldKind::Visible ? 1 : width,
                                     row, y.kind == YieldKind::Visible ? Value::scalar(v.truth() ? 1.0f : 0.0f) : v);
                     break;

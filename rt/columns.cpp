@@ -28,8 +28,20 @@ ColumnLayout columnLayout(const ir::Object& object, const ir::Kernel& kernel) {
         if (y.kind == ir::YieldKind::EmitRate) l.writes[static_cast<size_t>(l.emitRate(y.index) - l.emits)] = true;
         if (y.kind == ir::YieldKind::EmitCount) l.writes[static_cast<size_t>(l.emitCount(y.index) - l.emits)] = true;
     }
-    if (kernel.kind == ir::KernelKind::Render)  // writes every render column (visible: drawn or not)
-        for (int c = 0; c < ColumnLayout::kRenderColumns; ++c) l.writes[static_cast<size_t>(l.render - l.emits + c)] = true;
+    if (kernel.kind == ir::KernelKind::Render) {  // writes every render column (visible: drawn or not)…
+        l.renderFromState.assign(ColumnLayout::kRenderColumns, -1);
+        for (const ir::Yield& y : kernel.yields) {  // …but those that are state values as they are
+            const ir::Inst& value = kernel.at(y.value);
+            if (y.kind == ir::YieldKind::Visible || value.op != ir::Op::StateRead ||
+                (y.kind != ir::YieldKind::Position && y.kind != ir::YieldKind::Color && y.kind != ir::YieldKind::Size))
+                continue;
+            for (int c = 0; c < value.type.width; ++c)
+                l.renderFromState[static_cast<size_t>(ColumnLayout::renderColumn(y.kind) + c)] =
+                    l.stateOffset.at(static_cast<size_t>(value.attr)) + c;
+        }
+        for (int c = 0; c < ColumnLayout::kRenderColumns; ++c)
+            l.writes[static_cast<size_t>(l.render - l.emits + c)] = l.renderFromState[static_cast<size_t>(c)] < 0;
+    }
     for (const ir::Inst& i : kernel.insts()) {
         if (!ir::readsAncestor(i.op)) continue;
         l.parentColumns.push_back({i.op, i.attr2, i.op == ir::Op::ParentExport ? i.attr : -1, i.type.width, next});
@@ -71,6 +83,7 @@ std::string ColumnLayout::signature() const {
     for (int o : paramOffset) s += fmt::format(" p{}", o);
     for (int o : exportOffset) s += fmt::format(" e{}", o);
     for (const auto& p : parentColumns) s += fmt::format(" r{}:{}:{}", p.depth, p.exportIndex, p.offset);
+    for (int c : renderFromState) s += fmt::format(" d{}", c);
     return s;
 }
 

@@ -40,6 +40,19 @@ struct ColumnLayout {
     // columns only to these (and the parents'): a pool's update needs no render columns.
     std::vector<bool> writes;
     bool needs(int column) const { return column >= parents || writes[static_cast<size_t>(column - emits)]; }
+    // A render value that is a state value as it is (`point(pos, col, 2)`: the position is
+    // the state slot `pos`) is not copied into a render column: it is drawn from the state
+    // column itself. Per render column (kVisible … kSize): the state column it is drawn
+    // from, or -1 where the render kernel writes it. Every backend and the drawing read
+    // this one rule.
+    std::vector<int> renderFromState;
+    // The table column render column `c` is drawn from: its state column, or its own.
+    int drawnFrom(int c) const {
+        return renderFromState.empty() || renderFromState[static_cast<size_t>(c)] < 0
+                   ? render + c
+                   : renderFromState[static_cast<size_t>(c)];
+    }
+    bool fromState(ir::YieldKind kind) const { return drawnFrom(renderColumn(kind)) != render + renderColumn(kind); }
 
     int emitRate(int site) const { return emits + 2 * site; }
     int emitCount(int site) const { return emits + 2 * site + 1; }

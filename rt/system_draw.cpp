@@ -33,7 +33,8 @@ const DrawColumns& Drawing::draw(size_t type) {
     }
     const ColumnLayout& layout = info.renderLayout;
     s_.bindPool(type, layout, d.scratch, d.table);
-    auto column = [&](int offset) { return d.table[static_cast<size_t>(layout.render + offset)]; };
+    // A render value that is a state value is drawn from the state column itself.
+    auto column = [&](int offset) { return d.table[static_cast<size_t>(layout.drawnFrom(offset))]; };
     out.visible = column(ColumnLayout::kVisible);
     for (int c = 0; c < 3; ++c) out.position[c] = column(ColumnLayout::kPosition + c);
     for (int c = 0; c < 4; ++c) out.color[c] = column(ColumnLayout::kColor + c);

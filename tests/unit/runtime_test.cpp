@@ -356,3 +356,31 @@ TEST_CASE("each emission event creates `count` objects, all at the event's time"
     CHECK(perAge.size() == 10);
     for (auto& [age, n] : perAge) CHECK(n == 3);
 }
+
+TEST_CASE("a render value that is a state value is drawn from the state column itself, not copied") {
+    Run run("object a { pos = vec3(1, 2, 3) -> prev(pos) + vec3(0, dt, 0); point(pos, white, 2); }\n"
+            "object b { pos = vec3(1, 2, 3) -> prev(pos) + vec3(0, dt, 0); point(pos + vec3(1, 0, 0), white, 2); }\n"
+            "spawn a; spawn b;");
+    run.steps(3, 1.0 / 60);
+    for (std::string name : {"a", "b"}) {
+        INFO(name);
+        auto type = static_cast<size_t>(run.system->typeIndex(name));
+        const ir::Object& o = run.system->module().objects[type];
+        const rt::ColumnLayout layout = rt::columnLayout(o, *o.kernel(ir::KernelKind::Render));
+        const rt::Pool& pool = run.system->pool(type);
+        const rt::DrawColumns& drawn = run.system->draw(type);
+        bool fromState = name == "a";
+        for (int c = 0; c < 3; ++c) {
+            int column = rt::ColumnLayout::kPosition + c;
+            CHECK((layout.drawnFrom(column) == layout.stateOffset[0] + c) == fromState);
+            CHECK(layout.needs(layout.render + column) == !fromState);  // no scratch column for it
+            CHECK((drawn.position[static_cast<size_t>(c)] == pool.state.column(0, static_cast<size_t>(c))) == fromState);
+        }
+        // The colour is a constant, not a state value: written by the render kernel.
+        CHECK(layout.drawnFrom(rt::ColumnLayout::kColor) == layout.render + rt::ColumnLayout::kColor);
+        auto points = run.points(name);
+        REQUIRE(points.size() == 1);
+        CHECK(points[0].position[0] == (fromState ? 1.0f : 2.0f));
+        CHECK(points[0].position[1] == doctest::Approx(2.05f));
+    }
+}
