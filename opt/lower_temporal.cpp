@@ -29,7 +29,12 @@
 // In both cases, for methods with a stability limit, a decay rate the compiler can see
 // gets a compile-time warning when it is a constant beyond the limit, and an `unstable`
 // yield that counts the updates beyond it (opt/integrate_stability.cpp).
-// With relaxed maths, the integral of something fixed at creation is c·age, no state.
+// With relaxed maths, the integral of something fixed at creation is c·age, no state;
+// and under the default method `c + integrate(e)` with c fixed at creation (snapshots,
+// parameters, constants) is one integral that starts at c (slot `integrate@x.from-creation`,
+// value = first ? c : A + e·dt): equal in real arithmetic, rounded differently, and c is
+// no longer read every update (the fire's `pos = snapshot(ipos) + integrate(vel)`).
+#include <algorithm>
 #include <map>
 #include <set>
 
@@ -148,8 +153,11 @@ private:
     // Every construct becomes state (the table above) but, for the methods other than
     // the default, the integrals: they stay `integrate` instructions, with their slots.
     Kernel lowerPerUpdate() {
+        if (options_.relaxed && !stageMethod(method_)) findFolds();
         Kernel lowered = rewriter_.run([&](Rewriter& rw, ValueId old, const Inst& inst,
                                            const std::vector<ValueId>& ops) -> std::optional<ValueId> {
+            if (auto folded = folds_.find(old); folded != folds_.end() && folded->second.applied)
+                return rw.map(folded->second.integral);  // c + integrate(e): the integral that starts at c
             if (inst.op != Op::Integrate && inst.op != Op::Derive && inst.op != Op::Prev &&
                 inst.op != Op::Snapshot && inst.op != Op::FollowedBy)
                 return std::nullopt;
@@ -180,13 +188,17 @@ private:
                 // real arithmetic, whatever the method; no state needed (docs/optimizer.md).
                 if (options_.relaxed && creationInvariant(k, ops[0]))
                     return rw.emit(Inst::make(Op::Mul, t, {ops[0], broadcast(k, input(k, Op::Age, Type::f32()), t)}));
-                int slot = addSlot(t, StateInit::Zero);
+                auto fold = std::find_if(folds_.begin(), folds_.end(), [old](auto& f) { return f.second.integral == old; });
+                int slot = fold == folds_.end() ? addSlot(t, StateInit::Zero)
+                                                : addSlot(t, StateInit::Next, ".from-creation");  // starts at c
+                if (fold != folds_.end()) fold->second.applied = true;
                 integrals_.push_back({old, slot, std::nullopt});
                 if (stageMethod(method_)) return std::nullopt;  // the method lowers it (run)
                 ValueId a = input(k, Op::StateRead, t, slot);
                 ValueId dt = broadcast(k, input(k, Op::Dt, Type::f32()), t);
                 ValueId step = k.op(Op::Add, t, {a, k.op(Op::Mul, t, {ops[0], dt})});
-                ValueId value = rw.emit(Inst::make(Op::Select, t, {first, zero, step}));
+                ValueId start = fold == folds_.end() ? zero : atCreation(k, fold->second.start);
+                ValueId value = rw.emit(Inst::make(Op::Select, t, {first, start, step}));
                 nextNew_.push_back({slot, value});
                 return value;
             }
@@ -227,6 +239,52 @@ private:
                 return rw.emit(Inst::make(Op::Select, t, {first, ops[0], ops[1]}));
             default: return std::nullopt;
         }
+    }
+
+    // `c + integrate(e)` (either order) where c is fixed once the object is created and
+    // the integral is used nowhere else: the sum becomes one integral starting at c.
+    struct Fold {
+        ValueId integral, start;  // behaviour values
+        bool applied = false;     // the integral was lowered starting at c (not as c·age)
+    };
+    void findFolds() {
+        std::map<ValueId, int> uses;
+        for (ValueId v = 0; v < from_.size(); ++v)
+            for (ValueId o : from_.at(v).operands) ++uses[o];
+        for (const Yield& y : from_.yields) ++uses[y.value];
+        for (auto& [name, v] : from_.equations) ++uses[v];
+        for (ValueId v = 0; v < from_.size(); ++v) {
+            const Inst& add = from_.at(v);
+            if (add.op != Op::Add || !add.type.isFloat()) continue;
+            for (int side = 0; side < 2; ++side) {
+                ValueId integral = add.operands[static_cast<size_t>(side)], start = add.operands[static_cast<size_t>(1 - side)];
+                if (from_.at(integral).op == Op::Integrate && uses[integral] == 1 && fixedAtCreation(start)) {
+                    folds_[v] = {integral, start};
+                    break;
+                }
+            }
+        }
+    }
+    // Whether a behaviour value is fixed once the object is created: constants,
+    // parameters, snapshots of them, and pure operations of these.
+    bool fixedAtCreation(ValueId v) const {
+        const Inst& i = from_.at(v);
+        if (i.op == Op::Param || i.op == Op::Const) return true;
+        if (i.op != Op::Snapshot && (!isPure(i.op) || isLeaf(i.op))) return false;
+        for (ValueId o : i.operands)
+            if (!fixedAtCreation(o)) return false;
+        return true;
+    }
+    // A fixed behaviour value as it is at creation, built in `k`: a snapshot is its operand then.
+    ValueId atCreation(Kernel& k, ValueId v) {
+        const Inst& i = from_.at(v);
+        if (i.op == Op::Snapshot) return atCreation(k, i.operands[0]);
+        if (i.operands.empty() && rewriter_.visited(v)) return rewriter_.map(v);
+        // Rebuilt without its snapshots (so it reads no snapshot's slot); simplify merges
+        // what it repeats.
+        Inst copy = i;
+        for (ValueId& o : copy.operands) o = atCreation(k, o);
+        return k.add(std::move(copy));
     }
 
     // The decay rate of each integral whose derivative has a linear part in it.
@@ -286,6 +344,7 @@ private:
     std::vector<std::pair<int, ValueId>> nextOld_;  // (slot, old value its next is)
     std::map<ValueId, ValueId> stageViews_;         // (derive, what a stage sees), new values
     std::vector<ValueId> snapshotsOfFixed_;         // snapshots of what is fixed at creation
+    std::map<ValueId, Fold> folds_;                 // by the behaviour's `+`
     Kernel* target_ = nullptr;                      // where decay rates are built
     std::function<ValueId(ValueId)> leaf_;          // a behaviour value there
 };

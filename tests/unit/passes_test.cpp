@@ -278,3 +278,105 @@ end
   end
 )") != std::string::npos);
 }
+
+// x = snapshot(p0)·3 + integrate(age): under relaxed maths one integral that starts at p0·3.
+const char* kFoldable = R"(object p(p0: f32)
+  kernel behaviour
+    %0 = param.f32 #0
+    %1 = snapshot.f32 %0 #0
+    %2 = const.f32 3
+    %3 = mul.f32 %1, %2
+    %4 = age.f32
+    %5 = integrate.f32 %4 #1
+    %6 = add.f32 %3, %5  ; x
+    yield size = %6
+  end
+end
+)";
+
+void lowerTemporalRelaxed(Module& m, opt::PassErrors& e) {
+    opt::PassOptions options;
+    options.relaxed = true;
+    opt::lowerTemporal(m, options, e);
+}
+
+TEST_CASE("lower-temporal, relaxed: c + integrate(e) with c fixed at creation is one integral starting at c") {
+    CHECK(after(kFoldable, lowerTemporalRelaxed) == R"(object p(p0: f32)
+  state snapshot#0: f32 next
+  state integrate#1.from-creation: f32 next
+  kernel behaviour
+    %0 = param.f32 #0
+    %1 = first.bool
+    %2 = const.f32 0
+    %3 = state.f32 #0
+    %4 = select.f32 %1, %0, %3
+    %5 = const.f32 3
+    %6 = mul.f32 %4, %5
+    %7 = age.f32
+    %8 = state.f32 #1
+    %9 = dt.f32
+    %10 = mul.f32 %7, %9
+    %11 = add.f32 %8, %10
+    %12 = mul.f32 %0, %5
+    %13 = select.f32 %1, %12, %11  ; x
+    yield size = %13
+    yield state #0 = %4
+    yield state #1 = %13
+  end
+end
+)");
+}
+
+TEST_CASE("lower-temporal: exact maths, or an integral used elsewhere, keeps c + integrate(e) apart") {
+    CHECK(after(kFoldable, lowerTemporalDefault) == R"(object p(p0: f32)
+  state snapshot#0: f32 next
+  state integrate#1: f32 zero
+  kernel behaviour
+    %0 = param.f32 #0
+    %1 = first.bool
+    %2 = const.f32 0
+    %3 = state.f32 #0
+    %4 = select.f32 %1, %0, %3
+    %5 = const.f32 3
+    %6 = mul.f32 %4, %5
+    %7 = age.f32
+    %8 = state.f32 #1
+    %9 = dt.f32
+    %10 = mul.f32 %7, %9
+    %11 = add.f32 %8, %10
+    %12 = select.f32 %1, %2, %11
+    %13 = add.f32 %6, %12  ; x
+    yield size = %13
+    yield state #0 = %4
+    yield state #1 = %12
+  end
+end
+)");
+    std::string twice = kFoldable;
+    twice.replace(twice.find("    yield size = %6"), 19, "    %7 = add.f32 %6, %5\n    yield size = %7");
+    CHECK(after(twice, lowerTemporalRelaxed) == R"(object p(p0: f32)
+  state snapshot#0: f32 next
+  state integrate#1: f32 zero
+  kernel behaviour
+    %0 = param.f32 #0
+    %1 = first.bool
+    %2 = const.f32 0
+    %3 = state.f32 #0
+    %4 = select.f32 %1, %0, %3
+    %5 = const.f32 3
+    %6 = mul.f32 %4, %5
+    %7 = age.f32
+    %8 = state.f32 #1
+    %9 = dt.f32
+    %10 = mul.f32 %7, %9
+    %11 = add.f32 %8, %10
+    %12 = select.f32 %1, %2, %11
+    %13 = add.f32 %6, %12  ; x
+    %14 = add.f32 %12, %13
+    yield size = %14
+    yield state #0 = %4
+    yield state #1 = %12
+  end
+end
+)");
+}
