@@ -25,10 +25,12 @@ const Effect* findEffect(const std::string& name) {
     return e == kEffects.end() ? nullptr : &*e;
 }
 
-ir::Module compileEffect(const std::string& name) {
+ir::Module compileEffect(const std::string& name, bool relaxed) {
     SourceManager sources;
     DiagnosticEngine diags(sources);
-    auto module = compileFile(std::string(PSYS_SAMPLES_DIR) + "/" + name + ".psys", sources, diags, {});
+    CompileOptions options;
+    options.pipeline.pass.relaxed = relaxed;
+    auto module = compileFile(std::string(PSYS_SAMPLES_DIR) + "/" + name + ".psys", sources, diags, options);
     if (!module) {
         diags.print(std::cerr, false);
         std::exit(1);

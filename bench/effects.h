@@ -29,8 +29,10 @@ extern const std::vector<Effect> kEffects;
 // Null when there is no effect of that name.
 const Effect* findEffect(const std::string& name);
 
-// The effect's sample, compiled (exits with the diagnostics if it does not compile).
-ir::Module compileEffect(const std::string& name);
+// The effect's sample, compiled (exits with the diagnostics if it does not compile);
+// `relaxed`: with the optimizer's relaxed rewrites, as fast maths on the JIT compiles
+// (host::BackendChoice::relaxesMaths).
+ir::Module compileEffect(const std::string& name, bool relaxed = false);
 
 // The extern value that keeps about `particles` alive: populations are proportional to
 // it, so one short run at a small value on `backend` tells.

@@ -120,7 +120,7 @@ std::string measureMemory(const Effect& effect, double particles, int frames) {
     double knob = bench::calibrate(effect, jit, particles);
     rt::SystemOptions options;
     options.capacity = static_cast<size_t>(particles * 1.5) + 1024;
-    rt::System system(bench::compileEffect(effect.name), jit, options);
+    rt::System system(bench::compileEffect(effect.name, true), jit, options);
     float value = static_cast<float>(knob);
     system.setExtern(effect.knob, {&value, 1});
     auto type = static_cast<size_t>(system.typeIndex(effect.particles));
@@ -229,7 +229,7 @@ int main(int argc, char** argv) {
             auto capacity = static_cast<size_t>(particles * 1.5) + 1024;
             rt::SystemOptions options;
             options.capacity = capacity;
-            rt::System system(bench::compileEffect(name), jit, options);
+            rt::System system(bench::compileEffect(name, true), jit, options);
             float value = static_cast<float>(knob);
             system.setExtern(effect->knob, {&value, 1});
             auto type = static_cast<size_t>(system.typeIndex(effect->particles));
@@ -240,7 +240,7 @@ int main(int argc, char** argv) {
                 soa->step(1.0f / 60);
                 aos->step(1.0f / 60);
             }
-            double bytes = stateBytes(system.module().objects[type]);
+            double bytes = stateBytes(system.module().objects[type]);  // of the relaxed program the JIT runs
             for (unsigned threads : {1u, cores}) {
                 system.setThreads(threads);
                 soa->setThreads(threads);
@@ -335,7 +335,7 @@ int main(int argc, char** argv) {
         interp::Interpreter interpreter;
         rt::SystemOptions options;
         options.threads = 1;
-        rt::System slow(bench::compileEffect(name), interpreter, options), fast(bench::compileEffect(name), jit, options);
+        rt::System slow(bench::compileEffect(name), interpreter, options), fast(bench::compileEffect(name, true), jit, options);
         float value = static_cast<float>(knob);
         slow.setExtern(effect.knob, {&value, 1});
         fast.setExtern(effect.knob, {&value, 1});

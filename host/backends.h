@@ -16,6 +16,10 @@ namespace psys::host {
 struct BackendChoice {
     std::string name = "llvm";
     std::string math = "fast";  // llvm: fast or exact
+    // Fast maths also compiles with the optimizer's relaxed rewrites (docs/optimizer.md):
+    // it gives up bit-exactness for speed anyway. A session decides this when it opens
+    // and keeps it through reloads and backend switches, so one session runs one program.
+    bool relaxesMaths() const { return name == "llvm" && math == "fast"; }
 };
 
 // The backends this build has, the default first.

@@ -34,8 +34,10 @@ CompileResult compile(const std::string& path, const CompileOptions& options, st
     return result;
 }
 
-std::unique_ptr<Session> Session::open(const std::string& path, const SessionOptions& options, CompileResult& result,
+std::unique_ptr<Session> Session::open(const std::string& path, const SessionOptions& asked, CompileResult& result,
                                        std::string& error, const std::string* text) {
+    SessionOptions options = asked;
+    options.compile.pipeline.pass.relaxed |= options.backend.relaxesMaths();
     std::optional<ir::Module> module;
     result = compile(path, options.compile, module, text);
     if (!module) return nullptr;

@@ -139,3 +139,30 @@ TEST_CASE("a session moves onto the GPU backend and back without losing a step")
     REQUIRE_FALSE(moving->switchBackend({"interp", "fast"}));
     CHECK(test::drawnBytes(moving->system(), 60) == test::drawnBytes(straight->system(), 60));
 }
+
+TEST_CASE("fast maths compiles with the relaxed rewrites, exact maths and the interpreter without; a session keeps its choice") {
+    std::string text = sampleText("fire");
+    auto slots = [](const host::Session& s) {
+        std::string names;
+        for (const ir::StateSlot& slot : s.system().module().objects[0].state) names += slot.name + " ";
+        return names;
+    };
+    host::CompileResult compiled;
+    std::string error;
+    for (auto [name, math, relaxed] : {std::tuple{"llvm", "fast", true}, {"llvm", "exact", false}, {"interp", "fast", false}}) {
+        INFO(name << " " << math);
+        host::SessionOptions options;
+        options.backend = {name, math};
+        auto session = host::Session::open("fire.psys", options, compiled, error, &text);
+        REQUIRE(session);
+        // The fire's pos = snapshot(ipos) + integrate(vel): one integral starting at ipos.
+        CHECK((slots(*session).find("integrate@pos.from-creation") != std::string::npos) == relaxed);
+        CHECK(session->options().compile.pipeline.pass.relaxed == relaxed);
+        if (relaxed) {  // the interpreter runs the same (relaxed) program after a switch
+            REQUIRE_FALSE(session->switchBackend({"interp", "fast"}));
+            CHECK(slots(*session).find("integrate@pos.from-creation") != std::string::npos);
+            CHECK(session->reload(&text).compile.ok);
+            CHECK(slots(*session).find("integrate@pos.from-creation") != std::string::npos);
+        }
+    }
+}

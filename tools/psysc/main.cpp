@@ -92,8 +92,8 @@ void addRunOptions(CLI::App& run, psys::tools::RunOptions& o) {
     run.add_option("--backend", o.backend, "llvm (JIT-compiled, the default), interp (the reference) or glsl (compute shaders on OpenGL 4.5: a GPU, or llvmpipe)")
         ->check(CLI::IsMember(psys::host::backendNames()));
     run.add_option("--math", o.math,
-                    "llvm backend: fast (fused multiply-adds, vector math functions; the default) or exact "
-                    "(the interpreter's results bit for bit)")
+                    "llvm backend: fast (fused multiply-adds, vector math functions, the optimizer's relaxed "
+                    "rewrites; the default) or exact (the interpreter's results bit for bit)")
         ->check(CLI::IsMember({"fast", "exact"}));
     run.add_option("--threads", o.threads, "Threads for pool updates: 0 for every core (0)")
         ->check(CLI::Range(0, 256));  // TBB's own limit
