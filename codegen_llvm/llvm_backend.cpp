@@ -131,12 +131,14 @@ LlvmBackend::LlvmBackend(MathMode mode) : impl_(std::make_unique<Impl>(mode)) {}
 LlvmBackend::~LlvmBackend() = default;
 
 rt::Memory& LlvmBackend::memory() { return impl_->memory; }
+unsigned LlvmBackend::lanes() const { return impl_->lanes; }
 
 rt::BackendReport LlvmBackend::report() const {
     std::lock_guard lock(impl_->mutex);
     rt::BackendReport r = impl_->stats;
     r.target = impl_->engine.cpu();
     r.remarks = impl_->engine.remarks();
+    r.calls = impl_->engine.calls();
     return r;
 }
 

@@ -34,6 +34,8 @@ public:
     void run(const rt::ChildrenLaunch& launch) override;
     bool concurrent() const override { return true; }
     bool marksDrawn() const override { return true; }  // render loops mark and count what they draw
+    // Floats per vector register the loops over pools use (16 with AVX-512, 8 with AVX, else 4).
+    unsigned lanes() const;
     rt::BackendReport report() const override;
 
 private:

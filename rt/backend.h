@@ -96,6 +96,7 @@ struct BackendReport {
         std::string message;
     };
     std::vector<Remark> remarks; // what the compiler said about each loop
+    std::vector<std::string> calls;  // the library functions compiled code calls (sorted, once each)
 };
 
 class Backend {

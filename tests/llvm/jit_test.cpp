@@ -165,3 +165,19 @@ TEST_CASE("the JIT's render loops mark what is drawn as the run-time's rule says
         CHECK(s->stats().nonFiniteRender == 3);
     }
 }
+
+TEST_CASE("fast maths calls glibc's vector functions at the loops' full width; exact maths calls libm's") {
+    codegen_llvm::LlvmBackend fast(codegen_llvm::MathMode::Fast), exact(codegen_llvm::MathMode::Exact);
+    // The 16-lane (AVX-512) variants where loops run 16 floats a register, else 8 (AVX) or 4.
+    std::string wide = fast.lanes() == 16 ? "_ZGVeN16v_expf" : fast.lanes() == 8 ? "_ZGVdN8v_expf" : "_ZGVbN4v_expf";
+    rt::System a(compile(sample("fire")), fast), b(compile(sample("fire")), exact);
+    auto calls = [](const rt::Backend& backend) {
+        std::string all;
+        for (const std::string& c : backend.report().calls) all += c + " ";
+        return all;
+    };
+    INFO("fast: " << calls(fast) << "; exact: " << calls(exact));
+    CHECK(calls(fast).find(wide + " ") != std::string::npos);
+    CHECK(calls(exact).find("expf ") != std::string::npos);
+    CHECK(calls(exact).find("_ZGV") == std::string::npos);
+}

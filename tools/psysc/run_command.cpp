@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "host/session.h"
@@ -137,9 +138,12 @@ int runSystem(const RunOptions& options) {
     compiled.print(std::cerr, options.colour);
     if (!compiled.ok) return 1;
     if (!s) return fail(error);
-    if (options.remarks)
-        for (const auto& r : s->backend().report().remarks)
+    if (options.remarks) {
+        rt::BackendReport report = s->backend().report();
+        for (const auto& r : report.remarks)
             std::cout << fmt::format("{}: {}: {}\n", r.loop, r.vectorized ? "vectorized" : "not vectorized", r.message);
+        if (!report.calls.empty()) std::cout << fmt::format("library calls: {}\n", fmt::join(report.calls, " "));
+    }
     for (const host::ExternSetting& set : sets)
         if (auto e = s->apply(set)) return fail("--set " + set.name + ": " + *e);
     if (auto e = s->schedule(fires, options.frames)) return fail(*e);
