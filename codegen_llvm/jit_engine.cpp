@@ -1,6 +1,11 @@
 #include "codegen_llvm/jit_engine.h"
 
 #include <algorithm>
+#include <functional>
+#include <fstream>
+#include <filesystem>
+#include <cstdlib>
+#include <atomic>
 #include <cstdio>
 #include <optional>
 #include <set>
@@ -11,7 +16,11 @@
 #include <llvm/ExecutionEngine/Orc/CompileUtils.h>
 #include <llvm/ExecutionEngine/Orc/ExecutionUtils.h>
 #include <llvm/ExecutionEngine/Orc/JITTargetMachineBuilder.h>
+#include <unistd.h>
+
+#include <llvm/Config/llvm-config.h>
 #include <llvm/ExecutionEngine/JITLink/JITLink.h>
+#include <llvm/Object/ObjectFile.h>
 #include <llvm/ExecutionEngine/Orc/LLJIT.h>
 #include <llvm/ExecutionEngine/Orc/ObjectLinkingLayer.h>
 #include <llvm/ExecutionEngine/Orc/ThreadSafeModule.h>
@@ -24,6 +33,7 @@
 #include <llvm/TargetParser/Host.h>
 
 #include "codegen_llvm/perf_map.h"
+#include "ir/hash.h"
 
 namespace psys::codegen_llvm {
 
@@ -50,6 +60,96 @@ struct RemarkCollector : llvm::DiagnosticHandler {
     }
 };
 
+// Compiled objects on disk, so that a second run of a program starts without waiting for
+// LLVM: one file per module, named by a hash of the module's text before optimization,
+// the CPU and its features, the maths mode and LLVM's version (all that decides the
+// machine code). PSYS_JIT_CACHE names the folder, or turns it off ("0"); by default
+// $XDG_CACHE_HOME/psys/jit or ~/.cache/psys/jit. A file is written whole (to a temporary
+// name, then renamed), so a run never reads half an object; one that cannot be written
+// is simply not cached.
+class ObjectCache {
+public:
+    static std::optional<ObjectCache> fromEnvironment() {
+        const char* setting = std::getenv("PSYS_JIT_CACHE");
+        std::filesystem::path folder;
+        if (setting && *setting) {
+            if (std::string(setting) == "0") return std::nullopt;
+            folder = setting;
+        } else if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) {
+            folder = std::filesystem::path(xdg) / "psys" / "jit";
+        } else if (const char* home = std::getenv("HOME"); home && *home) {
+            folder = std::filesystem::path(home) / ".cache" / "psys" / "jit";
+        } else {
+            return std::nullopt;
+        }
+        ObjectCache cache;
+        cache.folder_ = folder;
+        return cache;
+    }
+    // The key of a module: its text and what else decides its machine code.
+    static std::string key(const llvm::Module& module, const std::string& machine) {
+        std::string text;
+        llvm::raw_string_ostream out(text);
+        module.print(out, nullptr);
+        // This file's build stands for how modules are optimized and compiled: a new build
+        // of it never reads objects an older one made.
+        return ir::Hasher()
+            .add(text)
+            .add(machine)
+            .add(std::string_view(LLVM_VERSION_STRING))
+            .add(std::string_view(__DATE__ " " __TIME__))
+            .finish()
+            .hex();
+    }
+    // The object stored under `key`, if there is one and it reads as an object file (a
+    // damaged one is removed, and the module compiled again).
+    std::unique_ptr<llvm::MemoryBuffer> load(const std::string& key) const {
+        std::filesystem::path file = folder_ / (key + ".o");
+        auto buffer = llvm::MemoryBuffer::getFile(file.string());
+        if (!buffer) return nullptr;
+        auto object = llvm::object::ObjectFile::createObjectFile((*buffer)->getMemBufferRef());
+        if (!object) {
+            llvm::consumeError(object.takeError());
+            std::error_code error;
+            std::filesystem::remove(file, error);
+            return nullptr;
+        }
+        return std::move(*buffer);
+    }
+    // The object, and beside it what the vectorizer said about the module's loops (a
+    // cached module is not optimized again, so its remarks come from here).
+    void store(const std::string& key, const llvm::MemoryBuffer& object, const std::string& remarks) const {
+        if (key.size() != 32) return;  // not a module keyed for the cache
+        std::error_code error;
+        std::filesystem::create_directories(folder_, error);
+        if (error) return;
+        write(key + ".remarks", remarks.data(), remarks.size());  // first: an object never lacks its remarks
+        write(key + ".o", object.getBufferStart(), object.getBufferSize());
+    }
+    std::string remarks(const std::string& key) const {
+        std::ifstream in(folder_ / (key + ".remarks"), std::ios::binary);
+        return {std::istreambuf_iterator<char>(in), {}};
+    }
+    const std::filesystem::path& folder() const { return folder_; }
+
+private:
+    void write(const std::string& name, const char* bytes, size_t size) const {
+        std::error_code error;
+        std::filesystem::path partial = folder_ / (name + "." + std::to_string(::getpid()) + ".part");
+        {
+            std::ofstream out(partial, std::ios::binary);
+            out.write(bytes, static_cast<std::streamsize>(size));
+            if (!out) {
+                std::filesystem::remove(partial, error);
+                return;
+            }
+        }
+        std::filesystem::rename(partial, folder_ / name, error);
+        if (error) std::filesystem::remove(partial, error);
+    }
+    std::filesystem::path folder_;
+};
+
 // Machine code for a module, with compile time linear in its size. Two parts of LLVM's code
 // generation grow faster than linearly: instruction selection with the size of a basic
 // block (so long blocks are cut, below), and register allocation at the higher levels with
@@ -61,8 +161,10 @@ class SizedCompiler : public llvm::orc::IRCompileLayer::IRCompiler {
 public:
     static constexpr size_t kLargeModule = 4000;
 
-    explicit SizedCompiler(llvm::orc::JITTargetMachineBuilder builder)
-        : IRCompiler(llvm::orc::irManglingOptionsFromTargetOptions(builder.getOptions())), builder_(std::move(builder)) {}
+    using Remarks = std::function<std::string(const llvm::Module&)>;
+    SizedCompiler(llvm::orc::JITTargetMachineBuilder builder, const ObjectCache* cache, Remarks remarks)
+        : IRCompiler(llvm::orc::irManglingOptionsFromTargetOptions(builder.getOptions())), builder_(std::move(builder)),
+          cache_(cache), remarks_(std::move(remarks)) {}
 
     llvm::Expected<std::unique_ptr<llvm::MemoryBuffer>> operator()(llvm::Module& module) override {
         size_t instructions = 0;
@@ -74,7 +176,9 @@ public:
         if (instructions > kLargeModule) builder.setCodeGenOptLevel(llvm::CodeGenOptLevel::None);
         auto machine = builder.createTargetMachine();
         if (!machine) return machine.takeError();
-        return llvm::orc::SimpleCompiler(**machine)(module);
+        auto object = llvm::orc::SimpleCompiler(**machine)(module);
+        if (object && cache_) cache_->store(module.getModuleIdentifier(), **object, remarks_(module));
+        return object;
     }
 
 private:
@@ -95,6 +199,8 @@ private:
     }
 
     llvm::orc::JITTargetMachineBuilder builder_;
+    const ObjectCache* cache_;
+    Remarks remarks_;
 };
 
 }  // namespace
@@ -150,6 +256,9 @@ private:
 
 struct JitEngine::Impl {
     MathMode mode;
+    std::optional<ObjectCache> cache;
+    std::string machine;          // the CPU, its features and the maths mode: part of a cache key
+    std::atomic<size_t> fromDisk = 0;
     std::mutex callsMutex;
     std::set<std::string> calls;
     bool avx512 = false;  // the host has AVX-512F: 16-lane loops, and their vector maths
@@ -158,6 +267,27 @@ struct JitEngine::Impl {
     std::string cpu;
     std::mutex remarksMutex;
     std::vector<rt::BackendReport::Remark> remarks;
+
+    // The remarks about `module`'s loops, one a line: loop, vectorized (0 or 1), message.
+    std::string remarksOf(const llvm::Module& module) {
+        std::set<std::string> functions;
+        for (const llvm::Function& f : module) functions.insert(f.getName().str());
+        std::lock_guard lock(remarksMutex);
+        std::string out;
+        for (const auto& r : remarks)
+            if (functions.count(r.loop)) out += r.loop + "\t" + (r.vectorized ? "1" : "0") + "\t" + r.message + "\n";
+        return out;
+    }
+    void addRemarks(const std::string& text) {
+        std::lock_guard lock(remarksMutex);
+        size_t at = 0;
+        while (at < text.size()) {
+            size_t end = text.find('\n', at), tab1 = text.find('\t', at);
+            if (end == std::string::npos || tab1 == std::string::npos || tab1 + 3 > end) break;
+            remarks.push_back({text.substr(at, tab1 - at), text[tab1 + 1] == '1', text.substr(tab1 + 3, end - tab1 - 3)});
+            at = end + 1;
+        }
+    }
 
     // Runs on the JIT's compile threads: a target machine of its own for the cost model.
     void optimize(llvm::Module& module) {
@@ -196,6 +326,7 @@ struct JitEngine::Impl {
 JitEngine::JitEngine(MathMode mode) : impl_(std::make_unique<Impl>()) {
     impl_->mode = mode;
     impl_->avx512 = llvm::sys::getHostCPUFeatures().lookup("avx512f");
+    impl_->cache = ObjectCache::fromEnvironment();
     llvm::InitializeNativeTarget();
     llvm::InitializeNativeTargetAsmPrinter();
     auto host = llvm::orc::JITTargetMachineBuilder::detectHost();
@@ -203,12 +334,15 @@ JitEngine::JitEngine(MathMode mode) : impl_(std::make_unique<Impl>()) {
     host->setCodeGenOptLevel(llvm::CodeGenOptLevel::Aggressive);
     impl_->cpu = host->getCPU();
     impl_->host = *host;
+    impl_->machine = impl_->cpu + " " + host->getFeatures().getString() + (mode == MathMode::Fast ? " fast" : " exact");
     unsigned threads = std::max(1u, std::thread::hardware_concurrency());
     auto jit = llvm::orc::LLJITBuilder()
                    .setJITTargetMachineBuilder(*host)
-                   .setCompileFunctionCreator([](llvm::orc::JITTargetMachineBuilder builder)
+                   .setCompileFunctionCreator([cache = impl_->cache ? &*impl_->cache : nullptr, impl = impl_.get()](
+                                                  llvm::orc::JITTargetMachineBuilder builder)
                                                   -> llvm::Expected<std::unique_ptr<llvm::orc::IRCompileLayer::IRCompiler>> {
-                       return std::make_unique<SizedCompiler>(std::move(builder));
+                       return std::make_unique<SizedCompiler>(std::move(builder), cache,
+                                                              [impl](const llvm::Module& m) { return impl->remarksOf(m); });
                    })
                    .setNumCompileThreads(threads)
                    .create();
@@ -268,6 +402,8 @@ std::vector<rt::BackendReport::Remark> JitEngine::remarks() const {
     return impl_->remarks;
 }
 
+size_t JitEngine::fromDisk() const { return impl_->fromDisk; }
+
 std::vector<std::string> JitEngine::calls() const {
     std::lock_guard lock(impl_->callsMutex);
     return {impl_->calls.begin(), impl_->calls.end()};
@@ -281,8 +417,21 @@ std::vector<void*> JitEngine::add(std::vector<Unit> units) {
         llvm::raw_string_ostream stream(problems);
         if (llvm::verifyModule(*unit.module, &stream))
             throw std::runtime_error("the LLVM backend built invalid IR: " + problems);
-        if (auto err = impl_->jit->addIRModule(llvm::orc::ThreadSafeModule(std::move(unit.module), std::move(unit.context))))
+        std::unique_ptr<llvm::MemoryBuffer> cached;
+        if (impl_->cache) {
+            std::string key = ObjectCache::key(*unit.module, impl_->machine);
+            cached = impl_->cache->load(key);
+            unit.module->setModuleIdentifier(key);  // SizedCompiler stores the object under it
+        }
+        if (cached) {
+            ++impl_->fromDisk;
+            impl_->addRemarks(impl_->cache->remarks(unit.module->getModuleIdentifier()));
+            if (auto err = impl_->jit->addObjectFile(std::move(cached)))
+                throw std::runtime_error(llvm::toString(std::move(err)));
+        } else if (auto err = impl_->jit->addIRModule(
+                       llvm::orc::ThreadSafeModule(std::move(unit.module), std::move(unit.context)))) {
             throw std::runtime_error(llvm::toString(std::move(err)));
+        }
         names.push_back(impl_->jit->mangleAndIntern(unit.name));
         symbols.add(names.back());
     }

@@ -38,6 +38,8 @@ public:
 
     // What the loop vectorizer said about every loop compiled so far.
     std::vector<rt::BackendReport::Remark> remarks() const;
+    // Modules whose machine code came from the disk cache (see ObjectCache in the .cpp).
+    size_t fromDisk() const;
     // The functions from outside the JIT (libm, libmvec, libc) that code linked so far calls.
     std::vector<std::string> calls() const;
     std::string cpu() const;

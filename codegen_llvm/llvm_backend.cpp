@@ -139,6 +139,7 @@ rt::BackendReport LlvmBackend::report() const {
     r.target = impl_->engine.cpu();
     r.remarks = impl_->engine.remarks();
     r.calls = impl_->engine.calls();
+    r.fromDisk = impl_->engine.fromDisk();
     return r;
 }
 

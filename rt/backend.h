@@ -89,6 +89,7 @@ struct BackendReport {
     std::string target;          // "interpreter", or the CPU the JIT compiles for
     size_t kernels = 0;          // functions compiled
     size_t cacheHits = 0;        // kernels found already compiled
+    size_t fromDisk = 0;         // kernels whose machine code came from the disk cache
     double compileSeconds = 0;
     struct Remark {
         std::string loop;

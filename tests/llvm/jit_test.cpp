@@ -181,3 +181,37 @@ TEST_CASE("fast maths calls glibc's vector functions at the loops' full width; e
     CHECK(calls(exact).find("expf ") != std::string::npos);
     CHECK(calls(exact).find("_ZGV") == std::string::npos);
 }
+
+TEST_CASE("compiled objects are cached on disk: a second backend loads them, runs the same bits, and survives a damaged file") {
+    std::filesystem::path folder = std::filesystem::temp_directory_path() / ("psys-jit-cache-" + std::to_string(::getpid()));
+    std::filesystem::remove_all(folder);
+    ::setenv("PSYS_JIT_CACHE", folder.c_str(), 1);
+    auto run = [](codegen_llvm::LlvmBackend& backend) {
+        rt::System system(compile(sample("fireworks")), backend);
+        return drawnBytes(system, 120);
+    };
+    codegen_llvm::LlvmBackend first;
+    std::string compiled = run(first);
+    CHECK(first.report().fromDisk == 0);
+    size_t files = 0;
+    for (auto& entry : std::filesystem::directory_iterator(folder)) files += entry.path().extension() == ".o";
+    CHECK(files == first.report().kernels);
+    codegen_llvm::LlvmBackend second;
+    CHECK(run(second) == compiled);
+    CHECK(second.report().fromDisk == second.report().kernels);
+    CHECK(second.report().remarks.size() == first.report().remarks.size());  // kept beside the objects
+    // A damaged object is removed and its module compiled again.
+    std::filesystem::path damaged;
+    for (auto& entry : std::filesystem::directory_iterator(folder))
+        if (entry.path().extension() == ".o") damaged = entry.path();
+    std::ofstream(damaged, std::ios::trunc) << "not an object";
+    codegen_llvm::LlvmBackend third;
+    CHECK(run(third) == compiled);
+    CHECK(third.report().fromDisk == third.report().kernels - 1);
+    ::setenv("PSYS_JIT_CACHE", "0", 1);
+    codegen_llvm::LlvmBackend off;
+    CHECK(run(off) == compiled);
+    CHECK(off.report().fromDisk == 0);
+    ::unsetenv("PSYS_JIT_CACHE");
+    std::filesystem::remove_all(folder);
+}

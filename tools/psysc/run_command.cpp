@@ -69,8 +69,9 @@ void printSummary(const RunOptions& options, host::Session& session, double draw
     if (options.timing) {
         rt::BackendReport r = session.backend().report();
         if (r.kernels > 0 || r.cacheHits > 0)
-            std::cout << fmt::format("compiled {} kernels in {:.1f} ms ({}, {} math)\n", r.kernels,
-                                     r.compileSeconds * 1e3, r.target, options.math);
+            std::cout << fmt::format("compiled {} kernels in {:.1f} ms ({}, {} math{})\n", r.kernels,
+                                     r.compileSeconds * 1e3, r.target, options.math,
+                                     r.fromDisk ? fmt::format("; {} from the disk cache", r.fromDisk) : "");
         int frames = std::max(options.frames, 1);
         std::cout << fmt::format("stepping {:.3f} ms per frame (update loops {:.3f}, kills and emissions {:.3f}, "
                                  "creation {:.3f}), drawing {:.3f} ms per frame\n",
