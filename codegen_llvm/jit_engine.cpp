@@ -84,7 +84,25 @@ public:
         }
         ObjectCache cache;
         cache.folder_ = folder;
+        cache.prune();
         return cache;
+    }
+    // At most kKept objects: past that, the least recently used go (a load touches its
+    // file), down to three quarters. Run once per JIT, so edits do not fill the disk.
+    static constexpr size_t kKept = 4096;
+    void prune() const {
+        std::error_code error;
+        std::vector<std::pair<std::filesystem::file_time_type, std::filesystem::path>> objects;
+        for (auto it = std::filesystem::directory_iterator(folder_, error); !error && it != std::filesystem::directory_iterator();
+             it.increment(error))
+            if (it->path().extension() == ".o") objects.push_back({it->last_write_time(error), it->path()});
+        if (objects.size() <= kKept) return;
+        std::sort(objects.begin(), objects.end());
+        for (size_t i = 0; i < objects.size() - kKept * 3 / 4; ++i) {
+            std::filesystem::path object = objects[i].second;
+            std::filesystem::remove(object, error);
+            std::filesystem::remove(object.replace_extension(".remarks"), error);
+        }
     }
     // The key of a module: its text and what else decides its machine code.
     static std::string key(const llvm::Module& module, const std::string& machine) {
@@ -108,12 +126,13 @@ public:
         auto buffer = llvm::MemoryBuffer::getFile(file.string());
         if (!buffer) return nullptr;
         auto object = llvm::object::ObjectFile::createObjectFile((*buffer)->getMemBufferRef());
+        std::error_code error;
         if (!object) {
             llvm::consumeError(object.takeError());
-            std::error_code error;
             std::filesystem::remove(file, error);
             return nullptr;
         }
+        std::filesystem::last_write_time(file, std::filesystem::file_time_type::clock::now(), error);  // used
         return std::move(*buffer);
     }
     // The object, and beside it what the vectorizer said about the module's loops (a

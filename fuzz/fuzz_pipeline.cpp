@@ -10,6 +10,12 @@
 #include "interp/interpreter.h"
 #include "rt/system.h"
 
+// Every input is a new program: caching its compiled code on disk would only fill the disk.
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+    ::setenv("PSYS_JIT_CACHE", "0", 1);
+    return 0;
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (size > 4096) return 0;  // the JIT's time per input
     psys::SourceManager sources;

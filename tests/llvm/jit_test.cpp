@@ -3,6 +3,7 @@
 // result.
 #include <doctest/doctest.h>
 
+#include <chrono>
 #include <cstring>
 #include <cstdlib>
 #include <map>
@@ -213,5 +214,31 @@ TEST_CASE("compiled objects are cached on disk: a second backend loads them, run
     CHECK(run(off) == compiled);
     CHECK(off.report().fromDisk == 0);
     ::unsetenv("PSYS_JIT_CACHE");
+    std::filesystem::remove_all(folder);
+}
+
+TEST_CASE("the disk cache keeps at most 4096 objects, dropping the least recently used") {
+    std::filesystem::path folder = std::filesystem::temp_directory_path() / ("psys-jit-prune-" + std::to_string(::getpid()));
+    std::filesystem::remove_all(folder);
+    std::filesystem::create_directories(folder);
+    auto now = std::filesystem::file_time_type::clock::now();
+    for (int i = 0; i < 4100; ++i) {
+        std::filesystem::path file = folder / (std::to_string(i) + ".o");
+        std::ofstream(file) << "x";
+        std::ofstream(folder / (std::to_string(i) + ".remarks")) << "";
+        std::filesystem::last_write_time(file, now - std::chrono::hours(5000 - i));  // 0 the oldest
+    }
+    ::setenv("PSYS_JIT_CACHE", folder.c_str(), 1);
+    { codegen_llvm::LlvmBackend jit; }
+    ::unsetenv("PSYS_JIT_CACHE");
+    size_t objects = 0, remarks = 0;
+    for (auto& entry : std::filesystem::directory_iterator(folder)) {
+        objects += entry.path().extension() == ".o";
+        remarks += entry.path().extension() == ".remarks";
+    }
+    CHECK(objects == 3072);
+    CHECK(remarks == 3072);
+    CHECK_FALSE(std::filesystem::exists(folder / "0.o"));
+    CHECK(std::filesystem::exists(folder / "4099.o"));
     std::filesystem::remove_all(folder);
 }
