@@ -32,6 +32,7 @@
 #include <llvm/Target/TargetMachine.h>
 #include <llvm/TargetParser/Host.h>
 
+#include "codegen_llvm/link_observer.h"
 #include "codegen_llvm/perf_map.h"
 #include "ir/hash.h"
 
@@ -249,24 +250,17 @@ static llvm::ArrayRef<llvm::VecDesc> wideVectorMath() {
 
 // Records the external symbols each linked graph refers to: which library functions the
 // compiled code calls (the vector maths it was meant to use, say).
-class CallRecorder : public llvm::orc::ObjectLinkingLayer::Plugin {
+class CallRecorder : public LinkObserver {
 public:
     CallRecorder(std::set<std::string>* calls, std::mutex* mutex) : calls_(calls), mutex_(mutex) {}
-    void modifyPassConfig(llvm::orc::MaterializationResponsibility&, llvm::jitlink::LinkGraph&,
-                          llvm::jitlink::PassConfiguration& config) override {
-        config.PostPrunePasses.push_back([this](llvm::jitlink::LinkGraph& graph) {
-            std::lock_guard lock(*mutex_);
-            for (llvm::jitlink::Symbol* symbol : graph.external_symbols())
-                if (symbol->hasName() && !symbol->getName().starts_with("_GLOBAL_OFFSET_TABLE_"))
-                    calls_->insert(symbol->getName().str());
-            return llvm::Error::success();
-        });
+
+protected:
+    void linked(llvm::jitlink::LinkGraph& graph) override {
+        std::lock_guard lock(*mutex_);
+        for (llvm::jitlink::Symbol* symbol : graph.external_symbols())
+            if (symbol->hasName() && !symbol->getName().starts_with("_GLOBAL_OFFSET_TABLE_"))
+                calls_->insert(symbol->getName().str());
     }
-    llvm::Error notifyFailed(llvm::orc::MaterializationResponsibility&) override { return llvm::Error::success(); }
-    llvm::Error notifyRemovingResources(llvm::orc::JITDylib&, llvm::orc::ResourceKey) override {
-        return llvm::Error::success();
-    }
-    void notifyTransferringResources(llvm::orc::JITDylib&, llvm::orc::ResourceKey, llvm::orc::ResourceKey) override {}
 
 private:
     std::set<std::string>* calls_;

@@ -1,6 +1,6 @@
 // The perf map writer (codegen_llvm/perf_map.h): a plugin of ORC's JITLink layer that,
-// after a graph is fixed up at its final addresses, appends each defined callable symbol
-// with its address and size. Lines are written whole under a lock: modules link on
+// after a graph is fixed up at its final addresses (LinkObserver), appends each defined
+// callable symbol with its address and size. Lines are written whole under a lock: modules link on
 // several compile threads at once.
 #include "codegen_llvm/perf_map.h"
 
@@ -12,31 +12,21 @@
 
 #include <unistd.h>
 
-#include <llvm/ExecutionEngine/JITLink/JITLink.h>
 #include <llvm/ExecutionEngine/Orc/LLJIT.h>
-#include <llvm/ExecutionEngine/Orc/ObjectLinkingLayer.h>
+
+#include "codegen_llvm/link_observer.h"
 
 namespace psys::codegen_llvm {
 
 namespace {
 
-class PerfMapPlugin : public llvm::orc::ObjectLinkingLayer::Plugin {
+class PerfMapPlugin : public LinkObserver {
 public:
     explicit PerfMapPlugin(std::FILE* file) : file_(file) {}
     ~PerfMapPlugin() override { std::fclose(file_); }
 
-    void modifyPassConfig(llvm::orc::MaterializationResponsibility&, llvm::jitlink::LinkGraph&,
-                          llvm::jitlink::PassConfiguration& config) override {
-        config.PostFixupPasses.push_back([this](llvm::jitlink::LinkGraph& graph) {
-            write(graph);
-            return llvm::Error::success();
-        });
-    }
-    llvm::Error notifyFailed(llvm::orc::MaterializationResponsibility&) override { return llvm::Error::success(); }
-    llvm::Error notifyRemovingResources(llvm::orc::JITDylib&, llvm::orc::ResourceKey) override {
-        return llvm::Error::success();
-    }
-    void notifyTransferringResources(llvm::orc::JITDylib&, llvm::orc::ResourceKey, llvm::orc::ResourceKey) override {}
+protected:
+    void linked(llvm::jitlink::LinkGraph& graph) override { write(graph); }
 
 private:
     // A module's exported function is a named symbol; the internal functions it calls (a
