@@ -22,6 +22,9 @@
 //                    before lower-temporal, and as simplify-kernels after the split)
 //   reassociate      (relaxed only) sums and products in one canonical order, so
 //                    (a+b+c)·(a+b+d) computes a+b once
+//   recompute-state  (relaxed only) a slot whose next value the next step can compute
+//                    from the other slots and the clock (the fire's previous `acc`) is
+//                    not stored
 //   dead-state       slots nothing needs go, equal slots merge, unchanged slots are not
 //                    stored, parameters read only at creation are not kept
 //   hoist-uniform    what is the same for every object of a type (constants, dt, time,
@@ -88,6 +91,7 @@ void splitKernels(ir::Module& module, PassErrors& errors);
 void simplify(ir::Module& module, const PassOptions& options, PassErrors& errors);
 void reassociate(ir::Module& module, PassErrors& errors);
 void hoistUniform(ir::Module& module, PassErrors& errors);
+void recomputeState(ir::Module& module, PassErrors& errors);
 void deadState(ir::Module& module, PassErrors& errors);
 
 struct PassInfo {

@@ -21,7 +21,7 @@ const std::vector<PassInfo>& passCatalogue() {
         {"simplify", "constant folding and exact identities (on the behaviour)"},
         {"simplify-kernels", "constant folding and exact identities (on the split kernels)"},
         {"reassociate", "(relaxed) sums and products in one canonical order, sharing common parts"},
-        {"hoist-uniform", "per-type work (constants, dt, time, externs) is done once per step"},
+        {"recompute-state", "(relaxed) a slot the next step can compute from the other slots and the clock is not stored"},
         {"dead-state", "unneeded slots go, equal slots merge, parameters used only at creation are not kept"},
     };
     return passes;
@@ -69,6 +69,10 @@ bool runPipeline(ir::Module& module, const PipelineOptions& options, PassErrors&
     }
     simplify(module, options.pass, errors);
     if (!after("simplify-kernels")) return false;
+    if (options.pass.relaxed) {
+        recomputeState(module, errors);
+        if (!after("recompute-state")) return false;
+    }
     deadState(module, errors);
     if (!after("dead-state")) return false;
     hoistUniform(module, errors);

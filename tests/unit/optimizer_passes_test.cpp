@@ -371,3 +371,96 @@ TEST_CASE("rewrite rules build their replacement, folding constants: x / 4 → x
     CHECK(k.at(mul.operands[1]).op == Op::Const);
     CHECK(k.at(mul.operands[1]).constant[0] == 0.25f);
 }
+
+namespace {
+
+void recomputeThenDeadState(Module& m, opt::PassErrors& e) {
+    opt::recomputeState(m, e);
+    opt::deadState(m, e);
+}
+
+// The fire's shape: slot #0 holds last step's acc = -v·2 + exp(-age) (v: slot #1), which
+// starts as the same function of v's start at age 0. `extra` is spliced into acc.
+std::string fireShaped(const std::string& initAcc, const std::string& clock) {
+    return R"(object p(iv: f32)
+  state prev@v: f32 next
+  state v: f32 next
+  kernel init
+    %0 = param.f32 #0
+    %1 = const.f32 -2
+    %2 = mul.f32 %0, %1
+    %3 = )" + initAcc + R"(
+    %4 = neg.f32 %3
+    %5 = exp.f32 %4
+    %6 = add.f32 %2, %5
+    yield state #0 = %6
+    yield state #1 = %0
+  end
+  kernel update
+    %0 = state.f32 #1
+    %1 = state.f32 #0
+    %2 = dt.f32
+    %3 = mul.f32 %1, %2
+    %4 = add.f32 %0, %3  ; v
+    %5 = const.f32 -2
+    %6 = mul.f32 %4, %5
+    %7 = )" + clock + R"(
+    %8 = neg.f32 %7
+    %9 = exp.f32 %8
+    %10 = add.f32 %6, %9  ; acc
+    yield state #0 = %10
+    yield state #1 = %4
+  end
+  kernel render
+    %0 = state.f32 #0
+    yield size = %0
+  end
+end
+)";
+}
+
+}  // namespace
+
+TEST_CASE("recompute-state: last step's acc is computed again from the stored v and age - dt, and not stored") {
+    CHECK(after(fireShaped("age.f32", "age.f32"), recomputeThenDeadState) == R"(object p(iv: f32 once)
+  state v: f32 next
+  kernel init
+    %0 = param.f32 #0
+    yield state #0 = %0
+  end
+  kernel update
+    %0 = state.f32 #0
+    %1 = const.f32 -2
+    %2 = mul.f32 %0, %1
+    %3 = age.f32
+    %4 = dt.f32
+    %5 = sub.f32 %3, %4
+    %6 = neg.f32 %5
+    %7 = exp.f32 %6
+    %8 = add.f32 %2, %7  ; acc
+    %9 = mul.f32 %4, %8
+    %10 = add.f32 %0, %9  ; v
+    yield state #0 = %10
+  end
+  kernel render
+    %0 = state.f32 #0
+    %1 = const.f32 -2
+    %2 = mul.f32 %0, %1
+    %3 = age.f32
+    %4 = neg.f32 %3
+    %5 = exp.f32 %4
+    %6 = add.f32 %2, %5  ; acc
+    yield size = %6
+  end
+end
+)");
+}
+
+TEST_CASE("recompute-state: not when the value reads dt, or starts as another function") {
+    // The previous step's dt is not known.
+    std::string readsDt = fireShaped("age.f32", "dt.f32");
+    CHECK(after(readsDt, opt::recomputeState) == after(readsDt, [](Module&, opt::PassErrors&) {}));
+    // Started at exp(-time) but stored as exp(-age): recomputing would change the first step.
+    std::string otherStart = fireShaped("time.f32", "age.f32");
+    CHECK(after(otherStart, opt::recomputeState) == after(otherStart, [](Module&, opt::PassErrors&) {}));
+}
