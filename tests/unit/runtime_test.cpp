@@ -340,8 +340,9 @@ TEST_CASE("creating objects in batches gives the run of creating them one by one
 TEST_CASE("with relaxed maths every sample's output stays within 1e-4 of max(1, |value|) over 600 frames") {
     // What differs: the last bits of reassociated sums and of x/c as x·(1/c), integrals of
     // constants taken as c·age instead of a float sum over 600 steps (the closed form is the
-    // more accurate of the two), and c + integrate(e) accumulated as one integral starting
-    // at c. That last one rounds relative to the summands, not to their sum: where a
+    // more accurate of the two), c + integrate(e) accumulated as one integral starting
+    // at c, and a slot computed again from the stored slots at age − dt (recompute-state)
+    // instead of stored. The fold rounds relative to the summands, not to their sum: where a
     // position crosses zero its error is a few ulps of the start position, so the
     // difference is measured against max(1, |value|), as the backends' are. Measured worst:
     // 5.4e-6 (for values above 0.01, 1.9e-4 of the value itself: the fire's positions).
