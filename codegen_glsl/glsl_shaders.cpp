@@ -1,5 +1,6 @@
 #include "codegen_glsl/glsl_shaders.h"
 
+#include <cmath>
 #include <fmt/format.h>
 
 #include "codegen_glsl/glsl_body.h"
@@ -190,8 +191,10 @@ void storeRowsYields(Statements& out, const Kernel& kernel, const ColumnLayout& 
                 storeColumns(out, l.render + ColumnLayout::kVisible, 1, value + " ? 1.0 : 0.0");
                 break;
             case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:
-                if (!l.fromState(y.kind))  // else drawn from the state column itself
-                    storeColumns(out, l.render + ColumnLayout::renderColumn(y.kind), width, value);
+                if (l.fromState(y.kind)) break;  // drawn from the state column itself
+                for (int c = 0; c < width; ++c)  // a constant lane has no column
+                    if (int column = ColumnLayout::renderColumn(y.kind) + c; !l.constant(column))
+                        out.line(fmt::format("sf({}u, i, {});", l.render + column, lane(value, width, c)));
                 break;
             default: break;
         }
@@ -204,7 +207,11 @@ void markDrawn(Statements& out, const ColumnLayout& l) {
     out.line("// drawn: visible, with a finite position, colour and size (counted)");
     std::string finite = "true";
     for (int c = ColumnLayout::kPosition; c < ColumnLayout::kRenderColumns; ++c)
-        finite += fmt::format(" && (floatBitsToUint(cf({}u, i)) & 0x7f800000u) != 0x7f800000u", l.drawnFrom(c));
+        if (auto k = l.constant(c)) {
+            if (!std::isfinite(*k)) finite = "false";  // every row's
+        } else {
+            finite += fmt::format(" && (floatBitsToUint(cf({}u, i)) & 0x7f800000u) != 0x7f800000u", l.drawnFrom(c));
+        }
     std::string visible = out.define("shown", "bool", fmt::format("cf({}u, i) != 0.0", l.render + ColumnLayout::kVisible));
     std::string ok = out.define("finite", "bool", finite);
     out.line(fmt::format("sf({}u, i, {} && {} ? 1.0 : 0.0);", l.render + ColumnLayout::kVisible, visible, ok));
@@ -320,11 +327,14 @@ std::string drawVertexShader() {
 // the words of the columns; rows that are not visible give no pixels.
 layout(std430, binding = 0) readonly buffer Words { uint w[]; };
 uniform uint columns[9];  // first words of visible, x, y, z, r, g, b, a, size
+uniform float constants[9];  // the value of a column whose first word is 0xffffffff (none)
 uniform mat4 view;
 uniform mat4 projection;
 uniform float reference;  // pixels per unit of size at depth 1
 out vec4 colour;
-float column(int c) { return uintBitsToFloat(w[columns[c] + uint(gl_VertexID)]); }
+float column(int c) {
+    return columns[c] == 0xffffffffu ? constants[c] : uintBitsToFloat(w[columns[c] + uint(gl_VertexID)]);
+}
 void main() {
     if (column(0) == 0.0) {
         gl_Position = vec4(2.0, 2.0, 2.0, 1.0);

@@ -102,7 +102,8 @@ public:
         for (const auto& p : layout.parentColumns)
             for (int l = 0; l < p.width; ++l) use(p.offset + l);
         if (kernel.kind == KernelKind::Render)  // it marks what it draws (markDrawn): every render column
-            for (int c = 0; c < ColumnLayout::kRenderColumns; ++c) use(layout.drawnFrom(c));
+            for (int c = 0; c < ColumnLayout::kRenderColumns; ++c)
+                if (!layout.constant(c)) use(layout.drawnFrom(c));
         for (const Yield& y : kernel.yields) {
             int width = kernel.at(y.value).type.width;
             auto lanes = [&](int first) { for (int l = 0; l < width; ++l) use(first + l); };
@@ -113,7 +114,9 @@ public:
                 case YieldKind::EmitRate: use(layout.emitRate(y.index)); break;
                 case YieldKind::EmitCount: use(layout.emitCount(y.index)); break;
                 case YieldKind::Visible: case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:
-                    if (!layout.fromState(y.kind)) lanes(layout.render + ColumnLayout::renderColumn(y.kind));
+                    if (!layout.fromState(y.kind))
+                        for (int l = 0; l < width; ++l)
+                            if (int c = ColumnLayout::renderColumn(y.kind) + l; !layout.constant(c)) use(layout.render + c);
                     break;
                 default: break;
             }
@@ -299,7 +302,8 @@ private:
                     for (int l = 0; l < t.width; ++l) {
                         int column = ColumnLayout::renderColumn(y.kind) + l;
                         render[column] = toFloat(v[static_cast<size_t>(l)], t);
-                        if (!layout.fromState(y.kind))  // else drawn from the state column itself
+                        // Else drawn from the state column itself, or a constant with no column.
+                        if (!layout.fromState(y.kind) && !layout.constant(column))
                             b_.CreateAlignedStore(render[column], columnAt(argOf, layout.render + column, f32),
                                                   llvm::Align(4));
                     }
@@ -320,7 +324,9 @@ private:
                                                     llvm::Value* drawnSoFar, llvm::Value* nonFiniteSoFar) {
         llvm::Type* f32 = b_.getFloatTy();
         for (int column = 0; column < ColumnLayout::kRenderColumns; ++column)
-            if (!render[column])
+            if (auto k = layout.constant(column))
+                render[column] = llvm::ConstantFP::get(f32, *k);
+            else if (!render[column])
                 render[column] = b_.CreateAlignedLoad(f32, columnAt(argOf, layout.drawnFrom(column), f32), llvm::Align(4));
         llvm::Value* finite = b_.getTrue();
         llvm::Value* infinity = llvm::ConstantFP::getInfinity(f32);

@@ -70,7 +70,7 @@ void writtenColumns(const ir::Kernel& kernel, const ColumnLayout& l, std::vector
     // drawn from state columns are the state's, resident already).
     if (kernel.kind == ir::KernelKind::Render)
         for (int c = 0; c < ColumnLayout::kRenderColumns; ++c)
-            if (l.drawnFrom(c) == l.render + c) resident.push_back(l.render + c);
+            if (l.drawnFrom(c) == l.render + c && !l.constant(c)) resident.push_back(l.render + c);
     for (const ir::Yield& y : kernel.yields) {
         int width = kernel.at(y.value).type.width;
         switch (y.kind) {

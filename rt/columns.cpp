@@ -4,6 +4,28 @@
 
 namespace psys::rt {
 
+namespace {
+
+// Lane `lane` of `v` when it is a constant: a constant, a splat of one, or a lane of a
+// compose that is.
+std::optional<float> constantLane(const ir::Kernel& k, ir::ValueId v, int lane) {
+    const ir::Inst& i = k.at(v);
+    switch (i.op) {
+        case ir::Op::Const: return i.type.isBool() ? std::nullopt : std::optional<float>(i.constant[static_cast<size_t>(lane)]);
+        case ir::Op::Splat: return constantLane(k, i.operands[0], 0);
+        case ir::Op::Compose:
+            for (ir::ValueId o : i.operands) {
+                int width = k.at(o).type.width;
+                if (lane < width) return constantLane(k, o, lane);
+                lane -= width;
+            }
+            return std::nullopt;
+        default: return std::nullopt;
+    }
+}
+
+}  // namespace
+
 ColumnLayout columnLayout(const ir::Object& object, const ir::Kernel& kernel) {
     ColumnLayout l;
     int next = ColumnLayout::kFirstColumn;
@@ -39,8 +61,17 @@ ColumnLayout columnLayout(const ir::Object& object, const ir::Kernel& kernel) {
                 l.renderFromState[static_cast<size_t>(ColumnLayout::renderColumn(y.kind) + c)] =
                     l.stateOffset.at(static_cast<size_t>(value.attr)) + c;
         }
+        l.renderConstant.assign(ColumnLayout::kRenderColumns, {});
+        for (const ir::Yield& y : kernel.yields)
+            if (y.kind == ir::YieldKind::Position || y.kind == ir::YieldKind::Color || y.kind == ir::YieldKind::Size) {
+                int first = ColumnLayout::renderColumn(y.kind);
+                for (int c = 0; c < kernel.at(y.value).type.width; ++c)
+                    if (auto v = constantLane(kernel, y.value, c))
+                        l.renderConstant[static_cast<size_t>(first + c)] = {true, *v};
+            }
         for (int c = 0; c < ColumnLayout::kRenderColumns; ++c)
-            l.writes[static_cast<size_t>(l.render - l.emits + c)] = l.renderFromState[static_cast<size_t>(c)] < 0;
+            l.writes[static_cast<size_t>(l.render - l.emits + c)] =
+                l.renderFromState[static_cast<size_t>(c)] < 0 && !l.renderConstant[static_cast<size_t>(c)].is;
     }
     for (const ir::Inst& i : kernel.insts()) {
         if (!ir::readsAncestor(i.op)) continue;
@@ -84,6 +115,8 @@ std::string ColumnLayout::signature() const {
     for (int o : exportOffset) s += fmt::format(" e{}", o);
     for (const auto& p : parentColumns) s += fmt::format(" r{}:{}:{}", p.depth, p.exportIndex, p.offset);
     for (int c : renderFromState) s += fmt::format(" d{}", c);
+    for (size_t c = 0; c < renderConstant.size(); ++c)
+        if (renderConstant[c].is) s += fmt::format(" k{}={:a}", c, renderConstant[c].value);
     return s;
 }
 

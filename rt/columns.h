@@ -10,12 +10,13 @@
 //     parameter the pool does not keep has no column (an invalid buffer)
 //   emits    per emit site, a rate and a count column (f32), written for every row
 //   render   visible (0 or 1), position x y z, colour r g b a, size: f32, written for
-//     every row by render kernels
+//     every row by render kernels (but those drawn from a state column or constant)
 //   parents  per parent read of the kernel, in instruction order, one f32 column per
 //     component (gathered by the run-time; `alive` is 0 or 1)
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,20 @@ struct ColumnLayout {
                    : renderFromState[static_cast<size_t>(c)];
     }
     bool fromState(ir::YieldKind kind) const { return drawnFrom(renderColumn(kind)) != render + renderColumn(kind); }
+    // A position, colour or size component every row draws alike (`point(pos, col, 2)`:
+    // the size is 2; `(0, 1 − age, 0, 1)`: three of the colour's four) has no column at
+    // all: the drawing hands over its value. Per render column (kVisible … kSize); the
+    // `visible` column is never constant (it is where the drawn rows are marked). Every
+    // backend and the drawing read this one rule.
+    struct Constant {
+        bool is = false;
+        float value = 0;
+    };
+    std::vector<Constant> renderConstant;
+    std::optional<float> constant(int c) const {
+        if (renderConstant.empty() || !renderConstant[static_cast<size_t>(c)].is) return std::nullopt;
+        return renderConstant[static_cast<size_t>(c)].value;
+    }
 
     int emitRate(int site) const { return emits + 2 * site; }
     int emitCount(int site) const { return emits + 2 * site + 1; }

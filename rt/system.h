@@ -93,6 +93,9 @@ struct DrawColumns {
     Buffer color[4];        // f32
     Buffer size;            // f32
     Buffer ids;             // u32
+    // A component every row draws alike has no column (an invalid buffer above) and its
+    // value here: position x y z, colour r g b a, size (ColumnLayout::renderConstant).
+    std::array<float, 8> constant{};
 };
 
 // What hot reload kept and lost (rt/reload.cpp, docs/runtime.md).

@@ -39,6 +39,8 @@ const DrawColumns& Drawing::draw(size_t type) {
     for (int c = 0; c < 3; ++c) out.position[c] = column(ColumnLayout::kPosition + c);
     for (int c = 0; c < 4; ++c) out.color[c] = column(ColumnLayout::kColor + c);
     out.size = column(ColumnLayout::kSize);
+    for (int c = 0; c < 8; ++c)
+        if (auto k = layout.constant(ColumnLayout::kPosition + c)) out.constant[static_cast<size_t>(c)] = *k;
     // The rows drawn are among the alive ones: the pool keeps that mask (synced by bindPool).
     RowsLaunch launch;
     launch.object = &pool.object();
@@ -57,8 +59,12 @@ const DrawColumns& Drawing::draw(size_t type) {
     const bool marked = s_.backend.marksDrawn();
     float* visible = marked ? nullptr : s_.host<float>(out.visible);
     const float* values[8] = {};
+    bool constantsFinite = true;  // the constant components: the same for every row
     if (!marked)
-        for (int c = 0; c < 8; ++c) values[c] = s_.view<float>(column(ColumnLayout::kPosition + c));
+        for (int c = 0; c < 8; ++c) {
+            if (auto k = layout.constant(ColumnLayout::kPosition + c)) constantsFinite &= std::isfinite(*k);
+            else values[c] = s_.view<float>(column(ColumnLayout::kPosition + c));
+        }
     std::mutex counting;
     size_t drawn = 0;
     uint64_t nonFinite = 0;
@@ -76,8 +82,9 @@ const DrawColumns& Drawing::draw(size_t type) {
                 visible[row] = 0;
                 continue;
             }
-            bool finite = true;
-            for (const float* v : values) finite &= std::isfinite(v[row]);
+            bool finite = constantsFinite;
+            for (const float* v : values)
+                if (v) finite &= std::isfinite(v[row]);
             visible[row] = finite ? 1.0f : 0.0f;
             chunkDrawn += finite;
             chunkNonFinite += !finite;
@@ -104,6 +111,10 @@ std::vector<RenderPoint> Drawing::points(size_t type) {
     memory.read(c.ids, 0, c.rows, ids.data());
     Buffer columns[8] = {c.position[0], c.position[1], c.position[2], c.color[0], c.color[1], c.color[2], c.color[3], c.size};
     for (int k = 0; k < 8; ++k) {
+        if (!columns[k].valid()) {  // a constant
+            values[k].assign(c.rows, c.constant[static_cast<size_t>(k)]);
+            continue;
+        }
         values[k].resize(c.rows);
         memory.read(columns[k], 0, c.rows, values[k].data());
     }

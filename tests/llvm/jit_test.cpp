@@ -167,6 +167,46 @@ TEST_CASE("the JIT's render loops mark what is drawn as the run-time's rule says
     }
 }
 
+TEST_CASE("a component every point draws alike has no column: the JIT and the interpreter hand over its value") {
+    // a: colour (0, 1 - age, 0, 1), size 2: five constants, one colour column. b: a NaN
+    // size, constant: no point of b is drawn, each counted as not finite.
+    const char* text =
+        "object a { point(vec3(age, 1, 2), mix(green, black, age), 2); }\n"
+        "object b { point(vec3(age), white, 0.0 / 0.0); }\n"
+        "spawn a; spawn a; spawn b;";
+    interp::Interpreter interpreter;
+    codegen_llvm::LlvmBackend jit;
+    rt::System slow(compile(text), interpreter), fast(compile(text), jit);
+    for (rt::System* s : {&slow, &fast}) {
+        s->step(0.25);
+        const rt::DrawColumns& a = s->draw(0);
+        CHECK(a.drawn == 2);
+        CHECK(a.position[0].valid());
+        for (int c : {1, 2}) CHECK_FALSE(a.position[c].valid());
+        CHECK(a.constant[1] == 1);
+        CHECK(a.constant[2] == 2);
+        CHECK_FALSE(a.color[0].valid());
+        CHECK(a.color[1].valid());
+        CHECK_FALSE(a.color[2].valid());
+        CHECK_FALSE(a.color[3].valid());
+        CHECK_FALSE(a.size.valid());
+        CHECK(a.constant[7] == 2);
+        auto points = s->points(0);
+        REQUIRE(points.size() == 2);
+        for (const rt::RenderPoint& p : points) {
+            CHECK(p.position[0] == 0.25f);
+            CHECK(p.position[2] == 2);
+            CHECK(p.color[0] == 0);
+            CHECK(p.color[1] == 0.75f);
+            CHECK(p.color[3] == 1);
+            CHECK(p.size == 2);
+        }
+        CHECK(s->draw(1).drawn == 0);
+        CHECK(s->points(1).empty());
+        CHECK(s->stats().nonFiniteRender == 1);
+    }
+}
+
 TEST_CASE("fast maths calls glibc's vector functions at the loops' full width; exact maths calls libm's") {
     codegen_llvm::LlvmBackend fast(codegen_llvm::MathMode::Fast), exact(codegen_llvm::MathMode::Exact);
     // The 16-lane (AVX-512) variants where loops run 16 floats a register, else 8 (AVX) or 4.

@@ -395,8 +395,13 @@ TEST_CASE("a render value that is a state value is drawn from the state column i
             CHECK(layout.needs(layout.render + column) == !fromState);  // no scratch column for it
             CHECK((drawn.position[static_cast<size_t>(c)] == pool.state.column(0, static_cast<size_t>(c))) == fromState);
         }
-        // The colour is a constant, not a state value: written by the render kernel.
-        CHECK(layout.drawnFrom(rt::ColumnLayout::kColor) == layout.render + rt::ColumnLayout::kColor);
+        // The colour and the size are constants: no column, the drawing hands over their values.
+        for (int c = rt::ColumnLayout::kColor; c < rt::ColumnLayout::kRenderColumns; ++c) {
+            CHECK(layout.constant(c).has_value());
+            CHECK_FALSE(layout.needs(layout.render + c));
+        }
+        CHECK_FALSE(drawn.size.valid());
+        CHECK(drawn.constant[7] == 2);
         auto points = run.points(name);
         REQUIRE(points.size() == 1);
         CHECK(points[0].position[0] == (fromState ? 1.0f : 2.0f));

@@ -123,6 +123,13 @@ void PointRenderer::draw(const rt::DrawColumns& c, const rt::Memory& memory, con
     const rt::Buffer columns[kColumns] = {c.visible, c.position[0], c.position[1], c.position[2], c.color[0],
                                           c.color[1], c.color[2], c.color[3], c.size};
     for (int i = 0; i < kColumns; ++i) {
+        // A component every point draws alike has no column: a constant attribute.
+        if (!columns[i].valid()) {
+            glDisableVertexArrayAttrib(vao_, static_cast<GLuint>(i));
+            glVertexAttrib1f(static_cast<GLuint>(i), i == 0 ? 1.0f : c.constant[static_cast<size_t>(i - 1)]);
+            continue;
+        }
+        glEnableVertexArrayAttrib(vao_, static_cast<GLuint>(i));
         // Straight from the column's GL buffer where the backend computes in GL (the GLSL
         // backend, in this context); else uploaded from the host.
         if (unsigned gl = memory.glBuffer(columns[i])) {
