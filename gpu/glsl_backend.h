@@ -37,6 +37,7 @@ public:
     void run(const rt::ChildrenLaunch& launch) override;
     rt::BackendReport report() const override;
     bool marksDrawn() const override { return true; }
+    bool rendersInStep() const override { return false; }
 
     // Time of the launches so far while timePasses is on, by kernel kind name: on the GPU
     // (GL timer queries), and on the wall from a glFinish before the dispatch to one after

@@ -119,6 +119,10 @@ public:
     // in the mask, its point visible and every render value finite, else 0; counted in
     // RowsResult. Else the run-time does it on the host after the launch.
     virtual bool marksDrawn() const { return false; }
+    // Whether a step should compute what is drawn while it updates (chunk by chunk, the
+    // rows still in cache) when the host draws every step: true where launches run on the
+    // host's memory; a GPU gains nothing from it and pays a dispatch per chunk.
+    virtual bool rendersInStep() const { return true; }
     virtual BackendReport report() const { return {}; }
 };
 

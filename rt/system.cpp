@@ -112,9 +112,15 @@ std::optional<std::string> System::step(double dt) {
     s.lastDt = dt;
     double t1 = s.now + dt;
     for (Pool& pool : s.pools) pool.beginStep();
+    // The host drew after the last step: this one draws as it goes.
+    bool drawing = s.options.drawInStep && drawing_->drewSinceStep() && s.backend.rendersInStep();
+    drawing_->stepping();
+    for (size_t type = 0; type < s.pools.size(); ++type)
+        s.work[type].inStep = {drawing && s.types[type].render && s.types[type].drawn[0], false, false, 0, 0};
     // Parents before children: a type's objects, then what they created, advanced to t1.
     for (size_t type = 0; type < s.pools.size(); ++type) {
         detail::updateType(s, *creation_, type, dt, t1);
+        s.work[type].inStep.updated = true;
         auto start = WallClock::now();
         creation_->drain(t1);
         s.stats.createSeconds += seconds(start, WallClock::now());
@@ -130,7 +136,11 @@ std::optional<std::string> System::step(double dt) {
     }
     s.dying.clear();
     s.stats.emitSeconds += seconds(releasing, WallClock::now());
-    drawing_->invalidate();
+    for (detail::TypeWork& w : s.work) {
+        w.inStep.fresh = w.inStep.on;
+        w.inStep.on = w.inStep.updated = false;
+    }
+    drawing_->invalidate(true);
     ++s.stats.steps;
     return std::nullopt;
 }
@@ -168,6 +178,8 @@ std::optional<std::string> System::setExtern(int index, std::span<const float> v
     }
     s.externs[static_cast<size_t>(index)] = v;
     ++s.externsVersion;
+    // A render kernel may read it: what the step drew as it went is drawn again.
+    for (detail::TypeWork& w : s.work) w.inStep.fresh = false;
     return std::nullopt;
 }
 

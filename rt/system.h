@@ -41,6 +41,10 @@ struct SystemOptions {
     // Create the objects queued in a step in batches of any size; false: one at a time.
     // Results are the same (tests compare the two).
     bool createInBatches = true;
+    // When the host draws every step, compute what is drawn during the step, chunk by
+    // chunk as the update leaves it in cache (rt/system_draw.h); false: in draw() alone.
+    // Results are the same (tests compare the two).
+    bool drawInStep = true;
 };
 
 struct TypeStats {

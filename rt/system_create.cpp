@@ -9,6 +9,7 @@
 #include <cstring>
 
 #include "rt/rng.h"
+#include "rt/system_draw.h"
 #include "rt/system_support.h"
 
 namespace psys::rt::detail {
@@ -26,10 +27,10 @@ struct Creation::Staging {
 // Per type: the scratch columns a batch is created in, indexed like the staging rows (so
 // the staging columns are the batch's parameters as they are).
 struct Creation::Batch {
-    explicit Batch(Memory& m) : columns(m), initParents(m), updateParents(m), exportsParents(m) {}
-    Scratch columns, initParents, updateParents, exportsParents;
+    explicit Batch(Memory& m) : columns(m), initParents(m), updateParents(m), exportsParents(m), renderParents(m) {}
+    Scratch columns, initParents, updateParents, exportsParents, renderParents;
     ColumnLayout initLayout;
-    std::vector<Buffer> initTable, updateTable, exportsTable;
+    std::vector<Buffer> initTable, updateTable, exportsTable, renderTable;
     std::vector<std::vector<Buffer>> burstTables;  // per emit site: the state at creation, for bursts
     size_t first = 0;                  // the batch's first staging row
     std::vector<uint32_t> poolRows;    // per object of the batch: its pool row, or kSkipRow (dropped)
@@ -41,7 +42,7 @@ namespace {
 
 // Scratch column indices of a batch.
 constexpr size_t kCreated = 0, kIds = 1, kKill = 2, kNow = 3, kDt = 4, kMask = 5, kStepMask = 6, kExportMask = 7,
-                 kZero = 8, kFirstValue = 9;
+                 kZero = 8, kRenderMask = 9, kFirstValue = 10;
 
 size_t components(const std::vector<ir::StateSlot>& slots) {
     size_t n = 0;
@@ -230,6 +231,10 @@ void Creation::bindBatch(size_t type, Batch& b, const ColumnLayout& layout, Scra
     for (size_t e = 0; e < 2 * o.emits.size(); ++e)
         table[static_cast<size_t>(layout.emits) + e] =
             b.columns.at(kFirstValue + 2 * stateCount + exportCount + e, Elem::F32, rows);
+    for (int c = 0; c < ColumnLayout::kRenderColumns; ++c)  // what a render kernel writes
+        if (layout.needs(layout.render + c))
+            table[static_cast<size_t>(layout.render + c)] = b.columns.at(
+                kFirstValue + 2 * stateCount + exportCount + 2 * o.emits.size() + static_cast<size_t>(c), Elem::F32, rows);
     for (size_t p = 0; p < layout.parentColumns.size(); ++p)
         for (int c = 0; c < layout.parentColumns[p].width; ++c) {
             size_t column = static_cast<size_t>(layout.parentColumns[p].offset + c);
@@ -275,6 +280,39 @@ void Creation::createBatch(size_t type, size_t from, size_t to, double t1) {
     identify(type, b, from, n);
     atCreation(type, b, n);
     firstUpdate(type, b, n, allocated, t1);
+    const DrawnInStep& drawing = s_.work[type].inStep;
+    if (drawing.on && drawing.updated) drawBatch(type, b, n, t1);
+}
+
+// Drawing as the step goes (rt/system_draw.h): objects created after their type's update
+// are rendered here, in the batch, and their render columns scattered into the pool's.
+void Creation::drawBatch(size_t type, Batch& b, size_t n, double t1) {
+    const TypeInfo& info = s_.types[type];
+    const ColumnLayout& layout = info.renderLayout;
+    Pool& pool = s_.pools[type];
+    TypeWork& work = s_.work[type];
+    const size_t first = b.first, end = first + n;
+    bindBatch(type, b, layout, b.renderParents, b.renderTable, false);
+    Buffer mask = b.columns.at(kRenderMask, Elem::U8, end);
+    auto* shown = s_.host<uint8_t>(mask);
+    for (size_t r = 0; r < n; ++r)  // not those dropped, nor those that died in their first update
+        shown[first + r] = b.poolRows[r] != kSkipRow && pool.status(b.poolRows[r]) == Status::Alive;
+    RowsLaunch launch = renderLaunch(s_, type, b.renderTable, mask, t1);
+    std::atomic<uint64_t> drawn = 0, nonFinite = 0;
+    s_.parallel->forEach((n + kRowsPerChunk - 1) / kRowsPerChunk, s_.backend.concurrent(), [&](size_t c) {
+        size_t begin = first + c * kRowsPerChunk;
+        DrawnCount count = renderRows(s_, type, launch, shown, begin, std::min(end, begin + kRowsPerChunk),
+                                      b.poolRows.data(), first);
+        drawn += count.drawn;
+        nonFinite += count.nonFinite;
+    });
+    work.inStep.drawn += drawn;
+    work.inStep.nonFinite += nonFinite;
+    s_.bindPool(type, layout, work.render, work.renderTable);
+    for (int c = 0; c < ColumnLayout::kRenderColumns; ++c)
+        if (int column = layout.render + c; layout.needs(column))
+            s_.memory.scatter(b.renderTable[static_cast<size_t>(column)], first,
+                              work.renderTable[static_cast<size_t>(column)], b.poolRows);
 }
 
 // The batch's objects in its columns and their pool rows: creation times, ids, parents

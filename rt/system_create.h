@@ -63,6 +63,7 @@ private:
     // Counts the updates beyond the stability limit in `type`'s stats.
     void runBatch(const RowsLaunch& launch, size_t first, size_t end, size_t type);
     void firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, double t1);
+    void drawBatch(size_t type, Batch& b, size_t n, double t1);
     void advance(size_t type, Batch& b, size_t n, size_t maskColumn);
     void queueBursts(size_t type, Batch& b, size_t r);
     void killOrEmit(size_t type, Batch& b, size_t r, double dt, double t1);

@@ -7,21 +7,88 @@
 
 namespace psys::rt::detail {
 
-Drawing::Drawing(State& state) : s_(state) {
-    for (size_t t = 0; t < s_.pools.size(); ++t) types_.emplace_back(s_.memory);
+RowsLaunch renderLaunch(State& s, size_t type, std::span<const Buffer> table, Buffer mask, double now) {
+    const TypeInfo& info = s.types[type];
+    RowsLaunch launch;
+    launch.object = &s.pools[type].object();
+    launch.kernel = info.render;
+    launch.layout = &info.renderLayout;
+    launch.columns = table;
+    launch.mask = mask;
+    launch.clock = {Clock::Source::Uniform, Clock::Source::Uniform, now, static_cast<float>(s.lastDt), false};
+    launch.externs = s.externs.data();
+    launch.uniforms = s.uniforms(type, *info.render, static_cast<float>(s.lastDt), static_cast<float>(now));
+    launch.seed = s.options.seed;
+    launch.draw = static_cast<uint32_t>(s.step);
+    return launch;
 }
 
-void Drawing::invalidate() {
+DrawnCount renderRows(State& s, size_t type, const RowsLaunch& launch, const uint8_t* mask, size_t begin, size_t end,
+                      const uint32_t* poolRows, size_t poolRowsFirst) {
+    const ColumnLayout& layout = *launch.layout;
+    RowsLaunch part = launch;
+    part.begin = begin;
+    part.end = end;
+    s.gatherParents(type, layout, launch.columns, mask, begin, end, launch.clock.nowValue, nullptr, poolRows,
+                    poolRowsFirst);
+    RowsResult result = s.backend.run(part);
+    DrawnCount count{result.drawn, result.nonFinite};
+    if (s.backend.marksDrawn()) return count;  // its render columns stay where it computed them
+    // Drawn: alive, visible, and position, colour and size all finite.
+    auto column = [&](int c) { return launch.columns[static_cast<size_t>(layout.drawnFrom(c))]; };
+    float* visible = s.host<float>(column(ColumnLayout::kVisible));
+    const float* values[8] = {};
+    bool constantsFinite = true;  // the constant components: the same for every row
+    for (int c = 0; c < 8; ++c) {
+        if (auto k = layout.constant(ColumnLayout::kPosition + c)) constantsFinite &= std::isfinite(*k);
+        else values[c] = s.view<float>(column(ColumnLayout::kPosition + c));
+    }
+    for (size_t row = begin; row < end; ++row) {
+        if (!mask[row] || visible[row] == 0) {
+            visible[row] = 0;
+            continue;
+        }
+        bool finite = constantsFinite;
+        for (const float* v : values)
+            if (v) finite &= std::isfinite(v[row]);
+        visible[row] = finite ? 1.0f : 0.0f;
+        count.drawn += finite;
+        count.nonFinite += !finite;
+    }
+    return count;
+}
+
+Drawing::Drawing(State& state) : s_(state), types_(state.pools.size()) {}
+
+void Drawing::invalidate(bool step) {
     for (Type& t : types_) t.stale = true;
+    if (!step)
+        for (TypeWork& w : s_.work) w.inStep.fresh = false;
+}
+
+// The render columns of `type`'s table as DrawColumns: a value that is a state value is
+// drawn from the state column itself, a constant is handed over as its value.
+void Drawing::hand(size_t type, DrawColumns& out) {
+    const ColumnLayout& layout = s_.types[type].renderLayout;
+    const std::vector<Buffer>& table = s_.work[type].renderTable;
+    auto column = [&](int offset) { return table[static_cast<size_t>(layout.drawnFrom(offset))]; };
+    out.visible = column(ColumnLayout::kVisible);
+    for (int c = 0; c < 3; ++c) out.position[c] = column(ColumnLayout::kPosition + c);
+    for (int c = 0; c < 4; ++c) out.color[c] = column(ColumnLayout::kColor + c);
+    out.size = column(ColumnLayout::kSize);
+    for (int c = 0; c < 8; ++c)
+        if (auto k = layout.constant(ColumnLayout::kPosition + c)) out.constant[static_cast<size_t>(c)] = *k;
 }
 
 const DrawColumns& Drawing::draw(size_t type) {
+    drew_ = true;
     Type& d = types_[type];
     if (!d.stale) return d.columns;
     d.stale = false;
     auto start = WallClock::now();
     const Pool& pool = s_.pools[type];
     const TypeInfo& info = s_.types[type];
+    TypeWork& work = s_.work[type];
     size_t rows = pool.rows();
     DrawColumns& out = d.columns;
     out = {};
@@ -31,70 +98,29 @@ const DrawColumns& Drawing::draw(size_t type) {
         out.rows = 0;
         return out;
     }
-    const ColumnLayout& layout = info.renderLayout;
-    s_.bindPool(type, layout, d.scratch, d.table);
-    // A render value that is a state value is drawn from the state column itself.
-    auto column = [&](int offset) { return d.table[static_cast<size_t>(layout.drawnFrom(offset))]; };
-    out.visible = column(ColumnLayout::kVisible);
-    for (int c = 0; c < 3; ++c) out.position[c] = column(ColumnLayout::kPosition + c);
-    for (int c = 0; c < 4; ++c) out.color[c] = column(ColumnLayout::kColor + c);
-    out.size = column(ColumnLayout::kSize);
-    for (int c = 0; c < 8; ++c)
-        if (auto k = layout.constant(ColumnLayout::kPosition + c)) out.constant[static_cast<size_t>(c)] = *k;
-    // The rows drawn are among the alive ones: the pool keeps that mask (synced by bindPool).
-    RowsLaunch launch;
-    launch.object = &pool.object();
-    launch.kernel = info.render;
-    launch.layout = &layout;
-    launch.columns = d.table;
-    launch.mask = pool.alive.column;
-    launch.clock = {Clock::Source::Uniform, Clock::Source::Uniform, s_.now, static_cast<float>(s_.lastDt), false};
-    launch.externs = s_.externs.data();
-    launch.uniforms = s_.uniforms(type, *info.render, static_cast<float>(s_.lastDt), static_cast<float>(s_.now));
-    launch.seed = s_.options.seed;
-    launch.draw = static_cast<uint32_t>(s_.step);
+    s_.bindPool(type, info.renderLayout, work.render, work.renderTable);  // the alive mask synced too
+    hand(type, out);
+    if (work.inStep.fresh) {  // the step drew as it went: the columns are what is drawn
+        out.drawn = work.inStep.drawn;
+        s_.stats.nonFiniteRender += work.inStep.nonFinite;
+        work.inStep.nonFinite = 0;
+        s_.stats.drawSeconds += seconds(start, WallClock::now());
+        return out;
+    }
+    // The rows drawn are among the alive ones, in parallel chunks.
+    RowsLaunch launch = renderLaunch(s_, type, work.renderTable, pool.alive.column, s_.now);
     const uint8_t* mask = pool.alive.host();
-    // The rows drawn: marked by the render launch itself on a backend that does so (its
-    // render columns stay where it computed them), else here.
-    const bool marked = s_.backend.marksDrawn();
-    float* visible = marked ? nullptr : s_.host<float>(out.visible);
-    const float* values[8] = {};
-    bool constantsFinite = true;  // the constant components: the same for every row
-    if (!marked)
-        for (int c = 0; c < 8; ++c) {
-            if (auto k = layout.constant(ColumnLayout::kPosition + c)) constantsFinite &= std::isfinite(*k);
-            else values[c] = s_.view<float>(column(ColumnLayout::kPosition + c));
-        }
     std::mutex counting;
-    size_t drawn = 0;
-    uint64_t nonFinite = 0;
+    DrawnCount all;
     s_.forChunks(rows, [&](size_t c) {
-        RowsLaunch part = launch;
-        part.begin = c * kRowsPerChunk;
-        part.end = std::min(rows, part.begin + kRowsPerChunk);
-        s_.gatherParents(type, layout, d.table, mask, part.begin, part.end, s_.now);
-        RowsResult result = s_.backend.run(part);
-        size_t chunkDrawn = result.drawn;
-        uint64_t chunkNonFinite = result.nonFinite;
-        // Drawn: alive, visible, and position, colour and size all finite.
-        for (size_t row = part.begin; !marked && row < part.end; ++row) {
-            if (!mask[row] || visible[row] == 0) {
-                visible[row] = 0;
-                continue;
-            }
-            bool finite = constantsFinite;
-            for (const float* v : values)
-                if (v) finite &= std::isfinite(v[row]);
-            visible[row] = finite ? 1.0f : 0.0f;
-            chunkDrawn += finite;
-            chunkNonFinite += !finite;
-        }
+        size_t begin = c * kRowsPerChunk;
+        DrawnCount chunk = renderRows(s_, type, launch, mask, begin, std::min(rows, begin + kRowsPerChunk));
         std::lock_guard lock(counting);
-        drawn += chunkDrawn;
-        nonFinite += chunkNonFinite;
+        all.drawn += chunk.drawn;
+        all.nonFinite += chunk.nonFinite;
     });
-    out.drawn = drawn;
-    s_.stats.nonFiniteRender += nonFinite;
+    out.drawn = all.drawn;
+    s_.stats.nonFiniteRender += all.nonFinite;
     s_.stats.drawSeconds += seconds(start, WallClock::now());
     return out;
 }

@@ -1,7 +1,14 @@
 // Internal to rt/: drawing. The render kernel runs over a pool's live rows into render
-// columns; a pass then marks the rows drawn (alive, visible, every value finite) and
-// counts the points not drawn for a NaN or an infinity. The columns are handed over as
-// they are (DrawColumns); reading them back to the host is `points`.
+// columns and the rows drawn are marked (alive, visible, every value finite), counting the
+// points not drawn for a NaN or an infinity. The columns are handed over as they are
+// (DrawColumns); reading them back to the host is `points`.
+//
+// Where the host draws every step, the step draws as it goes (DrawnInStep): each chunk of
+// an update is rendered right after it, while its rows are in cache, over the rows alive
+// at the end of the step, and objects created after their type's update are rendered in
+// their creation batch and scattered into the render columns. `draw` then hands over the
+// columns with no pass of its own. The values are the same bits either way: the render
+// kernel sees the same state, clock, uniforms and parents (a test compares the two).
 #pragma once
 
 #include <vector>
@@ -10,24 +17,41 @@
 
 namespace psys::rt::detail {
 
+struct DrawnCount {
+    size_t drawn = 0;
+    uint64_t nonFinite = 0;
+};
+
+// The render launch of `type` over `table` (bound for its render layout) at the end of the
+// step ending at `now`, rows to be chosen; `mask` selects the rows to draw.
+RowsLaunch renderLaunch(State& s, size_t type, std::span<const Buffer> table, Buffer mask, double now);
+// Renders rows [begin, end) of `launch` and marks the rows drawn (the backend, or here);
+// `mask` is the launch's mask on the host. `poolRows`: where the table is a creation
+// batch, its rows' pool rows (for their parents).
+DrawnCount renderRows(State& s, size_t type, const RowsLaunch& launch, const uint8_t* mask, size_t begin, size_t end,
+                      const uint32_t* poolRows = nullptr, size_t poolRowsFirst = 0);
+
 class Drawing {
 public:
     explicit Drawing(State& state);
-    // Everything drawn must be computed again (after a step or a trigger).
-    void invalidate();
+    // Everything drawn must be computed again (after a trigger, a reload, a new extern
+    // value); `step`: what the step drew as it went stays valid.
+    void invalidate(bool step = false);
     const DrawColumns& draw(size_t type);
     std::vector<RenderPoint> points(size_t type);
+    // Whether the host drew since the last step (the next step then draws as it goes).
+    bool drewSinceStep() const { return drew_; }
+    void stepping() { drew_ = false; }
 
 private:
     struct Type {
-        explicit Type(Memory& m) : scratch(m) {}
-        Scratch scratch;
-        std::vector<Buffer> table;
         DrawColumns columns;
         bool stale = true;
     };
+    void hand(size_t type, DrawColumns& out);
     State& s_;
     std::vector<Type> types_;
+    bool drew_ = false;
 };
 
 }  // namespace psys::rt::detail

@@ -49,11 +49,21 @@ struct TypeInfo {
     std::array<bool, 4> drawn{};       // visible, position, colour, size: whether render yields it
 };
 
+// What a step drew of a type while it updated it (rt/system_draw.h, DrawnInStep).
+struct DrawnInStep {
+    bool on = false;      // this step draws the type as it goes
+    bool updated = false; // its update is done: what is created after it is drawn at creation
+    bool fresh = false;   // the render columns hold what the last step drew, every row
+    size_t drawn = 0;
+    uint64_t nonFinite = 0;
+};
+
 // Per type: the scratch buffers and column tables of its launches over the pool.
 struct TypeWork {
-    explicit TypeWork(Memory& memory) : update(memory), exports(memory), masks(memory) {}
-    Scratch update, exports, masks;
-    std::vector<Buffer> updateTable, exportsTable;
+    explicit TypeWork(Memory& memory) : update(memory), exports(memory), masks(memory), render(memory) {}
+    Scratch update, exports, masks, render;
+    std::vector<Buffer> updateTable, exportsTable, renderTable;
+    DrawnInStep inStep;
     std::vector<std::vector<uint32_t>> killed;  // per chunk: the rows that died, in order
     std::vector<std::vector<Buffer>> spawnTables;  // per emit site: the pool's columns for its spawn kernel
 };

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "rt/system_draw.h"
 #include "rt/system_support.h"
 
 namespace psys::rt::detail {
@@ -28,6 +29,24 @@ void listKilled(const uint8_t* kill, size_t begin, size_t end, std::vector<uint3
     }
     for (; row < end; ++row)
         if (kill[row]) out.push_back(static_cast<uint32_t>(row));
+}
+
+// out[row] = keep[row] && !(unless[row] && also[row]) over [begin, end), for flags that are
+// 0 or 1; `unless` null: keep as it is; `also` null: unless alone. Eight rows at a time: a
+// byte loop over every row of a pool costs as much as the render it feeds.
+void maskRows(uint8_t* out, const uint8_t* keep, const uint8_t* unless, const uint8_t* also, size_t begin, size_t end) {
+    auto word = [](const uint8_t* p, size_t row) {
+        uint64_t w;
+        std::memcpy(&w, p + row, sizeof w);
+        return w;
+    };
+    size_t row = begin;
+    for (; row + 8 <= end; row += 8) {
+        uint64_t drop = unless ? word(unless, row) & (also ? word(also, row) : ~uint64_t{0}) : 0;
+        uint64_t w = word(keep, row) & ~drop;
+        std::memcpy(out + row, &w, sizeof w);
+    }
+    for (; row < end; ++row) out[row] = keep[row] && !(unless && unless[row] && (!also || also[row]));
 }
 
 // After an update of `type`: in row order, each updated object dies or emits.
@@ -65,13 +84,33 @@ void killAndEmit(State& s, Creation& creation, size_t type, double dt, double t1
 // and the exports kernel over chunks of rows (on several threads where the backend
 // allows), then kills and emissions in row order, so that ids, the queue and the free
 // list come out the same with any number of threads.
-void updatePool(State& s, Creation& creation, size_t type, double dt, double t1) {
+void updatePool(State& s, Creation& creation, size_t type, double dt, double t1, bool last) {
     Pool& pool = s.pools[type];
     TypeInfo& info = s.types[type];
     TypeWork& work = s.work[type];
     const ir::Object& o = pool.object();
     size_t rows = pool.rows();
-    if (rows == 0 || pool.live() == 0) return;
+    if (rows == 0) return;
+    // Drawing as it goes (rt/system_draw.h): each chunk is rendered after its update, over
+    // the rows alive at the end of the step (those updated and not killed, and those
+    // created earlier in the step), while they are in cache.
+    const bool drawing = last && work.inStep.on;
+    RowsLaunch render;
+    uint8_t* shown = nullptr;
+    if (drawing) {
+        s.bindPool(type, info.renderLayout, work.render, work.renderTable);
+        Buffer mask = work.masks.at(1, Elem::U8, rows);
+        shown = s.host<uint8_t>(mask);
+        render = renderLaunch(s, type, work.renderTable, mask, t1);
+    }
+    if (pool.live() == 0) {  // nothing is drawn (what is created later is drawn at creation)
+        if (drawing) {
+            std::memset(shown, 0, rows);
+            DrawnCount none = renderRows(s, type, render, shown, 0, rows);
+            (void)none;
+        }
+        return;
+    }
     s.bindPool(type, info.updateLayout, work.update, work.updateTable);
     RowsLaunch update;
     update.object = &o;
@@ -101,7 +140,8 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1)
     bool listKills = info.kills && !info.rateEmits;
     size_t chunks = (rows + kRowsPerChunk - 1) / kRowsPerChunk;
     if (listKills) work.killed.resize(chunks);
-    std::atomic<uint64_t> unstable = 0;
+    std::atomic<uint64_t> unstable = 0, drawn = 0, nonFinite = 0;
+    const uint8_t* alive = pool.alive.host();
     auto chunk = [&](size_t c) {
         RowsLaunch part = update;
         part.begin = c * kRowsPerChunk;
@@ -114,18 +154,26 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1)
             if (killed) listKilled(kill, part.begin, part.end, work.killed[c]);
             else work.killed[c].clear();
         }
-        if (!info.exports) return;
-        auto* alive = s.host<uint8_t>(exportMask);
-        for (size_t row = part.begin; row < part.end; ++row) alive[row] = updatable[row] && !(info.kills && kill[row]);
-        RowsLaunch post = exports;
-        post.begin = part.begin;
-        post.end = part.end;
-        s.gatherParents(type, info.exportsLayout, work.exportsTable, alive, post.begin, post.end, t1);
-        s.backend.run(post);
+        if (info.exports) {
+            auto* survivors = s.host<uint8_t>(exportMask);
+            maskRows(survivors, updatable, info.kills ? kill : nullptr, nullptr, part.begin, part.end);
+            RowsLaunch post = exports;
+            post.begin = part.begin;
+            post.end = part.end;
+            s.gatherParents(type, info.exportsLayout, work.exportsTable, survivors, post.begin, post.end, t1);
+            s.backend.run(post);
+        }
+        if (!drawing) return;
+        maskRows(shown, alive, info.kills ? updatable : nullptr, kill, part.begin, part.end);
+        DrawnCount count = renderRows(s, type, render, shown, part.begin, part.end);
+        drawn += count.drawn;
+        nonFinite += count.nonFinite;
     };
     auto start = WallClock::now();
     s.forChunks(rows, chunk);
     s.typeStats[type].unstable += unstable;
+    work.inStep.drawn += drawn;
+    work.inStep.nonFinite += nonFinite;
     auto loopsDone = WallClock::now();
     s.stats.loopSeconds += seconds(start, loopsDone);
     struct Timer {
@@ -147,14 +195,14 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1)
 void updateType(State& s, Creation& creation, size_t type, double dt, double t1) {
     uint32_t n = subStepCount(dt, s.types[type].stepLimit, s.typeStats[type].cappedSubSteps);
     if (n == 1) {
-        updatePool(s, creation, type, dt, t1);
+        updatePool(s, creation, type, dt, t1, true);
         return;
     }
     // Sub-steps of equal length, each a pass over the pool: an object killed in one takes
     // no more, and what it emits in each is queued in (sub-step, row) order.
     double t0 = t1 - dt;
     for (uint32_t i = 1; i <= n; ++i)
-        updatePool(s, creation, type, dt / n, i == n ? t1 : t0 + dt * (static_cast<double>(i) / n));
+        updatePool(s, creation, type, dt / n, i == n ? t1 : t0 + dt * (static_cast<double>(i) / n), i == n);
 }
 
 }  // namespace psys::rt::detail

@@ -4,8 +4,10 @@
 
 #include <doctest/doctest.h>
 
+#include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "driver/compile.h"
 #include "rt/system.h"
@@ -36,6 +38,42 @@ inline std::string drawnBytes(rt::System& system, int frames) {
         REQUIRE_FALSE(system.step(1.0 / 60));
         for (size_t t = 0; t < system.typeCount(); ++t)
             for (const rt::RenderPoint& p : system.points(t)) out.append(reinterpret_cast<const char*>(&p), sizeof p);
+    }
+    return out;
+}
+
+// What a host sees over `frames` steps of `text`, drawn on the frames `drawOn` picks,
+// with the system's `drawInStep` option as given: every point drawn (as bytes), the drawn
+// counts and the non-finite counter; on frame 20 an extern (the first) is set, on frame 40
+// every trigger is fired. Two runs that differ only in drawInStep must give the same bytes.
+inline std::string hostSees(const std::string& text, rt::Backend& backend, bool drawInStep, int frames,
+                            const std::function<bool(int)>& drawOn) {
+    rt::SystemOptions options;
+    options.drawInStep = drawInStep;
+    rt::System system(compileModule(text), backend, options);
+    std::string out;
+    for (int f = 0; f < frames; ++f) {
+        if (f == 20 && !system.module().externs.empty()) {
+            const ir::Extern& e = system.module().externs[0];
+            std::vector<float> v(static_cast<size_t>(e.type.width));
+            for (int c = 0; c < e.type.width; ++c) v[static_cast<size_t>(c)] = e.defaultValue[static_cast<size_t>(c)] * 0.5f + 0.25f;
+            (void)system.setExtern(0, v);  // may be out of its range: then refused alike
+        }
+        if (f == 40)
+            for (const ir::Trigger& t : system.module().triggers) {
+                size_t width = 0;
+                for (auto& p : t.params) width += static_cast<size_t>(p.type.width);
+                REQUIRE_FALSE(system.fire(t.name, std::vector<float>(width, 1.5f)));
+            }
+        REQUIRE_FALSE(system.step(1.0 / 60));
+        if (!drawOn(f)) continue;
+        for (size_t t = 0; t < system.typeCount(); ++t) {
+            size_t drawn = system.draw(t).drawn;
+            out.append(reinterpret_cast<const char*>(&drawn), sizeof drawn);
+            for (const rt::RenderPoint& p : system.points(t)) out.append(reinterpret_cast<const char*>(&p), sizeof p);
+        }
+        uint64_t nonFinite = system.stats().nonFiniteRender;
+        out.append(reinterpret_cast<const char*>(&nonFinite), sizeof nonFinite);
     }
     return out;
 }

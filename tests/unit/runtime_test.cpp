@@ -366,6 +366,82 @@ TEST_CASE("recompute-state runs only with relaxed maths") {
     CHECK(slots(true) == 2);
 }
 
+namespace {
+
+// The interpreter, counting the render launches it runs.
+struct CountingBackend : rt::Backend {
+    interp::Interpreter inner;
+    size_t renders = 0;
+    std::string name() const override { return "counting"; }
+    rt::Memory& memory() override { return inner.memory(); }
+    rt::RowsResult run(const rt::RowsLaunch& l) override {
+        renders += l.kernel->kind == ir::KernelKind::Render;
+        return inner.run(l);
+    }
+    void run(const rt::ChildrenLaunch& l) override { inner.run(l); }
+};
+
+// Every sample, the programs of tests/programs, and cells that emit their own type at
+// capacity (created after their type's update, some dying in their first update).
+std::vector<std::string> drawingPrograms() {
+    std::vector<std::string> all;
+    for (const char* dir : {PSYS_SAMPLES_DIR, PSYS_PROGRAMS_DIR})
+        for (auto& entry : std::filesystem::directory_iterator(dir))
+            if (entry.path().extension() == ".psys") all.push_back(test::readFile(entry.path().string()));
+    all.push_back(R"(
+        @capacity(300) object cell {
+            point(vec3(rand(), rand(), 0) * age, vec4(age, 1, 0, 1), 1 / (age - 0.25));
+            emit cell at 90 per second;
+            kill when age > 0.5 + rand();
+        }
+        spawn cell;)");
+    return all;
+}
+
+}  // namespace
+
+TEST_CASE("drawing as the step goes draws what drawing after it draws, bit for bit, whenever the host draws") {
+    std::vector<std::function<bool(int)>> patterns = {
+        [](int) { return true; }, [](int f) { return f % 3 == 2; }, [](int f) { return f % 7 < 4; }};
+    size_t bytes = 0;
+    for (const std::string& text : drawingPrograms())
+        for (const auto& drawOn : patterns) {
+            interp::Interpreter a, b;
+            std::string inStep = test::hostSees(text, a, true, 90, drawOn);
+            std::string after = test::hostSees(text, b, false, 90, drawOn);
+            CHECK(inStep == after);
+            bytes += inStep.size();
+        }
+    CHECK(bytes > 1000000);
+}
+
+TEST_CASE("a step after a drawn one draws as it goes: draw() then runs no render launch") {
+    for (bool inStep : {true, false}) {
+        CountingBackend backend;
+        rt::SystemOptions options;
+        options.drawInStep = inStep;
+        rt::System system(test::compileModule(test::readFile(PSYS_SAMPLES_DIR "/fountain.psys")), backend, options);
+        auto drop = static_cast<size_t>(system.typeIndex("drop"));
+        system.step(1.0 / 60);
+        system.step(1.0 / 60);
+        size_t before = backend.renders;
+        CHECK(system.draw(drop).drawn > 0);
+        CHECK(backend.renders > before);  // the first draw: no step drew before it
+        system.step(1.0 / 60);
+        size_t during = backend.renders;
+        CHECK((during > before + 1) == inStep);  // the step rendered the drops as it went
+        size_t drawn = system.draw(drop).drawn;
+        CHECK(drawn > 0);
+        CHECK((backend.renders == during) == inStep);
+        // A new extern value: the render kernel may read it, so draw() renders again.
+        system.step(1.0 / 60);
+        REQUIRE_FALSE(system.setExtern("population", std::vector<float>{4000}));
+        during = backend.renders;
+        CHECK(system.draw(drop).drawn > 0);
+        CHECK(backend.renders > during);
+    }
+}
+
 TEST_CASE("each emission event creates `count` objects, all at the event's time") {
     Run run("object s { point(origin, white, age); }\nobject e { emit s at 2 per second count 3; }\nspawn e;");
     run.steps(300, 1.0 / 60);  // 5 s: events at 0.5 s, 1 s, …, 5 s
