@@ -185,7 +185,8 @@ void Panel::stats() {
     ImGui::Text("step %.2f ms: loops %.2f, kills/emissions %.2f, creation %.2f", f.stepSeconds * 1e3,
                 (b.loopSeconds - a.loopSeconds) * 1e3, (b.emitSeconds - a.emitSeconds) * 1e3,
                 (b.createSeconds - a.createSeconds) * 1e3);
-    ImGui::Text("drawing %.2f ms (render kernels %.2f)", f.glSeconds * 1e3, (b.drawSeconds - a.drawSeconds) * 1e3);
+    // draw(): what the step did not render as it went (rt/system_draw.h); GL: uploading and drawing.
+    ImGui::Text("drawing %.2f ms (draw() %.2f)", f.glSeconds * 1e3, (b.drawSeconds - a.drawSeconds) * 1e3);
     ImGui::Text("last build %.1f ms", viewer_.lastCompileSeconds_ * 1e3);
     if (viewer_.lastReloadSeconds_) ImGui::Text("last reload: %.1f ms from save", *viewer_.lastReloadSeconds_ * 1e3);
     if (!viewer_.reloadNote_.empty()) ImGui::TextWrapped("%s", viewer_.reloadNote_.c_str());
