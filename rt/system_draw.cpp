@@ -1,6 +1,7 @@
 #include "rt/system_draw.h"
 
 #include <cmath>
+#include <cstring>
 #include <mutex>
 
 #include "rt/system_support.h"
@@ -56,6 +57,33 @@ DrawnCount renderRows(State& s, size_t type, const RowsLaunch& launch, const uin
         count.nonFinite += !finite;
     }
     return count;
+}
+
+ChunkDrawing::ChunkDrawing(State& s, size_t type, double now) : s_(s), type_(type), rows_(s.pools[type].rows()) {
+    TypeWork& work = s.work[type];
+    s.bindPool(type, s.types[type].renderLayout, work.render, work.renderTable);
+    Buffer mask = work.masks.at(1, Elem::U8, rows_);
+    shown_ = s.host<uint8_t>(mask);
+    alive_ = s.pools[type].alive.host();
+    launch_ = renderLaunch(s, type, work.renderTable, mask, now);
+}
+
+void ChunkDrawing::chunk(const uint8_t* updatable, const uint8_t* kill, size_t begin, size_t end) {
+    maskRows(shown_, alive_, kill ? updatable : nullptr, kill, begin, end);
+    DrawnCount count = renderRows(s_, type_, launch_, shown_, begin, end);
+    drawn_ += count.drawn;
+    nonFinite_ += count.nonFinite;
+}
+
+void ChunkDrawing::none() {
+    std::memset(shown_, 0, rows_);
+    renderRows(s_, type_, launch_, shown_, 0, rows_);
+}
+
+void ChunkDrawing::done() {
+    DrawnInStep& d = s_.work[type_].inStep;
+    d.drawn += drawn_;
+    d.nonFinite += nonFinite_;
 }
 
 Drawing::Drawing(State& state) : s_(state), types_(state.pools.size()) {}

@@ -11,6 +11,7 @@
 // kernel sees the same state, clock, uniforms and parents (a test compares the two).
 #pragma once
 
+#include <atomic>
 #include <vector>
 
 #include "rt/system_state.h"
@@ -30,6 +31,27 @@ RowsLaunch renderLaunch(State& s, size_t type, std::span<const Buffer> table, Bu
 // batch, its rows' pool rows (for their parents).
 DrawnCount renderRows(State& s, size_t type, const RowsLaunch& launch, const uint8_t* mask, size_t begin, size_t end,
                       const uint32_t* poolRows = nullptr, size_t poolRowsFirst = 0);
+
+// Drawing a pool chunk by chunk as its update goes (DrawnInStep): each chunk after its
+// update, over the rows alive at the end of the step (those updated and not killed, and
+// those created earlier in the step); the counts go to the type's DrawnInStep at done().
+class ChunkDrawing {
+public:
+    ChunkDrawing(State& s, size_t type, double now);
+    // Rows [begin, end) just updated (`kill`: their kill flags, or null).
+    void chunk(const uint8_t* updatable, const uint8_t* kill, size_t begin, size_t end);
+    // No row is alive: every row's mark is cleared.
+    void none();
+    void done();
+
+private:
+    State& s_;
+    size_t type_, rows_;
+    RowsLaunch launch_;
+    uint8_t* shown_;
+    const uint8_t* alive_;
+    std::atomic<uint64_t> drawn_ = 0, nonFinite_ = 0;
+};
 
 class Drawing {
 public:

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 #include "ir/value.h"
 
@@ -59,6 +60,24 @@ inline bool finite(const ir::Value& v, int width) {
     for (int i = 0; i < width; ++i)
         if (!std::isfinite(v.f[static_cast<size_t>(i)])) return false;
     return true;
+}
+
+// out[row] = keep[row] && !(unless[row] && also[row]) over [begin, end), for flags that are
+// 0 or 1; `unless` null: keep as it is; `also` null: unless alone. Eight rows at a time: a
+// byte loop over every row of a pool costs as much as the render it feeds.
+inline void maskRows(uint8_t* out, const uint8_t* keep, const uint8_t* unless, const uint8_t* also, size_t begin, size_t end) {
+    auto word = [](const uint8_t* p, size_t row) {
+        uint64_t w;
+        std::memcpy(&w, p + row, sizeof w);
+        return w;
+    };
+    size_t row = begin;
+    for (; row + 8 <= end; row += 8) {
+        uint64_t drop = unless ? word(unless, row) & (also ? word(also, row) : ~uint64_t{0}) : 0;
+        uint64_t w = word(keep, row) & ~drop;
+        std::memcpy(out + row, &w, sizeof w);
+    }
+    for (; row < end; ++row) out[row] = keep[row] && !(unless && unless[row] && (!also || also[row]));
 }
 
 }  // namespace psys::rt::detail

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <optional>
 
 #include "rt/system_draw.h"
 #include "rt/system_support.h"
@@ -29,24 +30,6 @@ void listKilled(const uint8_t* kill, size_t begin, size_t end, std::vector<uint3
     }
     for (; row < end; ++row)
         if (kill[row]) out.push_back(static_cast<uint32_t>(row));
-}
-
-// out[row] = keep[row] && !(unless[row] && also[row]) over [begin, end), for flags that are
-// 0 or 1; `unless` null: keep as it is; `also` null: unless alone. Eight rows at a time: a
-// byte loop over every row of a pool costs as much as the render it feeds.
-void maskRows(uint8_t* out, const uint8_t* keep, const uint8_t* unless, const uint8_t* also, size_t begin, size_t end) {
-    auto word = [](const uint8_t* p, size_t row) {
-        uint64_t w;
-        std::memcpy(&w, p + row, sizeof w);
-        return w;
-    };
-    size_t row = begin;
-    for (; row + 8 <= end; row += 8) {
-        uint64_t drop = unless ? word(unless, row) & (also ? word(also, row) : ~uint64_t{0}) : 0;
-        uint64_t w = word(keep, row) & ~drop;
-        std::memcpy(out + row, &w, sizeof w);
-    }
-    for (; row < end; ++row) out[row] = keep[row] && !(unless && unless[row] && (!also || also[row]));
 }
 
 // After an update of `type`: in row order, each updated object dies or emits.
@@ -91,24 +74,11 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1,
     const ir::Object& o = pool.object();
     size_t rows = pool.rows();
     if (rows == 0) return;
-    // Drawing as it goes (rt/system_draw.h): each chunk is rendered after its update, over
-    // the rows alive at the end of the step (those updated and not killed, and those
-    // created earlier in the step), while they are in cache.
-    const bool drawing = last && work.inStep.on;
-    RowsLaunch render;
-    uint8_t* shown = nullptr;
-    if (drawing) {
-        s.bindPool(type, info.renderLayout, work.render, work.renderTable);
-        Buffer mask = work.masks.at(1, Elem::U8, rows);
-        shown = s.host<uint8_t>(mask);
-        render = renderLaunch(s, type, work.renderTable, mask, t1);
-    }
+    // Drawing as it goes (rt/system_draw.h): each chunk rendered after its update.
+    std::optional<ChunkDrawing> drawing;
+    if (last && work.inStep.on) drawing.emplace(s, type, t1);
     if (pool.live() == 0) {  // nothing is drawn (what is created later is drawn at creation)
-        if (drawing) {
-            std::memset(shown, 0, rows);
-            DrawnCount none = renderRows(s, type, render, shown, 0, rows);
-            (void)none;
-        }
+        if (drawing) drawing->none();
         return;
     }
     s.bindPool(type, info.updateLayout, work.update, work.updateTable);
@@ -140,8 +110,7 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1,
     bool listKills = info.kills && !info.rateEmits;
     size_t chunks = (rows + kRowsPerChunk - 1) / kRowsPerChunk;
     if (listKills) work.killed.resize(chunks);
-    std::atomic<uint64_t> unstable = 0, drawn = 0, nonFinite = 0;
-    const uint8_t* alive = pool.alive.host();
+    std::atomic<uint64_t> unstable = 0;
     auto chunk = [&](size_t c) {
         RowsLaunch part = update;
         part.begin = c * kRowsPerChunk;
@@ -163,17 +132,12 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1,
             s.gatherParents(type, info.exportsLayout, work.exportsTable, survivors, post.begin, post.end, t1);
             s.backend.run(post);
         }
-        if (!drawing) return;
-        maskRows(shown, alive, info.kills ? updatable : nullptr, kill, part.begin, part.end);
-        DrawnCount count = renderRows(s, type, render, shown, part.begin, part.end);
-        drawn += count.drawn;
-        nonFinite += count.nonFinite;
+        if (drawing) drawing->chunk(updatable, info.kills ? kill : nullptr, part.begin, part.end);
     };
     auto start = WallClock::now();
     s.forChunks(rows, chunk);
     s.typeStats[type].unstable += unstable;
-    work.inStep.drawn += drawn;
-    work.inStep.nonFinite += nonFinite;
+    if (drawing) drawing->done();
     auto loopsDone = WallClock::now();
     s.stats.loopSeconds += seconds(start, loopsDone);
     struct Timer {
