@@ -176,7 +176,7 @@ int memoryTable(const std::vector<std::string>& effects, const std::vector<doubl
             std::cout << line;
             std::cout.flush();
         }
-    std::cout << "\n(row bytes: rt::Pool::rowBytes of the particles' type, as psysc --stats prints; fixed: the process "
+    std::cout << "\n(row bytes: rt::Pool::rowBytes of the particles' type in the relaxed program the JIT runs, as psysc --stats prints after the slash; fixed: the process "
                  "before the first step; peak: getrusage's maximum resident set, with the system drawn every step)\n";
     return 0;
 }

@@ -77,7 +77,7 @@ int printStats(const std::string& file, std::optional<core::Integrator> everyObj
         objects.push_back(o.name);
         own.emplace_back(core::integratorName(opt::methodOf(o, defaults)));
     }
-    std::cout << fmt::format("{:24} {:>14} {:>10} {:>22} {:>6} {:>6} {:>24} {:>16} {:>14} {:>10}\n", "object", "method",
+    std::cout << fmt::format("{:24} {:>14} {:>10} {:>22} {:>6} {:>6} {:>24} {:>16} {:>14} {:>12}\n", "object", "method",
                              "tree ops", "ops/update", "exact", "relax", "state bytes/object", "param bytes",
                              "uniform ops", "row bytes");
     size_t total[3] = {0, 0, 0}, tree = 0;
@@ -87,13 +87,14 @@ int printStats(const std::string& file, std::optional<core::Integrator> everyObj
         total[0] += b.opsPerUpdate;
         total[1] += e.opsPerUpdate;
         total[2] += r.opsPerUpdate;
-        std::cout << fmt::format("{:24} {:>14} {:>10} {:>22} {:>6} {:>6} {:>24} {:>16} {:>14} {:>10}\n", b.name, own[i],
+        std::cout << fmt::format("{:24} {:>14} {:>10} {:>22} {:>6} {:>6} {:>24} {:>16} {:>14} {:>12}\n", b.name, own[i],
                                  b.treeOpsPerUpdate, fmt::format("{} / {} / {}", b.opsPerUpdate, e.opsPerUpdate, r.opsPerUpdate),
                                  percent(e.opsPerUpdate, b.opsPerUpdate), percent(r.opsPerUpdate, b.opsPerUpdate),
                                  fmt::format("{} / {} / {}", b.stateBytes, e.stateBytes, r.stateBytes),
                                  fmt::format("{} / {} / {}", b.paramBytes, e.paramBytes, r.paramBytes),
                                  fmt::format("{} / {} / {}", b.uniformOps, e.uniformOps, r.uniformOps),
-                                 rt::Pool::rowBytes(levels[1].module->objects[i]));
+                                 fmt::format("{} / {}", rt::Pool::rowBytes(levels[1].module->objects[i]),
+                                             rt::Pool::rowBytes(levels[2].module->objects[i])));
     }
     std::cout << fmt::format("{:24} {:>14} {:>10} {:>22} {:>6} {:>6}\n", "all", "", tree,
                              fmt::format("{} / {} / {}", total[0], total[1], total[2]), percent(total[1], total[0]),
@@ -101,8 +102,9 @@ int printStats(const std::string& file, std::optional<core::Integrator> everyObj
     std::cout << fmt::format("optimized / tree ops: {} exact, {} relaxed\n", percent(total[1], tree), percent(total[2], tree));
     std::cout << "(ops/update: scalar operations per object per frame, without the optimizer / optimized / optimized "
                  "with --relaxed-math; tree ops: the same expressions evaluated as trees, nothing shared; uniform ops: "
-                 "per type per step; row bytes: one object's row in its pool, optimized — kept state, kept parameters, "
-                 "exports, creation time, id, update and alive masks and the run-time's bookkeeping)\n";
+                 "per type per step; row bytes: one object's row in its pool, optimized / with --relaxed-math (what the JIT "
+                 "runs with fast maths) — kept state, kept parameters, exports, creation time, id, update and alive "
+                 "masks and the run-time's bookkeeping)\n";
     printByMethod(file, objects, own);
     return 0;
 }
