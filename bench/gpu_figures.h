@@ -19,6 +19,7 @@ struct GpuFigures {
     bool wallPasses = false;       // the passes' times are wall times (the GL's timer saw nothing)
     double stateBytes = 0;         // per particle, what the update pass must read and write
     double transferBytes = 0;      // per particle per step, between the host and the GPU
+    double waits = 0;              // per step: times the host waited for a read-back from the GPU
 };
 
 // Runs `effect` to its steady population of about `particles` on `gpu`, then times `frames` steps.

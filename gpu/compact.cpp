@@ -59,16 +59,25 @@ void main() {
 }
 )";
 
-// Each group's set rows at its offset, in order.
+// Each group's set rows at its offset, in order. A group with none set leaves at once,
+// and one with all set needs no scan (the same for every invocation of the group, so no
+// barrier is skipped by some and not others): kills are sparse and bunched (objects
+// created together die together), and a pool is one launch.
 const char* kWrite = R"(#version 450
 layout(local_size_x = 256) in;
 layout(std430, binding = 0) readonly buffer Words { uint w[]; };
 layout(std430, binding = 1) readonly buffer Groups { uint groups[]; };
 layout(std430, binding = 2) writeonly buffer List { uint list[]; };
-uniform uint first, n;
+uniform uint first, n, set;
 shared uint prefix[256];
 void main() {
-    uint t = gl_LocalInvocationID.x, i = gl_GlobalInvocationID.x;
+    uint t = gl_LocalInvocationID.x, i = gl_GlobalInvocationID.x, g = gl_WorkGroupID.x;
+    uint count = (g + 1u < gl_NumWorkGroups.x ? groups[g + 1u] : set) - groups[g];
+    if (count == 0u) return;
+    if (count == gl_WorkGroupSize.x) {
+        list[groups[g] + t] = i;
+        return;
+    }
     uint flag = i < n && w[first + i] != 0u ? 1u : 0u;
     prefix[t] = flag;
     barrier();
@@ -78,7 +87,7 @@ void main() {
         prefix[t] += add;
         barrier();
     }
-    if (flag != 0u) list[groups[gl_WorkGroupID.x] + prefix[t] - 1u] = i;
+    if (flag != 0u) list[groups[g] + prefix[t] - 1u] = i;
 }
 )";
 
@@ -124,6 +133,7 @@ std::vector<uint32_t> Compactor::flagged(unsigned words, size_t word, size_t n, 
         setUint(p, "n", n);
     }
     setUint(scan_, "count", groups);
+    setUint(write_, "set", set);
     glUseProgram(count_);
     glDispatchCompute(static_cast<GLuint>(groups), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);

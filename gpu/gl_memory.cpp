@@ -134,6 +134,7 @@ void GlMemory::toHost(Column& c) const {
     std::vector<uint32_t> words(c.words());
     if (!words.empty()) glGetNamedBufferSubData(c.gl, 0, static_cast<GLsizeiptr>(words.size() * 4), words.data());
     transferred += words.size() * 4;
+    waits += !words.empty();
     fromWords(words.data(), c.elem, c.rows, c.hostCopy.data());
     c.device = false;
 }
@@ -170,6 +171,7 @@ void GlMemory::read(Buffer b, size_t first, size_t count, void* out) const {
         glGetNamedBufferSubData(c.gl, static_cast<GLintptr>(first * w * 4), static_cast<GLsizeiptr>(words.size() * 4),
                                 words.data());
     transferred += words.size() * 4;
+    ++waits;
     fromWords(words.data(), c.elem, count, out);
 }
 
@@ -230,6 +232,19 @@ void GlMemory::scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const
     glDispatchCompute(static_cast<GLuint>((rows.size() + 63) / 64), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     t.device = true;
+}
+
+void GlMemory::clear(Buffer b, size_t first, size_t count) {
+    if (count == 0) return;
+    Column& c = at(b);
+    if (!c.device) {
+        std::memset(c.hostCopy.data() + first * rt::elemSize(c.elem), 0, count * rt::elemSize(c.elem));
+        return;
+    }
+    size_t w = wordsPerRow(c.elem) * 4;
+    uint32_t zero = 0;
+    glClearNamedBufferSubData(c.gl, GL_R32UI, static_cast<GLintptr>(first * w), static_cast<GLsizeiptr>(count * w),
+                              GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
 }
 
 void* GlMemory::host(Buffer b) {

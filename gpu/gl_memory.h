@@ -31,6 +31,7 @@ public:
     void write(rt::Buffer buffer, size_t first, size_t count, const void* in) override;
     void copy(rt::Buffer from, size_t fromFirst, rt::Buffer to, size_t toFirst, size_t count) override;
     void scatter(rt::Buffer from, size_t fromFirst, rt::Buffer to, std::span<const uint32_t> rows) override;
+    void clear(rt::Buffer buffer, size_t first, size_t count) override;
     void* host(rt::Buffer buffer) override;
     const void* view(rt::Buffer buffer) const override;
     unsigned glBuffer(rt::Buffer buffer) const override;
@@ -47,6 +48,10 @@ public:
     // Bytes moved between the host and the GPU so far, either way (the backend adds its
     // launches' transfers).
     mutable uint64_t transferred = 0;
+    // Times the host waited for the GPU to read something back (a read of a column on the
+    // GPU; the backend adds its launches' read-backs): each one stalls the host until the
+    // GPU has finished everything before it.
+    mutable uint64_t waits = 0;
 
     static size_t wordsPerRow(rt::Elem e) { return e == rt::Elem::F64 ? 2 : 1; }
 

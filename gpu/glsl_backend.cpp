@@ -28,6 +28,7 @@ struct GlslBackend::Program {
     std::vector<int> resident, returned;  // the table columns the kernel writes (writtenColumns)
     std::vector<bool> needed;             // the table columns a launch carries (the others are not touched)
     std::string pass;          // "update", "spawn", …: what timer queries add up under
+    bool counts = false;       // whether the shader counts anything (kills, unstable rows, what is drawn)
 };
 
 namespace {
@@ -174,6 +175,10 @@ GlslBackend::Program& GlslBackend::rowsProgram(const ir::Object& object, const i
         p->needed = neededColumns(kernel, p->layout, now == rt::Clock::Source::PerRow || dt == rt::Clock::Source::PerRow,
                                   p->resident, p->returned);
         p->pass = ir::kernelName(kernel.kind);
+        p->counts = kernel.kind == ir::KernelKind::Render ||
+                    std::any_of(kernel.yields.begin(), kernel.yields.end(), [](const ir::Yield& y) {
+                        return y.kind == ir::YieldKind::Kill || y.kind == ir::YieldKind::Unstable;
+                    });
         slot = std::move(p);
     }
     return *slot;
@@ -222,10 +227,13 @@ void GlslBackend::ensureWords(size_t words) {
 }
 
 GlslBackend::Counts GlslBackend::dispatch(Program& program, const std::vector<uint32_t>& block, size_t count,
-                                                    const std::string& pass) {
+                                          const std::string& pass, std::span<const BlockFill> fill) {
     uint32_t zero[4] = {0, 0, 0, 0};
-    glNamedBufferSubData(counts_, 0, sizeof zero, zero);
+    if (program.counts) glNamedBufferSubData(counts_, 0, sizeof zero, zero);
     glNamedBufferData(block_, static_cast<GLsizeiptr>(block.size() * 4), block.data(), GL_STREAM_DRAW);
+    for (const BlockFill& f : fill)
+        glCopyNamedBufferSubData(f.from, block_, static_cast<GLintptr>(f.byte), static_cast<GLintptr>(f.word) * 4,
+                                 static_cast<GLsizeiptr>(f.words) * 4);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, words_);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, counts_);
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, block_);
@@ -254,7 +262,9 @@ GlslBackend::Counts GlslBackend::dispatch(Program& program, const std::vector<ui
     }
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     Counts counts;
+    if (!program.counts) return counts;
     glGetNamedBufferSubData(counts_, 0, sizeof counts.n, counts.n);
+    ++memory_.waits;
     return counts;
 }
 
@@ -345,6 +355,7 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
             size_t word = block[LaunchBlock::kColumns + ColumnLayout::kKill];
             std::vector<uint32_t> rows = compactor_.flagged(words_, word, n, killed);
             memory_.transferred += rows.size() * 4;
+            memory_.waits += killed > 0;
             auto* kill = static_cast<uint8_t*>(memory_.host(b)) + begin;
             std::memset(kill, 0, n);
             for (uint32_t r : rows) kill[r] = 1;
@@ -356,6 +367,7 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
         glGetNamedBufferSubData(words_, static_cast<GLintptr>(word * 4), static_cast<GLsizeiptr>(staging_.size() * 4),
                                 staging_.data());
         memory_.transferred += staging_.size() * 4;
+        ++memory_.waits;
         fromWords(staging_.data(), e, n, static_cast<char*>(memory_.host(b)) + begin * rt::elemSize(e));
     }
     return {killed, counts.n[1], counts.n[2], counts.n[3]};
@@ -370,34 +382,39 @@ void GlslBackend::run(const rt::ChildrenLaunch& launch) {
     size_t n = launch.count, columns = launch.args.size();
     std::vector<uint32_t> block = blockHeader(p.block, n, launch.clock, launch.seed, launch.draw);
     block[LaunchBlock::kFirstChild] = launch.firstChild;
-    double created = 0;
-    memory_.read(launch.columns[ColumnLayout::kCreated], launch.row, 1, &created);
-    putDouble(block, LaunchBlock::kCreated, created);
-    memory_.read(launch.columns[ColumnLayout::kIds], launch.row, 1, &block[LaunchBlock::kObjectId]);
     for (size_t c = 0; c < columns; ++c) block[LaunchBlock::kColumns + c] = static_cast<uint32_t>(c * n);
     for (uint32_t e = 0; e < p.block.externCount; ++e) putValue(block, p.block.externs + 4 * e, launch.externs[e]);
-    // The emitter's parameters and state, read from its row (a parameter the pool does
-    // not keep reads 0, as on every backend).
-    auto rowValue = [&](int column, int width) {
-        rt::Value v;
-        for (int c = 0; c < width; ++c) {
-            Buffer b = launch.columns[static_cast<size_t>(column + c)];
-            if (b.valid()) memory_.read(b, launch.row, 1, &v.f[static_cast<size_t>(c)]);
+    // The emitter's creation time, id, parameters and state, from its row: copied into the
+    // block on the GPU where the column is there (the host does not wait for it), from the
+    // host's copy where it is not. A parameter the pool does not keep reads 0, as on every
+    // backend.
+    std::vector<BlockFill> fill;
+    auto fromRow = [&](Buffer b, uint32_t word) {
+        if (!b.valid()) return;
+        size_t w = GlMemory::wordsPerRow(memory_.elem(b));
+        if (memory_.onDevice(b)) {
+            fill.push_back({memory_.deviceBuffer(b), launch.row * w * 4, word, static_cast<uint32_t>(w)});
+            return;
         }
-        return v;
+        uint32_t words[2] = {0, 0};
+        memory_.read(b, launch.row, 1, words);  // on the host: no wait
+        for (size_t k = 0; k < w; ++k) block[word + k] = words[k];
+    };
+    fromRow(launch.columns[ColumnLayout::kCreated], LaunchBlock::kCreated);
+    fromRow(launch.columns[ColumnLayout::kIds], LaunchBlock::kObjectId);
+    auto fromColumns = [&](int column, int width, uint32_t word) {
+        for (int c = 0; c < width; ++c) fromRow(launch.columns[static_cast<size_t>(column + c)], word + static_cast<uint32_t>(c));
     };
     for (size_t i = 0; i < o.params.size(); ++i)
-        putValue(block, p.block.params + 4 * static_cast<uint32_t>(i), rowValue(l.paramOffset[i], o.params[i].type.width));
+        fromColumns(l.paramOffset[i], o.params[i].type.width, p.block.params + 4 * static_cast<uint32_t>(i));
     for (size_t i = 0; i < o.state.size(); ++i)
-        putValue(block, p.block.state + 4 * static_cast<uint32_t>(i), rowValue(l.stateOffset[i], o.state[i].type.width));
+        fromColumns(l.stateOffset[i], o.state[i].type.width, p.block.state + 4 * static_cast<uint32_t>(i));
     for (size_t i = 0; i < l.parentColumns.size(); ++i)
         putValue(block, p.block.parents + 4 * static_cast<uint32_t>(i), launch.parents[i]);
     ensureWords(columns * n);
-    dispatch(p, block, n, p.pass);
-    staging_.resize(columns * n);
-    glGetNamedBufferSubData(words_, 0, static_cast<GLsizeiptr>(columns * n * 4), staging_.data());
-    memory_.transferred += columns * n * 4;
-    for (size_t c = 0; c < columns; ++c) memory_.write(launch.args[c], launch.argsFirst, n, &staging_[c * n]);
+    dispatch(p, block, n, p.pass, fill);
+    // The children's arguments stay on the GPU: creation scatters them into pool rows there.
+    for (size_t c = 0; c < columns; ++c) memory_.adopt(launch.args[c], launch.argsFirst, n, words_, c * n);
 }
 
 rt::BackendReport GlslBackend::report() const {

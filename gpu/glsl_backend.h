@@ -9,7 +9,9 @@
 // is drawn (docs/gpu.md).
 #pragma once
 
+#include <limits>
 #include <map>
+#include <span>
 #include <memory>
 #include <string>
 #include <tuple>
@@ -38,6 +40,8 @@ public:
     rt::BackendReport report() const override;
     bool marksDrawn() const override { return true; }
     bool rendersInStep() const override { return false; }
+    // One dispatch over every row (split only where a storage block cannot hold them).
+    size_t chunkRows() const override { return std::numeric_limits<size_t>::max(); }
 
     // Time of the launches so far while timePasses is on, by kernel kind name: on the GPU
     // (GL timer queries), and on the wall from a glFinish before the dispatch to one after
@@ -52,6 +56,8 @@ public:
     void timePasses(bool on) { timing_ = on; }
     // Bytes moved between the host and the GPU so far, either way.
     uint64_t transferredBytes() const { return memory_.transferred; }
+    // Times the host waited for a read-back from the GPU so far (GlMemory::waits).
+    uint64_t waits() const { return memory_.waits; }
 
 private:
     GlslBackend() = default;
@@ -62,13 +68,21 @@ private:
     Program& childrenProgram(const ir::Object& object, const ir::Kernel& spawn);
     Program compile(const std::string& source, const std::string& what);
     rt::RowsResult runRows(const rt::RowsLaunch& launch, Program& program, size_t begin, size_t end);
-    // Uploads the block, runs `program` over `count` invocations, and returns the counts
-    // (killed, unstable, drawn, not finite).
+    // Uploads the block, fills the words of it that `fill` names from columns on the GPU
+    // (on the GPU: no read-back), runs `program` over `count` invocations, and returns the
+    // counts (killed, unstable, drawn, not finite) — read back only for a program that
+    // has any.
     struct Counts {
         uint32_t n[4] = {0, 0, 0, 0};
     };
-    Counts dispatch(Program& program, const std::vector<uint32_t>& block, size_t count,
-                                           const std::string& pass);
+    struct BlockFill {
+        unsigned from;   // a GL buffer
+        size_t byte;     // where in it
+        uint32_t word;   // the block's word
+        uint32_t words;
+    };
+    Counts dispatch(Program& program, const std::vector<uint32_t>& block, size_t count, const std::string& pass,
+                    std::span<const BlockFill> fill = {});
     void ensureWords(size_t words);
 
     std::unique_ptr<HeadlessContext> context_;

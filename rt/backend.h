@@ -115,6 +115,10 @@ public:
     virtual void run(const ChildrenLaunch& launch) = 0;
     // Whether launches on disjoint rows may run on several threads at once.
     virtual bool concurrent() const { return false; }
+    // The rows a launch over a pool covers at most: a chunk that stays in cache (and gives
+    // several threads work) for the loops of a CPU; every row at once on a GPU, where a
+    // launch costs a dispatch and its counts a wait for the GPU.
+    virtual size_t chunkRows() const { return kRowsPerChunk; }
     // Whether render launches mark the rows drawn themselves: visible = 1 where the row is
     // in the mask, its point visible and every render value finite, else 0; counted in
     // RowsResult. Else the run-time does it on the host after the launch.

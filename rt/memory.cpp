@@ -11,6 +11,11 @@
 
 namespace psys::rt {
 
+void Memory::clear(Buffer buffer, size_t first, size_t count) {
+    if (count == 0) return;  // an empty column has no address
+    std::memset(static_cast<char*>(host(buffer)) + first * elemSize(elem(buffer)), 0, count * elemSize(elem(buffer)));
+}
+
 // One column: a 64-byte aligned array that grows by doubling, so that appending rows one
 // at a time costs amortized O(1). A large column is its own anonymous mapping, grown with
 // mremap: the kernel moves its pages instead of copying them, pages past the rows in use

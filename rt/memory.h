@@ -49,6 +49,9 @@ public:
     // to[rows[i]] = from[fromFirst + i] (rows[i] == kSkipRow: nothing).
     virtual void copy(Buffer from, size_t fromFirst, Buffer to, size_t toFirst, size_t count) = 0;
     virtual void scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const uint32_t> rows) = 0;
+    // Zeroes `count` elements from row `first`, where the buffer lives (a device memory
+    // does not bring the column to the host for it, as `host` would).
+    virtual void clear(Buffer buffer, size_t first, size_t count);
 
     // The address of a buffer's first element where the host can address it, else null:
     // `host` for reading and writing, `view` for reading only (a memory that keeps

@@ -299,10 +299,8 @@ void Creation::drawBatch(size_t type, Batch& b, size_t n, double t1) {
         shown[first + r] = b.poolRows[r] != kSkipRow && pool.status(b.poolRows[r]) == Status::Alive;
     RowsLaunch launch = renderLaunch(s_, type, b.renderTable, mask, t1);
     std::atomic<uint64_t> drawn = 0, nonFinite = 0;
-    s_.parallel->forEach((n + kRowsPerChunk - 1) / kRowsPerChunk, s_.backend.concurrent(), [&](size_t c) {
-        size_t begin = first + c * kRowsPerChunk;
-        DrawnCount count = renderRows(s_, type, launch, shown, begin, std::min(end, begin + kRowsPerChunk),
-                                      b.poolRows.data(), first);
+    s_.forChunks(first, end, [&](size_t, size_t begin, size_t stop) {
+        DrawnCount count = renderRows(s_, type, launch, shown, begin, stop, b.poolRows.data(), first);
         drawn += count.drawn;
         nonFinite += count.nonFinite;
     });
@@ -348,8 +346,7 @@ void Creation::identify(size_t type, Batch& b, size_t from, size_t n) {
                                   b.poolRows);
     for (size_t s = 0; s < o.state.size(); ++s)
         for (int c = 0; c < o.state[s].type.width; ++c)
-            std::memset(s_.host<float>(table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)]) + first, 0,
-                        n * sizeof(float));
+            s_.memory.clear(table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)], first, n);
 }
 
 // At creation: init (the state, the bursts' sizes) and the exports, at each object's
@@ -398,12 +395,11 @@ void Creation::atCreation(size_t type, Batch& b, size_t n) {
 // A launch over rows [first, end) of a batch, in chunks (on several threads where the
 // backend allows).
 void Creation::runBatch(const RowsLaunch& launch, size_t first, size_t end, size_t type) {
-    size_t n = end - first;
     std::atomic<uint64_t> unstable = 0;
-    s_.parallel->forEach((n + kRowsPerChunk - 1) / kRowsPerChunk, s_.backend.concurrent(), [&](size_t c) {
+    s_.forChunks(first, end, [&](size_t, size_t begin, size_t stop) {
         RowsLaunch part = launch;
-        part.begin = first + c * kRowsPerChunk;
-        part.end = std::min(end, part.begin + kRowsPerChunk);
+        part.begin = begin;
+        part.end = stop;
         if (size_t u = s_.backend.run(part).unstable) unstable += u;
     });
     s_.typeStats[type].unstable += unstable;

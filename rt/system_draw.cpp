@@ -140,9 +140,8 @@ const DrawColumns& Drawing::draw(size_t type) {
     const uint8_t* mask = pool.alive.host();
     std::mutex counting;
     DrawnCount all;
-    s_.forChunks(rows, [&](size_t c) {
-        size_t begin = c * kRowsPerChunk;
-        DrawnCount chunk = renderRows(s_, type, launch, mask, begin, std::min(rows, begin + kRowsPerChunk));
+    s_.forChunks(0, rows, [&](size_t, size_t begin, size_t end) {
+        DrawnCount chunk = renderRows(s_, type, launch, mask, begin, end);
         std::lock_guard lock(counting);
         all.drawn += chunk.drawn;
         all.nonFinite += chunk.nonFinite;

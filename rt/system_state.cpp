@@ -218,8 +218,17 @@ void State::bindPool(size_t type, const ColumnLayout& layout, Scratch& scratch, 
             table[static_cast<size_t>(column)] = scratch.at(static_cast<size_t>(1 + column - layout.emits), Elem::F32, rows);
 }
 
-void State::forChunks(size_t rows, const std::function<void(size_t)>& chunk) {
-    parallel->forEach((rows + kRowsPerChunk - 1) / kRowsPerChunk, backend.concurrent(), chunk);
+size_t State::chunkCount(size_t rows) const {
+    size_t per = backend.chunkRows();
+    return rows / per + (rows % per != 0);
+}
+
+void State::forChunks(size_t first, size_t end, const std::function<void(size_t, size_t, size_t)>& chunk) {
+    size_t per = backend.chunkRows();
+    parallel->forEach(chunkCount(end - first), backend.concurrent(), [&](size_t c) {
+        size_t begin = first + c * per;
+        chunk(c, begin, begin + std::min(per, end - begin));
+    });
 }
 
 }  // namespace psys::rt::detail

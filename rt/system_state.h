@@ -125,8 +125,10 @@ struct State {
                        const uint32_t* poolRows = nullptr, size_t poolRowsFirst = 0);
     // Points `table` at a pool's columns, kill flags and the scratch columns of the rest.
     void bindPool(size_t type, const ColumnLayout& layout, Scratch& scratch, std::vector<Buffer>& table);
-    // chunk(c) for every chunk of `rows` rows (rt/columns.h kRowsPerChunk).
-    void forChunks(size_t rows, const std::function<void(size_t)>& chunk);
+    // chunk(c, begin, end) for every chunk of rows [first, end) (Backend::chunkRows rows
+    // each), on several threads where the backend allows; chunkCount: how many there are.
+    size_t chunkCount(size_t rows) const;
+    void forChunks(size_t first, size_t end, const std::function<void(size_t, size_t, size_t)>& chunk);
 
     // A column's values on the host: to change (host) or to read (view).
     template <typename T>

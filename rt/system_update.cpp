@@ -108,13 +108,13 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1,
     const auto* kill = s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]);
     // Objects that only die (no rate emits) are found while their chunk is in cache.
     bool listKills = info.kills && !info.rateEmits;
-    size_t chunks = (rows + kRowsPerChunk - 1) / kRowsPerChunk;
+    size_t chunks = s.chunkCount(rows);
     if (listKills) work.killed.resize(chunks);
     std::atomic<uint64_t> unstable = 0;
-    auto chunk = [&](size_t c) {
+    auto chunk = [&](size_t c, size_t begin, size_t end) {
         RowsLaunch part = update;
-        part.begin = c * kRowsPerChunk;
-        part.end = std::min(rows, part.begin + kRowsPerChunk);
+        part.begin = begin;
+        part.end = end;
         s.gatherParents(type, info.updateLayout, work.updateTable, updatable, part.begin, part.end, t1);
         RowsResult result = s.backend.run(part);
         size_t killed = result.killed;
@@ -135,7 +135,7 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1,
         if (drawing) drawing->chunk(updatable, info.kills ? kill : nullptr, part.begin, part.end);
     };
     auto start = WallClock::now();
-    s.forChunks(rows, chunk);
+    s.forChunks(0, rows, chunk);
     s.typeStats[type].unstable += unstable;
     if (drawing) drawing->done();
     auto loopsDone = WallClock::now();

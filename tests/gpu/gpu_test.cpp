@@ -263,6 +263,57 @@ TEST_CASE("an object's state stays on the GPU from step to step") {
     CHECK(perDrop > 0);
 }
 
+TEST_CASE("the host waits for the GPU a few times a step, however many rows and emitters") {
+    // What a step must read back: per update of a pool its counts and the rows it killed
+    // (one launch however many rows), an emitting type's emissions, the first update's
+    // counts of the objects created; a draw, its counts. Not a launch per 8192 rows, not a
+    // read per value of each emitter's row for its children's arguments, not the
+    // children's arguments, not a column of new objects' state to zero it.
+    auto waitsPerStep = [](const std::string& sample, const char* knob, float value) {
+        auto gpu = gpuBackend();
+        rt::System system(test::compileModule(readFile(std::string(PSYS_SAMPLES_DIR) + "/" + sample + ".psys")), *gpu);
+        system.setExtern(knob, {&value, 1});
+        for (int f = 0; f < 120; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
+        uint64_t before = gpu->waits();
+        for (int f = 0; f < 10; ++f) {
+            REQUIRE_FALSE(system.step(1.0 / 60));
+            for (size_t t = 0; t < system.module().objects.size(); ++t) system.draw(t);
+        }
+        return static_cast<double>(gpu->waits() - before) / 10;
+    };
+    // 60,000 drops: 8 chunks of 8192 rows on a CPU.
+    double fountain = waitsPerStep("fountain", "population", 60000);
+    // 15 rockets emitting sparks every step, each its own spawn launch.
+    double fireworks = waitsPerStep("fireworks", "sparks", 200);
+    MESSAGE("waits per step and draw: fountain " << fountain << ", fireworks " << fireworks);
+    CHECK(fountain <= 6);   // emitter: counts, emissions; drops: counts, kills; first update; draw
+    CHECK(fireworks <= 12);
+}
+
+TEST_CASE("clearing rows of a column on the GPU zeroes them there, without a read-back") {
+    auto gpu = gpuBackend();
+    auto& memory = static_cast<gpu::GlMemory&>(gpu->memory());
+    rt::Buffer b = memory.create(rt::Elem::F32, 8);
+    std::vector<float> values = {1, 2, 3, 4, 5, 6, 7, 8};
+    memory.write(b, 0, 8, values.data());
+    rt::Buffer moved = memory.create(rt::Elem::F32, 8);
+    std::vector<uint32_t> rows = {0, 1, 2, 3, 4, 5, 6, 7};
+    memory.scatter(b, 0, moved, rows);  // a scatter runs on the GPU: `moved` lives there now
+    REQUIRE(memory.onDevice(moved));
+    uint64_t waits = memory.waits;
+    memory.clear(moved, 2, 3);
+    CHECK(memory.waits == waits);
+    CHECK(memory.onDevice(moved));
+    memory.clear(b, 7, 1);  // on the host
+    std::vector<float> out(8);
+    memory.read(moved, 0, 8, out.data());
+    CHECK(out == std::vector<float>{1, 2, 0, 0, 0, 6, 7, 8});
+    memory.read(b, 0, 8, out.data());
+    CHECK(out == std::vector<float>{1, 2, 3, 4, 5, 6, 7, 0});
+    memory.release(b);
+    memory.release(moved);
+}
+
 TEST_CASE("the rows killed are compacted on the GPU in row order, across work groups") {
     auto gpu = gpuBackend();  // a context
     gpu::Compactor compactor;
@@ -300,3 +351,4 @@ TEST_CASE("what is drawn is computed and marked on the GPU, and stays there") {
     CHECK(drawn.drawn == system.pool(drop).live());
     CHECK(system.backend().memory().glBuffer(drawn.position[0]) != 0);
 }
+
