@@ -18,7 +18,7 @@ GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::G
     // Wall times with the GPU untimed (a timer query waits for its pass), then the passes.
     std::vector<double> times;
     double live = 0;
-    uint64_t transferred = gpu.transferredBytes(), waits = gpu.waits();
+    uint64_t transferred = gpu.transferredBytes(), waits = gpu.waits(), staged = gpu.stagedBytes();
     for (int f = 0; f < frames; ++f) {
         auto start = Clock::now();
         system.step(1.0 / 60);
@@ -28,6 +28,7 @@ GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::G
     out.live = live / frames;
     out.transferBytes = static_cast<double>(gpu.transferredBytes() - transferred) / frames / std::max(out.live, 1.0);
     out.waits = static_cast<double>(gpu.waits() - waits) / frames;
+    out.stagedBytes = static_cast<double>(gpu.stagedBytes() - staged) / frames / std::max(out.live, 1.0);
     out.stepSeconds = median(times);
     out.perSecond = out.live / out.stepSeconds;
     auto before = gpu.passTimes();

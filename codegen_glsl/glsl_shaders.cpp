@@ -1,5 +1,6 @@
 #include "codegen_glsl/glsl_shaders.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
 
@@ -39,25 +40,35 @@ uint32_t valuesRead(const Kernel* kernel, Op op) {
 uint32_t uniformValues(const Kernel& kernel) { return valuesRead(&kernel, Op::Uniform); }
 
 // What every compute shader starts with: the bindings, the accessors and the helpers
-// that give GLSL built-ins core/lanes.h's results where GLSL leaves them undefined.
-std::string preamble(const std::string& comment, uint32_t blockWords) {
+// that give GLSL built-ins core/lanes.h's results where GLSL leaves them undefined. A
+// column in `direct` is read and written in its own storage block (2 + its place there),
+// the others in the launch's words; the accessors' switch on a literal column folds away.
+std::string preamble(const std::string& comment, uint32_t blockWords, const std::vector<int>& direct = {}) {
+    std::string blocks, reads, writes;
+    for (size_t k = 0; k < direct.size(); ++k) {
+        blocks += fmt::format("layout(std430, binding = {0}) buffer Column{0} {{ uint d{0}[]; }};\n", k + 2);
+        reads += fmt::format("case {}u: return d{}[o]; ", direct[k], k + 2);
+        writes += fmt::format("case {}u: d{}[o] = x; return; ", direct[k], k + 2);
+    }
     return fmt::format(R"(#version 450
 // {0}
 layout(local_size_x = {1}) in;
 layout(std430, binding = 0) buffer Words {{ uint w[]; }};
 layout(std430, binding = 1) buffer Counts {{ uint counts[]; }};
-layout(std140, binding = 0) uniform Launch {{ uvec4 L[{2}]; }};
+{4}layout(std140, binding = 0) uniform Launch {{ uvec4 L[{2}]; }};
 
 uint lw(uint k) {{ return L[k >> 2u][k & 3u]; }}
 float lf(uint k) {{ return uintBitsToFloat(lw(k)); }}
 double ld(uint k) {{ return packDouble2x32(uvec2(lw(k), lw(k + 1u))); }}
 vec4 lv(uint k) {{ return uintBitsToFloat(L[k >> 2u]); }}
 uint col(uint c) {{ return lw({3}u + c); }}
-float cf(uint c, uint i) {{ return uintBitsToFloat(w[col(c) + i]); }}
-uint cu(uint c, uint i) {{ return w[col(c) + i]; }}
-double cd(uint c, uint i) {{ uint o = col(c) + 2u * i; return packDouble2x32(uvec2(w[o], w[o + 1u])); }}
-void sf(uint c, uint i, float x) {{ w[col(c) + i] = floatBitsToUint(x); }}
-void su(uint c, uint i, uint x) {{ w[col(c) + i] = x; }}
+uint cw(uint c, uint o) {{ switch (c) {{ {5}default: return w[o]; }} }}
+void scw(uint c, uint o, uint x) {{ switch (c) {{ {6}default: w[o] = x; }} }}
+float cf(uint c, uint i) {{ return uintBitsToFloat(cw(c, col(c) + i)); }}
+uint cu(uint c, uint i) {{ return cw(c, col(c) + i); }}
+double cd(uint c, uint i) {{ uint o = col(c) + 2u * i; return packDouble2x32(uvec2(cw(c, o), cw(c, o + 1u))); }}
+void sf(uint c, uint i, float x) {{ scw(c, col(c) + i, floatBitsToUint(x)); }}
+void su(uint c, uint i, uint x) {{ scw(c, col(c) + i, x); }}
 
 #define psys_nan uintBitsToFloat(0x7fc00000u)
 #define psys_inf uintBitsToFloat(0x7f800000u)
@@ -95,7 +106,7 @@ float psys_pow(float x, float y) {{  // C's pow: defined for every base
 }}
 
 )",
-                       comment, kWorkGroupSize, align4(blockWords) / 4, LaunchBlock::kColumns);
+                       comment, kWorkGroupSize, align4(blockWords) / 4, LaunchBlock::kColumns, blocks, reads, writes);
 }
 
 const char* kIndex =
@@ -223,6 +234,45 @@ const char* clockName(rt::Clock::Source s) { return s == rt::Clock::Source::PerR
 
 }  // namespace
 
+std::vector<int> keptColumns(const Kernel& kernel, const ColumnLayout& l) {
+    std::vector<int> kept;
+    auto range = [&kept](int first, int width) {
+        for (int c = 0; c < width; ++c) kept.push_back(first + c);
+    };
+    // What is drawn stays on the GPU (the viewer draws from it): the render shader writes
+    // `visible` for every row, and the render columns not drawn from the state's.
+    if (kernel.kind == KernelKind::Render)
+        for (int c = 0; c < ColumnLayout::kRenderColumns; ++c)
+            if (l.drawnFrom(c) == l.render + c && !l.constant(c)) kept.push_back(l.render + c);
+    for (const Yield& y : kernel.yields) {
+        int width = kernel.at(y.value).type.width;
+        if (y.kind == YieldKind::StateNext) range(l.stateOffset[static_cast<size_t>(y.index)], width);
+        if (y.kind == YieldKind::Export) range(l.exportOffset[static_cast<size_t>(y.index)], width);
+    }
+    std::sort(kept.begin(), kept.end());
+    kept.erase(std::unique(kept.begin(), kept.end()), kept.end());
+    return kept;
+}
+
+std::vector<int> directColumns(const Kernel& kernel, const ColumnLayout& l) {
+    std::vector<int> direct = keptColumns(kernel, l);
+    auto add = [&direct](int c) {
+        if (std::find(direct.begin(), direct.end(), c) == direct.end()) direct.push_back(c);
+    };
+    for (const Inst& i : kernel.insts())
+        if (i.op == Op::StateRead)
+            for (int c = 0; c < i.type.width; ++c) add(l.stateOffset[static_cast<size_t>(i.attr)] + c);
+    add(ColumnLayout::kCreated);  // 8 bytes a row
+    add(l.total);                 // the mask
+    for (const Inst& i : kernel.insts()) {
+        if (i.op == Op::Param)
+            for (int c = 0; c < i.type.width; ++c) add(l.paramOffset[static_cast<size_t>(i.attr)] + c);
+        if (i.op == Op::ObjectId) add(ColumnLayout::kIds);
+    }
+    if (direct.size() > kDirectSlots) direct.resize(kDirectSlots);
+    return direct;
+}
+
 LaunchBlock rowsBlock(const Kernel& kernel, const Kernel* uniform, const ColumnLayout& layout) {
     LaunchBlock b;
     b.columns = static_cast<uint32_t>(layout.total) + 1;  // the mask last
@@ -244,7 +294,7 @@ std::string rowsShader(const Object& object, const Kernel& kernel, rt::Clock::So
     LaunchBlock block = rowsBlock(kernel, uniform, l);
     std::string text = preamble(fmt::format("object `{}`, kernel `{}`, clock: now {}, dt {}", object.name,
                                             kernelName(kernel.kind), clockName(now), clockName(dt)),
-                                block.words);
+                                block.words, directColumns(kernel, l));
     Statements out("t");
     bool kills = kernel.findOne(YieldKind::Kill) != nullptr;
     bool render = kernel.kind == KernelKind::Render;

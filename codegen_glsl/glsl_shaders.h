@@ -46,6 +46,22 @@ struct LaunchBlock {
 };
 
 constexpr uint32_t kWorkGroupSize = 64;
+
+// Storage blocks a rows shader binds columns to in place (blocks 2, 3, …): GL's 16 storage
+// blocks of a compute shader (llvmpipe's and NVIDIA's; GL 4.5 promises 8) less the
+// launch's words and counts.
+constexpr size_t kDirectSlots = 14;
+
+// The table columns a rows kernel writes and the pool keeps: its state, exports and what
+// it draws (not kill flags or emissions, which the host reads right after the launch).
+std::vector<int> keptColumns(const ir::Kernel& kernel, const rt::ColumnLayout& layout);
+// The columns a rows shader reads and writes in place, each in its own GL buffer bound
+// to storage block 2 + k, rather than copied into the launch's words and back: the kept
+// columns, then the state it reads, the creation times, the mask (column `layout.total`),
+// the parameters it reads and the ids, at most kDirectSlots. (Every table has a buffer
+// for each of them: a parameter a kernel reads is kept.) The launch
+// block's column word for one is the word its row `begin` sits at in the bound range.
+std::vector<int> directColumns(const ir::Kernel& kernel, const rt::ColumnLayout& layout);
 constexpr uint32_t kMaxGroupsX = 65535;
 
 // The blocks hold the externs the kernels read (the first `externs` of the module's).

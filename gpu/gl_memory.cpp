@@ -277,10 +277,13 @@ void GlMemory::adopt(Buffer b, size_t first, size_t count, unsigned words, size_
     Column& c = at(b);
     upload(c);
     size_t w = wordsPerRow(c.elem) * 4;
+    staged += count * w;
     glCopyNamedBufferSubData(words, c.gl, static_cast<GLintptr>(word * 4), static_cast<GLintptr>(first * w),
                              static_cast<GLsizeiptr>(count * w));
     c.device = true;
 }
+
+void GlMemory::written(Buffer b) { at(b).device = true; }
 
 size_t GlMemory::deviceBytes() const {
     size_t bytes = 0;

@@ -43,6 +43,9 @@ public:
     // The GPU wrote `count` rows from `first` into `words` (a GL buffer) at word `word`:
     // they become the column's, and the column's value is on the GPU from now on.
     void adopt(rt::Buffer buffer, size_t first, size_t count, unsigned words, size_t word);
+    // The GPU wrote rows of the column in its own GL buffer (bound in place): its value is
+    // on the GPU from now on.
+    void written(rt::Buffer buffer);
     // Bytes of GL buffers held.
     size_t deviceBytes() const;
     // Bytes moved between the host and the GPU so far, either way (the backend adds its
@@ -52,6 +55,9 @@ public:
     // GPU; the backend adds its launches' read-backs): each one stalls the host until the
     // GPU has finished everything before it.
     mutable uint64_t waits = 0;
+    // Bytes launches copied on the GPU between columns and the launch's words, either way
+    // (columns not bound in place: GlslBackend, adopt): memory traffic beyond the shader's.
+    uint64_t staged = 0;
 
     static size_t wordsPerRow(rt::Elem e) { return e == rt::Elem::F64 ? 2 : 1; }
 

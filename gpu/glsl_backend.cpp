@@ -26,6 +26,7 @@ struct GlslBackend::Program {
     LaunchBlock block;
     ColumnLayout layout;
     std::vector<int> resident, returned;  // the table columns the kernel writes (writtenColumns)
+    std::vector<int> direct;              // bound in place (codegen_glsl::directColumns): not staged, not adopted
     std::vector<bool> needed;             // the table columns a launch carries (the others are not touched)
     std::string pass;          // "update", "spawn", …: what timer queries add up under
     bool counts = false;       // whether the shader counts anything (kills, unstable rows, what is drawn)
@@ -58,35 +59,22 @@ void putValue(std::vector<uint32_t>& block, uint32_t word, const rt::Value& v) {
     for (size_t c = 0; c < 4; ++c) block[word + c] = bits(v.f[c]);
 }
 
-// The table columns a kernel writes: what stays on the GPU (state, exports, what is drawn)
-// and what the host reads right after the launch (kill flags, emissions).
+// The table columns a kernel writes: what stays on the GPU (state, exports, what is drawn:
+// codegen_glsl::keptColumns) and what the host reads right after the launch (kill flags,
+// emissions).
 void writtenColumns(const ir::Kernel& kernel, const ColumnLayout& l, std::vector<int>& resident,
                     std::vector<int>& returned) {
-    auto range = [](std::vector<int>& cols, int first, int width) {
-        for (int c = 0; c < width; ++c) cols.push_back(first + c);
-    };
-    std::vector<int>& cols = returned;
-    // What is drawn stays on the GPU (the viewer draws from it): the render shader writes
-    // `visible` for every row and reads every render column to mark the drawn rows (those
-    // drawn from state columns are the state's, resident already).
-    if (kernel.kind == ir::KernelKind::Render)
-        for (int c = 0; c < ColumnLayout::kRenderColumns; ++c)
-            if (l.drawnFrom(c) == l.render + c && !l.constant(c)) resident.push_back(l.render + c);
+    resident = codegen_glsl::keptColumns(kernel, l);
     for (const ir::Yield& y : kernel.yields) {
-        int width = kernel.at(y.value).type.width;
         switch (y.kind) {
-            case ir::YieldKind::StateNext: range(resident, l.stateOffset[static_cast<size_t>(y.index)], width); break;
-            case ir::YieldKind::Export: range(resident, l.exportOffset[static_cast<size_t>(y.index)], width); break;
-            case ir::YieldKind::Kill: cols.push_back(ColumnLayout::kKill); break;
-            case ir::YieldKind::EmitRate: cols.push_back(l.emitRate(y.index)); break;
-            case ir::YieldKind::EmitCount: cols.push_back(l.emitCount(y.index)); break;
+            case ir::YieldKind::Kill: returned.push_back(ColumnLayout::kKill); break;
+            case ir::YieldKind::EmitRate: returned.push_back(l.emitRate(y.index)); break;
+            case ir::YieldKind::EmitCount: returned.push_back(l.emitCount(y.index)); break;
             default: break;
         }
     }
-    for (std::vector<int>* list : {&resident, &returned}) {
-        std::sort(list->begin(), list->end());
-        list->erase(std::unique(list->begin(), list->end()), list->end());
-    }
+    std::sort(returned.begin(), returned.end());
+    returned.erase(std::unique(returned.begin(), returned.end()), returned.end());
 }
 
 // The table columns a launch of `kernel` carries to the GPU: what its shader reads (the
@@ -135,6 +123,15 @@ std::unique_ptr<GlslBackend> GlslBackend::create(std::string& error) {
     GLint64 maxBlock = 0;
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBlock);
     b->maxWords_ = static_cast<size_t>(std::min<GLint64>(maxBlock, GLint64{1} << 31)) / 4;
+    GLint alignment = 0, blocks = 0;
+    glGetIntegerv(GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT, &alignment);
+    b->storageAlignment_ = static_cast<size_t>(std::max(alignment, 1));
+    glGetIntegerv(GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS, &blocks);
+    if (static_cast<size_t>(blocks) < 2 + codegen_glsl::kDirectSlots) {
+        error = fmt::format("the GLSL backend needs {} storage blocks in a compute shader; {} has {}",
+                            2 + codegen_glsl::kDirectSlots, rendererName(), blocks);
+        return nullptr;
+    }
     b->renderer_ = rendererName();
     glCreateBuffers(1, &b->words_);
     glCreateBuffers(1, &b->counts_);
@@ -172,6 +169,7 @@ GlslBackend::Program& GlslBackend::rowsProgram(const ir::Object& object, const i
         p->layout = rt::columnLayout(object, kernel);
         p->block = codegen_glsl::rowsBlock(kernel, uniform, p->layout);
         writtenColumns(kernel, p->layout, p->resident, p->returned);
+        p->direct = codegen_glsl::directColumns(kernel, p->layout);
         p->needed = neededColumns(kernel, p->layout, now == rt::Clock::Source::PerRow || dt == rt::Clock::Source::PerRow,
                                   p->resident, p->returned);
         p->pass = ir::kernelName(kernel.kind);
@@ -260,7 +258,9 @@ GlslBackend::Counts GlslBackend::dispatch(Program& program, const std::vector<ui
         t.launches += 1;
         t.rows += count;
     }
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    // What the shader wrote is read next by shaders (columns bound in place), copies and
+    // read-backs, and the viewer's vertex pulls.
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT);
     Counts counts;
     if (!program.counts) return counts;
     glGetNamedBufferSubData(counts_, 0, sizeof counts.n, counts.n);
@@ -271,13 +271,18 @@ GlslBackend::Counts GlslBackend::dispatch(Program& program, const std::vector<ui
 rt::RowsResult GlslBackend::run(const rt::RowsLaunch& launch) {
     if (context_) context_->makeCurrent();
     Program& p = rowsProgram(*launch.object, *launch.kernel, launch.clock.now, launch.clock.dt);
-    // Rows per dispatch: as many as the largest storage block the GL binds holds.
-    size_t perRow = 0;
+    // Rows per dispatch: as many as the largest storage block the GL binds holds, for the
+    // launch's words (the columns not bound in place, and a row of zeros) and for each
+    // column bound in place (at most two words a row, from an aligned offset).
+    size_t perRow = 1;
+    if (std::find(p.direct.begin(), p.direct.end(), p.layout.total) == p.direct.end()) ++perRow;  // the mask
     for (int c = 0; c < p.layout.total; ++c) {
         Buffer b = launch.columns[static_cast<size_t>(c)];
-        perRow += b.valid() ? GlMemory::wordsPerRow(memory_.elem(b)) : 1;  // at most
+        if (std::find(p.direct.begin(), p.direct.end(), c) == p.direct.end())
+            perRow += b.valid() ? GlMemory::wordsPerRow(memory_.elem(b)) : 1;  // at most
     }
-    size_t rows = std::clamp<size_t>(maxWords_ / (perRow + 1), 1, size_t{codegen_glsl::kMaxGroupsX} * kCompactGroup);
+    size_t rows = std::min(maxWords_ / perRow, (maxWords_ - storageAlignment_ / 4) / 2);
+    rows = std::clamp<size_t>(std::min(rows, dispatchRows_), 1, size_t{codegen_glsl::kMaxGroupsX} * kCompactGroup);
     rt::RowsResult result;
     for (size_t begin = launch.begin; begin < launch.end; begin += rows) {
         rt::RowsResult r = runRows(launch, p, begin, std::min(launch.end, begin + rows));
@@ -287,6 +292,24 @@ rt::RowsResult GlslBackend::run(const rt::RowsLaunch& launch) {
         result.nonFinite += r.nonFinite;
     }
     return result;
+}
+
+// The columns a shader reads and writes in place (codegen_glsl::directColumns): each its
+// own GL buffer bound to storage block 2 + k from an aligned offset at or before row
+// `begin`; the block's column word says where row `begin` is in that range.
+void GlslBackend::bindDirect(const rt::RowsLaunch& launch, const Program& p, size_t begin, size_t end,
+                             std::vector<uint32_t>& block) {
+    for (size_t k = 0; k < p.direct.size(); ++k) {
+        auto c = static_cast<size_t>(p.direct[k]);
+        Buffer b = c == static_cast<size_t>(p.layout.total) ? launch.mask : launch.columns[c];
+        if (!b.valid())
+            throw std::logic_error(fmt::format("{}: column {} has no buffer to bind in place", p.pass, c));
+        size_t rowBytes = GlMemory::wordsPerRow(memory_.elem(b)) * 4;
+        size_t offset = begin * rowBytes / storageAlignment_ * storageAlignment_;
+        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, static_cast<GLuint>(2 + k), memory_.deviceBuffer(b),
+                          static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(end * rowBytes - offset));
+        block[LaunchBlock::kColumns + c] = static_cast<uint32_t>((begin * rowBytes - offset) / 4);
+    }
 }
 
 rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, size_t begin, size_t end) {
@@ -309,8 +332,10 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
         words += n * GlMemory::wordsPerRow(memory_.elem(b));
         return slots.back().word;
     };
+    std::vector<bool> direct(static_cast<size_t>(p.layout.total) + 1, false);
+    for (int c : p.direct) direct[static_cast<size_t>(c)] = true;
     for (int c = 0; c < p.layout.total; ++c)
-        if (p.needed[static_cast<size_t>(c)])
+        if (p.needed[static_cast<size_t>(c)] && !direct[static_cast<size_t>(c)])
             block[LaunchBlock::kColumns + static_cast<size_t>(c)] = static_cast<uint32_t>(place(launch.columns[static_cast<size_t>(c)]));
     // The kill flags: written for every row, carried only from the GPU.
     Buffer killBuffer = launch.columns[ColumnLayout::kKill];
@@ -319,7 +344,9 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
         block[LaunchBlock::kColumns + ColumnLayout::kKill] = static_cast<uint32_t>(words);
         words += n;
     }
-    block[LaunchBlock::kColumns + static_cast<size_t>(p.layout.total)] = static_cast<uint32_t>(place(launch.mask));
+    if (!direct.back())
+        block[LaunchBlock::kColumns + static_cast<size_t>(p.layout.total)] = static_cast<uint32_t>(place(launch.mask));
+    bindDirect(launch, p, begin, end, block);
     ensureWords(words);
     // Columns on the GPU are copied there; the others come from the host.
     uint32_t zero = 0;
@@ -328,6 +355,7 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
         Elem e = memory_.elem(s.buffer);
         size_t w = GlMemory::wordsPerRow(e);
         if (memory_.onDevice(s.buffer)) {
+            memory_.staged += n * w * 4;
             glCopyNamedBufferSubData(memory_.deviceBuffer(s.buffer), words_, static_cast<GLintptr>(begin * w * 4),
                                      static_cast<GLintptr>(s.word * 4), static_cast<GLsizeiptr>(n * w * 4));
             continue;
@@ -346,7 +374,11 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
 
     for (int c : p.resident) {
         Buffer b = launch.columns[static_cast<size_t>(c)];
-        if (b.valid()) memory_.adopt(b, begin, n, words_, block[LaunchBlock::kColumns + static_cast<size_t>(c)]);
+        if (!b.valid()) continue;
+        if (direct[static_cast<size_t>(c)])
+            memory_.written(b);
+        else
+            memory_.adopt(b, begin, n, words_, block[LaunchBlock::kColumns + static_cast<size_t>(c)]);
     }
     for (int c : p.returned) {
         Buffer b = launch.columns[static_cast<size_t>(c)];

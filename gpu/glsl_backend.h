@@ -54,8 +54,13 @@ public:
     };
     const std::map<std::string, PassTime>& passTimes() const { return passTimes_; }
     void timePasses(bool on) { timing_ = on; }
+    // At most this many rows per dispatch (else as many as a storage block holds): for
+    // tests, which cannot reach the GL's limit.
+    void limitDispatchRows(size_t rows) { dispatchRows_ = rows; }
     // Bytes moved between the host and the GPU so far, either way.
     uint64_t transferredBytes() const { return memory_.transferred; }
+    // Bytes launches copied on the GPU into and out of their words so far (GlMemory::staged).
+    uint64_t stagedBytes() const { return memory_.staged; }
     // Times the host waited for a read-back from the GPU so far (GlMemory::waits).
     uint64_t waits() const { return memory_.waits; }
 
@@ -68,6 +73,8 @@ private:
     Program& childrenProgram(const ir::Object& object, const ir::Kernel& spawn);
     Program compile(const std::string& source, const std::string& what);
     rt::RowsResult runRows(const rt::RowsLaunch& launch, Program& program, size_t begin, size_t end);
+    void bindDirect(const rt::RowsLaunch& launch, const Program& program, size_t begin, size_t end,
+                    std::vector<uint32_t>& block);
     // Uploads the block, fills the words of it that `fill` names from columns on the GPU
     // (on the GPU: no read-back), runs `program` over `count` invocations, and returns the
     // counts (killed, unstable, drawn, not finite) — read back only for a program that
@@ -93,6 +100,8 @@ private:
     unsigned words_ = 0, counts_ = 0, block_ = 0, query_ = 0;
     size_t wordsCapacity_ = 0;
     size_t maxWords_ = 0;  // the largest storage block the GL allows, in words
+    size_t storageAlignment_ = 16;  // of a storage block's offset, in bytes
+    size_t dispatchRows_ = std::numeric_limits<size_t>::max();
     std::vector<uint32_t> staging_;
     size_t kernels_ = 0;
     double compileSeconds_ = 0;
