@@ -219,8 +219,12 @@ void GlMemory::scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const
         scatterProgram_ = computeProgram(kScatter, "scatter");
         glCreateBuffers(1, &rowsBuffer_);
     }
-    glNamedBufferData(rowsBuffer_, static_cast<GLsizeiptr>(rows.size() * 4), rows.data(), GL_STREAM_DRAW);
-    transferred += rows.size() * 4;
+    // A batch scatters every column of its objects to the same rows: the list goes up once.
+    if (!std::equal(rows.begin(), rows.end(), rowsSent_.begin(), rowsSent_.end())) {
+        glNamedBufferData(rowsBuffer_, static_cast<GLsizeiptr>(rows.size() * 4), rows.data(), GL_STREAM_DRAW);
+        transferred += rows.size() * 4;
+        rowsSent_.assign(rows.begin(), rows.end());
+    }
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.gl);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, t.gl);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, rowsBuffer_);

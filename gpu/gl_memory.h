@@ -72,6 +72,7 @@ private:
     std::vector<std::unique_ptr<Column>> columns_;
     std::vector<uint32_t> free_;
     unsigned scatterProgram_ = 0, rowsBuffer_ = 0;
+    std::vector<uint32_t> rowsSent_;  // what rowsBuffer_ holds
 };
 
 // Host rows to GPU words (u8 widened to a word) and back.
