@@ -56,10 +56,12 @@ void main() {
         groups[g] = offset;
         offset += c;
     }
+    if (t == 255u) groups[count] = runs[255];  // the total, after the offsets
 }
 )";
 
-// Each group's set rows at its offset, in order. A group with none set leaves at once,
+// Each group's set rows at its offset, in order, after the total (list[at]: written by the
+// first invocation; the rows from list[at + 1]). A group with none set leaves at once,
 // and one with all set needs no scan (the same for every invocation of the group, so no
 // barrier is skipped by some and not others): kills are sparse and bunched (objects
 // created together die together), and a pool is one launch.
@@ -68,14 +70,15 @@ layout(local_size_x = 256) in;
 layout(std430, binding = 0) readonly buffer Words { uint w[]; };
 layout(std430, binding = 1) readonly buffer Groups { uint groups[]; };
 layout(std430, binding = 2) writeonly buffer List { uint list[]; };
-uniform uint first, n, set;
+uniform uint first, n, at;
 shared uint prefix[256];
 void main() {
     uint t = gl_LocalInvocationID.x, i = gl_GlobalInvocationID.x, g = gl_WorkGroupID.x;
-    uint count = (g + 1u < gl_NumWorkGroups.x ? groups[g + 1u] : set) - groups[g];
+    if (i == 0u) list[at] = groups[gl_NumWorkGroups.x];
+    uint count = groups[g + 1u] - groups[g];
     if (count == 0u) return;
     if (count == gl_WorkGroupSize.x) {
-        list[groups[g] + t] = i;
+        list[at + 1u + groups[g] + t] = i;
         return;
     }
     uint flag = i < n && w[first + i] != 0u ? 1u : 0u;
@@ -87,7 +90,7 @@ void main() {
         prefix[t] += add;
         barrier();
     }
-    if (flag != 0u) list[groups[g] + prefix[t] - 1u] = i;
+    if (flag != 0u) list[at + groups[g] + prefix[t]] = i;
 }
 )";
 
@@ -108,32 +111,32 @@ Compactor::Compactor() = default;
 Compactor::~Compactor() {
     for (GLuint p : {count_, scan_, write_})
         if (p) glDeleteProgram(p);
-    GLuint buffers[] = {groups_, list_};
-    if (groups_) glDeleteBuffers(2, buffers);
+    if (groups_) glDeleteBuffers(1, &groups_);
 }
 
-std::vector<uint32_t> Compactor::flagged(unsigned words, size_t word, size_t n, size_t set) {
-    std::vector<uint32_t> rows(set);
-    if (set == 0 || n == 0) return rows;
+void Compactor::compact(unsigned words, size_t word, size_t n, unsigned out, size_t at) {
     if (!count_) {
         count_ = computeProgram(kCount, "compaction (counts)");
         scan_ = computeProgram(kScan, "compaction (scan)");
         write_ = computeProgram(kWrite, "compaction (rows)");
         glCreateBuffers(1, &groups_);
-        glCreateBuffers(1, &list_);
+    }
+    if (n == 0) {  // nothing set: the total alone
+        uint32_t zero = 0;
+        glClearNamedBufferSubData(out, GL_R32UI, static_cast<GLintptr>(at * 4), 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+        return;
     }
     size_t groups = (n + kCompactGroup - 1) / kCompactGroup;
-    grow(groups_, groupsCapacity_, groups);
-    grow(list_, listCapacity_, set);
+    grow(groups_, groupsCapacity_, groups + 1);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, words);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, groups_);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, list_);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, out);
     for (GLuint p : {count_, write_}) {
         setUint(p, "first", word);
         setUint(p, "n", n);
     }
     setUint(scan_, "count", groups);
-    setUint(write_, "set", set);
+    setUint(write_, "at", at);
     glUseProgram(count_);
     glDispatchCompute(static_cast<GLuint>(groups), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -142,9 +145,7 @@ std::vector<uint32_t> Compactor::flagged(unsigned words, size_t word, size_t n, 
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     glUseProgram(write_);
     glDispatchCompute(static_cast<GLuint>(groups), 1, 1);
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    glGetNamedBufferSubData(list_, 0, static_cast<GLsizeiptr>(set * 4), rows.data());
-    return rows;
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_CLIENT_MAPPED_BUFFER_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
 }
 
 }  // namespace psys::gpu
@@ -152,14 +153,15 @@ std::vector<uint32_t> Compactor::flagged(unsigned words, size_t word, size_t n, 
 namespace psys::gpu {
 
 std::vector<uint32_t> Compactor::flagged(std::span<const uint32_t> flags) {
-    size_t set = 0;
-    for (uint32_t f : flags) set += f != 0;
-    GLuint buffer = 0;
-    glCreateBuffers(1, &buffer);
-    glNamedBufferData(buffer, static_cast<GLsizeiptr>(std::max<size_t>(flags.size(), 1) * 4), flags.data(), GL_STATIC_DRAW);
-    std::vector<uint32_t> rows = flagged(buffer, 0, flags.size(), set);
-    glDeleteBuffers(1, &buffer);
-    return rows;
+    GLuint buffers[2] = {0, 0};
+    glCreateBuffers(2, buffers);
+    glNamedBufferData(buffers[0], static_cast<GLsizeiptr>(std::max<size_t>(flags.size(), 1) * 4), flags.data(), GL_STATIC_DRAW);
+    glNamedBufferData(buffers[1], static_cast<GLsizeiptr>((flags.size() + 1) * 4), nullptr, GL_DYNAMIC_READ);
+    compact(buffers[0], 0, flags.size(), buffers[1], 0);
+    std::vector<uint32_t> list(flags.size() + 1);
+    glGetNamedBufferSubData(buffers[1], 0, static_cast<GLsizeiptr>(list.size() * 4), list.data());
+    glDeleteBuffers(2, buffers);
+    return std::vector<uint32_t>(list.begin() + 1, list.begin() + 1 + list[0]);
 }
 
 }  // namespace psys::gpu

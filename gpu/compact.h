@@ -4,8 +4,10 @@
 // rows an update killed instead of a flag per row.
 //
 // Three passes of 256 invocations a group: each group counts its set flags; one group
-// scans the counts (each invocation a run of groups, then a scan of the 256 runs); each
-// group scans its flags in shared memory and writes its rows at its offset.
+// scans the counts (each invocation a run of groups, then a scan of the 256 runs) and
+// writes the total; each group scans its flags in shared memory and writes its rows at
+// its offset, after the total. The host learns how many rows there are with the rows
+// (GlslBackend reads them back with the launch's counts: one wait).
 #pragma once
 
 #include <cstddef>
@@ -21,16 +23,16 @@ public:
     ~Compactor();
     Compactor(const Compactor&) = delete;
     Compactor& operator=(const Compactor&) = delete;
-    // The indices i < n with words[word + i] != 0 (a GL buffer of 32-bit words), in
-    // order; `set` is how many there are (known from the kernel's counter).
-    std::vector<uint32_t> flagged(unsigned words, size_t word, size_t n, size_t set);
-    // The same for flags on the host (uploaded first).
+    // Into `out` (a GL buffer) from word `at`: how many of words[word + i], i < n, are
+    // not 0, then those i in order (room for n + 1 words). All on the GPU: nothing waits.
+    void compact(unsigned words, size_t word, size_t n, unsigned out, size_t at);
+    // The same for flags on the host, read back: the indices set.
     std::vector<uint32_t> flagged(std::span<const uint32_t> flags);
 
 private:
     unsigned count_ = 0, scan_ = 0, write_ = 0;  // programs
-    unsigned groups_ = 0, list_ = 0;             // buffers
-    size_t groupsCapacity_ = 0, listCapacity_ = 0;
+    unsigned groups_ = 0;                        // a buffer: per group its count, then its offset; the total
+    size_t groupsCapacity_ = 0;
 };
 
 constexpr uint32_t kCompactGroup = 256;

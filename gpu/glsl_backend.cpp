@@ -136,7 +136,7 @@ std::unique_ptr<GlslBackend> GlslBackend::create(std::string& error) {
     glCreateBuffers(1, &b->words_);
     glCreateBuffers(1, &b->counts_);
     glCreateBuffers(1, &b->block_);
-    glNamedBufferData(b->counts_, sizeof(Counts::n), nullptr, GL_DYNAMIC_READ);
+    glNamedBufferData(b->counts_, 16, nullptr, GL_DYNAMIC_COPY);
     glCreateQueries(GL_TIME_ELAPSED, 1, &b->query_);
     return b;
 }
@@ -145,8 +145,9 @@ GlslBackend::~GlslBackend() {
     if (context_) context_->makeCurrent();
     for (auto& [key, p] : rows_) glDeleteProgram(p->program);
     for (auto& [key, p] : children_) glDeleteProgram(p->program);
-    GLuint buffers[] = {words_, counts_, block_};
-    glDeleteBuffers(3, buffers);
+    if (readback_) glUnmapNamedBuffer(readback_);
+    GLuint buffers[] = {words_, counts_, block_, readback_};
+    glDeleteBuffers(4, buffers);
     glDeleteQueries(1, &query_);
 }
 
@@ -224,8 +225,8 @@ void GlslBackend::ensureWords(size_t words) {
     glNamedBufferData(words_, static_cast<GLsizeiptr>(wordsCapacity_ * 4), nullptr, GL_DYNAMIC_COPY);
 }
 
-GlslBackend::Counts GlslBackend::dispatch(Program& program, const std::vector<uint32_t>& block, size_t count,
-                                          const std::string& pass, std::span<const BlockFill> fill) {
+void GlslBackend::dispatch(Program& program, const std::vector<uint32_t>& block, size_t count, const std::string& pass,
+                           std::span<const BlockFill> fill) {
     uint32_t zero[4] = {0, 0, 0, 0};
     if (program.counts) glNamedBufferSubData(counts_, 0, sizeof zero, zero);
     glNamedBufferData(block_, static_cast<GLsizeiptr>(block.size() * 4), block.data(), GL_STREAM_DRAW);
@@ -261,11 +262,6 @@ GlslBackend::Counts GlslBackend::dispatch(Program& program, const std::vector<ui
     // What the shader wrote is read next by shaders (columns bound in place), copies and
     // read-backs, and the viewer's vertex pulls.
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT);
-    Counts counts;
-    if (!program.counts) return counts;
-    glGetNamedBufferSubData(counts_, 0, sizeof counts.n, counts.n);
-    ++memory_.waits;
-    return counts;
 }
 
 rt::RowsResult GlslBackend::run(const rt::RowsLaunch& launch) {
@@ -369,9 +365,7 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
     for (uint32_t e = 0; e < p.block.externCount; ++e) putValue(block, p.block.externs + 4 * e, launch.externs[e]);
     if (launch.uniforms)
         for (uint32_t u = 0; u < p.block.uniformCount; ++u) putValue(block, p.block.uniforms + 4 * u, launch.uniforms[u]);
-    Counts counts = dispatch(p, block, n, p.pass);
-    size_t killed = counts.n[0];
-
+    dispatch(p, block, n, p.pass);
     for (int c : p.resident) {
         Buffer b = launch.columns[static_cast<size_t>(c)];
         if (!b.valid()) continue;
@@ -380,29 +374,93 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
         else
             memory_.adopt(b, begin, n, words_, block[LaunchBlock::kColumns + static_cast<size_t>(c)]);
     }
+    return readBack(launch, p, begin, n, block);
+}
+
+// What the host needs right after a launch — its counts, the rows it killed (compacted on
+// the GPU) and its emissions — gathered on the GPU into one buffer the host has mapped:
+// one wait. Counts at words 0–3; the kills' total and rows from word 4; the emission
+// columns after them.
+rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program& p, size_t begin, size_t n,
+                                     const std::vector<uint32_t>& block) {
+    std::vector<std::pair<Buffer, size_t>> returned;  // column, its first word in the read-back
+    size_t words = 4;
+    bool kills = false;
     for (int c : p.returned) {
         Buffer b = launch.columns[static_cast<size_t>(c)];
         if (!b.valid()) continue;
-        if (c == ColumnLayout::kKill) {  // the rows killed, compacted on the GPU
-            size_t word = block[LaunchBlock::kColumns + ColumnLayout::kKill];
-            std::vector<uint32_t> rows = compactor_.flagged(words_, word, n, killed);
-            memory_.transferred += rows.size() * 4;
-            memory_.waits += killed > 0;
-            auto* kill = static_cast<uint8_t*>(memory_.host(b)) + begin;
-            std::memset(kill, 0, n);
-            for (uint32_t r : rows) kill[r] = 1;
+        if (c == ColumnLayout::kKill) {
+            kills = true;
             continue;
         }
-        size_t word = block[LaunchBlock::kColumns + static_cast<size_t>(c)];
-        Elem e = memory_.elem(b);
-        staging_.resize(n * GlMemory::wordsPerRow(e));
-        glGetNamedBufferSubData(words_, static_cast<GLintptr>(word * 4), static_cast<GLsizeiptr>(staging_.size() * 4),
-                                staging_.data());
-        memory_.transferred += staging_.size() * 4;
-        ++memory_.waits;
-        fromWords(staging_.data(), e, n, static_cast<char*>(memory_.host(b)) + begin * rt::elemSize(e));
+        returned.emplace_back(b, 0);
     }
-    return {killed, counts.n[1], counts.n[2], counts.n[3]};
+    if (!p.counts && !kills && returned.empty()) return {};
+    size_t killsAt = words;
+    if (kills) words += 1 + n;
+    for (auto& [b, at] : returned) {
+        at = words;
+        words += n * GlMemory::wordsPerRow(memory_.elem(b));
+    }
+    ensureReadback(words);
+    if (p.counts) glCopyNamedBufferSubData(counts_, readback_, 0, 0, 16);
+    if (kills) compactor_.compact(words_, block[LaunchBlock::kColumns + ColumnLayout::kKill], n, readback_, killsAt);
+    size_t r = 0;
+    for (int c : p.returned) {
+        if (c == ColumnLayout::kKill || !launch.columns[static_cast<size_t>(c)].valid()) continue;
+        auto [b, at] = returned[r++];
+        size_t w = GlMemory::wordsPerRow(memory_.elem(b));
+        glCopyNamedBufferSubData(words_, readback_, static_cast<GLintptr>(block[LaunchBlock::kColumns + static_cast<size_t>(c)]) * 4,
+                                 static_cast<GLintptr>(at * 4), static_cast<GLsizeiptr>(n * w * 4));
+    }
+    const uint32_t* back = awaitReadback();
+    rt::RowsResult result;
+    if (p.counts) {
+        result = {back[0], back[1], back[2], back[3]};
+        memory_.transferred += 16;
+    }
+    if (kills) {
+        Buffer b = launch.columns[ColumnLayout::kKill];
+        uint32_t killed = back[killsAt];
+        memory_.transferred += (1 + killed) * 4;
+        auto* flags = static_cast<uint8_t*>(memory_.host(b)) + begin;
+        std::memset(flags, 0, n);
+        for (uint32_t k = 0; k < killed; ++k) flags[back[killsAt + 1 + k]] = 1;
+    }
+    for (auto [b, at] : returned) {
+        Elem e = memory_.elem(b);
+        memory_.transferred += n * GlMemory::wordsPerRow(e) * 4;
+        fromWords(back + at, e, n, static_cast<char*>(memory_.host(b)) + begin * rt::elemSize(e));
+    }
+    return result;
+}
+
+// A buffer of at least `words` words the host has mapped for reading, written by the GPU
+// (coherent: what the GPU wrote before a fence is there once the fence is passed).
+void GlslBackend::ensureReadback(size_t words) {
+    if (words <= readbackWords_) return;
+    if (readback_) {
+        glUnmapNamedBuffer(readback_);
+        glDeleteBuffers(1, &readback_);
+    }
+    readbackWords_ = std::max(words, 2 * readbackWords_);
+    auto bytes = static_cast<GLsizeiptr>(readbackWords_ * 4);
+    GLbitfield flags = GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT;
+    glCreateBuffers(1, &readback_);
+    glNamedBufferStorage(readback_, bytes, nullptr, flags | GL_CLIENT_STORAGE_BIT);
+    mappedReadback_ = static_cast<const uint32_t*>(glMapNamedBufferRange(readback_, 0, bytes, flags));
+    if (!mappedReadback_) throw std::runtime_error("the GL could not map a buffer for reading back");
+}
+
+const uint32_t* GlslBackend::awaitReadback() {
+    glMemoryBarrier(GL_CLIENT_MAPPED_BUFFER_BARRIER_BIT);
+    GLsync fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    GLenum status = GL_TIMEOUT_EXPIRED;
+    while (status == GL_TIMEOUT_EXPIRED) status = glClientWaitSync(fence, GL_SYNC_FLUSH_COMMANDS_BIT, 1'000'000'000);
+    glDeleteSync(fence);
+    if (status == GL_WAIT_FAILED) throw std::runtime_error("waiting for the GPU failed");
+    ++memory_.waits;
+    return mappedReadback_;
 }
 
 void GlslBackend::run(const rt::ChildrenLaunch& launch) {

@@ -76,20 +76,20 @@ private:
     void bindDirect(const rt::RowsLaunch& launch, const Program& program, size_t begin, size_t end,
                     std::vector<uint32_t>& block);
     // Uploads the block, fills the words of it that `fill` names from columns on the GPU
-    // (on the GPU: no read-back), runs `program` over `count` invocations, and returns the
-    // counts (killed, unstable, drawn, not finite) — read back only for a program that
-    // has any.
-    struct Counts {
-        uint32_t n[4] = {0, 0, 0, 0};
-    };
+    // (on the GPU: no read-back), and runs `program` over `count` invocations; its counts
+    // (killed, unstable, drawn, not finite) are left in the counts buffer.
     struct BlockFill {
         unsigned from;   // a GL buffer
         size_t byte;     // where in it
         uint32_t word;   // the block's word
         uint32_t words;
     };
-    Counts dispatch(Program& program, const std::vector<uint32_t>& block, size_t count, const std::string& pass,
-                    std::span<const BlockFill> fill = {});
+    void dispatch(Program& program, const std::vector<uint32_t>& block, size_t count, const std::string& pass,
+                  std::span<const BlockFill> fill = {});
+    rt::RowsResult readBack(const rt::RowsLaunch& launch, const Program& program, size_t begin, size_t n,
+                            const std::vector<uint32_t>& block);
+    void ensureReadback(size_t words);
+    const uint32_t* awaitReadback();  // a fence, one wait: the read-back buffer as the GPU left it
     void ensureWords(size_t words);
 
     std::unique_ptr<HeadlessContext> context_;
@@ -97,7 +97,9 @@ private:
     Compactor compactor_;
     std::map<RowsKey, std::unique_ptr<Program>> rows_;
     std::map<const ir::Kernel*, std::unique_ptr<Program>> children_;
-    unsigned words_ = 0, counts_ = 0, block_ = 0, query_ = 0;
+    unsigned words_ = 0, counts_ = 0, block_ = 0, query_ = 0, readback_ = 0;
+    const uint32_t* mappedReadback_ = nullptr;
+    size_t readbackWords_ = 0;
     size_t wordsCapacity_ = 0;
     size_t maxWords_ = 0;  // the largest storage block the GL allows, in words
     size_t storageAlignment_ = 16;  // of a storage block's offset, in bytes
