@@ -512,6 +512,10 @@ rt::BackendReport GlslBackend::report() const {
     r.target = renderer_;
     r.kernels = kernels_;
     r.compileSeconds = compileSeconds_;
+    r.device = true;
+    r.waits = memory_.waits;
+    r.transferredBytes = memory_.transferred;
+    r.stagedBytes = memory_.staged;
     return r;
 }
 

@@ -98,6 +98,11 @@ struct BackendReport {
     };
     std::vector<Remark> remarks; // what the compiler said about each loop
     std::vector<std::string> calls;  // the library functions compiled code calls (sorted, once each)
+    // A backend whose memory is a device's (the GPU): so far, the times the host waited
+    // for a read-back, the bytes moved between the host and the device, and the bytes
+    // launches copied on the device beyond what their kernels move.
+    bool device = false;
+    uint64_t waits = 0, transferredBytes = 0, stagedBytes = 0;
 };
 
 class Backend {

@@ -78,6 +78,12 @@ void printSummary(const RunOptions& options, host::Session& session, double draw
                                  session.stepSeconds() * 1e3 / frames, stats.loopSeconds * 1e3 / frames,
                                  stats.emitSeconds * 1e3 / frames, stats.createSeconds * 1e3 / frames,
                                  drawSeconds * 1e3 / frames);
+        if (r.device)
+            std::cout << fmt::format("on the GPU: the host waited for it {:.1f} times a frame; {:.1f} KB a frame "
+                                     "between host and GPU, {:.1f} KB copied on the GPU\n",
+                                     static_cast<double>(r.waits) / frames,
+                                     static_cast<double>(r.transferredBytes) / 1024 / frames,
+                                     static_cast<double>(r.stagedBytes) / 1024 / frames);
     }
     std::cout << fmt::format("after {} frames ({:.3f} s):\n", options.frames, system.time());
     for (auto& t : stats.types)
