@@ -102,6 +102,7 @@ void grow(GLuint buffer, size_t& capacity, size_t words) {
     if (words <= capacity) return;
     capacity = std::max(words, 2 * capacity);
     glNamedBufferData(buffer, static_cast<GLsizeiptr>(capacity * 4), nullptr, GL_DYNAMIC_COPY);
+    checkAllocation("a compaction", capacity * 4);
 }
 
 }  // namespace

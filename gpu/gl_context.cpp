@@ -86,6 +86,14 @@ unsigned computeProgram(const std::string& source, const std::string& what) {
     return program;
 }
 
+void checkAllocation(const char* what, size_t bytes) {
+    bool outOfMemory = false;
+    for (GLenum error = glGetError(); error != GL_NO_ERROR; error = glGetError()) outOfMemory |= error == GL_OUT_OF_MEMORY;
+    if (outOfMemory)
+        throw std::runtime_error("the GPU has no room for " + std::string(what) + " (" +
+                                 std::to_string(bytes >> 20) + " MiB)");
+}
+
 std::string rendererName() {
     auto text = [](GLenum e) {
         const auto* s = reinterpret_cast<const char*>(glGetString(e));

@@ -32,6 +32,10 @@ bool contextCurrent();
 // naming `what`, when the GL does not compile or link it (a fault of ours, not the user's).
 unsigned computeProgram(const std::string& source, const std::string& what);
 
+// Throws std::runtime_error naming `what` when the GL could not give a buffer its storage
+// (GL_OUT_OF_MEMORY): a buffer without storage would read zeros and drop writes.
+void checkAllocation(const char* what, size_t bytes);
+
 // "llvmpipe (LLVM 15.0.6, 256 bits), OpenGL 4.5 (Core Profile) Mesa 22.3.6", …
 std::string rendererName();
 

@@ -99,6 +99,7 @@ void GlMemory::resize(Buffer b, size_t rows) {
             GLuint grown = 0;
             glCreateBuffers(1, &grown);
             glNamedBufferData(grown, static_cast<GLsizeiptr>(room * w * 4), nullptr, GL_DYNAMIC_COPY);
+            checkAllocation("a column", room * w * 4);
             if (c.rows) glCopyNamedBufferSubData(c.gl, grown, 0, 0, static_cast<GLsizeiptr>(c.rows * w * 4));
             glDeleteBuffers(1, &c.gl);
             c.gl = grown;
@@ -121,6 +122,9 @@ void GlMemory::release(Buffer b) {
     c.live = false;
     c.device = false;
     c.rows = 0;
+    if (c.gl) glDeleteBuffers(1, &c.gl);  // its memory goes back to the GL (a pool of 10M rows holds GBs)
+    c.gl = 0;
+    c.glRows = 0;
     c.hostCopy.clear();
     c.hostCopy.shrink_to_fit();
     free_.push_back(b.id);
@@ -147,6 +151,7 @@ void GlMemory::uploadRows(Column& c, size_t first, size_t count) const {
     if (c.glRows < c.rows || c.glRows == 0) {
         size_t room = std::max<size_t>({c.rows, 2 * c.glRows, 1});
         glNamedBufferData(c.gl, static_cast<GLsizeiptr>(room * wordsPerRow(c.elem) * 4), nullptr, GL_DYNAMIC_COPY);
+        checkAllocation("a column", room * wordsPerRow(c.elem) * 4);
         c.glRows = room;
     }
     if (count == 0) return;

@@ -223,6 +223,7 @@ void GlslBackend::ensureWords(size_t words) {
     if (words <= wordsCapacity_) return;
     wordsCapacity_ = std::max(words, wordsCapacity_ * 2);
     glNamedBufferData(words_, static_cast<GLsizeiptr>(wordsCapacity_ * 4), nullptr, GL_DYNAMIC_COPY);
+    checkAllocation("a launch's words", wordsCapacity_ * 4);
 }
 
 void GlslBackend::dispatch(Program& program, const std::vector<uint32_t>& block, size_t count, const std::string& pass,
@@ -448,6 +449,7 @@ void GlslBackend::ensureReadback(size_t words) {
     GLbitfield flags = GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT;
     glCreateBuffers(1, &readback_);
     glNamedBufferStorage(readback_, bytes, nullptr, flags | GL_CLIENT_STORAGE_BIT);
+    checkAllocation("reading back", static_cast<size_t>(bytes));
     mappedReadback_ = static_cast<const uint32_t*>(glMapNamedBufferRange(readback_, 0, bytes, flags));
     if (!mappedReadback_) throw std::runtime_error("the GL could not map a buffer for reading back");
 }

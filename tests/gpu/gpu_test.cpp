@@ -337,8 +337,13 @@ TEST_CASE("clearing rows of a column on the GPU zeroes them there, without a rea
     CHECK(out == std::vector<float>{1, 2, 0, 0, 0, 6, 7, 8});
     memory.read(b, 0, 8, out.data());
     CHECK(out == std::vector<float>{1, 2, 3, 4, 5, 6, 7, 0});
+    // A released column gives its GL buffer back (a later column reusing its slot may be
+    // small).
+    size_t held = memory.deviceBytes();
     memory.release(b);
     memory.release(moved);
+    CHECK(memory.deviceBytes() < held);
+    CHECK(memory.deviceBytes() == held - 2 * 8 * 4);
 }
 
 TEST_CASE("the rows killed are compacted on the GPU in row order, across work groups") {
