@@ -275,8 +275,9 @@ rt::RowsResult GlslBackend::run(const rt::RowsLaunch& launch) {
     if (std::find(p.direct.begin(), p.direct.end(), p.layout.total) == p.direct.end()) ++perRow;  // the mask
     for (int c = 0; c < p.layout.total; ++c) {
         Buffer b = launch.columns[static_cast<size_t>(c)];
-        if (std::find(p.direct.begin(), p.direct.end(), c) == p.direct.end())
-            perRow += b.valid() ? GlMemory::wordsPerRow(memory_.elem(b)) : 1;  // at most
+        bool staged = p.needed[static_cast<size_t>(c)] || c == ColumnLayout::kKill;
+        if (staged && b.valid() && std::find(p.direct.begin(), p.direct.end(), c) == p.direct.end())
+            perRow += GlMemory::wordsPerRow(memory_.elem(b));
     }
     size_t rows = std::min(maxWords_ / perRow, (maxWords_ - storageAlignment_ / 4) / 2);
     rows = std::clamp<size_t>(std::min(rows, dispatchRows_), 1, size_t{codegen_glsl::kMaxGroupsX} * kCompactGroup);
