@@ -141,7 +141,12 @@ int realMain(int argc, char** argv) {
     if (auto e = session->schedule(o.fires, lastFrame)) return fail(*e);
     if (o.log) std::cout << "psys-view: " << o.file << " on " << session->backend().name() << ", " << surface->renderer() << std::endl;
     Viewer viewer(std::move(o), *surface, std::move(session), compiled);
-    return viewer.run();
+    try {
+        return viewer.run();
+    } catch (const std::exception& e) {  // a backend that cannot go on (a GPU out of memory, …): a frame failed
+        std::cerr << "psys-view: error: " << e.what() << "\n";
+        return 1;
+    }
 }
 
 }  // namespace
