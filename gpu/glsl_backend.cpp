@@ -282,6 +282,7 @@ rt::RowsResult GlslBackend::run(const rt::RowsLaunch& launch) {
     size_t rows = std::min(maxWords_ / perRow, (maxWords_ - storageAlignment_ / 4) / 2);
     rows = std::clamp<size_t>(std::min(rows, dispatchRows_), 1, size_t{codegen_glsl::kMaxGroupsX} * kCompactGroup);
     rt::RowsResult result;
+    killedRows_.clear();
     for (size_t begin = launch.begin; begin < launch.end; begin += rows) {
         rt::RowsResult r = runRows(launch, p, begin, std::min(launch.end, begin + rows));
         result.killed += r.killed;
@@ -289,6 +290,7 @@ rt::RowsResult GlslBackend::run(const rt::RowsLaunch& launch) {
         result.drawn += r.drawn;
         result.nonFinite += r.nonFinite;
     }
+    result.killedRows = killedRows_;  // every dispatch's, in order
     return result;
 }
 
@@ -427,7 +429,11 @@ rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program
         memory_.transferred += (1 + killed) * 4;
         auto* flags = static_cast<uint8_t*>(memory_.host(b)) + begin;
         std::memset(flags, 0, n);
-        for (uint32_t k = 0; k < killed; ++k) flags[back[killsAt + 1 + k]] = 1;
+        for (uint32_t k = 0; k < killed; ++k) {
+            uint32_t row = back[killsAt + 1 + k];
+            flags[row] = 1;
+            killedRows_.push_back(static_cast<uint32_t>(begin) + row);
+        }
     }
     for (auto [b, at] : returned) {
         Elem e = memory_.elem(b);

@@ -105,6 +105,7 @@ private:
     size_t storageAlignment_ = 16;  // of a storage block's offset, in bytes
     size_t dispatchRows_ = std::numeric_limits<size_t>::max();
     std::vector<uint32_t> staging_;
+    std::vector<uint32_t> killedRows_;  // the last launch's (RowsResult::killedRows)
     size_t kernels_ = 0;
     double compileSeconds_ = 0;
     std::string renderer_;

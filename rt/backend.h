@@ -48,6 +48,10 @@ struct RowsResult {
     // Render launches of a backend that marksDrawn(): rows drawn, and rows visible but
     // with a NaN or infinite position, colour or size (not drawn).
     size_t drawn = 0, nonFinite = 0;
+    // The rows killed, in order, where the backend has them listed (valid until its next
+    // launch: the GLSL backend compacts them on the GPU); else empty, and the run-time
+    // finds them in the kill flags.
+    std::span<const uint32_t> killedRows = {};
 };
 
 struct ChildrenLaunch {

@@ -120,8 +120,9 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1,
         size_t killed = result.killed;
         if (result.unstable) unstable += result.unstable;
         if (listKills) {
-            if (killed) listKilled(kill, part.begin, part.end, work.killed[c]);
-            else work.killed[c].clear();
+            if (killed == 0) work.killed[c].clear();
+            else if (result.killedRows.size() == killed) work.killed[c].assign(result.killedRows.begin(), result.killedRows.end());
+            else listKilled(kill, part.begin, part.end, work.killed[c]);
         }
         if (info.exports) {
             auto* survivors = s.host<uint8_t>(exportMask);

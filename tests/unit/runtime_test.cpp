@@ -442,6 +442,51 @@ TEST_CASE("a step after a drawn one draws as it goes: draw() then runs no render
     }
 }
 
+namespace {
+
+// The interpreter, listing the rows each update killed (RowsResult::killedRows) and
+// leaving no kill flag behind: what the run-time kills must come from the list.
+struct ListingBackend : rt::Backend {
+    interp::Interpreter inner;
+    std::vector<uint32_t> rows;
+    std::string name() const override { return "listing"; }
+    rt::Memory& memory() override { return inner.memory(); }
+    rt::RowsResult run(const rt::RowsLaunch& l) override {
+        rt::RowsResult r = inner.run(l);
+        bool kills = l.kernel->findOne(ir::YieldKind::Kill) != nullptr;
+        if (!kills || !l.columns[rt::ColumnLayout::kKill].valid()) return r;
+        auto* flags = rt::hostData<uint8_t>(memory(), l.columns[rt::ColumnLayout::kKill]);
+        rows.clear();
+        for (size_t i = l.begin; i < l.end; ++i)
+            if (flags[i]) {
+                rows.push_back(static_cast<uint32_t>(i));
+                flags[i] = 0;
+            }
+        r.killedRows = rows;
+        return r;
+    }
+    void run(const rt::ChildrenLaunch& l) override { inner.run(l); }
+};
+
+}  // namespace
+
+TEST_CASE("a backend that lists the rows an update killed is taken at its word, without the flags") {
+    // The fountain's drops only die (no emissions): the run-time takes the list the
+    // backend gives (the GLSL backend's, compacted on the GPU) instead of scanning flags.
+    std::string text = test::readFile(PSYS_SAMPLES_DIR "/fountain.psys");
+    ListingBackend listing;
+    interp::Interpreter plain;
+    rt::System a(test::compileModule(text), listing), b(test::compileModule(text), plain);
+    for (int f = 0; f < 300; ++f) {
+        REQUIRE_FALSE(a.step(1.0 / 60));
+        REQUIRE_FALSE(b.step(1.0 / 60));
+    }
+    auto drop = static_cast<size_t>(a.typeIndex("drop"));
+    CHECK(b.stats().types[drop].killed > 500);
+    CHECK(a.stats().types[drop].killed == b.stats().types[drop].killed);
+    CHECK(a.stats().types[drop].live == b.stats().types[drop].live);
+}
+
 TEST_CASE("each emission event creates `count` objects, all at the event's time") {
     Run run("object s { point(origin, white, age); }\nobject e { emit s at 2 per second count 3; }\nspawn e;");
     run.steps(300, 1.0 / 60);  // 5 s: events at 0.5 s, 1 s, …, 5 s
