@@ -41,11 +41,19 @@ uint32_t uniformValues(const Kernel& kernel) { return valuesRead(&kernel, Op::Un
 
 // What every compute shader starts with: the bindings, the accessors and the helpers
 // that give GLSL built-ins core/lanes.h's results where GLSL leaves them undefined. A
-// column in `direct` is read and written in its own storage block (2 + its place there),
-// the others in the launch's words; the accessors' switch on a literal column folds away.
+// column in `direct` is read and written in its own storage block (2 + its place there)
+// or, past kDirectSlots, read through a buffer texture (its unit: its place less
+// kDirectSlots); the others in the launch's words. The accessors' switch on a literal
+// column folds away.
 std::string preamble(const std::string& comment, uint32_t blockWords, const std::vector<int>& direct = {}) {
     std::string blocks, reads, writes;
     for (size_t k = 0; k < direct.size(); ++k) {
+        if (k >= kDirectSlots) {
+            size_t unit = k - kDirectSlots;
+            blocks += fmt::format("layout(binding = {0}) uniform usamplerBuffer t{0};\n", unit);
+            reads += fmt::format("case {}u: return texelFetch(t{}, int(o)).x; ", direct[k], unit);
+            continue;
+        }
         blocks += fmt::format("layout(std430, binding = {0}) buffer Column{0} {{ uint d{0}[]; }};\n", k + 2);
         reads += fmt::format("case {}u: return d{}[o]; ", direct[k], k + 2);
         writes += fmt::format("case {}u: d{}[o] = x; return; ", direct[k], k + 2);
@@ -255,9 +263,13 @@ std::vector<int> keptColumns(const Kernel& kernel, const ColumnLayout& l) {
 }
 
 std::vector<int> directColumns(const Kernel& kernel, const ColumnLayout& l) {
-    std::vector<int> direct = keptColumns(kernel, l);
-    auto add = [&direct](int c) {
-        if (std::find(direct.begin(), direct.end(), c) == direct.end()) direct.push_back(c);
+    const std::vector<int> kept = keptColumns(kernel, l);
+    std::vector<int> direct = kept;
+    if (direct.size() > kDirectSlots) direct.resize(kDirectSlots);  // written: storage blocks only
+    auto add = [&](int c) {  // read only (a kept column past the blocks stays in the words)
+        if (std::find(kept.begin(), kept.end(), c) == kept.end() &&
+            std::find(direct.begin(), direct.end(), c) == direct.end())
+            direct.push_back(c);
     };
     for (const Inst& i : kernel.insts())
         if (i.op == Op::StateRead)
@@ -269,7 +281,7 @@ std::vector<int> directColumns(const Kernel& kernel, const ColumnLayout& l) {
             for (int c = 0; c < i.type.width; ++c) add(l.paramOffset[static_cast<size_t>(i.attr)] + c);
         if (i.op == Op::ObjectId) add(ColumnLayout::kIds);
     }
-    if (direct.size() > kDirectSlots) direct.resize(kDirectSlots);
+    if (direct.size() > kDirectSlots + kTextureSlots) direct.resize(kDirectSlots + kTextureSlots);
     return direct;
 }
 

@@ -51,6 +51,9 @@ constexpr uint32_t kWorkGroupSize = 64;
 // blocks of a compute shader (llvmpipe's and NVIDIA's; GL 4.5 promises 8) less the
 // launch's words and counts.
 constexpr size_t kDirectSlots = 14;
+// Buffer textures a rows shader reads columns through once the storage blocks are taken
+// (GL 4.5 gives a compute shader at least 16 texture units).
+constexpr size_t kTextureSlots = 16;
 
 // The table columns a rows kernel writes and the pool keeps: its state, exports and what
 // it draws (not kill flags or emissions, which the host reads right after the launch).
@@ -58,8 +61,10 @@ std::vector<int> keptColumns(const ir::Kernel& kernel, const rt::ColumnLayout& l
 // The columns a rows shader reads and writes in place, each in its own GL buffer bound
 // to storage block 2 + k, rather than copied into the launch's words and back: the kept
 // columns, then the state it reads, the creation times, the mask (column `layout.total`),
-// the parameters it reads and the ids, at most kDirectSlots. (Every table has a buffer
-// for each of them: a parameter a kernel reads is kept.) The launch
+// the parameters it reads and the ids: the first kDirectSlots in storage blocks (what it
+// writes among them), the next kTextureSlots, read only, through buffer textures (unit
+// k − kDirectSlots). (Every table has a buffer for each of them: a parameter a kernel
+// reads is kept.) The launch
 // block's column word for one is the word its row `begin` sits at in the bound range.
 std::vector<int> directColumns(const ir::Kernel& kernel, const rt::ColumnLayout& layout);
 constexpr uint32_t kMaxGroupsX = 65535;

@@ -127,6 +127,19 @@ std::unique_ptr<GlslBackend> GlslBackend::create(std::string& error) {
     glGetIntegerv(GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT, &alignment);
     b->storageAlignment_ = static_cast<size_t>(std::max(alignment, 1));
     glGetIntegerv(GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS, &blocks);
+    GLint units = 0, textureAlignment = 0, texels = 0;
+    glGetIntegerv(GL_MAX_COMPUTE_TEXTURE_IMAGE_UNITS, &units);
+    glGetIntegerv(GL_TEXTURE_BUFFER_OFFSET_ALIGNMENT, &textureAlignment);
+    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &texels);
+    b->textureAlignment_ = static_cast<size_t>(std::max(textureAlignment, 1));
+    b->maxWords_ = std::min(b->maxWords_, static_cast<size_t>(std::max(texels, 1)));
+    if (static_cast<size_t>(units) < codegen_glsl::kTextureSlots) {
+        error = fmt::format("the GLSL backend needs {} texture units in a compute shader; {} has {}",
+                            codegen_glsl::kTextureSlots, rendererName(), units);
+        return nullptr;
+    }
+    b->textures_.resize(codegen_glsl::kTextureSlots);
+    glCreateTextures(GL_TEXTURE_BUFFER, static_cast<GLsizei>(b->textures_.size()), b->textures_.data());
     if (static_cast<size_t>(blocks) < 2 + codegen_glsl::kDirectSlots) {
         error = fmt::format("the GLSL backend needs {} storage blocks in a compute shader; {} has {}",
                             2 + codegen_glsl::kDirectSlots, rendererName(), blocks);
@@ -146,6 +159,7 @@ GlslBackend::~GlslBackend() {
     for (auto& [key, p] : rows_) glDeleteProgram(p->program);
     for (auto& [key, p] : children_) glDeleteProgram(p->program);
     if (readback_) glUnmapNamedBuffer(readback_);
+    glDeleteTextures(static_cast<GLsizei>(textures_.size()), textures_.data());
     GLuint buffers[] = {words_, counts_, block_, readback_};
     glDeleteBuffers(4, buffers);
     glDeleteQueries(1, &query_);
@@ -305,9 +319,18 @@ void GlslBackend::bindDirect(const rt::RowsLaunch& launch, const Program& p, siz
         if (!b.valid())
             throw std::logic_error(fmt::format("{}: column {} has no buffer to bind in place", p.pass, c));
         size_t rowBytes = GlMemory::wordsPerRow(memory_.elem(b)) * 4;
-        size_t offset = begin * rowBytes / storageAlignment_ * storageAlignment_;
-        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, static_cast<GLuint>(2 + k), memory_.deviceBuffer(b),
-                          static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(end * rowBytes - offset));
+        bool texture = k >= codegen_glsl::kDirectSlots;
+        size_t alignment = texture ? textureAlignment_ : storageAlignment_;
+        size_t offset = begin * rowBytes / alignment * alignment;
+        auto size = static_cast<GLsizeiptr>(end * rowBytes - offset);
+        if (texture) {
+            GLuint t = textures_[k - codegen_glsl::kDirectSlots];
+            glTextureBufferRange(t, GL_R32UI, memory_.deviceBuffer(b), static_cast<GLintptr>(offset), size);
+            glBindTextureUnit(static_cast<GLuint>(k - codegen_glsl::kDirectSlots), t);
+        } else {
+            glBindBufferRange(GL_SHADER_STORAGE_BUFFER, static_cast<GLuint>(2 + k), memory_.deviceBuffer(b),
+                              static_cast<GLintptr>(offset), size);
+        }
         block[LaunchBlock::kColumns + c] = static_cast<uint32_t>((begin * rowBytes - offset) / 4);
     }
 }

@@ -103,6 +103,8 @@ private:
     size_t wordsCapacity_ = 0;
     size_t maxWords_ = 0;  // the largest storage block the GL allows, in words
     size_t storageAlignment_ = 16;  // of a storage block's offset, in bytes
+    size_t textureAlignment_ = 16;  // of a buffer texture's offset, in bytes
+    std::vector<unsigned> textures_;  // buffer textures, by unit (codegen_glsl::kTextureSlots)
     size_t dispatchRows_ = std::numeric_limits<size_t>::max();
     std::vector<uint32_t> staging_;
     std::vector<uint32_t> killedRows_;  // the last launch's (RowsResult::killedRows)
