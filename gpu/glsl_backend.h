@@ -3,10 +3,11 @@
 // Mesa's llvmpipe on the CPU), headless through EGL unless a context is current.
 //
 // Where the columns live (gpu/gl_memory.h): an object's state and exports stay on the GPU
-// from step to step; the run-time's bookkeeping (kills, emissions, creation, parents) runs
-// on the host, so a launch takes the masks, ids and creation times from the host and
-// gives back the rows killed (compacted on the GPU: gpu/compact.h), emissions and what
-// is drawn (docs/gpu.md).
+// from step to step, and shaders read and write them in place (storage blocks, buffer
+// textures); the run-time's bookkeeping (kills, emissions, creation, parents) runs on
+// the host, so a launch takes the rows of the masks that changed from the host and gives
+// back, in one wait, its counts, the rows killed (compacted on the GPU: gpu/compact.h)
+// and its emissions (docs/gpu.md).
 #pragma once
 
 #include <limits>
