@@ -27,6 +27,7 @@ struct GlslBackend::Program {
     ColumnLayout layout;
     std::vector<int> resident, returned;  // the table columns the kernel writes (writtenColumns)
     std::vector<int> direct;              // bound in place (codegen_glsl::directColumns): not staged, not adopted
+    std::vector<bool> inPlace;            // per table column, the mask last: whether it is in `direct`
     std::vector<bool> needed;             // the table columns a launch carries (the others are not touched)
     std::string pass;          // "update", "spawn", …: what timer queries add up under
     bool counts = false;       // whether the shader counts anything (kills, unstable rows, what is drawn)
@@ -185,6 +186,8 @@ GlslBackend::Program& GlslBackend::rowsProgram(const ir::Object& object, const i
         p->block = codegen_glsl::rowsBlock(kernel, uniform, p->layout);
         writtenColumns(kernel, p->layout, p->resident, p->returned);
         p->direct = codegen_glsl::directColumns(kernel, p->layout);
+        p->inPlace.assign(static_cast<size_t>(p->layout.total) + 1, false);
+        for (int c : p->direct) p->inPlace[static_cast<size_t>(c)] = true;
         p->needed = neededColumns(kernel, p->layout, now == rt::Clock::Source::PerRow || dt == rt::Clock::Source::PerRow,
                                   p->resident, p->returned);
         p->pass = ir::kernelName(kernel.kind);
@@ -285,12 +288,11 @@ rt::RowsResult GlslBackend::run(const rt::RowsLaunch& launch) {
     // Rows per dispatch: as many as the largest storage block the GL binds holds, for the
     // launch's words (the columns not bound in place, and a row of zeros) and for each
     // column bound in place (at most two words a row, from an aligned offset).
-    size_t perRow = 1;
-    if (std::find(p.direct.begin(), p.direct.end(), p.layout.total) == p.direct.end()) ++perRow;  // the mask
+    size_t perRow = p.inPlace.back() ? 1 : 2;  // the zeros, and the mask where it is not in place
     for (int c = 0; c < p.layout.total; ++c) {
         Buffer b = launch.columns[static_cast<size_t>(c)];
         bool staged = p.needed[static_cast<size_t>(c)] || c == ColumnLayout::kKill;
-        if (staged && b.valid() && std::find(p.direct.begin(), p.direct.end(), c) == p.direct.end())
+        if (staged && b.valid() && !p.inPlace[static_cast<size_t>(c)])
             perRow += GlMemory::wordsPerRow(memory_.elem(b));
     }
     size_t rows = std::min(maxWords_ / perRow, (maxWords_ - storageAlignment_ / 4) / 2);
@@ -355,8 +357,7 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
         words += n * GlMemory::wordsPerRow(memory_.elem(b));
         return slots.back().word;
     };
-    std::vector<bool> direct(static_cast<size_t>(p.layout.total) + 1, false);
-    for (int c : p.direct) direct[static_cast<size_t>(c)] = true;
+    const std::vector<bool>& direct = p.inPlace;
     for (int c = 0; c < p.layout.total; ++c)
         if (p.needed[static_cast<size_t>(c)] && !direct[static_cast<size_t>(c)])
             block[LaunchBlock::kColumns + static_cast<size_t>(c)] = static_cast<uint32_t>(place(launch.columns[static_cast<size_t>(c)]));
@@ -410,8 +411,13 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
 // columns after them.
 rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program& p, size_t begin, size_t n,
                                      const std::vector<uint32_t>& block) {
-    std::vector<std::pair<Buffer, size_t>> returned;  // column, its first word in the read-back
-    size_t words = 4;
+    struct Returned {
+        Buffer buffer;
+        size_t from, at;  // its first word in the launch's words, in the read-back
+    };
+    std::vector<Returned> returned;  // the emission columns
+    const size_t killsAt = 4;
+    size_t words = killsAt;
     bool kills = false;
     for (int c : p.returned) {
         Buffer b = launch.columns[static_cast<size_t>(c)];
@@ -420,26 +426,20 @@ rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program
             kills = true;
             continue;
         }
-        returned.emplace_back(b, 0);
+        returned.push_back({b, block[LaunchBlock::kColumns + static_cast<size_t>(c)], 0});
     }
     if (!p.counts && !kills && returned.empty()) return {};
-    size_t killsAt = words;
     if (kills) words += 1 + n;
-    for (auto& [b, at] : returned) {
-        at = words;
-        words += n * GlMemory::wordsPerRow(memory_.elem(b));
+    for (Returned& r : returned) {
+        r.at = words;
+        words += n * GlMemory::wordsPerRow(memory_.elem(r.buffer));
     }
     ensureReadback(words);
     if (p.counts) glCopyNamedBufferSubData(counts_, readback_, 0, 0, 16);
     if (kills) compactor_.compact(words_, block[LaunchBlock::kColumns + ColumnLayout::kKill], n, readback_, killsAt);
-    size_t r = 0;
-    for (int c : p.returned) {
-        if (c == ColumnLayout::kKill || !launch.columns[static_cast<size_t>(c)].valid()) continue;
-        auto [b, at] = returned[r++];
-        size_t w = GlMemory::wordsPerRow(memory_.elem(b));
-        glCopyNamedBufferSubData(words_, readback_, static_cast<GLintptr>(block[LaunchBlock::kColumns + static_cast<size_t>(c)]) * 4,
-                                 static_cast<GLintptr>(at * 4), static_cast<GLsizeiptr>(n * w * 4));
-    }
+    for (const Returned& r : returned)
+        glCopyNamedBufferSubData(words_, readback_, static_cast<GLintptr>(r.from * 4), static_cast<GLintptr>(r.at * 4),
+                                 static_cast<GLsizeiptr>(n * GlMemory::wordsPerRow(memory_.elem(r.buffer)) * 4));
     const uint32_t* back = awaitReadback();
     rt::RowsResult result;
     if (p.counts) {
@@ -458,10 +458,10 @@ rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program
             killedRows_.push_back(static_cast<uint32_t>(begin) + row);
         }
     }
-    for (auto [b, at] : returned) {
-        Elem e = memory_.elem(b);
+    for (const Returned& r : returned) {
+        Elem e = memory_.elem(r.buffer);
         memory_.transferred += n * GlMemory::wordsPerRow(e) * 4;
-        fromWords(back + at, e, n, static_cast<char*>(memory_.host(b)) + begin * rt::elemSize(e));
+        fromWords(back + r.at, e, n, static_cast<char*>(memory_.host(r.buffer)) + begin * rt::elemSize(e));
     }
     return result;
 }
