@@ -38,7 +38,7 @@ int main(int argc, char** argv) {
         std::cout << "# llvmpipe computes the shaders on the CPU: these figures say the backend works, not how fast a "
                      "GPU runs it\n";
     std::cout << "\n| effect | live | step (ms) | M updates/s | update pass (ms) | other passes (ms) | state B/particle | "
-                 "update pass GB/s | host↔GPU B/particle/step | staged B/particle/step | waits/step |\n|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|\n";
+                 "update pass GB/s | host↔GPU B/particle/step | staged B/particle/step | waits/step | late/step (stalled) |\n|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|\n";
     for (const std::string& name : effects) {
         const bench::Effect* effect = bench::findEffect(name);
         if (!effect) {
@@ -51,15 +51,16 @@ int main(int argc, char** argv) {
             for (const auto& [pass, ms] : f.passMilliseconds)
                 if (pass != "update") others += fmt::format("{}{} {:.2f}", others.empty() ? "" : ", ", pass, ms);
             double gbs = f.updateMilliseconds > 0 ? f.stateBytes * f.live / (f.updateMilliseconds * 1e-3) / 1e9 : 0;
-            std::cout << fmt::format("| {} | {:.2g} | {:.2f} | {:.1f} | {:.2f}{} | {} | {:.0f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} |\n", name,
+            std::cout << fmt::format("| {} | {:.2g} | {:.2f} | {:.1f} | {:.2f}{} | {} | {:.0f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} ({:.1f}) |\n", name,
                                      f.live, f.stepSeconds * 1e3, f.perSecond / 1e6, f.updateMilliseconds,
                                      f.wallPasses ? " (wall)" : "", others,
-                                     f.stateBytes, gbs, f.transferBytes, f.stagedBytes, f.waits);
+                                     f.stateBytes, gbs, f.transferBytes, f.stagedBytes, f.waits, f.lateReads,
+                                     f.lateStalls);
             std::cout.flush();
         }
     }
     std::cout << "\n(passes: GPU time from GL timer queries, or \"wall\": from a glFinish before the pass to one after, "
                  "where the GL's timer does not see compute work; state B/particle: what the update pass must read and "
-                 "write; update pass GB/s: that ÷ the pass's time; staged: copied on the GPU into and out of launches' words, beyond what the shaders move; waits/step: read-backs the host waited for)\n";
+                 "write; update pass GB/s: that ÷ the pass's time; staged: copied on the GPU into and out of launches' words, beyond what the shaders move; waits/step: read-backs the host waited for mid-step; late/step: read-backs of kills taken at the step's end, and in brackets those the GPU had not finished by then)\n";
     return 0;
 }

@@ -19,6 +19,7 @@ GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::G
     std::vector<double> times;
     double live = 0;
     uint64_t transferred = gpu.transferredBytes(), waits = gpu.waits(), staged = gpu.stagedBytes();
+    uint64_t lateReads = gpu.lateReads(), lateStalls = gpu.lateStalls();
     for (int f = 0; f < frames; ++f) {
         auto start = Clock::now();
         system.step(1.0 / 60);
@@ -28,6 +29,8 @@ GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::G
     out.live = live / frames;
     out.transferBytes = static_cast<double>(gpu.transferredBytes() - transferred) / frames / std::max(out.live, 1.0);
     out.waits = static_cast<double>(gpu.waits() - waits) / frames;
+    out.lateReads = static_cast<double>(gpu.lateReads() - lateReads) / frames;
+    out.lateStalls = static_cast<double>(gpu.lateStalls() - lateStalls) / frames;
     out.stagedBytes = static_cast<double>(gpu.stagedBytes() - staged) / frames / std::max(out.live, 1.0);
     out.stepSeconds = median(times);
     out.perSecond = out.live / out.stepSeconds;

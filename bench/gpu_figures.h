@@ -20,6 +20,7 @@ struct GpuFigures {
     double stateBytes = 0;         // per particle, what the update pass must read and write
     double transferBytes = 0;      // per particle per step, between the host and the GPU
     double waits = 0;              // per step: times the host waited for a read-back from the GPU
+    double lateReads = 0, lateStalls = 0;  // per step: read-backs taken at the step's end; of them, not ready
     double stagedBytes = 0;        // per particle per step, copied on the GPU into and out of launches' words
 };
 

@@ -13,6 +13,7 @@
 #include "gpu/gl_context.h"
 #include "gpu/compact.h"
 #include "gpu/gl_memory.h"
+#include "gpu/glsl_program.h"
 
 namespace psys::gpu {
 
@@ -20,18 +21,6 @@ using codegen_glsl::LaunchBlock;
 using rt::Buffer;
 using rt::ColumnLayout;
 using rt::Elem;
-
-struct GlslBackend::Program {
-    GLuint program = 0;
-    LaunchBlock block;
-    ColumnLayout layout;
-    std::vector<int> resident, returned;  // the table columns the kernel writes (writtenColumns)
-    std::vector<int> direct;              // bound in place (codegen_glsl::directColumns): not staged, not adopted
-    std::vector<bool> inPlace;            // per table column, the mask last: whether it is in `direct`
-    std::vector<bool> needed;             // the table columns a launch carries (the others are not touched)
-    std::string pass;          // "update", "spawn", …: what timer queries add up under
-    bool counts = false;       // whether the shader counts anything (kills, unstable rows, what is drawn)
-};
 
 namespace {
 
@@ -159,6 +148,7 @@ GlslBackend::~GlslBackend() {
     if (context_) context_->makeCurrent();
     for (auto& [key, p] : rows_) glDeleteProgram(p->program);
     for (auto& [key, p] : children_) glDeleteProgram(p->program);
+    for (auto& [ticket, late] : late_) settle(*late);  // its fence deleted
     if (readback_) glUnmapNamedBuffer(readback_);
     glDeleteTextures(static_cast<GLsizei>(textures_.size()), textures_.data());
     GLuint buffers[] = {words_, counts_, block_, readback_};
@@ -297,15 +287,24 @@ rt::RowsResult GlslBackend::run(const rt::RowsLaunch& launch) {
     }
     size_t rows = std::min(maxWords_ / perRow, (maxWords_ - storageAlignment_ / 4) / 2);
     rows = std::clamp<size_t>(std::min(rows, dispatchRows_), 1, size_t{codegen_glsl::kMaxGroupsX} * kCompactGroup);
+    // Late: only the counts and kills come back, so they can wait for the run-time.
+    std::unique_ptr<Late> late;
+    if (launch.late && p.counts && std::all_of(p.returned.begin(), p.returned.end(), [](int c) { return c == ColumnLayout::kKill; }))
+        late = std::make_unique<Late>();
+    if (late) {  // room for every dispatch's counts and kills, so that no region moves while it is issued
+        size_t dispatches = (launch.end - launch.begin + rows - 1) / rows;
+        reserveReadback(dispatches * 5 + (launch.end - launch.begin));
+    }
     rt::RowsResult result;
     killedRows_.clear();
     for (size_t begin = launch.begin; begin < launch.end; begin += rows) {
-        rt::RowsResult r = runRows(launch, p, begin, std::min(launch.end, begin + rows));
+        rt::RowsResult r = runRows(launch, p, begin, std::min(launch.end, begin + rows), late.get());
         result.killed += r.killed;
         result.unstable += r.unstable;
         result.drawn += r.drawn;
         result.nonFinite += r.nonFinite;
     }
+    if (late) return {.ticket = finishLate(std::move(late))};
     result.killedRows = killedRows_;  // every dispatch's, in order
     return result;
 }
@@ -337,7 +336,7 @@ void GlslBackend::bindDirect(const rt::RowsLaunch& launch, const Program& p, siz
     }
 }
 
-rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, size_t begin, size_t end) {
+rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, size_t begin, size_t end, Late* late) {
     size_t n = end - begin;
     if (n == 0) return {};
     // Each distinct buffer of the table once (the mask last), a column of zeros for the
@@ -402,97 +401,7 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
         else
             memory_.adopt(b, begin, n, words_, block[LaunchBlock::kColumns + static_cast<size_t>(c)]);
     }
-    return readBack(launch, p, begin, n, block);
-}
-
-// What the host needs right after a launch — its counts, the rows it killed (compacted on
-// the GPU) and its emissions — gathered on the GPU into one buffer the host has mapped:
-// one wait. Counts at words 0–3; the kills' total and rows from word 4; the emission
-// columns after them.
-rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program& p, size_t begin, size_t n,
-                                     const std::vector<uint32_t>& block) {
-    struct Returned {
-        Buffer buffer;
-        size_t from, at;  // its first word in the launch's words, in the read-back
-    };
-    std::vector<Returned> returned;  // the emission columns
-    const size_t killsAt = 4;
-    size_t words = killsAt;
-    bool kills = false;
-    for (int c : p.returned) {
-        Buffer b = launch.columns[static_cast<size_t>(c)];
-        if (!b.valid()) continue;
-        if (c == ColumnLayout::kKill) {
-            kills = true;
-            continue;
-        }
-        returned.push_back({b, block[LaunchBlock::kColumns + static_cast<size_t>(c)], 0});
-    }
-    if (!p.counts && !kills && returned.empty()) return {};
-    if (kills) words += 1 + n;
-    for (Returned& r : returned) {
-        r.at = words;
-        words += n * GlMemory::wordsPerRow(memory_.elem(r.buffer));
-    }
-    ensureReadback(words);
-    if (p.counts) glCopyNamedBufferSubData(counts_, readback_, 0, 0, 16);
-    if (kills) compactor_.compact(words_, block[LaunchBlock::kColumns + ColumnLayout::kKill], n, readback_, killsAt);
-    for (const Returned& r : returned)
-        glCopyNamedBufferSubData(words_, readback_, static_cast<GLintptr>(r.from * 4), static_cast<GLintptr>(r.at * 4),
-                                 static_cast<GLsizeiptr>(n * GlMemory::wordsPerRow(memory_.elem(r.buffer)) * 4));
-    const uint32_t* back = awaitReadback();
-    rt::RowsResult result;
-    if (p.counts) {
-        result = {back[0], back[1], back[2], back[3]};
-        memory_.transferred += 16;
-    }
-    if (kills) {
-        Buffer b = launch.columns[ColumnLayout::kKill];
-        uint32_t killed = back[killsAt];
-        memory_.transferred += (1 + killed) * 4;
-        auto* flags = static_cast<uint8_t*>(memory_.host(b)) + begin;
-        std::memset(flags, 0, n);
-        for (uint32_t k = 0; k < killed; ++k) {
-            uint32_t row = back[killsAt + 1 + k];
-            flags[row] = 1;
-            killedRows_.push_back(static_cast<uint32_t>(begin) + row);
-        }
-    }
-    for (const Returned& r : returned) {
-        Elem e = memory_.elem(r.buffer);
-        memory_.transferred += n * GlMemory::wordsPerRow(e) * 4;
-        fromWords(back + r.at, e, n, static_cast<char*>(memory_.host(r.buffer)) + begin * rt::elemSize(e));
-    }
-    return result;
-}
-
-// A buffer of at least `words` words the host has mapped for reading, written by the GPU
-// (coherent: what the GPU wrote before a fence is there once the fence is passed).
-void GlslBackend::ensureReadback(size_t words) {
-    if (words <= readbackWords_) return;
-    if (readback_) {
-        glUnmapNamedBuffer(readback_);
-        glDeleteBuffers(1, &readback_);
-    }
-    readbackWords_ = std::max(words, 2 * readbackWords_);
-    auto bytes = static_cast<GLsizeiptr>(readbackWords_ * 4);
-    GLbitfield flags = GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT;
-    glCreateBuffers(1, &readback_);
-    glNamedBufferStorage(readback_, bytes, nullptr, flags | GL_CLIENT_STORAGE_BIT);
-    checkAllocation("reading back", static_cast<size_t>(bytes));
-    mappedReadback_ = static_cast<const uint32_t*>(glMapNamedBufferRange(readback_, 0, bytes, flags));
-    if (!mappedReadback_) throw std::runtime_error("the GL could not map a buffer for reading back");
-}
-
-const uint32_t* GlslBackend::awaitReadback() {
-    glMemoryBarrier(GL_CLIENT_MAPPED_BUFFER_BARRIER_BIT);
-    GLsync fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
-    GLenum status = GL_TIMEOUT_EXPIRED;
-    while (status == GL_TIMEOUT_EXPIRED) status = glClientWaitSync(fence, GL_SYNC_FLUSH_COMMANDS_BIT, 1'000'000'000);
-    glDeleteSync(fence);
-    if (status == GL_WAIT_FAILED) throw std::runtime_error("waiting for the GPU failed");
-    ++memory_.waits;
-    return mappedReadback_;
+    return readBack(launch, p, begin, n, block, late);
 }
 
 void GlslBackend::run(const rt::ChildrenLaunch& launch) {
@@ -548,6 +457,8 @@ rt::BackendReport GlslBackend::report() const {
     r.waits = memory_.waits;
     r.transferredBytes = memory_.transferred;
     r.stagedBytes = memory_.staged;
+    r.lateReads = lateReads_;
+    r.lateStalls = lateStalls_;
     return r;
 }
 

@@ -7,7 +7,8 @@
 // textures); the run-time's bookkeeping (kills, emissions, creation, parents) runs on
 // the host, so a launch takes the rows of the masks that changed from the host and gives
 // back, in one wait, its counts, the rows killed (compacted on the GPU: gpu/compact.h)
-// and its emissions (docs/gpu.md).
+// and its emissions (docs/gpu.md) — or, for a late launch (rt::RowsLaunch::late), no wait:
+// its counts and kills are taken when the run-time collects them at the end of the step.
 #pragma once
 
 #include <limits>
@@ -38,6 +39,7 @@ public:
     void forget(const ir::Module& module) override;
     rt::RowsResult run(const rt::RowsLaunch& launch) override;
     void run(const rt::ChildrenLaunch& launch) override;
+    rt::RowsResult collect(uint64_t ticket) override;
     rt::BackendReport report() const override;
     bool marksDrawn() const override { return true; }
     bool rendersInStep() const override { return false; }
@@ -64,6 +66,10 @@ public:
     uint64_t stagedBytes() const { return memory_.staged; }
     // Times the host waited for a read-back from the GPU so far (GlMemory::waits).
     uint64_t waits() const { return memory_.waits; }
+    // Late launches' read-backs taken so far, and of them those the host had to wait for
+    // (the GPU had not finished them when the run-time collected them).
+    uint64_t lateReads() const { return lateReads_; }
+    uint64_t lateStalls() const { return lateStalls_; }
 
 private:
     GlslBackend() = default;
@@ -73,7 +79,8 @@ private:
                          rt::Clock::Source dt);
     Program& childrenProgram(const ir::Object& object, const ir::Kernel& spawn);
     Program compile(const std::string& source, const std::string& what);
-    rt::RowsResult runRows(const rt::RowsLaunch& launch, Program& program, size_t begin, size_t end);
+    struct Late;
+    rt::RowsResult runRows(const rt::RowsLaunch& launch, Program& program, size_t begin, size_t end, Late* late);
     void bindDirect(const rt::RowsLaunch& launch, const Program& program, size_t begin, size_t end,
                     std::vector<uint32_t>& block);
     // Uploads the block, fills the words of it that `fill` names from columns on the GPU
@@ -87,10 +94,15 @@ private:
     };
     void dispatch(Program& program, const std::vector<uint32_t>& block, size_t count, const std::string& pass,
                   std::span<const BlockFill> fill = {});
+    // gpu/glsl_readback.cpp: what a launch sends back, into a region of one mapped buffer,
+    // read at once (one wait) or, for a late launch, when the run-time collects it.
     rt::RowsResult readBack(const rt::RowsLaunch& launch, const Program& program, size_t begin, size_t n,
-                            const std::vector<uint32_t>& block);
+                            const std::vector<uint32_t>& block, Late* late);
+    size_t reserveReadback(size_t words);  // a region's first word (late launches' regions kept)
     void ensureReadback(size_t words);
     const uint32_t* awaitReadback();  // a fence, one wait: the read-back buffer as the GPU left it
+    uint64_t finishLate(std::unique_ptr<Late> late);  // its fence; its ticket
+    void settle(Late& late);          // waits for it if it must, and reads its counts and kills
     void ensureWords(size_t words);
 
     std::unique_ptr<HeadlessContext> context_;
@@ -108,7 +120,10 @@ private:
     std::vector<unsigned> textures_;  // buffer textures, by unit (codegen_glsl::kTextureSlots)
     size_t dispatchRows_ = std::numeric_limits<size_t>::max();
     std::vector<uint32_t> staging_;
-    std::vector<uint32_t> killedRows_;  // the last launch's (RowsResult::killedRows)
+    size_t readbackUsed_ = 0;  // words of the read-back buffer held by late launches' regions
+    std::map<uint64_t, std::unique_ptr<Late>> late_;
+    uint64_t nextTicket_ = 1, lateReads_ = 0, lateStalls_ = 0;
+    std::vector<uint32_t> killedRows_;  // the last launch's or collect's (RowsResult::killedRows)
     size_t kernels_ = 0;
     double compileSeconds_ = 0;
     std::string renderer_;

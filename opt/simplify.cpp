@@ -28,6 +28,9 @@
 //                           folding what became constant: mix(green, black, age) is
 //                           (0, 1 − age, 0, 1), one operation instead of eight
 //   x + (−y) → x − y        exact
+//   yield kill = false      dropped: nothing dies (an object with no `kill` command), so
+//                           no backend writes kill flags nor counts them, and the
+//                           run-time has nothing to wait for
 //
 // With relaxed maths (PassOptions::relaxed) also: x+0 → x (wrong only in the sign of a
 // zero: −0+0 is +0) and x/c → x·(1/c) for any finite non-zero c (at most 2 ulp away).
@@ -35,6 +38,7 @@
 // The rules are tried in the order they are listed; a round rebuilds the kernel once,
 // applying the first rule that matches each instruction, and rounds repeat until one
 // fires no rule.
+#include <algorithm>
 #include <cmath>
 
 #include "ir/evaluate.h"
@@ -301,6 +305,21 @@ const Rules& simplifyRules(const Context& ctx) {
     return rules;
 }
 
+// A kill that is constant false says nothing: it goes, and so does its constant.
+void dropFalseKill(Kernel& kernel) {
+    auto never = [&](const Yield& y) {
+        const Inst& v = kernel.at(y.value);
+        return y.kind == YieldKind::Kill && v.op == Op::Const && v.constant[0] == 0;
+    };
+    if (std::none_of(kernel.yields.begin(), kernel.yields.end(), never)) return;
+    std::erase_if(kernel.yields, never);
+    Rewriter rw(kernel);
+    Kernel clean = rw.run(nullptr);
+    clean.kind = kernel.kind;
+    clean.site = kernel.site;
+    kernel = std::move(clean);
+}
+
 void simplifyKernel(Kernel& kernel, bool relaxed) {
     for (int round = 0; round < 16; ++round) {
         Context ctx;
@@ -326,6 +345,7 @@ void simplifyKernel(Kernel& kernel, bool relaxed) {
         kernel = std::move(next);
         if (fired == 0) break;
     }
+    dropFalseKill(kernel);
 }
 
 }  // namespace

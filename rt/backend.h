@@ -40,6 +40,10 @@ struct RowsLaunch {
     const ir::Kernel* uniformKernel = nullptr;  // per-row clock: evaluated at each row's clock
     uint32_t seed = 0;
     uint32_t draw = 0;                      // draw.index #0 (the step, or kCreationDraw)
+    // The run-time takes this launch's counts and kills later, by Backend::collect (at the
+    // end of the step): a backend on a device may answer with a ticket instead of waiting
+    // for them. Asked only of launches whose kernel emits nothing it must read back.
+    bool late = false;
 };
 
 struct RowsResult {
@@ -52,6 +56,9 @@ struct RowsResult {
     // launch: the GLSL backend compacts them on the GPU); else empty, and the run-time
     // finds them in the kill flags.
     std::span<const uint32_t> killedRows = {};
+    // Non-zero: a late launch (RowsLaunch::late) whose counts and kills are not here yet:
+    // Backend::collect(ticket) gives them.
+    uint64_t ticket = 0;
 };
 
 struct ChildrenLaunch {
@@ -107,6 +114,9 @@ struct BackendReport {
     // launches copied on the device beyond what their kernels move.
     bool device = false;
     uint64_t waits = 0, transferredBytes = 0, stagedBytes = 0;
+    // Late launches' read-backs taken (RowsLaunch::late), and of them those the GPU had not
+    // finished when the host took them (the host waited).
+    uint64_t lateReads = 0, lateStalls = 0;
 };
 
 class Backend {
@@ -122,6 +132,12 @@ public:
     virtual void forget(const ir::Module&) {}
     virtual RowsResult run(const RowsLaunch& launch) = 0;
     virtual void run(const ChildrenLaunch& launch) = 0;
+    // The counts and kills of a late launch that answered with `ticket` (its killedRows
+    // valid until the next launch or collect), once each ticket.
+    virtual RowsResult collect(uint64_t ticket) {
+        (void)ticket;
+        return {};
+    }
     // Whether launches on disjoint rows may run on several threads at once.
     virtual bool concurrent() const { return false; }
     // The rows a launch over a pool covers at most: a chunk that stays in cache (and gives

@@ -46,9 +46,14 @@ ColumnLayout columnLayout(const ir::Object& object, const ir::Kernel& kernel) {
     next += ColumnLayout::kRenderColumns;
     l.parents = next;
     l.writes.assign(static_cast<size_t>(l.parents - l.emits), false);
+    l.emitShared.assign(static_cast<size_t>(l.render - l.emits), {});
     for (const ir::Yield& y : kernel.yields) {
-        if (y.kind == ir::YieldKind::EmitRate) l.writes[static_cast<size_t>(l.emitRate(y.index) - l.emits)] = true;
-        if (y.kind == ir::YieldKind::EmitCount) l.writes[static_cast<size_t>(l.emitCount(y.index) - l.emits)] = true;
+        if (y.kind != ir::YieldKind::EmitRate && y.kind != ir::YieldKind::EmitCount) continue;
+        auto at = static_cast<size_t>((y.kind == ir::YieldKind::EmitRate ? l.emitRate(y.index) : l.emitCount(y.index)) - l.emits);
+        l.writes[at] = true;
+        const ir::Inst& value = kernel.at(y.value);
+        if (value.op == ir::Op::Const) l.emitShared[at] = {true, -1, value.constant[0]};
+        if (value.op == ir::Op::Uniform) l.emitShared[at] = {true, value.attr, 0};
     }
     if (kernel.kind == ir::KernelKind::Render) {  // writes every render column (visible: drawn or not)…
         l.renderFromState.assign(ColumnLayout::kRenderColumns, -1);

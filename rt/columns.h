@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "ir/ir.h"
+#include "ir/value.h"
 
 namespace psys::rt {
 
@@ -67,6 +68,26 @@ struct ColumnLayout {
     std::optional<float> constant(int c) const {
         if (renderConstant.empty() || !renderConstant[static_cast<size_t>(c)].is) return std::nullopt;
         return renderConstant[static_cast<size_t>(c)].value;
+    }
+
+    // An emission rate or count that every row of a launch at a uniform clock shares: a
+    // constant, or a value of the kernel's uniform kernel (`at population / 3 per second`).
+    // At a uniform clock the run-time takes it from there, not from its column (which a
+    // backend still writes), so a backend whose columns live on a device need not send
+    // the column back. Per emit column (a site's rate, then its count); the run-time and
+    // every backend read this one rule.
+    struct Shared {
+        bool is = false;
+        int uniform = -1;  // ≥ 0: the uniform kernel's value #uniform; else `value`
+        float value = 0;
+    };
+    std::vector<Shared> emitShared;
+    // The value emit column `column` has in every row of a launch at a uniform clock whose
+    // uniform values are `uniforms`, if it is shared.
+    std::optional<float> sharedEmit(int column, const ir::Value* uniforms) const {
+        const Shared& s = emitShared.at(static_cast<size_t>(column - emits));
+        if (!s.is) return std::nullopt;
+        return s.uniform >= 0 ? uniforms[s.uniform].f[0] : s.value;
     }
 
     int emitRate(int site) const { return emits + 2 * site; }

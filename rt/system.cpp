@@ -93,6 +93,7 @@ void System::start() {
     s.started = true;
     creation_->emitFromKernel(s.module.start, {}, kStartObject);
     creation_->drain(s.now);
+    s.settleLate();
 }
 
 std::optional<std::string> System::step(double dt) {
@@ -127,6 +128,7 @@ std::optional<std::string> System::step(double dt) {
     }
     s.now = t1;
     auto releasing = WallClock::now();
+    s.settleLate();
     for (auto [type, row] : s.dying) {
         Pool& pool = s.pools[type];
         if (pool.status(row) != Status::Frozen || pool.readers[row] > 0) continue;
@@ -234,6 +236,7 @@ std::optional<std::string> System::fire(std::string_view name, std::span<const f
     start();
     creation_->emitFromKernel(*trigger, params, kTriggerObject);
     creation_->drain(s.now);
+    s.settleLate();
     drawing_->invalidate();
     return std::nullopt;
 }

@@ -45,6 +45,10 @@ struct SystemOptions {
     // chunk as the update leaves it in cache (rt/system_draw.h); false: in draw() alone.
     // Results are the same (tests compare the two).
     bool drawInStep = true;
+    // Take the kills of objects whose dead nobody looks at during the step at its end
+    // (rt/system_state.h, LateKills), so a device need not wait for them mid-step;
+    // false: at once. Results are the same, rows included (tests compare the two).
+    bool lateKills = true;
 };
 
 struct TypeStats {

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <optional>
 
 #include "rt/rng.h"
 #include "rt/system_draw.h"
@@ -394,13 +395,17 @@ void Creation::atCreation(size_t type, Batch& b, size_t n) {
 
 // A launch over rows [first, end) of a batch, in chunks (on several threads where the
 // backend allows).
-void Creation::runBatch(const RowsLaunch& launch, size_t first, size_t end, size_t type) {
+void Creation::runBatch(const RowsLaunch& launch, size_t first, size_t end, size_t type, LateKills* late) {
     std::atomic<uint64_t> unstable = 0;
-    s_.forChunks(first, end, [&](size_t, size_t begin, size_t stop) {
+    if (late) late->parts.resize(s_.chunkCount(end - first));
+    s_.forChunks(first, end, [&](size_t c, size_t begin, size_t stop) {
         RowsLaunch part = launch;
         part.begin = begin;
         part.end = stop;
-        if (size_t u = s_.backend.run(part).unstable) unstable += u;
+        part.late = late != nullptr;
+        RowsResult result = s_.backend.run(part);
+        if (result.unstable) unstable += result.unstable;
+        if (late) s_.latePart(late->parts[c], result, launch.columns[ColumnLayout::kKill], begin, stop);
     });
     s_.typeStats[type].unstable += unstable;
 }
@@ -441,11 +446,25 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
         pending_[type] = 0;
     };
     if (most == 1) {
-        advance(type, b, n, kMask);
+        // Deaths nobody looks at before the end of the step are taken then (LateKills);
+        // drawing as the step goes shows only the objects alive after their first update.
+        const DrawnInStep& drawing = s_.work[type].inStep;
+        std::optional<LateKills> late;
+        if (info.killsLate && !(drawing.on && drawing.updated)) late.emplace();
+        advance(type, b, n, kMask, late ? &*late : nullptr);
         inOrder(true, [&](size_t r) {
             queueBursts(type, b, r);
-            killOrEmit(type, b, r, b.spans[r], t1);
+            if (!late) killOrEmit(type, b, r, b.spans[r], t1);
         });
+        if (late) {
+            late->type = type;
+            late->at = s_.dying.size();
+            late->t1 = t1;
+            late->first = first;
+            late->poolRows = b.poolRows;
+            late->spans = b.spans;
+            s_.late.push_back(std::move(*late));
+        }
         return;
     }
     // Sub-steps: every object through its own, the k-th of each at once.
@@ -471,7 +490,7 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
 
 // One update of the batch rows `maskColumn` selects, at their own clocks, then their
 // exports (those not killed), then the state and exports to their pool rows.
-void Creation::advance(size_t type, Batch& b, size_t n, size_t maskColumn) {
+void Creation::advance(size_t type, Batch& b, size_t n, size_t maskColumn, LateKills* late) {
     const TypeInfo& info = s_.types[type];
     const ir::Object& o = s_.module.objects[type];
     const size_t first = b.first, end = first + n;
@@ -479,7 +498,8 @@ void Creation::advance(size_t type, Batch& b, size_t n, size_t maskColumn) {
     Buffer maskBuffer = b.columns.at(maskColumn, Elem::U8, end);
     auto* mask = s_.host<uint8_t>(maskBuffer);
     auto* now = s_.host<double>(table[ColumnLayout::kNow]);
-    auto launchOn = [&](const ir::Kernel& kernel, const ColumnLayout& layout, std::vector<Buffer>& t, Buffer m) {
+    auto launchOn = [&](const ir::Kernel& kernel, const ColumnLayout& layout, std::vector<Buffer>& t, Buffer m,
+                        LateKills* kills) {
         t[ColumnLayout::kNow] = table[ColumnLayout::kNow];
         t[ColumnLayout::kDt] = table[ColumnLayout::kDt];
         RowsLaunch launch;
@@ -494,15 +514,15 @@ void Creation::advance(size_t type, Batch& b, size_t n, size_t maskColumn) {
         launch.seed = s_.options.seed;
         launch.draw = static_cast<uint32_t>(s_.step);
         s_.gatherParents(type, layout, t, s_.host<uint8_t>(m), first, end, 0, now, b.poolRows.data(), first);
-        runBatch(launch, first, end, type);
+        runBatch(launch, first, end, type, kills);
     };
-    launchOn(*info.update, info.updateLayout, table, maskBuffer);
+    launchOn(*info.update, info.updateLayout, table, maskBuffer, late);
     if (info.exports) {
         Buffer exportMask = b.columns.at(kExportMask, Elem::U8, end);
         auto* alive = s_.host<uint8_t>(exportMask);
         const auto* kill = s_.view<uint8_t>(table[ColumnLayout::kKill]);
         for (size_t i = first; i < end; ++i) alive[i] = mask[i] && !(info.kills && kill[i]);
-        launchOn(*info.exports, info.exportsLayout, b.exportsTable, exportMask);
+        launchOn(*info.exports, info.exportsLayout, b.exportsTable, exportMask, nullptr);
     }
     Pool& pool = s_.pools[type];
     for (size_t s = 0; s < o.state.size(); ++s)

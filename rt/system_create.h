@@ -61,10 +61,11 @@ private:
     void identify(size_t type, Batch& b, size_t from, size_t n);
     void atCreation(size_t type, Batch& b, size_t n);
     // Counts the updates beyond the stability limit in `type`'s stats.
-    void runBatch(const RowsLaunch& launch, size_t first, size_t end, size_t type);
+    // `late`: its kills taken at the end of the step (LateKills), listed there.
+    void runBatch(const RowsLaunch& launch, size_t first, size_t end, size_t type, LateKills* late = nullptr);
     void firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, double t1);
     void drawBatch(size_t type, Batch& b, size_t n, double t1);
-    void advance(size_t type, Batch& b, size_t n, size_t maskColumn);
+    void advance(size_t type, Batch& b, size_t n, size_t maskColumn, LateKills* late = nullptr);
     void queueBursts(size_t type, Batch& b, size_t r);
     void killOrEmit(size_t type, Batch& b, size_t r, double dt, double t1);
     void bindBatch(size_t type, Batch& b, const ColumnLayout& layout, Scratch& parents, std::vector<Buffer>& table,

@@ -4,6 +4,8 @@
 
 #include <stdexcept>
 
+#include "rt/system_support.h"
+
 namespace psys::rt::detail {
 
 using ir::KernelKind;
@@ -75,6 +77,9 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         types.push_back(typeInfo(module, obj));
         typeStats.push_back({obj.name, 0, 0, 0, 0, 0});
     }
+    for (const TypeInfo& t : types)
+        if (t.parentType >= 0) types[static_cast<size_t>(t.parentType)].read = true;
+    for (TypeInfo& t : types) t.killsLate = options.lateKills && t.kills && !t.rateEmits && !t.exports && !t.read;
     // Spawn kernels read the emitter's own columns, whose buffers never change: their
     // tables are bound once (the parent values come with each launch).
     for (size_t t = 0; t < pools.size(); ++t) {
@@ -111,6 +116,51 @@ void State::kill(size_t type, uint32_t row, double at) {
     ++typeStats[type].killed;
     pools[type].freeze(row, at);  // no longer alive; freed at the end of the step if nobody reads it
     dying.push_back({type, row});
+}
+
+void State::latePart(LateKills::Part& part, const RowsResult& result, Buffer flags, size_t begin, size_t end) const {
+    part.ticket = result.ticket;
+    part.rows.clear();
+    if (result.ticket || result.killed == 0) return;
+    if (result.killedRows.size() == result.killed)
+        part.rows.assign(result.killedRows.begin(), result.killedRows.end());
+    else
+        listKilled(view<uint8_t>(flags), begin, end, part.rows);
+}
+
+void State::settleLate() {
+    if (late.empty()) return;
+    std::vector<std::pair<size_t, uint32_t>> merged;
+    merged.reserve(dying.size());
+    size_t next = 0;
+    for (LateKills& l : late) {
+        for (; next < l.at; ++next) merged.push_back(dying[next]);
+        Pool& pool = pools[l.type];
+        for (LateKills::Part& part : l.parts) {
+            RowsResult result;
+            std::span<const uint32_t> rows = part.rows;
+            if (part.ticket) {
+                result = backend.collect(part.ticket);
+                rows = result.killedRows;
+                typeStats[l.type].unstable += result.unstable;
+            }
+            for (uint32_t launchRow : rows) {
+                uint32_t row = launchRow;
+                double at = l.t1 - l.dt;
+                if (!l.poolRows.empty()) {
+                    size_t r = launchRow - l.first;
+                    row = l.poolRows[r];
+                    at = l.t1 - l.spans[r];
+                }
+                ++typeStats[l.type].killed;
+                pool.freeze(row, at);
+                merged.push_back({l.type, row});
+            }
+        }
+    }
+    for (; next < dying.size(); ++next) merged.push_back(dying[next]);
+    dying = std::move(merged);
+    late.clear();
 }
 
 void State::releaseReader(size_t childType, Handle parent) {

@@ -45,6 +45,10 @@ struct TypeInfo {
     std::vector<ColumnLayout> spawnLayout;
     std::vector<size_t> emitTarget;    // per emit site: the type it creates
     bool kills = false, rateEmits = false, bursts = false;
+    bool read = false;                 // a type's objects read this type's live (its parent type)
+    // Its kills may be taken at the end of the step (LateKills): it only dies (no rate
+    // emits, no exports) and nothing reads it, so no one looks at its dead before then.
+    bool killsLate = false;
     std::vector<bool> counted, rated;  // per emit site: whether the update yields its count, its rate
     std::array<bool, 4> drawn{};       // visible, position, colour, size: whether render yields it
 };
@@ -65,6 +69,7 @@ struct TypeWork {
     std::vector<Buffer> updateTable, exportsTable, renderTable;
     DrawnInStep inStep;
     std::vector<std::vector<uint32_t>> killed;  // per chunk: the rows that died, in order
+    std::vector<uint64_t> tickets;              // per chunk: a late launch's ticket, or 0
     std::vector<std::vector<Buffer>> spawnTables;  // per emit site: the pool's columns for its spawn kernel
 };
 
@@ -75,6 +80,27 @@ struct UniformCache {
     float dt = 0, time = 0;
     uint64_t externs = 0;
     std::vector<Value> values;
+};
+
+// The kills of launches that answered late (RowsLaunch::late) or whose kills are taken
+// late: applied at the end of the step (State::settleLate), in their place among the
+// step's kills, so that rows are freed in the order they would have been at once. Only
+// for types whose dead nobody looks at before then (TypeInfo::killsLate): the room a
+// creation sees counts a killed object as taken until the end of the step anyway.
+struct LateKills {
+    size_t type = 0;
+    size_t at = 0;  // its place among State::dying
+    struct Part {
+        uint64_t ticket = 0;          // to collect (Backend::collect); 0: `rows` are here
+        std::vector<uint32_t> rows;   // launch rows, in order
+    };
+    std::vector<Part> parts;
+    double t1 = 0, dt = 0;  // a pool's update: killed at t1 − dt
+    // A creation batch's first update: launch row first + r is pool row poolRows[r],
+    // killed at t1 − spans[r].
+    size_t first = 0;
+    std::vector<uint32_t> poolRows;
+    std::vector<double> spans;
 };
 
 struct State {
@@ -99,6 +125,7 @@ struct State {
     uint32_t nextId = 0;
     bool started = false;
     std::vector<std::pair<size_t, uint32_t>> dying;
+    std::vector<LateKills> late;
     ir::Evaluator evaluator;  // the kernels the run-time evaluates itself (start, triggers, uniform kernels)
     std::unique_ptr<Parallel> parallel;
 
@@ -107,6 +134,11 @@ struct State {
     // An object is dead: frozen now, freed at the end of the step unless children read it.
     // `at`: the time of its last values (those of the update before the one that killed it).
     void kill(size_t type, uint32_t row, double at);
+    // The late kills (LateKills), each in its place: at the end of a step, a trigger, the start.
+    void settleLate();
+    // A launch's kills as a part of a LateKills: its ticket, or the rows it listed, else
+    // those of [begin, end) its kill flags (`flags`) mark.
+    void latePart(LateKills::Part& part, const RowsResult& result, Buffer flags, size_t begin, size_t end) const;
     // A reader of `parent` is gone; a frozen parent without readers is freed, and so on up.
     void releaseReader(size_t childType, Handle parent);
     // The values of `kernel`'s uniform kernel at (dt, time), evaluated on the host and

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <vector>
 
 #include "ir/value.h"
 
@@ -78,6 +79,22 @@ inline void maskRows(uint8_t* out, const uint8_t* keep, const uint8_t* unless, c
         std::memcpy(out + row, &w, sizeof w);
     }
     for (; row < end; ++row) out[row] = keep[row] && !(unless && unless[row] && (!also || also[row]));
+}
+
+// The rows of [begin, end) whose kill flag is set, in order (most objects live: eight
+// flags are tested at a time).
+inline void listKilled(const uint8_t* kill, size_t begin, size_t end, std::vector<uint32_t>& out) {
+    out.clear();
+    size_t row = begin;
+    for (; row + 8 <= end; row += 8) {
+        uint64_t flags;
+        std::memcpy(&flags, kill + row, sizeof flags);
+        if (!flags) continue;
+        for (size_t r = row; r < row + 8; ++r)
+            if (kill[r]) out.push_back(static_cast<uint32_t>(r));
+    }
+    for (; row < end; ++row)
+        if (kill[row]) out.push_back(static_cast<uint32_t>(row));
 }
 
 }  // namespace psys::rt::detail

@@ -16,48 +16,41 @@ namespace psys::rt::detail {
 
 namespace {
 
-// The rows of [begin, end) whose kill flag is set, in order (most objects live: eight
-// flags are tested at a time).
-void listKilled(const uint8_t* kill, size_t begin, size_t end, std::vector<uint32_t>& out) {
-    out.clear();
-    size_t row = begin;
-    for (; row + 8 <= end; row += 8) {
-        uint64_t flags;
-        std::memcpy(&flags, kill + row, sizeof flags);
-        if (!flags) continue;
-        for (size_t r = row; r < row + 8; ++r)
-            if (kill[r]) out.push_back(static_cast<uint32_t>(r));
-    }
-    for (; row < end; ++row)
-        if (kill[row]) out.push_back(static_cast<uint32_t>(row));
-}
-
-// After an update of `type`: in row order, each updated object dies or emits.
-void killAndEmit(State& s, Creation& creation, size_t type, double dt, double t1) {
+// After an update of `type`: in row order, each updated object dies or emits. A rate or
+// count every row shares (ColumnLayout::sharedEmit) is taken from the launch's uniform
+// values, not from its column: a device need not send it back.
+void killAndEmit(State& s, Creation& creation, size_t type, double dt, double t1, const Value* uniforms) {
     const Pool& pool = s.pools[type];
     const TypeInfo& info = s.types[type];
     const TypeWork& work = s.work[type];
     const ir::Object& o = pool.object();
     const uint8_t* updatable = pool.mask();
-    const auto* kill = s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]);
+    const auto* kill = info.kills ? s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]) : nullptr;
     std::vector<float> rate(o.emits.size(), 0), count(o.emits.size(), 1);
     std::vector<const float*> rates(o.emits.size()), counts(o.emits.size());
+    const ColumnLayout& layout = info.updateLayout;
+    auto source = [&](bool yielded, int column, float& shared, const float*& perRow) {
+        if (!yielded) return;
+        if (auto v = layout.sharedEmit(column, uniforms))
+            shared = *v;
+        else
+            perRow = s.view<float>(work.updateTable[static_cast<size_t>(column)]);
+    };
     for (size_t site = 0; site < o.emits.size(); ++site) {
         auto i = static_cast<int>(site);
-        if (info.rated[site]) rates[site] = s.view<float>(work.updateTable[static_cast<size_t>(info.updateLayout.emitRate(i))]);
-        if (info.counted[site])
-            counts[site] = s.view<float>(work.updateTable[static_cast<size_t>(info.updateLayout.emitCount(i))]);
+        source(info.rated[site], layout.emitRate(i), rate[site], rates[site]);
+        source(info.counted[site], layout.emitCount(i), count[site], counts[site]);
     }
     for (uint32_t row = 0; row < pool.rows(); ++row) {
         if (!updatable[row]) continue;
-        if (info.kills && kill[row]) {
+        if (kill && kill[row]) {
             s.kill(type, row, t1 - dt);
             continue;
         }
         if (!info.rateEmits) continue;
         for (size_t site = 0; site < o.emits.size(); ++site) {
-            if (info.rated[site]) rate[site] = rates[site][row];
-            if (info.counted[site]) count[site] = counts[site][row];
+            if (rates[site]) rate[site] = rates[site][row];
+            if (counts[site]) count[site] = counts[site][row];
         }
         creation.emitAtRate({type, row, {}, row, t1, false}, rate, count, dt, t1);
     }
@@ -106,20 +99,28 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1,
     }
     const uint8_t* updatable = pool.mask();
     const auto* kill = s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]);
-    // Objects that only die (no rate emits) are found while their chunk is in cache.
+    // Objects that only die (no rate emits) are found while their chunk is in cache; where
+    // nobody looks at them before the end of the step (the last sub-step of a type whose
+    // dead nobody reads), they are taken then (LateKills), and a device need not wait.
     bool listKills = info.kills && !info.rateEmits;
+    bool late = info.killsLate && last;
     size_t chunks = s.chunkCount(rows);
     if (listKills) work.killed.resize(chunks);
+    if (late) work.tickets.assign(chunks, 0);
     std::atomic<uint64_t> unstable = 0;
     auto chunk = [&](size_t c, size_t begin, size_t end) {
         RowsLaunch part = update;
         part.begin = begin;
         part.end = end;
+        part.late = late;
         s.gatherParents(type, info.updateLayout, work.updateTable, updatable, part.begin, part.end, t1);
         RowsResult result = s.backend.run(part);
         size_t killed = result.killed;
         if (result.unstable) unstable += result.unstable;
-        if (listKills) {
+        if (result.ticket) {
+            work.tickets[c] = result.ticket;
+            work.killed[c].clear();
+        } else if (listKills) {
             if (killed == 0) work.killed[c].clear();
             else if (result.killedRows.size() == killed) work.killed[c].assign(result.killedRows.begin(), result.killedRows.end());
             else listKilled(kill, part.begin, part.end, work.killed[c]);
@@ -147,12 +148,21 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1,
         ~Timer() { stats.emitSeconds += seconds(start, WallClock::now()); }
     } timer{s.stats, loopsDone};
     if (!info.kills && !info.rateEmits) return;
+    if (late) {
+        LateKills& l = s.late.emplace_back();
+        l.type = type;
+        l.at = s.dying.size();
+        l.t1 = t1;
+        l.dt = dt;
+        for (size_t c = 0; c < chunks; ++c) l.parts.push_back({work.tickets[c], std::move(work.killed[c])});
+        return;
+    }
     if (listKills) {
         for (size_t c = 0; c < chunks; ++c)
             for (uint32_t row : work.killed[c]) s.kill(type, row, t1 - dt);
         return;
     }
-    killAndEmit(s, creation, type, dt, t1);
+    killAndEmit(s, creation, type, dt, t1, update.uniforms);
 }
 
 }  // namespace

@@ -42,6 +42,26 @@ inline std::string drawnBytes(rt::System& system, int frames) {
     return out;
 }
 
+// Where a system keeps its objects, as text: per type the high-water row, the free rows
+// in order, and each row's status, generation and (not free) id. Two runs that free and
+// reuse rows alike give the same text.
+inline std::string poolRows(const rt::System& system) {
+    std::string out;
+    for (size_t t = 0; t < system.typeCount(); ++t) {
+        const rt::Pool& pool = system.pool(t);
+        const auto* ids = rt::viewData<uint32_t>(system.backend().memory(), pool.ids);
+        out += "type " + std::to_string(t) + ": rows " + std::to_string(pool.rows()) + ", free";
+        for (uint32_t row : pool.freeRows()) out += " " + std::to_string(row);
+        out += "\n";
+        for (uint32_t row = 0; row < pool.rows(); ++row) {
+            out += " " + std::to_string(static_cast<int>(pool.status(row))) + "/" + std::to_string(pool.generations()[row]);
+            if (pool.status(row) != rt::Status::Free) out += "#" + std::to_string(ids[row]);
+        }
+        out += "\n";
+    }
+    return out;
+}
+
 // What a host sees over `frames` steps of `text`, drawn on the frames `drawOn` picks,
 // with the system's `drawInStep` option as given: every point drawn (as bytes), the drawn
 // counts and the non-finite counter; on frame 20 an extern (the first) is set, on frame 40

@@ -65,6 +65,26 @@ end
 )");
 }
 
+TEST_CASE("simplify: a kill that is constant false is dropped, with its constant") {
+    CHECK(after(R"(object p(v: vec3)
+  kernel update
+    %0 = const.bool 0
+    %1 = param.vec3 #0
+    %2 = const.bool 1
+    %3 = and.bool %0, %2
+    yield kill = %3
+    yield position = %1
+  end
+end
+)", simplifyExact) == R"(object p(v: vec3)
+  kernel update
+    %0 = param.vec3 #0
+    yield position = %0
+  end
+end
+)");
+}
+
 TEST_CASE("simplify: relaxed maths drops x+0 and divides by multiplying") {
     CHECK(after(R"(object p(v: vec3)
   kernel update

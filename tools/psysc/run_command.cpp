@@ -79,9 +79,11 @@ void printSummary(const RunOptions& options, host::Session& session, double draw
                                  stats.emitSeconds * 1e3 / frames, stats.createSeconds * 1e3 / frames,
                                  drawSeconds * 1e3 / frames);
         if (r.device)
-            std::cout << fmt::format("on the GPU: the host waited for it {:.1f} times a frame; {:.1f} KB a frame "
+            std::cout << fmt::format("on the GPU: the host waited for it {:.1f} times a frame, and took {:.1f} "
+                                     "read-backs a frame at the step's end ({:.1f} not ready); {:.1f} KB a frame "
                                      "between host and GPU, {:.1f} KB copied on the GPU\n",
-                                     static_cast<double>(r.waits) / frames,
+                                     static_cast<double>(r.waits) / frames, static_cast<double>(r.lateReads) / frames,
+                                     static_cast<double>(r.lateStalls) / frames,
                                      static_cast<double>(r.transferredBytes) / 1024 / frames,
                                      static_cast<double>(r.stagedBytes) / 1024 / frames);
     }
