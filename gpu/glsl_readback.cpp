@@ -55,9 +55,9 @@ rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program
             kills = true;
             continue;
         }
-        // A rate or count every row shares: the run-time reads it from the uniform values.
-        if (launch.clock.now == rt::Clock::Source::Uniform && c >= p.layout.emits && c < p.layout.render &&
-            p.layout.sharedEmit(c, launch.uniforms))
+        // A rate or count every row shares: the run-time has it (ColumnLayout::sharedEmit).
+        if (!launch.clock.perRow() && c >= p.layout.emits && c < p.layout.render &&
+            p.layout.emitShared[static_cast<size_t>(c - p.layout.emits)].from != ColumnLayout::Shared::From::Column)
             continue;
         returned.push_back({b, block[LaunchBlock::kColumns + static_cast<size_t>(c)], 0});
     }

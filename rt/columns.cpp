@@ -52,8 +52,10 @@ ColumnLayout columnLayout(const ir::Object& object, const ir::Kernel& kernel) {
         auto at = static_cast<size_t>((y.kind == ir::YieldKind::EmitRate ? l.emitRate(y.index) : l.emitCount(y.index)) - l.emits);
         l.writes[at] = true;
         const ir::Inst& value = kernel.at(y.value);
-        if (value.op == ir::Op::Const) l.emitShared[at] = {true, -1, value.constant[0]};
-        if (value.op == ir::Op::Uniform) l.emitShared[at] = {true, value.attr, 0};
+        using From = ColumnLayout::Shared::From;
+        if (value.op == ir::Op::Const) l.emitShared[at] = {From::Constant, 0, value.constant[0]};
+        if (value.op == ir::Op::Extern) l.emitShared[at] = {From::Extern, value.attr, 0};
+        if (value.op == ir::Op::Uniform) l.emitShared[at] = {From::Uniform, value.attr, 0};
     }
     if (kernel.kind == ir::KernelKind::Render) {  // writes every render column (visible: drawn or not)…
         l.renderFromState.assign(ColumnLayout::kRenderColumns, -1);

@@ -71,23 +71,28 @@ struct ColumnLayout {
     }
 
     // An emission rate or count that every row of a launch at a uniform clock shares: a
-    // constant, or a value of the kernel's uniform kernel (`at population / 3 per second`).
-    // At a uniform clock the run-time takes it from there, not from its column (which a
-    // backend still writes), so a backend whose columns live on a device need not send
-    // the column back. Per emit column (a site's rate, then its count); the run-time and
-    // every backend read this one rule.
+    // constant, an extern (`at rate per second`) or a value of the kernel's uniform
+    // kernel (`at population / 3 per second`). At a uniform clock the run-time takes it
+    // from there, not from its column (which a backend still writes), so a backend whose
+    // columns live on a device need not send the column back. Per emit column (a site's
+    // rate, then its count); the run-time and every backend read this one rule.
     struct Shared {
-        bool is = false;
-        int uniform = -1;  // ≥ 0: the uniform kernel's value #uniform; else `value`
-        float value = 0;
+        enum class From : uint8_t { Column, Constant, Extern, Uniform } from = From::Column;
+        int index = 0;     // Extern: the extern; Uniform: the uniform kernel's value
+        float value = 0;   // Constant
     };
     std::vector<Shared> emitShared;
-    // The value emit column `column` has in every row of a launch at a uniform clock whose
-    // uniform values are `uniforms`, if it is shared.
-    std::optional<float> sharedEmit(int column, const ir::Value* uniforms) const {
+    // The value emit column `column` has in every row of a launch at a uniform clock, with
+    // these externs and uniform values, if it is shared.
+    std::optional<float> sharedEmit(int column, const ir::Value* externs, const ir::Value* uniforms) const {
         const Shared& s = emitShared.at(static_cast<size_t>(column - emits));
-        if (!s.is) return std::nullopt;
-        return s.uniform >= 0 ? uniforms[s.uniform].f[0] : s.value;
+        switch (s.from) {
+            case Shared::From::Constant: return s.value;
+            case Shared::From::Extern: return externs[s.index].f[0];
+            case Shared::From::Uniform: return uniforms[s.index].f[0];
+            case Shared::From::Column: break;
+        }
+        return std::nullopt;
     }
 
     int emitRate(int site) const { return emits + 2 * site; }

@@ -17,8 +17,8 @@ namespace psys::rt::detail {
 namespace {
 
 // After an update of `type`: in row order, each updated object dies or emits. A rate or
-// count every row shares (ColumnLayout::sharedEmit) is taken from the launch's uniform
-// values, not from its column: a device need not send it back.
+// count every row shares (ColumnLayout::sharedEmit) is taken from the externs or the
+// launch's uniform values, not from its column: a device need not send it back.
 void killAndEmit(State& s, Creation& creation, size_t type, double dt, double t1, const Value* uniforms) {
     const Pool& pool = s.pools[type];
     const TypeInfo& info = s.types[type];
@@ -31,7 +31,7 @@ void killAndEmit(State& s, Creation& creation, size_t type, double dt, double t1
     const ColumnLayout& layout = info.updateLayout;
     auto source = [&](bool yielded, int column, float& shared, const float*& perRow) {
         if (!yielded) return;
-        if (auto v = layout.sharedEmit(column, uniforms))
+        if (auto v = layout.sharedEmit(column, s.externs.data(), uniforms))
             shared = *v;
         else
             perRow = s.view<float>(work.updateTable[static_cast<size_t>(column)]);

@@ -596,11 +596,11 @@ TEST_CASE("an emission rate or count every row shares is taken from the uniform 
     ir::Module module = test::compileModule(shared);
     const ir::Object& e = module.objects.at(static_cast<size_t>(module.objectIndex("e")));
     rt::ColumnLayout layout = rt::columnLayout(e, *e.kernel(ir::KernelKind::Update));
+    using From = rt::ColumnLayout::Shared::From;
     REQUIRE(layout.emitShared.size() == 2);
-    CHECK(layout.emitShared[0].is);
-    CHECK(layout.emitShared[0].uniform >= 0);  // rate / 3: a value of the uniform kernel
-    CHECK(layout.emitShared[1].is);
-    CHECK(layout.emitShared[1].value == 2);   // the count: a constant
+    CHECK(layout.emitShared[0].from == From::Uniform);  // rate / 3: a value of the uniform kernel
+    CHECK(layout.emitShared[1].from == From::Constant);
+    CHECK(layout.emitShared[1].value == 2);
     CHECK(e.kernel(ir::KernelKind::Update)->findOne(ir::YieldKind::Kill) == nullptr);  // it never dies
     // The run-time takes them from there: poisoned columns change nothing…
     auto created = [](const std::string& text, rt::Backend& backend) {
@@ -612,6 +612,14 @@ TEST_CASE("an emission rate or count every row shares is taken from the uniform 
     PoisonedEmissions poisoned;
     CHECK(created(shared, poisoned) == created(shared, plain));
     CHECK(created(shared, plain).first == 3 * 2 * 30);
+    // An extern as it is (`at rate per second`): the run-time reads the extern.
+    std::string asExtern = shared;
+    asExtern.replace(asExtern.find("rate / 3"), 8, "rate");
+    ir::Module externModule = test::compileModule(asExtern);
+    const ir::Object& e2 = externModule.objects.at(static_cast<size_t>(externModule.objectIndex("e")));
+    CHECK(rt::columnLayout(e2, *e2.kernel(ir::KernelKind::Update)).emitShared[0].from == From::Extern);
+    CHECK(created(asExtern, poisoned) == created(asExtern, plain));
+    CHECK(created(asExtern, plain).first == 3 * 2 * 90);
     // …while a rate each row has its own is read from its column (so the poison shows).
     std::string ownRate = R"(
         extern rate: float = 90;
