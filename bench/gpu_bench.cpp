@@ -61,6 +61,6 @@ int main(int argc, char** argv) {
     }
     std::cout << "\n(passes: GPU time from GL timer queries, or \"wall\": from a glFinish before the pass to one after, "
                  "where the GL's timer does not see compute work; state B/particle: what the update pass must read and "
-                 "write; update pass GB/s: that ÷ the pass's time; staged: copied on the GPU into and out of launches' words, beyond what the shaders move; waits/step: read-backs the host waited for mid-step; late/step: read-backs of kills taken at the step's end, and in brackets those the GPU had not finished by then)\n";
+                 "write; update pass GB/s: that ÷ the pass's time; staged: copied on the GPU into and out of launches' words, beyond what the shaders move; waits/step: read-backs the host waited for mid-step; late/step: read-backs taken when the run-time needed them (kills at the step's end), and in brackets those the GPU had not finished by then)\n";
     return 0;
 }

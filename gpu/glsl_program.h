@@ -30,6 +30,7 @@ struct GlslBackend::Late {
     struct Part {
         size_t begin;  // the dispatch's first row
         size_t at;     // its region's first word
+        bool kills;    // whether its kills follow its counts
     };
     std::vector<Part> parts;
     GLsync fence = nullptr;

@@ -77,7 +77,7 @@ rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program
                                  static_cast<GLsizeiptr>(n * GlMemory::wordsPerRow(memory_.elem(r.buffer)) * 4));
     if (late) {  // kept for collect(): no wait now
         readbackUsed_ = at + words;
-        late->parts.push_back({begin, at});
+        late->parts.push_back({begin, at, kills});
         return {};
     }
     const uint32_t* back = awaitReadback() + at;
@@ -159,8 +159,12 @@ void GlslBackend::settle(Late& late) {
         const uint32_t* back = mappedReadback_ + part.at;
         late.counts.killed += back[0];
         late.counts.unstable += back[1];
+        late.counts.drawn += back[2];
+        late.counts.nonFinite += back[3];
+        memory_.transferred += 16;
+        if (!part.kills) continue;
         uint32_t killed = back[kKillsAt];
-        memory_.transferred += 16 + (1 + killed) * 4;
+        memory_.transferred += (1 + killed) * 4;
         for (uint32_t k = 0; k < killed; ++k)
             late.rows.push_back(static_cast<uint32_t>(part.begin) + back[kKillsAt + 1 + k]);
     }

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <set>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -66,6 +67,11 @@ System::System(ir::Module module, Backend& backend, SystemOptions options)
 }
 
 System::~System() {
+    try {
+        drawing_->takeCounts();  // a device's, so it keeps nothing for this system
+    } catch (const std::exception&) {
+        // a device that failed has nothing to give back
+    }
     drawing_.reset();
     creation_.reset();
     state_->backend.forget(state_->module);
@@ -252,6 +258,7 @@ std::vector<RenderPoint> System::points(size_t type) {
 }
 
 Stats System::stats() const {
+    drawing_->takeCounts();
     const detail::State& s = *state_;
     Stats out = s.stats;
     out.types = s.typeStats;

@@ -95,7 +95,10 @@ struct RenderPoint {
 // A viewer draws straight from these; `System::points` reads them back.
 struct DrawColumns {
     size_t rows = 0;
-    size_t drawn = 0;       // rows with visible = 1
+    size_t drawn = 0;       // rows with visible = 1, where `counted`
+    // False where a device computed what is drawn and the host did not wait for its count:
+    // `drawn` is then not known yet (the columns are); System::stats and points take it.
+    bool counted = true;
     Buffer visible;         // f32, 0 or 1
     Buffer position[3];     // f32
     Buffer color[4];        // f32
@@ -160,9 +163,11 @@ public:
     Backend& backend() const;
 
     // What is drawn for `type` after the latest step (or trigger), computed on first ask.
+    // On a device the host does not wait for it: its count comes later (DrawColumns::counted).
     const DrawColumns& draw(size_t type);
     // The same read back to the host: the drawn points in row order (for dumps and tests).
     std::vector<RenderPoint> points(size_t type);
+    // The counters (a device's render counts taken first: it may wait for the GPU).
     Stats stats() const;
 
     // Hot reload: this (new, not yet stepped) system takes over `old`'s objects, carried

@@ -33,7 +33,7 @@ DrawnCount renderRows(State& s, size_t type, const RowsLaunch& launch, const uin
     s.gatherParents(type, layout, launch.columns, mask, begin, end, launch.clock.nowValue, nullptr, poolRows,
                     poolRowsFirst);
     RowsResult result = s.backend.run(part);
-    DrawnCount count{result.drawn, result.nonFinite};
+    DrawnCount count{result.drawn, result.nonFinite, result.ticket};
     if (s.backend.marksDrawn()) return count;  // its render columns stay where it computed them
     // Drawn: alive, visible, and position, colour and size all finite.
     auto column = [&](int c) { return launch.columns[static_cast<size_t>(layout.drawnFrom(c))]; };
@@ -108,10 +108,26 @@ void Drawing::hand(size_t type, DrawColumns& out) {
         if (auto k = layout.constant(ColumnLayout::kPosition + c)) out.constant[static_cast<size_t>(c)] = *k;
 }
 
+void Drawing::takeCounts(size_t type) {
+    Type& d = types_[type];
+    for (uint64_t ticket : d.tickets) {
+        RowsResult r = s_.backend.collect(ticket);
+        d.columns.drawn += r.drawn;
+        s_.stats.nonFiniteRender += r.nonFinite;
+    }
+    d.tickets.clear();
+    d.columns.counted = true;
+}
+
+void Drawing::takeCounts() {
+    for (size_t t = 0; t < types_.size(); ++t) takeCounts(t);
+}
+
 const DrawColumns& Drawing::draw(size_t type) {
     drew_ = true;
     Type& d = types_[type];
     if (!d.stale) return d.columns;
+    takeCounts(type);
     d.stale = false;
     auto start = WallClock::now();
     const Pool& pool = s_.pools[type];
@@ -135,8 +151,10 @@ const DrawColumns& Drawing::draw(size_t type) {
         s_.stats.drawSeconds += seconds(start, WallClock::now());
         return out;
     }
-    // The rows drawn are among the alive ones, in parallel chunks.
+    // The rows drawn are among the alive ones, in parallel chunks. A device may answer
+    // late: its counts are taken when they are asked for (takeCounts).
     RowsLaunch launch = renderLaunch(s_, type, work.renderTable, pool.alive.column, s_.now);
+    launch.late = true;
     const uint8_t* mask = pool.alive.host();
     std::mutex counting;
     DrawnCount all;
@@ -145,8 +163,10 @@ const DrawColumns& Drawing::draw(size_t type) {
         std::lock_guard lock(counting);
         all.drawn += chunk.drawn;
         all.nonFinite += chunk.nonFinite;
+        if (chunk.ticket) d.tickets.push_back(chunk.ticket);
     });
     out.drawn = all.drawn;
+    out.counted = d.tickets.empty();
     s_.stats.nonFiniteRender += all.nonFinite;
     s_.stats.drawSeconds += seconds(start, WallClock::now());
     return out;
@@ -154,6 +174,7 @@ const DrawColumns& Drawing::draw(size_t type) {
 
 std::vector<RenderPoint> Drawing::points(size_t type) {
     const DrawColumns& c = draw(type);
+    takeCounts(type);
     std::vector<RenderPoint> out;
     if (c.rows == 0 || c.drawn == 0) return out;
     out.reserve(c.drawn);

@@ -21,6 +21,7 @@ namespace psys::rt::detail {
 struct DrawnCount {
     size_t drawn = 0;
     uint64_t nonFinite = 0;
+    uint64_t ticket = 0;  // a late launch's (RowsLaunch::late): the counts are to be collected
 };
 
 // The render launch of `type` over `table` (bound for its render layout) at the end of the
@@ -61,6 +62,10 @@ public:
     void invalidate(bool step = false);
     const DrawColumns& draw(size_t type);
     std::vector<RenderPoint> points(size_t type);
+    // The counts of draws a device answered late (RowsLaunch::late), into their
+    // DrawColumns and the stats: at the next draw of the type, points(), stats().
+    void takeCounts(size_t type);
+    void takeCounts();
     // Whether the host drew since the last step (the next step then draws as it goes).
     bool drewSinceStep() const { return drew_; }
     void stepping() { drew_ = false; }
@@ -69,6 +74,7 @@ private:
     struct Type {
         DrawColumns columns;
         bool stale = true;
+        std::vector<uint64_t> tickets;  // its render launches' counts, still to be collected
     };
     void hand(size_t type, DrawColumns& out);
     State& s_;

@@ -80,7 +80,7 @@ void printSummary(const RunOptions& options, host::Session& session, double draw
                                  drawSeconds * 1e3 / frames);
         if (r.device)
             std::cout << fmt::format("on the GPU: the host waited for it {:.1f} times a frame, and took {:.1f} "
-                                     "read-backs a frame at the step's end ({:.1f} not ready); {:.1f} KB a frame "
+                                     "read-backs a frame later, when they were needed ({:.1f} not ready); {:.1f} KB a frame "
                                      "between host and GPU, {:.1f} KB copied on the GPU\n",
                                      static_cast<double>(r.waits) / frames, static_cast<double>(r.lateReads) / frames,
                                      static_cast<double>(r.lateStalls) / frames,

@@ -119,7 +119,7 @@ PointRenderer::~PointRenderer() {
 
 void PointRenderer::draw(const rt::DrawColumns& c, const rt::Memory& memory, const glm::mat4& view,
                          const glm::mat4& projection, float viewportHeight, Blend blend) {
-    if (c.rows == 0 || c.drawn == 0) return;
+    if (c.rows == 0 || (c.counted && c.drawn == 0)) return;
     const rt::Buffer columns[kColumns] = {c.visible, c.position[0], c.position[1], c.position[2], c.color[0],
                                           c.color[1], c.color[2], c.color[3], c.size};
     for (int i = 0; i < kColumns; ++i) {
