@@ -56,6 +56,42 @@ void killAndEmit(State& s, Creation& creation, size_t type, double dt, double t1
     }
 }
 
+// The kills of an update of objects that only die, listed per chunk (or ticketed, for a
+// late launch): now, or at the end of the step in their place (LateKills).
+void takeKills(State& s, size_t type, size_t chunks, bool late, double dt, double t1) {
+    TypeWork& work = s.work[type];
+    if (!late) {
+        for (size_t c = 0; c < chunks; ++c)
+            for (uint32_t row : work.killed[c]) s.kill(type, row, t1 - dt);
+        return;
+    }
+    LateKills& l = s.late.emplace_back();
+    l.type = type;
+    l.at = s.dying.size();
+    l.t1 = t1;
+    l.dt = dt;
+    for (size_t c = 0; c < chunks; ++c) l.parts.push_back({work.tickets[c], std::move(work.killed[c])});
+}
+
+// The update launch over `type`'s pool (its table bound) for (t1 − dt, t1], rows to be chosen.
+RowsLaunch poolUpdate(State& s, size_t type, double dt, double t1) {
+    const TypeInfo& info = s.types[type];
+    TypeWork& work = s.work[type];
+    s.bindPool(type, info.updateLayout, work.update, work.updateTable);
+    RowsLaunch update;
+    update.object = &s.pools[type].object();
+    update.kernel = info.update;
+    update.layout = &info.updateLayout;
+    update.columns = work.updateTable;
+    update.mask = s.pools[type].updatable.column;
+    update.clock = {Clock::Source::Uniform, Clock::Source::Uniform, t1, static_cast<float>(dt), false};
+    update.externs = s.externs.data();
+    update.uniforms = s.uniforms(type, *info.update, static_cast<float>(dt), static_cast<float>(t1));
+    update.seed = s.options.seed;
+    update.draw = static_cast<uint32_t>(s.step);
+    return update;
+}
+
 // One update of every updatable object of `type` over (t1 − dt, t1]: the update kernel
 // and the exports kernel over chunks of rows (on several threads where the backend
 // allows), then kills and emissions in row order, so that ids, the queue and the free
@@ -64,7 +100,6 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1,
     Pool& pool = s.pools[type];
     TypeInfo& info = s.types[type];
     TypeWork& work = s.work[type];
-    const ir::Object& o = pool.object();
     size_t rows = pool.rows();
     if (rows == 0) return;
     // Drawing as it goes (rt/system_draw.h): each chunk rendered after its update.
@@ -74,18 +109,7 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1,
         if (drawing) drawing->none();
         return;
     }
-    s.bindPool(type, info.updateLayout, work.update, work.updateTable);
-    RowsLaunch update;
-    update.object = &o;
-    update.kernel = info.update;
-    update.layout = &info.updateLayout;
-    update.columns = work.updateTable;
-    update.mask = pool.updatable.column;
-    update.clock = {Clock::Source::Uniform, Clock::Source::Uniform, t1, static_cast<float>(dt), false};
-    update.externs = s.externs.data();
-    update.uniforms = s.uniforms(type, *info.update, static_cast<float>(dt), static_cast<float>(t1));
-    update.seed = s.options.seed;
-    update.draw = static_cast<uint32_t>(s.step);
+    RowsLaunch update = poolUpdate(s, type, dt, t1);
     RowsLaunch exports = update;
     Buffer exportMask;
     if (info.exports) {
@@ -148,21 +172,10 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1,
         ~Timer() { stats.emitSeconds += seconds(start, WallClock::now()); }
     } timer{s.stats, loopsDone};
     if (!info.kills && !info.rateEmits) return;
-    if (late) {
-        LateKills& l = s.late.emplace_back();
-        l.type = type;
-        l.at = s.dying.size();
-        l.t1 = t1;
-        l.dt = dt;
-        for (size_t c = 0; c < chunks; ++c) l.parts.push_back({work.tickets[c], std::move(work.killed[c])});
-        return;
-    }
-    if (listKills) {
-        for (size_t c = 0; c < chunks; ++c)
-            for (uint32_t row : work.killed[c]) s.kill(type, row, t1 - dt);
-        return;
-    }
-    killAndEmit(s, creation, type, dt, t1, update.uniforms);
+    if (listKills)
+        takeKills(s, type, chunks, late, dt, t1);
+    else
+        killAndEmit(s, creation, type, dt, t1, update.uniforms);
 }
 
 }  // namespace
