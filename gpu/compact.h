@@ -7,7 +7,7 @@
 // scans the counts (each invocation a run of groups, then a scan of the 256 runs) and
 // writes the total; each group scans its flags in shared memory and writes its rows at
 // its offset, after the total. The host learns how many rows there are with the rows
-// (GlslBackend reads them back with the launch's counts: one wait).
+// (GlslBackend reads them back with the launch's counts, at once or late: gpu/glsl_readback.cpp).
 #pragma once
 
 #include <cstddef>
