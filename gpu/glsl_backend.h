@@ -70,6 +70,9 @@ public:
     // (the GPU had not finished them when the run-time collected them).
     uint64_t lateReads() const { return lateReads_; }
     uint64_t lateStalls() const { return lateStalls_; }
+    // Late launches read before the run-time collected them, because the read-back buffer
+    // had to grow (while the pools grow; none once it has).
+    uint64_t lateEarly() const { return lateEarly_; }
 
 private:
     GlslBackend() = default;
@@ -122,7 +125,7 @@ private:
     std::vector<uint32_t> staging_;
     size_t readbackUsed_ = 0;  // words of the read-back buffer held by late launches' regions
     std::map<uint64_t, std::unique_ptr<Late>> late_;
-    uint64_t nextTicket_ = 1, lateReads_ = 0, lateStalls_ = 0;
+    uint64_t nextTicket_ = 1, lateReads_ = 0, lateStalls_ = 0, lateEarly_ = 0;
     std::vector<uint32_t> killedRows_;  // the last launch's or collect's (RowsResult::killedRows)
     size_t kernels_ = 0;
     double compileSeconds_ = 0;

@@ -7,8 +7,9 @@
 // it and the host does not wait at all.
 //
 // Regions: an immediate read-back uses the words after those late launches hold; late
-// launches keep theirs until collected. When the buffer must grow, the late launches are
-// settled first (their counts and kills read into host memory), so no region moves.
+// launches keep theirs until collected (or settled: read into host memory). When the
+// words run out, the late launches are settled and the buffer grows to twice what was
+// asked, so that a step's regions soon fit without settling anything early.
 #include <algorithm>
 #include <cstring>
 #include <stdexcept>
@@ -108,9 +109,15 @@ rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program
 
 size_t GlslBackend::reserveReadback(size_t words) {
     if (readbackUsed_ + words > readbackWords_) {
-        for (auto& [ticket, late] : late_) settle(*late);
+        // The buffer moves: what late launches keep in it is read first. It is made room
+        // for twice what was asked, so that the steps to come fit without moving it again.
+        size_t wanted = readbackUsed_ + words;
+        for (auto& [ticket, late] : late_) {
+            lateEarly_ += !late->settled;
+            settle(*late);
+        }
         readbackUsed_ = 0;
-        ensureReadback(words);
+        ensureReadback(2 * wanted);
     }
     return readbackUsed_;
 }
@@ -180,7 +187,9 @@ rt::RowsResult GlslBackend::collect(uint64_t ticket) {
     rt::RowsResult result = late.counts;
     result.killedRows = killedRows_;
     late_.erase(it);
-    if (late_.empty()) readbackUsed_ = 0;
+    // No region is kept once every late launch is settled (read, or waiting to be collected).
+    if (std::all_of(late_.begin(), late_.end(), [](const auto& entry) { return entry.second->settled; }))
+        readbackUsed_ = 0;
     return result;
 }
 
