@@ -152,6 +152,35 @@ TEST_CASE("a launch split over dispatches computes what one dispatch computes") 
     }
 }
 
+TEST_CASE("a reload on the GPU carries every object on, the old system's last draws still uncounted") {
+    // As the viewer reloads: a new system on the same backend takes the old one's objects
+    // over, right after the old one drew (its counts not yet taken), and the old one goes.
+    for (const char* sample : {"fountain", "fireworks"}) {
+        INFO(sample);
+        std::string text = readFile(std::string(PSYS_SAMPLES_DIR) + "/" + sample + ".psys");
+        interp::Interpreter interpreter;
+        auto gpu = gpuBackend();
+        rt::System straight(test::compileModule(text), interpreter);
+        auto before = std::make_unique<rt::System>(test::compileModule(text), *gpu);
+        for (int f = 0; f < 90; ++f) {
+            REQUIRE_FALSE(straight.step(1.0 / 60));
+            REQUIRE_FALSE(before->step(1.0 / 60));
+            for (size_t t = 0; t < before->typeCount(); ++t) before->draw(t);
+        }
+        size_t uncounted = 0;
+        for (size_t t = 0; t < before->typeCount(); ++t) uncounted += !before->draw(t).counted;
+        CHECK(uncounted > 0);
+        rt::System after(test::compileModule(text), *gpu);
+        rt::ReloadReport report = after.carryOver(*before);
+        CHECK(report.dropped == 0);
+        before.reset();
+        test::Comparison c = test::compareSystems(straight, after, 60);
+        CHECK(c.points > 1000);
+        CHECK(c.worst <= kSamplesTolerance);
+        CHECK(test::poolRows(straight) == test::poolRows(after));
+    }
+}
+
 TEST_CASE("every operation computes on the GPU what the interpreter computes") {
     std::string text = readFile(PSYS_EVERY_OPERATION);
     for (bool optimize : {false, true}) {
