@@ -450,7 +450,7 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
         // drawing as the step goes shows only the objects alive after their first update.
         const DrawnInStep& drawing = s_.work[type].inStep;
         std::optional<LateKills> late;
-        if (info.killsLate && !(drawing.on && drawing.updated)) late.emplace();
+        if (info.late && !(drawing.on && drawing.updated)) late.emplace();
         advance(type, b, n, kMask, late ? &*late : nullptr);
         inOrder(true, [&](size_t r) {
             queueBursts(type, b, r);

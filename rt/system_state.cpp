@@ -53,6 +53,7 @@ TypeInfo typeInfo(const ir::Module& module, const ir::Object& o) {
     t.rated.assign(o.emits.size(), false);
     for (const ir::Yield& y : t.update->yields) {
         if (y.kind == YieldKind::Kill) t.kills = true;
+        if (y.kind == YieldKind::Unstable) t.unstable = true;
         if (y.kind == YieldKind::EmitCount) t.counted[static_cast<size_t>(y.index)] = true;
         if (y.kind == YieldKind::EmitRate) t.rated[static_cast<size_t>(y.index)] = true;
     }
@@ -79,7 +80,8 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     }
     for (const TypeInfo& t : types)
         if (t.parentType >= 0) types[static_cast<size_t>(t.parentType)].read = true;
-    for (TypeInfo& t : types) t.killsLate = options.lateKills && t.kills && !t.rateEmits && !t.exports && !t.read;
+    for (TypeInfo& t : types)
+        t.late = options.lateKills && (t.kills || t.unstable) && !t.rateEmits && !t.exports && !t.read;
     // Spawn kernels read the emitter's own columns, whose buffers never change: their
     // tables are bound once (the parent values come with each launch).
     for (size_t t = 0; t < pools.size(); ++t) {

@@ -46,9 +46,11 @@ struct TypeInfo {
     std::vector<size_t> emitTarget;    // per emit site: the type it creates
     bool kills = false, rateEmits = false, bursts = false;
     bool read = false;                 // a type's objects read this type's live (its parent type)
-    // Its kills may be taken at the end of the step (LateKills): it only dies (no rate
-    // emits, no exports) and nothing reads it, so no one looks at its dead before then.
-    bool killsLate = false;
+    bool unstable = false;             // its update counts updates beyond the stability limit
+    // What its updates give back — kills, the unstable count — may be taken at the end of
+    // the step (LateKills): it emits nothing at a rate, has no exports and nothing reads
+    // it, so no one looks at its dead before then.
+    bool late = false;
     std::vector<bool> counted, rated;  // per emit site: whether the update yields its count, its rate
     std::array<bool, 4> drawn{};       // visible, position, colour, size: whether render yields it
 };
@@ -82,10 +84,10 @@ struct UniformCache {
     std::vector<Value> values;
 };
 
-// The kills of launches that answered late (RowsLaunch::late) or whose kills are taken
-// late: applied at the end of the step (State::settleLate), in their place among the
-// step's kills, so that rows are freed in the order they would have been at once. Only
-// for types whose dead nobody looks at before then (TypeInfo::killsLate): the room a
+// The kills (and unstable counts) of launches that answered late (RowsLaunch::late) or
+// whose kills are taken late: applied at the end of the step (State::settleLate), in
+// their place among the step's kills, so that rows are freed in the order they would have been at once. Only
+// for types whose dead nobody looks at before then (TypeInfo::late): the room a
 // creation sees counts a killed object as taken until the end of the step anyway.
 struct LateKills {
     size_t type = 0;

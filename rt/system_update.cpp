@@ -56,8 +56,9 @@ void killAndEmit(State& s, Creation& creation, size_t type, double dt, double t1
     }
 }
 
-// The kills of an update of objects that only die, listed per chunk (or ticketed, for a
-// late launch): now, or at the end of the step in their place (LateKills).
+// The kills of an update of objects that only die, listed per chunk, now; or, for late
+// launches, their kills (listed or ticketed) and unstable counts at the end of the step,
+// in their place (LateKills).
 void takeKills(State& s, size_t type, size_t chunks, bool late, double dt, double t1) {
     TypeWork& work = s.work[type];
     if (!late) {
@@ -127,9 +128,9 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1,
     // nobody looks at them before the end of the step (the last sub-step of a type whose
     // dead nobody reads), they are taken then (LateKills), and a device need not wait.
     bool listKills = info.kills && !info.rateEmits;
-    bool late = info.killsLate && last;
+    bool late = info.late && last;
     size_t chunks = s.chunkCount(rows);
-    if (listKills) work.killed.resize(chunks);
+    if (listKills || late) work.killed.resize(chunks);
     if (late) work.tickets.assign(chunks, 0);
     std::atomic<uint64_t> unstable = 0;
     auto chunk = [&](size_t c, size_t begin, size_t end) {
@@ -171,10 +172,9 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1,
         WallClock::time_point start;
         ~Timer() { stats.emitSeconds += seconds(start, WallClock::now()); }
     } timer{s.stats, loopsDone};
-    if (!info.kills && !info.rateEmits) return;
-    if (listKills)
+    if (late || listKills)
         takeKills(s, type, chunks, late, dt, t1);
-    else
+    else if (info.rateEmits)
         killAndEmit(s, creation, type, dt, t1, update.uniforms);
 }
 

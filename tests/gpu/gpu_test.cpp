@@ -337,7 +337,7 @@ TEST_CASE("the host waits for the GPU mid-step only for what the step decides by
     auto waitsPerStep = [](const std::string& sample, const char* knob, float value) {
         auto gpu = gpuBackend();
         rt::System system(test::compileModule(readFile(std::string(PSYS_SAMPLES_DIR) + "/" + sample + ".psys")), *gpu);
-        system.setExtern(knob, {&value, 1});
+        if (knob) REQUIRE_FALSE(system.setExtern(knob, {&value, 1}));
         for (int f = 0; f < 200; ++f) {  // past 3 s: the drops' pool has stopped growing
             REQUIRE_FALSE(system.step(1.0 / 60));
             for (size_t t = 0; t < system.module().objects.size(); ++t) system.draw(t);
@@ -375,6 +375,11 @@ TEST_CASE("the host waits for the GPU mid-step only for what the step decides by
     CHECK(fountain.draw == 0);
     CHECK(fireworks.step <= 20);
     CHECK(fireworks.draw == 0);
+    // An update whose only answer is its count of updates past the stability limit (the
+    // wind's `- vel`: a decay rate): a counter, taken at the step's end.
+    Waits wind = waitsPerStep("wind", nullptr, 0);
+    CHECK(wind.step == 0);
+    CHECK(wind.late == 20);
 }
 
 TEST_CASE("clearing rows of a column on the GPU zeroes them there, without a read-back") {
