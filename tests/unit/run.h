@@ -48,6 +48,23 @@ struct Run {
     rt::TypeStats stats(const std::string& name) const { return system->stats().types[type(name)]; }
 };
 
+// Every sample, the programs of tests/programs, and cells that emit their own type at
+// capacity (created after their type's update, some dying in their first update).
+inline std::vector<std::string> samplesAndPrograms() {
+    std::vector<std::string> all;
+    for (const char* dir : {PSYS_SAMPLES_DIR, PSYS_PROGRAMS_DIR})
+        for (auto& entry : std::filesystem::directory_iterator(dir))
+            if (entry.path().extension() == ".psys") all.push_back(test::readFile(entry.path().string()));
+    all.push_back(R"(
+        @capacity(300) object cell {
+            point(vec3(rand(), rand(), 0) * age, vec4(age, 1, 0, 1), 1 / (age - 0.25));
+            emit cell at 90 per second;
+            kill when age > 0.5 + rand();
+        }
+        spawn cell;)");
+    return all;
+}
+
 inline bool bitwise(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 // Runs two systems side by side for `frames` frames, firing every trigger once, and

@@ -1,0 +1,157 @@
+// What a step need not wait for, on every backend: kills taken at the end of the step
+// (LateKills) against kills taken at once, with a backend that answers late as a device
+// does; emission rates and counts every row shares, read from the host's values.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "interp/interpreter.h"
+#include "rt/system.h"
+#include "run.h"
+
+using namespace psys;
+
+namespace {
+
+// Answers every late launch (RowsLaunch::late) with a ticket, as a device would, and wipes
+// its kill flags: the run-time must take those kills from collect(), at the end of the step.
+struct LateBackend : rt::Backend {
+    interp::Interpreter inner;
+    std::map<uint64_t, std::pair<rt::RowsResult, std::vector<uint32_t>>> held;
+    std::vector<uint32_t> rows;
+    uint64_t next = 1;
+    size_t late = 0;
+    std::string name() const override { return "late"; }
+    rt::Memory& memory() override { return inner.memory(); }
+    rt::RowsResult run(const rt::RowsLaunch& l) override {
+        rt::RowsResult r = inner.run(l);
+        if (!l.late) return r;
+        std::vector<uint32_t> killed;
+        auto* flags = rt::hostData<uint8_t>(inner.memory(), l.columns[rt::ColumnLayout::kKill]);
+        for (size_t i = l.begin; i < l.end; ++i)
+            if (flags[i]) {
+                killed.push_back(static_cast<uint32_t>(i));
+                flags[i] = 0;
+            }
+        held[next] = {r, std::move(killed)};
+        ++late;
+        return {.ticket = next++};
+    }
+    void run(const rt::ChildrenLaunch& l) override { inner.run(l); }
+    rt::RowsResult collect(uint64_t ticket) override {
+        auto [result, killed] = held.at(ticket);
+        held.erase(ticket);
+        rows = std::move(killed);
+        result.killedRows = rows;
+        return result;
+    }
+};
+
+}  // namespace
+
+TEST_CASE("kills taken at the end of the step free the rows, in the order, that kills taken at once free") {
+    // Drops, sparks, cells dying in their first update, objects created by triggers: a
+    // backend answering late, the kills at the step's end, against the kills at once.
+    std::vector<std::string> programs = test::samplesAndPrograms();
+    programs.push_back(R"(
+        @step(0.01) object leaf { point(vec3(age, 0, 0), white, 1); kill when age > 0.01 + 0.05 * rand(); }
+        object root { emit leaf at 3000 per second; }
+        trigger boom { emit leaf count 50; }
+        spawn root;)");
+    size_t late = 0;
+    for (const std::string& text : programs) {
+        INFO(text.substr(0, 200));
+        interp::Interpreter immediateBackend;
+        LateBackend lateBackend;
+        rt::SystemOptions atOnce;
+        atOnce.lateKills = false;
+        rt::System a(test::compileModule(text), immediateBackend, atOnce), b(test::compileModule(text), lateBackend);
+        for (int f = 0; f < 200; ++f) {
+            if (f % 50 == 10)
+                for (const ir::Trigger& t : a.module().triggers) {
+                    size_t width = 0;
+                    for (auto& p : t.params) width += static_cast<size_t>(p.type.width);
+                    REQUIRE_FALSE(a.fire(t.name, std::vector<float>(width, 1.5f)));
+                    REQUIRE_FALSE(b.fire(t.name, std::vector<float>(width, 1.5f)));
+                }
+            REQUIRE_FALSE(a.step(1.0 / 60));
+            REQUIRE_FALSE(b.step(1.0 / 60));
+            REQUIRE(test::poolRows(a) == test::poolRows(b));
+            for (size_t t = 0; t < a.typeCount(); ++t) {
+                CHECK(a.stats().types[t].killed == b.stats().types[t].killed);
+                CHECK(a.stats().types[t].unstable == b.stats().types[t].unstable);
+            }
+        }
+        CHECK(lateBackend.held.empty());  // every ticket collected
+        late += lateBackend.late;
+    }
+    CHECK(late > 1000);
+}
+
+
+namespace {
+
+// Writes NaN over the emission columns of every update at a uniform clock, after it ran:
+// what the run-time reads of them then is NaN (an invalid emission).
+struct PoisonedEmissions : rt::Backend {
+    interp::Interpreter inner;
+    std::string name() const override { return "poisoned"; }
+    rt::Memory& memory() override { return inner.memory(); }
+    rt::RowsResult run(const rt::RowsLaunch& l) override {
+        rt::RowsResult r = inner.run(l);
+        if (l.kernel->kind != ir::KernelKind::Update || l.clock.perRow()) return r;
+        for (int c = l.layout->emits; c < l.layout->render; ++c)
+            if (rt::Buffer b = l.columns[static_cast<size_t>(c)]; b.valid())
+                std::fill(rt::hostData<float>(inner.memory(), b) + l.begin, rt::hostData<float>(inner.memory(), b) + l.end, NAN);
+        return r;
+    }
+    void run(const rt::ChildrenLaunch& l) override { inner.run(l); }
+};
+
+}  // namespace
+
+TEST_CASE("an emission rate or count every row shares is read from the host's values, not its column") {
+    const std::string shared = R"(
+        extern rate: float = 90;
+        object p { point(vec3(0), white, 1); kill when age > 0.5; }
+        object e { emit p at rate / 3 per second count 2; }
+        spawn e; spawn e; spawn e;)";
+    ir::Module module = test::compileModule(shared);
+    const ir::Object& e = module.objects.at(static_cast<size_t>(module.objectIndex("e")));
+    rt::ColumnLayout layout = rt::columnLayout(e, *e.kernel(ir::KernelKind::Update));
+    using From = rt::ColumnLayout::Shared::From;
+    REQUIRE(layout.emitShared.size() == 2);
+    CHECK(layout.emitShared[0].from == From::Uniform);  // rate / 3: a value of the uniform kernel
+    CHECK(layout.emitShared[1].from == From::Constant);
+    CHECK(layout.emitShared[1].value == 2);
+    CHECK(e.kernel(ir::KernelKind::Update)->findOne(ir::YieldKind::Kill) == nullptr);  // it never dies
+    // The run-time takes them from there: poisoned columns change nothing…
+    auto created = [](const std::string& text, rt::Backend& backend) {
+        rt::System system(test::compileModule(text), backend);
+        for (int f = 0; f < 60; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
+        return std::pair{system.stats().types.at(0).created, system.stats().invalidEmissions};
+    };
+    interp::Interpreter plain;
+    PoisonedEmissions poisoned;
+    CHECK(created(shared, poisoned) == created(shared, plain));
+    CHECK(created(shared, plain).first == 3 * 2 * 30);
+    // An extern as it is (`at rate per second`): the run-time reads the extern.
+    std::string asExtern = shared;
+    asExtern.replace(asExtern.find("rate / 3"), 8, "rate");
+    ir::Module externModule = test::compileModule(asExtern);
+    const ir::Object& e2 = externModule.objects.at(static_cast<size_t>(externModule.objectIndex("e")));
+    CHECK(rt::columnLayout(e2, *e2.kernel(ir::KernelKind::Update)).emitShared[0].from == From::Extern);
+    CHECK(created(asExtern, poisoned) == created(asExtern, plain));
+    CHECK(created(asExtern, plain).first == 3 * 2 * 90);
+    // …while a rate each row has its own is read from its column (so the poison shows).
+    std::string ownRate = R"(
+        extern rate: float = 90;
+        object p { point(vec3(0), white, 1); kill when age > 0.5; }
+        object e { emit p at rate / 3 + rand() per second count 2; }
+        spawn e; spawn e; spawn e;)";
+    CHECK(created(ownRate, poisoned).second > 0);
+}
