@@ -64,26 +64,6 @@ struct DrawnInStep {
     uint64_t nonFinite = 0;
 };
 
-// Per type: the scratch buffers and column tables of its launches over the pool.
-struct TypeWork {
-    explicit TypeWork(Memory& memory) : update(memory), exports(memory), masks(memory), render(memory) {}
-    Scratch update, exports, masks, render;
-    std::vector<Buffer> updateTable, exportsTable, renderTable;
-    DrawnInStep inStep;
-    std::vector<std::vector<uint32_t>> killed;  // per chunk: the rows that died, in order
-    std::vector<uint64_t> tickets;              // per chunk: a late launch's ticket, or 0
-    std::vector<std::vector<Buffer>> spawnTables;  // per emit site: the pool's columns for its spawn kernel
-};
-
-// Per type and served kernel (update, render, exports): the uniform values and the
-// (dt, time, externs) they were computed for.
-struct UniformCache {
-    bool valid = false;
-    float dt = 0, time = 0;
-    uint64_t externs = 0;
-    std::vector<Value> values;
-};
-
 // The kills (and unstable counts) of launches that answered late (RowsLaunch::late) or
 // whose kills are taken late: applied at the end of the step (State::settleLate), in
 // their place among the step's kills, so that rows are freed in the order they would have been at once. Only
@@ -103,6 +83,25 @@ struct LateKills {
     size_t first = 0;
     std::vector<uint32_t> poolRows;
     std::vector<double> spans;
+};
+
+// Per type: the scratch buffers and column tables of its launches over the pool.
+struct TypeWork {
+    explicit TypeWork(Memory& memory) : update(memory), exports(memory), masks(memory), render(memory) {}
+    Scratch update, exports, masks, render;
+    std::vector<Buffer> updateTable, exportsTable, renderTable;
+    DrawnInStep inStep;
+    std::vector<LateKills::Part> killed;  // per chunk: the rows that died, in order (or a late launch's ticket)
+    std::vector<std::vector<Buffer>> spawnTables;  // per emit site: the pool's columns for its spawn kernel
+};
+
+// Per type and served kernel (update, render, exports): the uniform values and the
+// (dt, time, externs) they were computed for.
+struct UniformCache {
+    bool valid = false;
+    float dt = 0, time = 0;
+    uint64_t externs = 0;
+    std::vector<Value> values;
 };
 
 struct State {

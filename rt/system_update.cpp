@@ -63,7 +63,7 @@ void takeKills(State& s, size_t type, size_t chunks, bool late, double dt, doubl
     TypeWork& work = s.work[type];
     if (!late) {
         for (size_t c = 0; c < chunks; ++c)
-            for (uint32_t row : work.killed[c]) s.kill(type, row, t1 - dt);
+            for (uint32_t row : work.killed[c].rows) s.kill(type, row, t1 - dt);
         return;
     }
     LateKills& l = s.late.emplace_back();
@@ -71,7 +71,7 @@ void takeKills(State& s, size_t type, size_t chunks, bool late, double dt, doubl
     l.at = s.dying.size();
     l.t1 = t1;
     l.dt = dt;
-    for (size_t c = 0; c < chunks; ++c) l.parts.push_back({work.tickets[c], std::move(work.killed[c])});
+    for (size_t c = 0; c < chunks; ++c) l.parts.push_back(std::move(work.killed[c]));
 }
 
 // The update launch over `type`'s pool (its table bound) for (t1 − dt, t1], rows to be chosen.
@@ -130,8 +130,7 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1,
     bool listKills = info.kills && !info.rateEmits;
     bool late = info.late && last;
     size_t chunks = s.chunkCount(rows);
-    if (listKills || late) work.killed.resize(chunks);
-    if (late) work.tickets.assign(chunks, 0);
+    if (listKills || late) work.killed.resize(chunks);  // each chunk sets its own (State::latePart)
     std::atomic<uint64_t> unstable = 0;
     auto chunk = [&](size_t c, size_t begin, size_t end) {
         RowsLaunch part = update;
@@ -140,16 +139,8 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1,
         part.late = late;
         s.gatherParents(type, info.updateLayout, work.updateTable, updatable, part.begin, part.end, t1);
         RowsResult result = s.backend.run(part);
-        size_t killed = result.killed;
         if (result.unstable) unstable += result.unstable;
-        if (result.ticket) {
-            work.tickets[c] = result.ticket;
-            work.killed[c].clear();
-        } else if (listKills) {
-            if (killed == 0) work.killed[c].clear();
-            else if (result.killedRows.size() == killed) work.killed[c].assign(result.killedRows.begin(), result.killedRows.end());
-            else listKilled(kill, part.begin, part.end, work.killed[c]);
-        }
+        if (listKills || late) s.latePart(work.killed[c], result, work.updateTable[ColumnLayout::kKill], begin, end);
         if (info.exports) {
             auto* survivors = s.host<uint8_t>(exportMask);
             maskRows(survivors, updatable, info.kills ? kill : nullptr, nullptr, part.begin, part.end);
