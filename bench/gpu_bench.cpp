@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "gpu_figures.h"
+#include "interp/interpreter.h"
 
 using namespace psys;
 
@@ -32,6 +33,7 @@ int main(int argc, char** argv) {
         std::cerr << "psys_gpu_bench: " << error << "\n";
         return 1;
     }
+    gpu->setHostSide(std::make_unique<interp::Interpreter>(gpu->memory()));  // the emitters (few rows) on the host
     std::string renderer = gpu->report().target;
     std::cout << fmt::format("# psys_gpu_bench on {}, {} timed steps per figure (median)\n", renderer, frames);
     if (renderer.find("llvmpipe") != std::string::npos)

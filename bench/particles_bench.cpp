@@ -322,6 +322,7 @@ int main(int argc, char** argv) {
             std::cerr << "psys_bench: --gpu: " << error << "\n";
             return 1;
         }
+        gpu->setHostSide(std::make_unique<interp::Interpreter>(gpu->memory()));
         std::cout << fmt::format("The GLSL backend on {} beside the JIT on {} cores (psys_gpu_bench has the passes):\n\n",
                                  gpu->report().target, cores)
                   << "| effect | live | JIT (M/s) | GLSL (M/s) | GLSL / JIT | GLSL update pass (ms) |\n|---|---:|---:|---:|---:|---:|\n";

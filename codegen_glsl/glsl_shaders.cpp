@@ -281,6 +281,8 @@ std::vector<int> directColumns(const Kernel& kernel, const ColumnLayout& l) {
             for (int c = 0; c < i.type.width; ++c) add(l.paramOffset[static_cast<size_t>(i.attr)] + c);
         if (i.op == Op::ObjectId) add(ColumnLayout::kIds);
     }
+    for (const auto& p : l.parentColumns)  // gathered on the GPU (Memory::gather)
+        for (int c = 0; c < p.width; ++c) add(p.offset + c);
     if (direct.size() > kDirectSlots + kTextureSlots) direct.resize(kDirectSlots + kTextureSlots);
     return direct;
 }

@@ -61,10 +61,10 @@ std::vector<int> keptColumns(const ir::Kernel& kernel, const rt::ColumnLayout& l
 // The columns a rows shader reads and writes in place, each in its own GL buffer bound
 // to storage block 2 + k, rather than copied into the launch's words and back: the kept
 // columns, then the state it reads, the creation times, the mask (column `layout.total`),
-// the parameters it reads and the ids: the first kDirectSlots in storage blocks (what it
-// writes among them), the next kTextureSlots, read only, through buffer textures (unit
-// k − kDirectSlots). (Every table has a buffer for each of them: a parameter a kernel
-// reads is kept.) The launch
+// the parameters it reads, the ids and the parents' values (gathered on the GPU): the
+// first kDirectSlots in storage blocks (what it writes among them), the next
+// kTextureSlots, read only, through buffer textures (unit k − kDirectSlots). (Every
+// table has a buffer for each of them: a parameter a kernel reads is kept.) The launch
 // block's column word for one is the word its row `begin` sits at in the bound range.
 std::vector<int> directColumns(const ir::Kernel& kernel, const rt::ColumnLayout& layout);
 constexpr uint32_t kMaxGroupsX = 65535;

@@ -45,17 +45,29 @@ struct GlMemory::Column {
 
 namespace {
 
-// to[rows[i]] = from[first + i], a row of `w` words at a time (kSkipRow: nothing).
-const char* kScatter = R"(#version 450
+// A scatter's or a gather's blocks and uniforms (GlMemory::runRows binds them); `main`
+// follows, invocation i moving a row of `w` words.
+const char* kRowsHeader = R"(#version 450
 layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer From { uint from[]; };
 layout(std430, binding = 1) buffer To { uint to[]; };
 layout(std430, binding = 2) readonly buffer Rows { uint rows[]; };
 uniform uint count, first, w;
-void main() {
+)";
+
+// to[rows[i]] = from[first + i] (kSkipRow: nothing).
+const char* kScatter = R"(void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= count || rows[i] == 0xFFFFFFFFu) return;
     for (uint k = 0u; k < w; ++k) to[rows[i] * w + k] = from[(first + i) * w + k];
+}
+)";
+
+// to[first + i] = from[rows[i]], or 0 for kSkipRow.
+const char* kGather = R"(void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= count) return;
+    for (uint k = 0u; k < w; ++k) to[(first + i) * w + k] = rows[i] == 0xFFFFFFFFu ? 0u : from[rows[i] * w + k];
 }
 )";
 
@@ -67,6 +79,7 @@ GlMemory::~GlMemory() {
     for (auto& c : columns_)
         if (c && c->gl) glDeleteBuffers(1, &c->gl);
     if (scatterProgram_) glDeleteProgram(scatterProgram_);
+    if (gatherProgram_) glDeleteProgram(gatherProgram_);
     if (rowsBuffer_) glDeleteBuffers(1, &rowsBuffer_);
 }
 
@@ -213,34 +226,75 @@ void GlMemory::copy(Buffer from, size_t fromFirst, Buffer to, size_t toFirst, si
     t.device = true;
 }
 
-// On the GPU, always: scatters fill pools' columns with what creation computed (state,
-// exports, parameters), which then stay on the GPU.
+// On the GPU, but for small columns that are on the host with their source (hostRows):
+// scatters fill pools' columns with what creation computed (state, exports, parameters),
+// which then stay on the GPU.
 void GlMemory::scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const uint32_t> rows) {
     Column &f = at(from), &t = at(to);
     if (rows.empty()) return;
+    if (!f.device && !t.device && t.rows <= hostRows) {
+        size_t n = rt::elemSize(f.elem);
+        for (size_t i = 0; i < rows.size(); ++i)
+            if (rows[i] != rt::kSkipRow)
+                std::memcpy(t.hostCopy.data() + rows[i] * n, f.hostCopy.data() + (fromFirst + i) * n, n);
+        return;
+    }
     uploadRows(f, fromFirst, rows.size());  // only the rows scattered: the source stays on the host
     upload(t);
-    if (!scatterProgram_) {
-        scatterProgram_ = computeProgram(kScatter, "scatter");
-        glCreateBuffers(1, &rowsBuffer_);
+    if (!scatterProgram_) scatterProgram_ = computeProgram(std::string(kRowsHeader) + kScatter, "scatter");
+    runRows(scatterProgram_, f, t, fromFirst, rows);
+    t.device = true;
+}
+
+// On the GPU where the source is (a parent's exports, written there by its kernel), so
+// that children read their parents without the host waiting for them.
+void GlMemory::gather(Buffer from, Buffer to, size_t toFirst, std::span<const uint32_t> rows) {
+    Column &f = at(from), &t = at(to);
+    if (rows.empty()) return;
+    if (!f.device && !t.device) {
+        size_t n = rt::elemSize(f.elem);
+        for (size_t i = 0; i < rows.size(); ++i) {
+            uint8_t* out = t.hostCopy.data() + (toFirst + i) * n;
+            if (rows[i] == rt::kSkipRow)
+                std::memset(out, 0, n);
+            else
+                std::memcpy(out, f.hostCopy.data() + rows[i] * n, n);
+        }
+        return;
     }
-    // A batch scatters every column of its objects to the same rows: the list goes up once.
+    upload(f);
+    upload(t);
+    if (!gatherProgram_) gatherProgram_ = computeProgram(std::string(kRowsHeader) + kGather, "gather");
+    runRows(gatherProgram_, f, t, toFirst, rows);
+    t.device = true;
+}
+
+unsigned GlMemory::rowList(std::span<const uint32_t> rows) {
+    if (!rowsBuffer_) glCreateBuffers(1, &rowsBuffer_);
     if (!std::equal(rows.begin(), rows.end(), rowsSent_.begin(), rowsSent_.end())) {
-        glNamedBufferData(rowsBuffer_, static_cast<GLsizeiptr>(rows.size() * 4), rows.data(), GL_STREAM_DRAW);
+        glNamedBufferData(rowsBuffer_, static_cast<GLsizeiptr>(std::max<size_t>(rows.size(), 1) * 4),
+                          rows.empty() ? nullptr : rows.data(),
+                          GL_STREAM_DRAW);
         transferred += rows.size() * 4;
         rowsSent_.assign(rows.begin(), rows.end());
     }
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.gl);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, t.gl);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, rowsBuffer_);
-    glUseProgram(scatterProgram_);
-    glProgramUniform1ui(scatterProgram_, glGetUniformLocation(scatterProgram_, "count"), static_cast<GLuint>(rows.size()));
-    glProgramUniform1ui(scatterProgram_, glGetUniformLocation(scatterProgram_, "first"), static_cast<GLuint>(fromFirst));
-    glProgramUniform1ui(scatterProgram_, glGetUniformLocation(scatterProgram_, "w"),
-                        static_cast<GLuint>(wordsPerRow(f.elem)));
+    return rowsBuffer_;
+}
+
+// A scatter or gather over a list of rows; the list goes up once for every column of a
+// batch or a parent that uses it.
+void GlMemory::runRows(unsigned program, const Column& from, const Column& to, size_t first,
+                       std::span<const uint32_t> rows) {
+    unsigned list = rowList(rows);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, from.gl);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, to.gl);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, list);
+    glUseProgram(program);
+    glProgramUniform1ui(program, glGetUniformLocation(program, "count"), static_cast<GLuint>(rows.size()));
+    glProgramUniform1ui(program, glGetUniformLocation(program, "first"), static_cast<GLuint>(first));
+    glProgramUniform1ui(program, glGetUniformLocation(program, "w"), static_cast<GLuint>(wordsPerRow(from.elem)));
     glDispatchCompute(static_cast<GLuint>((rows.size() + 63) / 64), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    t.device = true;
 }
 
 void GlMemory::clear(Buffer b, size_t first, size_t count) {

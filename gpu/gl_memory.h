@@ -31,6 +31,7 @@ public:
     void write(rt::Buffer buffer, size_t first, size_t count, const void* in) override;
     void copy(rt::Buffer from, size_t fromFirst, rt::Buffer to, size_t toFirst, size_t count) override;
     void scatter(rt::Buffer from, size_t fromFirst, rt::Buffer to, std::span<const uint32_t> rows) override;
+    void gather(rt::Buffer from, rt::Buffer to, size_t toFirst, std::span<const uint32_t> rows) override;
     void clear(rt::Buffer buffer, size_t first, size_t count) override;
     void* host(rt::Buffer buffer) override;
     const void* view(rt::Buffer buffer) const override;
@@ -46,6 +47,9 @@ public:
     // The GPU wrote rows of the column in its own GL buffer (bound in place): its value is
     // on the GPU from now on.
     void written(rt::Buffer buffer);
+    // A GL buffer holding `rows` (sent once for every scatter, gather and launch that uses
+    // the same list in a row: a creation batch's rows).
+    unsigned rowList(std::span<const uint32_t> rows);
     // Bytes of GL buffers held.
     size_t deviceBytes() const;
     // Bytes moved between the host and the GPU so far, either way (the backend adds its
@@ -58,6 +62,10 @@ public:
     // Bytes launches copied on the GPU between columns and the launch's words, either way
     // (columns not bound in place: GlslBackend, adopt): memory traffic beyond the shader's.
     uint64_t staged = 0;
+    // A scatter between columns on the host into a column of at most this many rows runs
+    // on the host, and the column stays there (a small pool whose launches run on the
+    // host: GlslBackend::setHostSide); 0: every scatter runs on the GPU.
+    size_t hostRows = 0;
 
     static size_t wordsPerRow(rt::Elem e) { return e == rt::Elem::F64 ? 2 : 1; }
 
@@ -71,7 +79,8 @@ private:
     void uploadRows(Column& c, size_t first, size_t count) const;
     std::vector<std::unique_ptr<Column>> columns_;
     std::vector<uint32_t> free_;
-    unsigned scatterProgram_ = 0, rowsBuffer_ = 0;
+    void runRows(unsigned program, const Column& from, const Column& to, size_t first, std::span<const uint32_t> rows);
+    unsigned scatterProgram_ = 0, gatherProgram_ = 0, rowsBuffer_ = 0;
     std::vector<uint32_t> rowsSent_;  // what rowsBuffer_ holds
 };
 

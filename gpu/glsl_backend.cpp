@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstring>
 #include <stdexcept>
+#include <thread>
 
 #include <epoxy/gl.h>
 #include <fmt/format.h>
@@ -102,6 +103,7 @@ const ir::Kernel* uniformKernelOf(const ir::Object& object, const ir::Kernel& ke
 
 std::unique_ptr<GlslBackend> GlslBackend::create(std::string& error) {
     std::unique_ptr<GlslBackend> b(new GlslBackend);
+    b->owner_ = std::this_thread::get_id();
     if (!contextCurrent()) {
         b->context_ = HeadlessContext::open(error);
         if (!b->context_) return nullptr;
@@ -148,6 +150,7 @@ GlslBackend::~GlslBackend() {
     if (context_) context_->makeCurrent();
     for (auto& [key, p] : rows_) glDeleteProgram(p->program);
     for (auto& [key, p] : children_) glDeleteProgram(p->program);
+    if (clearKilled_) glDeleteProgram(clearKilled_);
     for (auto& [ticket, late] : late_) settle(*late);  // its fence deleted
     if (readback_) glUnmapNamedBuffer(readback_);
     glDeleteTextures(static_cast<GLsizei>(textures_.size()), textures_.data());
@@ -203,7 +206,12 @@ GlslBackend::Program& GlslBackend::childrenProgram(const ir::Object& object, con
     return *slot;
 }
 
+// On the thread that has the GL context only: a host that prepares off its frame loop
+// (the viewer's reloader) gets nothing done there — GL calls on a thread without the
+// context abort, and making it current there would take it from the frame loop — and the
+// programs compile when the System is made, on the frame loop's thread.
 void GlslBackend::prepare(const rt::Plan& plan) {
+    if (std::this_thread::get_id() != owner_) return;
     if (context_) context_->makeCurrent();
     for (const auto& r : plan.rows) rowsProgram(*r.object, *r.kernel, r.now, r.dt);
     for (const auto& c : plan.children) childrenProgram(*c.object, *c.spawn);
@@ -272,7 +280,23 @@ void GlslBackend::dispatch(Program& program, const std::vector<uint32_t>& block,
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT);
 }
 
+void GlslBackend::setHostSide(std::unique_ptr<rt::Backend> host, size_t rows) {
+    hostSide_ = std::move(host);
+    hostRows_ = hostSide_ ? rows : 0;
+    memory_.hostRows = hostRows_;
+}
+
+bool GlslBackend::onHost(std::span<const Buffer> columns, Buffer mask, size_t rows) const {
+    if (!hostSide_ || rows > hostRows_) return false;
+    auto there = [&](Buffer b) { return !b.valid() || !memory_.onDevice(b); };
+    return there(mask) && std::all_of(columns.begin(), columns.end(), there);
+}
+
 rt::RowsResult GlslBackend::run(const rt::RowsLaunch& launch) {
+    if (!launch.late && launch.kernel->kind != ir::KernelKind::Render && onHost(launch.columns, launch.mask, launch.end)) {
+        ++hostLaunches_;
+        return hostSide_->run(launch);
+    }
     if (context_) context_->makeCurrent();
     Program& p = rowsProgram(*launch.object, *launch.kernel, launch.clock.now, launch.clock.dt);
     // Rows per dispatch: as many as the largest storage block the GL binds holds, for the
@@ -393,6 +417,8 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
     if (launch.uniforms)
         for (uint32_t u = 0; u < p.block.uniformCount; ++u) putValue(block, p.block.uniforms + 4 * u, launch.uniforms[u]);
     dispatch(p, block, n, p.pass);
+    if (kills && killBuffer.valid() && launch.aliveMask.valid())  // the run-time may take them at the next step
+        clearKilled(launch, begin, n, block[LaunchBlock::kColumns + ColumnLayout::kKill]);
     for (int c : p.resident) {
         Buffer b = launch.columns[static_cast<size_t>(c)];
         if (!b.valid()) continue;
@@ -406,6 +432,11 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
 
 void GlslBackend::run(const rt::ChildrenLaunch& launch) {
     if (launch.count == 0) return;
+    if (onHost(launch.columns, Buffer{}, launch.count) && onHost(launch.args, Buffer{}, launch.count)) {
+        ++hostLaunches_;
+        hostSide_->run(launch);
+        return;
+    }
     if (context_) context_->makeCurrent();
     Program& p = childrenProgram(*launch.object, *launch.spawn);
     const ir::Object& o = *launch.object;
@@ -459,6 +490,7 @@ rt::BackendReport GlslBackend::report() const {
     r.stagedBytes = memory_.staged;
     r.lateReads = lateReads_;
     r.lateStalls = lateStalls_;
+    r.hostLaunches = hostLaunches_;
     return r;
 }
 

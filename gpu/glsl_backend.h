@@ -5,10 +5,11 @@
 // Where the columns live (gpu/gl_memory.h): an object's state and exports stay on the GPU
 // from step to step, and shaders read and write them in place (storage blocks, buffer
 // textures); the run-time's bookkeeping (kills, emissions, creation, parents) runs on
-// the host, so a launch takes the rows of the masks that changed from the host and gives
+// the host, and so do the launches of the few rows of emitters (setHostSide), so a launch takes the rows of the masks that changed from the host and gives
 // back, in one wait, its counts, the rows killed (compacted on the GPU: gpu/compact.h)
 // and its emissions (docs/gpu.md) — or, for a late launch (rt::RowsLaunch::late), no wait:
-// its counts and kills are taken when the run-time collects them at the end of the step.
+// its counts and kills are taken when the run-time collects them (at the next step: its
+// kills have cleared their rows in the alive mask the draws read, clearKilled).
 #pragma once
 
 #include <limits>
@@ -16,6 +17,7 @@
 #include <span>
 #include <memory>
 #include <string>
+#include <thread>
 #include <tuple>
 #include <vector>
 
@@ -40,6 +42,8 @@ public:
     rt::RowsResult run(const rt::RowsLaunch& launch) override;
     void run(const rt::ChildrenLaunch& launch) override;
     rt::RowsResult collect(uint64_t ticket) override;
+    bool ready(uint64_t ticket) override;
+    bool clearsKilled() const override { return true; }
     rt::BackendReport report() const override;
     bool marksDrawn() const override { return true; }
     bool rendersInStep() const override { return false; }
@@ -74,6 +78,19 @@ public:
     // had to grow (while the pools grow; none once it has).
     uint64_t lateEarly() const { return lateEarly_; }
 
+    // A backend that runs launches on the host over this backend's memory (an interpreter:
+    // host/backends.cpp makes it), and the rows up to which a launch runs there: a launch
+    // the step would wait for (not late, not a draw) over at most `rows` rows, or a spawn
+    // of at most `rows` children, whose columns are all on the host. The few objects that
+    // emit — a launcher, a comet, rockets — then stay on the host, as emitters do in the
+    // big engines, and the step need not wait for the GPU to learn what they kill and emit;
+    // their many particles run on the GPU. Data decides: a pool whose columns are on the
+    // GPU stays there (GlMemory::hostRows: scatters into small pools on the host stay there).
+    void setHostSide(std::unique_ptr<rt::Backend> host, size_t rows = kHostRows);
+    static constexpr size_t kHostRows = 64;
+    // Launches run by the host side so far.
+    uint64_t hostLaunches() const { return hostLaunches_; }
+
 private:
     GlslBackend() = default;
     struct Program;
@@ -106,14 +123,19 @@ private:
     const uint32_t* awaitReadback();  // a fence, one wait: the read-back buffer as the GPU left it
     uint64_t finishLate(std::unique_ptr<Late> late);  // its fence; its ticket
     void settle(Late& late);          // waits for it if it must, and reads its counts and kills
+    // A late launch's kills cleared in its aliveMask on the GPU (rt::Backend::clearsKilled),
+    // from the kill flags at word `flags` of the launch's words.
+    void clearKilled(const rt::RowsLaunch& launch, size_t begin, size_t n, uint32_t flags);
     void ensureWords(size_t words);
+    bool onHost(std::span<const rt::Buffer> columns, rt::Buffer mask, size_t rows) const;
 
     std::unique_ptr<HeadlessContext> context_;
+    std::thread::id owner_;  // the thread whose GL context the backend uses
     GlMemory memory_;
     Compactor compactor_;
     std::map<RowsKey, std::unique_ptr<Program>> rows_;
     std::map<const ir::Kernel*, std::unique_ptr<Program>> children_;
-    unsigned words_ = 0, counts_ = 0, block_ = 0, query_ = 0, readback_ = 0;
+    unsigned words_ = 0, counts_ = 0, block_ = 0, query_ = 0, readback_ = 0, clearKilled_ = 0;
     const uint32_t* mappedReadback_ = nullptr;
     size_t readbackWords_ = 0;
     size_t wordsCapacity_ = 0;
@@ -127,6 +149,9 @@ private:
     std::map<uint64_t, std::unique_ptr<Late>> late_;
     uint64_t nextTicket_ = 1, lateReads_ = 0, lateStalls_ = 0, lateEarly_ = 0;
     std::vector<uint32_t> killedRows_;  // the last launch's or collect's (RowsResult::killedRows)
+    std::unique_ptr<rt::Backend> hostSide_;
+    size_t hostRows_ = 0;
+    uint64_t hostLaunches_ = 0;
     size_t kernels_ = 0;
     double compileSeconds_ = 0;
     std::string renderer_;

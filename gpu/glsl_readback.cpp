@@ -3,7 +3,7 @@
 // has mapped (coherent: what the GPU wrote before a fence is there once the fence is
 // passed). The host reads the region after a fence: at once (one wait), or — a late
 // launch (rt::RowsLaunch::late), which sends back only counts and kills — when the
-// run-time collects it at the end of the step, by which time the GPU has usually finished
+// run-time collects it (at the next step's start), by which time the GPU has usually finished
 // it and the host does not wait at all.
 //
 // Regions: an immediate read-back uses the words after those late launches hold; late
@@ -29,6 +29,21 @@ using rt::Elem;
 namespace {
 
 constexpr size_t kKillsAt = 4;  // in a region: counts at words 0–3, the kills' total and rows from word 4
+
+// mask[row of launch row i] = 0 where the kill flag words[flags + i] is set; the row is
+// rows[offset + i] where `mapped` (a creation batch's), else base + i.
+const char* kClearKilled = R"(#version 450
+layout(local_size_x = 64) in;
+layout(std430, binding = 0) readonly buffer Words { uint words[]; };
+layout(std430, binding = 1) buffer Mask { uint mask[]; };
+layout(std430, binding = 2) readonly buffer Rows { uint rows[]; };
+uniform uint count, flags, base, offset, mapped;
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= count || words[flags + i] == 0u) return;
+    mask[mapped != 0u ? rows[offset + i] : base + i] = 0u;
+}
+)";
 
 // Waits for `fence` (flushing what is queued), then deletes it.
 void waitFor(GLsync fence) {
@@ -175,6 +190,37 @@ void GlslBackend::settle(Late& late) {
         for (uint32_t k = 0; k < killed; ++k)
             late.rows.push_back(static_cast<uint32_t>(part.begin) + back[kKillsAt + 1 + k]);
     }
+}
+
+// What is drawn before the run-time takes these kills (at the next step) must leave them
+// out: the render launches read the alive mask on the GPU, so the kills clear it there.
+// The host clears the same rows when it takes the kills (and sends them again: the same 0).
+void GlslBackend::clearKilled(const rt::RowsLaunch& launch, size_t begin, size_t n, uint32_t flags) {
+    if (!clearKilled_) clearKilled_ = computeProgram(kClearKilled, "clearing killed rows");
+    bool mapped = !launch.aliveRows.empty();
+    unsigned rows = mapped ? memory_.rowList(launch.aliveRows) : words_;
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, words_);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, memory_.deviceBuffer(launch.aliveMask));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, rows);
+    glUseProgram(clearKilled_);
+    auto set = [&](const char* name, size_t value) {
+        glProgramUniform1ui(clearKilled_, glGetUniformLocation(clearKilled_, name), static_cast<GLuint>(value));
+    };
+    set("count", n);
+    set("flags", flags);
+    set("base", begin);
+    set("offset", mapped ? begin - launch.aliveRowsFirst : 0);
+    set("mapped", mapped);
+    glDispatchCompute(static_cast<GLuint>((n + 63) / 64), 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    memory_.written(launch.aliveMask);
+}
+
+bool GlslBackend::ready(uint64_t ticket) {
+    auto it = late_.find(ticket);
+    if (it == late_.end() || it->second->settled) return true;
+    if (context_) context_->makeCurrent();
+    return glClientWaitSync(it->second->fence, 0, 0) != GL_TIMEOUT_EXPIRED;
 }
 
 rt::RowsResult GlslBackend::collect(uint64_t ticket) {

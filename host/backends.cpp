@@ -19,8 +19,9 @@ Parsed<std::shared_ptr<rt::Backend>> makeBackend(const BackendChoice& choice) {
     if (choice.name == "interp") return {std::make_shared<interp::Interpreter>(), {}};
     if (choice.name == "glsl") {
         std::string error;
-        std::shared_ptr<rt::Backend> gpu = gpu::GlslBackend::create(error);
+        std::shared_ptr<gpu::GlslBackend> gpu = gpu::GlslBackend::create(error);
         if (!gpu) return Result::fail("the glsl backend cannot start: " + error);
+        gpu->setHostSide(std::make_unique<interp::Interpreter>(gpu->memory()));
         return {gpu, {}};
     }
     std::string names;

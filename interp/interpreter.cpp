@@ -51,21 +51,21 @@ rt::RowsResult Interpreter::run(const rt::RowsLaunch& launch) {
     const Object& o = *launch.object;
     const Kernel& kernel = *launch.kernel;
     const ColumnLayout& l = *launch.layout;
-    Columns columns(memory_, launch.columns);
-    const auto* created = rt::hostData<double>(memory_, launch.columns[ColumnLayout::kCreated]);
-    const auto* ids = rt::hostData<uint32_t>(memory_, launch.columns[ColumnLayout::kIds]);
-    const auto* mask = rt::hostData<uint8_t>(memory_, launch.mask);
+    Columns columns(*memory_, launch.columns);
+    const auto* created = rt::hostData<double>(*memory_, launch.columns[ColumnLayout::kCreated]);
+    const auto* ids = rt::hostData<uint32_t>(*memory_, launch.columns[ColumnLayout::kIds]);
+    const auto* mask = rt::hostData<uint8_t>(*memory_, launch.mask);
     const rt::Clock& clock = launch.clock;
     const double* nows = clock.now == rt::Clock::Source::PerRow
-                             ? rt::hostData<double>(memory_, launch.columns[ColumnLayout::kNow])
+                             ? rt::hostData<double>(*memory_, launch.columns[ColumnLayout::kNow])
                              : nullptr;
     const float* dts = clock.dt == rt::Clock::Source::PerRow
-                           ? rt::hostData<float>(memory_, launch.columns[ColumnLayout::kDt])
+                           ? rt::hostData<float>(*memory_, launch.columns[ColumnLayout::kDt])
                            : nullptr;
     // The kill column is written only by kernels that can kill.
     uint8_t* kill = nullptr;
     for (const Yield& y : kernel.yields)
-        if (y.kind == YieldKind::Kill) kill = rt::hostData<uint8_t>(memory_, launch.columns[ColumnLayout::kKill]);
+        if (y.kind == YieldKind::Kill) kill = rt::hostData<uint8_t>(*memory_, launch.columns[ColumnLayout::kKill]);
     rt::RowsResult result;
     for (size_t row = launch.begin; row < launch.end; ++row) {
         if (kill) kill[row] = 0;
@@ -135,10 +135,10 @@ rt::RowsResult Interpreter::run(const rt::RowsLaunch& launch) {
 // component of each parameter, in parameter order.
 void Interpreter::run(const rt::ChildrenLaunch& launch) {
     const Kernel& spawn = *launch.spawn;
-    Columns columns(memory_, launch.columns);
+    Columns columns(*memory_, launch.columns);
     columns.inputs(*launch.object, *launch.layout, launch.row, params_, state_);
-    const auto* created = rt::hostData<double>(memory_, launch.columns[ColumnLayout::kCreated]);
-    const auto* ids = rt::hostData<uint32_t>(memory_, launch.columns[ColumnLayout::kIds]);
+    const auto* created = rt::hostData<double>(*memory_, launch.columns[ColumnLayout::kCreated]);
+    const auto* ids = rt::hostData<uint32_t>(*memory_, launch.columns[ColumnLayout::kIds]);
     const std::vector<size_t> firstColumn = rt::argumentColumns(spawn).first;
     KernelInputs in;
     in.params = params_.data();
@@ -160,7 +160,7 @@ void Interpreter::run(const rt::ChildrenLaunch& launch) {
             if (y.kind != YieldKind::EmitArg) continue;
             size_t column = firstColumn[static_cast<size_t>(y.sub)];
             for (int c = 0; c < spawn.at(y.value).type.width; ++c)
-                rt::hostData<float>(memory_, launch.args[column + static_cast<size_t>(c)])[launch.argsFirst + k] =
+                rt::hostData<float>(*memory_, launch.args[column + static_cast<size_t>(c)])[launch.argsFirst + k] =
                     yields_[i].f[static_cast<size_t>(c)];
         }
     }

@@ -41,9 +41,16 @@ struct RowsLaunch {
     uint32_t seed = 0;
     uint32_t draw = 0;                      // draw.index #0 (the step, or kCreationDraw)
     // The run-time takes this launch's counts and kills later, by Backend::collect (at the
-    // end of the step): a backend on a device may answer with a ticket instead of waiting
-    // for them. Asked only of launches whose kernel emits nothing it must read back.
+    // end of the step, or at the next one on a backend that clearsKilled): a backend on a
+    // device may answer with a ticket instead of waiting for them. Asked only of launches
+    // whose kernel emits nothing it must read back.
     bool late = false;
+    // A late launch's pool `alive` mask, for a backend that clearsKilled: it clears the
+    // rows killed there, on the device — launch row r is pool row aliveRows[r −
+    // aliveRowsFirst] (a creation batch's), or r where aliveRows is empty.
+    Buffer aliveMask;
+    std::span<const uint32_t> aliveRows;
+    size_t aliveRowsFirst = 0;
 };
 
 struct RowsResult {
@@ -117,6 +124,9 @@ struct BackendReport {
     // Late launches' read-backs taken (RowsLaunch::late), and of them those the GPU had not
     // finished when the host took them (the host waited).
     uint64_t lateReads = 0, lateStalls = 0;
+    // Launches a device backend ran on the host instead (small pools whose columns are
+    // there: GlslBackend::setHostSide).
+    uint64_t hostLaunches = 0;
 };
 
 class Backend {
@@ -138,6 +148,16 @@ public:
         (void)ticket;
         return {};
     }
+    // Whether a late launch's ticket can be collected without waiting now.
+    virtual bool ready(uint64_t ticket) {
+        (void)ticket;
+        return true;
+    }
+    // Whether the kills of a late launch that answered with a ticket clear its aliveMask
+    // on the device, which the backend's render launches read: what is drawn then leaves
+    // them out before the run-time has taken them, and the run-time may take them at the
+    // next step instead of waiting at the end of this one (State::endStep).
+    virtual bool clearsKilled() const { return false; }
     // Whether launches on disjoint rows may run on several threads at once.
     virtual bool concurrent() const { return false; }
     // The rows a launch over a pool covers at most: a chunk that stays in cache (and gives

@@ -129,6 +129,22 @@ void HostMemory::scatter(Buffer from, size_t fromFirst, Buffer to, std::span<con
     }
 }
 
+void HostMemory::gather(Buffer from, Buffer to, size_t toFirst, std::span<const uint32_t> rows) {
+    Column &f = *columns_.at(from.id), &t = *columns_.at(to.id);
+    if (f.elem != t.elem || toFirst + rows.size() > t.rows)
+        throw std::out_of_range("HostMemory::gather between mismatched buffers");
+    size_t n = f.size();
+    for (size_t i = 0; i < rows.size(); ++i) {
+        std::byte* out = t.data + (toFirst + i) * n;
+        if (rows[i] == kSkipRow) {
+            std::memset(out, 0, n);
+            continue;
+        }
+        if (rows[i] >= f.rows) throw std::out_of_range("HostMemory::gather past the end of a buffer");
+        std::memcpy(out, f.data + rows[i] * n, n);
+    }
+}
+
 void* HostMemory::host(Buffer b) { return columns_.at(b.id)->data; }
 
 size_t HostMemory::bytes() const {

@@ -49,6 +49,9 @@ public:
     // to[rows[i]] = from[fromFirst + i] (rows[i] == kSkipRow: nothing).
     virtual void copy(Buffer from, size_t fromFirst, Buffer to, size_t toFirst, size_t count) = 0;
     virtual void scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const uint32_t> rows) = 0;
+    // The other way: to[toFirst + i] = from[rows[i]], and 0 where rows[i] == kSkipRow
+    // (children reading their parents' exports: the values are fetched where they live).
+    virtual void gather(Buffer from, Buffer to, size_t toFirst, std::span<const uint32_t> rows) = 0;
     // Zeroes `count` elements from row `first`, where the buffer lives (a device memory
     // does not bring the column to the host for it, as `host` would).
     virtual void clear(Buffer buffer, size_t first, size_t count);
@@ -78,6 +81,7 @@ public:
     void write(Buffer buffer, size_t first, size_t count, const void* in) override;
     void copy(Buffer from, size_t fromFirst, Buffer to, size_t toFirst, size_t count) override;
     void scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const uint32_t> rows) override;
+    void gather(Buffer from, Buffer to, size_t toFirst, std::span<const uint32_t> rows) override;
     void* host(Buffer buffer) override;
     // Bytes held by every live buffer (their capacity).
     size_t bytes() const;

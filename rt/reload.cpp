@@ -127,6 +127,10 @@ void reconnect(const detail::State& old, detail::State& s, const std::vector<int
 
 ReloadReport System::carryOver(const System& oldSystem) {
     detail::State& s = *state_;
+    // What a device still owes the old system first, so that its pools are what they would
+    // be on the host: its last step's rows freed, its kills counted.
+    oldSystem.state_->settleOwed();
+    oldSystem.state_->settleLate();
     const detail::State& old = *oldSystem.state_;
     ReloadReport report;
     s.now = old.now;

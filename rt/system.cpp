@@ -68,7 +68,7 @@ System::System(ir::Module module, Backend& backend, SystemOptions options)
 
 System::~System() {
     try {
-        drawing_->takeCounts();  // a device's, so it keeps nothing for this system
+        finish();  // a device's counts and kills, so that it keeps nothing for this system
     } catch (const std::exception&) {
         // a device that failed has nothing to give back
     }
@@ -99,7 +99,14 @@ void System::start() {
     s.started = true;
     creation_->emitFromKernel(s.module.start, {}, kStartObject);
     creation_->drain(s.now);
+    if (!s.backend.clearsKilled()) s.settleLate();  // else at the end of the next step
+}
+
+void System::finish() {
+    detail::State& s = *state_;
+    s.settleOwed();
     s.settleLate();
+    drawing_->takeCounts();
 }
 
 std::optional<std::string> System::step(double dt) {
@@ -109,6 +116,10 @@ std::optional<std::string> System::step(double dt) {
         return fmt::format("a step must be a finite, non-negative number of seconds, not {}", dt);
     }
     start();
+    // What a device still owes, before anything is updated: the last step's deaths (their
+    // rows freed), and those of triggers since (they are updated no more).
+    s.settleOwed();
+    s.settleLate();
     // No time passes: no update runs, so nothing moves, nothing is emitted, and no `prev`
     // or `->` chain advances (it would count updates, not time).
     if (dt == 0) {
@@ -134,15 +145,7 @@ std::optional<std::string> System::step(double dt) {
     }
     s.now = t1;
     auto releasing = WallClock::now();
-    s.settleLate();
-    for (auto [type, row] : s.dying) {
-        Pool& pool = s.pools[type];
-        if (pool.status(row) != Status::Frozen || pool.readers[row] > 0) continue;
-        Handle parent = pool.parent[row];
-        pool.release(row);
-        s.releaseReader(type, parent);
-    }
-    s.dying.clear();
+    s.endStep();
     s.stats.emitSeconds += seconds(releasing, WallClock::now());
     for (detail::TypeWork& w : s.work) {
         w.inStep.fresh = w.inStep.on;
@@ -240,9 +243,10 @@ std::optional<std::string> System::fire(std::string_view name, std::span<const f
         params.push_back(v);
     }
     start();
+    s.settleOwed();  // the rows the last step freed, before these objects take rows
     creation_->emitFromKernel(*trigger, params, kTriggerObject);
     creation_->drain(s.now);
-    s.settleLate();
+    if (!s.backend.clearsKilled()) s.settleLate();  // else at the end of the next step
     drawing_->invalidate();
     return std::nullopt;
 }
@@ -258,6 +262,7 @@ std::vector<RenderPoint> System::points(size_t type) {
 }
 
 Stats System::stats() const {
+    if (state_->owedReady()) state_->settleOwed();  // without waiting: else a step late
     drawing_->takeCounts();
     const detail::State& s = *state_;
     Stats out = s.stats;

@@ -167,8 +167,14 @@ public:
     const DrawColumns& draw(size_t type);
     // The same read back to the host: the drawn points in row order (for dumps and tests).
     std::vector<RenderPoint> points(size_t type);
-    // The counters (a device's render counts taken first: it may wait for the GPU).
+    // The counters (a device's render counts taken first: it may wait for the GPU). The
+    // kills a device still owes from the last step (RowsLaunch::late) are counted once it
+    // has them ready, without waiting: until then `killed` and `live` are a step behind.
     Stats stats() const;
+    // Takes everything a device still owes — the last step's late kills, draws' counts —
+    // waiting for it: the stats and pools are then exact (before a final report, a
+    // comparison of rows).
+    void finish();
 
     // Hot reload: this (new, not yet stepped) system takes over `old`'s objects, carried
     // over by type name: ids, creation times, parents, the state slots and parameters whose

@@ -447,10 +447,11 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
     };
     if (most == 1) {
         // Deaths nobody looks at before the end of the step are taken then (LateKills);
-        // drawing as the step goes shows only the objects alive after their first update.
-        const DrawnInStep& drawing = s_.work[type].inStep;
+        // drawing as the step goes shows only the objects alive after their first update,
+        // whether at their creation (after their type's update) or in that update (they
+        // were created before it): it takes them at once.
         std::optional<LateKills> late;
-        if (info.late && !(drawing.on && drawing.updated)) late.emplace();
+        if (info.late && !s_.work[type].inStep.on) late.emplace();
         advance(type, b, n, kMask, late ? &*late : nullptr);
         inOrder(true, [&](size_t r) {
             queueBursts(type, b, r);
@@ -513,6 +514,13 @@ void Creation::advance(size_t type, Batch& b, size_t n, size_t maskColumn, LateK
         launch.uniformKernel = s_.uniformKernel(type, kernel);
         launch.seed = s_.options.seed;
         launch.draw = static_cast<uint32_t>(s_.step);
+        if (kills) {  // its kills cleared in the pool's alive mask (Backend::clearsKilled), after the
+                      // host has set the new rows' there: a later sync does not undo them
+            s_.pools[type].syncMasks();
+            launch.aliveMask = s_.pools[type].alive.column;
+            launch.aliveRows = b.poolRows;
+            launch.aliveRowsFirst = first;
+        }
         s_.gatherParents(type, layout, t, s_.host<uint8_t>(m), first, end, 0, now, b.poolRows.data(), first);
         runBatch(launch, first, end, type, kills);
     };

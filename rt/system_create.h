@@ -61,7 +61,7 @@ private:
     void identify(size_t type, Batch& b, size_t from, size_t n);
     void atCreation(size_t type, Batch& b, size_t n);
     // Counts the updates beyond the stability limit in `type`'s stats.
-    // `late`: its kills taken at the end of the step (LateKills), listed there.
+    // `late`: its kills taken at the end of the step, or later (LateKills), listed there.
     void runBatch(const RowsLaunch& launch, size_t first, size_t end, size_t type, LateKills* late = nullptr);
     void firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, double t1);
     void drawBatch(size_t type, Batch& b, size_t n, double t1);

@@ -2,6 +2,7 @@
 // uniform values, parent gathering and the column tables of launches over pools.
 #include "rt/system_state.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "rt/system_support.h"
@@ -130,9 +131,9 @@ void State::latePart(LateKills::Part& part, const RowsResult& result, Buffer fla
         listKilled(view<uint8_t>(flags), begin, end, part.rows);
 }
 
-void State::settleLate() {
+void State::settleLate(Deaths& dying, std::vector<LateKills>& late) {
     if (late.empty()) return;
-    std::vector<std::pair<size_t, uint32_t>> merged;
+    Deaths merged;
     merged.reserve(dying.size());
     size_t next = 0;
     for (LateKills& l : late) {
@@ -163,6 +164,47 @@ void State::settleLate() {
     for (; next < dying.size(); ++next) merged.push_back(dying[next]);
     dying = std::move(merged);
     late.clear();
+}
+
+void State::release(Deaths& deaths) {
+    for (auto [type, row] : deaths) {
+        Pool& pool = pools[type];
+        if (pool.status(row) != Status::Frozen || pool.readers[row] > 0) continue;
+        Handle parent = pool.parent[row];
+        pool.release(row);
+        releaseReader(type, parent);
+    }
+    deaths.clear();
+}
+
+void State::endStep() {
+    auto owes = [](const LateKills& l) {
+        return std::any_of(l.parts.begin(), l.parts.end(), [](const LateKills::Part& p) { return p.ticket != 0; });
+    };
+    if (backend.clearsKilled() && std::any_of(late.begin(), late.end(), owes)) {
+        owed = Owed{std::move(dying), std::move(late)};
+        dying.clear();
+        late.clear();
+        return;
+    }
+    settleLate();
+    release(dying);
+}
+
+void State::settleOwed() {
+    if (!owed) return;
+    Owed o = std::move(*owed);
+    owed.reset();
+    settleLate(o.dying, o.late);
+    release(o.dying);
+}
+
+bool State::owedReady() {
+    if (!owed) return true;
+    for (const LateKills& l : owed->late)
+        for (const LateKills::Part& p : l.parts)
+            if (p.ticket && !backend.ready(p.ticket)) return false;
+    return true;
 }
 
 void State::releaseReader(size_t childType, Handle parent) {
@@ -221,27 +263,50 @@ void State::parentValues(size_t type, uint32_t row, const ColumnLayout& layout, 
     }
 }
 
+// A parent's exports are gathered where they live (Memory::gather: on the GPU for a GPU
+// backend, so that children read their parents without the host waiting for the GPU);
+// whether it is alive and its age are the host's, written into the launch's rows.
 void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<const Buffer> table, const uint8_t* mask,
                           size_t begin, size_t end, double at, const double* atRows, const uint32_t* poolRows,
                           size_t poolRowsFirst) {
+    if (layout.parentColumns.empty() || end <= begin) return;
+    std::vector<uint32_t> rows(end - begin);
+    std::vector<float> values;
+    int rowsDepth = -1;
     for (const auto& p : layout.parentColumns) {
-        for (size_t i = begin; i < end; ++i) {
-            if (!mask[i]) continue;
-            uint32_t row = poolRows ? poolRows[i - poolRowsFirst] : static_cast<uint32_t>(i);
-            auto [t, r] = ancestor(type, row, p.depth);
-            const Pool* parent = t < 0 ? nullptr : &pools[static_cast<size_t>(t)];
-            for (int c = 0; c < p.width; ++c) {
-                float x = 0;
-                if (parent) {
-                    if (p.op == ir::Op::ParentExport)
-                        x = view<float>(parent->exports.column(static_cast<size_t>(p.exportIndex), static_cast<size_t>(c)))[r];
-                    if (p.op == ir::Op::ParentAlive) x = parent->status(r) == Status::Alive ? 1.0f : 0.0f;
-                    if (p.op == ir::Op::ParentAge)
-                        x = ageAt(parent->ageClock(r, atRows ? atRows[i] : at), view<double>(parent->created)[r]);
-                }
-                host<float>(table[static_cast<size_t>(p.offset + c)])[i] = x;
+        int parentType = static_cast<int>(type);
+        for (int d = 0; d < p.depth && parentType >= 0; ++d) parentType = types[static_cast<size_t>(parentType)].parentType;
+        if (p.depth != rowsDepth) {  // the parents' rows, kSkipRow where there is none
+            for (size_t i = begin; i < end; ++i) {
+                uint32_t row = poolRows ? poolRows[i - poolRowsFirst] : static_cast<uint32_t>(i);
+                auto [t, r] = mask[i] ? ancestor(type, row, p.depth) : std::pair<int, uint32_t>{-1, 0};
+                rows[i - begin] = t < 0 ? kSkipRow : r;
             }
+            rowsDepth = p.depth;
         }
+        if (p.op == ir::Op::ParentExport) {
+            for (int c = 0; c < p.width; ++c) {
+                Buffer to = table[static_cast<size_t>(p.offset + c)];
+                if (parentType < 0) {
+                    memory.clear(to, begin, end - begin);
+                    continue;
+                }
+                const Pool& parent = pools[static_cast<size_t>(parentType)];
+                memory.gather(parent.exports.column(static_cast<size_t>(p.exportIndex), static_cast<size_t>(c)), to, begin,
+                              rows);
+            }
+            continue;
+        }
+        values.assign(end - begin, 0.0f);
+        for (size_t i = begin; i < end; ++i) {
+            if (rows[i - begin] == kSkipRow) continue;
+            const Pool& parent = pools[static_cast<size_t>(parentType)];
+            uint32_t r = rows[i - begin];
+            if (p.op == ir::Op::ParentAlive) values[i - begin] = parent.status(r) == Status::Alive ? 1.0f : 0.0f;
+            if (p.op == ir::Op::ParentAge)
+                values[i - begin] = ageAt(parent.ageClock(r, atRows ? atRows[i] : at), view<double>(parent.created)[r]);
+        }
+        memory.write(table[static_cast<size_t>(p.offset)], begin, end - begin, values.data());
     }
 }
 

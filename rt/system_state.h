@@ -6,6 +6,7 @@
 #include <array>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -66,9 +67,11 @@ struct DrawnInStep {
 
 // The kills (and unstable counts) of launches that answered late (RowsLaunch::late) or
 // whose kills are taken late: applied at the end of the step (State::settleLate), in
-// their place among the step's kills, so that rows are freed in the order they would have been at once. Only
-// for types whose dead nobody looks at before then (TypeInfo::late): the room a
-// creation sees counts a killed object as taken until the end of the step anyway.
+// their place among the step's kills, so that rows are freed in the order they would have
+// been at once — or, where the backend clearsKilled and still owes some, at the next step
+// (State::owed), the rows freed then in that same order. Only for types whose dead nobody
+// looks at before then (TypeInfo::late): the room a creation sees counts a killed object
+// as taken until the end of the step anyway.
 struct LateKills {
     size_t type = 0;
     size_t at = 0;  // its place among State::dying
@@ -125,8 +128,17 @@ struct State {
     uint64_t step = 0;
     uint32_t nextId = 0;
     bool started = false;
-    std::vector<std::pair<size_t, uint32_t>> dying;
+    using Deaths = std::vector<std::pair<size_t, uint32_t>>;
+    Deaths dying;
     std::vector<LateKills> late;
+    // A step's deaths whose late kills the backend still owed at the step's end (it
+    // clearsKilled): taken, and the rows freed, at the next step's start, a trigger, a
+    // reload, finish, or by stats() once the backend has them ready.
+    struct Owed {
+        Deaths dying;
+        std::vector<LateKills> late;
+    };
+    std::optional<Owed> owed;
     ir::Evaluator evaluator;  // the kernels the run-time evaluates itself (start, triggers, uniform kernels)
     std::unique_ptr<Parallel> parallel;
 
@@ -136,7 +148,16 @@ struct State {
     // `at`: the time of its last values (those of the update before the one that killed it).
     void kill(size_t type, uint32_t row, double at);
     // The late kills (LateKills), each in its place: at the end of a step, a trigger, the start.
-    void settleLate();
+    void settleLate() { settleLate(dying, late); }
+    void settleLate(Deaths& deaths, std::vector<LateKills>& lates);
+    // At the end of a step: its deaths freed (frozen parents with readers kept), or, where
+    // the backend clearsKilled and some late kill is not taken yet, handed to `owed`.
+    void endStep();
+    // What `owed` holds taken and freed (waiting for the backend where it must); `ready`:
+    // only if the backend has every ticket ready.
+    void settleOwed();
+    bool owedReady();
+    void release(Deaths& deaths);
     // A launch's kills as a part of a LateKills: its ticket, or the rows it listed, else
     // those of [begin, end) its kill flags (`flags`) mark.
     void latePart(LateKills::Part& part, const RowsResult& result, Buffer flags, size_t begin, size_t end) const;

@@ -57,8 +57,8 @@ void killAndEmit(State& s, Creation& creation, size_t type, double dt, double t1
 }
 
 // The kills of an update of objects that only die, listed per chunk, now; or, for late
-// launches, their kills (listed or ticketed) and unstable counts at the end of the step,
-// in their place (LateKills).
+// launches, their kills (listed or ticketed) and unstable counts at the end of the step
+// (or the next step's start: State::owed), in their place (LateKills).
 void takeKills(State& s, size_t type, size_t chunks, bool late, double dt, double t1) {
     TypeWork& work = s.work[type];
     if (!late) {
@@ -137,6 +137,7 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1,
         part.begin = begin;
         part.end = end;
         part.late = late;
+        if (late) part.aliveMask = pool.alive.column;  // its kills cleared there (Backend::clearsKilled)
         s.gatherParents(type, info.updateLayout, work.updateTable, updatable, part.begin, part.end, t1);
         RowsResult result = s.backend.run(part);
         if (result.unstable) unstable += result.unstable;

@@ -27,6 +27,9 @@ struct LateBackend : rt::Backend {
     size_t late = 0;
     std::string name() const override { return "late"; }
     rt::Memory& memory() override { return inner.memory(); }
+    // As a device: what is drawn is computed after the step (drawing as the step goes reads
+    // the kill flags this backend wipes).
+    bool rendersInStep() const override { return false; }
     rt::RowsResult run(const rt::RowsLaunch& l) override {
         rt::RowsResult r = inner.run(l);
         if (!l.late) return r;
@@ -62,6 +65,12 @@ TEST_CASE("kills taken at the end of the step free the rows, in the order, that 
         object root { emit leaf at 3000 per second; }
         trigger boom { emit leaf count 50; }
         spawn root;)");
+    // Created before their type's update in the step and dying in their first update: a
+    // step that draws as it goes draws them in that update, so they die at once.
+    programs.push_back(R"(
+        object source { emit flash at 120 per second; }
+        object flash { point(vec3(age, 1, 0), white, 1); kill when age > 0.001; }
+        spawn source;)");
     size_t late = 0;
     for (const std::string& text : programs) {
         INFO(text.substr(0, 200));
@@ -69,7 +78,10 @@ TEST_CASE("kills taken at the end of the step free the rows, in the order, that 
         LateBackend lateBackend;
         rt::SystemOptions atOnce;
         atOnce.lateKills = false;
-        rt::System a(test::compileModule(text), immediateBackend, atOnce), b(test::compileModule(text), lateBackend);
+        // c: late kills on a backend that answers at once and draws as the step goes.
+        interp::Interpreter listingBackend;
+        rt::System a(test::compileModule(text), immediateBackend, atOnce), b(test::compileModule(text), lateBackend),
+            c(test::compileModule(text), listingBackend);
         for (int f = 0; f < 200; ++f) {
             if (f % 50 == 10)
                 for (const ir::Trigger& t : a.module().triggers) {
@@ -77,11 +89,21 @@ TEST_CASE("kills taken at the end of the step free the rows, in the order, that 
                     for (auto& p : t.params) width += static_cast<size_t>(p.type.width);
                     REQUIRE_FALSE(a.fire(t.name, std::vector<float>(width, 1.5f)));
                     REQUIRE_FALSE(b.fire(t.name, std::vector<float>(width, 1.5f)));
+                    REQUIRE_FALSE(c.fire(t.name, std::vector<float>(width, 1.5f)));
                 }
             REQUIRE_FALSE(a.step(1.0 / 60));
             REQUIRE_FALSE(b.step(1.0 / 60));
+            REQUIRE_FALSE(c.step(1.0 / 60));
             REQUIRE(test::poolRows(a) == test::poolRows(b));
-            for (size_t t = 0; t < a.typeCount(); ++t) {
+            REQUIRE(test::poolRows(a) == test::poolRows(c));
+            for (size_t t = 0; t < a.typeCount(); ++t) {  // drawn every step (a and c as the step goes)
+                std::vector<rt::RenderPoint> pa = a.points(t), pb = b.points(t), pc = c.points(t);
+                REQUIRE(pa.size() == pb.size());
+                REQUIRE(pa.size() == pc.size());
+                for (size_t i = 0; i < pa.size(); ++i) {
+                    REQUIRE(pa[i].id == pb[i].id);
+                    REQUIRE(pa[i].id == pc[i].id);
+                }
                 CHECK(a.stats().types[t].killed == b.stats().types[t].killed);
                 CHECK(a.stats().types[t].unstable == b.stats().types[t].unstable);
             }

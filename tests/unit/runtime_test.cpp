@@ -13,6 +13,7 @@
 
 #include "driver/compile.h"
 #include "interp/interpreter.h"
+#include "rt/memory.h"
 #include "rt/system.h"
 #include "tests/run_length.h"
 #include "run.h"
@@ -114,6 +115,21 @@ TEST_CASE("a child reads its parent live, then the frozen value with alive false
     CHECK(c[0].position[0] == doctest::Approx(1.0));  // its last exported value, frozen
     CHECK(c[0].position[1] == 0);
     CHECK(run.stats("parent").frozen == 1);
+}
+
+TEST_CASE("a gather reads the rows it names, 0 for a skipped row; past the end is an error") {
+    rt::HostMemory memory;
+    rt::Buffer from = memory.create(rt::Elem::F32, 4), to = memory.create(rt::Elem::F32, 5);
+    std::vector<float> values = {10, 11, 12, 13}, filled(5, -1);
+    memory.write(from, 0, 4, values.data());
+    memory.write(to, 0, 5, filled.data());
+    std::vector<uint32_t> rows = {3, rt::kSkipRow, 1};
+    memory.gather(from, to, 1, rows);
+    const float* out = rt::viewData<float>(memory, to);
+    CHECK(std::vector<float>(out, out + 5) == std::vector<float>{-1, 13, 0, 11, -1});
+    std::vector<uint32_t> past = {4};
+    CHECK_THROWS_AS(memory.gather(from, to, 0, past), std::out_of_range);
+    CHECK_THROWS_AS(memory.gather(from, to, 3, rows), std::out_of_range);
 }
 
 TEST_CASE("a frozen parent is freed after its last reader dies") {

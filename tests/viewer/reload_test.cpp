@@ -56,6 +56,25 @@ const char* kMain = "import \"lib.psys\";\n"
                     "object p { pos = integrate(lift()); point(pos, white, 1); }\n"
                     "object e { emit p at 60 per second; }\nspawn e;\n";
 
+// Saves kMain drawing red points of size 3 and waits for the reload: adopted, the `live`
+// particles and their emitter carried over, drawn as the edit says.
+void saveRedAndReload(const Folder& folder, Watcher& watcher, Reloader& reloader, host::Session& session, int& frame,
+                      size_t live) {
+    std::string edited = kMain;
+    edited.replace(edited.find("point(pos, white, 1)"), 20, "point(pos, red, 3)");
+    folder.save("main.psys", edited);
+    waitForSave(watcher);
+    reloader.saved(Clock::now());
+    Reloader::Outcome outcome = waitForReload(reloader, session, frame);
+    REQUIRE(outcome.kind == Reloader::Outcome::Kind::Adopted);
+    CHECK(outcome.report->carried >= live + 1);
+    auto points = session.system().points(0);
+    REQUIRE(points.size() >= live);
+    CHECK(points[0].size == 3);
+    CHECK(points[0].color[1] == 0);
+    CHECK(points[0].position[1] > 0.5f);  // the integral carried on from before the reload
+}
+
 }  // namespace
 
 TEST_CASE("a save is seen, compiled off the frame loop, and the particles stay") {
@@ -78,21 +97,7 @@ TEST_CASE("a save is seen, compiled off the frame loop, and the particles stay")
     size_t live = session->system().stats().types[0].live;
     REQUIRE(live > 50);
 
-    SUBCASE("an edit of the file") {
-        std::string edited = kMain;
-        edited.replace(edited.find("point(pos, white, 1)"), 20, "point(pos, red, 3)");
-        folder.save("main.psys", edited);
-        waitForSave(watcher);
-        reloader.saved(Clock::now());
-        Reloader::Outcome outcome = waitForReload(reloader, *session, frame);
-        REQUIRE(outcome.kind == Reloader::Outcome::Kind::Adopted);
-        CHECK(outcome.report->carried >= live + 1);  // the particles and their emitter
-        auto points = session->system().points(0);
-        REQUIRE(points.size() >= live);
-        CHECK(points[0].size == 3);
-        CHECK(points[0].color[1] == 0);
-        CHECK(points[0].position[1] > 0.5f);  // the integral carried on from before the reload
-    }
+    SUBCASE("an edit of the file") { saveRedAndReload(folder, watcher, reloader, *session, frame, live); }
     SUBCASE("a broken edit keeps the old system running, until the next good save") {
         folder.save("main.psys", std::string(kMain) + "broken\n");
         waitForSave(watcher);
@@ -120,6 +125,31 @@ TEST_CASE("a save is seen, compiled off the frame loop, and the particles stay")
         reloader.saved(Clock::now());
         CHECK(waitForReload(reloader, *session, frame).kind == Reloader::Outcome::Kind::Adopted);
     }
+}
+
+TEST_CASE("a save reloads a system on the GPU: its shaders compile on the frame loop's thread, not the reloader's") {
+    // The reloader prepares the new module off the frame loop; the GLSL backend's GL
+    // context is the frame loop's, so it compiles when the new system is made there
+    // (before, the reloader's thread made GL calls without a context: the viewer aborted).
+    Folder folder;
+    folder.save("lib.psys", kLib);
+    folder.save("main.psys", kMain);
+    host::SessionOptions options;
+    options.backend = {"glsl", "fast"};
+    host::CompileResult compiled;
+    std::string error;
+    auto session = host::Session::open((folder.path / "main.psys").string(), options, compiled, error);
+    REQUIRE_MESSAGE(session != nullptr, compiled.text(), error);
+    REQUIRE(session->backend().name() == "glsl");
+    Watcher watcher;
+    REQUIRE(watcher.ok());
+    watcher.watch({(folder.path / "main.psys").string()});
+    Reloader reloader(*session);
+    int frame = 0;
+    for (; frame < 60;) REQUIRE_FALSE(session->frame(++frame, 1.0 / 60));
+    size_t live = session->system().stats().types[0].live;
+    REQUIRE(live > 50);
+    saveRedAndReload(folder, watcher, reloader, *session, frame, live);
 }
 
 TEST_CASE("a reload that waits too long for the JIT runs on the interpreter meanwhile, then moves to the JIT") {

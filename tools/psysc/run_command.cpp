@@ -65,6 +65,7 @@ private:
 
 void printSummary(const RunOptions& options, host::Session& session, double drawSeconds) {
     rt::System& system = session.system();
+    system.finish();  // the last step's kills a GPU still owes: the summary is exact
     rt::Stats stats = system.stats();
     if (options.timing) {
         rt::BackendReport r = session.backend().report();
@@ -81,11 +82,13 @@ void printSummary(const RunOptions& options, host::Session& session, double draw
         if (r.device)
             std::cout << fmt::format("on the GPU: the host waited for it {:.1f} times a frame, and took {:.1f} "
                                      "read-backs a frame later, when they were needed ({:.1f} not ready); {:.1f} KB a frame "
-                                     "between host and GPU, {:.1f} KB copied on the GPU\n",
+                                     "between host and GPU, {:.1f} KB copied on the GPU; {:.1f} launches a frame ran on the "
+                                     "host (pools of few rows, their columns there)\n",
                                      static_cast<double>(r.waits) / frames, static_cast<double>(r.lateReads) / frames,
                                      static_cast<double>(r.lateStalls) / frames,
                                      static_cast<double>(r.transferredBytes) / 1024 / frames,
-                                     static_cast<double>(r.stagedBytes) / 1024 / frames);
+                                     static_cast<double>(r.stagedBytes) / 1024 / frames,
+                                     static_cast<double>(r.hostLaunches) / frames);
     }
     std::cout << fmt::format("after {} frames ({:.3f} s):\n", options.frames, system.time());
     for (auto& t : stats.types)

@@ -1,0 +1,111 @@
+// What the GPU tests share: the GLSL backend (with or without its host side), a program on
+// the interpreter and on the GPU stepped together, and the tolerances (gpu_test.cpp says
+// why they are what they are).
+#pragma once
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include "gpu/glsl_backend.h"
+#include "interp/interpreter.h"
+#include "tests/differential.h"
+#include "tests/run_length.h"
+#include "tests/system_support.h"
+
+namespace psys::test {
+
+inline constexpr double kSamplesTolerance = 1e-4, kEveryOperationTolerance = 1e-2;
+
+inline std::string readFile(const std::filesystem::path& p) {
+    std::ifstream in(p);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+// hostSide: small pools' launches on the host, as psysc and the viewer run them
+// (GlslBackend::setHostSide); without it every launch runs on the GPU, which the
+// differential tests must cover.
+inline std::unique_ptr<gpu::GlslBackend> gpuBackend(bool hostSide = false) {
+    std::string error;
+    auto b = gpu::GlslBackend::create(error);
+    INFO(error);
+    REQUIRE(b);
+    if (hostSide) b->setHostSide(std::make_unique<interp::Interpreter>(b->memory()));
+    return b;
+}
+
+// A program on the interpreter and on the GPU, stepped together.
+struct Pair {
+    interp::Interpreter interpreter;
+    std::unique_ptr<gpu::GlslBackend> gpu;
+    std::unique_ptr<rt::System> cpu, gl;
+
+    explicit Pair(const std::string& text, bool optimize = true, bool hostSide = false) : gpu(gpuBackend(hostSide)) {
+        cpu = std::make_unique<rt::System>(test::compileModule(text, optimize), interpreter);
+        gl = std::make_unique<rt::System>(test::compileModule(text, optimize), *gpu);
+    }
+    void steps(int n, double dt) {
+        for (int i = 0; i < n; ++i) {
+            REQUIRE_FALSE(cpu->step(dt));
+            REQUIRE_FALSE(gl->step(dt));
+        }
+    }
+    void setExtern(const char* name, std::span<const float> v) {
+        REQUIRE_FALSE(cpu->setExtern(name, v));
+        REQUIRE_FALSE(gl->setExtern(name, v));
+    }
+    void fire(const char* name) {
+        REQUIRE_FALSE(cpu->fire(name, {}));
+        REQUIRE_FALSE(gl->fire(name, {}));
+    }
+    rt::TypeStats stats(const char* type) const { return gl->stats().types.at(static_cast<size_t>(gl->typeIndex(type))); }
+    // What both draw now, and every count: the same.
+    double compare() {
+        double worst = 0;
+        // What is drawn before the GPU's late kills are taken (at the next step) leaves them
+        // out; the counts are exact once they are.
+        for (size_t t = 0; t < cpu->typeCount(); ++t) {
+            auto a = cpu->points(t), b = gl->points(t);
+            INFO("type " << cpu->module().objects[t].name << ", step " << cpu->stepCount());
+            REQUIRE(a.size() == b.size());
+            for (size_t i = 0; i < a.size(); ++i) {
+                REQUIRE(a[i].id == b[i].id);
+                worst = std::max(worst, test::pointDifference(a[i], b[i]));
+            }
+        }
+        gl->finish();
+        for (size_t t = 0; t < cpu->typeCount(); ++t) {
+            const rt::TypeStats sa = cpu->stats().types[t];
+            const rt::TypeStats sb = gl->stats().types[t];
+            CHECK(sa.live == sb.live);
+            CHECK(sa.created == sb.created);
+            CHECK(sa.killed == sb.killed);
+            CHECK(sa.dropped == sb.dropped);
+            CHECK(sa.frozen == sb.frozen);
+        }
+        CHECK(cpu->stats().nonFiniteRender == gl->stats().nonFiniteRender);
+        CHECK(cpu->stats().nonFiniteExterns == gl->stats().nonFiniteExterns);
+        CHECK(cpu->stats().invalidEmissions == gl->stats().invalidEmissions);
+        CHECK(worst <= kSamplesTolerance);
+        return worst;
+    }
+};
+
+inline test::Comparison compareProgram(const std::string& text, int frames, bool optimize, double tolerance,
+                                bool hostSide = false) {
+    interp::Interpreter interpreter;
+    auto gpu = gpuBackend(hostSide);
+    rt::System a(test::compileModule(text, optimize), interpreter), b(test::compileModule(text, optimize), *gpu);
+    test::Comparison result = test::compareSystems(a, b, frames);
+    CHECK(result.worst <= tolerance);
+    return result;
+}
+
+
+}  // namespace psys::test

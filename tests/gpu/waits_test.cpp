@@ -1,0 +1,201 @@
+// What the host waits for on the GPU: a step waits only for what it decides by (and, with
+// the emitters on the host side, for nothing); late kills are taken at the next step, and
+// what is drawn before leaves them out.
+#include <doctest/doctest.h>
+
+#include "gpu_support.h"
+
+using namespace psys;
+using namespace psys::test;
+
+TEST_CASE("with small pools run on the host, every sample draws what the interpreter draws, for 600 frames") {
+    // The emitters (a launcher, a comet, rockets: few rows, their columns on the host) run
+    // on the host side; their particles on the GPU, reading them (spawns, parents' exports)
+    // from the host's copies.
+    for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
+        if (entry.path().extension() != ".psys") continue;
+        INFO(entry.path().filename().string());
+        test::Comparison c = compareProgram(readFile(entry.path()), test::kLongRun, true, kSamplesTolerance, true);
+        CHECK(c.points > 0);
+    }
+}
+
+TEST_CASE("a small pool on the host that outgrows the host side moves to the GPU, and computes the same") {
+    // Emitters created 30 a second, living 4 s: past 64 rows after about 2 s. Their update
+    // (they emit and die: the step must know which) runs on the host while the pool is
+    // small, then on the GPU once a launch has put its columns there; never back.
+    Pair p(R"(
+        object launcher {
+            emit burster(vec3(nrand(), 0, nrand())) at 30 per second;
+        }
+        object burster(start: vec3) {
+            pos = snapshot(start) + integrate(vec3(0, 1, 0));
+            point(pos, white, 2);
+            emit ember(pos) at 20 + 10 * sin(age * 3) per second;
+            kill when age > 4;
+        }
+        object ember(from: vec3) {
+            pos = snapshot(from) + integrate(vel);
+            vel = snapshot(nrand3());
+            point(pos, red, 1);
+            kill when age > 0.5;
+        }
+        spawn launcher;)",
+           true, true);
+    auto waitsOver = [&](int frames) {
+        uint64_t before = p.gpu->waits(), host = p.gpu->hostLaunches();
+        for (int f = 0; f < frames; ++f) {
+            p.steps(1, 1.0 / 60);
+            for (size_t t = 0; t < p.gl->typeCount(); ++t) p.gl->draw(t);
+            p.gl->stats();
+        }
+        return std::pair{p.gpu->waits() - before, p.gpu->hostLaunches() - host};
+    };
+    auto [smallWaits, smallHost] = waitsOver(60);  // at most 31 bursters
+    CHECK(smallWaits == 0);
+    CHECK(smallHost >= 60 * 2);  // the launcher's and the bursters' updates, at least
+    p.compare();
+    waitsOver(120);  // 120 bursters
+    auto [bigWaits, bigHost] = waitsOver(10);
+    CHECK(bigWaits >= 10);  // the bursters' update, on the GPU
+    CHECK(bigHost < 10 * 3);
+    p.compare();
+    for (int f = 0; f < 60; ++f) {
+        p.steps(1, 1.0 / 60);
+        if (f % 10 == 0) p.compare();
+    }
+}
+
+TEST_CASE("the host waits for the GPU mid-step only for what the step decides by, however many rows and emitters") {
+    // What a step must read back at once, one wait for each launch that has any: the
+    // counts, kills and emissions of an update whose objects emit at a rate the rows do not
+    // share (a rocket's sparks). Not a launch per 8192 rows, not a read per value of each
+    // emitter's row for its children's arguments, not the children's arguments, not a
+    // column of new objects' state to zero it; not an emitter whose rate every row shares
+    // (the fountain's: the run-time has it); not the kills of objects whose dead nobody
+    // reads during the step (drops, sparks: taken at its end); not a draw's counts (taken
+    // when the stats ask for them).
+    struct Waits {  // over 10 steps
+        uint64_t step, late, draw;
+    };
+    auto waitsPerStep = [](const std::string& sample, const char* knob, float value) {
+        auto gpu = gpuBackend();
+        rt::System system(test::compileModule(readFile(std::string(PSYS_SAMPLES_DIR) + "/" + sample + ".psys")), *gpu);
+        if (knob) REQUIRE_FALSE(system.setExtern(knob, {&value, 1}));
+        for (int f = 0; f < 200; ++f) {  // past 3 s: the drops' pool has stopped growing
+            REQUIRE_FALSE(system.step(1.0 / 60));
+            for (size_t t = 0; t < system.module().objects.size(); ++t) system.draw(t);
+            system.stats();
+        }
+        Waits w{0, 0, 0};
+        uint64_t early = gpu->lateEarly();
+        for (int f = 0; f < 10; ++f) {
+            uint64_t before = gpu->waits(), late = gpu->lateReads();
+            REQUIRE_FALSE(system.step(1.0 / 60));
+            w.step += gpu->waits() - before;
+            w.late += gpu->lateReads() - late;
+            before = gpu->waits();
+            late = gpu->lateReads();
+            for (size_t t = 0; t < system.module().objects.size(); ++t) system.draw(t);
+            w.draw += gpu->waits() - before;
+            system.stats();  // takes the draws' counts
+            w.late += gpu->lateReads() - late;
+        }
+        // The read-back buffer has grown to what a step keeps in it: no late launch is
+        // read before the run-time asks for it.
+        INFO(sample);
+        CHECK(gpu->lateEarly() == early);
+        return w;
+    };
+    // 60,000 drops: 8 chunks of 8192 rows on a CPU.
+    Waits fountain = waitsPerStep("fountain", "population", 60000);
+    // 15 rockets emitting sparks every step, each its own spawn launch.
+    Waits fireworks = waitsPerStep("fireworks", "sparks", 200);
+    MESSAGE("over 10 steps and draws, waits mid-step, read-backs taken late, waits for draws: fountain " << fountain.step << ", "
+            << fountain.late << ", " << fountain.draw << "; fireworks " << fireworks.step << ", " << fireworks.late
+            << ", " << fireworks.draw);
+    CHECK(fountain.step == 0);
+    CHECK(fountain.late == 30);  // the drops' update, the new drops' first update, the draw
+    CHECK(fountain.draw == 0);
+    CHECK(fireworks.step <= 20);
+    CHECK(fireworks.draw == 0);
+    // An update whose only answer is its count of updates past the stability limit (the
+    // wind's `- vel`: a decay rate): a counter, taken at the step's end.
+    Waits wind = waitsPerStep("wind", nullptr, 0);
+    CHECK(wind.step == 0);
+    CHECK(wind.late == 20);
+    // Children reading their parent's exports live (the comet's tail): the values are
+    // gathered on the GPU, for the update and for the draw. What remains is the comet's
+    // update, once a step: it emits and may die.
+    Waits comet = waitsPerStep("follow_parent", nullptr, 0);
+    MESSAGE("follow_parent: " << comet.step << ", " << comet.late << ", " << comet.draw);
+    CHECK(comet.step <= 10);
+    CHECK(comet.draw == 0);
+}
+
+TEST_CASE("with the emitters on the host, a step waits for the GPU never, and the particles stay on the GPU") {
+    // What remained of the waits: emitters that may die (the rockets, the comet) or that
+    // each have their own rate (the emitter's sine): a few rows, run by the host side.
+    auto run = [](const std::string& sample) {
+        auto gpu = gpuBackend(true);
+        rt::System system(test::compileModule(readFile(std::string(PSYS_SAMPLES_DIR) + "/" + sample + ".psys")), *gpu);
+        for (int f = 0; f < 200; ++f) {
+            REQUIRE_FALSE(system.step(1.0 / 60));
+            for (size_t t = 0; t < system.module().objects.size(); ++t) system.draw(t);
+            system.stats();
+        }
+        uint64_t waits = gpu->waits(), late = gpu->lateReads(), host = gpu->hostLaunches();
+        for (int f = 0; f < 10; ++f) {
+            REQUIRE_FALSE(system.step(1.0 / 60));
+            for (size_t t = 0; t < system.module().objects.size(); ++t) system.draw(t);
+            system.stats();
+        }
+        INFO(sample);
+        CHECK(gpu->waits() == waits);
+        CHECK(gpu->hostLaunches() > host);
+        return gpu->lateReads() - late;
+    };
+    // The particles' updates (and the new ones' first), and the draws, still on the GPU.
+    CHECK(run("fireworks") >= 20);
+    CHECK(run("follow_parent") >= 20);
+    CHECK(run("emitter") >= 20);
+    CHECK(run("fountain") == 30);
+}
+
+TEST_CASE("a step's late kills are taken at the next step; what is drawn before leaves them out") {
+    // Flashes die in their first update (they live 1 ms; a step is 16.7), drops in a later
+    // one: the GPU clears their rows in the alive mask the draws read, and the host takes
+    // the kills — freeing the rows, in the interpreter's order — when the next step starts
+    // (or stats() finds them ready, or finish()). Without the clearing, the points drawn
+    // after a step would include the dead.
+    for (bool hostSide : {false, true}) {
+        INFO("host side " << hostSide);
+        Pair p(R"(
+            object source {
+                emit flash at 120 per second;
+                emit drop at 60 per second;
+            }
+            object flash {
+                point(vec3(age, 1, 0), white, 1);
+                kill when age > 0.001;
+            }
+            object drop {
+                pos = integrate(vec3(0, 1, 0));
+                point(pos, red, 1);
+                kill when age > 0.25;
+            }
+            spawn source;)",
+               true, hostSide);
+        bool owed = false;
+        for (int f = 0; f < 90; ++f) {
+            p.steps(1, 1.0 / 60);
+            // Taken late: the host's pools still count the step's dead (they are alive
+            // until the kills are taken).
+            for (size_t t = 0; t < p.cpu->typeCount(); ++t) owed |= p.gl->pool(t).live() != p.cpu->pool(t).live();
+            p.compare();
+            REQUIRE(test::poolRows(*p.cpu) == test::poolRows(*p.gl));
+        }
+        CHECK(owed);
+        CHECK(p.gl->stats().types.at(static_cast<size_t>(p.gl->typeIndex("flash"))).killed > 100);
+    }
+}
