@@ -68,7 +68,8 @@ struct GlslTimeAlgebra {
     using Float = std::string;
     Statements& out;
     Double minus(const Double& a, const Double& b) { return out.let("double", a + " - " + b, true); }
-    Float narrow(const Double& x) { return out.let("float", "float(" + x + ")", true); }
+    // Rounded to nearest as C rounds it, whatever the GL's conversion does (psys_narrow).
+    Float narrow(const Double& x) { return out.let("float", "psys_narrow(" + x + ")", true); }
 };
 
 const char* kLane = "xyzw";
@@ -103,12 +104,18 @@ private:
         return lanes == 1 ? value : value + "." + kLane[lane];
     }
 
+    // A zero is the opaque psys_zero (the preamble says why), -0 its negation.
+    static std::string kernelFloat(float x) {
+        if (x != 0) return floatLiteral(x);
+        return std::signbit(x) ? "(-psys_zero)" : "psys_zero";
+    }
+
     static std::string constant(const Inst& inst) {
         if (inst.type.isBool()) return inst.constant[0] != 0 ? "true" : "false";
         if (inst.type.kind == Type::Kind::U32) return fmt::format("{}u", static_cast<uint32_t>(inst.constant[0]));
-        if (inst.type.width == 1) return floatLiteral(inst.constant[0]);
+        if (inst.type.width == 1) return kernelFloat(inst.constant[0]);
         std::string s = fmt::format("vec{}(", inst.type.width);
-        for (int c = 0; c < inst.type.width; ++c) s += (c ? ", " : "") + floatLiteral(inst.constant[static_cast<size_t>(c)]);
+        for (int c = 0; c < inst.type.width; ++c) s += (c ? ", " : "") + kernelFloat(inst.constant[static_cast<size_t>(c)]);
         return s + ")";
     }
 
@@ -138,8 +145,8 @@ private:
             case Op::Add: return a(0) + " + " + a(1);
             case Op::Sub: return a(0) + " - " + a(1);
             case Op::Mul: return a(0) + " * " + a(1);
-            case Op::Div: return a(0) + " / " + a(1);
-            case Op::Mod: return fmt::format("{0} - {1} * floor({0} / {1})", a(0), a(1));
+            case Op::Div: return perLane(inst, "psys_div");
+            case Op::Mod: return fmt::format("{0} - {1} * floor({2})", a(0), a(1), perLane(inst, "psys_div"));
             case Op::Neg: return "-" + a(0);
             case Op::Min: return perLane(inst, "psys_min");
             case Op::Max: return perLane(inst, "psys_max");

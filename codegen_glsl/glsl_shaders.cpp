@@ -78,6 +78,10 @@ double cd(uint c, uint i) {{ uint o = col(c) + 2u * i; return packDouble2x32(uve
 void sf(uint c, uint i, float x) {{ scw(c, col(c) + i, floatBitsToUint(x)); }}
 void su(uint c, uint i, uint x) {{ scw(c, col(c) + i, x); }}
 
+// A zero the GL's compiler cannot see: GLSL does not ask it to keep NaN and infinity, and
+// drivers fold x · 0 to 0 even in `precise` code (Mesa does), where IEEE 754 and the
+// interpreter give NaN for x = ∞ or NaN. Every float constant 0 of a kernel is this.
+#define psys_zero uintBitsToFloat(lw({7}u))
 #define psys_nan uintBitsToFloat(0x7fc00000u)
 #define psys_inf uintBitsToFloat(0x7f800000u)
 float psys_sign(float x) {{ return x > 0.0 ? 1.0 : x < 0.0 ? -1.0 : 0.0; }}
@@ -86,6 +90,26 @@ bool psys_isnan(float x) {{ return (floatBitsToUint(x) & 0x7fffffffu) > 0x7f8000
 bool psys_negative(float x) {{ return (floatBitsToUint(x) >> 31) != 0u; }}
 float psys_min(float x, float y) {{ return (psys_isnan(x) || y < x || (y == x && psys_negative(y))) ? y : x; }}
 float psys_max(float x, float y) {{ return (psys_isnan(x) || x < y || (y == x && !psys_negative(y))) ? y : x; }}
+// IEEE 754's quotient where y is a zero (GLSL leaves x / 0 undefined: llvmpipe's is NaN,
+// its reciprocal's refinement computing 0 · ∞): ±∞ by the operands' signs, NaN for 0/0.
+float psys_div(float x, float y) {{
+    if (y != 0.0) return x / y;
+    if (psys_isnan(x) || x == 0.0) return psys_nan;
+    return uintBitsToFloat(0x7f800000u | ((floatBitsToUint(x) ^ floatBitsToUint(y)) & 0x80000000u));
+}}
+// A double to the nearest float, ties to even, as C converts it (rt/clock.h's ages): GLSL
+// does not say how float(double) rounds. The conversion is within an ulp either way, so
+// x − f is exact in doubles and the neighbour toward x is the only other candidate.
+float psys_narrow(double x) {{
+    precise float f = float(x);
+    precise double e = x - double(f);
+    if (e == 0.0LF || isinf(f) || isnan(f)) return f;
+    uint b = floatBitsToUint(f);
+    precise float g = f == 0.0 ? uintBitsToFloat(e > 0.0LF ? 1u : 0x80000001u)
+                               : uintBitsToFloat((e > 0.0LF) == (f > 0.0) ? b + 1u : b - 1u);
+    precise double d = abs(x - double(g)), a = abs(e);
+    return d < a || (d == a && (floatBitsToUint(g) & 1u) == 0u) ? g : f;
+}}
 float psys_sqrt(float x) {{ return x < 0.0 ? psys_nan : sqrt(x); }}
 float psys_log(float x) {{ return x < 0.0 ? psys_nan : x == 0.0 ? -psys_inf : log(x); }}
 float psys_asin(float x) {{ return abs(x) > 1.0 ? psys_nan : asin(x); }}
@@ -102,7 +126,7 @@ float psys_pow(float x, float y) {{  // C's pow: defined for every base
     if (isnan(x) || isnan(y)) return psys_nan;
     bool integer = floor(y) == y;
     bool odd = integer && abs(y) < 16777216.0 && mod(abs(y), 2.0) == 1.0;
-    if (x == 0.0) return y < 0.0 ? (odd ? 1.0 / x : psys_inf) : (odd ? x : 0.0);
+    if (x == 0.0) return y < 0.0 ? (odd ? psys_div(1.0, x) : psys_inf) : (odd ? x : 0.0);
     if (isinf(y)) return abs(x) == 1.0 ? 1.0 : (abs(x) > 1.0) == (y > 0.0) ? psys_inf : 0.0;
     if (x < 0.0) {{
         if (!integer) return psys_nan;
@@ -114,7 +138,8 @@ float psys_pow(float x, float y) {{  // C's pow: defined for every base
 }}
 
 )",
-                       comment, kWorkGroupSize, align4(blockWords) / 4, LaunchBlock::kColumns, blocks, reads, writes);
+                       comment, kWorkGroupSize, align4(blockWords) / 4, LaunchBlock::kColumns, blocks, reads, writes,
+                       LaunchBlock::kZero);
 }
 
 const char* kIndex =
@@ -159,7 +184,7 @@ ClockNames emitClock(Statements& out, rt::Clock::Source now, rt::Clock::Source d
                                                 : fmt::format("ld({}u)", LaunchBlock::kNow));
     c.dt = out.define("dt", "float", dt == S::PerRow ? fmt::format("cf({}u, i)", ColumnLayout::kDt)
                                              : fmt::format("lf({}u)", LaunchBlock::kDt), true);
-    c.time = out.define("time", "float", "float(" + c.now + ")", true);
+    c.time = out.define("time", "float", "psys_narrow(" + c.now + ")", true);
     c.first = out.define("first", "bool", fmt::format("lw({}u) != 0u", LaunchBlock::kFirst));
     std::string created = perRowCreated ? fmt::format("cd({}u, i)", ColumnLayout::kCreated)
                                         : fmt::format("ld({}u)", LaunchBlock::kCreated);

@@ -37,6 +37,7 @@ struct LaunchBlock {
     static constexpr uint32_t kFirstChild = 8;  // children: draw.index #1 of the first child
     static constexpr uint32_t kCreated = 10;    // children: f64, the emitter's creation time
     static constexpr uint32_t kObjectId = 12;   // children: the emitter's id
+    static constexpr uint32_t kZero = 15;       // always 0: the shaders' zero constants (psys_zero)
     static constexpr uint32_t kColumns = 16;    // the columns' first words
     uint32_t columns = 0;  // how many: rows launches, the layout's columns and then the mask;
                            // children launches, one per component of the arguments

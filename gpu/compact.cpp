@@ -1,6 +1,8 @@
 #include "gpu/compact.h"
 
 #include "gpu/gl_context.h"
+#include "gpu/hazards.h"
+#include "codegen_glsl/glsl_shaders.h"
 
 #include <algorithm>
 #include <stdexcept>
@@ -125,9 +127,12 @@ void Compactor::compact(unsigned words, size_t word, size_t n, unsigned out, siz
     if (n == 0) {  // nothing set: the total alone
         uint32_t zero = 0;
         glClearNamedBufferSubData(out, GL_R32UI, static_cast<GLintptr>(at * 4), 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+        afterWrite(Write::Clear, kHostMap | kCopy);
         return;
     }
     size_t groups = (n + kCompactGroup - 1) / kCompactGroup;
+    // The shaders index groups in x alone: a launch splits its dispatches below this.
+    if (groups > codegen_glsl::kMaxGroupsX) throw std::logic_error("compaction: more rows than one dispatch takes");
     grow(groups_, groupsCapacity_, groups + 1);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, words);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, groups_);
@@ -140,13 +145,15 @@ void Compactor::compact(unsigned words, size_t word, size_t n, unsigned out, siz
     setUint(write_, "at", at);
     glUseProgram(count_);
     glDispatchCompute(static_cast<GLuint>(groups), 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    afterWrite(Write::Dispatch, kStorageBlock);  // the counts: the scan reads them
     glUseProgram(scan_);
     glDispatchCompute(1, 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    afterWrite(Write::Dispatch, kStorageBlock);  // the offsets: the rows' pass reads them
     glUseProgram(write_);
     glDispatchCompute(static_cast<GLuint>(groups), 1, 1);
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_CLIENT_MAPPED_BUFFER_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    // The list: the host maps it (a read-back region) or reads it (flagged), a shader may
+    // read it next.
+    afterWrite(Write::Dispatch, kHostMap | kCopy | kStorageBlock);
 }
 
 }  // namespace psys::gpu

@@ -1,4 +1,7 @@
 #include "gpu/gl_context.h"
+#include "gpu/gl_debug.h"
+
+#include "codegen_glsl/glsl_shaders.h"
 
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>
@@ -22,7 +25,8 @@ std::unique_ptr<HeadlessContext> HeadlessContext::open(std::string& error) {
     EGLint configs = 0;
     eglChooseConfig(display, configAttributes, &config, 1, &configs);
     EGLint contextAttributes[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
-                                  EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+                                  EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                  EGL_CONTEXT_OPENGL_DEBUG, debugOutputRequested() ? EGL_TRUE : EGL_FALSE, EGL_NONE};
     EGLContext context = eglCreateContext(display, configs ? config : EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, contextAttributes);
     if (context == EGL_NO_CONTEXT) {
         error = "cannot make an OpenGL 4.5 core context on the EGL surfaceless display";
@@ -92,6 +96,14 @@ void checkAllocation(const char* what, size_t bytes) {
     if (outOfMemory)
         throw std::runtime_error("the GPU has no room for " + std::string(what) + " (" +
                                  std::to_string(bytes >> 20) + " MiB)");
+}
+
+void dispatchInvocations(size_t invocations, unsigned groupSize) {
+    size_t groups = (invocations + groupSize - 1) / groupSize;
+    if (groups == 0) return;
+    size_t x = std::min<size_t>(groups, codegen_glsl::kMaxGroupsX);
+    size_t y = (groups + x - 1) / x;
+    glDispatchCompute(static_cast<GLuint>(x), static_cast<GLuint>(y), 1);
 }
 
 std::string rendererName() {

@@ -36,6 +36,14 @@ unsigned computeProgram(const std::string& source, const std::string& what);
 // (GL_OUT_OF_MEMORY): a buffer without storage would read zeros and drop writes.
 void checkAllocation(const char* what, size_t bytes);
 
+// Runs the bound compute program over `invocations` invocations, `groupSize` to a work group,
+// the grid in x then y: GL promises only 65,535 groups in a dimension, so a 1-D grid stops
+// at 4,194,240 invocations of 64. A shader finds its invocation with kInvocationIndex
+// and returns past the count.
+void dispatchInvocations(size_t invocations, unsigned groupSize);
+inline constexpr const char* kInvocationIndex =
+    "((gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x)";
+
 // "llvmpipe (LLVM 15.0.6, 256 bits), OpenGL 4.5 (Core Profile) Mesa 22.3.6", …
 std::string rendererName();
 

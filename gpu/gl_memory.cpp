@@ -1,6 +1,7 @@
 #include "gpu/gl_memory.h"
 
 #include "gpu/gl_context.h"
+#include "gpu/hazards.h"
 
 #include <algorithm>
 #include <cstring>
@@ -55,9 +56,13 @@ layout(std430, binding = 2) readonly buffer Rows { uint rows[]; };
 uniform uint count, first, w;
 )";
 
+std::string rowsShader(const char* main) {
+    return std::string(kRowsHeader) + "#define INVOCATION " + kInvocationIndex + "\n" + main;
+}
+
 // to[rows[i]] = from[first + i] (kSkipRow: nothing).
 const char* kScatter = R"(void main() {
-    uint i = gl_GlobalInvocationID.x;
+    uint i = INVOCATION;
     if (i >= count || rows[i] == 0xFFFFFFFFu) return;
     for (uint k = 0u; k < w; ++k) to[rows[i] * w + k] = from[(first + i) * w + k];
 }
@@ -65,7 +70,7 @@ const char* kScatter = R"(void main() {
 
 // to[first + i] = from[rows[i]], or 0 for kSkipRow.
 const char* kGather = R"(void main() {
-    uint i = gl_GlobalInvocationID.x;
+    uint i = INVOCATION;
     if (i >= count) return;
     for (uint k = 0u; k < w; ++k) to[(first + i) * w + k] = rows[i] == 0xFFFFFFFFu ? 0u : from[rows[i] * w + k];
 }
@@ -114,6 +119,7 @@ void GlMemory::resize(Buffer b, size_t rows) {
             glNamedBufferData(grown, static_cast<GLsizeiptr>(room * w * 4), nullptr, GL_DYNAMIC_COPY);
             checkAllocation("a column", room * w * 4);
             if (c.rows) glCopyNamedBufferSubData(c.gl, grown, 0, 0, static_cast<GLsizeiptr>(c.rows * w * 4));
+            afterWrite(Write::Copy, kColumnReaders);
             glDeleteBuffers(1, &c.gl);
             c.gl = grown;
             c.glRows = room;
@@ -123,6 +129,7 @@ void GlMemory::resize(Buffer b, size_t rows) {
             glClearNamedBufferSubData(c.gl, GL_R32UI, static_cast<GLintptr>(c.rows * w * 4),
                                       static_cast<GLsizeiptr>((rows - c.rows) * w * 4), GL_RED_INTEGER, GL_UNSIGNED_INT,
                                       &zero);
+            afterWrite(Write::Clear, kColumnReaders);
         }
     }
     c.hostCopy.resize(rows * rt::elemSize(c.elem), 0);
@@ -173,6 +180,7 @@ void GlMemory::uploadRows(Column& c, size_t first, size_t count) const {
     toWords(c.hostCopy.data() + first * rt::elemSize(c.elem), c.elem, count, staging.data());
     glNamedBufferSubData(c.gl, static_cast<GLintptr>(first * w * 4), static_cast<GLsizeiptr>(staging.size() * 4),
                          staging.data());
+    afterWrite(Write::Upload, kColumnReaders);
     transferred += staging.size() * 4;
 }
 
@@ -206,6 +214,7 @@ void GlMemory::write(Buffer b, size_t first, size_t count, const void* in) {
     if (count)
         glNamedBufferSubData(c.gl, static_cast<GLintptr>(first * w * 4), static_cast<GLsizeiptr>(words.size() * 4),
                              words.data());
+    afterWrite(Write::Upload, kColumnReaders);
     transferred += words.size() * 4;
 }
 
@@ -223,6 +232,7 @@ void GlMemory::copy(Buffer from, size_t fromFirst, Buffer to, size_t toFirst, si
     if (count)
         glCopyNamedBufferSubData(f.gl, t.gl, static_cast<GLintptr>(fromFirst * w), static_cast<GLintptr>(toFirst * w),
                                  static_cast<GLsizeiptr>(count * w));
+    afterWrite(Write::Copy, kColumnReaders);
     t.device = true;
 }
 
@@ -241,7 +251,7 @@ void GlMemory::scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const
     }
     uploadRows(f, fromFirst, rows.size());  // only the rows scattered: the source stays on the host
     upload(t);
-    if (!scatterProgram_) scatterProgram_ = computeProgram(std::string(kRowsHeader) + kScatter, "scatter");
+    if (!scatterProgram_) scatterProgram_ = computeProgram(rowsShader(kScatter), "scatter");
     runRows(scatterProgram_, f, t, fromFirst, rows);
     t.device = true;
 }
@@ -264,7 +274,7 @@ void GlMemory::gather(Buffer from, Buffer to, size_t toFirst, std::span<const ui
     }
     upload(f);
     upload(t);
-    if (!gatherProgram_) gatherProgram_ = computeProgram(std::string(kRowsHeader) + kGather, "gather");
+    if (!gatherProgram_) gatherProgram_ = computeProgram(rowsShader(kGather), "gather");
     runRows(gatherProgram_, f, t, toFirst, rows);
     t.device = true;
 }
@@ -275,6 +285,7 @@ unsigned GlMemory::rowList(std::span<const uint32_t> rows) {
         glNamedBufferData(rowsBuffer_, static_cast<GLsizeiptr>(std::max<size_t>(rows.size(), 1) * 4),
                           rows.empty() ? nullptr : rows.data(),
                           GL_STREAM_DRAW);
+        afterWrite(Write::Upload, kStorageBlock);
         transferred += rows.size() * 4;
         rowsSent_.assign(rows.begin(), rows.end());
     }
@@ -293,8 +304,8 @@ void GlMemory::runRows(unsigned program, const Column& from, const Column& to, s
     glProgramUniform1ui(program, glGetUniformLocation(program, "count"), static_cast<GLuint>(rows.size()));
     glProgramUniform1ui(program, glGetUniformLocation(program, "first"), static_cast<GLuint>(first));
     glProgramUniform1ui(program, glGetUniformLocation(program, "w"), static_cast<GLuint>(wordsPerRow(from.elem)));
-    glDispatchCompute(static_cast<GLuint>((rows.size() + 63) / 64), 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    dispatchInvocations(rows.size(), 64);
+    afterWrite(Write::Dispatch, kColumnReaders);  // into a column: any reader may follow
 }
 
 void GlMemory::clear(Buffer b, size_t first, size_t count) {
@@ -308,6 +319,7 @@ void GlMemory::clear(Buffer b, size_t first, size_t count) {
     uint32_t zero = 0;
     glClearNamedBufferSubData(c.gl, GL_R32UI, static_cast<GLintptr>(first * w), static_cast<GLsizeiptr>(count * w),
                               GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    afterWrite(Write::Clear, kColumnReaders);
 }
 
 void* GlMemory::host(Buffer b) {
@@ -343,6 +355,7 @@ void GlMemory::adopt(Buffer b, size_t first, size_t count, unsigned words, size_
     staged += count * w;
     glCopyNamedBufferSubData(words, c.gl, static_cast<GLintptr>(word * 4), static_cast<GLintptr>(first * w),
                              static_cast<GLsizeiptr>(count * w));
+    afterWrite(Write::Copy, kColumnReaders);
     c.device = true;
 }
 

@@ -12,9 +12,11 @@
 
 #include "codegen_glsl/glsl_shaders.h"
 #include "gpu/gl_context.h"
+#include "gpu/gl_debug.h"
 #include "gpu/compact.h"
 #include "gpu/gl_memory.h"
 #include "gpu/glsl_program.h"
+#include "gpu/hazards.h"
 
 namespace psys::gpu {
 
@@ -112,6 +114,7 @@ std::unique_ptr<GlslBackend> GlslBackend::create(std::string& error) {
         error = "the GLSL backend needs OpenGL 4.5; this context has " + rendererName();
         return nullptr;
     }
+    if (debugOutputRequested()) installDebugOutput();
     GLint64 maxBlock = 0;
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBlock);
     b->maxWords_ = static_cast<size_t>(std::min<GLint64>(maxBlock, GLint64{1} << 31)) / 4;
@@ -246,23 +249,22 @@ void GlslBackend::dispatch(Program& program, const std::vector<uint32_t>& block,
     uint32_t zero[4] = {0, 0, 0, 0};
     if (program.counts) glNamedBufferSubData(counts_, 0, sizeof zero, zero);
     glNamedBufferData(block_, static_cast<GLsizeiptr>(block.size() * 4), block.data(), GL_STREAM_DRAW);
+    afterWrite(Write::Upload, kStorageBlock | kUniformBlock);
     for (const BlockFill& f : fill)
         glCopyNamedBufferSubData(f.from, block_, static_cast<GLintptr>(f.byte), static_cast<GLintptr>(f.word) * 4,
                                  static_cast<GLsizeiptr>(f.words) * 4);
+    if (!fill.empty()) afterWrite(Write::Copy, kUniformBlock);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, words_);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, counts_);
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, block_);
     glUseProgram(program.program);
-    size_t groups = (count + codegen_glsl::kWorkGroupSize - 1) / codegen_glsl::kWorkGroupSize;
-    size_t x = std::min<size_t>(groups, codegen_glsl::kMaxGroupsX);
-    size_t y = (groups + x - 1) / x;
     auto start = std::chrono::steady_clock::now();
     if (timing_) {
         glFinish();
         start = std::chrono::steady_clock::now();
         glBeginQuery(GL_TIME_ELAPSED, query_);
     }
-    glDispatchCompute(static_cast<GLuint>(x), static_cast<GLuint>(y), 1);
+    dispatchInvocations(count, codegen_glsl::kWorkGroupSize);
     if (timing_) {
         glEndQuery(GL_TIME_ELAPSED);
         glFinish();
@@ -275,9 +277,10 @@ void GlslBackend::dispatch(Program& program, const std::vector<uint32_t>& block,
         t.launches += 1;
         t.rows += count;
     }
-    // What the shader wrote is read next by shaders (columns bound in place), copies and
-    // read-backs, and the viewer's vertex pulls.
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT);
+    // What the shader wrote — columns in place, the launch's words, the counts — is read
+    // next by anything a column has: kernels (storage blocks, buffer textures), copies
+    // into launch blocks and read-backs, the viewer's vertex pulls.
+    afterWrite(Write::Dispatch, kColumnReaders);
 }
 
 void GlslBackend::setHostSide(std::unique_ptr<rt::Backend> host, size_t rows) {
@@ -398,6 +401,7 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
     // Columns on the GPU are copied there; the others come from the host.
     uint32_t zero = 0;
     glClearNamedBufferSubData(words_, GL_R32UI, 0, static_cast<GLsizeiptr>(n * 4), GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    afterWrite(Write::Clear, kStorageBlock);
     for (const Slot& s : slots) {
         Elem e = memory_.elem(s.buffer);
         size_t w = GlMemory::wordsPerRow(e);
@@ -405,11 +409,13 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
             memory_.staged += n * w * 4;
             glCopyNamedBufferSubData(memory_.deviceBuffer(s.buffer), words_, static_cast<GLintptr>(begin * w * 4),
                                      static_cast<GLintptr>(s.word * 4), static_cast<GLsizeiptr>(n * w * 4));
+            afterWrite(Write::Copy, kStorageBlock);
             continue;
         }
         staging_.resize(n * w);
         toWords(static_cast<const char*>(memory_.view(s.buffer)) + begin * rt::elemSize(e), e, n, staging_.data());
         glNamedBufferSubData(words_, static_cast<GLintptr>(s.word * 4), static_cast<GLsizeiptr>(n * w * 4), staging_.data());
+        afterWrite(Write::Upload, kStorageBlock);
         memory_.transferred += n * w * 4;
     }
 

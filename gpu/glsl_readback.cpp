@@ -12,12 +12,14 @@
 // asked, so that a step's regions soon fit without settling anything early.
 #include <algorithm>
 #include <cstring>
+#include <string>
 #include <stdexcept>
 
 #include <epoxy/gl.h>
 
 #include "gpu/gl_context.h"
 #include "gpu/glsl_program.h"
+#include "gpu/hazards.h"
 
 namespace psys::gpu {
 
@@ -30,16 +32,18 @@ namespace {
 
 constexpr size_t kKillsAt = 4;  // in a region: counts at words 0–3, the kills' total and rows from word 4
 
+// (%s: the invocation's index, kInvocationIndex.)
 // mask[row of launch row i] = 0 where the kill flag words[flags + i] is set; the row is
 // rows[offset + i] where `mapped` (a creation batch's), else base + i.
 const char* kClearKilled = R"(#version 450
 layout(local_size_x = 64) in;
+#define INVOCATION %s
 layout(std430, binding = 0) readonly buffer Words { uint words[]; };
 layout(std430, binding = 1) buffer Mask { uint mask[]; };
 layout(std430, binding = 2) readonly buffer Rows { uint rows[]; };
 uniform uint count, flags, base, offset, mapped;
 void main() {
-    uint i = gl_GlobalInvocationID.x;
+    uint i = INVOCATION;
     if (i >= count || words[flags + i] == 0u) return;
     mask[mapped != 0u ? rows[offset + i] : base + i] = 0u;
 }
@@ -85,12 +89,14 @@ rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program
     }
     size_t at = reserveReadback(words);
     if (p.counts) glCopyNamedBufferSubData(counts_, readback_, 0, static_cast<GLintptr>(at * 4), 16);
+    if (p.counts) afterWrite(Write::Copy, kHostMap);
     if (kills)
         compactor_.compact(words_, block[LaunchBlock::kColumns + ColumnLayout::kKill], n, readback_, at + kKillsAt);
     for (const Returned& r : returned)
         glCopyNamedBufferSubData(words_, readback_, static_cast<GLintptr>(r.from * 4),
                                  static_cast<GLintptr>((at + r.at) * 4),
                                  static_cast<GLsizeiptr>(n * GlMemory::wordsPerRow(memory_.elem(r.buffer)) * 4));
+    if (!returned.empty()) afterWrite(Write::Copy, kHostMap);
     if (late) {  // kept for collect(): no wait now
         readbackUsed_ = at + words;
         late->parts.push_back({begin, at, kills});
@@ -154,15 +160,15 @@ void GlslBackend::ensureReadback(size_t words) {
     if (!mappedReadback_) throw std::runtime_error("the GL could not map a buffer for reading back");
 }
 
+// The regions were written by copies and the compaction's dispatch, each followed by its
+// barrier (gpu/hazards.h); what a host map needs besides is this fence.
 const uint32_t* GlslBackend::awaitReadback() {
-    glMemoryBarrier(GL_CLIENT_MAPPED_BUFFER_BARRIER_BIT);
     waitFor(glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0));
     ++memory_.waits;
     return mappedReadback_;
 }
 
 uint64_t GlslBackend::finishLate(std::unique_ptr<Late> late) {
-    glMemoryBarrier(GL_CLIENT_MAPPED_BUFFER_BARRIER_BIT);
     late->fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
     glFlush();  // the GPU starts on it while the host goes on
     uint64_t ticket = nextTicket_++;
@@ -196,7 +202,11 @@ void GlslBackend::settle(Late& late) {
 // out: the render launches read the alive mask on the GPU, so the kills clear it there.
 // The host clears the same rows when it takes the kills (and sends them again: the same 0).
 void GlslBackend::clearKilled(const rt::RowsLaunch& launch, size_t begin, size_t n, uint32_t flags) {
-    if (!clearKilled_) clearKilled_ = computeProgram(kClearKilled, "clearing killed rows");
+    if (!clearKilled_) {
+        std::string source = kClearKilled;
+        source.replace(source.find("%s"), 2, kInvocationIndex);
+        clearKilled_ = computeProgram(source, "clearing killed rows");
+    }
     bool mapped = !launch.aliveRows.empty();
     unsigned rows = mapped ? memory_.rowList(launch.aliveRows) : words_;
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, words_);
@@ -211,8 +221,8 @@ void GlslBackend::clearKilled(const rt::RowsLaunch& launch, size_t begin, size_t
     set("base", begin);
     set("offset", mapped ? begin - launch.aliveRowsFirst : 0);
     set("mapped", mapped);
-    glDispatchCompute(static_cast<GLuint>((n + 63) / 64), 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    dispatchInvocations(n, 64);
+    afterWrite(Write::Dispatch, kColumnReaders);  // the mask: the draws read it (in place, a texture, a copy)
     memory_.written(launch.aliveMask);
 }
 

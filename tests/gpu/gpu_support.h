@@ -6,11 +6,13 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 #include <sstream>
 
+#include "gpu/gl_debug.h"
 #include "gpu/glsl_backend.h"
 #include "interp/interpreter.h"
 #include "tests/differential.h"
@@ -21,6 +23,16 @@ namespace psys::test {
 
 inline constexpr double kSamplesTolerance = 1e-4, kEveryOperationTolerance = 1e-2;
 
+// Where the samples and test programs are: the source tree's (compiled in), or where the
+// environment says (a GPU bundle carries them beside its binaries: scripts/gpu-bundle.sh).
+inline std::string dataPath(const char* variable, const char* compiledIn) {
+    const char* v = std::getenv(variable);
+    return v && *v ? v : compiledIn;
+}
+inline std::string samplesDir() { return dataPath("PSYS_SAMPLES_DIR", PSYS_SAMPLES_DIR); }
+inline std::string programsDir() { return dataPath("PSYS_PROGRAMS_DIR", PSYS_PROGRAMS_DIR); }
+inline std::string sample(const std::string& name) { return samplesDir() + "/" + name + ".psys"; }
+
 inline std::string readFile(const std::filesystem::path& p) {
     std::ifstream in(p);
     std::ostringstream s;
@@ -28,14 +40,27 @@ inline std::string readFile(const std::filesystem::path& p) {
     return s.str();
 }
 
+// Every GPU test runs in a debug context (KHR_debug): a GL error or undefined behaviour
+// reported while a backend lives fails the test that made it, when the backend goes.
+struct GlMessagesChecked {
+    uint64_t before = gpu::glErrorMessages();
+    void operator()(gpu::GlslBackend* b) const {
+        delete b;
+        CHECK_MESSAGE(gpu::glErrorMessages() == before, "the GL reported: " << gpu::lastGlErrorMessage());
+    }
+};
+using GpuBackend = std::unique_ptr<gpu::GlslBackend, GlMessagesChecked>;
+
 // hostSide: small pools' launches on the host, as psysc and the viewer run them
 // (GlslBackend::setHostSide); without it every launch runs on the GPU, which the
 // differential tests must cover.
-inline std::unique_ptr<gpu::GlslBackend> gpuBackend(bool hostSide = false) {
+inline GpuBackend gpuBackend(bool hostSide = false) {
+    gpu::requestDebugOutput(true);
     std::string error;
-    auto b = gpu::GlslBackend::create(error);
+    auto created = gpu::GlslBackend::create(error);
     INFO(error);
-    REQUIRE(b);
+    REQUIRE(created);
+    GpuBackend b(created.release());
     if (hostSide) b->setHostSide(std::make_unique<interp::Interpreter>(b->memory()));
     return b;
 }
@@ -43,7 +68,7 @@ inline std::unique_ptr<gpu::GlslBackend> gpuBackend(bool hostSide = false) {
 // A program on the interpreter and on the GPU, stepped together.
 struct Pair {
     interp::Interpreter interpreter;
-    std::unique_ptr<gpu::GlslBackend> gpu;
+    GpuBackend gpu;
     std::unique_ptr<rt::System> cpu, gl;
 
     explicit Pair(const std::string& text, bool optimize = true, bool hostSide = false) : gpu(gpuBackend(hostSide)) {

@@ -41,7 +41,7 @@ using namespace psys::test;
 
 TEST_CASE("every sample draws the same on the GPU as on the interpreter, for 600 frames (200 sanitized)") {
     double worst = 0;
-    for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
+    for (auto& entry : std::filesystem::directory_iterator(test::samplesDir())) {
         if (entry.path().extension() != ".psys") continue;
         INFO(entry.path().filename().string());
         test::Comparison c = compareProgram(readFile(entry.path()), test::kLongRun, true, kSamplesTolerance);
@@ -59,7 +59,7 @@ TEST_CASE("a launch split over dispatches computes what one dispatch computes") 
     // first row. 99 rows a dispatch: first rows at every alignment.
     for (const char* sample : {"fountain", "fire", "fireworks"}) {
         INFO(sample);
-        Pair p(readFile(std::string(PSYS_SAMPLES_DIR) + "/" + sample + ".psys"));
+        Pair p(readFile(test::sample(sample)));
         p.gpu->limitDispatchRows(99);
         for (int f = 0; f < 150; ++f) {
             p.steps(1, 1.0 / 60);
@@ -81,7 +81,7 @@ TEST_CASE("a reload on the GPU carries every object on, the old system's last dr
     for (bool hostSide : {false, true})
     for (const char* sample : {"fountain", "fireworks"}) {
         INFO(sample << (hostSide ? ", host side" : ""));
-        std::string text = readFile(std::string(PSYS_SAMPLES_DIR) + "/" + sample + ".psys");
+        std::string text = readFile(test::sample(sample));
         interp::Interpreter interpreter;
         auto gpu = gpuBackend(hostSide);
         rt::System straight(test::compileModule(text), interpreter);
@@ -106,7 +106,7 @@ TEST_CASE("a reload on the GPU carries every object on, the old system's last dr
 }
 
 TEST_CASE("every operation computes on the GPU what the interpreter computes") {
-    std::string text = readFile(PSYS_EVERY_OPERATION);
+    std::string text = readFile(test::programsDir() + "/every_operation.psys");
     for (bool optimize : {false, true}) {
         test::Comparison c = compareProgram(text, 300, optimize, kEveryOperationTolerance);
         CHECK(c.points > 1000);
@@ -116,7 +116,7 @@ TEST_CASE("every operation computes on the GPU what the interpreter computes") {
 }
 
 TEST_CASE("min, max and clamp on NaN and signed zeros: the GPU picks the interpreter's operand") {
-    std::string text = readFile(std::string(PSYS_PROGRAMS_DIR) + "/nan_edges.psys");
+    std::string text = readFile(test::programsDir() + "/nan_edges.psys");
     for (bool optimize : {false, true}) {
         test::Comparison c = compareProgram(text, 10, optimize, 0);
         CHECK(c.points == 20);
@@ -229,7 +229,7 @@ TEST_CASE("an object's state stays on the GPU from step to step") {
     // creation times, ids and rows: once for all their columns; their arguments are
     // computed on the GPU and stay there).
     auto gpu = gpuBackend();
-    rt::System system(test::compileModule(readFile(std::string(PSYS_SAMPLES_DIR) + "/fountain.psys")), *gpu);
+    rt::System system(test::compileModule(readFile(test::sample("fountain"))), *gpu);
     for (int f = 0; f < 120; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
     size_t live = system.pool(static_cast<size_t>(system.typeIndex("drop"))).live();
     uint64_t before = gpu->transferredBytes(), staged = gpu->stagedBytes();
@@ -310,7 +310,7 @@ TEST_CASE("a kernel with more columns than storage blocks reads the rest through
     // are read in place through buffer textures, not copied through the launch's words
     // (12 bytes a particle a step).
     auto gpu = gpuBackend();
-    rt::System system(test::compileModule(readFile(std::string(PSYS_SAMPLES_DIR) + "/fire.psys")), *gpu);
+    rt::System system(test::compileModule(readFile(test::sample("fire"))), *gpu);
     auto part = static_cast<size_t>(system.typeIndex("part"));
     const ir::Object& o = system.module().objects[part];
     std::vector<int> direct = codegen_glsl::directColumns(*o.kernel(ir::KernelKind::Update),
@@ -349,7 +349,7 @@ TEST_CASE("what is drawn is computed and marked on the GPU, and stays there") {
     // drawn rows itself; its 36 bytes of render columns a row stay on the GPU, where the
     // viewer draws from them.
     auto gpu = gpuBackend();
-    rt::System system(test::compileModule(readFile(std::string(PSYS_SAMPLES_DIR) + "/fountain.psys")), *gpu);
+    rt::System system(test::compileModule(readFile(test::sample("fountain"))), *gpu);
     for (int f = 0; f < 60; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
     auto drop = static_cast<size_t>(system.typeIndex("drop"));
     system.draw(drop);  // the first draw puts the render columns on the GPU

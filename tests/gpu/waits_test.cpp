@@ -12,7 +12,7 @@ TEST_CASE("with small pools run on the host, every sample draws what the interpr
     // The emitters (a launcher, a comet, rockets: few rows, their columns on the host) run
     // on the host side; their particles on the GPU, reading them (spawns, parents' exports)
     // from the host's copies.
-    for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
+    for (auto& entry : std::filesystem::directory_iterator(test::samplesDir())) {
         if (entry.path().extension() != ".psys") continue;
         INFO(entry.path().filename().string());
         test::Comparison c = compareProgram(readFile(entry.path()), test::kLongRun, true, kSamplesTolerance, true);
@@ -80,7 +80,7 @@ TEST_CASE("the host waits for the GPU mid-step only for what the step decides by
     };
     auto waitsPerStep = [](const std::string& sample, const char* knob, float value) {
         auto gpu = gpuBackend();
-        rt::System system(test::compileModule(readFile(std::string(PSYS_SAMPLES_DIR) + "/" + sample + ".psys")), *gpu);
+        rt::System system(test::compileModule(readFile(test::sample(sample))), *gpu);
         if (knob) REQUIRE_FALSE(system.setExtern(knob, {&value, 1}));
         for (int f = 0; f < 200; ++f) {  // past 3 s: the drops' pool has stopped growing
             REQUIRE_FALSE(system.step(1.0 / 60));
@@ -138,7 +138,7 @@ TEST_CASE("with the emitters on the host, a step waits for the GPU never, and th
     // each have their own rate (the emitter's sine): a few rows, run by the host side.
     auto run = [](const std::string& sample) {
         auto gpu = gpuBackend(true);
-        rt::System system(test::compileModule(readFile(std::string(PSYS_SAMPLES_DIR) + "/" + sample + ".psys")), *gpu);
+        rt::System system(test::compileModule(readFile(test::sample(sample))), *gpu);
         for (int f = 0; f < 200; ++f) {
             REQUIRE_FALSE(system.step(1.0 / 60));
             for (size_t t = 0; t < system.module().objects.size(); ++t) system.draw(t);
