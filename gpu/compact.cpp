@@ -19,7 +19,8 @@ const char* kCount = R"(#version 450
 layout(local_size_x = 256) in;
 layout(std430, binding = 0) readonly buffer Words { uint w[]; };
 layout(std430, binding = 1) buffer Groups { uint groups[]; };
-uniform uint first, n;
+#define first param(0u)
+#define n param(1u)
 shared uint total;
 void main() {
     if (gl_LocalInvocationID.x == 0u) total = 0u;
@@ -36,7 +37,7 @@ void main() {
 const char* kScan = R"(#version 450
 layout(local_size_x = 256) in;
 layout(std430, binding = 1) buffer Groups { uint groups[]; };
-uniform uint count;
+#define count param(2u)
 shared uint runs[256];
 void main() {
     uint t = gl_LocalInvocationID.x;
@@ -72,7 +73,9 @@ layout(local_size_x = 256) in;
 layout(std430, binding = 0) readonly buffer Words { uint w[]; };
 layout(std430, binding = 1) readonly buffer Groups { uint groups[]; };
 layout(std430, binding = 2) writeonly buffer List { uint list[]; };
-uniform uint first, n, at;
+#define first param(0u)
+#define n param(1u)
+#define at param(3u)
 shared uint prefix[256];
 void main() {
     uint t = gl_LocalInvocationID.x, i = gl_GlobalInvocationID.x, g = gl_WorkGroupID.x;
@@ -96,8 +99,11 @@ void main() {
 }
 )";
 
-void setUint(GLuint p, const char* name, size_t value) {
-    glProgramUniform1ui(p, glGetUniformLocation(p, name), static_cast<GLuint>(value));
+// The passes' shaders with the parameters' block (gl_context.h) after their version line.
+std::string withParams(const char* source) {
+    std::string s = source;
+    s.insert(s.find('\n') + 1, kParamsBlock);
+    return s;
 }
 
 void grow(GLuint buffer, size_t& capacity, size_t words) {
@@ -115,13 +121,14 @@ Compactor::~Compactor() {
     for (GLuint p : {count_, scan_, write_})
         if (p) glDeleteProgram(p);
     if (groups_) glDeleteBuffers(1, &groups_);
+    if (params_) glDeleteBuffers(1, &params_);
 }
 
 void Compactor::compact(unsigned words, size_t word, size_t n, unsigned out, size_t at) {
     if (!count_) {
-        count_ = computeProgram(kCount, "compaction (counts)");
-        scan_ = computeProgram(kScan, "compaction (scan)");
-        write_ = computeProgram(kWrite, "compaction (rows)");
+        count_ = computeProgram(withParams(kCount), "compaction (counts)");
+        scan_ = computeProgram(withParams(kScan), "compaction (scan)");
+        write_ = computeProgram(withParams(kWrite), "compaction (rows)");
         glCreateBuffers(1, &groups_);
     }
     if (n == 0) {  // nothing set: the total alone
@@ -137,12 +144,8 @@ void Compactor::compact(unsigned words, size_t word, size_t n, unsigned out, siz
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, words);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, groups_);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, out);
-    for (GLuint p : {count_, write_}) {
-        setUint(p, "first", word);
-        setUint(p, "n", n);
-    }
-    setUint(scan_, "count", groups);
-    setUint(write_, "at", at);
+    bindParams(params_, {static_cast<uint32_t>(word), static_cast<uint32_t>(n), static_cast<uint32_t>(groups),
+                         static_cast<uint32_t>(at)});
     glUseProgram(count_);
     glDispatchCompute(static_cast<GLuint>(groups), 1, 1);
     afterWrite(Write::Dispatch, kStorageBlock);  // the counts: the scan reads them

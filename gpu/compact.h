@@ -33,6 +33,7 @@ private:
     unsigned count_ = 0, scan_ = 0, write_ = 0;  // programs
     unsigned groups_ = 0;                        // a buffer: per group its count, then its offset; the total
     size_t groupsCapacity_ = 0;
+    unsigned params_ = 0;                        // the passes' parameters (gl_context.h, bindParams)
 };
 
 constexpr uint32_t kCompactGroup = 256;

@@ -7,16 +7,26 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+
+#include <fmt/format.h>
 #include <stdexcept>
 
 namespace psys::gpu {
 
 std::unique_ptr<HeadlessContext> HeadlessContext::open(std::string& error) {
-    // eglGetPlatformDisplay (without EXT) aborts in libepoxy before a display exists.
+    // eglGetPlatformDisplay (without EXT) aborts in libepoxy before a display exists, and
+    // so does the EXT entry point where no EGL offers it (no vendor library at all).
+    if (!epoxy_has_egl_extension(EGL_NO_DISPLAY, "EGL_EXT_platform_base") ||
+        !epoxy_has_egl_extension(EGL_NO_DISPLAY, "EGL_MESA_platform_surfaceless")) {
+        error = "EGL has no surfaceless platform (EGL_MESA_platform_surfaceless): no EGL driver is installed, "
+                "or it cannot run without a window system";
+        return nullptr;
+    }
     EGLDisplay display = eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
     EGLint major = 0, minor = 0;
     if (display == EGL_NO_DISPLAY || !eglInitialize(display, &major, &minor)) {
-        error = "no EGL surfaceless display (Mesa's EGL, or a GPU driver's, is needed)";
+        error = fmt::format("no EGL surfaceless display (EGL error 0x{:04x}; Mesa's EGL, or a GPU driver's, is needed)",
+                            eglGetError());
         return nullptr;
     }
     eglBindAPI(EGL_OPENGL_API);
@@ -29,7 +39,8 @@ std::unique_ptr<HeadlessContext> HeadlessContext::open(std::string& error) {
                                   EGL_CONTEXT_OPENGL_DEBUG, debugOutputRequested() ? EGL_TRUE : EGL_FALSE, EGL_NONE};
     EGLContext context = eglCreateContext(display, configs ? config : EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, contextAttributes);
     if (context == EGL_NO_CONTEXT) {
-        error = "cannot make an OpenGL 4.5 core context on the EGL surfaceless display";
+        error = fmt::format("cannot make an OpenGL 4.5 core context on the EGL surfaceless display (EGL error 0x{:04x})",
+                            eglGetError());
         return nullptr;
     }
     std::unique_ptr<HeadlessContext> c(new HeadlessContext);
@@ -104,6 +115,15 @@ void dispatchInvocations(size_t invocations, unsigned groupSize) {
     size_t x = std::min<size_t>(groups, codegen_glsl::kMaxGroupsX);
     size_t y = (groups + x - 1) / x;
     glDispatchCompute(static_cast<GLuint>(x), static_cast<GLuint>(y), 1);
+}
+
+void bindParams(unsigned& buffer, std::initializer_list<uint32_t> values) {
+    uint32_t words[8] = {};
+    if (values.size() > 8) throw std::logic_error("a utility shader takes at most 8 parameters");
+    std::copy(values.begin(), values.end(), words);
+    if (!buffer) glCreateBuffers(1, &buffer);
+    glNamedBufferData(buffer, sizeof words, words, GL_STREAM_DRAW);  // a new store: no dispatch in flight sees it
+    glBindBufferBase(GL_UNIFORM_BUFFER, 1, buffer);
 }
 
 std::string rendererName() {

@@ -4,6 +4,7 @@
 // offscreen into one.
 #pragma once
 
+#include <initializer_list>
 #include <memory>
 #include <string>
 
@@ -43,6 +44,19 @@ void checkAllocation(const char* what, size_t bytes);
 void dispatchInvocations(size_t invocations, unsigned groupSize);
 inline constexpr const char* kInvocationIndex =
     "((gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x)";
+
+// The parameters of a utility shader (scatter, gather, compaction, clearing killed rows):
+// a uniform block at binding 1 (the kernels' launch block is at 0), `param(k)` in the
+// shader, written before each dispatch. Not default-block uniforms set with
+// glProgramUniform: zink over lavapipe keeps using the values of a program's first
+// dispatch (a clearing of killed rows then cleared one row of a thousand), and a block the
+// host writes is what the kernels already use everywhere.
+inline constexpr const char* kParamsBlock =
+    "layout(std140, binding = 1) uniform Params { uvec4 P[2]; };\n"
+    "uint param(uint k) { return P[k >> 2u][k & 3u]; }\n";
+// Writes up to 8 values into `buffer` (created on first use: the caller owns it) and
+// binds it as the Params block.
+void bindParams(unsigned& buffer, std::initializer_list<uint32_t> values);
 
 // "llvmpipe (LLVM 15.0.6, 256 bits), OpenGL 4.5 (Core Profile) Mesa 22.3.6", …
 std::string rendererName();

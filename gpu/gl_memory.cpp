@@ -53,11 +53,13 @@ layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer From { uint from[]; };
 layout(std430, binding = 1) buffer To { uint to[]; };
 layout(std430, binding = 2) readonly buffer Rows { uint rows[]; };
-uniform uint count, first, w;
+#define count param(0u)
+#define first param(1u)
+#define w param(2u)
 )";
 
 std::string rowsShader(const char* main) {
-    return std::string(kRowsHeader) + "#define INVOCATION " + kInvocationIndex + "\n" + main;
+    return std::string(kRowsHeader) + kParamsBlock + "#define INVOCATION " + kInvocationIndex + "\n" + main;
 }
 
 // to[rows[i]] = from[first + i] (kSkipRow: nothing).
@@ -86,6 +88,7 @@ GlMemory::~GlMemory() {
     if (scatterProgram_) glDeleteProgram(scatterProgram_);
     if (gatherProgram_) glDeleteProgram(gatherProgram_);
     if (rowsBuffer_) glDeleteBuffers(1, &rowsBuffer_);
+    if (paramsBuffer_) glDeleteBuffers(1, &paramsBuffer_);
 }
 
 GlMemory::Column& GlMemory::at(Buffer b) const { return *columns_.at(b.id); }
@@ -301,9 +304,8 @@ void GlMemory::runRows(unsigned program, const Column& from, const Column& to, s
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, to.gl);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, list);
     glUseProgram(program);
-    glProgramUniform1ui(program, glGetUniformLocation(program, "count"), static_cast<GLuint>(rows.size()));
-    glProgramUniform1ui(program, glGetUniformLocation(program, "first"), static_cast<GLuint>(first));
-    glProgramUniform1ui(program, glGetUniformLocation(program, "w"), static_cast<GLuint>(wordsPerRow(from.elem)));
+    bindParams(paramsBuffer_, {static_cast<uint32_t>(rows.size()), static_cast<uint32_t>(first),
+                               static_cast<uint32_t>(wordsPerRow(from.elem))});
     dispatchInvocations(rows.size(), 64);
     afterWrite(Write::Dispatch, kColumnReaders);  // into a column: any reader may follow
 }

@@ -80,7 +80,7 @@ private:
     std::vector<std::unique_ptr<Column>> columns_;
     std::vector<uint32_t> free_;
     void runRows(unsigned program, const Column& from, const Column& to, size_t first, std::span<const uint32_t> rows);
-    unsigned scatterProgram_ = 0, gatherProgram_ = 0, rowsBuffer_ = 0;
+    unsigned scatterProgram_ = 0, gatherProgram_ = 0, rowsBuffer_ = 0, paramsBuffer_ = 0;
     std::vector<uint32_t> rowsSent_;  // what rowsBuffer_ holds
 };
 

@@ -150,6 +150,9 @@ std::unique_ptr<GlslBackend> GlslBackend::create(std::string& error) {
 }
 
 GlslBackend::~GlslBackend() {
+    // A backend whose context could not be made has nothing of the GL's to give back (and
+    // a GL call without a context aborts in libepoxy).
+    if (!context_ && !contextCurrent()) return;
     if (context_) context_->makeCurrent();
     for (auto& [key, p] : rows_) glDeleteProgram(p->program);
     for (auto& [key, p] : children_) glDeleteProgram(p->program);
@@ -157,8 +160,8 @@ GlslBackend::~GlslBackend() {
     for (auto& [ticket, late] : late_) settle(*late);  // its fence deleted
     if (readback_) glUnmapNamedBuffer(readback_);
     glDeleteTextures(static_cast<GLsizei>(textures_.size()), textures_.data());
-    GLuint buffers[] = {words_, counts_, block_, readback_};
-    glDeleteBuffers(4, buffers);
+    GLuint buffers[] = {words_, counts_, block_, readback_, params_};
+    glDeleteBuffers(5, buffers);
     glDeleteQueries(1, &query_);
 }
 

@@ -135,7 +135,7 @@ private:
     Compactor compactor_;
     std::map<RowsKey, std::unique_ptr<Program>> rows_;
     std::map<const ir::Kernel*, std::unique_ptr<Program>> children_;
-    unsigned words_ = 0, counts_ = 0, block_ = 0, query_ = 0, readback_ = 0, clearKilled_ = 0;
+    unsigned words_ = 0, counts_ = 0, block_ = 0, query_ = 0, readback_ = 0, clearKilled_ = 0, params_ = 0;
     const uint32_t* mappedReadback_ = nullptr;
     size_t readbackWords_ = 0;
     size_t wordsCapacity_ = 0;

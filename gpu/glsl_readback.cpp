@@ -32,7 +32,7 @@ namespace {
 
 constexpr size_t kKillsAt = 4;  // in a region: counts at words 0–3, the kills' total and rows from word 4
 
-// (%s: the invocation's index, kInvocationIndex.)
+// (%s: the invocation's index, kInvocationIndex, and the parameters' block, kParamsBlock.)
 // mask[row of launch row i] = 0 where the kill flag words[flags + i] is set; the row is
 // rows[offset + i] where `mapped` (a creation batch's), else base + i.
 const char* kClearKilled = R"(#version 450
@@ -41,7 +41,11 @@ layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer Words { uint words[]; };
 layout(std430, binding = 1) buffer Mask { uint mask[]; };
 layout(std430, binding = 2) readonly buffer Rows { uint rows[]; };
-uniform uint count, flags, base, offset, mapped;
+#define count param(0u)
+#define flags param(1u)
+#define base param(2u)
+#define offset param(3u)
+#define mapped param(4u)
 void main() {
     uint i = INVOCATION;
     if (i >= count || words[flags + i] == 0u) return;
@@ -204,7 +208,7 @@ void GlslBackend::settle(Late& late) {
 void GlslBackend::clearKilled(const rt::RowsLaunch& launch, size_t begin, size_t n, uint32_t flags) {
     if (!clearKilled_) {
         std::string source = kClearKilled;
-        source.replace(source.find("%s"), 2, kInvocationIndex);
+        source.replace(source.find("%s"), 2, std::string(kInvocationIndex) + "\n" + kParamsBlock);
         clearKilled_ = computeProgram(source, "clearing killed rows");
     }
     bool mapped = !launch.aliveRows.empty();
@@ -213,14 +217,8 @@ void GlslBackend::clearKilled(const rt::RowsLaunch& launch, size_t begin, size_t
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, memory_.deviceBuffer(launch.aliveMask));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, rows);
     glUseProgram(clearKilled_);
-    auto set = [&](const char* name, size_t value) {
-        glProgramUniform1ui(clearKilled_, glGetUniformLocation(clearKilled_, name), static_cast<GLuint>(value));
-    };
-    set("count", n);
-    set("flags", flags);
-    set("base", begin);
-    set("offset", mapped ? begin - launch.aliveRowsFirst : 0);
-    set("mapped", mapped);
+    bindParams(params_, {static_cast<uint32_t>(n), flags, static_cast<uint32_t>(begin),
+                         static_cast<uint32_t>(mapped ? begin - launch.aliveRowsFirst : 0), mapped ? 1u : 0u});
     dispatchInvocations(n, 64);
     afterWrite(Write::Dispatch, kColumnReaders);  // the mask: the draws read it (in place, a texture, a copy)
     memory_.written(launch.aliveMask);

@@ -9,6 +9,7 @@ packages=(
   antlr4 libantlr4-runtime-dev
   llvm-19-dev libzstd-dev
   libglm-dev libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libimgui-dev
+  mesa-vulkan-drivers libvulkan1
   doctest-dev libcli11-dev libfmt-dev nlohmann-json3-dev libstb-dev libtbb-dev
   glslang-tools xvfb xauth libbenchmark-dev python3-matplotlib vim
   clang-19 libclang-rt-19-dev
