@@ -30,7 +30,11 @@ ir::Module compileEffect(const std::string& name, bool relaxed) {
     DiagnosticEngine diags(sources);
     CompileOptions options;
     options.pipeline.pass.relaxed = relaxed;
-    auto module = compileFile(std::string(PSYS_SAMPLES_DIR) + "/" + name + ".psys", sources, diags, options);
+    // The samples of the source tree, or where the environment says (a GPU bundle carries
+    // them beside its binaries: scripts/gpu-bundle.sh).
+    const char* dir = std::getenv("PSYS_SAMPLES_DIR");
+    std::string samples = dir && *dir ? dir : PSYS_SAMPLES_DIR;
+    auto module = compileFile(samples + "/" + name + ".psys", sources, diags, options);
     if (!module) {
         diags.print(std::cerr, false);
         std::exit(1);

@@ -11,7 +11,7 @@ packages=(
   libglm-dev libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libimgui-dev
   mesa-vulkan-drivers libvulkan1
   doctest-dev libcli11-dev libfmt-dev nlohmann-json3-dev libstb-dev libtbb-dev
-  glslang-tools xvfb xauth libbenchmark-dev python3-matplotlib vim
+  glslang-tools xvfb xauth patchelf xz-utils libbenchmark-dev python3-matplotlib vim
   clang-19 libclang-rt-19-dev
 )
 # Node.js 20 and npm (the editor extension's tests and package) come with the machine;

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# The GPU bundle (scripts/gpu-bundle.sh) from this build, unpacked into an empty
+# directory and run from there with a bare environment: every library but the C
+# library's comes from the bundle, it is at most 60 MiB, and its tests pass there
+# (a few of them here: the whole suite runs as gpu.* already).
+#   bundle_test.sh BUILD_DIR SOURCE_DIR
+set -euo pipefail
+build=$1 root=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+PSYS_BUNDLE_BUILD=$build bash "$root/scripts/gpu-bundle.sh" "$tmp/bundle.tar.xz"
+size=$(stat -c %s "$tmp/bundle.tar.xz")
+[ "$size" -le $((60 * 1024 * 1024)) ] || { echo "bundle_test: the bundle is $size bytes, over 60 MiB" >&2; exit 1; }
+mkdir "$tmp/empty"
+tar -C "$tmp/empty" -xJf "$tmp/bundle.tar.xz"
+top=$tmp/empty/psys-gpu
+for b in "$top"/bin/*; do
+  [ -f "$b" ] || continue
+  outside=$(ldd "$b" | awk '$3 ~ /^\// {print $3}' | grep -v "^$top/bin/lib/" |
+            grep -Ev '/(libc|libm|libdl|libpthread|librt)\.so' || true)
+  [ -z "$outside" ] || { echo "bundle_test: $(basename "$b") loads from outside the bundle: $outside" >&2; exit 1; }
+done
+cd "$tmp/empty"
+env -i PATH=/usr/bin:/bin HOME="$tmp" ./psys-gpu/run.sh tests -tc="every operation*,IEEE*" | tee "$tmp/out"
+grep -q "^GL: " "$tmp/out"
+grep -q "run.sh tests: passed, strict mode passed" "$tmp/out"
