@@ -7,6 +7,7 @@
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <unordered_set>
 
 #include <epoxy/gl.h>
 
@@ -40,7 +41,13 @@ struct GlMemory::Column {
     GLuint gl = 0;
     size_t glRows = 0;    // rows the GL buffer has room for (pools grow a row at a time: doubled)
     bool device = false;  // the value is the GL buffer's (the host copy is stale)
+    size_t zeroFrom = 0;  // on the GPU: the GL buffer holds zeros from this row on
     bool live = false;
+    // Rows the host scattered into it while it is on the GPU, not sent yet (each row's
+    // words after it, in the order written): sent in one scatter when the GPU next uses
+    // the column or the host reads it (GlMemory::flush).
+    std::vector<uint32_t> pending;
+    size_t pendingRows = 0;
     size_t words() const { return rows * wordsPerRow(elem); }
 };
 
@@ -89,6 +96,7 @@ GlMemory::~GlMemory() {
     if (gatherProgram_) glDeleteProgram(gatherProgram_);
     if (rowsBuffer_) glDeleteBuffers(1, &rowsBuffer_);
     if (paramsBuffer_) glDeleteBuffers(1, &paramsBuffer_);
+    if (pendingBuffer_) glDeleteBuffers(1, &pendingBuffer_);
 }
 
 GlMemory::Column& GlMemory::at(Buffer b) const { return *columns_.at(b.id); }
@@ -114,7 +122,18 @@ Buffer GlMemory::create(Elem elem, size_t rows) {
 void GlMemory::resize(Buffer b, size_t rows) {
     Column& c = at(b);
     if (c.device) {  // grown or shrunk on the GPU: the column stays there
+        if (rows < c.rows) flush(c);  // (rows pending past the end would land in rows to be zeroed)
         size_t w = wordsPerRow(c.elem);
+        // A pool grows a row at a time: the GL buffer doubles, and is zeroed past the rows
+        // once then, not at each row.
+        auto clear = [&](size_t from, size_t to) {
+            if (to <= from) return;
+            uint32_t zero = 0;
+            glClearNamedBufferSubData(c.gl, GL_R32UI, static_cast<GLintptr>(from * w * 4),
+                                      static_cast<GLsizeiptr>((to - from) * w * 4), GL_RED_INTEGER, GL_UNSIGNED_INT,
+                                      &zero);
+            afterWrite(Write::Clear, kColumnReaders);
+        };
         if (rows > c.glRows) {
             size_t room = std::max(rows, 2 * c.glRows);
             GLuint grown = 0;
@@ -126,13 +145,12 @@ void GlMemory::resize(Buffer b, size_t rows) {
             glDeleteBuffers(1, &c.gl);
             c.gl = grown;
             c.glRows = room;
+            clear(c.rows, room);
+            c.zeroFrom = c.rows;
         }
         if (rows > c.rows) {  // new rows are zero
-            uint32_t zero = 0;
-            glClearNamedBufferSubData(c.gl, GL_R32UI, static_cast<GLintptr>(c.rows * w * 4),
-                                      static_cast<GLsizeiptr>((rows - c.rows) * w * 4), GL_RED_INTEGER, GL_UNSIGNED_INT,
-                                      &zero);
-            afterWrite(Write::Clear, kColumnReaders);
+            clear(c.rows, std::min(rows, c.zeroFrom));
+            c.zeroFrom = std::max(c.zeroFrom, rows);
         }
     }
     c.hostCopy.resize(rows * rt::elemSize(c.elem), 0);
@@ -145,6 +163,8 @@ void GlMemory::release(Buffer b) {
     c.live = false;
     c.device = false;
     c.rows = 0;
+    c.pending.clear();
+    c.pendingRows = 0;
     if (c.gl) glDeleteBuffers(1, &c.gl);  // its memory goes back to the GL (a pool of 10M rows holds GBs)
     c.gl = 0;
     c.glRows = 0;
@@ -158,6 +178,7 @@ Elem GlMemory::elem(Buffer b) const { return at(b).elem; }
 
 void GlMemory::toHost(Column& c) const {
     if (!c.device) return;
+    flush(c);
     std::vector<uint32_t> words(c.words());
     if (!words.empty()) glGetNamedBufferSubData(c.gl, 0, static_cast<GLsizeiptr>(words.size() * 4), words.data());
     transferred += words.size() * 4;
@@ -177,6 +198,7 @@ void GlMemory::uploadRows(Column& c, size_t first, size_t count) const {
         checkAllocation("a column", room * wordsPerRow(c.elem) * 4);
         c.glRows = room;
     }
+    c.zeroFrom = c.glRows;  // what is past the rows in the GL buffer is not known
     if (count == 0) return;
     size_t w = wordsPerRow(c.elem);
     std::vector<uint32_t> staging(count * w);
@@ -194,6 +216,7 @@ void GlMemory::read(Buffer b, size_t first, size_t count, void* out) const {
         std::memcpy(out, c.hostCopy.data() + first * rt::elemSize(c.elem), count * rt::elemSize(c.elem));
         return;
     }
+    flush(c);
     size_t w = wordsPerRow(c.elem);
     std::vector<uint32_t> words(count * w);
     if (count)
@@ -211,6 +234,7 @@ void GlMemory::write(Buffer b, size_t first, size_t count, const void* in) {
         std::memcpy(c.hostCopy.data() + first * rt::elemSize(c.elem), in, count * rt::elemSize(c.elem));
         return;
     }
+    flush(c);
     size_t w = wordsPerRow(c.elem);
     std::vector<uint32_t> words(count * w);
     toWords(in, c.elem, count, words.data());
@@ -229,6 +253,8 @@ void GlMemory::copy(Buffer from, size_t fromFirst, Buffer to, size_t toFirst, si
         std::memmove(t.hostCopy.data() + toFirst * e, f.hostCopy.data() + fromFirst * e, count * e);
         return;
     }
+    flush(f);
+    flush(t);
     uploadRows(f, fromFirst, count);  // only the rows copied: the source stays on the host
     upload(t);
     size_t w = wordsPerRow(f.elem) * 4;
@@ -252,11 +278,63 @@ void GlMemory::scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const
                 std::memcpy(t.hostCopy.data() + rows[i] * n, f.hostCopy.data() + (fromFirst + i) * n, n);
         return;
     }
+    if (!f.device && t.device && rows.size() <= kPendingScatter) {  // a few rows: sent with the next ones
+        size_t w = wordsPerRow(f.elem);
+        for (size_t i = 0; i < rows.size(); ++i) {
+            if (rows[i] == rt::kSkipRow) continue;
+            t.pending.push_back(rows[i]);
+            size_t at = t.pending.size();
+            t.pending.resize(at + w);
+            toWords(f.hostCopy.data() + (fromFirst + i) * rt::elemSize(f.elem), f.elem, 1, t.pending.data() + at);
+            ++t.pendingRows;
+        }
+        if (!t.pending.empty() && std::find(pendingColumns_.begin(), pendingColumns_.end(), to.id) == pendingColumns_.end())
+            pendingColumns_.push_back(to.id);
+        if (t.pendingRows >= kPendingFlush) flush(t);
+        return;
+    }
+    flush(f);
+    flush(t);
     uploadRows(f, fromFirst, rows.size());  // only the rows scattered: the source stays on the host
     upload(t);
     if (!scatterProgram_) scatterProgram_ = computeProgram(rowsShader(kScatter), "scatter");
-    runRows(scatterProgram_, f, t, fromFirst, rows);
+    runRows(scatterProgram_, f.gl, t.gl, wordsPerRow(f.elem), fromFirst, rows);
     t.device = true;
+}
+
+// The rows scattered into a column on the GPU while it stayed there, in one upload and
+// one scatter: a burst chain creates an object at a time, a hundred thousand times in a
+// step, and would otherwise run a dispatch for each column of each. A row written twice
+// keeps its last value (the scatter's rows must be distinct: its writes are unordered).
+void GlMemory::flushPending() {
+    for (uint32_t id : pendingColumns_)
+        if (columns_[id]->live) flush(*columns_[id]);
+    pendingColumns_.clear();
+}
+
+void GlMemory::flush(Column& c) const {
+    if (c.pending.empty()) return;
+    size_t w = wordsPerRow(c.elem);
+    std::vector<uint32_t> rows, words;
+    rows.reserve(c.pendingRows);
+    words.reserve(c.pendingRows * w);
+    std::unordered_set<uint32_t> seen;
+    for (size_t at = c.pending.size(); at > 0;) {  // the last write of each row first
+        at -= 1 + w;
+        uint32_t row = c.pending[at];
+        if (!seen.insert(row).second) continue;
+        rows.push_back(row);
+        words.insert(words.end(), c.pending.begin() + static_cast<std::ptrdiff_t>(at + 1),
+                     c.pending.begin() + static_cast<std::ptrdiff_t>(at + 1 + w));
+    }
+    c.pending.clear();
+    c.pendingRows = 0;
+    if (!pendingBuffer_) glCreateBuffers(1, &pendingBuffer_);
+    glNamedBufferData(pendingBuffer_, static_cast<GLsizeiptr>(words.size() * 4), words.data(), GL_STREAM_DRAW);
+    afterWrite(Write::Upload, kStorageBlock);
+    transferred += words.size() * 4;
+    if (!scatterProgram_) scatterProgram_ = computeProgram(rowsShader(kScatter), "scatter");
+    runRows(scatterProgram_, pendingBuffer_, c.gl, w, 0, rows);
 }
 
 // On the GPU where the source is (a parent's exports, written there by its kernel), so
@@ -275,14 +353,16 @@ void GlMemory::gather(Buffer from, Buffer to, size_t toFirst, std::span<const ui
         }
         return;
     }
+    flush(f);
+    flush(t);
     upload(f);
     upload(t);
     if (!gatherProgram_) gatherProgram_ = computeProgram(rowsShader(kGather), "gather");
-    runRows(gatherProgram_, f, t, toFirst, rows);
+    runRows(gatherProgram_, f.gl, t.gl, wordsPerRow(f.elem), toFirst, rows);
     t.device = true;
 }
 
-unsigned GlMemory::rowList(std::span<const uint32_t> rows) {
+unsigned GlMemory::rowList(std::span<const uint32_t> rows) const {
     if (!rowsBuffer_) glCreateBuffers(1, &rowsBuffer_);
     if (!std::equal(rows.begin(), rows.end(), rowsSent_.begin(), rowsSent_.end())) {
         glNamedBufferData(rowsBuffer_, static_cast<GLsizeiptr>(std::max<size_t>(rows.size(), 1) * 4),
@@ -297,16 +377,17 @@ unsigned GlMemory::rowList(std::span<const uint32_t> rows) {
 
 // A scatter or gather over a list of rows; the list goes up once for every column of a
 // batch or a parent that uses it.
-void GlMemory::runRows(unsigned program, const Column& from, const Column& to, size_t first,
-                       std::span<const uint32_t> rows) {
+void GlMemory::runRows(unsigned program, unsigned from, unsigned to, size_t w, size_t first,
+                       std::span<const uint32_t> rows) const {
     unsigned list = rowList(rows);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, from.gl);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, to.gl);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, from);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, to);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, list);
     glUseProgram(program);
     bindParams(paramsBuffer_, {static_cast<uint32_t>(rows.size()), static_cast<uint32_t>(first),
-                               static_cast<uint32_t>(wordsPerRow(from.elem))});
+                               static_cast<uint32_t>(w)});
     dispatchInvocations(rows.size(), 64);
+    ++dispatches;
     afterWrite(Write::Dispatch, kColumnReaders);  // into a column: any reader may follow
 }
 
@@ -317,6 +398,7 @@ void GlMemory::clear(Buffer b, size_t first, size_t count) {
         std::memset(c.hostCopy.data() + first * rt::elemSize(c.elem), 0, count * rt::elemSize(c.elem));
         return;
     }
+    flush(c);
     size_t w = wordsPerRow(c.elem) * 4;
     uint32_t zero = 0;
     glClearNamedBufferSubData(c.gl, GL_R32UI, static_cast<GLintptr>(first * w), static_cast<GLsizeiptr>(count * w),
@@ -340,18 +422,21 @@ bool GlMemory::onDevice(Buffer b) const { return at(b).device; }
 
 unsigned GlMemory::glBuffer(Buffer b) const {
     Column& c = at(b);
+    flush(c);
     upload(c);
     return c.gl;
 }
 
 unsigned GlMemory::deviceBuffer(Buffer b) {
     Column& c = at(b);
+    flush(c);
     upload(c);
     return c.gl;
 }
 
 void GlMemory::adopt(Buffer b, size_t first, size_t count, unsigned words, size_t word) {
     Column& c = at(b);
+    flush(c);
     upload(c);
     size_t w = wordsPerRow(c.elem) * 4;
     staged += count * w;

@@ -49,7 +49,11 @@ public:
     void written(rt::Buffer buffer);
     // A GL buffer holding `rows` (sent once for every scatter, gather and launch that uses
     // the same list in a row: a creation batch's rows).
-    unsigned rowList(std::span<const uint32_t> rows);
+    unsigned rowList(std::span<const uint32_t> rows) const;
+    // Sends every column's pending rows (scatters of a few rows from the host wait, to go
+    // up together): before a launch binds anything, since sending them runs a dispatch of
+    // its own (deviceBuffer sends a column's too, but mid-binding it would undo bindings).
+    void flushPending();
     // Bytes of GL buffers held.
     size_t deviceBytes() const;
     // Bytes moved between the host and the GPU so far, either way (the backend adds its
@@ -59,6 +63,8 @@ public:
     // GPU; the backend adds its launches' read-backs): each one stalls the host until the
     // GPU has finished everything before it.
     mutable uint64_t waits = 0;
+    // Compute dispatches so far: the backend's launches, and the scatters and gathers here.
+    mutable uint64_t dispatches = 0;
     // Bytes launches copied on the GPU between columns and the launch's words, either way
     // (columns not bound in place: GlslBackend, adopt): memory traffic beyond the shader's.
     uint64_t staged = 0;
@@ -79,9 +85,15 @@ private:
     void uploadRows(Column& c, size_t first, size_t count) const;
     std::vector<std::unique_ptr<Column>> columns_;
     std::vector<uint32_t> free_;
-    void runRows(unsigned program, const Column& from, const Column& to, size_t first, std::span<const uint32_t> rows);
-    unsigned scatterProgram_ = 0, gatherProgram_ = 0, rowsBuffer_ = 0, paramsBuffer_ = 0;
-    std::vector<uint32_t> rowsSent_;  // what rowsBuffer_ holds
+    void runRows(unsigned program, unsigned from, unsigned to, size_t w, size_t first,
+                 std::span<const uint32_t> rows) const;
+    void flush(Column& c) const;  // its pending rows to the GPU
+    std::vector<uint32_t> pendingColumns_;  // columns that may have rows pending
+    // Scatters from the host of at most this many rows into a column on the GPU wait, and
+    // go with the next ones once this many rows are pending (or the column is used).
+    static constexpr size_t kPendingScatter = 64, kPendingFlush = 65536;
+    mutable unsigned scatterProgram_ = 0, gatherProgram_ = 0, rowsBuffer_ = 0, paramsBuffer_ = 0, pendingBuffer_ = 0;
+    mutable std::vector<uint32_t> rowsSent_;  // what rowsBuffer_ holds
 };
 
 // Host rows to GPU words (u8 widened to a word) and back.

@@ -13,6 +13,7 @@
 #include "codegen_glsl/glsl_shaders.h"
 #include "gpu/gl_context.h"
 #include "gpu/gl_debug.h"
+#include "gpu/gl_programs.h"
 #include "gpu/compact.h"
 #include "gpu/gl_memory.h"
 #include "gpu/glsl_program.h"
@@ -165,10 +166,17 @@ GlslBackend::~GlslBackend() {
     glDeleteQueries(1, &query_);
 }
 
+// Begun, and finished at once unless a plan is being prepared: then every program of it
+// is begun first, so that a driver that compiles in parallel has them all (gl_programs.h).
 GlslBackend::Program GlslBackend::compile(const std::string& source, const std::string& what) {
     auto start = std::chrono::steady_clock::now();
+    if (!compiler_) compiler_ = std::make_unique<ProgramCompiler>();
     Program p;
-    p.program = computeProgram(source, what);
+    p.program = compiler_->begin(source);
+    if (preparing_)
+        unfinished_.push_back({p.program, source, what});
+    else
+        compiler_->finish(p.program, source, what);
     ++kernels_;
     compileSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return p;
@@ -219,8 +227,20 @@ GlslBackend::Program& GlslBackend::childrenProgram(const ir::Object& object, con
 void GlslBackend::prepare(const rt::Plan& plan) {
     if (std::this_thread::get_id() != owner_) return;
     if (context_) context_->makeCurrent();
-    for (const auto& r : plan.rows) rowsProgram(*r.object, *r.kernel, r.now, r.dt);
-    for (const auto& c : plan.children) childrenProgram(*c.object, *c.spawn);
+    preparing_ = true;
+    try {
+        for (const auto& r : plan.rows) rowsProgram(*r.object, *r.kernel, r.now, r.dt);
+        for (const auto& c : plan.children) childrenProgram(*c.object, *c.spawn);
+    } catch (...) {
+        preparing_ = false;
+        throw;
+    }
+    preparing_ = false;
+    auto start = std::chrono::steady_clock::now();
+    std::vector<Unfinished> unfinished = std::move(unfinished_);
+    unfinished_.clear();
+    for (const Unfinished& u : unfinished) compiler_->finish(u.program, u.source, u.what);
+    compileSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 void GlslBackend::forget(const ir::Module& module) {
@@ -268,6 +288,7 @@ void GlslBackend::dispatch(Program& program, const std::vector<uint32_t>& block,
         glBeginQuery(GL_TIME_ELAPSED, query_);
     }
     dispatchInvocations(count, codegen_glsl::kWorkGroupSize);
+    ++memory_.dispatches;
     if (timing_) {
         glEndQuery(GL_TIME_ELAPSED);
         glFinish();
@@ -292,6 +313,20 @@ void GlslBackend::setHostSide(std::unique_ptr<rt::Backend> host, size_t rows) {
     memory_.hostRows = hostRows_;
 }
 
+// A late launch's kills cleared in its alive mask (Backend::clearsKilled) where the host
+// side ran it, as clearKilled does on the GPU: the run-time may take them at the next step
+// (when another late launch of the step is still owed), and what is drawn before must
+// leave them out (objects that died in their first update were drawn on the GPU).
+void GlslBackend::hostClearKilled(const rt::RowsLaunch& launch) {
+    const auto* flags = static_cast<const uint8_t*>(memory_.view(launch.columns[ColumnLayout::kKill]));
+    uint8_t zero = 0;
+    for (size_t i = launch.begin; i < launch.end; ++i) {
+        if (!flags[i]) continue;
+        size_t row = launch.aliveRows.empty() ? i : launch.aliveRows[i - launch.aliveRowsFirst];
+        memory_.write(launch.aliveMask, row, 1, &zero);
+    }
+}
+
 bool GlslBackend::onHost(std::span<const Buffer> columns, Buffer mask, size_t rows) const {
     if (!hostSide_ || rows > hostRows_) return false;
     auto there = [&](Buffer b) { return !b.valid() || !memory_.onDevice(b); };
@@ -299,11 +334,17 @@ bool GlslBackend::onHost(std::span<const Buffer> columns, Buffer mask, size_t ro
 }
 
 rt::RowsResult GlslBackend::run(const rt::RowsLaunch& launch) {
-    if (!launch.late && launch.kernel->kind != ir::KernelKind::Render && onHost(launch.columns, launch.mask, launch.end)) {
+    if (onHost(launch.columns, launch.mask, launch.end - launch.begin)) {
         ++hostLaunches_;
-        return hostSide_->run(launch);
+        rt::RowsResult result = hostSide_->run(launch);
+        if (launch.kernel->kind == ir::KernelKind::Render)  // this backend marks what is drawn
+            rt::markDrawn(memory_, launch, static_cast<const uint8_t*>(memory_.view(launch.mask)), launch.begin,
+                          launch.end, result);
+        if (launch.late && launch.aliveMask.valid() && result.killed) hostClearKilled(launch);
+        return result;
     }
     if (context_) context_->makeCurrent();
+    memory_.flushPending();  // before anything is bound
     Program& p = rowsProgram(*launch.object, *launch.kernel, launch.clock.now, launch.clock.dt);
     // Rows per dispatch: as many as the largest storage block the GL binds holds, for the
     // launch's words (the columns not bound in place, and a row of zeros) and for each
@@ -447,6 +488,7 @@ void GlslBackend::run(const rt::ChildrenLaunch& launch) {
         return;
     }
     if (context_) context_->makeCurrent();
+    memory_.flushPending();  // before anything is bound
     Program& p = childrenProgram(*launch.object, *launch.spawn);
     const ir::Object& o = *launch.object;
     const ColumnLayout& l = *launch.layout;
@@ -488,11 +530,24 @@ void GlslBackend::run(const rt::ChildrenLaunch& launch) {
     for (size_t c = 0; c < columns; ++c) memory_.adopt(launch.args[c], launch.argsFirst, n, words_, c * n);
 }
 
+bool GlslBackend::parallelCompile() {
+    if (!compiler_) compiler_ = std::make_unique<ProgramCompiler>();
+    return compiler_->parallel;
+}
+
+bool GlslBackend::programBinaries() {
+    if (!compiler_) compiler_ = std::make_unique<ProgramCompiler>();
+    return compiler_->binaries;
+}
+
+size_t GlslBackend::programsLoaded() const { return compiler_ ? compiler_->loaded : 0; }
+
 rt::BackendReport GlslBackend::report() const {
     rt::BackendReport r;
     r.target = renderer_;
     r.kernels = kernels_;
     r.compileSeconds = compileSeconds_;
+    r.fromDisk = compiler_ ? compiler_->loaded : 0;
     r.device = true;
     r.waits = memory_.waits;
     r.transferredBytes = memory_.transferred;

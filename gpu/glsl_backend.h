@@ -28,6 +28,7 @@
 namespace psys::gpu {
 
 class HeadlessContext;
+class ProgramCompiler;
 
 class GlslBackend final : public rt::Backend {
 public:
@@ -64,6 +65,13 @@ public:
     // At most this many rows per dispatch (else as many as a storage block holds): for
     // tests, which cannot reach the GL's limit.
     void limitDispatchRows(size_t rows) { dispatchRows_ = rows; }
+    // Whether the driver compiles programs in parallel, and gives program binaries to keep
+    // on disk (gpu/gl_programs.h); how many programs came from that cache.
+    bool parallelCompile();
+    bool programBinaries();
+    size_t programsLoaded() const;
+    // Compute dispatches so far (kernels, compactions, scatters, gathers, clearings).
+    uint64_t dispatches() const { return memory_.dispatches; }
     // Bytes moved between the host and the GPU so far, either way.
     uint64_t transferredBytes() const { return memory_.transferred; }
     // Bytes launches copied on the GPU into and out of their words so far (GlMemory::staged).
@@ -80,12 +88,14 @@ public:
 
     // A backend that runs launches on the host over this backend's memory (an interpreter:
     // host/backends.cpp makes it), and the rows up to which a launch runs there: a launch
-    // the step would wait for (not late, not a draw) over at most `rows` rows, or a spawn
-    // of at most `rows` children, whose columns are all on the host. The few objects that
-    // emit — a launcher, a comet, rockets — then stay on the host, as emitters do in the
-    // big engines, and the step need not wait for the GPU to learn what they kill and emit;
-    // their many particles run on the GPU. Data decides: a pool whose columns are on the
-    // GPU stays there (GlMemory::hostRows: scatters into small pools on the host stay there).
+    // over at most `rows` rows, or a spawn of at most `rows` children, whose columns are
+    // all on the host. The few objects that emit — a launcher, a comet, rockets — then
+    // stay on the host, as emitters do in the big engines, and the step need not wait for
+    // the GPU to learn what they kill and emit; their many particles run on the GPU. So do
+    // small pools of particles and the one-row batches of a burst chain: a launch costs a
+    // dispatch or more on the GPU, a few rows cost microseconds here. Data decides: a
+    // pool whose columns are on the GPU stays there (GlMemory::hostRows: scatters into
+    // small pools on the host stay there).
     void setHostSide(std::unique_ptr<rt::Backend> host, size_t rows = kHostRows);
     static constexpr size_t kHostRows = 64;
     // Launches run by the host side so far.
@@ -126,6 +136,7 @@ private:
     // A late launch's kills cleared in its aliveMask on the GPU (rt::Backend::clearsKilled),
     // from the kill flags at word `flags` of the launch's words.
     void clearKilled(const rt::RowsLaunch& launch, size_t begin, size_t n, uint32_t flags);
+    void hostClearKilled(const rt::RowsLaunch& launch);
     void ensureWords(size_t words);
     bool onHost(std::span<const rt::Buffer> columns, rt::Buffer mask, size_t rows) const;
 
@@ -152,6 +163,13 @@ private:
     std::unique_ptr<rt::Backend> hostSide_;
     size_t hostRows_ = 0;
     uint64_t hostLaunches_ = 0;
+    std::unique_ptr<ProgramCompiler> compiler_;  // made on first use, on the context's thread
+    bool preparing_ = false;
+    struct Unfinished {
+        unsigned program;
+        std::string source, what;
+    };
+    std::vector<Unfinished> unfinished_;  // begun while preparing a plan, finished at its end
     size_t kernels_ = 0;
     double compileSeconds_ = 0;
     std::string renderer_;

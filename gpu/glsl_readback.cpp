@@ -94,8 +94,10 @@ rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program
     size_t at = reserveReadback(words);
     if (p.counts) glCopyNamedBufferSubData(counts_, readback_, 0, static_cast<GLintptr>(at * 4), 16);
     if (p.counts) afterWrite(Write::Copy, kHostMap);
-    if (kills)
+    if (kills) {
         compactor_.compact(words_, block[LaunchBlock::kColumns + ColumnLayout::kKill], n, readback_, at + kKillsAt);
+        memory_.dispatches += 3;  // its passes
+    }
     for (const Returned& r : returned)
         glCopyNamedBufferSubData(words_, readback_, static_cast<GLintptr>(r.from * 4),
                                  static_cast<GLintptr>((at + r.at) * 4),
@@ -220,6 +222,7 @@ void GlslBackend::clearKilled(const rt::RowsLaunch& launch, size_t begin, size_t
     bindParams(params_, {static_cast<uint32_t>(n), flags, static_cast<uint32_t>(begin),
                          static_cast<uint32_t>(mapped ? begin - launch.aliveRowsFirst : 0), mapped ? 1u : 0u});
     dispatchInvocations(n, 64);
+    ++memory_.dispatches;
     afterWrite(Write::Dispatch, kColumnReaders);  // the mask: the draws read it (in place, a texture, a copy)
     memory_.written(launch.aliveMask);
 }

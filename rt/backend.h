@@ -68,6 +68,15 @@ struct RowsResult {
     uint64_t ticket = 0;
 };
 
+// What is drawn, one rule for every backend: a row of a render launch is drawn when it is
+// in `mask` (alive), visible, and its position, colour and size are all finite; the
+// visible column is rewritten to 1 or 0, and the rows drawn and those not drawn for a NaN
+// or an infinity are added to `result`. The run-time applies it after the launches of a
+// backend that does not mark drawn rows itself (Backend::marksDrawn), and the GLSL
+// backend to the render launches its host side runs.
+void markDrawn(Memory& memory, const RowsLaunch& launch, const uint8_t* mask, size_t begin, size_t end,
+               RowsResult& result);
+
 struct ChildrenLaunch {
     const ir::Object* object = nullptr;     // the emitter's type
     const ir::Kernel* spawn = nullptr;

@@ -6,6 +6,35 @@
 
 #include "rt/system_support.h"
 
+namespace psys::rt {
+
+void markDrawn(Memory& memory, const RowsLaunch& launch, const uint8_t* mask, size_t begin, size_t end,
+               RowsResult& result) {
+    const ColumnLayout& layout = *launch.layout;
+    auto column = [&](int c) { return launch.columns[static_cast<size_t>(layout.drawnFrom(c))]; };
+    float* visible = hostData<float>(memory, column(ColumnLayout::kVisible));
+    const float* values[8] = {};
+    bool constantsFinite = true;  // the constant components: the same for every row
+    for (int c = 0; c < 8; ++c) {
+        if (auto k = layout.constant(ColumnLayout::kPosition + c)) constantsFinite &= std::isfinite(*k);
+        else values[c] = viewData<float>(memory, column(ColumnLayout::kPosition + c));
+    }
+    for (size_t row = begin; row < end; ++row) {
+        if (!mask[row] || visible[row] == 0) {
+            visible[row] = 0;
+            continue;
+        }
+        bool finite = constantsFinite;
+        for (const float* v : values)
+            if (v) finite &= std::isfinite(v[row]);
+        visible[row] = finite ? 1.0f : 0.0f;
+        result.drawn += finite;
+        result.nonFinite += !finite;
+    }
+}
+
+}  // namespace psys::rt
+
 namespace psys::rt::detail {
 
 RowsLaunch renderLaunch(State& s, size_t type, std::span<const Buffer> table, Buffer mask, double now) {
@@ -35,27 +64,10 @@ DrawnCount renderRows(State& s, size_t type, const RowsLaunch& launch, const uin
     RowsResult result = s.backend.run(part);
     DrawnCount count{result.drawn, result.nonFinite, result.ticket};
     if (s.backend.marksDrawn()) return count;  // its render columns stay where it computed them
-    // Drawn: alive, visible, and position, colour and size all finite.
-    auto column = [&](int c) { return launch.columns[static_cast<size_t>(layout.drawnFrom(c))]; };
-    float* visible = s.host<float>(column(ColumnLayout::kVisible));
-    const float* values[8] = {};
-    bool constantsFinite = true;  // the constant components: the same for every row
-    for (int c = 0; c < 8; ++c) {
-        if (auto k = layout.constant(ColumnLayout::kPosition + c)) constantsFinite &= std::isfinite(*k);
-        else values[c] = s.view<float>(column(ColumnLayout::kPosition + c));
-    }
-    for (size_t row = begin; row < end; ++row) {
-        if (!mask[row] || visible[row] == 0) {
-            visible[row] = 0;
-            continue;
-        }
-        bool finite = constantsFinite;
-        for (const float* v : values)
-            if (v) finite &= std::isfinite(v[row]);
-        visible[row] = finite ? 1.0f : 0.0f;
-        count.drawn += finite;
-        count.nonFinite += !finite;
-    }
+    RowsResult marked;
+    markDrawn(s.memory, part, mask, begin, end, marked);
+    count.drawn += marked.drawn;
+    count.nonFinite += marked.nonFinite;
     return count;
 }
 

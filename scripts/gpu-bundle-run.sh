@@ -18,7 +18,7 @@ if ! info=$("$bin/psysc" run --backend glsl --timing --quiet --frames 1 "$here/s
   echo "run.sh: no OpenGL 4.5 to run on (above: why)" >&2
   exit 2
 fi
-echo "GL: $(echo "$info" | sed -n 's/^compiled [0-9]* kernels in [0-9.]* ms (\(.*\), [a-z]* math)$/\1/p')"
+echo "GL: $(echo "$info" | sed -n 's/^compiled [0-9]* kernels in [0-9.]* ms (\(.*\), [a-z]* math.*)$/\1/p')"
 
 what=${1:-}
 shift || true
