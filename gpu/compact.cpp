@@ -1,6 +1,7 @@
 #include "gpu/compact.h"
 
 #include "gpu/gl_context.h"
+#include "gpu/gl_programs.h"
 #include "gpu/hazards.h"
 #include "codegen_glsl/glsl_shaders.h"
 

@@ -68,39 +68,6 @@ bool HeadlessContext::makeCurrent() {
 
 bool contextCurrent() { return eglGetCurrentContext() != EGL_NO_CONTEXT; }
 
-unsigned computeProgram(const std::string& source, const std::string& what) {
-    auto log = [](GLuint object, bool isProgram) {
-        GLint length = 0;
-        isProgram ? glGetProgramiv(object, GL_INFO_LOG_LENGTH, &length) : glGetShaderiv(object, GL_INFO_LOG_LENGTH, &length);
-        std::string text(static_cast<size_t>(std::max(length, 1)), '\0');
-        isProgram ? glGetProgramInfoLog(object, length, nullptr, text.data())
-                  : glGetShaderInfoLog(object, length, nullptr, text.data());
-        return text;
-    };
-    GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
-    const char* text = source.c_str();
-    glShaderSource(shader, 1, &text, nullptr);
-    glCompileShader(shader);
-    GLint ok = 0;
-    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        std::string message = log(shader, false);
-        glDeleteShader(shader);
-        throw std::runtime_error("the GL did not compile the shader of " + what + ":\n" + message);
-    }
-    GLuint program = glCreateProgram();
-    glAttachShader(program, shader);
-    glLinkProgram(program);
-    glDeleteShader(shader);
-    glGetProgramiv(program, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        std::string message = log(program, true);
-        glDeleteProgram(program);
-        throw std::runtime_error("the GL did not link the shader of " + what + ":\n" + message);
-    }
-    return program;
-}
-
 void checkAllocation(const char* what, size_t bytes) {
     bool outOfMemory = false;
     for (GLenum error = glGetError(); error != GL_NO_ERROR; error = glGetError()) outOfMemory |= error == GL_OUT_OF_MEMORY;

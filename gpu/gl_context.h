@@ -29,9 +29,6 @@ private:
 // Whether the calling thread has a current EGL context (the viewer's, for one).
 bool contextCurrent();
 
-// A linked program of one compute shader; throws std::runtime_error with the GL's log,
-// naming `what`, when the GL does not compile or link it (a fault of ours, not the user's).
-unsigned computeProgram(const std::string& source, const std::string& what);
 
 // Throws std::runtime_error naming `what` when the GL could not give a buffer its storage
 // (GL_OUT_OF_MEMORY): a buffer without storage would read zeros and drop writes.

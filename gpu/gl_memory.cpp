@@ -1,6 +1,7 @@
 #include "gpu/gl_memory.h"
 
 #include "gpu/gl_context.h"
+#include "gpu/gl_programs.h"
 #include "gpu/hazards.h"
 
 #include <algorithm>

@@ -42,7 +42,14 @@ std::string infoLog(GLuint object, bool isProgram) {
 
 }  // namespace
 
-ProgramCompiler::ProgramCompiler() {
+unsigned computeProgram(const std::string& source, const std::string& what) {
+    ProgramCompiler compiler(false);
+    unsigned program = compiler.begin(source);
+    compiler.finish(program, source, what);
+    return program;
+}
+
+ProgramCompiler::ProgramCompiler(bool cache) {
     renderer_ = rendererName();
     if (epoxy_has_gl_extension("GL_KHR_parallel_shader_compile")) {
         glMaxShaderCompilerThreadsKHR(0xFFFFFFFFu);  // as many as the driver likes
@@ -53,7 +60,7 @@ ProgramCompiler::ProgramCompiler() {
     }
     GLint formats = 0;
     glGetIntegerv(GL_NUM_PROGRAM_BINARY_FORMATS, &formats);
-    directory_ = cacheDirectory();
+    if (cache) directory_ = cacheDirectory();
     binaries = formats > 0 && !directory_.empty();
 }
 

@@ -18,10 +18,15 @@
 
 namespace psys::gpu {
 
+// A linked program of one compute shader (the backend's own utility shaders: no cache);
+// throws std::runtime_error with the GL's log, naming `what`, when the GL does not
+// compile or link it (a fault of ours, not the user's).
+unsigned computeProgram(const std::string& source, const std::string& what);
+
 class ProgramCompiler {
 public:
-    // On the current context.
-    ProgramCompiler();
+    // On the current context; `cache`: keep binaries on disk where the driver gives them.
+    explicit ProgramCompiler(bool cache = true);
     // A program for `source`: loaded from the cache, or compiled and linked (not waited for).
     unsigned begin(const std::string& source);
     // Waits for it; throws std::runtime_error with the GL's log, naming `what`, where it

@@ -18,6 +18,7 @@
 #include <epoxy/gl.h>
 
 #include "gpu/gl_context.h"
+#include "gpu/gl_programs.h"
 #include "gpu/glsl_program.h"
 #include "gpu/hazards.h"
 
