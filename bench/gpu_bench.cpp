@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "gpu_figures.h"
+#include "gpu_stress.h"
 #include "interp/interpreter.h"
 
 using namespace psys;
@@ -30,7 +31,11 @@ int main(int argc, char** argv) {
     size_t hostRows = gpu::GlslBackend::kHostRows;
     app.add_option("--host-rows", hostRows,
                    "Launches over at most this many rows run on the host when their columns are there (64; 0: none)");
+    bool stress = false;
+    app.add_flag("--stress", stress,
+                 "The hostile shapes instead: burst chains and many types, against the interpreter (docs/gpu.md)");
     CLI11_PARSE(app, argc, argv);
+    if (stress) return bench::stressFigures(std::cout, frames);
 
     std::string error;
     auto gpu = gpu::GlslBackend::create(error);
