@@ -5,12 +5,14 @@
 //
 // It links no LLVM: it is built to be copied, with the few shared libraries `ldd` lists,
 // to a GPU machine that has none of this build (docs/gpu.md).
+#include <fstream>
 #include <iostream>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "gpu_figures.h"
 #include "gpu_stress.h"
@@ -31,6 +33,8 @@ int main(int argc, char** argv) {
     size_t hostRows = gpu::GlslBackend::kHostRows;
     app.add_option("--host-rows", hostRows,
                    "Launches over at most this many rows run on the host when their columns are there (64; 0: none)");
+    std::string json;
+    app.add_option("--json", json, "Also write the figures as JSON, a list of rows (bench/README.md names the fields)");
     bool stress = false;
     app.add_flag("--stress", stress,
                  "The hostile shapes instead: burst chains and many types, against the interpreter (docs/gpu.md)");
@@ -51,8 +55,9 @@ int main(int argc, char** argv) {
     if (renderer.find("llvmpipe") != std::string::npos)
         std::cout << "# llvmpipe computes the shaders on the CPU: these figures say the backend works, not how fast a "
                      "GPU runs it\n";
-    std::cout << "\n| effect | live | step (ms) | M updates/s | update pass (ms) | other passes (ms) | state B/particle | "
-                 "update pass GB/s | host↔GPU B/particle/step | staged B/particle/step | waits/step | late/step (stalled) |\n|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|\n";
+    nlohmann::json rows = nlohmann::json::array();
+    std::cout << "\n| effect | live | step (ms) | host CPU (ms) | M updates/s | update pass (ms) | other passes (ms) | state B/particle | "
+                 "update pass GB/s | host↔GPU B/particle/step | staged B/particle/step | waits/step | late/step (stalled) |\n|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|\n";
     for (const std::string& name : effects) {
         const bench::Effect* effect = bench::findEffect(name);
         if (!effect) {
@@ -65,15 +70,31 @@ int main(int argc, char** argv) {
             for (const auto& [pass, ms] : f.passMilliseconds)
                 if (pass != "update") others += fmt::format("{}{} {:.2f}", others.empty() ? "" : ", ", pass, ms);
             double gbs = f.updateMilliseconds > 0 ? f.stateBytes * f.live / (f.updateMilliseconds * 1e-3) / 1e9 : 0;
-            std::cout << fmt::format("| {} | {:.2g} | {:.2f} | {:.1f} | {:.2f}{} | {} | {:.0f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} ({:.1f}) |\n", name,
-                                     f.live, f.stepSeconds * 1e3, f.perSecond / 1e6, f.updateMilliseconds,
+            double passes = 0;
+            for (const auto& [pass, ms] : f.passMilliseconds) passes += ms;
+            rows.push_back({{"effect", name}, {"particles", f.live}, {"step_ms", f.stepSeconds * 1e3},
+                            {"passes_ms", passes}, {"passes_wall", f.wallPasses}, {"host_cpu_ms", f.hostCpuSeconds * 1e3},
+                            {"mups", f.perSecond / 1e6}, {"update_ms", f.updateMilliseconds},
+                            {"update_gbs", gbs}, {"state_bytes", f.stateBytes}, {"transfer_bytes", f.transferBytes},
+                            {"staged_bytes", f.stagedBytes}, {"waits", f.waits}, {"late_reads", f.lateReads},
+                            {"late_stalls", f.lateStalls}, {"renderer", renderer}});
+            std::cout << fmt::format("| {} | {:.2g} | {:.2f} | {:.2f} | {:.1f} | {:.2f}{} | {} | {:.0f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} ({:.1f}) |\n", name,
+                                     f.live, f.stepSeconds * 1e3, f.hostCpuSeconds * 1e3, f.perSecond / 1e6, f.updateMilliseconds,
                                      f.wallPasses ? " (wall)" : "", others,
                                      f.stateBytes, gbs, f.transferBytes, f.stagedBytes, f.waits, f.lateReads,
                                      f.lateStalls);
             std::cout.flush();
         }
     }
-    std::cout << "\n(passes: GPU time from GL timer queries, or \"wall\": from a glFinish before the pass to one after, "
+    if (!json.empty()) {
+        std::ofstream out(json);
+        out << rows.dump(2) << "\n";
+        if (!out) {
+            std::cerr << "psys_gpu_bench: cannot write " << json << "\n";
+            return 1;
+        }
+    }
+    std::cout << "\n(host CPU: the CPU time of the thread that steps, the GL driver's threads not counted; passes: GPU time from GL timer queries, or \"wall\": from a glFinish before the pass to one after, "
                  "where the GL's timer does not see compute work; state B/particle: what the update pass must read and "
                  "write; update pass GB/s: that ÷ the pass's time; staged: copied on the GPU into and out of launches' words, beyond what the shaders move; waits/step: read-backs the host waited for mid-step; late/step: read-backs taken when the run-time needed them (kills at the step's end), and in brackets those the GPU had not finished by then)\n";
     return 0;

@@ -1,5 +1,7 @@
 #include "gpu_figures.h"
 
+#include <time.h>
+
 #include "rt/system.h"
 
 namespace psys::bench {
@@ -16,13 +18,20 @@ GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::G
     GpuFigures out;
     out.stateBytes = stateBytes(system.module().objects[type]);
     // Wall times with the GPU untimed (a timer query waits for its pass), then the passes.
-    std::vector<double> times;
+    std::vector<double> times, cpu;
+    auto threadSeconds = [] {
+        timespec t{};
+        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+        return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_nsec) * 1e-9;
+    };
     double live = 0;
     uint64_t transferred = gpu.transferredBytes(), waits = gpu.waits(), staged = gpu.stagedBytes();
     uint64_t lateReads = gpu.lateReads(), lateStalls = gpu.lateStalls();
     for (int f = 0; f < frames; ++f) {
         auto start = Clock::now();
+        double cpuStart = threadSeconds();
         system.step(1.0 / 60);
+        cpu.push_back(threadSeconds() - cpuStart);
         times.push_back(seconds(start, Clock::now()));
         live += static_cast<double>(system.pool(type).live());
     }
@@ -33,6 +42,7 @@ GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::G
     out.lateStalls = static_cast<double>(gpu.lateStalls() - lateStalls) / frames;
     out.stagedBytes = static_cast<double>(gpu.stagedBytes() - staged) / frames / std::max(out.live, 1.0);
     out.stepSeconds = median(times);
+    out.hostCpuSeconds = median(cpu);
     out.perSecond = out.live / out.stepSeconds;
     auto before = gpu.passTimes();
     gpu.timePasses(true);

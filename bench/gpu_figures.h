@@ -13,6 +13,8 @@ namespace psys::bench {
 struct GpuFigures {
     double live = 0;
     double stepSeconds = 0;        // median wall time of a step (everything, host included)
+    double hostCpuSeconds = 0;     // median CPU time of the host's thread in a step (CLOCK_THREAD_CPUTIME_ID:
+                                   // the GL driver's own threads, llvmpipe's workers among them, not counted)
     double perSecond = 0;          // particle updates per second: live ÷ stepSeconds
     double updateMilliseconds = 0; // GPU time of the update pass per step (timer queries)
     std::map<std::string, double> passMilliseconds;  // every pass, per step
