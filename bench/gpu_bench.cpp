@@ -41,14 +41,8 @@ int main(int argc, char** argv) {
     CLI11_PARSE(app, argc, argv);
     if (stress) return bench::stressFigures(std::cout, frames);
 
-    std::string error;
-    auto gpu = gpu::GlslBackend::create(error);
-    if (!gpu) {
-        std::cerr << "psys_gpu_bench: " << error << "\n";
-        return 1;
-    }
-    if (hostRows > 0)  // the emitters (few rows) on the host
-        gpu->setHostSide(std::make_unique<interp::Interpreter>(gpu->memory()), hostRows);
+    auto gpu = bench::gpuBackend("psys_gpu_bench", hostRows);  // the emitters (few rows) on the host
+    if (!gpu) return 1;
     std::string renderer = gpu->report().target;
     std::cout << fmt::format("# psys_gpu_bench on {}, {} timed steps per figure (median), host side: {}\n", renderer,
                              frames, hostRows > 0 ? fmt::format("launches of at most {} rows", hostRows) : "off");

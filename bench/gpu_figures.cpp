@@ -2,9 +2,24 @@
 
 #include <time.h>
 
+#include <iostream>
+
+#include "interp/interpreter.h"
+
 #include "rt/system.h"
 
 namespace psys::bench {
+
+std::unique_ptr<gpu::GlslBackend> gpuBackend(const char* who, size_t hostRows) {
+    std::string error;
+    auto gpu = gpu::GlslBackend::create(error);
+    if (!gpu) {
+        std::cerr << who << ": " << error << "\n";
+        return nullptr;
+    }
+    if (hostRows > 0) gpu->setHostSide(std::make_unique<interp::Interpreter>(gpu->memory()), hostRows);
+    return gpu;
+}
 
 GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::GlslBackend& gpu) {
     double knob = calibrate(effect, gpu, particles);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <map>
+#include <memory>
 #include <string>
 
 #include "effects.h"
@@ -25,6 +26,11 @@ struct GpuFigures {
     double lateReads = 0, lateStalls = 0;  // per step: read-backs taken at the step's end; of them, not ready
     double stagedBytes = 0;        // per particle per step, copied on the GPU into and out of launches' words
 };
+
+// The GLSL backend as psysc and the viewer make it, its host side taking launches of at
+// most `hostRows` rows (0: none); null, with the GL's reason printed after `who`, where
+// there is no OpenGL 4.5.
+std::unique_ptr<gpu::GlslBackend> gpuBackend(const char* who, size_t hostRows = gpu::GlslBackend::kHostRows);
 
 // Runs `effect` to its steady population of about `particles` on `gpu`, then times `frames` steps.
 GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::GlslBackend& gpu);

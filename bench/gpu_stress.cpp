@@ -8,7 +8,7 @@
 
 #include "driver/compile.h"
 #include "effects.h"
-#include "gpu/glsl_backend.h"
+#include "gpu_figures.h"
 #include "interp/interpreter.h"
 #include "rt/system.h"
 
@@ -58,13 +58,8 @@ int stressFigures(std::ostream& out, int frames) {
     out << fmt::format("\n| shape ({} frames, drawn each) | GLSL backend (s) | interpreter (s) | GLSL ÷ interpreter |\n"
                        "|---|---:|---:|---:|\n", frames);
     for (const Shape& s : shapes) {
-        std::string error;
-        auto gpu = gpu::GlslBackend::create(error);
-        if (!gpu) {
-            std::cerr << "psys_gpu_bench: " << error << "\n";
-            return 1;
-        }
-        gpu->setHostSide(std::make_unique<interp::Interpreter>(gpu->memory()));
+        auto gpu = gpuBackend("psys_gpu_bench");
+        if (!gpu) return 1;
         interp::Interpreter interpreter;
         double g = run(s.text, *gpu, frames), i = run(s.text, interpreter, frames);
         if (g < 0 || i < 0) return 1;

@@ -316,13 +316,8 @@ int main(int argc, char** argv) {
               << breakdown << "\n";
 
     if (gpuToo) {
-        std::string error;
-        auto gpu = gpu::GlslBackend::create(error);
-        if (!gpu) {
-            std::cerr << "psys_bench: --gpu: " << error << "\n";
-            return 1;
-        }
-        gpu->setHostSide(std::make_unique<interp::Interpreter>(gpu->memory()));
+        auto gpu = bench::gpuBackend("psys_bench: --gpu");
+        if (!gpu) return 1;
         std::cout << fmt::format("The GLSL backend on {} beside the JIT on {} cores (psys_gpu_bench has the passes):\n\n",
                                  gpu->report().target, cores)
                   << "| effect | live | JIT (M/s) | GLSL (M/s) | GLSL / JIT | GLSL update pass (ms) |\n|---|---:|---:|---:|---:|---:|\n";
