@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <iostream>
@@ -26,6 +27,7 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -194,6 +196,7 @@ int main(int argc, char** argv) {
     bool gpuToo = false;
     bool memory = false;
     int compileRuns = 5;
+    std::string json;
     app.add_option("--particles", sizes, "Live particles per effect (1e6 1e7)");
     app.add_option("--frames", frames, "Timed steps per measurement; the median counts (15)")->check(CLI::Range(5, 100000));
     app.add_option("--effects", effects, "fountain fire fireworks");
@@ -203,6 +206,7 @@ int main(int argc, char** argv) {
     app.add_flag("--gpu", gpuToo, "Also run the GLSL backend on each effect and size, beside the JIT");
     app.add_flag("--memory", memory, "Only the peak memory of each effect and size, each in a process of its own");
     app.add_option("--compile-runs", compileRuns, "Compiles per sample; the median counts (5)")->check(CLI::PositiveNumber);
+    app.add_option("--json", json, "Also write the JIT's figures as JSON, a list of rows (bench/README.md names the fields)");
     CLI11_PARSE(app, argc, argv);
     if (memory) return memoryTable(effects, sizes, frames);
 
@@ -215,6 +219,7 @@ int main(int argc, char** argv) {
                              bandwidthAll / 1e9, cores);
 
     std::string breakdown;
+    nlohmann::json rows = nlohmann::json::array();
     std::map<std::pair<std::string, double>, Rate> jitAllCores;  // for --gpu
     std::cout << "| effect | live | threads | psys JIT | hand SoA | hand AoS | JIT / SoA | JIT / AoS | bound | JIT / bound |\n";
     std::cout << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
@@ -298,12 +303,36 @@ int main(int argc, char** argv) {
                     created > 0 ? (after.createSeconds - before.createSeconds) * 1e9 / created : 0.0, drawMs, inDrawMs,
                     100 * drawMs / stepMs, s.live, a.live);
                 double bound = (threads == 1 ? bandwidth1 : bandwidthAll) / bytes;
+                rows.push_back({{"effect", name},
+                                {"particles", j.live},
+                                {"threads", threads},
+                                {"jit_mups", j.perSecond / 1e6},
+                                {"soa_mups", s.perSecond / 1e6},
+                                {"aos_mups", a.perSecond / 1e6},
+                                {"jit_over_soa", j.perSecond / s.perSecond},
+                                {"bound_mups", bound / 1e6},
+                                {"step_ms", stepMs},
+                                {"update_ms", (after.loopSeconds - before.loopSeconds) * 1e3 / steps},
+                                {"kills_emissions_ms", (after.emitSeconds - before.emitSeconds) * 1e3 / steps},
+                                {"creation_ms", (after.createSeconds - before.createSeconds) * 1e3 / steps},
+                                {"created_per_step", created / steps},
+                                {"creation_ns", created > 0 ? (after.createSeconds - before.createSeconds) * 1e9 / created : 0.0},
+                                {"drawing_ms", drawMs},
+                                {"drawing_share", drawMs / stepMs}});
                 std::cout << fmt::format("| {} | {:.2g} | {} | {:.0f} | {:.0f} | {:.0f} | {:.2f} | {:.2f} | {:.0f} | {:.0f}% |\n",
                                          name, j.live, threads, j.perSecond / 1e6, s.perSecond / 1e6,
                                          a.perSecond / 1e6, j.perSecond / s.perSecond, j.perSecond / a.perSecond,
                                          bound / 1e6, 100 * j.perSecond / bound);
                 std::cout.flush();
             }
+        }
+    }
+    if (!json.empty()) {
+        std::ofstream out(json);
+        out << rows.dump(2) << "\n";
+        if (!out) {
+            std::cerr << "psys_bench: cannot write " << json << "\n";
+            return 1;
         }
     }
     std::cout << "\n(million particle updates per second; bound: triad bandwidth ÷ the bytes psys's update loop "
