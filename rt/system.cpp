@@ -63,6 +63,7 @@ System::System(ir::Module module, Backend& backend, SystemOptions options)
     : state_(std::make_unique<detail::State>(std::move(module), backend, options)),
       creation_(std::make_unique<detail::Creation>(*state_)),
       drawing_(std::make_unique<detail::Drawing>(*state_)) {
+    state_->schedule = detail::stepSchedule(*state_);
     backend.prepare(launchPlan(state_->module));
 }
 
@@ -89,6 +90,7 @@ const SystemOptions& System::options() const { return state_->options; }
 const Pool& System::pool(size_t type) const { return state_->pools[type]; }
 size_t System::typeCount() const { return state_->pools.size(); }
 Backend& System::backend() const { return state_->backend; }
+const Schedule& System::schedule() const { return state_->schedule; }
 int System::typeIndex(std::string_view name) const { return state_->module.objectIndex(std::string(name)); }
 int System::externHandle(std::string_view name) const { return state_->module.externIndex(std::string(name)); }
 
@@ -109,6 +111,51 @@ void System::finish() {
     drawing_->takeCounts();
 }
 
+// The executor of the schedule (rt/schedule.h) on any backend: phases [first, end) of a
+// step, or of one of its sub-steps, over (t1 − dt, t1]; `last`: the sub-step ending the step.
+void System::runPhases(size_t first, size_t end, double dt, double t1, bool last) {
+    detail::State& s = *state_;
+    const std::vector<Phase>& phases = s.schedule.phases;
+    for (size_t i = first; i < end; ++i) {
+        const Phase& p = phases[i];
+        auto type = static_cast<size_t>(p.type);
+        auto start = WallClock::now();
+        switch (p.kind) {
+            case PhaseKind::Settle: break;  // before a step's time is known (step)
+            case PhaseKind::Ready:
+                for (Pool& pool : s.pools) pool.beginStep();
+                break;
+            case PhaseKind::SubSteps: {
+                // Sub-steps of equal length, each a pass over the pool: an object killed in one
+                // takes no more, and what it emits in each is queued in (sub-step, row) order.
+                uint32_t n = detail::subStepCount(dt, p.stepLimit, s.typeStats[type].cappedSubSteps);
+                double t0 = t1 - dt;
+                for (uint32_t k = 1; k <= n; ++k)
+                    runPhases(i + 1, i + 1 + p.span, dt / n, k == n ? t1 : t0 + dt * (static_cast<double>(k) / n),
+                              last && k == n);
+                i += p.span;
+                continue;
+            }
+            case PhaseKind::Update:
+                detail::runUpdate(s, type, dt, t1, last);
+                if (last) s.work[type].inStep.updated = true;
+                s.stats.loopSeconds += seconds(start, WallClock::now());
+                continue;
+            case PhaseKind::Kills: detail::runKills(s, type, dt, t1); break;
+            case PhaseKind::Emissions: detail::runEmissions(s, *creation_, type, dt, t1); break;
+            case PhaseKind::Create:
+                creation_->drain(t1);
+                s.stats.createSeconds += seconds(start, WallClock::now());
+                continue;
+            case PhaseKind::Release:
+                s.now = t1;  // the time moves on
+                s.endStep();
+                break;
+        }
+        s.stats.emitSeconds += seconds(start, WallClock::now());
+    }
+}
+
 std::optional<std::string> System::step(double dt) {
     detail::State& s = *state_;
     if (!std::isfinite(dt) || dt < 0) {
@@ -116,8 +163,8 @@ std::optional<std::string> System::step(double dt) {
         return fmt::format("a step must be a finite, non-negative number of seconds, not {}", dt);
     }
     start();
-    // What a device still owes, before anything is updated: the last step's deaths (their
-    // rows freed), and those of triggers since (they are updated no more).
+    // What a device still owes, before anything is updated (the schedule's settle): the last
+    // step's deaths (their rows freed), and those of triggers since (they are updated no more).
     s.settleOwed();
     s.settleLate();
     // No time passes: no update runs, so nothing moves, nothing is emitted, and no `prev`
@@ -129,24 +176,16 @@ std::optional<std::string> System::step(double dt) {
     ++s.step;
     s.lastDt = dt;
     double t1 = s.now + dt;
-    for (Pool& pool : s.pools) pool.beginStep();
     // The host drew after the last step: this one draws as it goes.
     bool drawing = s.options.drawInStep && drawing_->drewSinceStep() && s.backend.rendersInStep();
     drawing_->stepping();
     for (size_t type = 0; type < s.pools.size(); ++type)
         s.work[type].inStep = {drawing && s.types[type].render && s.types[type].drawn[0], false, false, 0, 0};
-    // Parents before children: a type's objects, then what they created, advanced to t1.
-    for (size_t type = 0; type < s.pools.size(); ++type) {
-        detail::updateType(s, *creation_, type, dt, t1);
-        s.work[type].inStep.updated = true;
-        auto start = WallClock::now();
-        creation_->drain(t1);
-        s.stats.createSeconds += seconds(start, WallClock::now());
-    }
+    // The schedule's phases (settle is done above: a step of no time settles too): ready,
+    // per type, parents before children, its update, kills and emissions (in sub-steps),
+    // what it queued created; release.
+    runPhases(0, s.schedule.phases.size(), dt, t1, true);
     s.now = t1;
-    auto releasing = WallClock::now();
-    s.endStep();
-    s.stats.emitSeconds += seconds(releasing, WallClock::now());
     for (detail::TypeWork& w : s.work) {
         w.inStep.fresh = w.inStep.on;
         w.inStep.on = w.inStep.updated = false;

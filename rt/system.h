@@ -30,6 +30,7 @@
 #include "ir/ir.h"
 #include "rt/backend.h"
 #include "rt/pool.h"
+#include "rt/schedule.h"
 
 namespace psys::rt {
 
@@ -161,6 +162,8 @@ public:
     size_t typeCount() const;
     int typeIndex(std::string_view name) const;
     Backend& backend() const;
+    // The phases a step runs, in order (rt/schedule.h; psysc run --print-schedule).
+    const Schedule& schedule() const;
 
     // What is drawn for `type` after the latest step (or trigger), computed on first ask.
     // On a device the host does not wait for it: its count comes later (DrawColumns::counted).
@@ -184,6 +187,7 @@ public:
 
 private:
     void start();
+    void runPhases(size_t first, size_t end, double dt, double t1, bool last);
     void initNewSlots(const ReloadReport& report);
 
     std::unique_ptr<detail::State> state_;

@@ -12,6 +12,7 @@
 
 #include "ir/evaluate.h"
 #include "rt/parallel.h"
+#include "rt/schedule.h"
 #include "rt/system.h"
 
 namespace psys::rt::detail {
@@ -95,6 +96,12 @@ struct TypeWork {
     std::vector<Buffer> updateTable, exportsTable, renderTable;
     DrawnInStep inStep;
     std::vector<LateKills::Part> killed;  // per chunk: the rows that died, in order (or a late launch's ticket)
+    // The update pass just run: whether it ran (a pool with live rows), its kills are late or
+    // listed per chunk, its chunks.
+    struct Pass {
+        bool ran = false, late = false, listed = false;
+        size_t chunks = 0;
+    } pass;
     std::vector<std::vector<Buffer>> spawnTables;  // per emit site: the pool's columns for its spawn kernel
 };
 
@@ -141,6 +148,7 @@ struct State {
     std::optional<Owed> owed;
     ir::Evaluator evaluator;  // the kernels the run-time evaluates itself (start, triggers, uniform kernels)
     std::unique_ptr<Parallel> parallel;
+    Schedule schedule;  // the phases of a step (rt/schedule.h)
 
     // The ancestor `depth` levels up of (type, row), or (-1, 0) when there is none.
     std::pair<int, uint32_t> ancestor(size_t type, uint32_t row, int depth) const;
@@ -194,5 +202,8 @@ struct State {
         return viewData<T>(memory, b);
     }
 };
+
+// The phases of a step of `state`'s module (rt/schedule.cpp).
+Schedule stepSchedule(const State& state);
 
 }  // namespace psys::rt::detail

@@ -1,5 +1,5 @@
-// Updating: one step of every updatable object of a type, as launches over its pool (in
-// sub-steps under @step), then kills and emissions in row order.
+// Updating: the phases of a step over a type's pool (rt/schedule.h) — the update pass as
+// launches over chunks, then its kills and its emissions in row order.
 #include "rt/system_update.h"
 
 #include <algorithm>
@@ -16,14 +16,16 @@ namespace psys::rt::detail {
 
 namespace {
 
-// After an update of `type`: in row order, each updated object dies or emits. A rate or
-// count every row shares (ColumnLayout::sharedEmit) is taken from the externs or the
-// launch's uniform values, not from its column: a device need not send it back.
-void killAndEmit(State& s, Creation& creation, size_t type, double dt, double t1, const Value* uniforms) {
+// After an update of `type`: the survivors emit, in row order. A rate or count every
+// row shares (ColumnLayout::sharedEmit) is taken from the externs or the launch's uniform
+// values, not from its column: a device need not send it back.
+void emitRows(State& s, Creation& creation, size_t type, double dt, double t1) {
     const Pool& pool = s.pools[type];
     const TypeInfo& info = s.types[type];
     const TypeWork& work = s.work[type];
+    if (!work.pass.ran) return;
     const ir::Object& o = pool.object();
+    const Value* uniforms = s.uniforms(type, *info.update, static_cast<float>(dt), static_cast<float>(t1));
     const uint8_t* updatable = pool.mask();
     const auto* kill = info.kills ? s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]) : nullptr;
     std::vector<float> rate(o.emits.size(), 0), count(o.emits.size(), 1);
@@ -42,12 +44,7 @@ void killAndEmit(State& s, Creation& creation, size_t type, double dt, double t1
         source(info.counted[site], layout.emitCount(i), count[site], counts[site]);
     }
     for (uint32_t row = 0; row < pool.rows(); ++row) {
-        if (!updatable[row]) continue;
-        if (kill && kill[row]) {
-            s.kill(type, row, t1 - dt);
-            continue;
-        }
-        if (!info.rateEmits) continue;
+        if (!updatable[row] || (kill && kill[row])) continue;
         for (size_t site = 0; site < o.emits.size(); ++site) {
             if (rates[site]) rate[site] = rates[site][row];
             if (counts[site]) count[site] = counts[site][row];
@@ -56,22 +53,35 @@ void killAndEmit(State& s, Creation& creation, size_t type, double dt, double t1
     }
 }
 
-// The kills of an update of objects that only die, listed per chunk, now; or, for late
-// launches, their kills (listed or ticketed) and unstable counts at the end of the step
-// (or the next step's start: State::owed), in their place (LateKills).
-void takeKills(State& s, size_t type, size_t chunks, bool late, double dt, double t1) {
+// The kills of the update pass just run: listed per chunk (objects that only die) and
+// taken now, or, for late launches, their kills (listed or ticketed) and unstable counts
+// kept for the end of the step (or the next step's start: State::owed), in their place
+// (LateKills); else read from the kill flags in row order.
+void takeKills(State& s, size_t type, double dt, double t1) {
     TypeWork& work = s.work[type];
-    if (!late) {
+    const TypeInfo& info = s.types[type];
+    if (!work.pass.ran) return;
+    size_t chunks = work.pass.chunks;
+    if (work.pass.late) {
+        LateKills& l = s.late.emplace_back();
+        l.type = type;
+        l.at = s.dying.size();
+        l.t1 = t1;
+        l.dt = dt;
+        for (size_t c = 0; c < chunks; ++c) l.parts.push_back(std::move(work.killed[c]));
+        return;
+    }
+    if (work.pass.listed) {
         for (size_t c = 0; c < chunks; ++c)
             for (uint32_t row : work.killed[c].rows) s.kill(type, row, t1 - dt);
         return;
     }
-    LateKills& l = s.late.emplace_back();
-    l.type = type;
-    l.at = s.dying.size();
-    l.t1 = t1;
-    l.dt = dt;
-    for (size_t c = 0; c < chunks; ++c) l.parts.push_back(std::move(work.killed[c]));
+    if (!info.kills) return;
+    const Pool& pool = s.pools[type];
+    const uint8_t* updatable = pool.mask();
+    const auto* kill = s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]);
+    for (uint32_t row = 0; row < pool.rows(); ++row)
+        if (updatable[row] && kill[row]) s.kill(type, row, t1 - dt);
 }
 
 // The update launch over `type`'s pool (its table bound) for (t1 − dt, t1], rows to be chosen.
@@ -95,12 +105,14 @@ RowsLaunch poolUpdate(State& s, size_t type, double dt, double t1) {
 
 // One update of every updatable object of `type` over (t1 − dt, t1]: the update kernel
 // and the exports kernel over chunks of rows (on several threads where the backend
-// allows), then kills and emissions in row order, so that ids, the queue and the free
-// list come out the same with any number of threads.
-void updatePool(State& s, Creation& creation, size_t type, double dt, double t1, bool last) {
+// allows), what each chunk killed listed by the chunk; the kills and emissions are the
+// phases after it (takeKills, emitRows), in row order, so that ids, the queue and the
+// free list come out the same with any number of threads.
+void updatePass(State& s, size_t type, double dt, double t1, bool last) {
     Pool& pool = s.pools[type];
     TypeInfo& info = s.types[type];
     TypeWork& work = s.work[type];
+    work.pass = {};
     size_t rows = pool.rows();
     if (rows == 0) return;
     // Drawing as it goes (rt/system_draw.h): each chunk rendered after its update.
@@ -130,6 +142,7 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1,
     bool listKills = info.kills && !info.rateEmits;
     bool late = info.late && last;
     size_t chunks = s.chunkCount(rows);
+    work.pass = {true, late, listKills && !late, chunks};
     if (listKills || late) work.killed.resize(chunks);  // each chunk sets its own (State::latePart)
     std::atomic<uint64_t> unstable = 0;
     auto chunk = [&](size_t c, size_t begin, size_t end) {
@@ -153,36 +166,15 @@ void updatePool(State& s, Creation& creation, size_t type, double dt, double t1,
         }
         if (drawing) drawing->chunk(updatable, info.kills ? kill : nullptr, part.begin, part.end);
     };
-    auto start = WallClock::now();
     s.forChunks(0, rows, chunk);
     s.typeStats[type].unstable += unstable;
     if (drawing) drawing->done();
-    auto loopsDone = WallClock::now();
-    s.stats.loopSeconds += seconds(start, loopsDone);
-    struct Timer {
-        Stats& stats;
-        WallClock::time_point start;
-        ~Timer() { stats.emitSeconds += seconds(start, WallClock::now()); }
-    } timer{s.stats, loopsDone};
-    if (late || listKills)
-        takeKills(s, type, chunks, late, dt, t1);
-    else if (info.rateEmits)
-        killAndEmit(s, creation, type, dt, t1, update.uniforms);
 }
 
 }  // namespace
 
-void updateType(State& s, Creation& creation, size_t type, double dt, double t1) {
-    uint32_t n = subStepCount(dt, s.types[type].stepLimit, s.typeStats[type].cappedSubSteps);
-    if (n == 1) {
-        updatePool(s, creation, type, dt, t1, true);
-        return;
-    }
-    // Sub-steps of equal length, each a pass over the pool: an object killed in one takes
-    // no more, and what it emits in each is queued in (sub-step, row) order.
-    double t0 = t1 - dt;
-    for (uint32_t i = 1; i <= n; ++i)
-        updatePool(s, creation, type, dt / n, i == n ? t1 : t0 + dt * (static_cast<double>(i) / n), i == n);
-}
+void runUpdate(State& s, size_t type, double dt, double t1, bool last) { updatePass(s, type, dt, t1, last); }
+void runKills(State& s, size_t type, double dt, double t1) { takeKills(s, type, dt, t1); }
+void runEmissions(State& s, Creation& creation, size_t type, double dt, double t1) { emitRows(s, creation, type, dt, t1); }
 
 }  // namespace psys::rt::detail

@@ -6,8 +6,11 @@
 
 namespace psys::rt::detail {
 
-// Advances every updatable object of `type` over (t1 − dt, t1], in sub-steps no longer
-// than its @step: its next state, its exports, kills, and what it emits (queued).
-void updateType(State& state, Creation& creation, size_t type, double dt, double t1);
+// The phases of a step over `type`'s pool for (t1 − dt, t1] (one sub-step of @step, the
+// `last` ending the step): the update pass (update, the survivors' exports, the render as
+// it goes), its kills, the survivors' rate emissions (queued for Creation).
+void runUpdate(State& state, size_t type, double dt, double t1, bool last);
+void runKills(State& state, size_t type, double dt, double t1);
+void runEmissions(State& state, Creation& creation, size_t type, double dt, double t1);
 
 }  // namespace psys::rt::detail

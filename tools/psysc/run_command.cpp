@@ -150,6 +150,11 @@ int runSystem(const RunOptions& options) {
     compiled.print(std::cerr, options.colour);
     if (!compiled.ok) return 1;
     if (!s) return fail(error);
+    if (options.printSchedule) {
+        std::cout << fmt::format("A step of {} ({} backend), phase by phase:\n", options.file, options.backend)
+                  << rt::printSchedule(s->system().schedule());
+        return 0;
+    }
     if (options.remarks) {
         rt::BackendReport report = s->backend().report();
         for (const auto& r : report.remarks)

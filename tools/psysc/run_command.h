@@ -29,6 +29,7 @@ struct RunOptions {
     unsigned threads = 0;            // 0: every core
     bool timing = false;
     bool remarks = false;
+    bool printSchedule = false;
     bool colour = false;
 };
 

@@ -1,0 +1,135 @@
+// The schedule of a step (rt/schedule.h): built from what each type's kernels yield, and
+// printed.
+#include "rt/schedule.h"
+
+#include <fmt/format.h>
+
+#include "rt/system_state.h"
+
+namespace psys::rt {
+
+const char* phaseName(PhaseKind kind) {
+    switch (kind) {
+        case PhaseKind::Settle: return "settle";
+        case PhaseKind::Ready: return "ready";
+        case PhaseKind::SubSteps: return "sub-steps";
+        case PhaseKind::Update: return "update";
+        case PhaseKind::Kills: return "kills";
+        case PhaseKind::Emissions: return "emissions";
+        case PhaseKind::Create: return "create";
+        case PhaseKind::Release: return "release";
+    }
+    return "?";
+}
+
+namespace {
+
+const char* parallelismName(Parallelism p) {
+    switch (p) {
+        case Parallelism::Chunks: return "chunks on every thread";
+        case Parallelism::Ordered: return "in order";
+        case Parallelism::Host: return "host";
+    }
+    return "?";
+}
+
+std::string names(const Schedule& s, const std::vector<int>& types) {
+    std::string out;
+    for (int t : types) out += (out.empty() ? "" : ", ") + s.types[static_cast<size_t>(t)];
+    return out;
+}
+
+std::string describe(const Schedule& s, const Phase& p) {
+    std::string type = p.type >= 0 ? s.types[static_cast<size_t>(p.type)] : "";
+    switch (p.kind) {
+        case PhaseKind::Settle: return "what the last step owes: its late kills taken, its dead freed";
+        case PhaseKind::Ready: return "the rows created during the last step become updatable";
+        case PhaseKind::SubSteps:
+            return fmt::format("{}: the next {} phases once per sub-step of @step({:g})", type, p.span, p.stepLimit);
+        case PhaseKind::Update: {
+            std::string also;
+            if (p.exports) also += ", the survivors' exports";
+            if (p.render) also += ", the render when the host draws every step";
+            std::string listed = p.late ? ", its kills listed" : p.listed ? ", its kills listed" : "";
+            return fmt::format("{}: the update kernel over the pool{}{}", type, also, listed);
+        }
+        case PhaseKind::Kills:
+            return p.late ? fmt::format("{}: the listed kills kept for the step's end (nobody looks at them before)", type)
+                          : fmt::format("{}: the killed rows frozen, in row order", type);
+        case PhaseKind::Emissions:
+            return fmt::format("{}: rate emissions of the survivors ({}): events, times, ids, the queue", type,
+                               names(s, p.targets));
+        case PhaseKind::Create:
+            return fmt::format("what {} queued ({}) and what that queues: rows, init, bursts, the first update, its kills "
+                               "and emissions",
+                               type, names(s, p.targets));
+        case PhaseKind::Release: return "late kills taken in their place; the dead nobody reads freed onto the free stack";
+    }
+    return "";
+}
+
+}  // namespace
+
+std::string printSchedule(const Schedule& s) {
+    std::string out;
+    std::vector<size_t> ends;  // where each open sub-step group ends
+    for (size_t i = 0; i < s.phases.size(); ++i) {
+        while (!ends.empty() && ends.back() <= i) ends.pop_back();
+        const Phase& p = s.phases[i];
+        std::string indent(2 * ends.size(), ' ');
+        out += fmt::format("{:>3}. {}{:<10} {:<24} {}\n", i + 1, indent, phaseName(p.kind), parallelismName(p.parallelism),
+                           describe(s, p));
+        if (p.kind == PhaseKind::SubSteps) ends.push_back(i + 1 + p.span);
+    }
+    return out;
+}
+
+namespace detail {
+
+// Per type, parents before children (the module's order): its update (in sub-steps under
+// @step, each with its kills and emissions), then the creation of what it queued.
+Schedule stepSchedule(const State& s) {
+    Schedule out;
+    for (const ir::Object& o : s.module.objects) out.types.push_back(o.name);
+    auto add = [&](PhaseKind kind, int type, Parallelism parallelism) -> Phase& {
+        Phase& p = out.phases.emplace_back();
+        p.kind = kind;
+        p.type = type;
+        p.parallelism = parallelism;
+        return p;
+    };
+    add(PhaseKind::Settle, -1, Parallelism::Ordered);
+    add(PhaseKind::Ready, -1, Parallelism::Ordered);
+    for (size_t t = 0; t < s.types.size(); ++t) {
+        const TypeInfo& info = s.types[t];
+        auto type = static_cast<int>(t);
+        size_t group = out.phases.size();
+        if (info.stepLimit > 0) add(PhaseKind::SubSteps, type, Parallelism::Host).stepLimit = info.stepLimit;
+        bool listed = info.kills && !info.rateEmits;
+        Phase& update = add(PhaseKind::Update, type, Parallelism::Chunks);
+        update.late = info.late;
+        update.listed = listed;
+        update.exports = info.exports != nullptr;
+        update.render = info.render != nullptr && info.drawn[0];
+        if (info.kills || info.late) {
+            Phase& kills = add(PhaseKind::Kills, type, Parallelism::Ordered);
+            kills.late = info.late;
+            kills.listed = listed;
+        }
+        std::vector<int> rated, targets;
+        for (size_t site = 0; site < info.emitTarget.size(); ++site) {
+            auto target = static_cast<int>(info.emitTarget[site]);
+            if (s.module.objects[t].emits[site].rate) rated.push_back(target);
+            targets.push_back(target);
+        }
+        if (info.rateEmits) add(PhaseKind::Emissions, type, Parallelism::Ordered).targets = rated;
+        if (info.stepLimit > 0) out.phases[group].span = out.phases.size() - group - 1;
+        if (info.rateEmits) add(PhaseKind::Create, type, Parallelism::Ordered).targets = targets;
+    }
+    add(PhaseKind::Release, -1, Parallelism::Ordered);
+    return out;
+}
+
+}  // namespace detail
+
+}  // namespace psys::rt
