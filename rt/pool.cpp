@@ -1,5 +1,7 @@
 #include "rt/pool.h"
 
+#include <algorithm>
+
 namespace psys::rt {
 
 void ValueColumns::define(Memory& memory, const std::vector<ir::Type>& types, size_t rows) {
@@ -140,23 +142,29 @@ void Pool::grow(size_t n) {
 
 std::optional<uint32_t> Pool::allocate() {
     uint32_t row;
-    if (!freeRows_.empty()) {
-        row = freeRows_.back();
-        freeRows_.pop_back();
-    } else {
-        if (rows() >= capacity_) return std::nullopt;
-        row = static_cast<uint32_t>(rows());
-        grow(rows() + 1);
-    }
-    status_[row] = Status::Alive;
-    updatable.set(row, 0);
-    alive.set(row, 1);
-    fresh.push_back(row);
-    ++live_;
-    readers[row] = 0;
-    parent[row] = {};
-    for (auto& e : emitted) e[row] = 0;
+    if (allocate(1, &row) == 0) return std::nullopt;
     return row;
+}
+
+size_t Pool::allocate(size_t n, uint32_t* out) {
+    FreeRows free{freeRows_.data(), freeRows_.size(), rows(), capacity_};
+    size_t kept = std::min(n, free.room());
+    for (size_t k = 0; k < kept; ++k) out[k] = free.row(k);
+    std::fill(out + kept, out + n, kSkipRow);
+    if (kept > free.top) grow(free.highWater + (kept - free.top));  // once, for the whole batch
+    freeRows_.resize(free.top - std::min(kept, free.top));
+    std::span<const uint32_t> rows(out, kept);
+    for (uint32_t row : rows) {
+        status_[row] = Status::Alive;
+        readers[row] = 0;
+        parent[row] = {};
+        for (auto& e : emitted) e[row] = 0;
+    }
+    updatable.set(rows, 0);
+    alive.set(rows, 1);
+    fresh.insert(fresh.end(), rows.begin(), rows.end());
+    live_ += kept;
+    return kept;
 }
 
 void Pool::freeze(uint32_t row, double at) {

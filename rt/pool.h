@@ -12,10 +12,12 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "ir/ir.h"
 #include "ir/value.h"
+#include "rt/allocation.h"
 #include "rt/memory.h"
 
 namespace psys::rt {
@@ -40,6 +42,9 @@ public:
         if (host_[row] == value) return;
         host_[row] = value;
         changed_.push_back(row);
+    }
+    void set(std::span<const uint32_t> rows, uint8_t value) {
+        for (uint32_t row : rows) set(row, value);
     }
     const uint8_t* host() const { return host_.data(); }
     void sync(Memory& memory);
@@ -89,6 +94,9 @@ public:
 
     // A new row for an object, or nullopt at capacity.
     std::optional<uint32_t> allocate();
+    // Rows for `n` new objects at once, by the allocation rule (rt/allocation.h): rows[k]
+    // for the k-th, kSkipRow for those past capacity; returns how many got one.
+    size_t allocate(size_t n, uint32_t* rows);
     void release(uint32_t row);  // back to the free list; the generation moves on
     void freeze(uint32_t row, double at);  // `at`: the time of its last values; its age stays what it was then
     bool matches(Handle h) const { return h.row < rows() && generation_[h.row] == h.generation && status_[h.row] != Status::Free; }

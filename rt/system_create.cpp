@@ -255,17 +255,9 @@ void Creation::createBatch(size_t type, size_t from, size_t to, double t1) {
     Batch& b = batches_[type];
     const size_t n = to - from;
     b.first = queue_[from].staging;
-    b.poolRows.assign(n, kSkipRow);
-    size_t allocated = 0;
-    for (size_t r = 0; r < n; ++r) {
-        auto row = pool.allocate();
-        if (!row) {
-            ++s_.typeStats[type].dropped;
-            continue;
-        }
-        b.poolRows[r] = *row;
-        ++allocated;
-    }
+    b.poolRows.resize(n);
+    size_t allocated = pool.allocate(n, b.poolRows.data());  // the allocation rule (rt/allocation.h)
+    s_.typeStats[type].dropped += n - allocated;
     if (allocated == 0) {
         queued_[type] -= n;
         return;
@@ -296,8 +288,10 @@ void Creation::drawBatch(size_t type, Batch& b, size_t n, double t1) {
     bindBatch(type, b, layout, b.renderParents, b.renderTable, false);
     Buffer mask = b.columns.at(kRenderMask, Elem::U8, end);
     auto* shown = s_.host<uint8_t>(mask);
-    for (size_t r = 0; r < n; ++r)  // not those dropped, nor those that died in their first update
-        shown[first + r] = b.poolRows[r] != kSkipRow && pool.status(b.poolRows[r]) == Status::Alive;
+    s_.forRows(0, n, [&](size_t begin, size_t end) {  // not those dropped, nor those that died in their first update
+        for (size_t r = begin; r < end; ++r)
+            shown[first + r] = b.poolRows[r] != kSkipRow && pool.status(b.poolRows[r]) == Status::Alive;
+    });
     RowsLaunch launch = renderLaunch(s_, type, b.renderTable, mask, t1);
     std::atomic<uint64_t> drawn = 0, nonFinite = 0;
     s_.forChunks(first, end, [&](size_t, size_t begin, size_t stop) {
@@ -308,10 +302,11 @@ void Creation::drawBatch(size_t type, Batch& b, size_t n, double t1) {
     work.inStep.drawn += drawn;
     work.inStep.nonFinite += nonFinite;
     s_.bindPool(type, layout, work.render, work.renderTable);
+    std::vector<std::pair<Buffer, Buffer>> columns;
     for (int c = 0; c < ColumnLayout::kRenderColumns; ++c)
         if (int column = layout.render + c; layout.needs(column))
-            s_.memory.scatter(b.renderTable[static_cast<size_t>(column)], first,
-                              work.renderTable[static_cast<size_t>(column)], b.poolRows);
+            columns.push_back({b.renderTable[static_cast<size_t>(column)], work.renderTable[static_cast<size_t>(column)]});
+    s_.scatter(columns, first, b.poolRows);
 }
 
 // The batch's objects in its columns and their pool rows: creation times, ids, parents
@@ -325,26 +320,31 @@ void Creation::identify(size_t type, Batch& b, size_t from, size_t n) {
     auto* mask = s_.host<uint8_t>(b.columns.at(kMask, Elem::U8, end));
     auto* created = s_.host<double>(table[ColumnLayout::kCreated]);
     auto* ids = s_.host<uint32_t>(table[ColumnLayout::kIds]);
-    for (size_t r = 0; r < n; ++r) {
-        size_t i = first + r;
-        uint32_t row = b.poolRows[r];
-        mask[i] = row != kSkipRow;
-        if (!mask[i]) continue;
-        const Entry& e = queue_[from + r];
-        created[i] = e.time;
-        ids[i] = e.id;
-        pool.parent[row] = e.parent;
-        if (e.parent.valid()) ++s_.pools[static_cast<size_t>(info.parentType)].readers[e.parent.row];
-    }
+    s_.forRows(0, n, [&](size_t begin, size_t end) {  // rows of their own: on every thread
+        for (size_t r = begin; r < end; ++r) {
+            size_t i = first + r;
+            uint32_t row = b.poolRows[r];
+            mask[i] = row != kSkipRow;
+            if (!mask[i]) continue;
+            const Entry& e = queue_[from + r];
+            created[i] = e.time;
+            ids[i] = e.id;
+            pool.parent[row] = e.parent;
+        }
+    });
+    if (info.parentType >= 0)  // several children may share a parent: its readers counted in order
+        for (size_t r = 0; r < n; ++r)
+            if (Handle parent = queue_[from + r].parent; b.poolRows[r] != kSkipRow && parent.valid())
+                ++s_.pools[static_cast<size_t>(info.parentType)].readers[parent.row];
     // Into the pool rows through the memory (the pool's columns may live on a device).
-    s_.memory.scatter(table[ColumnLayout::kCreated], first, pool.created, b.poolRows);
-    s_.memory.scatter(table[ColumnLayout::kIds], first, pool.ids, b.poolRows);
+    std::vector<std::pair<Buffer, Buffer>> columns = {{table[ColumnLayout::kCreated], pool.created},
+                                                      {table[ColumnLayout::kIds], pool.ids}};
     for (size_t p = 0; p < o.params.size(); ++p)
         if (pool.paramColumn[p] >= 0)
             for (int c = 0; c < o.params[p].type.width; ++c)
-                s_.memory.scatter(table[static_cast<size_t>(info.updateLayout.paramOffset[p] + c)], first,
-                                  pool.params.column(static_cast<size_t>(pool.paramColumn[p]), static_cast<size_t>(c)),
-                                  b.poolRows);
+                columns.push_back({table[static_cast<size_t>(info.updateLayout.paramOffset[p] + c)],
+                                   pool.params.column(static_cast<size_t>(pool.paramColumn[p]), static_cast<size_t>(c))});
+    s_.scatter(columns, first, b.poolRows);
     for (size_t s = 0; s < o.state.size(); ++s)
         for (int c = 0; c < o.state[s].type.width; ++c)
             s_.memory.clear(table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)], first, n);
@@ -422,17 +422,26 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
     auto* dt = s_.host<float>(table[ColumnLayout::kDt]);
     b.spans.assign(n, 0);
     b.subSteps.assign(n, 1);
-    uint32_t most = 1;
-    for (size_t r = 0; r < n; ++r) {
-        size_t i = first + r;
-        if (!mask[i]) continue;
-        double span = t1 - created[i], h = info.stepLimit;
-        b.spans[r] = span;
-        b.subSteps[r] = subStepCount(span, h, s_.typeStats[type].cappedSubSteps);
-        most = std::max(most, b.subSteps[r]);
-        now[i] = t1;
-        dt[i] = static_cast<float>(span);
-    }
+    std::atomic<uint32_t> most = 1;
+    std::atomic<uint64_t> capped = 0;
+    s_.forRows(0, n, [&](size_t begin, size_t end) {
+        uint32_t chunkMost = 1;
+        uint64_t chunkCapped = 0;
+        for (size_t r = begin; r < end; ++r) {
+            size_t i = first + r;
+            if (!mask[i]) continue;
+            double span = t1 - created[i];
+            b.spans[r] = span;
+            b.subSteps[r] = subStepCount(span, info.stepLimit, chunkCapped);
+            chunkMost = std::max(chunkMost, b.subSteps[r]);
+            now[i] = t1;
+            dt[i] = static_cast<float>(span);
+        }
+        capped += chunkCapped;
+        for (uint32_t m = most.load(); chunkMost > m && !most.compare_exchange_weak(m, chunkMost);) {
+        }
+    });
+    s_.typeStats[type].cappedSubSteps += capped;
     // In queue order: `each(r, ordinal)` for the objects created, with the accounting of
     // rows allocated for the objects after them.
     auto inOrder = [&](bool leaveQueue, auto each) {
@@ -453,10 +462,19 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
         std::optional<LateKills> late;
         if (info.late && !s_.work[type].inStep.on) late.emplace();
         advance(type, b, n, kMask, late ? &*late : nullptr);
-        inOrder(true, [&](size_t r) {
-            queueBursts(type, b, r);
-            if (!late) killOrEmit(type, b, r, b.spans[r], t1);
-        });
+        if (info.bursts || info.rateEmits) {
+            inOrder(true, [&](size_t r) {
+                queueBursts(type, b, r);
+                if (!late) killOrEmit(type, b, r, b.spans[r], t1);
+            });
+        } else {  // they emit nothing: no room to account for, only their kills in queue order
+            queued_[type] -= n;
+            if (!late && info.kills) {
+                const auto* kill = s_.view<uint8_t>(b.updateTable[ColumnLayout::kKill]);
+                for (size_t r = 0; r < n; ++r)
+                    if (b.poolRows[r] != kSkipRow && kill[first + r]) s_.kill(type, b.poolRows[r], t1 - b.spans[r]);
+            }
+        }
         if (late) {
             late->type = type;
             late->at = s_.dying.size();
@@ -529,18 +547,22 @@ void Creation::advance(size_t type, Batch& b, size_t n, size_t maskColumn, LateK
         Buffer exportMask = b.columns.at(kExportMask, Elem::U8, end);
         auto* alive = s_.host<uint8_t>(exportMask);
         const auto* kill = s_.view<uint8_t>(table[ColumnLayout::kKill]);
-        for (size_t i = first; i < end; ++i) alive[i] = mask[i] && !(info.kills && kill[i]);
+        s_.forRows(first, end, [&](size_t begin, size_t stop) {
+            for (size_t i = begin; i < stop; ++i) alive[i] = mask[i] && !(info.kills && kill[i]);
+        });
         launchOn(*info.exports, info.exportsLayout, b.exportsTable, exportMask, nullptr);
     }
     Pool& pool = s_.pools[type];
+    std::vector<std::pair<Buffer, Buffer>> columns;
     for (size_t s = 0; s < o.state.size(); ++s)
         for (int c = 0; c < o.state[s].type.width; ++c)
-            s_.memory.scatter(table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)], first,
-                              pool.state.column(s, static_cast<size_t>(c)), b.poolRows);
+            columns.push_back({table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)],
+                               pool.state.column(s, static_cast<size_t>(c))});
     for (size_t e = 0; e < o.exports.size(); ++e)
         for (int c = 0; c < o.exports[e].type.width; ++c)
-            s_.memory.scatter(b.exportsTable[static_cast<size_t>(info.exportsLayout.exportOffset[e] + c)], first,
-                              pool.exports.column(e, static_cast<size_t>(c)), b.poolRows);
+            columns.push_back({b.exportsTable[static_cast<size_t>(info.exportsLayout.exportOffset[e] + c)],
+                               pool.exports.column(e, static_cast<size_t>(c))});
+    s_.scatter(columns, first, b.poolRows);
 }
 
 void Creation::queueBursts(size_t type, Batch& b, size_t r) {

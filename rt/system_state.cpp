@@ -340,6 +340,29 @@ size_t State::chunkCount(size_t rows) const {
     return rows / per + (rows % per != 0);
 }
 
+namespace {
+constexpr size_t kHostRows = 16384;  // rows of host bookkeeping a chunk (a few cache-sized pieces of each array)
+}
+
+void State::forRows(size_t first, size_t end, const std::function<void(size_t, size_t)>& fn) {
+    if (end <= first) return;
+    size_t chunks = (end - first + kHostRows - 1) / kHostRows;
+    parallel->forEach(chunks, true, [&](size_t c) {
+        size_t begin = first + c * kHostRows;
+        fn(begin, std::min(end, begin + kHostRows));
+    });
+}
+
+void State::scatter(std::span<const std::pair<Buffer, Buffer>> columns, size_t fromFirst, std::span<const uint32_t> rows) {
+    if (!backend.concurrent()) {
+        for (auto [from, to] : columns) memory.scatter(from, fromFirst, to, rows);
+        return;
+    }
+    forRows(0, rows.size(), [&](size_t begin, size_t end) {
+        for (auto [from, to] : columns) memory.scatter(from, fromFirst + begin, to, rows.subspan(begin, end - begin));
+    });
+}
+
 void State::forChunks(size_t first, size_t end, const std::function<void(size_t, size_t, size_t)>& chunk) {
     size_t per = backend.chunkRows();
     parallel->forEach(chunkCount(end - first), backend.concurrent(), [&](size_t c) {

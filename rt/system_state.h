@@ -190,6 +190,13 @@ struct State {
     // chunk(c, begin, end) for every chunk of rows [first, end) (Backend::chunkRows rows
     // each), on several threads where the backend allows; chunkCount: how many there are.
     size_t chunkCount(size_t rows) const;
+    // fn(begin, end) over chunks of rows [first, end) of the host's bookkeeping (its own
+    // arrays, not a backend's memory), on every thread: chunks write rows of their own, so
+    // results do not depend on the split.
+    void forRows(size_t first, size_t end, const std::function<void(size_t, size_t)>& fn);
+    // Memory::scatter of several columns by the same rows: to[rows[i]] = from[fromFirst + i]
+    // for each (from, to), split by rows over every thread where the backend is concurrent.
+    void scatter(std::span<const std::pair<Buffer, Buffer>> columns, size_t fromFirst, std::span<const uint32_t> rows);
     void forChunks(size_t first, size_t end, const std::function<void(size_t, size_t, size_t)>& chunk);
 
     // A column's values on the host: to change (host) or to read (view).
