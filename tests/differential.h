@@ -41,6 +41,19 @@ struct Comparison {
     double worst = 0;        // the largest pointDifference
 };
 
+// The same objects in the same rows: every pool's rows, their status and generations,
+// and its free stack (the allocation rule, rt/allocation.h, on both sides).
+inline bool sameRows(const rt::System& a, const rt::System& b) {
+    for (size_t t = 0; t < a.typeCount(); ++t) {
+        const rt::Pool &pa = a.pool(t), &pb = b.pool(t);
+        INFO("type " << a.module().objects[t].name);
+        if (pa.rows() != pb.rows() || pa.generations() != pb.generations() || pa.freeRows() != pb.freeRows()) return false;
+        for (uint32_t row = 0; row < pa.rows(); ++row)
+            if (pa.status(row) != pb.status(row)) return false;
+    }
+    return true;
+}
+
 // Fires every trigger (each argument 1.5), then steps both systems `frames` times by
 // 1/60 s, comparing what is drawn after each step and the counts at the end.
 inline Comparison compareSystems(rt::System& a, rt::System& b, int frames) {
@@ -70,6 +83,7 @@ inline Comparison compareSystems(rt::System& a, rt::System& b, int frames) {
     }
     a.finish();  // what a device still owes from the last step
     b.finish();
+    CHECK(sameRows(a, b));
     CHECK(a.stats().types.size() == b.stats().types.size());
     for (size_t t = 0; t < a.stats().types.size(); ++t) {
         CHECK(a.stats().types[t].created == b.stats().types[t].created);

@@ -53,10 +53,12 @@ constexpr double kTolerance = 5e-4;
 
 // Runs `text` on both backends for `frames` frames.
 test::Comparison compareBackends(const std::string& text, int frames, bool optimize, MathMode mode,
-                                 std::optional<core::Integrator> integrator = {}) {
+                                 std::optional<core::Integrator> integrator = {}, unsigned threads = 0) {
     interp::Interpreter interpreter;
     codegen_llvm::LlvmBackend jit(mode);
-    rt::System a(compile(text, optimize, integrator), interpreter), b(compile(text, optimize, integrator), jit);
+    rt::SystemOptions options;
+    options.threads = threads;
+    rt::System a(compile(text, optimize, integrator), interpreter), b(compile(text, optimize, integrator), jit, options);
     test::Comparison result = test::compareSystems(a, b, frames);
     if (mode == MathMode::Exact) CHECK(result.differences == 0);
     CHECK(result.worst <= kTolerance);
@@ -73,6 +75,50 @@ TEST_CASE("every sample draws the same on the LLVM backend as on the interpreter
             CHECK(compareBackends(readFile(entry.path()), test::kLongRun, true, mode).points > 0);
         }
     }
+}
+
+// The extremes of docs/runtime.md, each past one chunk of rows (8,192) so that threads
+// split the work: a pool at capacity under a rate of 10^6 a second, everything killed in
+// one frame, a burst of 100k, frozen parents read by their children, a trigger (fired by
+// compareSystems).
+const char* const kExtremes[] = {
+    R"(@capacity(20000) object p { point(vec3(rand(), age, 0), white, 1); kill when age > 0.5 + rand(); }
+       object e { emit p at 1000000 per second; }
+       spawn e;)",
+    R"(object p { point(vec3(rand(), age, 0), white, 1); kill when age > 0.2; }
+       object e { emit p count 30000; kill when age > 0.5; }
+       spawn e;)",
+    R"(object c { point(vec3(rand(), age, 0), white, 1); kill when age > 0.3 + rand(); }
+       object b { emit c count 100000; kill when age > 0.1; }
+       spawn b;)",
+    R"(object grandma {
+           emit mom at 20 per second;
+           object mom {
+               pos = vec3(age, 0, 0);
+               point(pos, white, 2);
+               emit kid at 40000 per second;
+               kill when age > 0.25 + rand() * 0.2;
+               object kid {
+                   pos = mom.pos + vec3(rand(), age, 0);
+                   point(pos, vec4(1, 1, 1, mom.alive ? 1 : 0.5), 1);
+                   kill when age > 1 + rand();
+               }
+           }
+       }
+       spawn grandma;)",
+    R"(object spark(v: vec3) { pos = integrate(v); point(pos, white, 1); kill when age > 0.4; }
+       trigger boom(where: vec3) { emit spark(where + nrand3()) count 9000; })",
+};
+
+TEST_CASE("the JIT at 1, 2 and 7 threads creates the objects the interpreter creates, in the same rows, with the same ids") {
+    std::vector<std::string> programs(std::begin(kExtremes), std::end(kExtremes));
+    for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR))
+        if (entry.path().extension() == ".psys") programs.push_back(readFile(entry.path()));
+    for (unsigned threads : {1u, 2u, 7u})
+        for (size_t i = 0; i < programs.size(); ++i) {
+            INFO("program " << i << " at " << threads << " threads:\n" << programs[i]);
+            CHECK(compareBackends(programs[i], test::kLongRun / 6, true, MathMode::Exact, {}, threads).points > 0);
+        }
 }
 
 TEST_CASE("every operation compiles to the interpreter's result") {
