@@ -188,6 +188,20 @@ void Pool::release(uint32_t row) {
     freeRows_.push_back(row);
 }
 
+void Pool::releaseKilled(std::span<const uint32_t> rows) {
+    size_t freed = 0;
+    for (uint32_t row : rows) {
+        if (status_[row] != Status::Alive) continue;  // as release() of a row not alive
+        status_[row] = Status::Free;
+        ++generation_[row];
+        freeRows_.push_back(row);
+        ++freed;
+    }
+    live_ -= freed;
+    updatable.set(rows, 0);
+    alive.set(rows, 0);
+}
+
 void Pool::beginStep() {
     for (uint32_t row : fresh)
         if (status_[row] == Status::Alive) updatable.set(row, 1);

@@ -98,6 +98,9 @@ public:
     // for the k-th, kSkipRow for those past capacity; returns how many got one.
     size_t allocate(size_t n, uint32_t* rows);
     void release(uint32_t row);  // back to the free list; the generation moves on
+    // Objects that died alive and nobody reads, freed at once (no frozen state between):
+    // onto the free stack in the order given, each row's generation moved on.
+    void releaseKilled(std::span<const uint32_t> rows);
     void freeze(uint32_t row, double at);  // `at`: the time of its last values; its age stays what it was then
     bool matches(Handle h) const { return h.row < rows() && generation_[h.row] == h.generation && status_[h.row] != Status::Free; }
     Handle handle(uint32_t row) const { return {row, generation_[row]}; }

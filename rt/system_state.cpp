@@ -166,6 +166,61 @@ void State::settleLate(Deaths& dying, std::vector<LateKills>& late) {
     late.clear();
 }
 
+void State::settleAndRelease(Deaths& deaths, std::vector<LateKills>& lates) {
+    auto simple = [&](const LateKills& l) { return !types[l.type].read && types[l.type].parentType < 0; };
+    if (std::none_of(lates.begin(), lates.end(), simple)) {
+        settleLate(deaths, lates);
+        release(deaths);
+        return;
+    }
+    // In the merged order of settleLate: the deaths before each late launch's place, then
+    // its kills. A pool's free stack gets its rows in that order, and a simple type's rows
+    // touch no other pool, so each part goes as one run.
+    size_t next = 0;
+    Deaths one;
+    auto releaseUpTo = [&](size_t at) {
+        if (next >= at) return;
+        one.assign(deaths.begin() + static_cast<std::ptrdiff_t>(next), deaths.begin() + static_cast<std::ptrdiff_t>(at));
+        release(one);
+        next = at;
+    };
+    std::vector<LateKills> single(1);
+    for (LateKills& l : lates) {
+        releaseUpTo(l.at);
+        if (!simple(l)) {  // its kills frozen and released in its place, as settleLate and release would
+            Deaths its;
+            single[0] = std::move(l);
+            single[0].at = 0;
+            settleLate(its, single);
+            release(its);
+            continue;
+        }
+        Pool& pool = pools[l.type];
+        std::vector<uint32_t> rows;
+        for (LateKills::Part& part : l.parts) {
+            std::span<const uint32_t> listed = part.rows;
+            RowsResult result;
+            if (part.ticket) {
+                result = backend.collect(part.ticket);
+                listed = result.killedRows;
+                typeStats[l.type].unstable += result.unstable;
+            }
+            if (l.poolRows.empty()) {
+                typeStats[l.type].killed += listed.size();
+                pool.releaseKilled(listed);
+                continue;
+            }
+            rows.clear();
+            for (uint32_t launchRow : listed) rows.push_back(l.poolRows[launchRow - l.first]);
+            typeStats[l.type].killed += rows.size();
+            pool.releaseKilled(rows);
+        }
+    }
+    releaseUpTo(deaths.size());
+    deaths.clear();
+    lates.clear();
+}
+
 void State::release(Deaths& deaths) {
     for (auto [type, row] : deaths) {
         Pool& pool = pools[type];
@@ -187,16 +242,14 @@ void State::endStep() {
         late.clear();
         return;
     }
-    settleLate();
-    release(dying);
+    settleAndRelease(dying, late);
 }
 
 void State::settleOwed() {
     if (!owed) return;
     Owed o = std::move(*owed);
     owed.reset();
-    settleLate(o.dying, o.late);
-    release(o.dying);
+    settleAndRelease(o.dying, o.late);
 }
 
 bool State::owedReady() {

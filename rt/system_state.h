@@ -166,6 +166,10 @@ struct State {
     void settleOwed();
     bool owedReady();
     void release(Deaths& deaths);
+    // settleLate then release, at once: the late kills of a type that nobody reads and
+    // that reads no parent go straight onto its free stack in their place (nothing else
+    // can happen to them between), each part as one run of rows.
+    void settleAndRelease(Deaths& deaths, std::vector<LateKills>& lates);
     // A launch's kills as a part of a LateKills: its ticket, or the rows it listed, else
     // those of [begin, end) its kill flags (`flags`) mark.
     void latePart(LateKills::Part& part, const RowsResult& result, Buffer flags, size_t begin, size_t end) const;

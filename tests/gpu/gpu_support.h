@@ -105,6 +105,8 @@ struct Pair {
             }
         }
         gl->finish();
+        cpu->finish();
+        CHECK(test::sameRows(*cpu, *gl));  // the same objects in the same rows
         for (size_t t = 0; t < cpu->typeCount(); ++t) {
             const rt::TypeStats sa = cpu->stats().types[t];
             const rt::TypeStats sb = gl->stats().types[t];
