@@ -65,6 +65,9 @@ public:
     // The OpenGL buffer object holding the column's value, on a memory that keeps columns
     // in GL buffers (a viewer draws straight from it); 0 on any other.
     virtual unsigned glBuffer(Buffer) const { return 0; }
+    // Whether every buffer lives in the host's memory, `host` never moving anything: the
+    // run-time may then keep its masks in the columns themselves (rt::SyncedMask).
+    virtual bool hostResident() const { return false; }
 };
 
 // Host RAM: buffers are arrays the host addresses directly (aligned to 64 bytes).
@@ -83,6 +86,7 @@ public:
     void scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const uint32_t> rows) override;
     void gather(Buffer from, Buffer to, size_t toFirst, std::span<const uint32_t> rows) override;
     void* host(Buffer buffer) override;
+    bool hostResident() const override { return true; }
     // Bytes held by every live buffer (their capacity).
     size_t bytes() const;
 

@@ -40,6 +40,7 @@ void ValueColumns::set(Memory& memory, size_t i, size_t row, const ir::Value& v)
 void SyncedMask::create(Memory& memory) {
     column = memory.create(Elem::U8, 0);
     staging_ = memory.create(Elem::U8, 0);
+    resident_ = memory.hostResident();
 }
 
 void SyncedMask::release(Memory& memory) {
@@ -48,8 +49,11 @@ void SyncedMask::release(Memory& memory) {
 }
 
 void SyncedMask::grow(Memory& memory, size_t rows) {
-    host_.resize(rows, 0);
     memory.resize(column, rows);
+    if (resident_)
+        direct_ = hostData<uint8_t>(memory, column);  // it may have moved
+    else
+        host_.resize(rows, 0);
 }
 
 void SyncedMask::sync(Memory& memory) {
@@ -65,10 +69,13 @@ void SyncedMask::sync(Memory& memory) {
 }
 
 void SyncedMask::restore(Memory& memory, std::vector<uint8_t> values) {
-    values.resize(host_.size(), 0);
-    host_ = std::move(values);
+    values.resize(memory.rows(column), 0);
     changed_.clear();
-    memory.write(column, 0, host_.size(), host_.data());
+    memory.write(column, 0, values.size(), values.data());
+    if (resident_)
+        direct_ = hostData<uint8_t>(memory, column);
+    else
+        host_ = std::move(values);
 }
 
 Pool::Pool(const ir::Object& object, size_t capacity, Memory& memory)

@@ -32,29 +32,35 @@ enum class Status : uint8_t { Free, Alive, Frozen };
 
 // A u8 column the host keeps and changes row by row, and a backend reads whole: the host's
 // copy is the truth, and the rows changed since the last sync reach the column as one
-// scatter (so the column may live on a device and a step moves only what changed).
+// scatter (so the column may live on a device and a step moves only what changed). In a
+// memory the host addresses (Memory::hostResident) the column is the host's copy itself:
+// nothing to list or sync.
 class SyncedMask {
 public:
     void create(Memory& memory);
     void release(Memory& memory);
     void grow(Memory& memory, size_t rows);
     void set(uint32_t row, uint8_t value) {
-        if (host_[row] == value) return;
-        host_[row] = value;
-        changed_.push_back(row);
+        uint8_t* h = data();
+        if (h[row] == value) return;
+        h[row] = value;
+        if (!direct_) changed_.push_back(row);
     }
     void set(std::span<const uint32_t> rows, uint8_t value) {
         for (uint32_t row : rows) set(row, value);
     }
-    const uint8_t* host() const { return host_.data(); }
+    const uint8_t* host() const { return direct_ ? direct_ : host_.data(); }
     void sync(Memory& memory);
     void restore(Memory& memory, std::vector<uint8_t> values);  // every row at once
     Buffer column;
 
 private:
-    std::vector<uint8_t> host_;
-    std::vector<uint32_t> changed_;  // rows changed since the last sync
-    Buffer staging_;                 // their values, for the scatter
+    uint8_t* data() { return direct_ ? direct_ : host_.data(); }
+    uint8_t* direct_ = nullptr;      // the column, where the host addresses it
+    bool resident_ = false;          // the memory is the host's
+    std::vector<uint8_t> host_;      // else the host's copy,
+    std::vector<uint32_t> changed_;  // the rows changed since the last sync,
+    Buffer staging_;                 // and their values, for the scatter
 };
 
 // Typed values as component columns: value i's component c is column(i, c).
