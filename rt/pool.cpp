@@ -147,12 +147,6 @@ void Pool::grow(size_t n) {
     exports.resize(*memory_, n);
 }
 
-std::optional<uint32_t> Pool::allocate() {
-    uint32_t row;
-    if (allocate(1, &row) == 0) return std::nullopt;
-    return row;
-}
-
 size_t Pool::allocate(size_t n, uint32_t* out) {
     FreeRows free{freeRows_.data(), freeRows_.size(), rows(), capacity_};
     size_t kept = std::min(n, free.room());

@@ -98,8 +98,6 @@ public:
     size_t frozen() const { return frozen_; }
     size_t free() const { return capacity_ - live_ - frozen_; }
 
-    // A new row for an object, or nullopt at capacity.
-    std::optional<uint32_t> allocate();
     // Rows for `n` new objects at once, by the allocation rule (rt/allocation.h): rows[k]
     // for the k-th, kSkipRow for those past capacity; returns how many got one.
     size_t allocate(size_t n, uint32_t* rows);

@@ -14,12 +14,10 @@
 
 namespace psys::rt::detail {
 
-namespace {
-
 // After an update of `type`: the survivors emit, in row order. A rate or count every
 // row shares (ColumnLayout::sharedEmit) is taken from the externs or the launch's uniform
 // values, not from its column: a device need not send it back.
-void emitRows(State& s, Creation& creation, size_t type, double dt, double t1) {
+void runEmissions(State& s, Creation& creation, size_t type, double dt, double t1) {
     const Pool& pool = s.pools[type];
     const TypeInfo& info = s.types[type];
     const TypeWork& work = s.work[type];
@@ -57,7 +55,7 @@ void emitRows(State& s, Creation& creation, size_t type, double dt, double t1) {
 // taken now, or, for late launches, their kills (listed or ticketed) and unstable counts
 // kept for the end of the step (or the next step's start: State::owed), in their place
 // (LateKills); else read from the kill flags in row order.
-void takeKills(State& s, size_t type, double dt, double t1) {
+void runKills(State& s, size_t type, double dt, double t1) {
     TypeWork& work = s.work[type];
     const TypeInfo& info = s.types[type];
     if (!work.pass.ran) return;
@@ -84,6 +82,8 @@ void takeKills(State& s, size_t type, double dt, double t1) {
         if (updatable[row] && kill[row]) s.kill(type, row, t1 - dt);
 }
 
+namespace {
+
 // The update launch over `type`'s pool (its table bound) for (t1 − dt, t1], rows to be chosen.
 RowsLaunch poolUpdate(State& s, size_t type, double dt, double t1) {
     const TypeInfo& info = s.types[type];
@@ -103,12 +103,14 @@ RowsLaunch poolUpdate(State& s, size_t type, double dt, double t1) {
     return update;
 }
 
+}  // namespace
+
 // One update of every updatable object of `type` over (t1 − dt, t1]: the update kernel
 // and the exports kernel over chunks of rows (on several threads where the backend
 // allows), what each chunk killed listed by the chunk; the kills and emissions are the
-// phases after it (takeKills, emitRows), in row order, so that ids, the queue and the
+// phases after it (runKills, runEmissions), in row order, so that ids, the queue and the
 // free list come out the same with any number of threads.
-void updatePass(State& s, size_t type, double dt, double t1, bool last) {
+void runUpdate(State& s, size_t type, double dt, double t1, bool last) {
     Pool& pool = s.pools[type];
     TypeInfo& info = s.types[type];
     TypeWork& work = s.work[type];
@@ -170,11 +172,5 @@ void updatePass(State& s, size_t type, double dt, double t1, bool last) {
     s.typeStats[type].unstable += unstable;
     if (drawing) drawing->done();
 }
-
-}  // namespace
-
-void runUpdate(State& s, size_t type, double dt, double t1, bool last) { updatePass(s, type, dt, t1, last); }
-void runKills(State& s, size_t type, double dt, double t1) { takeKills(s, type, dt, t1); }
-void runEmissions(State& s, Creation& creation, size_t type, double dt, double t1) { emitRows(s, creation, type, dt, t1); }
 
 }  // namespace psys::rt::detail
