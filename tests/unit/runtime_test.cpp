@@ -321,8 +321,8 @@ TEST_CASE("@step(h) advances an object in sub-steps no longer than h") {
     CHECK(after("@step(0.3)") == doctest::Approx(std::pow(0.75, 4)));  // 4 equal sub-steps of 0.25
 }
 
-TEST_CASE("the optimizer leaves every sample's output unchanged, bit for bit, over 600 frames") {
-    size_t points = test::compareWithUnoptimized(false, {}, 600, bitwise);
+TEST_CASE("the optimizer leaves every sample's output unchanged, bit for bit, over 600 frames (200 sanitized)") {
+    size_t points = test::compareWithUnoptimized(false, {}, test::kLongRun, bitwise);
     CHECK(points > 100000);
 }
 
@@ -353,7 +353,7 @@ TEST_CASE("creating objects in batches gives the run of creating them one by one
     CHECK(d.stats("cell").dropped > 0);
 }
 
-TEST_CASE("with relaxed maths every sample's output stays within 1e-4 of max(1, |value|) over 600 frames") {
+TEST_CASE("with relaxed maths every sample's output stays within 1e-4 of max(1, |value|) over 600 frames (200 sanitized)") {
     // What differs: the last bits of reassociated sums and of x/c as x·(1/c), integrals of
     // constants taken as c·age instead of a float sum over 600 steps (the closed form is the
     // more accurate of the two), c + integrate(e) accumulated as one integral starting
@@ -363,7 +363,7 @@ TEST_CASE("with relaxed maths every sample's output stays within 1e-4 of max(1, 
     // difference is measured against max(1, |value|), as the backends' are. Measured worst:
     // 5.4e-6 (for values above 0.01, 1.9e-4 of the value itself: the fire's positions).
     float worst = 0;
-    size_t points = test::compareWithUnoptimized(true, {}, 600, [&](float a, float b) {
+    size_t points = test::compareWithUnoptimized(true, {}, test::kLongRun, [&](float a, float b) {
         float d = std::fabs(a - b) / std::max(std::fabs(a), 1.0f);
         if (std::isfinite(d)) worst = std::max(worst, d);
         return d <= 1e-4f;
