@@ -50,7 +50,7 @@ std::string describe(const Schedule& s, const Phase& p) {
             std::string also;
             if (p.exports) also += ", the survivors' exports";
             if (p.render) also += ", the render when the host draws every step";
-            std::string listed = p.late ? ", its kills listed" : p.listed ? ", its kills listed" : "";
+            std::string listed = p.late || p.listed ? ", its kills listed" : "";
             return fmt::format("{}: the update kernel over the pool{}{}", type, also, listed);
         }
         case PhaseKind::Kills:
