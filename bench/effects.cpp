@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
 
 #include "driver/compile.h"
@@ -59,6 +60,14 @@ double stateBytes(const ir::Object& o) {
     for (const auto& p : o.params)
         if (p.kept) bytes += 4 * p.type.width;
     return bytes;
+}
+
+bool writeJson(const std::string& path, const std::string& rows, const char* program) {
+    std::ofstream out(path);
+    out << rows << "\n";
+    if (out) return true;
+    std::cerr << program << ": cannot write " << path << "\n";
+    return false;
 }
 
 }  // namespace psys::bench

@@ -42,4 +42,8 @@ double calibrate(const Effect& e, rt::Backend& backend, double particles);
 // and written, every kept parameter read.
 double stateBytes(const ir::Object& o);
 
+// Writes a bench's rows (a JSON array) to `path`; false, with the reason on stderr under
+// `program`'s name, when it cannot.
+bool writeJson(const std::string& path, const std::string& rows, const char* program);
+
 }  // namespace psys::bench

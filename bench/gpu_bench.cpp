@@ -80,14 +80,7 @@ int main(int argc, char** argv) {
             std::cout.flush();
         }
     }
-    if (!json.empty()) {
-        std::ofstream out(json);
-        out << rows.dump(2) << "\n";
-        if (!out) {
-            std::cerr << "psys_gpu_bench: cannot write " << json << "\n";
-            return 1;
-        }
-    }
+    if (!json.empty() && !bench::writeJson(json, rows.dump(2), "psys_gpu_bench")) return 1;
     std::cout << "\n(host CPU: the CPU time of the thread that steps, the GL driver's threads not counted; passes: GPU time from GL timer queries, or \"wall\": from a glFinish before the pass to one after, "
                  "where the GL's timer does not see compute work; state B/particle: what the update pass must read and "
                  "write; update pass GB/s: that ÷ the pass's time; staged: copied on the GPU into and out of launches' words, beyond what the shaders move; waits/step: read-backs the host waited for mid-step; late/step: read-backs taken when the run-time needed them (kills at the step's end), and in brackets those the GPU had not finished by then)\n";

@@ -327,14 +327,7 @@ int main(int argc, char** argv) {
             }
         }
     }
-    if (!json.empty()) {
-        std::ofstream out(json);
-        out << rows.dump(2) << "\n";
-        if (!out) {
-            std::cerr << "psys_bench: cannot write " << json << "\n";
-            return 1;
-        }
-    }
+    if (!json.empty() && !bench::writeJson(json, rows.dump(2), "psys_bench")) return 1;
     std::cout << "\n(million particle updates per second; bound: triad bandwidth ÷ the bytes psys's update loop "
                  "must move per particle (state read and written, kept parameters read))\n\n";
     std::cout << "Where psys's steps went (ms per step), what drawing every step adds to it (a step and a draw against "

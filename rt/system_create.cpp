@@ -1,5 +1,5 @@
-// Creating objects: the queue of objects asked for, with their arguments in staging
-// columns, and their creation in batches (rt/system_create.h).
+// Creating objects: their creation in batches, from the queue (rt/system_queue.cpp) and
+// its staging columns (rt/system_create.h).
 #include "rt/system_create.h"
 
 #include <algorithm>
@@ -17,13 +17,6 @@ namespace psys::rt::detail {
 
 using ir::KernelKind;
 using ir::YieldKind;
-
-// Per type: the arguments of queued objects, one f32 column per component of the type's
-// parameters (kept or not); an entry's row is its place among the type's queued entries.
-struct Creation::Staging {
-    std::vector<Buffer> args;
-    size_t used = 0;
-};
 
 // Per type: the scratch columns a batch is created in, indexed like the staging rows (so
 // the staging columns are the batch's parameters as they are).
@@ -69,136 +62,6 @@ Creation::Creation(State& state) : s_(state) {
 Creation::~Creation() {
     for (Staging& st : staging_)
         for (Buffer b : st.args) s_.memory.release(b);
-}
-
-size_t Creation::stage(size_t type, size_t count) {
-    Staging& st = staging_[type];
-    size_t row = st.used;
-    st.used += count;
-    for (Buffer b : st.args)
-        if (s_.memory.rows(b) < st.used) s_.memory.resize(b, std::max(st.used, 2 * s_.memory.rows(b)));
-    return row;
-}
-
-void Creation::queueChildren(const Emitter& e, int site, uint64_t count, uint64_t perEvent, double firstTime,
-                             double spacing) {
-    const TypeInfo& info = s_.types[e.type];
-    size_t target = info.emitTarget[static_cast<size_t>(site)];
-    size_t free = s_.pools[target].free() + pending_[target];
-    size_t room = free > queued_[target] ? free - queued_[target] : 0;
-    uint64_t kept = std::min<uint64_t>(count, room);
-    addSaturating(s_.typeStats[target].dropped, count - kept);
-    if (kept == 0) return;
-    Handle parent = s_.types[target].parentType == static_cast<int>(e.type) ? s_.pools[e.type].handle(e.row) : Handle{};
-    size_t base = stage(target, static_cast<size_t>(kept));
-    if (const ir::Kernel* spawn = info.spawn[static_cast<size_t>(site)]) {
-        const ColumnLayout& layout = info.spawnLayout[static_cast<size_t>(site)];
-        s_.parentValues(e.type, e.row, layout, e.at, parents_);
-        ChildrenLaunch launch;
-        launch.object = &s_.pools[e.type].object();
-        launch.spawn = spawn;
-        launch.layout = &layout;
-        launch.columns = e.columns.empty() ? std::span<const Buffer>(s_.work[e.type].spawnTables[static_cast<size_t>(site)])
-                                           : e.columns;
-        launch.row = e.columns.empty() ? e.row : e.columnRow;
-        launch.parents = parents_.data();
-        launch.clock.nowValue = e.at;
-        launch.clock.dtValue = static_cast<float>(s_.lastDt);
-        launch.clock.first = e.first;
-        launch.externs = s_.externs.data();
-        launch.seed = s_.options.seed;
-        launch.draw = e.first ? kCreationDraw : static_cast<uint32_t>(s_.step);
-        launch.firstChild = s_.nextId;
-        launch.count = static_cast<size_t>(kept);
-        launch.args = staging_[target].args;
-        launch.argsFirst = base;
-        s_.backend.run(launch);
-    }
-    for (uint64_t k = 0; k < kept; ++k) {
-        queue_.push_back({target, base + static_cast<size_t>(k), parent,
-                          firstTime + static_cast<double>(k / perEvent) * spacing, s_.nextId++});
-        ++queued_[target];
-    }
-}
-
-void Creation::emitAtRate(const Emitter& e, std::span<const float> rate, std::span<const float> count, double dt,
-                          double t1) {
-    Pool& pool = s_.pools[e.type];
-    const ir::Object& o = pool.object();
-    for (size_t site = 0; site < o.emits.size(); ++site) {
-        if (!o.emits[site].rate) continue;
-        double r = validCount(rate[site], s_.stats.invalidEmissions);
-        double size = validCount(count[site], s_.stats.invalidEmissions);
-        double before = pool.emitted[site][e.row];
-        double total = before + r * dt;
-        // A whole number reached by adding up rounded rates (0.25 · 1/60, 240 times) counts as reached.
-        double events = std::floor(total + 1e-9);
-        pool.emitted[site][e.row] = std::max(0.0, total - events);
-        if (events < 1 || size < 1) continue;
-        uint64_t perEvent = wholeCount(size, s_.stats.clampedEmissions);  // counted when it is asked for
-        double firstTime = (t1 - dt) + (1.0 - before) / r;
-        uint64_t children = wholeCount(events * static_cast<double>(perEvent), s_.stats.clampedEmissions);
-        queueChildren(e, static_cast<int>(site), children, perEvent, firstTime, 1.0 / r);
-    }
-}
-
-void Creation::emitFromKernel(const ir::Trigger& trigger, std::span<const Value> params, uint32_t objectId) {
-    const ir::Kernel& k = trigger.kernel;
-    ir::KernelInputs in;
-    in.params = params.data();
-    in.externs = s_.externs.data();
-    in.time = static_cast<float>(s_.now);
-    in.seed = s_.options.seed;
-    in.objectId = objectId;
-    in.draw = static_cast<uint32_t>(s_.step);
-    s_.evaluator.run(k, in, yields_);
-    std::vector<uint64_t> counts(trigger.emits.size(), 0);
-    for (size_t i = 0; i < k.yields.size(); ++i)
-        if (k.yields[i].kind == YieldKind::EmitCount)
-            counts[static_cast<size_t>(k.yields[i].index)] =
-                wholeCount(validCount(yields_[i].f[0], s_.stats.invalidEmissions), s_.stats.clampedEmissions);
-    for (size_t site = 0; site < trigger.emits.size(); ++site) {
-        auto target = static_cast<size_t>(s_.module.objectIndex(trigger.emits[site].target));
-        Pool& pool = s_.pools[target];
-        size_t room = pool.free() > queued_[target] ? pool.free() - queued_[target] : 0;
-        uint64_t kept = std::min<uint64_t>(counts[site], room);
-        addSaturating(s_.typeStats[target].dropped, counts[site] - kept);
-        // The first column of each parameter among the staging columns.
-        std::vector<size_t> column;
-        size_t next = 0;
-        for (const ir::Param& p : pool.object().params) {
-            column.push_back(next);
-            next += static_cast<size_t>(p.type.width);
-        }
-        for (uint64_t n = 0; n < kept; ++n) {
-            Entry entry{target, stage(target, 1), {}, s_.now, s_.nextId++};
-            in.childDraw = entry.id;
-            s_.evaluator.run(k, in, yields_);
-            for (size_t i = 0; i < k.yields.size(); ++i) {
-                const ir::Yield& y = k.yields[i];
-                if (y.kind != YieldKind::EmitArg || y.index != static_cast<int>(site)) continue;
-                auto p = static_cast<size_t>(y.sub);
-                for (int c = 0; c < pool.object().params[p].type.width; ++c)
-                    s_.memory.write(staging_[target].args[column[p] + static_cast<size_t>(c)], entry.staging, 1,
-                                    &yields_[i].f[static_cast<size_t>(c)]);
-            }
-            ++queued_[target];
-            queue_.push_back(entry);
-        }
-    }
-}
-
-void Creation::drain(double t1) {
-    for (size_t i = 0; i < queue_.size();) {
-        size_t type = queue_[i].type;
-        size_t end = i + 1;
-        if (s_.options.createInBatches)
-            while (end < queue_.size() && queue_[end].type == type) ++end;
-        createBatch(type, i, end, t1);
-        i = end;
-    }
-    queue_.clear();
-    for (Staging& st : staging_) st.used = 0;
 }
 
 // A table over the batch's scratch columns for `layout`: the staging columns as the

@@ -53,7 +53,13 @@ private:
         double time;
         uint32_t id;
     };
-    struct Staging;
+    // Per type: the arguments of queued objects, one f32 column per component of the
+    // type's parameters (kept or not); an entry's row is its place among the type's
+    // queued entries.
+    struct Staging {
+        std::vector<Buffer> args;
+        size_t used = 0;
+    };
     struct Batch;
 
     size_t stage(size_t type, size_t count);  // staging rows for `count` new entries of `type`
