@@ -19,6 +19,7 @@
 // beyond both.
 #define DOCTEST_CONFIG_IMPLEMENT_WITH_MAIN
 #include <doctest/doctest.h>
+#include <epoxy/gl.h>
 
 #include <cmath>
 #include <filesystem>
@@ -340,6 +341,39 @@ TEST_CASE("the rows killed are compacted on the GPU in row order, across work gr
             }
             INFO("n " << n << ", " << density << "% set");
             CHECK(compactor.flagged(flags) == expected);
+        }
+    }
+}
+
+TEST_CASE("the compaction zeroes a mask at the rows it lists, directly or through a list of rows") {
+    // A late launch's kills cleared in its pool's alive mask: rows base + i of a pool's
+    // update, or rows[offset + i] of a creation batch's.
+    auto gpu = gpuBackend();  // a context
+    gpu::Compactor compactor;
+    uint32_t x = 777;
+    for (size_t n : {size_t{1}, size_t{256}, size_t{1000}, size_t{70'001}}) {
+        for (bool mapped : {false, true}) {
+            const uint32_t base = 3, offset = 5;
+            const size_t maskRows = n + 64;
+            std::vector<uint32_t> flags(n), rows(n + offset), mask(maskRows, 1u), expected = mask;
+            for (size_t i = 0; i < n + offset; ++i) rows[i] = static_cast<uint32_t>((i * 7919) % maskRows);
+            for (size_t i = 0; i < n; ++i) {
+                x = x * 1664525u + 1013904223u;
+                flags[i] = (x >> 8) % 100 < 20 || (i >= 256 && i < 512) ? 1u : 0u;  // a whole group set too
+                if (flags[i]) expected[mapped ? rows[offset + i] : base + i] = 0;
+            }
+            GLuint buffers[4] = {};
+            glCreateBuffers(4, buffers);
+            glNamedBufferData(buffers[0], static_cast<GLsizeiptr>(n * 4), flags.data(), GL_STATIC_DRAW);
+            glNamedBufferData(buffers[1], static_cast<GLsizeiptr>((n + 1) * 4), nullptr, GL_DYNAMIC_READ);
+            glNamedBufferData(buffers[2], static_cast<GLsizeiptr>(maskRows * 4), mask.data(), GL_DYNAMIC_COPY);
+            glNamedBufferData(buffers[3], static_cast<GLsizeiptr>(rows.size() * 4), rows.data(), GL_STATIC_DRAW);
+            gpu::Compactor::Clear clear{buffers[2], mapped ? buffers[3] : 0u, base, mapped ? offset : 0u};
+            compactor.compact(buffers[0], 0, n, buffers[1], 0, &clear);
+            glGetNamedBufferSubData(buffers[2], 0, static_cast<GLsizeiptr>(maskRows * 4), mask.data());
+            glDeleteBuffers(4, buffers);
+            INFO("n " << n << (mapped ? ", through rows" : ", directly"));
+            CHECK(mask == expected);
         }
     }
 }

@@ -174,7 +174,7 @@ TEST_CASE("with the emitters on the host, a step waits for the GPU never, and th
     CHECK(run("fountain") == 20);
 }
 
-TEST_CASE("a step's late kills are taken at the next step; what is drawn before leaves them out") {
+TEST_CASE("a step's late kills are taken at the next step — what is drawn before leaves them out") {
     // Flashes die in their first update (they live 1 ms; a step is 16.7), drops in a later
     // one: the GPU clears their rows in the alive mask the draws read, and the host takes
     // the kills — freeing the rows, in the interpreter's order — when the next step starts

@@ -140,7 +140,7 @@ TEST_CASE("a session moves onto the GPU backend and back without losing a step")
     CHECK(test::drawnBytes(moving->system(), 60) == test::drawnBytes(straight->system(), 60));
 }
 
-TEST_CASE("fast maths compiles with the relaxed rewrites, exact maths and the interpreter without; a session keeps its choice") {
+TEST_CASE("fast maths compiles with the relaxed rewrites, exact maths and the interpreter without — a session keeps its choice") {
     std::string text = sampleText("fire");
     auto slots = [](const host::Session& s) {
         std::string names;

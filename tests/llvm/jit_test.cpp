@@ -224,7 +224,7 @@ TEST_CASE("the JIT draws as the step goes what it draws after the step: bit for 
     }
 }
 
-TEST_CASE("fast maths calls glibc's vector functions at the loops' full width; exact maths calls libm's") {
+TEST_CASE("fast maths calls glibc's vector functions at the loops' full width — exact maths calls libm's") {
     codegen_llvm::LlvmBackend fast(codegen_llvm::MathMode::Fast), exact(codegen_llvm::MathMode::Exact);
     // The 16-lane (AVX-512) variants where loops run 16 floats a register, else 8 (AVX) or 4.
     std::string wide = fast.lanes() == 16 ? "_ZGVeN16v_expf" : fast.lanes() == 8 ? "_ZGVdN8v_expf" : "_ZGVbN4v_expf";

@@ -201,7 +201,7 @@ TEST_CASE("diagnostics: ranges in UTF-16, notes as related information, warnings
     CHECK(hover(syntax, 12).is_null());
 }
 
-TEST_CASE("positions: UTF-16 columns to bytes and back; URIs with spaces") {
+TEST_CASE("positions: UTF-16 columns to bytes and back — URIs with spaces") {
     SourceFile f("x", "a𝄞b\né=1\n");
     CHECK(position(f, 5) == json{{"line", 0}, {"character", 3}});  // after the 4-byte 𝄞: 2 UTF-16 units
     CHECK(offsetOf(f, json{{"line", 0}, {"character", 3}}) == 5);

@@ -28,7 +28,7 @@ TEST_CASE("tabs in the source line are kept in the underline so the caret lines 
     CHECK(diags.render().find(" 1 | \tx = $;\n   | \t    ^\n") != std::string::npos);
 }
 
-TEST_CASE("an empty range gets one caret; a range past its line is cut at the line end") {
+TEST_CASE("an empty range gets one caret — a range past its line is cut at the line end") {
     SourceManager sources;
     int f = sources.add("t.psys", "ab\ncd\n");
     DiagnosticEngine diags(sources);

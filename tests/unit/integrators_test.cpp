@@ -347,7 +347,7 @@ TEST_CASE("exact has no closed form for a coupled system or a non-polynomial der
                                "derivative applies `sin` to a value that changes within the step") != std::string::npos);
 }
 
-TEST_CASE("every sample runs under every method; exact reports the three without closed forms") {
+TEST_CASE("every sample runs under every method — exact reports the three without closed forms") {
     for (Integrator m : allMethods()) {
         for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
             if (entry.path().extension() != ".psys") continue;

@@ -135,7 +135,7 @@ TEST_CASE("the op table: every op is named, found by its name, and has the prope
     CHECK(isLeaf(Op::Const));
 }
 
-TEST_CASE("the structural hash: equal structure hashes alike; names and locations do not count") {
+TEST_CASE("the structural hash: equal structure hashes alike — names and locations do not count") {
     auto build = [](const char* name, uint32_t line, float constant) {
         Kernel k;
         k.setLoc({0, line, 1, 1});

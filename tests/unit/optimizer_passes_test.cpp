@@ -107,7 +107,7 @@ end
 )");
 }
 
-TEST_CASE("simplify: a lane used alone is computed alone; vectors rebuilt unchanged are the vector") {
+TEST_CASE("simplify: a lane used alone is computed alone — vectors rebuilt unchanged are the vector") {
     CHECK(after(R"(object p(u: vec3, v: vec3)
   kernel update
     %0 = param.vec3 #0

@@ -216,7 +216,7 @@ end
     CHECK(out.find("draw.index.u32 #1") == std::string::npos);  // %1 was not used: dropped
 }
 
-TEST_CASE("split-kernels: init, update and render; render reads the new state") {
+TEST_CASE("split-kernels: init, update and render — render reads the new state") {
     // pos = integrate(v) with v a parameter; point(pos, white, prev-based size)
     Module m = parse(R"(object p(v: vec3)
   state integrate#0: vec3 zero

@@ -100,7 +100,7 @@ TEST_CASE("a reload that adds an equation starts its state as at each object's c
     }
 }
 
-TEST_CASE("a reload that removes an equation drops its state; the rest carries on") {
+TEST_CASE("a reload that removes an equation drops its state — the rest carries on") {
     std::string old = "object p { a = integrate(vec3(1, 0, 0)); b = integrate(vec3(0, 2, 0));\n"
                       "  point(a + b, white, 1); }\nspawn p;";
     std::string removed = "object p { a = integrate(vec3(1, 0, 0)); point(a, white, 1); }\nspawn p;";
@@ -251,7 +251,7 @@ TEST_CASE("a renamed object type is a removed type and a new one") {
     CHECK(after.stats().types[0].created == 15);
 }
 
-TEST_CASE("a reload that adds a parameter carries the objects; the new parameter reads 0") {
+TEST_CASE("a reload that adds a parameter carries the objects — the new parameter reads 0") {
     std::string old = "object p(a: float) { point(vec3(a, 0, 0), white, 1); }\nspawn p(2);";
     std::string added = "object p(a: float, b: float) { point(vec3(a, b + 7, 0), white, 1); }\nspawn p(2, 3);";
     interp::Interpreter backend;
@@ -285,7 +285,7 @@ TEST_CASE("a reload right after a burst carries every object of it, as if nothin
     CHECK(run(after, 60) == run(straight, 60));
 }
 
-TEST_CASE("a reload that changes the integrator carries the integrals; the new method takes over") {
+TEST_CASE("a reload that changes the integrator carries the integrals — the new method takes over") {
     // A ball thrown up under drag: its integrals keep their slots (integrate@vel,
     // integrate@pos) whatever the method, so switching carries them and the ball goes on
     // from where it was, now integrated by rk4. (The default method also kept the

@@ -11,7 +11,7 @@
 using namespace psys;
 using test::Run;
 
-TEST_CASE("counts and rates past 1e18 are taken as 1e18 and counted; dropped stops at 2^64 - 1") {
+TEST_CASE("counts and rates past 1e18 are taken as 1e18 and counted — dropped stops at 2^64 - 1") {
     SUBCASE("a count of 1e30 per event") {
         Run run("@capacity(100) object b { point(origin, white, 1); }\n"
                 "object e { emit b at 1 per second count 1e30; }\nspawn e;");

@@ -117,7 +117,7 @@ TEST_CASE("a child reads its parent live, then the frozen value with alive false
     CHECK(run.stats("parent").frozen == 1);
 }
 
-TEST_CASE("a gather reads the rows it names, 0 for a skipped row; past the end is an error") {
+TEST_CASE("a gather reads the rows it names, 0 for a skipped row — past the end is an error") {
     rt::HostMemory memory;
     rt::Buffer from = memory.create(rt::Elem::F32, 4), to = memory.create(rt::Elem::F32, 5);
     std::vector<float> values = {10, 11, 12, 13}, filled(5, -1);
@@ -147,7 +147,7 @@ TEST_CASE("a frozen parent is freed after its last reader dies") {
     CHECK(run.stats("parent").frozen == 0);
 }
 
-TEST_CASE("the same seed gives the same run; another seed another") {
+TEST_CASE("the same seed gives the same run — another seed another") {
     std::string fireworks = test::readFile((std::filesystem::path(PSYS_SAMPLES_DIR) / "fireworks.psys").string());
     auto positions = [&](uint32_t seed) {
         Run run(fireworks, {seed, 1 << 20});
@@ -178,7 +178,7 @@ TEST_CASE("every sample compiles, verifies and runs 600 frames at dt = 1/60") {
 
 // ---------------------------------------------------------------- extremes
 
-TEST_CASE("dt = 0 changes nothing; negative, NaN and infinite dt are refused and counted") {
+TEST_CASE("dt = 0 changes nothing — negative, NaN and infinite dt are refused and counted") {
     Run run("object a { pos = integrate(vec3(1)); point(pos, white, age); }\nspawn a;");
     run.steps(1, 0.5);
     auto before = run.points("a");
@@ -252,7 +252,7 @@ TEST_CASE("after 10^7 s ages are still exact to a millisecond") {
     CHECK(run.points("a")[0].size == doctest::Approx(0.001).epsilon(1e-3));
 }
 
-TEST_CASE("NaN and infinity set on an extern are refused and counted; it keeps its last good value") {
+TEST_CASE("NaN and infinity set on an extern are refused and counted — it keeps its last good value") {
     Run run("extern w: vec3 = 0;\nobject a(k: float) { point(vec3(k) + w * k, white, 1); }\n"
             "spawn a(0); spawn a(1);");
     float good[3] = {1, 2, 3};
@@ -268,7 +268,7 @@ TEST_CASE("NaN and infinity set on an extern are refused and counted; it keeps i
     CHECK(run.system->stats().nonFiniteRender == 0);
 }
 
-TEST_CASE("a value outside an extern's range is refused and counted; it keeps its value") {
+TEST_CASE("a value outside an extern's range is refused and counted — it keeps its value") {
     Run run("extern k: float = 1 range(0, 2);\nextern v: vec3 = 0 range(-1, 1);\n"
             "object a { point(v, white, k); }\nspawn a;");
     float five = 5, two = 2;

@@ -50,7 +50,7 @@ TEST_CASE("a step's schedule has a phase for what each type does, and none for w
     CHECK(s.phases[7].parallelism == rt::Parallelism::Ordered);
 }
 
-TEST_CASE("under @step a type's update, kills and emissions repeat per sub-step; its creation does not") {
+TEST_CASE("under @step a type's update, kills and emissions repeat per sub-step — its creation does not") {
     test::Run run(R"(
         object mote { point(vec3(age), white, 1); }
         @step(0.005) object ball {

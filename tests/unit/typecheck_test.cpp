@@ -185,7 +185,7 @@ TEST_CASE("a failed composite equation does not cascade into its users") {
     CHECK(c.output.find("unknown function `undefined_fn`") != std::string::npos);
 }
 
-TEST_CASE("cycles through integrate, prev or the next side of -> are legal; others are algebraic loops") {
+TEST_CASE("cycles through integrate, prev or the next side of -> are legal — others are algebraic loops") {
     auto legal = test::check(R"(object a {
         p = integrate(v); v = 1 - p;               // through integrate
         q = prev(r) + 1; r = q * 2;                // through prev
