@@ -65,19 +65,29 @@ void main() {
 )";
 
 // Each group's set rows at its offset, in order, after the total (list[at]: written by the
-// first invocation; the rows from list[at + 1]). A group with none set leaves at once,
-// and one with all set needs no scan (the same for every invocation of the group, so no
-// barrier is skipped by some and not others): kills are sparse and bunched (objects
-// created together die together), and a pool is one launch.
+// first invocation; the rows from list[at + 1]), and the mask zeroed at each where asked
+// (Compactor::Clear). A group with none set leaves at once, and one with all set needs
+// no scan (the same for every invocation of the group, so no barrier is skipped by some
+// and not others): kills are sparse and bunched (objects created together die together),
+// and a pool is one launch.
 const char* kWrite = R"(#version 450
 layout(local_size_x = 256) in;
 layout(std430, binding = 0) readonly buffer Words { uint w[]; };
 layout(std430, binding = 1) readonly buffer Groups { uint groups[]; };
 layout(std430, binding = 2) writeonly buffer List { uint list[]; };
+layout(std430, binding = 3) writeonly buffer Mask { uint mask[]; };
+layout(std430, binding = 4) readonly buffer Rows { uint rows[]; };
 #define first param(0u)
 #define n param(1u)
 #define at param(3u)
+#define clearing param(4u)
+#define base param(5u)
+#define offset param(6u)
+#define mapped param(7u)
 shared uint prefix[256];
+void clear(uint i) {
+    if (clearing != 0u) mask[mapped != 0u ? rows[offset + i] : base + i] = 0u;
+}
 void main() {
     uint t = gl_LocalInvocationID.x, i = gl_GlobalInvocationID.x, g = gl_WorkGroupID.x;
     if (i == 0u) list[at] = groups[gl_NumWorkGroups.x];
@@ -85,6 +95,7 @@ void main() {
     if (count == 0u) return;
     if (count == gl_WorkGroupSize.x) {
         list[at + 1u + groups[g] + t] = i;
+        clear(i);
         return;
     }
     uint flag = i < n && w[first + i] != 0u ? 1u : 0u;
@@ -96,7 +107,10 @@ void main() {
         prefix[t] += add;
         barrier();
     }
-    if (flag != 0u) list[at + groups[g] + prefix[t]] = i;
+    if (flag != 0u) {
+        list[at + groups[g] + prefix[t]] = i;
+        clear(i);
+    }
 }
 )";
 
@@ -125,13 +139,14 @@ Compactor::~Compactor() {
     if (params_) glDeleteBuffers(1, &params_);
 }
 
-void Compactor::compact(unsigned words, size_t word, size_t n, unsigned out, size_t at) {
+void Compactor::compact(unsigned words, size_t word, size_t n, unsigned out, size_t at, const Clear* clear) {
     if (!count_) {
         count_ = computeProgram(withParams(kCount), "compaction (counts)");
         scan_ = computeProgram(withParams(kScan), "compaction (scan)");
         write_ = computeProgram(withParams(kWrite), "compaction (rows)");
         glCreateBuffers(1, &groups_);
     }
+    PassTimer::Scope timed(timer, "compaction", n);
     if (n == 0) {  // nothing set: the total alone
         uint32_t zero = 0;
         glClearNamedBufferSubData(out, GL_R32UI, static_cast<GLintptr>(at * 4), 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
@@ -145,8 +160,13 @@ void Compactor::compact(unsigned words, size_t word, size_t n, unsigned out, siz
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, words);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, groups_);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, out);
+    // Without a clearing, the mask's and rows' blocks are bound to a buffer the pass never
+    // writes through them.
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, clear ? clear->mask : groups_);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, clear && clear->rows ? clear->rows : groups_);
     bindParams(params_, {static_cast<uint32_t>(word), static_cast<uint32_t>(n), static_cast<uint32_t>(groups),
-                         static_cast<uint32_t>(at)});
+                         static_cast<uint32_t>(at), clear ? 1u : 0u, clear ? clear->base : 0u,
+                         clear ? clear->offset : 0u, clear && clear->rows ? 1u : 0u});
     glUseProgram(count_);
     glDispatchCompute(static_cast<GLuint>(groups), 1, 1);
     afterWrite(Write::Dispatch, kStorageBlock);  // the counts: the scan reads them
@@ -156,8 +176,8 @@ void Compactor::compact(unsigned words, size_t word, size_t n, unsigned out, siz
     glUseProgram(write_);
     glDispatchCompute(static_cast<GLuint>(groups), 1, 1);
     // The list: the host maps it (a read-back region) or reads it (flagged), a shader may
-    // read it next.
-    afterWrite(Write::Dispatch, kHostMap | kCopy | kStorageBlock);
+    // read it next; the mask: whatever reads a column (the draws).
+    afterWrite(Write::Dispatch, kHostMap | kCopy | kStorageBlock | (clear ? kColumnReaders : 0));
 }
 
 }  // namespace psys::gpu

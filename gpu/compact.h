@@ -8,9 +8,13 @@
 // writes the total; each group scans its flags in shared memory and writes its rows at
 // its offset, after the total. The host learns how many rows there are with the rows
 // (GlslBackend reads them back with the launch's counts, at once or late: gpu/glsl_readback.cpp).
+// The last pass may also zero a mask where the flags are set (a late launch's kills
+// cleared in its pool's alive mask, rt::Backend::clearsKilled): it visits only the groups
+// that have some, so the clearing costs no pass of its own over every row.
 #pragma once
 
 #include <cstddef>
+#include "gpu/pass_timer.h"
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -23,11 +27,20 @@ public:
     ~Compactor();
     Compactor(const Compactor&) = delete;
     Compactor& operator=(const Compactor&) = delete;
+    // Where set flags also zero a mask: mask[base + i], or mask[rows[offset + i]] where
+    // `rows` (a GL buffer) is given.
+    struct Clear {
+        unsigned mask = 0;
+        unsigned rows = 0;
+        uint32_t base = 0, offset = 0;
+    };
     // Into `out` (a GL buffer) from word `at`: how many of words[word + i], i < n, are
-    // not 0, then those i in order (room for n + 1 words). All on the GPU: nothing waits.
-    void compact(unsigned words, size_t word, size_t n, unsigned out, size_t at);
+    // not 0, then those i in order (room for n + 1 words); and `clear`, where given. All
+    // on the GPU: nothing waits.
+    void compact(unsigned words, size_t word, size_t n, unsigned out, size_t at, const Clear* clear = nullptr);
     // The same for flags on the host, read back: the indices set.
     std::vector<uint32_t> flagged(std::span<const uint32_t> flags);
+    PassTimer* timer = nullptr;  // its passes timed there ("compaction"), where set
 
 private:
     unsigned count_ = 0, scan_ = 0, write_ = 0;  // programs

@@ -123,7 +123,8 @@ Buffer GlMemory::create(Elem elem, size_t rows) {
 void GlMemory::resize(Buffer b, size_t rows) {
     Column& c = at(b);
     if (c.device) {  // grown or shrunk on the GPU: the column stays there
-        if (rows < c.rows) flush(c);  // (rows pending past the end would land in rows to be zeroed)
+        if (rows < c.rows) flush(c);
+        PassTimer::Scope timed(timer, "grow", rows);  // (rows pending past the end would land in rows to be zeroed)
         size_t w = wordsPerRow(c.elem);
         // A pool grows a row at a time: the GL buffer doubles, and is zeroed past the rows
         // once then, not at each row.
@@ -202,6 +203,7 @@ void GlMemory::uploadRows(Column& c, size_t first, size_t count) const {
     c.zeroFrom = c.glRows;  // what is past the rows in the GL buffer is not known
     if (count == 0) return;
     size_t w = wordsPerRow(c.elem);
+    PassTimer::Scope timed(timer, "upload", count);
     std::vector<uint32_t> staging(count * w);
     toWords(c.hostCopy.data() + first * rt::elemSize(c.elem), c.elem, count, staging.data());
     glNamedBufferSubData(c.gl, static_cast<GLintptr>(first * w * 4), static_cast<GLsizeiptr>(staging.size() * 4),
@@ -258,6 +260,7 @@ void GlMemory::copy(Buffer from, size_t fromFirst, Buffer to, size_t toFirst, si
     flush(t);
     uploadRows(f, fromFirst, count);  // only the rows copied: the source stays on the host
     upload(t);
+    PassTimer::Scope timed(timer, "copy", count);
     size_t w = wordsPerRow(f.elem) * 4;
     if (count)
         glCopyNamedBufferSubData(f.gl, t.gl, static_cast<GLintptr>(fromFirst * w), static_cast<GLintptr>(toFirst * w),
@@ -299,7 +302,7 @@ void GlMemory::scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const
     uploadRows(f, fromFirst, rows.size());  // only the rows scattered: the source stays on the host
     upload(t);
     if (!scatterProgram_) scatterProgram_ = computeProgram(rowsShader(kScatter), "scatter");
-    runRows(scatterProgram_, f.gl, t.gl, wordsPerRow(f.elem), fromFirst, rows);
+    runRows(scatterProgram_, f.gl, t.gl, wordsPerRow(f.elem), fromFirst, rows, "scatter");
     t.device = true;
 }
 
@@ -335,7 +338,7 @@ void GlMemory::flush(Column& c) const {
     afterWrite(Write::Upload, kStorageBlock);
     transferred += words.size() * 4;
     if (!scatterProgram_) scatterProgram_ = computeProgram(rowsShader(kScatter), "scatter");
-    runRows(scatterProgram_, pendingBuffer_, c.gl, w, 0, rows);
+    runRows(scatterProgram_, pendingBuffer_, c.gl, w, 0, rows, "scatter");
 }
 
 // On the GPU where the source is (a parent's exports, written there by its kernel), so
@@ -359,7 +362,7 @@ void GlMemory::gather(Buffer from, Buffer to, size_t toFirst, std::span<const ui
     upload(f);
     upload(t);
     if (!gatherProgram_) gatherProgram_ = computeProgram(rowsShader(kGather), "gather");
-    runRows(gatherProgram_, f.gl, t.gl, wordsPerRow(f.elem), toFirst, rows);
+    runRows(gatherProgram_, f.gl, t.gl, wordsPerRow(f.elem), toFirst, rows, "gather");
     t.device = true;
 }
 
@@ -379,7 +382,8 @@ unsigned GlMemory::rowList(std::span<const uint32_t> rows) const {
 // A scatter or gather over a list of rows; the list goes up once for every column of a
 // batch or a parent that uses it.
 void GlMemory::runRows(unsigned program, unsigned from, unsigned to, size_t w, size_t first,
-                       std::span<const uint32_t> rows) const {
+                       std::span<const uint32_t> rows, const char* pass) const {
+    PassTimer::Scope timed(timer, pass, rows.size());
     unsigned list = rowList(rows);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, from);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, to);
@@ -400,6 +404,7 @@ void GlMemory::clear(Buffer b, size_t first, size_t count) {
         return;
     }
     flush(c);
+    PassTimer::Scope timed(timer, "clear", count);
     size_t w = wordsPerRow(c.elem) * 4;
     uint32_t zero = 0;
     glClearNamedBufferSubData(c.gl, GL_R32UI, static_cast<GLintptr>(first * w), static_cast<GLsizeiptr>(count * w),
@@ -441,6 +446,7 @@ void GlMemory::adopt(Buffer b, size_t first, size_t count, unsigned words, size_
     upload(c);
     size_t w = wordsPerRow(c.elem) * 4;
     staged += count * w;
+    PassTimer::Scope timed(timer, "adopt", count);
     glCopyNamedBufferSubData(words, c.gl, static_cast<GLintptr>(word * 4), static_cast<GLintptr>(first * w),
                              static_cast<GLsizeiptr>(count * w));
     afterWrite(Write::Copy, kColumnReaders);

@@ -14,6 +14,7 @@
 #include <memory>
 #include <vector>
 
+#include "gpu/pass_timer.h"
 #include "rt/memory.h"
 
 namespace psys::gpu {
@@ -72,6 +73,8 @@ public:
     // on the host, and the column stays there (a small pool whose launches run on the
     // host: GlslBackend::setHostSide); 0: every scatter runs on the GPU.
     size_t hostRows = 0;
+    // Where its work on the GPU is timed, by pass (the backend's; null: nowhere).
+    PassTimer* timer = nullptr;
 
     static size_t wordsPerRow(rt::Elem e) { return e == rt::Elem::F64 ? 2 : 1; }
 
@@ -86,7 +89,7 @@ private:
     std::vector<std::unique_ptr<Column>> columns_;
     std::vector<uint32_t> free_;
     void runRows(unsigned program, unsigned from, unsigned to, size_t w, size_t first,
-                 std::span<const uint32_t> rows) const;
+                 std::span<const uint32_t> rows, const char* pass) const;
     void flush(Column& c) const;  // its pending rows to the GPU
     std::vector<uint32_t> pendingColumns_;  // columns that may have rows pending
     // Scatters from the host of at most this many rows into a column on the GPU wait, and

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <optional>
 #include <cstring>
 #include <stdexcept>
 #include <thread>
@@ -146,7 +147,8 @@ std::unique_ptr<GlslBackend> GlslBackend::create(std::string& error) {
     glCreateBuffers(1, &b->counts_);
     glCreateBuffers(1, &b->block_);
     glNamedBufferData(b->counts_, 16, nullptr, GL_DYNAMIC_COPY);
-    glCreateQueries(GL_TIME_ELAPSED, 1, &b->query_);
+    b->memory_.timer = &b->timer_;
+    b->compactor_.timer = &b->timer_;
     return b;
 }
 
@@ -157,13 +159,12 @@ GlslBackend::~GlslBackend() {
     if (context_) context_->makeCurrent();
     for (auto& [key, p] : rows_) glDeleteProgram(p->program);
     for (auto& [key, p] : children_) glDeleteProgram(p->program);
-    if (clearKilled_) glDeleteProgram(clearKilled_);
     for (auto& [ticket, late] : late_) settle(*late);  // its fence deleted
     if (readback_) glUnmapNamedBuffer(readback_);
     glDeleteTextures(static_cast<GLsizei>(textures_.size()), textures_.data());
     GLuint buffers[] = {words_, counts_, block_, readback_, params_};
     glDeleteBuffers(5, buffers);
-    glDeleteQueries(1, &query_);
+    timer_.release();
 }
 
 // Begun, and finished at once unless a plan is being prepared: then every program of it
@@ -281,26 +282,11 @@ void GlslBackend::dispatch(Program& program, const std::vector<uint32_t>& block,
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, counts_);
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, block_);
     glUseProgram(program.program);
-    auto start = std::chrono::steady_clock::now();
-    if (timing_) {
-        glFinish();
-        start = std::chrono::steady_clock::now();
-        glBeginQuery(GL_TIME_ELAPSED, query_);
+    {
+        PassTimer::Scope timed(&timer_, pass.c_str(), count);
+        dispatchInvocations(count, codegen_glsl::kWorkGroupSize);
     }
-    dispatchInvocations(count, codegen_glsl::kWorkGroupSize);
     ++memory_.dispatches;
-    if (timing_) {
-        glEndQuery(GL_TIME_ELAPSED);
-        glFinish();
-        double wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-        GLuint64 ns = 0;
-        glGetQueryObjectui64v(query_, GL_QUERY_RESULT, &ns);
-        PassTime& t = passTimes_[pass];
-        t.milliseconds += static_cast<double>(ns) * 1e-6;
-        t.wallMilliseconds += wall;
-        t.launches += 1;
-        t.rows += count;
-    }
     // What the shader wrote — columns in place, the launch's words, the counts — is read
     // next by anything a column has: kernels (storage blocks, buffer textures), copies
     // into launch blocks and read-backs, the viewer's vertex pulls.
@@ -314,7 +300,7 @@ void GlslBackend::setHostSide(std::unique_ptr<rt::Backend> host, size_t rows) {
 }
 
 // A late launch's kills cleared in its alive mask (Backend::clearsKilled) where the host
-// side ran it, as clearKilled does on the GPU: the run-time may take them at the next step
+// side ran it, as the compaction of its kills does on the GPU (readBack): the run-time may take them at the next step
 // (when another late launch of the step is still owed), and what is drawn before must
 // leave them out (objects that died in their first update were drawn on the GPU).
 void GlslBackend::hostClearKilled(const rt::RowsLaunch& launch) {
@@ -443,6 +429,7 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
     bindDirect(launch, p, begin, end, block);
     ensureWords(words);
     // Columns on the GPU are copied there; the others come from the host.
+    std::optional<PassTimer::Scope> staging(std::in_place, &timer_, "staging", n);
     uint32_t zero = 0;
     glClearNamedBufferSubData(words_, GL_R32UI, 0, static_cast<GLsizeiptr>(n * 4), GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     afterWrite(Write::Clear, kStorageBlock);
@@ -463,12 +450,11 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
         memory_.transferred += n * w * 4;
     }
 
+    staging.reset();
     for (uint32_t e = 0; e < p.block.externCount; ++e) putValue(block, p.block.externs + 4 * e, launch.externs[e]);
     if (launch.uniforms)
         for (uint32_t u = 0; u < p.block.uniformCount; ++u) putValue(block, p.block.uniforms + 4 * u, launch.uniforms[u]);
     dispatch(p, block, n, p.pass);
-    if (kills && killBuffer.valid() && launch.aliveMask.valid())  // the run-time may take them at the next step
-        clearKilled(launch, begin, n, block[LaunchBlock::kColumns + ColumnLayout::kKill]);
     for (int c : p.resident) {
         Buffer b = launch.columns[static_cast<size_t>(c)];
         if (!b.valid()) continue;

@@ -9,7 +9,7 @@
 // back, in one wait, its counts, the rows killed (compacted on the GPU: gpu/compact.h)
 // and its emissions (docs/gpu.md) — or, for a late launch (rt::RowsLaunch::late), no wait:
 // its counts and kills are taken when the run-time collects them (at the next step: its
-// kills have cleared their rows in the alive mask the draws read, clearKilled).
+// kills have cleared their rows in the alive mask the draws read, in their compaction).
 #pragma once
 
 #include <limits>
@@ -23,6 +23,7 @@
 
 #include "gpu/compact.h"
 #include "gpu/gl_memory.h"
+#include "gpu/pass_timer.h"
 #include "rt/backend.h"
 
 namespace psys::gpu {
@@ -51,17 +52,13 @@ public:
     // One dispatch over every row (split only where a storage block cannot hold them).
     size_t chunkRows() const override { return std::numeric_limits<size_t>::max(); }
 
-    // Time of the launches so far while timePasses is on, by kernel kind name: on the GPU
-    // (GL timer queries), and on the wall from a glFinish before the dispatch to one after
-    // (what a GL whose timer does not see its compute work, as llvmpipe's, can give).
-    struct PassTime {
-        double milliseconds = 0;
-        double wallMilliseconds = 0;
-        size_t launches = 0;
-        size_t rows = 0;
-    };
-    const std::map<std::string, PassTime>& passTimes() const { return passTimes_; }
-    void timePasses(bool on) { timing_ = on; }
+    // The GPU's work so far while timePasses is on, by pass (gpu/pass_timer.h): the
+    // launches by kernel kind name, and what is recorded around them ("staging",
+    // "scatter", "gather", "compaction", "read-back", "clear", "copy",
+    // "adopt", "upload", "grow").
+    using PassTime = PassTimer::Time;
+    const std::map<std::string, PassTime>& passTimes() const { return timer_.times(); }
+    void timePasses(bool on) { timer_.enable(on); }
     // At most this many rows per dispatch (else as many as a storage block holds): for
     // tests, which cannot reach the GL's limit.
     void limitDispatchRows(size_t rows) { dispatchRows_ = rows; }
@@ -133,9 +130,6 @@ private:
     const uint32_t* awaitReadback();  // a fence, one wait: the read-back buffer as the GPU left it
     uint64_t finishLate(std::unique_ptr<Late> late);  // its fence; its ticket
     void settle(Late& late);          // waits for it if it must, and reads its counts and kills
-    // A late launch's kills cleared in its aliveMask on the GPU (rt::Backend::clearsKilled),
-    // from the kill flags at word `flags` of the launch's words.
-    void clearKilled(const rt::RowsLaunch& launch, size_t begin, size_t n, uint32_t flags);
     void hostClearKilled(const rt::RowsLaunch& launch);
     void ensureWords(size_t words);
     bool onHost(std::span<const rt::Buffer> columns, rt::Buffer mask, size_t rows) const;
@@ -146,7 +140,7 @@ private:
     Compactor compactor_;
     std::map<RowsKey, std::unique_ptr<Program>> rows_;
     std::map<const ir::Kernel*, std::unique_ptr<Program>> children_;
-    unsigned words_ = 0, counts_ = 0, block_ = 0, query_ = 0, readback_ = 0, clearKilled_ = 0, params_ = 0;
+    unsigned words_ = 0, counts_ = 0, block_ = 0, readback_ = 0, params_ = 0;
     const uint32_t* mappedReadback_ = nullptr;
     size_t readbackWords_ = 0;
     size_t wordsCapacity_ = 0;
@@ -173,8 +167,7 @@ private:
     size_t kernels_ = 0;
     double compileSeconds_ = 0;
     std::string renderer_;
-    bool timing_ = false;
-    std::map<std::string, PassTime> passTimes_;
+    PassTimer timer_;
 };
 
 }  // namespace psys::gpu

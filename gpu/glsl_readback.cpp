@@ -12,6 +12,7 @@
 // asked, so that a step's regions soon fit without settling anything early.
 #include <algorithm>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <stdexcept>
 
@@ -36,24 +37,6 @@ constexpr size_t kKillsAt = 4;  // in a region: counts at words 0–3, the kills
 // (%s: the invocation's index, kInvocationIndex, and the parameters' block, kParamsBlock.)
 // mask[row of launch row i] = 0 where the kill flag words[flags + i] is set; the row is
 // rows[offset + i] where `mapped` (a creation batch's), else base + i.
-const char* kClearKilled = R"(#version 450
-layout(local_size_x = 64) in;
-#define INVOCATION %s
-layout(std430, binding = 0) readonly buffer Words { uint words[]; };
-layout(std430, binding = 1) buffer Mask { uint mask[]; };
-layout(std430, binding = 2) readonly buffer Rows { uint rows[]; };
-#define count param(0u)
-#define flags param(1u)
-#define base param(2u)
-#define offset param(3u)
-#define mapped param(4u)
-void main() {
-    uint i = INVOCATION;
-    if (i >= count || words[flags + i] == 0u) return;
-    mask[mapped != 0u ? rows[offset + i] : base + i] = 0u;
-}
-)";
-
 // Waits for `fence` (flushing what is queued), then deletes it.
 void waitFor(GLsync fence) {
     GLenum status = GL_TIMEOUT_EXPIRED;
@@ -93,17 +76,34 @@ rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program
         words += n * GlMemory::wordsPerRow(memory_.elem(r.buffer));
     }
     size_t at = reserveReadback(words);
+    std::optional<PassTimer::Scope> timed(std::in_place, &timer_, "read-back", n);
     if (p.counts) glCopyNamedBufferSubData(counts_, readback_, 0, static_cast<GLintptr>(at * 4), 16);
     if (p.counts) afterWrite(Write::Copy, kHostMap);
+    timed.reset();
     if (kills) {
-        compactor_.compact(words_, block[LaunchBlock::kColumns + ColumnLayout::kKill], n, readback_, at + kKillsAt);
+        // What is drawn before the run-time takes a late launch's kills (at the next step)
+        // must leave them out: the render launches read the alive mask on the GPU, so the
+        // compaction clears the killed rows there (the host clears the same rows when it
+        // takes the kills, and sends them again: the same 0).
+        std::optional<Compactor::Clear> clear;
+        if (launch.aliveMask.valid()) {
+            bool mapped = !launch.aliveRows.empty();
+            clear = Compactor::Clear{memory_.deviceBuffer(launch.aliveMask), mapped ? memory_.rowList(launch.aliveRows) : 0u,
+                                     static_cast<uint32_t>(begin),
+                                     static_cast<uint32_t>(mapped ? begin - launch.aliveRowsFirst : 0)};
+        }
+        compactor_.compact(words_, block[LaunchBlock::kColumns + ColumnLayout::kKill], n, readback_, at + kKillsAt,
+                           clear ? &*clear : nullptr);
+        if (clear) memory_.written(launch.aliveMask);
         memory_.dispatches += 3;  // its passes
     }
+    timed.emplace(&timer_, "read-back", n);
     for (const Returned& r : returned)
         glCopyNamedBufferSubData(words_, readback_, static_cast<GLintptr>(r.from * 4),
                                  static_cast<GLintptr>((at + r.at) * 4),
                                  static_cast<GLsizeiptr>(n * GlMemory::wordsPerRow(memory_.elem(r.buffer)) * 4));
     if (!returned.empty()) afterWrite(Write::Copy, kHostMap);
+    timed.reset();
     if (late) {  // kept for collect(): no wait now
         readbackUsed_ = at + words;
         late->parts.push_back({begin, at, kills});
@@ -203,29 +203,6 @@ void GlslBackend::settle(Late& late) {
         for (uint32_t k = 0; k < killed; ++k)
             late.rows.push_back(static_cast<uint32_t>(part.begin) + back[kKillsAt + 1 + k]);
     }
-}
-
-// What is drawn before the run-time takes these kills (at the next step) must leave them
-// out: the render launches read the alive mask on the GPU, so the kills clear it there.
-// The host clears the same rows when it takes the kills (and sends them again: the same 0).
-void GlslBackend::clearKilled(const rt::RowsLaunch& launch, size_t begin, size_t n, uint32_t flags) {
-    if (!clearKilled_) {
-        std::string source = kClearKilled;
-        source.replace(source.find("%s"), 2, std::string(kInvocationIndex) + "\n" + kParamsBlock);
-        clearKilled_ = computeProgram(source, "clearing killed rows");
-    }
-    bool mapped = !launch.aliveRows.empty();
-    unsigned rows = mapped ? memory_.rowList(launch.aliveRows) : words_;
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, words_);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, memory_.deviceBuffer(launch.aliveMask));
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, rows);
-    glUseProgram(clearKilled_);
-    bindParams(params_, {static_cast<uint32_t>(n), flags, static_cast<uint32_t>(begin),
-                         static_cast<uint32_t>(mapped ? begin - launch.aliveRowsFirst : 0), mapped ? 1u : 0u});
-    dispatchInvocations(n, 64);
-    ++memory_.dispatches;
-    afterWrite(Write::Dispatch, kColumnReaders);  // the mask: the draws read it (in place, a texture, a copy)
-    memory_.written(launch.aliveMask);
 }
 
 bool GlslBackend::ready(uint64_t ticket) {
