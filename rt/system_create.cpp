@@ -26,6 +26,8 @@ struct Creation::Batch {
     ColumnLayout initLayout;
     std::vector<Buffer> initTable, updateTable, exportsTable, renderTable;
     std::vector<std::vector<Buffer>> burstTables;  // per emit site: the state at creation, for bursts
+    std::vector<Run> runs;             // its runs (Creation::Run)
+    std::vector<size_t> runFirst;      // per run: its first object's place in the batch
     size_t first = 0;                  // the batch's first staging row
     std::vector<uint32_t> poolRows;    // per object of the batch: its pool row, or kSkipRow (dropped)
     std::vector<uint32_t> subSteps;    // per object: the sub-steps of its first update
@@ -106,7 +108,8 @@ void Creation::bindBatch(size_t type, Batch& b, const ColumnLayout& layout, Scra
         }
 }
 
-// Creates queue_[from, to), all of one type: see rt/system_create.h. Rows are allocated
+// Creates the objects of runs queue_[from, to), all of one type: see rt/system_create.h
+// (one run an object where objects are not created in batches). Rows are allocated
 // in queue order (what does not fit is dropped and counted); init, exports at creation
 // and the first update run over the whole batch; then object by object, in queue order,
 // its bursts, its death or its emissions. While an object emits, the rows allocated for
@@ -116,8 +119,15 @@ void Creation::createBatch(size_t type, size_t from, size_t to, double t1) {
     const TypeInfo& info = s_.types[type];
     const ir::Object& o = pool.object();
     Batch& b = batches_[type];
-    const size_t n = to - from;
-    b.first = queue_[from].staging;
+    // Its runs, kept (creating it queues more runs) with each one's first object in the batch.
+    b.runs.assign(queue_.begin() + static_cast<std::ptrdiff_t>(from), queue_.begin() + static_cast<std::ptrdiff_t>(to));
+    b.runFirst.clear();
+    size_t n = 0;
+    for (const Run& run : b.runs) {
+        b.runFirst.push_back(n);
+        n += run.count;
+    }
+    b.first = b.runs.front().staging;
     b.poolRows.resize(n);
     size_t allocated = pool.allocate(n, b.poolRows.data());  // the allocation rule (rt/allocation.h)
     s_.typeStats[type].dropped += n - allocated;
@@ -133,7 +143,7 @@ void Creation::createBatch(size_t type, size_t from, size_t to, double t1) {
     for (size_t site = 0; site < o.emits.size(); ++site)
         if (!o.emits[site].rate && info.spawn[site])
             bindBatch(type, b, info.spawnLayout[site], b.initParents, b.burstTables[site], true);
-    identify(type, b, from, n);
+    identify(type, b, n);
     atCreation(type, b, n);
     firstUpdate(type, b, n, allocated, t1);
     const DrawnInStep& drawing = s_.work[type].inStep;
@@ -174,7 +184,7 @@ void Creation::drawBatch(size_t type, Batch& b, size_t n, double t1) {
 
 // The batch's objects in its columns and their pool rows: creation times, ids, parents
 // (and their readers), kept parameters; the state zeroed for init.
-void Creation::identify(size_t type, Batch& b, size_t from, size_t n) {
+void Creation::identify(size_t type, Batch& b, size_t n) {
     Pool& pool = s_.pools[type];
     const TypeInfo& info = s_.types[type];
     const ir::Object& o = pool.object();
@@ -184,21 +194,29 @@ void Creation::identify(size_t type, Batch& b, size_t from, size_t n) {
     auto* created = s_.host<double>(table[ColumnLayout::kCreated]);
     auto* ids = s_.host<uint32_t>(table[ColumnLayout::kIds]);
     s_.forRows(0, n, [&](size_t begin, size_t end) {  // rows of their own: on every thread
+        // The run of object `begin`, then each run's objects in order.
+        size_t u = static_cast<size_t>(std::upper_bound(b.runFirst.begin(), b.runFirst.end(), begin) - b.runFirst.begin()) - 1;
         for (size_t r = begin; r < end; ++r) {
+            while (r >= b.runFirst[u] + b.runs[u].count) ++u;
+            const Run& run = b.runs[u];
+            size_t k = r - b.runFirst[u];
             size_t i = first + r;
             uint32_t row = b.poolRows[r];
             mask[i] = row != kSkipRow;
             if (!mask[i]) continue;
-            const Entry& e = queue_[from + r];
-            created[i] = e.time;
-            ids[i] = e.id;
-            pool.parent[row] = e.parent;
+            created[i] = run.time(k);
+            ids[i] = run.id + static_cast<uint32_t>(k);
+            pool.parent[row] = run.parent;
         }
     });
-    if (info.parentType >= 0)  // several children may share a parent: its readers counted in order
-        for (size_t r = 0; r < n; ++r)
-            if (Handle parent = queue_[from + r].parent; b.poolRows[r] != kSkipRow && parent.valid())
-                ++s_.pools[static_cast<size_t>(info.parentType)].readers[parent.row];
+    if (info.parentType >= 0)  // several children may share a parent: its readers counted
+        for (size_t u = 0; u < b.runs.size(); ++u) {
+            const Run& run = b.runs[u];
+            if (!run.parent.valid()) continue;
+            size_t kept = 0;
+            for (size_t r = b.runFirst[u]; r < b.runFirst[u] + run.count; ++r) kept += b.poolRows[r] != kSkipRow;
+            s_.pools[static_cast<size_t>(info.parentType)].readers[run.parent.row] += static_cast<uint32_t>(kept);
+        }
     // Into the pool rows through the memory (the pool's columns may live on a device).
     std::vector<std::pair<Buffer, Buffer>> columns = {{table[ColumnLayout::kCreated], pool.created},
                                                       {table[ColumnLayout::kIds], pool.ids}};

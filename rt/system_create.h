@@ -46,25 +46,35 @@ public:
     void drain(double t1);
 
 private:
-    struct Entry {
+    // A run of objects queued together — one emitter's children at one site in one step,
+    // a trigger's at one site — held as the rule that gives each its values, not object
+    // by object: object k (k < count) has its arguments at staging row `staging + k`, the
+    // id `id + k`, and is created at time(k).
+    struct Run {
         size_t type;
-        size_t staging;  // its arguments' row in the type's staging columns
+        size_t staging;
+        size_t count;
         Handle parent;
-        double time;
+        double firstTime, spacing;  // events `spacing` apart, the first at firstTime,
+        uint64_t perEvent;          // this many objects each
         uint32_t id;
+        double time(size_t k) const { return firstTime + static_cast<double>(k / perEvent) * spacing; }
     };
     // Per type: the arguments of queued objects, one f32 column per component of the
-    // type's parameters (kept or not); an entry's row is its place among the type's
-    // queued entries.
+    // type's parameters (kept or not); an object's row is its place among the type's
+    // queued objects.
     struct Staging {
         std::vector<Buffer> args;
         size_t used = 0;
     };
     struct Batch;
 
-    size_t stage(size_t type, size_t count);  // staging rows for `count` new entries of `type`
+    size_t stage(size_t type, size_t count);  // staging rows for `count` new objects of `type`
+    // Queues `count` objects of `type` (a run, or one run an object where objects are not
+    // created in batches).
+    void enqueue(const Run& run);
     void createBatch(size_t type, size_t from, size_t to, double t1);
-    void identify(size_t type, Batch& b, size_t from, size_t n);
+    void identify(size_t type, Batch& b, size_t n);
     void atCreation(size_t type, Batch& b, size_t n);
     // Counts the updates beyond the stability limit in `type`'s stats.
     // `late`: its kills taken at the end of the step, or later (LateKills), listed there.
@@ -78,8 +88,8 @@ private:
                    bool atCreation);
 
     State& s_;
-    std::vector<Entry> queue_;
-    std::vector<size_t> queued_;   // per type: entries waiting in the queue
+    std::vector<Run> queue_;
+    std::vector<size_t> queued_;   // per type: objects waiting in the queue
     std::vector<size_t> pending_;  // per type: rows a batch allocated for objects not yet created in order
     std::vector<Staging> staging_;
     std::vector<Batch> batches_;

@@ -56,11 +56,18 @@ void Creation::queueChildren(const Emitter& e, int site, uint64_t count, uint64_
         launch.argsFirst = base;
         s_.backend.run(launch);
     }
-    for (uint64_t k = 0; k < kept; ++k) {
-        queue_.push_back({target, base + static_cast<size_t>(k), parent,
-                          firstTime + static_cast<double>(k / perEvent) * spacing, s_.nextId++});
-        ++queued_[target];
+    enqueue({target, base, static_cast<size_t>(kept), parent, firstTime, spacing, perEvent, s_.nextId});
+    s_.nextId += static_cast<uint32_t>(kept);
+}
+
+void Creation::enqueue(const Run& run) {
+    queued_[run.type] += run.count;
+    if (s_.options.createInBatches) {
+        queue_.push_back(run);
+        return;
     }
+    for (size_t k = 0; k < run.count; ++k)
+        queue_.push_back({run.type, run.staging + k, 1, run.parent, run.time(k), 0, 1, run.id + static_cast<uint32_t>(k)});
 }
 
 void Creation::emitAtRate(const Emitter& e, std::span<const float> rate, std::span<const float> count, double dt,
@@ -112,26 +119,27 @@ void Creation::emitFromKernel(const ir::Trigger& trigger, std::span<const Value>
             column.push_back(next);
             next += static_cast<size_t>(p.type.width);
         }
+        size_t base = stage(target, static_cast<size_t>(kept));
+        uint32_t id = s_.nextId;
+        s_.nextId += static_cast<uint32_t>(kept);
         for (uint64_t n = 0; n < kept; ++n) {
-            Entry entry{target, stage(target, 1), {}, s_.now, s_.nextId++};
-            in.childDraw = entry.id;
+            in.childDraw = id + static_cast<uint32_t>(n);
             s_.evaluator.run(k, in, yields_);
             for (size_t i = 0; i < k.yields.size(); ++i) {
                 const ir::Yield& y = k.yields[i];
                 if (y.kind != YieldKind::EmitArg || y.index != static_cast<int>(site)) continue;
                 auto p = static_cast<size_t>(y.sub);
                 for (int c = 0; c < pool.object().params[p].type.width; ++c)
-                    s_.memory.write(staging_[target].args[column[p] + static_cast<size_t>(c)], entry.staging, 1,
+                    s_.memory.write(staging_[target].args[column[p] + static_cast<size_t>(c)], base + n, 1,
                                     &yields_[i].f[static_cast<size_t>(c)]);
             }
-            ++queued_[target];
-            queue_.push_back(entry);
         }
+        if (kept) enqueue({target, base, static_cast<size_t>(kept), {}, s_.now, 0, 1, id});
     }
 }
 
 void Creation::drain(double t1) {
-    for (size_t i = 0; i < queue_.size();) {
+    for (size_t i = 0; i < queue_.size();) {  // (creating queues more at its end)
         size_t type = queue_[i].type;
         size_t end = i + 1;
         if (s_.options.createInBatches)
