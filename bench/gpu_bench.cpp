@@ -65,9 +65,13 @@ int main(int argc, char** argv) {
                 if (pass != "update") others += fmt::format("{}{} {:.2f}", others.empty() ? "" : ", ", pass, ms);
             double gbs = f.updateMilliseconds > 0 ? f.stateBytes * f.live / (f.updateMilliseconds * 1e-3) / 1e9 : 0;
             double passes = 0;
-            for (const auto& [pass, ms] : f.passMilliseconds) passes += ms;
+            nlohmann::json byPass = nlohmann::json::object();
+            for (const auto& [pass, ms] : f.passMilliseconds) {
+                passes += ms;
+                byPass[pass] = ms;
+            }
             rows.push_back({{"effect", name}, {"particles", f.live}, {"step_ms", f.stepSeconds * 1e3},
-                            {"passes_ms", passes}, {"passes_wall", f.wallPasses}, {"host_cpu_ms", f.hostCpuSeconds * 1e3},
+                            {"passes_ms", passes}, {"passes", byPass}, {"passes_wall", f.wallPasses}, {"host_cpu_ms", f.hostCpuSeconds * 1e3},
                             {"mups", f.perSecond / 1e6}, {"update_ms", f.updateMilliseconds},
                             {"update_gbs", gbs}, {"state_bytes", f.stateBytes}, {"transfer_bytes", f.transferBytes},
                             {"staged_bytes", f.stagedBytes}, {"waits", f.waits}, {"late_reads", f.lateReads},
