@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
         std::cout << "# llvmpipe computes the shaders on the CPU: these figures say the backend works, not how fast a "
                      "GPU runs it\n";
     nlohmann::json rows = nlohmann::json::array();
-    std::cout << "\n| effect | live | step (ms) | host CPU (ms) | M updates/s | update pass (ms) | other passes (ms) | state B/particle | "
+    std::cout << "\n| effect | live | step (ms) | host CPU (ms) | M updates/s | update pass (ms) | other passes (ms, and how many a step) | state B/particle | "
                  "update pass GB/s | host↔GPU B/particle/step | staged B/particle/step | waits/step | late/step (stalled) |\n|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|\n";
     for (const std::string& name : effects) {
         const bench::Effect* effect = bench::findEffect(name);
@@ -62,7 +62,8 @@ int main(int argc, char** argv) {
             bench::GpuFigures f = bench::measureGpu(*effect, particles, frames, *gpu);
             std::string others;
             for (const auto& [pass, ms] : f.passMilliseconds)
-                if (pass != "update") others += fmt::format("{}{} {:.2f}", others.empty() ? "" : ", ", pass, ms);
+                if (pass != "update")
+                    others += fmt::format("{}{} {:.2f} ({:.0f}×)", others.empty() ? "" : ", ", pass, ms, f.passLaunches[pass]);
             double gbs = f.updateMilliseconds > 0 ? f.stateBytes * f.live / (f.updateMilliseconds * 1e-3) / 1e9 : 0;
             double passes = 0;
             nlohmann::json byPass = nlohmann::json::object();

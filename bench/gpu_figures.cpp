@@ -75,6 +75,7 @@ GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::G
         const auto* b = before.count(pass) ? &before.at(pass) : nullptr;
         double ms = out.wallPasses ? t.wallMilliseconds - (b ? b->wallMilliseconds : 0) : t.milliseconds - (b ? b->milliseconds : 0);
         out.passMilliseconds[pass] = ms / timed;
+        out.passLaunches[pass] = static_cast<double>(t.launches - (b ? b->launches : 0)) / timed;
     }
     out.updateMilliseconds = out.passMilliseconds.count("update") ? out.passMilliseconds["update"] : 0;
     return out;

@@ -19,6 +19,7 @@ struct GpuFigures {
     double perSecond = 0;          // particle updates per second: live ÷ stepSeconds
     double updateMilliseconds = 0; // GPU time of the update pass per step (timer queries)
     std::map<std::string, double> passMilliseconds;  // every pass, per step
+    std::map<std::string, double> passLaunches;      // every pass: the pieces of work timed, per step
     bool wallPasses = false;       // the passes' times are wall times (the GL's timer saw nothing)
     double stateBytes = 0;         // per particle, what the update pass must read and write
     double transferBytes = 0;      // per particle per step, between the host and the GPU
