@@ -15,6 +15,10 @@ namespace psys::gpu {
 
 namespace {
 
+// A group covers 1024 rows, 4 consecutive rows an invocation: a quarter of the
+// invocations of one a row, which is what a GL that runs them on the CPU (llvmpipe) pays
+// for, and as many loads on a GPU.
+
 // The flags at words[first + i]; per group, its count.
 const char* kCount = R"(#version 450
 layout(local_size_x = 256) in;
@@ -26,8 +30,9 @@ shared uint total;
 void main() {
     if (gl_LocalInvocationID.x == 0u) total = 0u;
     barrier();
-    uint i = gl_GlobalInvocationID.x;
-    if (i < n && w[first + i] != 0u) atomicAdd(total, 1u);
+    uint i = gl_GlobalInvocationID.x * 4u, c = 0u;
+    for (uint k = 0u; k < 4u; ++k) c += i + k < n && w[first + i + k] != 0u ? 1u : 0u;
+    if (c != 0u) atomicAdd(total, c);
     barrier();
     if (gl_LocalInvocationID.x == 0u) groups[gl_WorkGroupID.x] = total;
 }
@@ -89,17 +94,24 @@ void clear(uint i) {
     if (clearing != 0u) mask[mapped != 0u ? rows[offset + i] : base + i] = 0u;
 }
 void main() {
-    uint t = gl_LocalInvocationID.x, i = gl_GlobalInvocationID.x, g = gl_WorkGroupID.x;
-    if (i == 0u) list[at] = groups[gl_NumWorkGroups.x];
+    uint t = gl_LocalInvocationID.x, g = gl_WorkGroupID.x, i = gl_GlobalInvocationID.x * 4u;
+    if (gl_GlobalInvocationID.x == 0u) list[at] = groups[gl_NumWorkGroups.x];
     uint count = groups[g + 1u] - groups[g];
     if (count == 0u) return;
-    if (count == gl_WorkGroupSize.x) {
-        list[at + 1u + groups[g] + t] = i;
-        clear(i);
+    if (count == 4u * gl_WorkGroupSize.x) {
+        for (uint k = 0u; k < 4u; ++k) {
+            list[at + 1u + groups[g] + 4u * t + k] = i + k;
+            clear(i + k);
+        }
         return;
     }
-    uint flag = i < n && w[first + i] != 0u ? 1u : 0u;
-    prefix[t] = flag;
+    uint flags = 0u, c = 0u;  // this invocation's 4 rows: which are set, how many
+    for (uint k = 0u; k < 4u; ++k)
+        if (i + k < n && w[first + i + k] != 0u) {
+            flags |= 1u << k;
+            ++c;
+        }
+    prefix[t] = c;
     barrier();
     for (uint step = 1u; step < 256u; step *= 2u) {
         uint add = t >= step ? prefix[t - step] : 0u;
@@ -107,10 +119,12 @@ void main() {
         prefix[t] += add;
         barrier();
     }
-    if (flag != 0u) {
-        list[at + groups[g] + prefix[t]] = i;
-        clear(i);
-    }
+    uint to = at + 1u + groups[g] + prefix[t] - c;
+    for (uint k = 0u; k < 4u; ++k)
+        if ((flags & (1u << k)) != 0u) {
+            list[to++] = i + k;
+            clear(i + k);
+        }
 }
 )";
 

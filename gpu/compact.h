@@ -3,10 +3,10 @@
 // give the same list on any GPU, every time. The GLSL backend sends the host the list of
 // rows an update killed instead of a flag per row.
 //
-// Three passes of 256 invocations a group: each group counts its set flags; one group
-// scans the counts (each invocation a run of groups, then a scan of the 256 runs) and
-// writes the total; each group scans its flags in shared memory and writes its rows at
-// its offset, after the total. The host learns how many rows there are with the rows
+// Three passes of 256 invocations a group, 4 rows an invocation: each group counts its
+// set flags; one group scans the counts (each invocation a run of groups, then a scan of
+// the 256 runs) and writes the total; each group scans its invocations' counts in shared
+// memory and writes its rows at its offset, after the total. The host learns how many rows there are with the rows
 // (GlslBackend reads them back with the launch's counts, at once or late: gpu/glsl_readback.cpp).
 // The last pass may also zero a mask where the flags are set (a late launch's kills
 // cleared in its pool's alive mask, rt::Backend::clearsKilled): it visits only the groups
@@ -49,6 +49,7 @@ private:
     unsigned params_ = 0;                        // the passes' parameters (gl_context.h, bindParams)
 };
 
-constexpr uint32_t kCompactGroup = 256;
+// Rows a work group of the compaction covers (256 invocations of 4 rows).
+constexpr uint32_t kCompactGroup = 1024;
 
 }  // namespace psys::gpu
