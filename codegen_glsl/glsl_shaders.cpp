@@ -182,13 +182,15 @@ ClockNames emitClock(Statements& out, rt::Clock::Source now, rt::Clock::Source d
     ClockNames c;
     c.now = out.define("now", "double", now == S::PerRow ? fmt::format("cd({}u, i)", ColumnLayout::kNow)
                                                 : fmt::format("ld({}u)", LaunchBlock::kNow));
-    c.dt = out.define("dt", "float", dt == S::PerRow ? fmt::format("cf({}u, i)", ColumnLayout::kDt)
-                                             : fmt::format("lf({}u)", LaunchBlock::kDt), true);
     c.time = out.define("time", "float", "psys_narrow(" + c.now + ")", true);
     c.first = out.define("first", "bool", fmt::format("lw({}u) != 0u", LaunchBlock::kFirst));
     std::string created = perRowCreated ? fmt::format("cd({}u, i)", ColumnLayout::kCreated)
                                         : fmt::format("ld({}u)", LaunchBlock::kCreated);
     c.age = out.define("age", "float", emitAge(out, c.now, created), true);
+    c.dt = out.define("dt", "float", dt == S::PerRow         ? fmt::format("cf({}u, i)", ColumnLayout::kDt)
+                                     : dt == S::SinceCreated ? c.age
+                                                             : fmt::format("lf({}u)", LaunchBlock::kDt),
+                      true);
     return c;
 }
 
@@ -263,7 +265,9 @@ void markDrawn(Statements& out, const ColumnLayout& l) {
     out.line(fmt::format("if ({} && !{}) atomicAdd(counts[3], 1u);", visible, ok));
 }
 
-const char* clockName(rt::Clock::Source s) { return s == rt::Clock::Source::PerRow ? "per row" : "uniform"; }
+const char* clockName(rt::Clock::Source s) {
+    return s == rt::Clock::Source::PerRow ? "per row" : s == rt::Clock::Source::SinceCreated ? "since creation" : "uniform";
+}
 
 }  // namespace
 
@@ -344,7 +348,7 @@ std::string rowsShader(const Object& object, const Kernel& kernel, rt::Clock::So
     else
         out.line(fmt::format("if (cu({}u, i) == 0u) return;  // masked out", l.total));
     ClockNames clock = emitClock(out, now, dt, true);
-    bool perRow = now == rt::Clock::Source::PerRow || dt == rt::Clock::Source::PerRow;
+    bool perRow = rt::Clock::perRow(now, dt);
     std::vector<std::string> uniforms;
     if (perRow && uniform) uniforms = inlineUniforms(out, *uniform, clock, block);
     const Kernel& k = kernel;

@@ -83,7 +83,8 @@ public:
         const ColumnLayout layout = rt::columnLayout(object, kernel);
         perRowNow_ = now == rt::Clock::Source::PerRow;
         perRowDt_ = dt == rt::Clock::Source::PerRow;
-        uniformKernel_ = perRowNow_ || perRowDt_ ? uniformKernel : nullptr;
+        dtSinceCreated_ = dt == rt::Clock::Source::SinceCreated;
+        uniformKernel_ = rt::Clock::perRow(now, dt) ? uniformKernel : nullptr;
         // The columns the kernel touches, in first-use order.
         std::map<int, unsigned> argOf;
         std::vector<int> columns;
@@ -188,8 +189,10 @@ private:
         llvm::Value* created = b_.CreateAlignedLoad(f64, columnAt(argOf, ColumnLayout::kCreated, f64), llvm::Align(8));
         llvm::Value* now = perRowNow_ ? b_.CreateAlignedLoad(f64, columnAt(argOf, ColumnLayout::kNow, f64), llvm::Align(8))
                                       : static_cast<llvm::Value*>(loop_->getArg(kNow));
-        llvm::Value* dt = perRowDt_ ? loadFloat(ColumnLayout::kDt) : static_cast<llvm::Value*>(loop_->getArg(kDt));
         llvm::Value* rowAge = nullptr;
+        llvm::Value* dt = perRowDt_ ? loadFloat(ColumnLayout::kDt)
+                          : dtSinceCreated_ ? (rowAge = age(now, created))
+                                            : static_cast<llvm::Value*>(loop_->getArg(kDt));
         std::map<int, Lanes> uniforms;
         llvm::Value* seed = loop_->getArg(kSeed);
         auto leaf = [&](const Inst& i, int parent) -> Lanes {
@@ -346,7 +349,7 @@ private:
     llvm::Function* loop_ = nullptr;
     llvm::StructType* counts_ = nullptr;
     llvm::Value* row_ = nullptr;
-    bool perRowNow_ = false, perRowDt_ = false;
+    bool perRowNow_ = false, perRowDt_ = false, dtSinceCreated_ = false;
     const Kernel* uniformKernel_ = nullptr;
     unsigned lanes_;
 };

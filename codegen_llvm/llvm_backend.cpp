@@ -53,7 +53,7 @@ struct LlvmBackend::Impl {
     Request request(const Object& o, const Kernel& k, bool children, Clock::Source now, Clock::Source dt,
                     bool many = true) {
         const Kernel* uniform = nullptr;
-        if (!children && (now == Clock::Source::PerRow || dt == Clock::Source::PerRow))
+        if (!children && Clock::perRow(now, dt))
             if (auto served = uniformFor(k.kind)) uniform = o.kernel(*served);
         Hasher h;
         h.add(mode == MathMode::Exact).add(children).add(static_cast<uint64_t>(now)).add(static_cast<uint64_t>(dt));
@@ -81,7 +81,7 @@ struct LlvmBackend::Impl {
                 // Names say what a function is, for remarks and profiles: drop.update.created.7
                 std::string name = r.object->name + "." + kernelName(r.shape.kernel->kind);
                 if (r.shape.children) name += ".children";
-                else if (r.shape.now == Clock::Source::PerRow || r.shape.dt == Clock::Source::PerRow) name += ".created";
+                else if (Clock::perRow(r.shape.now, r.shape.dt)) name += ".created";
                 missing.push_back({&r, name + "." + std::to_string(counter++)});
             }
         }

@@ -197,7 +197,7 @@ GlslBackend::Program& GlslBackend::rowsProgram(const ir::Object& object, const i
         p->inPlace.assign(static_cast<size_t>(p->layout.total) + 1, false);
         for (int c : p->direct) p->inPlace[static_cast<size_t>(c)] = true;
         p->needed = neededColumns(kernel, p->layout, now == rt::Clock::Source::PerRow || dt == rt::Clock::Source::PerRow,
-                                  p->resident, p->returned);
+                                  p->resident, p->returned);  // (a dt since creation is computed: no column)
         p->pass = ir::kernelName(kernel.kind);
         p->counts = kernel.kind == ir::KernelKind::Render ||
                     std::any_of(kernel.yields.begin(), kernel.yields.end(), [](const ir::Yield& y) {

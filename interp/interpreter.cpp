@@ -81,7 +81,7 @@ rt::RowsResult Interpreter::run(const rt::RowsLaunch& launch) {
         in.uniforms = launch.uniforms;
         in.parents = parents_.data();
         in.age = rt::ageAt(now, created[row]);
-        in.dt = dts ? dts[row] : clock.dtValue;
+        in.dt = dts ? dts[row] : clock.dt == rt::Clock::Source::SinceCreated ? in.age : clock.dtValue;
         in.time = static_cast<float>(now);
         in.first = clock.first;
         in.seed = launch.seed;

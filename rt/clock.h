@@ -7,9 +7,10 @@
 //   a step of existing objects      now = the step's end, dt = its length (both uniform)
 //   objects being created (init)    now = each one's creation time (the created column),
 //                                   dt = 0 (a column of zeros), first = true
-//   their first, partial update     now = the step's end, dt = now − created, per row
-//                                   (filled by the run-time: rt/system_create.cpp)
-//   sub-steps of new objects        now and dt per row
+//   their first, partial update     now = the step's end, dt = now − created, per row:
+//                                   the row's age at now, computed where the row is
+//                                   (SinceCreated: no column for it)
+//   sub-steps of new objects        now and dt per row (columns the run-time fills)
 // and age is always `ageAt(now, created)`. `time` in equations is float(now).
 #pragma once
 
@@ -21,13 +22,18 @@ struct Clock {
     enum class Source : uint8_t {
         Uniform,  // the value below, for every row
         PerRow,   // the launch's column (ColumnLayout::kNow: f64, kDt: f32)
+        // dt only: the row's age at now, ageAt(now, created) — the length of an update
+        // from the row's creation to now, as a first update is.
+        SinceCreated,
     };
     Source now = Source::Uniform, dt = Source::Uniform;
     double nowValue = 0;
     float dtValue = 0;
     bool first = false;  // the rows are being created
 
-    bool perRow() const { return now == Source::PerRow || dt == Source::PerRow; }
+    // Whether some row's clock differs from another's.
+    static bool perRow(Source now, Source dt) { return now != Source::Uniform || dt != Source::Uniform; }
+    bool perRow() const { return perRow(now, dt); }
 };
 
 // An object's age at `now`: the difference of two doubles, rounded to float once, so that

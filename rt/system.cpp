@@ -39,16 +39,22 @@ Plan launchPlan(const ir::Module& module) {
     Plan plan;
     for (const ir::Object& o : module.objects) {
         bool stream = streams.count(o.name) > 0;
+        // A new object's first update (and its exports after it) runs to the step's end
+        // with dt its age then; under @step, where it is longer than a sub-step, in
+        // sub-steps at per-row clocks.
+        bool subSteps = o.attributes.step > 0;
         for (const ir::Kernel& k : o.kernels) {
             switch (k.kind) {
                 case KernelKind::Init: plan.rows.push_back({&o, &k, S::PerRow, S::PerRow, stream}); break;
                 case KernelKind::Update:
                     plan.rows.push_back({&o, &k, S::Uniform, S::Uniform});
-                    plan.rows.push_back({&o, &k, S::PerRow, S::PerRow, stream});
+                    plan.rows.push_back({&o, &k, S::Uniform, S::SinceCreated, stream});
+                    if (subSteps) plan.rows.push_back({&o, &k, S::PerRow, S::PerRow, stream});
                     break;
-                case KernelKind::Exports:
+                case KernelKind::Exports:  // also at creation, at each object's creation time
                     plan.rows.push_back({&o, &k, S::Uniform, S::Uniform});
                     plan.rows.push_back({&o, &k, S::PerRow, S::PerRow, stream});
+                    plan.rows.push_back({&o, &k, S::Uniform, S::SinceCreated, stream});
                     break;
                 case KernelKind::Render: plan.rows.push_back({&o, &k, S::Uniform, S::Uniform}); break;
                 case KernelKind::Spawn: plan.children.push_back({&o, &k}); break;

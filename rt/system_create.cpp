@@ -297,10 +297,8 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
     const TypeInfo& info = s_.types[type];
     const size_t first = b.first, end = first + n;
     const std::vector<Buffer>& table = b.updateTable;
-    auto* mask = s_.host<uint8_t>(b.columns.at(kMask, Elem::U8, end));
-    auto* created = s_.host<double>(table[ColumnLayout::kCreated]);
-    auto* now = s_.host<double>(table[ColumnLayout::kNow]);
-    auto* dt = s_.host<float>(table[ColumnLayout::kDt]);
+    const auto* mask = s_.view<uint8_t>(b.columns.at(kMask, Elem::U8, end));
+    const auto* created = s_.view<double>(table[ColumnLayout::kCreated]);
     b.spans.assign(n, 0);
     b.subSteps.assign(n, 1);
     std::atomic<uint32_t> most = 1;
@@ -315,8 +313,6 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
             b.spans[r] = span;
             b.subSteps[r] = subStepCount(span, info.stepLimit, chunkCapped);
             chunkMost = std::max(chunkMost, b.subSteps[r]);
-            now[i] = t1;
-            dt[i] = static_cast<float>(span);
         }
         capped += chunkCapped;
         for (uint32_t m = most.load(); chunkMost > m && !most.compare_exchange_weak(m, chunkMost);) {
@@ -342,7 +338,9 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
         // were created before it): it takes them at once.
         std::optional<LateKills> late;
         if (info.late && !s_.work[type].inStep.on) late.emplace();
-        advance(type, b, n, kMask, late ? &*late : nullptr);
+        // One update to t1: dt is each object's age then (Clock::Source::SinceCreated).
+        advance(type, b, n, kMask, {Clock::Source::Uniform, Clock::Source::SinceCreated, t1, 0, false},
+                late ? &*late : nullptr);
         if (info.bursts || info.rateEmits) {
             inOrder(true, [&](size_t r) {
                 queueBursts(type, b, r);
@@ -370,6 +368,8 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
     // Sub-steps: every object through its own, the k-th of each at once.
     inOrder(true, [&](size_t r) { queueBursts(type, b, r); });
     auto* stepMask = s_.host<uint8_t>(b.columns.at(kStepMask, Elem::U8, end));
+    auto* now = s_.host<double>(table[ColumnLayout::kNow]);
+    auto* dt = s_.host<float>(table[ColumnLayout::kDt]);
     const Pool& pool = s_.pools[type];
     for (uint32_t k = 1; k <= most; ++k) {
         for (size_t r = 0; r < n; ++r) {
@@ -381,7 +381,7 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
             now[i] = k == steps ? t1 : t0 + span * (static_cast<double>(k) / steps);
             dt[i] = static_cast<float>(span / steps);
         }
-        advance(type, b, n, kStepMask);
+        advance(type, b, n, kStepMask, {Clock::Source::PerRow, Clock::Source::PerRow, 0, 0, false});
         inOrder(false, [&](size_t r) {
             if (stepMask[first + r]) killOrEmit(type, b, r, b.spans[r] / b.subSteps[r], now[first + r]);
         });
@@ -390,14 +390,14 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
 
 // One update of the batch rows `maskColumn` selects, at their own clocks, then their
 // exports (those not killed), then the state and exports to their pool rows.
-void Creation::advance(size_t type, Batch& b, size_t n, size_t maskColumn, LateKills* late) {
+void Creation::advance(size_t type, Batch& b, size_t n, size_t maskColumn, const Clock& clock, LateKills* late) {
     const TypeInfo& info = s_.types[type];
     const ir::Object& o = s_.module.objects[type];
     const size_t first = b.first, end = first + n;
     std::vector<Buffer>& table = b.updateTable;
     Buffer maskBuffer = b.columns.at(maskColumn, Elem::U8, end);
     auto* mask = s_.host<uint8_t>(maskBuffer);
-    auto* now = s_.host<double>(table[ColumnLayout::kNow]);
+    const double* now = clock.now == Clock::Source::PerRow ? s_.view<double>(table[ColumnLayout::kNow]) : nullptr;
     auto launchOn = [&](const ir::Kernel& kernel, const ColumnLayout& layout, std::vector<Buffer>& t, Buffer m,
                         LateKills* kills) {
         t[ColumnLayout::kNow] = table[ColumnLayout::kNow];
@@ -408,7 +408,7 @@ void Creation::advance(size_t type, Batch& b, size_t n, size_t maskColumn, LateK
         launch.layout = &layout;
         launch.columns = t;
         launch.mask = m;
-        launch.clock = {Clock::Source::PerRow, Clock::Source::PerRow, 0, 0, false};
+        launch.clock = clock;
         launch.externs = s_.externs.data();
         launch.uniformKernel = s_.uniformKernel(type, kernel);
         launch.seed = s_.options.seed;
@@ -420,7 +420,7 @@ void Creation::advance(size_t type, Batch& b, size_t n, size_t maskColumn, LateK
             launch.aliveRows = b.poolRows;
             launch.aliveRowsFirst = first;
         }
-        s_.gatherParents(type, layout, t, s_.host<uint8_t>(m), first, end, 0, now, b.poolRows.data(), first);
+        s_.gatherParents(type, layout, t, s_.host<uint8_t>(m), first, end, clock.nowValue, now, b.poolRows.data(), first);
         runBatch(launch, first, end, type, kills);
     };
     launchOn(*info.update, info.updateLayout, table, maskBuffer, late);

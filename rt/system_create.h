@@ -81,7 +81,9 @@ private:
     void runBatch(const RowsLaunch& launch, size_t first, size_t end, size_t type, LateKills* late = nullptr);
     void firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, double t1);
     void drawBatch(size_t type, Batch& b, size_t n, double t1);
-    void advance(size_t type, Batch& b, size_t n, size_t maskColumn, LateKills* late = nullptr);
+    // `clock`: one update to the step's end (dt each object's age), or a sub-step's
+    // per-row clock (the batch's now and dt columns).
+    void advance(size_t type, Batch& b, size_t n, size_t maskColumn, const Clock& clock, LateKills* late = nullptr);
     void queueBursts(size_t type, Batch& b, size_t r);
     void killOrEmit(size_t type, Batch& b, size_t r, double dt, double t1);
     void bindBatch(size_t type, Batch& b, const ColumnLayout& layout, Scratch& parents, std::vector<Buffer>& table,

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "interp/interpreter.h"
 #include "run.h"
 
 using namespace psys;
@@ -74,4 +75,46 @@ TEST_CASE("under @step a type's update, kills and emissions repeat per sub-step 
     run.steps(1, 1.0 / 60);
     run.steps(1, 1.0 / 60);
     CHECK(run.stats("ball").live == 1);
+}
+
+namespace {
+
+// The clocks of the update launches over creation batches (their clock is per row).
+struct FirstUpdateClocks : rt::Backend {
+    interp::Interpreter inner;
+    std::vector<std::pair<rt::Clock::Source, rt::Clock::Source>> clocks;
+    std::string name() const override { return "clocks"; }
+    rt::Memory& memory() override { return inner.memory(); }
+    rt::RowsResult run(const rt::RowsLaunch& l) override {
+        if (l.kernel->kind == ir::KernelKind::Update && l.clock.perRow()) clocks.push_back({l.clock.now, l.clock.dt});
+        return inner.run(l);
+    }
+    void run(const rt::ChildrenLaunch& l) override { inner.run(l); }
+};
+
+}  // namespace
+
+TEST_CASE("a new object's first update has dt its age at the step's end, computed by the backend — sub-steps under @step, per-row columns") {
+    using S = rt::Clock::Source;
+    for (bool step : {false, true}) {
+        std::string text = std::string(step ? "@step(0.004) " : "") +
+                           "object p { x = integrate(1); point(vec3(x, age, 0), white, 1); kill when age > 0.3; }\n"
+                           "object e { emit p at 500 per second; }\nspawn e;";
+        FirstUpdateClocks backend;
+        rt::System system(test::compileModule(text), backend);
+        for (int f = 0; f < 10; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
+        REQUIRE_FALSE(backend.clocks.empty());
+        size_t subStepped = 0;  // batches where some object needs more than one sub-step
+        for (auto [now, dt] : backend.clocks) {
+            bool since = now == S::Uniform && dt == S::SinceCreated, columns = now == S::PerRow && dt == S::PerRow;
+            CHECK((since || (step && columns)));
+            subStepped += columns;
+        }
+        CHECK((subStepped > 0) == step);
+        // The values are those of the rule: x = age for every object, created at any time.
+        auto type = static_cast<size_t>(system.typeIndex("p"));
+        std::vector<rt::RenderPoint> points = system.points(type);
+        REQUIRE(points.size() > 50);
+        for (const rt::RenderPoint& p : points) CHECK(p.position[0] == doctest::Approx(p.position[1]).epsilon(1e-5));
+    }
 }
