@@ -6,8 +6,9 @@
 // Three passes of 256 invocations a group, 4 rows an invocation: each group counts its
 // set flags; one group scans the counts (each invocation a run of groups, then a scan of
 // the 256 runs) and writes the total; each group scans its invocations' counts in shared
-// memory and writes its rows at its offset, after the total. The host learns how many rows there are with the rows
-// (GlslBackend reads them back with the launch's counts, at once or late: gpu/glsl_readback.cpp).
+// memory and writes its rows at its offset, after the total. The host learns how many
+// rows there are with the rows (GlslBackend reads them back with the launch's counts, at
+// once or late: gpu/glsl_readback.cpp).
 // The last pass may also zero a mask where the flags are set (a late launch's kills
 // cleared in its pool's alive mask, rt::Backend::clearsKilled): it visits only the groups
 // that have some, so the clearing costs no pass of its own over every row.

@@ -123,8 +123,8 @@ Buffer GlMemory::create(Elem elem, size_t rows) {
 void GlMemory::resize(Buffer b, size_t rows) {
     Column& c = at(b);
     if (c.device) {  // grown or shrunk on the GPU: the column stays there
-        if (rows < c.rows) flush(c);
-        PassTimer::Scope timed(timer, "grow", rows);  // (rows pending past the end would land in rows to be zeroed)
+        if (rows < c.rows) flush(c);  // (rows pending past the end would land in rows to be zeroed)
+        PassTimer::Scope timed(timer, "grow", rows);
         size_t w = wordsPerRow(c.elem);
         // A pool grows a row at a time: the GL buffer doubles, and is zeroed past the rows
         // once then, not at each row.

@@ -197,7 +197,7 @@ GlslBackend::Program& GlslBackend::rowsProgram(const ir::Object& object, const i
         p->inPlace.assign(static_cast<size_t>(p->layout.total) + 1, false);
         for (int c : p->direct) p->inPlace[static_cast<size_t>(c)] = true;
         p->needed = neededColumns(kernel, p->layout, now == rt::Clock::Source::PerRow || dt == rt::Clock::Source::PerRow,
-                                  p->resident, p->returned);  // (a dt since creation is computed: no column)
+                                  p->resident, p->returned);  // (a dt since creation: computed, no column)
         p->pass = ir::kernelName(kernel.kind);
         p->counts = kernel.kind == ir::KernelKind::Render ||
                     std::any_of(kernel.yields.begin(), kernel.yields.end(), [](const ir::Yield& y) {
@@ -300,9 +300,10 @@ void GlslBackend::setHostSide(std::unique_ptr<rt::Backend> host, size_t rows) {
 }
 
 // A late launch's kills cleared in its alive mask (Backend::clearsKilled) where the host
-// side ran it, as the compaction of its kills does on the GPU (readBack): the run-time may take them at the next step
-// (when another late launch of the step is still owed), and what is drawn before must
-// leave them out (objects that died in their first update were drawn on the GPU).
+// side ran it, as the compaction of its kills does on the GPU (readBack): the run-time
+// may take them at the next step (when another late launch of the step is still owed),
+// and what is drawn before must leave them out (objects that died in their first update
+// were drawn on the GPU).
 void GlslBackend::hostClearKilled(const rt::RowsLaunch& launch) {
     const auto* flags = static_cast<const uint8_t*>(memory_.view(launch.columns[ColumnLayout::kKill]));
     uint8_t zero = 0;
