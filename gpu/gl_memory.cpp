@@ -64,6 +64,7 @@ layout(std430, binding = 2) readonly buffer Rows { uint rows[]; };
 #define count param(0u)
 #define first param(1u)
 #define w param(2u)
+#define rowsAt param(3u)
 )";
 
 std::string rowsShader(const char* main) {
@@ -73,8 +74,8 @@ std::string rowsShader(const char* main) {
 // to[rows[i]] = from[first + i] (kSkipRow: nothing).
 const char* kScatter = R"(void main() {
     uint i = INVOCATION;
-    if (i >= count || rows[i] == 0xFFFFFFFFu) return;
-    for (uint k = 0u; k < w; ++k) to[rows[i] * w + k] = from[(first + i) * w + k];
+    if (i >= count || rows[rowsAt + i] == 0xFFFFFFFFu) return;
+    for (uint k = 0u; k < w; ++k) to[rows[rowsAt + i] * w + k] = from[(first + i) * w + k];
 }
 )";
 
@@ -82,7 +83,8 @@ const char* kScatter = R"(void main() {
 const char* kGather = R"(void main() {
     uint i = INVOCATION;
     if (i >= count) return;
-    for (uint k = 0u; k < w; ++k) to[(first + i) * w + k] = rows[i] == 0xFFFFFFFFu ? 0u : from[rows[i] * w + k];
+    uint row = rows[rowsAt + i];
+    for (uint k = 0u; k < w; ++k) to[(first + i) * w + k] = row == 0xFFFFFFFFu ? 0u : from[row * w + k];
 }
 )";
 
@@ -93,8 +95,10 @@ GlMemory::GlMemory() = default;
 GlMemory::~GlMemory() {
     for (auto& c : columns_)
         if (c && c->gl) glDeleteBuffers(1, &c->gl);
-    if (scatterProgram_) glDeleteProgram(scatterProgram_);
-    if (gatherProgram_) glDeleteProgram(gatherProgram_);
+    for (unsigned program : {scatterProgram_, gatherProgram_, allocateProgram_, releaseProgram_, pushedProgram_, freshProgram_,
+                             identifyProgram_})
+        if (program) glDeleteProgram(program);
+    if (runsBuffer_) glDeleteBuffers(1, &runsBuffer_);
     if (rowsBuffer_) glDeleteBuffers(1, &rowsBuffer_);
     if (paramsBuffer_) glDeleteBuffers(1, &paramsBuffer_);
     if (pendingBuffer_) glDeleteBuffers(1, &pendingBuffer_);
@@ -306,6 +310,30 @@ void GlMemory::scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const
     t.device = true;
 }
 
+// With the rows already on the GPU (a pool's rows allocated there: Memory::allocateRows).
+void GlMemory::scatter(Buffer from, size_t fromFirst, Buffer to, Buffer rows, size_t rowsFirst, size_t count) {
+    if (count == 0) return;
+    if (!at(rows).device) return rt::Memory::scatter(from, fromFirst, to, rows, rowsFirst, count);  // the list's on the host
+    Column &f = at(from), &t = at(to);
+    flush(f);
+    flush(t);
+    uploadRows(f, fromFirst, count);  // only the rows scattered: the source stays on the host
+    upload(t);
+    unsigned list = deviceBuffer(rows);
+    if (!scatterProgram_) scatterProgram_ = computeProgram(rowsShader(kScatter), "scatter");
+    PassTimer::Scope timed(timer, "scatter", count);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.gl);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, t.gl);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, list);
+    glUseProgram(scatterProgram_);
+    bindParams(paramsBuffer_, {static_cast<uint32_t>(count), static_cast<uint32_t>(fromFirst),
+                               static_cast<uint32_t>(wordsPerRow(f.elem)), static_cast<uint32_t>(rowsFirst)});
+    dispatchInvocations(count, 64);
+    ++dispatches;
+    afterWrite(Write::Dispatch, kColumnReaders);
+    t.device = true;
+}
+
 // The rows scattered into a column on the GPU while it stayed there, in one upload and
 // one scatter: a burst chain creates an object at a time, a hundred thousand times in a
 // step, and would otherwise run a dispatch for each column of each. A row written twice
@@ -390,7 +418,7 @@ void GlMemory::runRows(unsigned program, unsigned from, unsigned to, size_t w, s
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, list);
     glUseProgram(program);
     bindParams(paramsBuffer_, {static_cast<uint32_t>(rows.size()), static_cast<uint32_t>(first),
-                               static_cast<uint32_t>(w)});
+                               static_cast<uint32_t>(w), 0u});
     dispatchInvocations(rows.size(), 64);
     ++dispatches;
     afterWrite(Write::Dispatch, kColumnReaders);  // into a column: any reader may follow

@@ -11,6 +11,7 @@
 // On the GPU a column is 32-bit words: one per row (f32, u32, u8 widened) or two (f64).
 #pragma once
 
+#include <initializer_list>
 #include <memory>
 #include <vector>
 
@@ -37,6 +38,18 @@ public:
     void* host(rt::Buffer buffer) override;
     const void* view(rt::Buffer buffer) const override;
     unsigned glBuffer(rt::Buffer buffer) const override;
+    // A pool's rows kept on the GPU: the rules of rt::Memory's, a dispatch each
+    // (gpu/gl_rows.cpp).
+    void allocateRows(const rt::PoolRows& pool, size_t top, size_t highWater, size_t n, rt::Buffer out,
+                      size_t outFirst) override;
+    void releaseRows(const rt::PoolRows& pool, rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map,
+                     size_t mapFirst) override;
+    void markFresh(const rt::PoolRows& pool, rt::Buffer rows, size_t first, size_t count) override;
+    using rt::Memory::scatter;
+    void scatter(rt::Buffer from, size_t fromFirst, rt::Buffer to, rt::Buffer rows, size_t rowsFirst,
+                 size_t count) override;
+    void identify(const rt::ObjectRuns& runs, size_t n, size_t kept, rt::Buffer created, rt::Buffer ids,
+                  rt::Buffer mask, size_t first) override;
 
     // For the backend's launches. Whether the column's value is on the GPU.
     bool onDevice(rt::Buffer buffer) const;
@@ -96,6 +109,10 @@ private:
     // go with the next ones once this many rows are pending (or the column is used).
     static constexpr size_t kPendingScatter = 64, kPendingFlush = 65536;
     mutable unsigned scatterProgram_ = 0, gatherProgram_ = 0, rowsBuffer_ = 0, paramsBuffer_ = 0, pendingBuffer_ = 0;
+    // gpu/gl_rows.cpp: its programs (made on first use) and the runs' buffer.
+    unsigned allocateProgram_ = 0, releaseProgram_ = 0, pushedProgram_ = 0, freshProgram_ = 0, identifyProgram_ = 0, runsBuffer_ = 0;
+    unsigned bound(rt::Buffer b);  // deviceBuffer, for a column the dispatch writes
+    bool allOnHost(std::initializer_list<rt::Buffer> buffers) const;
     mutable std::vector<uint32_t> rowsSent_;  // what rowsBuffer_ holds
 };
 

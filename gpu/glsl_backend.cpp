@@ -352,6 +352,8 @@ rt::RowsResult GlslBackend::run(const rt::RowsLaunch& launch) {
     if (late) {  // room for every dispatch's counts and kills, so that no region moves while it is issued
         size_t dispatches = (launch.end - launch.begin + rows - 1) / rows;
         reserveReadback(dispatches * 5 + (launch.end - launch.begin));
+        // Kills listed on the GPU for a pool that frees them there: one dispatch, one list.
+        late->listed = launch.killList.valid() && launch.end - launch.begin <= rows;
     }
     rt::RowsResult result;
     killedRows_.clear();
@@ -362,7 +364,10 @@ rt::RowsResult GlslBackend::run(const rt::RowsLaunch& launch) {
         result.drawn += r.drawn;
         result.nonFinite += r.nonFinite;
     }
-    if (late) return {.ticket = finishLate(std::move(late))};
+    if (late) {
+        bool listed = late->listed;
+        return {.ticket = finishLate(std::move(late)), .killsListed = listed};
+    }
     result.killedRows = killedRows_;  // every dispatch's, in order
     return result;
 }

@@ -46,6 +46,8 @@ public:
     rt::RowsResult collect(uint64_t ticket) override;
     bool ready(uint64_t ticket) override;
     bool clearsKilled() const override { return true; }
+    // Unless dispatches are limited (a launch's kills then come in several lists).
+    bool keepsRowsInMemory() const override { return dispatchRows_ == std::numeric_limits<size_t>::max(); }
     rt::BackendReport report() const override;
     bool marksDrawn() const override { return true; }
     bool rendersInStep() const override { return false; }

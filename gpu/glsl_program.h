@@ -35,6 +35,7 @@ struct GlslBackend::Late {
     std::vector<Part> parts;
     GLsync fence = nullptr;
     bool settled = false;
+    bool listed = false;  // its kills go to the launch's kill list (rt::RowsLaunch::killList), not here
     rt::RowsResult counts;
     std::vector<uint32_t> rows;
 };

@@ -70,7 +70,8 @@ rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program
         returned.push_back({b, block[LaunchBlock::kColumns + static_cast<size_t>(c)], 0});
     }
     if (!p.counts && !kills && returned.empty()) return {};
-    if (kills) words += 1 + n;
+    bool listed = late && late->listed;  // the kills into the launch's kill list instead
+    if (kills && !listed) words += 1 + n;
     for (Returned& r : returned) {
         r.at = words;
         words += n * GlMemory::wordsPerRow(memory_.elem(r.buffer));
@@ -92,8 +93,13 @@ rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program
                                      static_cast<uint32_t>(begin),
                                      static_cast<uint32_t>(mapped ? begin - launch.aliveRowsFirst : 0)};
         }
-        compactor_.compact(words_, block[LaunchBlock::kColumns + ColumnLayout::kKill], n, readback_, at + kKillsAt,
-                           clear ? &*clear : nullptr);
+        if (listed)
+            compactor_.compact(words_, block[LaunchBlock::kColumns + ColumnLayout::kKill], n,
+                               memory_.deviceBuffer(launch.killList), 0, clear ? &*clear : nullptr);
+        else
+            compactor_.compact(words_, block[LaunchBlock::kColumns + ColumnLayout::kKill], n, readback_, at + kKillsAt,
+                               clear ? &*clear : nullptr);
+        if (listed) memory_.written(launch.killList);
         if (clear) memory_.written(launch.aliveMask);
         memory_.dispatches += 3;  // its passes
     }
@@ -106,7 +112,7 @@ rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program
     timed.reset();
     if (late) {  // kept for collect(): no wait now
         readbackUsed_ = at + words;
-        late->parts.push_back({begin, at, kills});
+        late->parts.push_back({begin, at, kills && !listed});
         return {};
     }
     const uint32_t* back = awaitReadback() + at;

@@ -25,4 +25,12 @@ struct FreeRows {
     uint32_t row(size_t k) const { return static_cast<uint32_t>(k < top ? stack[top - 1 - k] : highWater + (k - top)); }
 };
 
+// The creation time of the k-th object of a run whose events, `perEvent` objects each,
+// are `spacing` apart from `firstTime` (Creation::Run; a device computes the same from
+// rt::ObjectRuns). The product and the sum rounded each on its own (no fused multiply-add:
+// -ffp-contract=off here, `precise` in GLSL).
+inline double eventTime(double firstTime, uint64_t k, uint64_t perEvent, double spacing) {
+    return firstTime + static_cast<double>(k / perEvent) * spacing;
+}
+
 }  // namespace psys::rt

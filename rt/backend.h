@@ -51,6 +51,12 @@ struct RowsLaunch {
     Buffer aliveMask;
     std::span<const uint32_t> aliveRows;
     size_t aliveRowsFirst = 0;
+    // A late launch over a pool whose rows are in the memory (Pool::keepRowsInMemory): a
+    // u32 buffer of end − begin + 1 rows for its kills — their count, then their rows less
+    // `begin` — which the pool frees there (rt::Memory::releaseRows). A backend that lists
+    // them says so (RowsResult::killsListed); else the run-time lists them from the rows
+    // it is given.
+    Buffer killList;
 };
 
 struct RowsResult {
@@ -66,6 +72,9 @@ struct RowsResult {
     // Non-zero: a late launch (RowsLaunch::late) whose counts and kills are not here yet:
     // Backend::collect(ticket) gives them.
     uint64_t ticket = 0;
+    // The kills are listed in RowsLaunch::killList (killedRows stays empty: the host need
+    // not see them), now or, with a ticket, by the time the launch is done.
+    bool killsListed = false;
 };
 
 // What is drawn, one rule for every backend: a row of a render launch is drawn when it is
@@ -167,6 +176,10 @@ public:
     // them out before the run-time has taken them, and the run-time may take them at the
     // next step instead of waiting at the end of this one (State::endStep).
     virtual bool clearsKilled() const { return false; }
+    // Whether the pools of objects that only die should keep their rows in the memory
+    // (Pool::keepRowsInMemory): where the memory is a device's, so that a step's
+    // bookkeeping happens there and the host keeps counts.
+    virtual bool keepsRowsInMemory() const { return false; }
     // Whether launches on disjoint rows may run on several threads at once.
     virtual bool concurrent() const { return false; }
     // The rows a launch over a pool covers at most: a chunk that stays in cache (and gives

@@ -16,6 +16,71 @@ void Memory::clear(Buffer buffer, size_t first, size_t count) {
     std::memset(static_cast<char*>(host(buffer)) + first * elemSize(elem(buffer)), 0, count * elemSize(elem(buffer)));
 }
 
+// The bookkeeping of a pool's rows kept in a memory (Memory::allocateRows): the rules of
+// rt/allocation.h over the buffers where the host addresses them.
+void Memory::allocateRows(const PoolRows& pool, size_t top, size_t highWater, size_t n, Buffer out, size_t outFirst) {
+    if (n == 0) return;
+    const FreeRows free{static_cast<const uint32_t*>(view(pool.stack)), top, highWater, 0};
+    auto* rows = static_cast<uint32_t*>(host(out)) + outFirst;
+    for (size_t k = 0; k < n; ++k) rows[k] = free.row(k);
+    auto* updatable = static_cast<uint8_t*>(host(pool.updatable));
+    auto* alive = static_cast<uint8_t*>(host(pool.alive));
+    for (size_t k = 0; k < n; ++k) {
+        updatable[rows[k]] = 0;
+        alive[rows[k]] = 1;
+    }
+    static_cast<uint32_t*>(host(pool.counters))[0] = static_cast<uint32_t>(top - std::min(n, top));
+}
+
+void Memory::releaseRows(const PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
+                         size_t mapFirst) {
+    const auto* list = static_cast<const uint32_t*>(view(killed)) + killedAt;
+    uint32_t count = list[0];
+    if (count == 0) return;
+    uint32_t& top = static_cast<uint32_t*>(host(pool.counters))[0];
+    const auto* rows = map.valid() ? static_cast<const uint32_t*>(view(map)) + mapFirst : nullptr;
+    auto* stack = static_cast<uint32_t*>(host(pool.stack));
+    auto* generation = static_cast<uint32_t*>(host(pool.generation));
+    auto* updatable = static_cast<uint8_t*>(host(pool.updatable));
+    auto* alive = static_cast<uint8_t*>(host(pool.alive));
+    for (uint32_t i = 0; i < count; ++i) {
+        uint32_t r = list[1 + i], row = rows ? rows[r] : base + r;
+        stack[top + i] = row;
+        ++generation[row];
+        updatable[row] = alive[row] = 0;
+    }
+    top += count;
+}
+
+void Memory::markFresh(const PoolRows& pool, Buffer rows, size_t first, size_t count) {
+    if (count == 0) return;
+    const auto* list = static_cast<const uint32_t*>(view(rows)) + first;
+    auto* updatable = static_cast<uint8_t*>(host(pool.updatable));
+    const auto* alive = static_cast<const uint8_t*>(view(pool.alive));
+    for (size_t i = 0; i < count; ++i) updatable[list[i]] = alive[list[i]];
+}
+
+void Memory::scatter(Buffer from, size_t fromFirst, Buffer to, Buffer rows, size_t rowsFirst, size_t count) {
+    if (count == 0) return;
+    const auto* list = static_cast<const uint32_t*>(view(rows)) + rowsFirst;
+    scatter(from, fromFirst, to, std::span<const uint32_t>(list, count));
+}
+
+void Memory::identify(const ObjectRuns& runs, size_t n, size_t kept, Buffer created, Buffer ids, Buffer mask,
+                      size_t first) {
+    if (n == 0) return;
+    auto* c = static_cast<double*>(host(created)) + first;
+    auto* id = static_cast<uint32_t*>(host(ids)) + first;
+    auto* m = static_cast<uint8_t*>(host(mask)) + first;
+    for (size_t u = 0; u < runs.size(); ++u)
+        for (uint32_t k = 0; k < runs.count[u]; ++k) {
+            size_t r = runs.first[u] + k;
+            m[r] = r < kept;
+            c[r] = runs.time(u, k);
+            id[r] = runs.id[u] + k;
+        }
+}
+
 // One column: a 64-byte aligned array that grows by doubling, so that appending rows one
 // at a time costs amortized O(1). A large column is its own anonymous mapping, grown with
 // mremap: the kernel moves its pages instead of copying them, pages past the rows in use

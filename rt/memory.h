@@ -17,6 +17,8 @@
 #include <span>
 #include <vector>
 
+#include "rt/allocation.h"
+
 namespace psys::rt {
 
 enum class Elem : uint8_t { F32, F64, U32, U8 };
@@ -29,6 +31,24 @@ struct Buffer {
     uint32_t id = std::numeric_limits<uint32_t>::max();
     bool valid() const { return id != std::numeric_limits<uint32_t>::max(); }
     bool operator==(const Buffer&) const = default;
+};
+
+// A pool's rows in a memory (Memory::allocateRows): its free stack, each row's generation
+// (u32 columns of the pool's rows) and its masks (u8).
+struct PoolRows {
+    Buffer stack, generation, updatable, alive;
+    Buffer counters;  // u32: the stack's top, where a release pushes (the memory's own count of it)
+};
+
+// A creation batch's objects as runs (rt/system_create.h, Creation::Run): object r of
+// run u (first[u] <= r < first[u] + count[u], k = r − first[u]) has the id id[u] + k and
+// the creation time firstTime[u] + ⌊k / perEvent[u]⌋ · spacing[u].
+struct ObjectRuns {
+    std::vector<uint32_t> first, count, id, perEvent;
+    std::vector<double> firstTime, spacing;
+    size_t size() const { return first.size(); }
+    // The creation time of object k of run u: one rule for every memory.
+    double time(size_t u, uint32_t k) const { return eventTime(firstTime[u], k, perEvent[u], spacing[u]); }
 };
 
 class Memory {
@@ -68,6 +88,33 @@ public:
     // Whether every buffer lives in the host's memory, `host` never moving anything: the
     // run-time may then keep its masks in the columns themselves (rt::SyncedMask).
     virtual bool hostResident() const { return false; }
+
+    // A pool's rows kept where its columns are (Pool::keepRowsInMemory): the bookkeeping
+    // of rows as operations on buffers, so that a device does it where the rows are and
+    // the host keeps only counts. Each is written here once for any memory, by the rule
+    // of rt/allocation.h (through `host`: the CPU's memories); a device's memory does the
+    // same on the device (GlMemory: one dispatch each).
+    //
+    // Rows for objects k < n of a batch, out[outFirst + k] = FreeRows{stack, top,
+    // highWater}.row(k) (n at most the room; the pool's columns already hold the rows);
+    // each new row alive, not updatable; the stack's top in `counters` what is left of it.
+    virtual void allocateRows(const PoolRows& pool, size_t top, size_t highWater, size_t n, Buffer out, size_t outFirst);
+    // The rows a late launch killed, freed in order: `killed` holds their count at word
+    // `killedAt`, then launch rows; launch row r is pool row base + r, or map[mapFirst + r]
+    // where `map` is given (a batch's rows). Each is pushed onto the stack at the top
+    // `counters` holds (the host need not know how many there are), its generation moved
+    // on, its masks cleared; the top moves on.
+    virtual void releaseRows(const PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
+                             size_t mapFirst);
+    // The rows rows[first, first + count) become updatable where they are alive (the rows a
+    // step created, at the next step's start).
+    virtual void markFresh(const PoolRows& pool, Buffer rows, size_t first, size_t count);
+    // to[rows[rowsFirst + i]] = from[fromFirst + i], i < count, with the rows in a buffer.
+    virtual void scatter(Buffer from, size_t fromFirst, Buffer to, Buffer rows, size_t rowsFirst, size_t count);
+    // A creation batch's objects r < n from their runs (rt::ObjectRuns): created[first + r],
+    // ids[first + r], and mask[first + r] = r < kept.
+    virtual void identify(const ObjectRuns& runs, size_t n, size_t kept, Buffer created, Buffer ids, Buffer mask,
+                          size_t first);
 };
 
 // Host RAM: buffers are arrays the host addresses directly (aligned to 64 bytes).

@@ -1,6 +1,7 @@
 #include "rt/pool.h"
 
 #include <algorithm>
+#include <stdexcept>
 
 namespace psys::rt {
 
@@ -117,7 +118,10 @@ Pool::Pool(Pool&& other) noexcept
       parent(std::move(other.parent)), readers(std::move(other.readers)), fresh(std::move(other.fresh)),
       emitted(std::move(other.emitted)), object_(other.object_), capacity_(other.capacity_), memory_(other.memory_),
       status_(std::move(other.status_)), generation_(std::move(other.generation_)),
-      freeRows_(std::move(other.freeRows_)), live_(other.live_), frozen_(other.frozen_) {
+      freeRows_(std::move(other.freeRows_)), live_(other.live_), frozen_(other.frozen_), inMemory_(other.inMemory_),
+      rows_(other.rows_), top_(other.top_), highWater_(other.highWater_), uncounted_(other.uncounted_),
+      freshRows_(std::move(other.freshRows_)), spare_(std::move(other.spare_)), version_(other.version_),
+      fetched_(other.fetched_), mask_(std::move(other.mask_)) {
     other.memory_ = nullptr;
 }
 
@@ -130,11 +134,20 @@ Pool::~Pool() {
     state.release(*memory_);
     params.release(*memory_);
     exports.release(*memory_);
+    for (Buffer b : {rows_.stack, rows_.generation, rows_.counters})
+        if (b.valid()) memory_->release(b);
+    for (const FreshRows& f : freshRows_) memory_->release(f.rows);
+    for (Buffer b : spare_) memory_->release(b);
 }
 
 void Pool::grow(size_t n) {
-    status_.resize(n, Status::Free);
-    generation_.resize(n, 0);
+    if (inMemory_) {
+        highWater_ = n;
+        for (Buffer b : {rows_.stack, rows_.generation}) memory_->resize(b, n);
+    } else {
+        status_.resize(n, Status::Free);
+        generation_.resize(n, 0);
+    }
     parent.resize(n);
     readers.resize(n, 0);
     diedAt.resize(n, 0);
@@ -203,7 +216,84 @@ void Pool::releaseKilled(std::span<const uint32_t> rows) {
     alive.set(rows, 0);
 }
 
+void Pool::keepRowsInMemory() {
+    if (inMemory_) return;
+    inMemory_ = true;
+    rows_ = {memory_->create(Elem::U32, rows()), memory_->create(Elem::U32, rows()), updatable.column, alive.column,
+             memory_->create(Elem::U32, 1)};
+    restoreInMemory();  // what the host has so far (nothing, before the first object)
+}
+
+size_t Pool::allocate(size_t n, Buffer out, size_t outFirst) {
+    if (uncounted_) throw std::logic_error("a pool's rows allocated before its last releases were counted");
+    size_t room = top_ + (capacity_ > highWater_ ? capacity_ - highWater_ : 0);
+    size_t kept = std::min(n, room);
+    if (kept == 0) return 0;
+    size_t fromStack = std::min(kept, top_), highWater = highWater_;
+    if (kept > fromStack) grow(highWater_ + (kept - fromStack));  // once, for the whole batch
+    memory_->allocateRows(rows_, top_, highWater, kept, out, outFirst);
+    top_ -= fromStack;
+    live_ += kept;
+    ++version_;
+    return kept;
+}
+
+void Pool::release(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst) {
+    memory_->releaseRows(rows_, killed, killedAt, base, map, mapFirst);
+    ++uncounted_;
+    ++version_;
+}
+
+void Pool::released(size_t count) {
+    if (uncounted_ == 0) throw std::logic_error("a pool's release counted twice");
+    --uncounted_;
+    top_ += count;
+    live_ -= count;
+}
+
+void Pool::createdRows(Buffer rows, size_t count) { freshRows_.push_back({rows, count}); }
+
+Buffer Pool::scratchRows(size_t n) {
+    Buffer b;
+    if (spare_.empty()) {
+        b = memory_->create(Elem::U32, n);
+    } else {
+        b = spare_.back();
+        spare_.pop_back();
+        if (memory_->rows(b) < n) memory_->resize(b, n);
+    }
+    return b;
+}
+
+void Pool::fetch() const {
+    if (!inMemory_ || fetched_ == version_) return;
+    size_t rows = highWater_;
+    uint32_t top = 0;
+    memory_->read(rows_.counters, 0, 1, &top);  // the memory's: counted or not
+    generation_.resize(rows);
+    freeRows_.resize(top);
+    mask_.resize(rows);
+    status_.assign(rows, Status::Free);
+    memory_->read(rows_.generation, 0, rows, generation_.data());
+    memory_->read(rows_.stack, 0, top, freeRows_.data());
+    memory_->read(rows_.updatable, 0, rows, mask_.data());
+    std::vector<uint8_t> isAlive(rows);
+    memory_->read(rows_.alive, 0, rows, isAlive.data());
+    for (size_t row = 0; row < rows; ++row)
+        if (isAlive[row]) status_[row] = Status::Alive;
+    fetched_ = version_;
+}
+
 void Pool::beginStep() {
+    if (inMemory_) {
+        for (const FreshRows& f : freshRows_) {
+            memory_->markFresh(rows_, f.rows, 0, f.count);
+            recycle(f.rows);
+        }
+        if (!freshRows_.empty()) ++version_;
+        freshRows_.clear();
+        return;
+    }
     for (uint32_t row : fresh)
         if (status_[row] == Status::Alive) updatable.set(row, 1);
     fresh.clear();
@@ -214,7 +304,26 @@ void Pool::syncMasks() {
     alive.sync(*memory_);
 }
 
-void Pool::restoreMask(std::vector<uint8_t> mask) { updatable.restore(*memory_, std::move(mask)); }
+// The rows alive but not updatable are those created since the last step's start.
+std::vector<uint32_t> Pool::freshRows() const {
+    if (!inMemory_) return fresh;
+    std::vector<uint32_t> out;
+    for (uint32_t row = 0; row < rows(); ++row)
+        if (status(row) == Status::Alive && !mask()[row]) out.push_back(row);
+    return out;
+}
+
+void Pool::restoreMask(std::vector<uint8_t> mask) {
+    updatable.restore(*memory_, std::move(mask));
+    if (!inMemory_) return;
+    fetched_ = 0;
+    ++version_;
+    std::vector<uint32_t> fresh = freshRows();
+    if (fresh.empty()) return;
+    Buffer list = scratchRows(fresh.size());
+    memory_->write(list, 0, fresh.size(), fresh.data());
+    createdRows(list, fresh.size());
+}
 
 void Pool::restore(std::vector<Status> status, std::vector<uint32_t> generation, std::vector<uint32_t> freeRows) {
     grow(status.size());
@@ -229,6 +338,35 @@ void Pool::restore(std::vector<Status> status, std::vector<uint32_t> generation,
         isAlive[row] = status_[row] == Status::Alive;
     }
     alive.restore(*memory_, std::move(isAlive));
+    if (inMemory_) restoreInMemory();
+}
+
+// The rows restore() gave the host, into the memory. A frozen row is freed at once, after
+// the free rows given and in row order, as a reload frees the frozen rows nobody reads
+// (rt/reload.cpp): a pool whose rows are in the memory has no readers.
+void Pool::restoreInMemory() {
+    for (uint32_t row = 0; row < status_.size(); ++row)
+        if (status_[row] == Status::Frozen) {
+            status_[row] = Status::Free;
+            ++generation_[row];
+            freeRows_.push_back(row);
+            --frozen_;
+        }
+    for (const FreshRows& f : freshRows_) recycle(f.rows);
+    freshRows_.clear();
+    uncounted_ = 0;
+    highWater_ = status_.size();
+    top_ = freeRows_.size();
+    for (Buffer b : {rows_.stack, rows_.generation}) memory_->resize(b, highWater_);
+    if (top_) memory_->write(rows_.stack, 0, top_, freeRows_.data());
+    if (highWater_) memory_->write(rows_.generation, 0, highWater_, generation_.data());
+    auto top = static_cast<uint32_t>(top_);
+    memory_->write(rows_.counters, 0, 1, &top);
+    std::vector<uint8_t> isAlive(highWater_);
+    for (size_t row = 0; row < highWater_; ++row) isAlive[row] = status_[row] == Status::Alive;
+    alive.restore(*memory_, std::move(isAlive));
+    ++version_;
+    fetched_ = 0;  // the masks: read back when asked
 }
 
 }  // namespace psys::rt

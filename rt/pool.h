@@ -7,6 +7,13 @@
 // generation changes whenever it is freed, so a stale handle never reads a reused row.
 // A killed object that children still read stays in its row, frozen (not updated, not
 // drawn, its exports kept) until its last reader is gone.
+//
+// A pool may keep its rows in the memory of its columns instead (keepRowsInMemory: the
+// objects of a type that only die, on a device): the free stack, the generations and the
+// masks are buffers there, changed by the memory's operations (rt::Memory::allocateRows),
+// and the host keeps the counts — the stack's top, the high-water mark, the live count —
+// which are all a step needs. The rows' statuses, generations and free stack are read
+// back when asked (tests, hot reload), not kept on the host.
 #pragma once
 
 #include <cstdint>
@@ -93,7 +100,7 @@ public:
 
     const ir::Object& object() const { return *object_; }
     size_t capacity() const { return capacity_; }
-    size_t rows() const { return status_.size(); }  // the high-water mark
+    size_t rows() const { return inMemory_ ? highWater_ : status_.size(); }  // the high-water mark
     size_t live() const { return live_; }
     size_t frozen() const { return frozen_; }
     size_t free() const { return capacity_ - live_ - frozen_; }
@@ -106,9 +113,35 @@ public:
     // onto the free stack in the order given, each row's generation moved on.
     void releaseKilled(std::span<const uint32_t> rows);
     void freeze(uint32_t row, double at);  // `at`: the time of its last values; its age stays what it was then
-    bool matches(Handle h) const { return h.row < rows() && generation_[h.row] == h.generation && status_[h.row] != Status::Free; }
-    Handle handle(uint32_t row) const { return {row, generation_[row]}; }
-    Status status(uint32_t row) const { return status_[row]; }
+    bool matches(Handle h) const {
+        fetch();
+        return h.row < rows() && generation_[h.row] == h.generation && status_[h.row] != Status::Free;
+    }
+    Handle handle(uint32_t row) const { return {row, generations()[row]}; }
+    Status status(uint32_t row) const {
+        fetch();
+        return status_[row];
+    }
+
+    // The rows kept in the memory (see above): from now on, before any object is created.
+    void keepRowsInMemory();
+    bool rowsInMemory() const { return inMemory_; }
+    // Rows for `n` objects of a batch by the allocation rule, in the memory: into
+    // out[outFirst + k] for the first min(n, free()) of them; returns how many got one.
+    // Every release before it must be counted (released).
+    size_t allocate(size_t n, Buffer out, size_t outFirst);
+    // A late launch's kills (their count, then launch rows, in `killed` from word
+    // `killedAt`: rt::Memory::releaseRows) freed in the memory, onto the stack in order;
+    // the host counts them when it learns how many there were (released).
+    void release(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst);
+    void released(size_t count);
+    // The rows of a batch just allocated (rows[0, count)), made updatable at the next step's
+    // start; the buffer is the pool's from then on (a scratch one: scratchRows).
+    void createdRows(Buffer rows, size_t count);
+    // A u32 buffer of at least `n` rows the pool keeps for a step's lists of rows (a batch's
+    // rows, a launch's kills), and back to it once used.
+    Buffer scratchRows(size_t n);
+    void recycle(Buffer b) { spare_.push_back(b); }
 
     // Columns in the backend's memory.
     Buffer created, ids;             // f64, u32
@@ -116,7 +149,11 @@ public:
     // `updatable`, the rows a step updates (alive, not created during it); `alive`, the
     // rows alive (what is drawn is among them).
     SyncedMask updatable, alive;
-    const uint8_t* mask() const { return updatable.host(); }
+    const uint8_t* mask() const {
+        if (!inMemory_) return updatable.host();
+        fetch();
+        return mask_.data();
+    }
     void syncMasks();
     void restoreMask(std::vector<uint8_t> mask);  // hot reload: the whole update mask
     ValueColumns state, params, exports;  // params: only the kept ones
@@ -129,15 +166,22 @@ public:
     // The time a child reading `row`'s age reads it at: `now`, or its death for a frozen
     // object (frozen with its last values, its age too).
     double ageClock(uint32_t row, double now) const { return status_[row] == Status::Frozen ? diedAt[row] : now; }
-    std::vector<uint32_t> fresh;     // rows created during the current step
+    std::vector<uint32_t> fresh;     // rows created during the current step (rows on the host)
+    std::vector<uint32_t> freshRows() const;  // those rows, wherever the rows are kept
     void beginStep();                // the rows created before this step become updatable
     std::vector<std::vector<double>> emitted;  // per rate site: events accumulated, in [0, 1)
 
     Memory& memory() const { return *memory_; }
     // Rebuilds the host bookkeeping of rows as given (hot reload, rt/reload.cpp).
     void restore(std::vector<Status> status, std::vector<uint32_t> generation, std::vector<uint32_t> freeRows);
-    const std::vector<uint32_t>& generations() const { return generation_; }
-    const std::vector<uint32_t>& freeRows() const { return freeRows_; }
+    const std::vector<uint32_t>& generations() const {
+        fetch();
+        return generation_;
+    }
+    const std::vector<uint32_t>& freeRows() const {
+        fetch();
+        return freeRows_;
+    }
     // The bytes one row of `object`'s pool takes: its columns (creation time, id, update
     // mask, kept state, kept parameters, exports) and the host's bookkeeping of it.
     static size_t rowBytes(const ir::Object& object);
@@ -148,10 +192,27 @@ private:
     const ir::Object* object_;
     size_t capacity_;
     Memory* memory_;
-    std::vector<Status> status_;
-    std::vector<uint32_t> generation_;
-    std::vector<uint32_t> freeRows_;
+    // On the host, or (rows in the memory) what was last read back: fetch().
+    mutable std::vector<Status> status_;
+    mutable std::vector<uint32_t> generation_;
+    mutable std::vector<uint32_t> freeRows_;
     size_t live_ = 0, frozen_ = 0;
+    // The rows in the memory: its buffers and the host's counts; what changed them since
+    // the host copies were read back (a version each change, the one read back).
+    bool inMemory_ = false;
+    PoolRows rows_;
+    size_t top_ = 0, highWater_ = 0, uncounted_ = 0;
+    struct FreshRows {
+        Buffer rows;
+        size_t count;
+    };
+    std::vector<FreshRows> freshRows_;
+    std::vector<Buffer> spare_;
+    uint64_t version_ = 0;
+    mutable uint64_t fetched_ = 0;
+    mutable std::vector<uint8_t> mask_;
+    void fetch() const;  // the host copies of the rows in the memory, where they are stale
+    void restoreInMemory();
 };
 
 }  // namespace psys::rt

@@ -65,7 +65,7 @@ void carryType(const detail::State& old, size_t ot, detail::State& s, size_t t, 
     copyColumn(old.memory, from.created, s.memory, to.created, rows, 8);
     copyColumn(old.memory, from.ids, s.memory, to.ids, rows, 4);
     to.restoreMask({from.mask(), from.mask() + rows});
-    to.fresh = from.fresh;
+    to.fresh = from.freshRows();
     for (auto [i, j] : matchByName(o.state, oo.state)) {
         if (j >= 0) copyValues(old.memory, from.state, static_cast<size_t>(j), s.memory, to.state, i, rows);
         else report.newSlots.push_back(o.name + "." + o.state[i].name);

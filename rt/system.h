@@ -50,6 +50,12 @@ struct SystemOptions {
     // (rt/system_state.h, LateKills), so a device need not wait for them mid-step;
     // false: at once. Results are the same, rows included (tests compare the two).
     bool lateKills = true;
+    // Where the pools of objects that only die (late kills, nothing reads them, no bursts
+    // or sub-steps) keep their rows — the free stack, generations, masks: in the memory
+    // (Pool::keepRowsInMemory, its operations doing the bookkeeping where the columns
+    // are) where the backend asks for it (Backend::keepsRowsInMemory: a device), always,
+    // or never. Results are the same, rows included (tests compare them).
+    enum class Rows : uint8_t { AsBackend, InMemory, OnHost } rows = Rows::AsBackend;
 };
 
 struct TypeStats {

@@ -18,27 +18,7 @@ namespace psys::rt::detail {
 using ir::KernelKind;
 using ir::YieldKind;
 
-// Per type: the scratch columns a batch is created in, indexed like the staging rows (so
-// the staging columns are the batch's parameters as they are).
-struct Creation::Batch {
-    explicit Batch(Memory& m) : columns(m), initParents(m), updateParents(m), exportsParents(m), renderParents(m) {}
-    Scratch columns, initParents, updateParents, exportsParents, renderParents;
-    ColumnLayout initLayout;
-    std::vector<Buffer> initTable, updateTable, exportsTable, renderTable;
-    std::vector<std::vector<Buffer>> burstTables;  // per emit site: the state at creation, for bursts
-    std::vector<Run> runs;             // its runs (Creation::Run)
-    std::vector<size_t> runFirst;      // per run: its first object's place in the batch
-    size_t first = 0;                  // the batch's first staging row
-    std::vector<uint32_t> poolRows;    // per object of the batch: its pool row, or kSkipRow (dropped)
-    std::vector<uint32_t> subSteps;    // per object: the sub-steps of its first update
-    std::vector<double> spans;         // per object: the length of its first update
-};
-
 namespace {
-
-// Scratch column indices of a batch.
-constexpr size_t kCreated = 0, kIds = 1, kKill = 2, kNow = 3, kDt = 4, kMask = 5, kStepMask = 6, kExportMask = 7,
-                 kZero = 8, kRenderMask = 9, kFirstValue = 10;
 
 size_t components(const std::vector<ir::StateSlot>& slots) {
     size_t n = 0;
@@ -128,6 +108,10 @@ void Creation::createBatch(size_t type, size_t from, size_t to, double t1) {
         n += run.count;
     }
     b.first = b.runs.front().staging;
+    if (pool.rowsInMemory()) {
+        createInMemory(type, b, n, t1);
+        return;
+    }
     b.poolRows.resize(n);
     size_t allocated = pool.allocate(n, b.poolRows.data());  // the allocation rule (rt/allocation.h)
     s_.typeStats[type].dropped += n - allocated;

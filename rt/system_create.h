@@ -58,7 +58,7 @@ private:
         double firstTime, spacing;  // events `spacing` apart, the first at firstTime,
         uint64_t perEvent;          // this many objects each
         uint32_t id;
-        double time(size_t k) const { return firstTime + static_cast<double>(k / perEvent) * spacing; }
+        double time(size_t k) const { return eventTime(firstTime, k, perEvent, spacing); }
     };
     // Per type: the arguments of queued objects, one f32 column per component of the
     // type's parameters (kept or not); an object's row is its place among the type's
@@ -74,6 +74,10 @@ private:
     // created in batches).
     void enqueue(const Run& run);
     void createBatch(size_t type, size_t from, size_t to, double t1);
+    // createBatch for a type whose rows are in the memory (rt/system_create_rows.cpp).
+    void createInMemory(size_t type, Batch& b, size_t n, double t1);
+    void launchInMemory(size_t type, Batch& b, size_t n, const ir::Kernel& kernel, const ColumnLayout& layout,
+                        std::vector<Buffer>& table, const Clock& clock, LateKills* late);
     void identify(size_t type, Batch& b, size_t n);
     void atCreation(size_t type, Batch& b, size_t n);
     // Counts the updates beyond the stability limit in `type`'s stats.
@@ -98,5 +102,25 @@ private:
     std::vector<Value> yields_, parents_;
     std::vector<float> rate_, count_;
 };
+
+// Per type: the scratch columns a batch is created in, indexed like the staging rows (so
+// the staging columns are the batch's parameters as they are).
+struct Creation::Batch {
+    explicit Batch(Memory& m) : columns(m), initParents(m), updateParents(m), exportsParents(m), renderParents(m) {}
+    Scratch columns, initParents, updateParents, exportsParents, renderParents;
+    ColumnLayout initLayout;
+    std::vector<Buffer> initTable, updateTable, exportsTable, renderTable;
+    std::vector<std::vector<Buffer>> burstTables;  // per emit site: the state at creation, for bursts
+    std::vector<Run> runs;             // its runs (Creation::Run)
+    std::vector<size_t> runFirst;      // per run: its first object's place in the batch
+    size_t first = 0;                  // the batch's first staging row
+    std::vector<uint32_t> poolRows;    // per object of the batch: its pool row, or kSkipRow (dropped)
+    std::vector<uint32_t> subSteps;    // per object: the sub-steps of its first update
+    std::vector<double> spans;         // per object: the length of its first update
+};
+
+// Scratch column indices of a batch.
+constexpr size_t kCreated = 0, kIds = 1, kKill = 2, kNow = 3, kDt = 4, kMask = 5, kStepMask = 6, kExportMask = 7,
+                 kZero = 8, kRenderMask = 9, kFirstValue = 10;
 
 }  // namespace psys::rt::detail

@@ -83,6 +83,16 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         if (t.parentType >= 0) types[static_cast<size_t>(t.parentType)].read = true;
     for (TypeInfo& t : types)
         t.late = options.lateKills && (t.kills || t.unstable) && !t.rateEmits && !t.exports && !t.read;
+    // Rows in the memory: where nothing but the type's own late kills frees them, and its
+    // objects are created whole in a batch (no sub-steps, no bursts, not drawn as the step goes).
+    bool inMemory = options.rows == SystemOptions::Rows::InMemory ||
+                    (options.rows == SystemOptions::Rows::AsBackend && backend.keepsRowsInMemory());
+    for (size_t t = 0; t < types.size(); ++t) {
+        TypeInfo& info = types[t];
+        info.rowsInMemory = inMemory && info.late && info.parentType < 0 && !info.bursts && info.stepLimit == 0 &&
+                            !(options.drawInStep && backend.rendersInStep() && info.render);
+        if (info.rowsInMemory) pools[t].keepRowsInMemory();
+    }
     // Spawn kernels read the emitter's own columns, whose buffers never change: their
     // tables are bound once (the parent values come with each launch).
     for (size_t t = 0; t < pools.size(); ++t) {
@@ -123,6 +133,9 @@ void State::kill(size_t type, uint32_t row, double at) {
 
 void State::latePart(LateKills::Part& part, const RowsResult& result, Buffer flags, size_t begin, size_t end) const {
     part.ticket = result.ticket;
+    part.begin = begin;
+    part.listed = result.killsListed;
+    part.counted = false;
     part.rows.clear();
     if (result.ticket || result.killed == 0) return;
     if (result.killedRows.size() == result.killed)
@@ -131,12 +144,70 @@ void State::latePart(LateKills::Part& part, const RowsResult& result, Buffer fla
         listKilled(view<uint8_t>(flags), begin, end, part.rows);
 }
 
+void State::releaseInMemory(LateKills& l) {
+    if (l.released) return;
+    l.released = true;
+    Pool& pool = pools[l.type];
+    std::vector<uint32_t> list;
+    for (LateKills::Part& part : l.parts) {
+        if (!part.killList.valid()) continue;
+        if (!part.listed) {  // listed here, from the rows the backend gives
+            std::span<const uint32_t> rows = part.rows;
+            RowsResult result;
+            if (part.ticket) {
+                result = backend.collect(part.ticket);
+                part.ticket = 0;
+                rows = result.killedRows;
+                typeStats[l.type].unstable += result.unstable;
+            }
+            list.assign(1, static_cast<uint32_t>(rows.size()));
+            for (uint32_t row : rows) list.push_back(static_cast<uint32_t>(row - part.begin));
+            typeStats[l.type].killed += rows.size();
+            part.counted = true;
+            if (rows.empty()) {  // nothing to free
+                pool.recycle(part.killList);
+                part.killList = {};
+                continue;
+            }
+            memory.write(part.killList, 0, list.size(), list.data());
+        }
+        if (l.map.valid())
+            pool.release(part.killList, 0, 0, l.map, part.begin - l.first);
+        else
+            pool.release(part.killList, 0, static_cast<uint32_t>(part.begin), {}, 0);
+        if (part.counted) pool.released(list[0]);
+        pool.recycle(part.killList);
+        part.killList = {};
+    }
+}
+
+void State::countInMemory(LateKills& l) {
+    Pool& pool = pools[l.type];
+    for (LateKills::Part& part : l.parts) {
+        if (part.counted) continue;
+        part.counted = true;
+        RowsResult result;
+        if (part.ticket) result = backend.collect(part.ticket);
+        typeStats[l.type].killed += result.killed;
+        typeStats[l.type].unstable += result.unstable;
+        pool.released(result.killed);
+    }
+}
+
 void State::settleLate(Deaths& dying, std::vector<LateKills>& late) {
     if (late.empty()) return;
     Deaths merged;
     merged.reserve(dying.size());
     size_t next = 0;
+    std::vector<LateKills> kept;  // those of types whose rows are in the memory, not freed yet
     for (LateKills& l : late) {
+        if (types[l.type].rowsInMemory) {
+            if (l.released)
+                countInMemory(l);
+            else
+                kept.push_back(std::move(l));
+            continue;
+        }
         for (; next < l.at; ++next) merged.push_back(dying[next]);
         Pool& pool = pools[l.type];
         for (LateKills::Part& part : l.parts) {
@@ -163,7 +234,7 @@ void State::settleLate(Deaths& dying, std::vector<LateKills>& late) {
     }
     for (; next < dying.size(); ++next) merged.push_back(dying[next]);
     dying = std::move(merged);
-    late.clear();
+    late = std::move(kept);
 }
 
 void State::settleAndRelease(Deaths& deaths, std::vector<LateKills>& lates) {
@@ -186,6 +257,10 @@ void State::settleAndRelease(Deaths& deaths, std::vector<LateKills>& lates) {
     };
     std::vector<LateKills> single(1);
     for (LateKills& l : lates) {
+        if (types[l.type].rowsInMemory) {  // freed in the memory at the step's end (endStep): counted
+            countInMemory(l);
+            continue;
+        }
         releaseUpTo(l.at);
         if (!simple(l)) {  // its kills frozen and released in its place, as settleLate and release would
             Deaths its;
@@ -233,6 +308,8 @@ void State::release(Deaths& deaths) {
 }
 
 void State::endStep() {
+    for (LateKills& l : late)
+        if (types[l.type].rowsInMemory) releaseInMemory(l);
     auto owes = [](const LateKills& l) {
         return std::any_of(l.parts.begin(), l.parts.end(), [](const LateKills::Part& p) { return p.ticket != 0; });
     };

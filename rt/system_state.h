@@ -53,6 +53,9 @@ struct TypeInfo {
     // the step (LateKills): it emits nothing at a rate, has no exports and nothing reads
     // it, so no one looks at its dead before then.
     bool late = false;
+    // Its pool keeps its rows in the memory (Pool::keepRowsInMemory): a type whose
+    // kills are late, with no parent, no bursts and no sub-steps.
+    bool rowsInMemory = false;
     std::vector<bool> counted, rated;  // per emit site: whether the update yields its count, its rate
     std::array<bool, 4> drawn{};       // visible, position, colour, size: whether render yields it
 };
@@ -79,8 +82,19 @@ struct LateKills {
     struct Part {
         uint64_t ticket = 0;          // to collect (Backend::collect); 0: `rows` are here
         std::vector<uint32_t> rows;   // launch rows, in order
+        // A type whose rows are in the memory: its launch's first row and kill list
+        // (RowsLaunch::killList), whether the backend listed the kills there, and whether
+        // they are counted (Pool::released).
+        size_t begin = 0;
+        Buffer killList;
+        bool listed = false, counted = false;
     };
     std::vector<Part> parts;
+    // A type whose rows are in the memory: its kills freed there (State::releaseInMemory)
+    // at the end of the step, in their place; a creation batch's rows (launch row first + r
+    // is pool row map[r]).
+    bool released = false;
+    Buffer map;
     double t1 = 0, dt = 0;  // a pool's update: killed at t1 − dt
     // A creation batch's first update: launch row first + r is pool row poolRows[r],
     // killed at t1 − spans[r].
@@ -170,6 +184,11 @@ struct State {
     // that reads no parent go straight onto its free stack in their place (nothing else
     // can happen to them between), each part as one run of rows.
     void settleAndRelease(Deaths& deaths, std::vector<LateKills>& lates);
+    // The late kills of a type whose rows are in the memory: freed there, at the end of
+    // the step (their rows listed on the host first where the backend did not list them);
+    // counted once the backend gives their counts (settleLate, settleAndRelease).
+    void releaseInMemory(LateKills& l);
+    void countInMemory(LateKills& l);
     // A launch's kills as a part of a LateKills: its ticket, or the rows it listed, else
     // those of [begin, end) its kill flags (`flags`) mark.
     void latePart(LateKills::Part& part, const RowsResult& result, Buffer flags, size_t begin, size_t end) const;

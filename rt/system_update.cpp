@@ -136,7 +136,9 @@ void runUpdate(State& s, size_t type, double dt, double t1, bool last) {
         exports.mask = exportMask;
         exports.uniforms = s.uniforms(type, *info.exports, static_cast<float>(dt), static_cast<float>(t1));
     }
-    const uint8_t* updatable = pool.mask();
+    // (Where the rows are in the memory, nothing here reads the mask: no parents, no
+    // exports, no drawing as the step goes.)
+    const uint8_t* updatable = info.rowsInMemory ? nullptr : pool.mask();
     const auto* kill = s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]);
     // Objects that only die (no rate emits) are found while their chunk is in cache; where
     // nobody looks at them before the end of the step (the last sub-step of a type whose
@@ -146,13 +148,19 @@ void runUpdate(State& s, size_t type, double dt, double t1, bool last) {
     size_t chunks = s.chunkCount(rows);
     work.pass = {true, late, listKills && !late, chunks};
     if (listKills || late) work.killed.resize(chunks);  // each chunk sets its own (State::latePart)
+    if (late && info.rowsInMemory)
+        for (size_t c = 0; c < chunks; ++c)
+            work.killed[c].killList = pool.scratchRows(std::min(s.backend.chunkRows(), rows - c * s.backend.chunkRows()) + 1);
     std::atomic<uint64_t> unstable = 0;
     auto chunk = [&](size_t c, size_t begin, size_t end) {
         RowsLaunch part = update;
         part.begin = begin;
         part.end = end;
         part.late = late;
-        if (late) part.aliveMask = pool.alive.column;  // its kills cleared there (Backend::clearsKilled)
+        if (late && info.rowsInMemory)  // its kills listed, for the pool to free them where its rows are
+            part.killList = work.killed[c].killList;
+        else if (late)
+            part.aliveMask = pool.alive.column;  // its kills cleared there (Backend::clearsKilled)
         s.gatherParents(type, info.updateLayout, work.updateTable, updatable, part.begin, part.end, t1);
         RowsResult result = s.backend.run(part);
         if (result.unstable) unstable += result.unstable;

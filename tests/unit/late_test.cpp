@@ -114,6 +114,63 @@ TEST_CASE("kills taken at the end of the step free the rows, in the order, that 
     CHECK(late > 1000);
 }
 
+TEST_CASE("rows kept in the memory: the same objects in the same rows as rows kept on the host") {
+    // Pool::keepRowsInMemory through the memory's own operations (rt::Memory::allocateRows,
+    // releaseRows, identify, markFresh, scatter by a row list), on a backend that answers
+    // at once (kills listed by the run-time) and one that answers late (listed at the end
+    // of the step from what it collects), against the rows kept on the host; the samples,
+    // the programs, a pool at capacity under a rate of 10^6/s, every object killed in one
+    // frame, a burst, triggers.
+    std::vector<std::string> programs = test::samplesAndPrograms();
+    programs.push_back("@capacity(1000) object s { point(origin, white, age); kill when age > 0.3; }\n"
+                       "object e { emit s at 1e6 per second; }\nspawn e;");
+    programs.push_back("object s(k: float) { point(vec3(k, 0, 0), white, 1); kill when age > 1; }\n"
+                       "object e { emit s(rand()) count 5000; kill; }\nspawn e;");
+    programs.push_back("object s { point(vec3(age), white, 1); kill when age > 0.5 * rand(); }\n"
+                       "trigger boom { emit s count 20000; }");
+    size_t inMemory = 0;
+    for (const std::string& text : programs) {
+        INFO(text.substr(0, 200));
+        rt::SystemOptions onHost, kept;
+        onHost.rows = rt::SystemOptions::Rows::OnHost;
+        kept.rows = rt::SystemOptions::Rows::InMemory;
+        kept.drawInStep = false;  // (a type drawn as the step goes keeps its rows on the host)
+        interp::Interpreter hostBackend, keptBackend;
+        LateBackend lateBackend;
+        rt::System a(test::compileModule(text), hostBackend, onHost), b(test::compileModule(text), keptBackend, kept),
+            c(test::compileModule(text), lateBackend, kept);
+        for (size_t t = 0; t < b.typeCount(); ++t) inMemory += b.pool(t).rowsInMemory();
+        for (int f = 0; f < 120; ++f) {
+            if (f % 40 == 10)
+                for (const ir::Trigger& t : a.module().triggers) {
+                    size_t width = 0;
+                    for (auto& p : t.params) width += static_cast<size_t>(p.type.width);
+                    for (rt::System* s : {&a, &b, &c}) REQUIRE_FALSE(s->fire(t.name, std::vector<float>(width, 1.5f)));
+                }
+            for (rt::System* s : {&a, &b, &c}) REQUIRE_FALSE(s->step(1.0 / 60));
+            REQUIRE(test::poolRows(a) == test::poolRows(b));
+            REQUIRE(test::poolRows(a) == test::poolRows(c));
+            for (size_t t = 0; t < a.typeCount(); ++t) {
+                std::vector<rt::RenderPoint> pa = a.points(t), pb = b.points(t), pc = c.points(t);
+                REQUIRE(pa.size() == pb.size());
+                REQUIRE(pa.size() == pc.size());
+                for (size_t i = 0; i < pa.size(); ++i) {
+                    REQUIRE(pa[i].id == pb[i].id);
+                    REQUIRE(pa[i].id == pc[i].id);
+                    REQUIRE(pa[i].position == pb[i].position);
+                }
+                const rt::TypeStats sa = a.stats().types[t], sb = b.stats().types[t], sc = c.stats().types[t];
+                CHECK(sa.live == sb.live);
+                CHECK(sa.live == sc.live);
+                CHECK(sa.killed == sb.killed);
+                CHECK(sa.killed == sc.killed);
+                CHECK(sa.dropped == sb.dropped);
+                CHECK(sa.dropped == sc.dropped);
+            }
+        }
+    }
+    CHECK(inMemory >= 5);  // drops, sparks, the fire's particles, …
+}
 
 namespace {
 

@@ -1,0 +1,243 @@
+// A pool's rows kept on the GPU (rt::Memory::allocateRows): the allocation rule of
+// rt/allocation.h, the release of a late launch's kills, the rows a step created made
+// updatable, and a batch's ids and creation times from its runs — each one dispatch over
+// buffers that stay on the GPU, so that the host keeps only counts (the stack's top, the
+// high-water mark, the live count) and a step's bookkeeping does not grow with its objects.
+// Each shader is the GLSL spelling of the rule rt/memory.cpp writes for the host; the
+// differential tests hold the two to the same rows, ids and generations.
+#include <algorithm>
+#include <cstring>
+#include <initializer_list>
+#include <string>
+
+#include <epoxy/gl.h>
+
+#include "gpu/gl_context.h"
+#include "gpu/gl_memory.h"
+#include "gpu/gl_programs.h"
+#include "gpu/hazards.h"
+
+namespace psys::gpu {
+
+using rt::Buffer;
+
+namespace {
+
+std::string shader(const char* body) {
+    return std::string("#version 450\nlayout(local_size_x = 64) in;\n") + kParamsBlock + "#define INVOCATION " +
+           kInvocationIndex + "\n" + body;
+}
+
+// FreeRows::row(k): stack[top − 1 − k] while the stack lasts, then past the high-water mark.
+const char* kAllocate = R"(
+layout(std430, binding = 0) readonly buffer Stack { uint stack[]; };
+layout(std430, binding = 2) buffer Out { uint rows[]; };
+layout(std430, binding = 3) buffer Updatable { uint updatable[]; };
+layout(std430, binding = 4) buffer Alive { uint alive[]; };
+layout(std430, binding = 6) buffer Counters { uint counters[]; };
+void main() {
+    uint k = INVOCATION, n = param(0u), top = param(1u), highWater = param(2u), at = param(3u);
+    if (k >= n) return;
+    if (k == 0u) counters[0] = top - min(n, top);
+    uint row = k < top ? stack[top - 1u - k] : highWater + (k - top);
+    rows[at + k] = row;
+    updatable[row] = 0u;
+    alive[row] = 1u;
+}
+)";
+
+// The kills' count, then their launch rows; each pushed at top + i. A grid of at most
+// kReleaseGrid invocations strides over them: the host does not know how many there are.
+const char* kRelease = R"(
+layout(std430, binding = 0) readonly buffer Killed { uint killed[]; };
+layout(std430, binding = 1) readonly buffer Map { uint map[]; };
+layout(std430, binding = 2) buffer Stack { uint stack[]; };
+layout(std430, binding = 3) buffer Generation { uint generation[]; };
+layout(std430, binding = 4) buffer Updatable { uint updatable[]; };
+layout(std430, binding = 5) buffer Alive { uint alive[]; };
+layout(std430, binding = 6) readonly buffer Counters { uint counters[]; };
+void main() {
+    uint at = param(1u), base = param(2u), mapFirst = param(3u), mapped = param(4u), grid = param(5u);
+    uint top = counters[0], count = killed[at];
+    for (uint i = INVOCATION; i < count; i += grid) {
+        uint r = killed[at + 1u + i];
+        uint row = mapped != 0u ? map[mapFirst + r] : base + r;
+        stack[top + i] = row;
+        generation[row] += 1u;
+        updatable[row] = 0u;
+        alive[row] = 0u;
+    }
+}
+)";
+
+// After a release: the stack's top moved on by its count.
+const char* kPushed = R"(
+layout(std430, binding = 0) readonly buffer Killed { uint killed[]; };
+layout(std430, binding = 6) buffer Counters { uint counters[]; };
+void main() {
+    if (INVOCATION == 0u) counters[0] += killed[param(1u)];
+}
+)";
+
+const char* kFresh = R"(
+layout(std430, binding = 0) readonly buffer Rows { uint rows[]; };
+layout(std430, binding = 3) buffer Updatable { uint updatable[]; };
+layout(std430, binding = 4) readonly buffer Alive { uint alive[]; };
+void main() {
+    uint i = INVOCATION, first = param(0u), count = param(1u);
+    if (i >= count) return;
+    uint row = rows[first + i];
+    updatable[row] = alive[row];
+}
+)";
+
+// Object r's run: the last whose first object is at or before r (rt::ObjectRuns; a run of
+// no objects shares its first with the next, which wins). Its time rounded as
+// rt::eventTime's: `precise`, no fused multiply-add.
+const char* kIdentify = R"(
+layout(std430, binding = 0) readonly buffer Runs { uint runs[]; };
+layout(std430, binding = 1) buffer Created { uint created[]; };
+layout(std430, binding = 2) buffer Ids { uint ids[]; };
+layout(std430, binding = 3) buffer Mask { uint mask[]; };
+void main() {
+    uint r = INVOCATION, n = param(0u), kept = param(1u), runCount = param(2u), first = param(3u);
+    if (r >= n) return;
+    uint lo = 0u, hi = runCount - 1u;
+    while (lo < hi) {
+        uint mid = (lo + hi + 1u) >> 1u;
+        if (runs[mid * 8u] <= r) lo = mid; else hi = mid - 1u;
+    }
+    uint u = lo * 8u, k = r - runs[u];
+    double firstTime = packDouble2x32(uvec2(runs[u + 4u], runs[u + 5u]));
+    double spacing = packDouble2x32(uvec2(runs[u + 6u], runs[u + 7u]));
+    precise double offset = double(k / runs[u + 3u]) * spacing;
+    precise double t = firstTime + offset;
+    uvec2 words = unpackDouble2x32(t);
+    created[(first + r) * 2u] = words.x;
+    created[(first + r) * 2u + 1u] = words.y;
+    ids[first + r] = runs[u + 2u] + k;
+    mask[first + r] = r < kept ? 1u : 0u;
+}
+)";
+
+constexpr uint32_t kReleaseGrid = 64 * 1024;
+
+}  // namespace
+
+// Where every buffer an operation touches is small and on the host (a pool of a few rows
+// whose launches run on the host side: hostRows), it runs there, as rt::Memory writes it,
+// and the columns stay on the host.
+bool GlMemory::allOnHost(std::initializer_list<Buffer> buffers) const {
+    if (hostRows == 0) return false;
+    return std::all_of(buffers.begin(), buffers.end(), [&](Buffer b) {
+        return !b.valid() || (!onDevice(b) && rows(b) <= hostRows);
+    });
+}
+
+unsigned GlMemory::bound(Buffer b) {
+    unsigned gl = deviceBuffer(b);
+    written(b);
+    return gl;
+}
+
+void GlMemory::allocateRows(const rt::PoolRows& pool, size_t top, size_t highWater, size_t n, Buffer out,
+                            size_t outFirst) {
+    if (n == 0) return;
+    if (allOnHost({pool.stack, pool.generation, pool.updatable, pool.alive, pool.counters, out}))
+        return rt::Memory::allocateRows(pool, top, highWater, n, out, outFirst);
+    flushPending();
+    if (!allocateProgram_) allocateProgram_ = computeProgram(shader(kAllocate), "allocation");
+    PassTimer::Scope timed(timer, "allocation", n);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceBuffer(pool.stack));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, bound(out));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(pool.updatable));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, bound(pool.alive));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, bound(pool.counters));
+    glUseProgram(allocateProgram_);
+    bindParams(paramsBuffer_, {static_cast<uint32_t>(n), static_cast<uint32_t>(top), static_cast<uint32_t>(highWater),
+                               static_cast<uint32_t>(outFirst)});
+    dispatchInvocations(n, 64);
+    ++dispatches;
+    afterWrite(Write::Dispatch, kColumnReaders);
+}
+
+void GlMemory::releaseRows(const rt::PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
+                           size_t mapFirst) {
+    if (allOnHost({pool.stack, pool.generation, pool.updatable, pool.alive, pool.counters, killed, map}))
+        return rt::Memory::releaseRows(pool, killed, killedAt, base, map, mapFirst);
+    flushPending();
+    size_t most = rows(killed) > killedAt ? rows(killed) - killedAt - 1 : 0;
+    if (most == 0) return;
+    if (!releaseProgram_) releaseProgram_ = computeProgram(shader(kRelease), "release");
+    if (!pushedProgram_) pushedProgram_ = computeProgram(shader(kPushed), "release count");
+    auto grid = static_cast<uint32_t>(std::min<size_t>(most, kReleaseGrid));
+    PassTimer::Scope timed(timer, "release", grid);
+    unsigned list = deviceBuffer(killed);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, list);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, map.valid() ? deviceBuffer(map) : list);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, bound(pool.stack));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(pool.generation));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, bound(pool.updatable));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, bound(pool.alive));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, bound(pool.counters));
+    glUseProgram(releaseProgram_);
+    bindParams(paramsBuffer_, {0u, static_cast<uint32_t>(killedAt), base, static_cast<uint32_t>(mapFirst),
+                               map.valid() ? 1u : 0u, grid});
+    dispatchInvocations(grid, 64);
+    afterWrite(Write::Dispatch, kColumnReaders);
+    glUseProgram(pushedProgram_);  // the same bindings and parameters
+    dispatchInvocations(1, 64);
+    dispatches += 2;
+    afterWrite(Write::Dispatch, kColumnReaders);
+}
+
+void GlMemory::markFresh(const rt::PoolRows& pool, Buffer rows, size_t first, size_t count) {
+    if (count == 0) return;
+    if (allOnHost({rows, pool.updatable, pool.alive})) return rt::Memory::markFresh(pool, rows, first, count);
+    flushPending();
+    if (!freshProgram_) freshProgram_ = computeProgram(shader(kFresh), "fresh rows");
+    PassTimer::Scope timed(timer, "fresh", count);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceBuffer(rows));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(pool.updatable));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, deviceBuffer(pool.alive));
+    glUseProgram(freshProgram_);
+    bindParams(paramsBuffer_, {static_cast<uint32_t>(first), static_cast<uint32_t>(count)});
+    dispatchInvocations(count, 64);
+    ++dispatches;
+    afterWrite(Write::Dispatch, kColumnReaders);
+}
+
+void GlMemory::identify(const rt::ObjectRuns& runs, size_t n, size_t kept, Buffer created, Buffer ids, Buffer mask,
+                        size_t first) {
+    if (n == 0) return;
+    if (allOnHost({created, ids, mask})) return rt::Memory::identify(runs, n, kept, created, ids, mask, first);
+    flushPending();
+    if (!identifyProgram_) identifyProgram_ = computeProgram(shader(kIdentify), "identify");
+    std::vector<uint32_t> words(runs.size() * 8);
+    for (size_t u = 0; u < runs.size(); ++u) {
+        uint32_t* w = words.data() + u * 8;
+        w[0] = runs.first[u];
+        w[1] = runs.count[u];
+        w[2] = runs.id[u];
+        w[3] = runs.perEvent[u];
+        std::memcpy(w + 4, &runs.firstTime[u], 8);
+        std::memcpy(w + 6, &runs.spacing[u], 8);
+    }
+    PassTimer::Scope timed(timer, "identify", n);
+    if (!runsBuffer_) glCreateBuffers(1, &runsBuffer_);
+    glNamedBufferData(runsBuffer_, static_cast<GLsizeiptr>(words.size() * 4), words.data(), GL_STREAM_DRAW);
+    afterWrite(Write::Upload, kStorageBlock);
+    transferred += words.size() * 4;
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, runsBuffer_);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, bound(created));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, bound(ids));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(mask));
+    glUseProgram(identifyProgram_);
+    bindParams(paramsBuffer_, {static_cast<uint32_t>(n), static_cast<uint32_t>(kept),
+                               static_cast<uint32_t>(runs.size()), static_cast<uint32_t>(first)});
+    dispatchInvocations(n, 64);
+    ++dispatches;
+    afterWrite(Write::Dispatch, kColumnReaders);
+}
+
+}  // namespace psys::gpu

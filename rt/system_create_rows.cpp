@@ -1,0 +1,125 @@
+// Creating the objects of a type whose pool keeps its rows in the memory
+// (Pool::keepRowsInMemory): the same batch as Creation::createBatch — rows by the
+// allocation rule, ids and creation times from the runs, init, the first update to the
+// step's end — with every per-object step an operation of the memory (rt::Memory::
+// allocateRows, identify, scatter by a row list), so that on a device the host's work is
+// the batch's, not its objects'. Such a type dies late, has no parent, no bursts, no
+// sub-steps and emits nothing: after its first update an object only waits to be freed
+// with the step's late kills (State::releaseInMemory).
+#include "rt/system_create.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+
+#include "rt/rng.h"
+#include "rt/system_support.h"
+
+namespace psys::rt::detail {
+
+void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
+    Pool& pool = s_.pools[type];
+    const TypeInfo& info = s_.types[type];
+    const ir::Object& o = pool.object();
+    const size_t first = b.first;
+    queued_[type] -= n;  // it queues nothing: no room to account for while it is created
+    Buffer rows = pool.scratchRows(n);
+    size_t kept = pool.allocate(n, rows, 0);  // the first `kept` objects: rows[0, kept)
+    s_.typeStats[type].dropped += n - kept;
+    if (kept == 0) {
+        pool.recycle(rows);
+        return;
+    }
+    s_.typeStats[type].created += kept;
+    pool.createdRows(rows, kept);  // updatable from the next step on
+    if (info.init) bindBatch(type, b, b.initLayout, b.initParents, b.initTable, false);
+    bindBatch(type, b, info.updateLayout, b.updateParents, b.updateTable, false);
+    std::vector<Buffer>& table = b.updateTable;
+    ObjectRuns runs;
+    for (size_t u = 0; u < b.runs.size(); ++u) {
+        const Run& run = b.runs[u];
+        runs.first.push_back(static_cast<uint32_t>(b.runFirst[u]));
+        runs.count.push_back(static_cast<uint32_t>(run.count));
+        runs.id.push_back(run.id);
+        runs.perEvent.push_back(static_cast<uint32_t>(std::min<uint64_t>(run.perEvent, UINT32_MAX)));
+        runs.firstTime.push_back(run.firstTime);
+        runs.spacing.push_back(run.spacing);
+    }
+    Memory& memory = s_.memory;
+    Buffer mask = b.columns.at(kMask, Elem::U8, first + n);
+    memory.identify(runs, n, kept, table[ColumnLayout::kCreated], table[ColumnLayout::kIds], mask, first);
+    std::vector<std::pair<Buffer, Buffer>> columns = {{table[ColumnLayout::kCreated], pool.created},
+                                                      {table[ColumnLayout::kIds], pool.ids}};
+    for (size_t p = 0; p < o.params.size(); ++p)
+        if (pool.paramColumn[p] >= 0)
+            for (int c = 0; c < o.params[p].type.width; ++c)
+                columns.push_back({table[static_cast<size_t>(info.updateLayout.paramOffset[p] + c)],
+                                   pool.params.column(static_cast<size_t>(pool.paramColumn[p]), static_cast<size_t>(c))});
+    for (auto [from, to] : columns) memory.scatter(from, first, to, rows, 0, kept);
+    for (size_t s = 0; s < o.state.size(); ++s)
+        for (int c = 0; c < o.state[s].type.width; ++c)
+            memory.clear(table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)], first, n);
+    // Init at each object's creation time with dt 0; then one update to t1, dt each
+    // object's age (Clock::Source::SinceCreated), its kills late.
+    if (info.init) {
+        Buffer zero = b.columns.at(kZero, Elem::F32, first + n);
+        memory.clear(zero, first, n);
+        b.initTable[ColumnLayout::kNow] = b.initTable[ColumnLayout::kCreated];
+        b.initTable[ColumnLayout::kDt] = zero;
+        launchInMemory(type, b, n, *info.init, b.initLayout, b.initTable,
+                       {Clock::Source::PerRow, Clock::Source::PerRow, 0, 0, true}, nullptr);
+    }
+    LateKills late;
+    launchInMemory(type, b, n, *info.update, info.updateLayout, table,
+                   {Clock::Source::Uniform, Clock::Source::SinceCreated, t1, 0, false}, &late);
+    columns.clear();
+    for (size_t s = 0; s < o.state.size(); ++s)
+        for (int c = 0; c < o.state[s].type.width; ++c)
+            columns.push_back({table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)],
+                               pool.state.column(s, static_cast<size_t>(c))});
+    for (auto [from, to] : columns) memory.scatter(from, first, to, rows, 0, kept);
+    late.type = type;
+    late.at = s_.dying.size();
+    late.t1 = t1;
+    late.first = first;
+    late.map = rows;
+    s_.late.push_back(std::move(late));
+}
+
+// A launch over the batch's objects (those kept: its mask), in chunks; `late`: its kills
+// listed, each chunk into a kill list of its own.
+void Creation::launchInMemory(size_t type, Batch& b, size_t n, const ir::Kernel& kernel, const ColumnLayout& layout,
+                              std::vector<Buffer>& table, const Clock& clock, LateKills* late) {
+    const size_t first = b.first, end = first + n;
+    RowsLaunch launch;
+    launch.object = &s_.pools[type].object();
+    launch.kernel = &kernel;
+    launch.layout = &layout;
+    launch.columns = table;
+    launch.mask = b.columns.at(kMask, Elem::U8, end);
+    launch.clock = clock;
+    launch.externs = s_.externs.data();
+    launch.uniformKernel = s_.uniformKernel(type, kernel);
+    launch.seed = s_.options.seed;
+    launch.draw = late ? static_cast<uint32_t>(s_.step) : kCreationDraw;
+    if (late) {
+        size_t per = s_.backend.chunkRows(), chunks = s_.chunkCount(n);
+        late->parts.resize(chunks);
+        for (size_t c = 0; c < chunks; ++c)
+            late->parts[c].killList = s_.pools[type].scratchRows(std::min(per, n - c * per) + 1);
+    }
+    std::atomic<uint64_t> unstable = 0;
+    s_.forChunks(first, end, [&](size_t c, size_t begin, size_t stop) {
+        RowsLaunch part = launch;
+        part.begin = begin;
+        part.end = stop;
+        part.late = late != nullptr;
+        if (late) part.killList = late->parts[c].killList;
+        RowsResult result = s_.backend.run(part);
+        if (result.unstable) unstable += result.unstable;
+        if (late) s_.latePart(late->parts[c], result, table[ColumnLayout::kKill], begin, stop);
+    });
+    s_.typeStats[type].unstable += unstable;
+}
+
+}  // namespace psys::rt::detail
