@@ -72,17 +72,18 @@ void writtenColumns(const ir::Kernel& kernel, const ColumnLayout& l, std::vector
     returned.erase(std::unique(returned.begin(), returned.end()), returned.end());
 }
 
-// The table columns a launch of `kernel` carries to the GPU: what its shader reads (the
-// clock's columns and the creation times are always read), and what it writes where
+// The table columns a launch of `kernel` carries to the GPU: what its shader reads (a
+// per-row clock's columns, the creation times always), and what it writes where
 // rows keep their values (all but the kill flags, written for every row).
-std::vector<bool> neededColumns(const ir::Kernel& kernel, const ColumnLayout& l, bool perRowClock,
-                                const std::vector<int>& resident, const std::vector<int>& returned) {
+std::vector<bool> neededColumns(const ir::Kernel& kernel, const ColumnLayout& l, rt::Clock::Source now,
+                                rt::Clock::Source dt, const std::vector<int>& resident, const std::vector<int>& returned) {
     std::vector<bool> needed(static_cast<size_t>(l.total), false);
     auto mark = [&needed](int first, int width) {
         for (int c = 0; c < width; ++c) needed[static_cast<size_t>(first + c)] = true;
     };
     mark(ColumnLayout::kCreated, 1);
-    if (perRowClock) mark(ColumnLayout::kNow, 2);
+    if (now == rt::Clock::Source::PerRow) mark(ColumnLayout::kNow, 1);
+    if (dt == rt::Clock::Source::PerRow) mark(ColumnLayout::kDt, 1);
     for (const ir::Inst& i : kernel.insts()) {
         switch (i.op) {
             case ir::Op::Param: mark(l.paramOffset[static_cast<size_t>(i.attr)], i.type.width); break;
@@ -196,7 +197,7 @@ GlslBackend::Program& GlslBackend::rowsProgram(const ir::Object& object, const i
         p->direct = codegen_glsl::directColumns(kernel, p->layout);
         p->inPlace.assign(static_cast<size_t>(p->layout.total) + 1, false);
         for (int c : p->direct) p->inPlace[static_cast<size_t>(c)] = true;
-        p->needed = neededColumns(kernel, p->layout, now == rt::Clock::Source::PerRow || dt == rt::Clock::Source::PerRow,
+        p->needed = neededColumns(kernel, p->layout, now, dt,
                                   p->resident, p->returned);  // (a dt since creation: computed, no column)
         p->pass = ir::kernelName(kernel.kind);
         p->counts = kernel.kind == ir::KernelKind::Render ||

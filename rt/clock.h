@@ -6,7 +6,8 @@
 // come from: one value for every row, or a column with a value per row:
 //   a step of existing objects      now = the step's end, dt = its length (both uniform)
 //   objects being created (init)    now = each one's creation time (the created column),
-//                                   dt = 0 (a column of zeros), first = true
+//                                   dt = 0 (uniform), first = true; their exports at
+//                                   creation the same, dt a column of zeros
 //   their first, partial update     now = the step's end, dt = now − created, per row:
 //                                   the row's age at now, computed where the row is
 //                                   (SinceCreated: no column for it)

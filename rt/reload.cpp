@@ -194,7 +194,6 @@ void System::initNewSlots(const ReloadReport& report) {
             if (!fresh.count(i))
                 for (int c = 0; c < o.state[i].type.width; ++c)
                     table[static_cast<size_t>(layout.stateOffset[i] + c)] = scratch.at(next++, Elem::F32, rows);
-        table[ColumnLayout::kDt] = scratch.at(next++, Elem::F32, rows);  // dt 0
         Buffer mask = scratch.at(next++, Elem::U8, rows);
         auto* carried = s.host<uint8_t>(mask);
         for (uint32_t r = 0; r < rows; ++r) carried[r] = pool.status(r) != Status::Free;
@@ -204,7 +203,7 @@ void System::initNewSlots(const ReloadReport& report) {
         launch.layout = &layout;
         launch.columns = table;
         launch.mask = mask;
-        launch.clock = {Clock::Source::PerRow, Clock::Source::PerRow, 0, 0, true};
+        launch.clock = {Clock::Source::PerRow, Clock::Source::Uniform, 0, 0, true};  // as at creation: dt 0
         launch.externs = s.externs.data();
         launch.seed = s.options.seed;
         launch.draw = kCreationDraw;

@@ -227,7 +227,7 @@ void Creation::atCreation(size_t type, Batch& b, size_t n) {
     auto* created = s_.host<double>(table[ColumnLayout::kCreated]);
     Buffer zero = b.columns.at(kZero, Elem::F32, end);
     std::memset(s_.host<float>(zero) + first, 0, n * sizeof(float));
-    auto atCreation = [&](const ir::Kernel& kernel, const ColumnLayout& layout, std::vector<Buffer>& t) {
+    auto atCreation = [&](const ir::Kernel& kernel, const ColumnLayout& layout, std::vector<Buffer>& t, Clock::Source dt) {
         t[ColumnLayout::kNow] = t[ColumnLayout::kCreated];
         t[ColumnLayout::kDt] = zero;
         RowsLaunch launch;
@@ -236,7 +236,7 @@ void Creation::atCreation(size_t type, Batch& b, size_t n) {
         launch.layout = &layout;
         launch.columns = t;
         launch.mask = b.columns.at(kMask, Elem::U8, end);
-        launch.clock = {Clock::Source::PerRow, Clock::Source::PerRow, 0, 0, true};
+        launch.clock = {Clock::Source::PerRow, dt, 0, 0, true};
         launch.externs = s_.externs.data();
         launch.uniformKernel = s_.uniformKernel(type, kernel);
         launch.seed = s_.options.seed;
@@ -244,8 +244,9 @@ void Creation::atCreation(size_t type, Batch& b, size_t n) {
         s_.gatherParents(type, layout, t, mask, first, end, 0, created, b.poolRows.data(), first);
         runBatch(launch, first, end, type);
     };
-    if (info.init) atCreation(*info.init, b.initLayout, b.initTable);
-    if (info.exports) atCreation(*info.exports, info.exportsLayout, b.exportsTable);
+    // (init at a uniform dt of 0; the exports at the clock of their other per-row launches)
+    if (info.init) atCreation(*info.init, b.initLayout, b.initTable, Clock::Source::Uniform);
+    if (info.exports) atCreation(*info.exports, info.exportsLayout, b.exportsTable, Clock::Source::PerRow);
     if (info.bursts)  // bursts read the state at creation, after the first update changed it
         for (size_t s = 0; s < o.state.size(); ++s)
             for (int c = 0; c < o.state[s].type.width; ++c) {

@@ -62,12 +62,9 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     // Init at each object's creation time with dt 0; then one update to t1, dt each
     // object's age (Clock::Source::SinceCreated), its kills late.
     if (info.init) {
-        Buffer zero = b.columns.at(kZero, Elem::F32, first + n);
-        memory.clear(zero, first, n);
         b.initTable[ColumnLayout::kNow] = b.initTable[ColumnLayout::kCreated];
-        b.initTable[ColumnLayout::kDt] = zero;
         launchInMemory(type, b, n, *info.init, b.initLayout, b.initTable,
-                       {Clock::Source::PerRow, Clock::Source::PerRow, 0, 0, true}, nullptr);
+                       {Clock::Source::PerRow, Clock::Source::Uniform, 0, 0, true}, nullptr);
     }
     LateKills late;
     launchInMemory(type, b, n, *info.update, info.updateLayout, table,

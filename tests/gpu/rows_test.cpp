@@ -1,0 +1,181 @@
+// A pool's rows kept on the GPU (rt::Pool::keepRowsInMemory): the memory's row operations
+// on the GPU against the same operations on the host (the allocation rule, the release of a
+// kill list, the fresh rows, ids and creation times from runs, written once for the host in
+// rt/memory.cpp and once in GLSL in gpu/gl_rows.cpp), and what a step of a pool kept there
+// moves between the host and the GPU as its objects grow.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "gpu_support.h"
+#include "rt/memory.h"
+
+using namespace psys;
+using psys::test::gpuBackend;
+using psys::test::readFile;
+
+namespace {
+
+// A pool's rows on one memory: the buffers the operations change, and the host's counts.
+struct Rows {
+    rt::Memory& memory;
+    rt::PoolRows rows;
+    rt::Buffer out, killed, map;
+    explicit Rows(rt::Memory& m, size_t n) : memory(m) {
+        rows = {m.create(rt::Elem::U32, n), m.create(rt::Elem::U32, n), m.create(rt::Elem::U8, n),
+                m.create(rt::Elem::U8, n), m.create(rt::Elem::U32, 1)};
+        out = m.create(rt::Elem::U32, n);
+        killed = m.create(rt::Elem::U32, n + 1);
+        map = m.create(rt::Elem::U32, n);
+    }
+    template <typename T>
+    std::vector<T> read(rt::Buffer b, size_t n) const {
+        std::vector<T> v(n);
+        memory.read(b, 0, n, v.data());
+        return v;
+    }
+};
+
+}  // namespace
+
+TEST_CASE("the memory's row operations compute on the GPU what they compute on the host") {
+    // Batches allocated from the stack and past the high-water mark, kill lists released
+    // through a batch's row list and at a base, the fresh rows marked: the stacks,
+    // generations, masks and row lists of the two memories agree after every operation.
+    auto gpu = gpuBackend();
+    rt::HostMemory hostMemory;
+    constexpr size_t kRows = 5000;
+    Rows host(hostMemory, kRows), device(gpu->memory(), kRows);
+    std::mt19937 random(7);
+    size_t top = 0, highWater = 0, live = 0;
+    std::vector<uint32_t> alive;  // the rows alive, host side
+    for (int round = 0; round < 60; ++round) {
+        INFO("round " << round);
+        // A batch of n objects: rows by the allocation rule.
+        size_t room = top + (kRows - highWater);
+        size_t n = std::min<size_t>(room, random() % 400);
+        for (Rows* r : {&host, &device}) r->memory.allocateRows(r->rows, top, highWater, n, r->out, 0);
+        std::vector<uint32_t> batch = host.read<uint32_t>(host.out, n);
+        REQUIRE(batch == device.read<uint32_t>(device.out, n));
+        size_t fromStack = std::min(n, top);
+        highWater += n - fromStack;
+        top -= fromStack;
+        live += n;
+        alive.insert(alive.end(), batch.begin(), batch.end());
+        // Some die: a kill list of launch rows over a batch's row list, or at a base.
+        std::vector<uint32_t> list{0};
+        bool mapped = round % 2 == 1 && n > 0;
+        if (mapped) {
+            for (Rows* r : {&host, &device}) r->memory.write(r->map, 0, n, batch.data());
+            for (uint32_t k = 0; k < n; ++k)
+                if (random() % 3 == 0) list.push_back(k);
+        } else {
+            std::shuffle(alive.begin(), alive.end(), random);
+            std::vector<uint32_t> dying(alive.begin(), alive.begin() + static_cast<std::ptrdiff_t>(alive.size() / 4));
+            std::sort(dying.begin(), dying.end());
+            for (uint32_t row : dying) list.push_back(row - 3);  // launch rows from a base of 3
+        }
+        list[0] = static_cast<uint32_t>(list.size() - 1);
+        for (Rows* r : {&host, &device}) {
+            r->memory.write(r->killed, 0, list.size(), list.data());
+            r->memory.releaseRows(r->rows, r->killed, 0, 3, mapped ? r->map : rt::Buffer{}, 0);
+        }
+        std::vector<uint32_t> freed;
+        for (size_t i = 1; i < list.size(); ++i) freed.push_back(mapped ? batch[list[i]] : list[i] + 3);
+        std::erase_if(alive, [&](uint32_t row) { return std::find(freed.begin(), freed.end(), row) != freed.end(); });
+        top += freed.size();
+        live -= freed.size();
+        // The batch's survivors become updatable.
+        if (round % 3 == 0) {
+            for (Rows* r : {&host, &device}) {
+                r->memory.write(r->map, 0, n, batch.data());
+                r->memory.markFresh(r->rows, r->map, 0, n);
+            }
+        }
+        REQUIRE(host.read<uint32_t>(host.rows.counters, 1) == device.read<uint32_t>(device.rows.counters, 1));
+        REQUIRE(host.read<uint32_t>(host.rows.counters, 1)[0] == top);
+        REQUIRE(host.read<uint32_t>(host.rows.stack, top) == device.read<uint32_t>(device.rows.stack, top));
+        REQUIRE(host.read<uint32_t>(host.rows.generation, highWater) ==
+                device.read<uint32_t>(device.rows.generation, highWater));
+        REQUIRE(host.read<uint8_t>(host.rows.alive, highWater) == device.read<uint8_t>(device.rows.alive, highWater));
+        REQUIRE(host.read<uint8_t>(host.rows.updatable, highWater) ==
+                device.read<uint8_t>(device.rows.updatable, highWater));
+        auto aliveMask = host.read<uint8_t>(host.rows.alive, highWater);
+        REQUIRE(static_cast<size_t>(std::count(aliveMask.begin(), aliveMask.end(), 1)) == live);
+    }
+    CHECK(highWater > 1000);
+    CHECK(top > 100);
+}
+
+TEST_CASE("ids and creation times from a batch's runs: the same bits on the GPU as on the host") {
+    // Runs of one object, of many at once, of events apart (perEvent objects each), one of
+    // none; times that round differently if a product and a sum were fused.
+    auto gpu = gpuBackend();
+    rt::HostMemory hostMemory;
+    rt::ObjectRuns runs;
+    auto add = [&](uint32_t count, uint32_t id, uint32_t perEvent, double firstTime, double spacing) {
+        runs.first.push_back(runs.first.empty() ? 0 : runs.first.back() + runs.count.back());
+        runs.count.push_back(count);
+        runs.id.push_back(id);
+        runs.perEvent.push_back(perEvent);
+        runs.firstTime.push_back(firstTime);
+        runs.spacing.push_back(spacing);
+    };
+    add(1, 10, 1, 0.1, 0);
+    add(700, 11, 1, 1.0 / 3, 1.0 / 7000);
+    add(0, 711, 1, 2, 1);
+    add(300, 711, 7, 12345.678, 0.1 / 3);
+    add(50, 1011, 50, 1e7 + 1.0 / 3, 0);
+    size_t n = runs.first.back() + runs.count.back(), kept = n - 20, first = 5;
+    std::vector<double> created[2];
+    std::vector<uint32_t> ids[2];
+    std::vector<uint8_t> mask[2];
+    int which = 0;
+    for (rt::Memory* m : {static_cast<rt::Memory*>(&hostMemory), &gpu->memory()}) {
+        rt::Buffer c = m->create(rt::Elem::F64, first + n), i = m->create(rt::Elem::U32, first + n),
+                   k = m->create(rt::Elem::U8, first + n);
+        m->identify(runs, n, kept, c, i, k, first);
+        created[which].resize(n);
+        ids[which].resize(n);
+        mask[which].resize(n);
+        m->read(c, first, n, created[which].data());
+        m->read(i, first, n, ids[which].data());
+        m->read(k, first, n, mask[which].data());
+        ++which;
+    }
+    CHECK(std::memcmp(created[0].data(), created[1].data(), n * sizeof(double)) == 0);
+    CHECK(ids[0] == ids[1]);
+    CHECK(mask[0] == mask[1]);
+    CHECK(ids[0][1] == 11);
+    CHECK(ids[0][n - 1] == 1011 + 49);
+    CHECK(created[0][701 + 14] == rt::eventTime(12345.678, 14, 7, 0.1 / 3));
+    CHECK(mask[0][kept - 1] == 1);
+    CHECK(mask[0][kept] == 0);
+}
+
+TEST_CASE("a pool of objects that only die keeps its rows on the GPU: what a step moves does not grow with them") {
+    // The fountain at 2,000 and at 20,000 drops: the drops' rows — the free stack, the
+    // generations, the masks — are on the GPU, and their rows, ids and creation times are
+    // computed there; a step moves the same few hundred bytes between host and GPU (the
+    // runs of the step's emissions, the counts of the kills) however many drops there are.
+    auto perStep = [](float population) {
+        auto gpu = gpuBackend();
+        rt::System system(test::compileModule(readFile(test::sample("fountain"))), *gpu);
+        REQUIRE_FALSE(system.setExtern("population", std::vector<float>{population}));
+        for (int f = 0; f < 200; ++f) REQUIRE_FALSE(system.step(1.0 / 60));  // the pool full: drops die
+        const rt::Pool& drops = system.pool(static_cast<size_t>(system.typeIndex("drop")));
+        CHECK(drops.rowsInMemory());
+        CHECK(drops.live() > population * 0.9);
+        uint64_t before = gpu->transferredBytes(), waits = gpu->waits();
+        for (int f = 0; f < 20; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
+        CHECK(gpu->waits() == waits);
+        return static_cast<double>(gpu->transferredBytes() - before) / 20;
+    };
+    double small = perStep(2000), large = perStep(20000);
+    MESSAGE("bytes between host and GPU a step: " << small << " with 2,000 drops, " << large << " with 20,000");
+    CHECK(large <= 1.1 * small + 8);
+    CHECK(large < 1024);
+}
