@@ -50,20 +50,35 @@ std::string describe(const Schedule& s, const Phase& p) {
             std::string also;
             if (p.exports) also += ", the survivors' exports";
             if (p.render) also += ", the render when the host draws every step";
-            std::string listed = p.late || p.listed ? ", its kills listed" : "";
+            std::string listed = p.inMemory ? ", its kills listed in the memory"
+                                 : p.late || p.listed ? ", its kills listed" : "";
             return fmt::format("{}: the update kernel over the pool{}{}", type, also, listed);
         }
         case PhaseKind::Kills:
+            if (p.inMemory) return fmt::format("{}: the kill lists kept for the step's end, where the memory frees them", type);
             return p.late ? fmt::format("{}: the listed kills kept for the step's end (nobody looks at them before)", type)
                           : fmt::format("{}: the killed rows frozen, in row order", type);
         case PhaseKind::Emissions:
             return fmt::format("{}: rate emissions of the survivors ({}): events, times, ids, the queue", type,
                                names(s, p.targets));
-        case PhaseKind::Create:
+        case PhaseKind::Create: {
+            std::vector<int> kept;
+            for (int t : p.targets)
+                if (static_cast<size_t>(t) < s.inMemory.size() && s.inMemory[static_cast<size_t>(t)]) kept.push_back(t);
+            std::string memory = kept.empty() ? "" : fmt::format(" ({}: rows, ids and creation times by the memory's "
+                                                                 "operations)", names(s, kept));
             return fmt::format("what {} queued ({}) and what that queues: rows, init, bursts, the first update, its kills "
-                               "and emissions",
-                               type, names(s, p.targets));
-        case PhaseKind::Release: return "late kills taken in their place; the dead nobody reads freed onto the free stack";
+                               "and emissions{}",
+                               type, names(s, p.targets), memory);
+        }
+        case PhaseKind::Release: {
+            std::vector<int> kept;
+            for (size_t t = 0; t < s.inMemory.size(); ++t)
+                if (s.inMemory[t]) kept.push_back(static_cast<int>(t));
+            std::string memory = kept.empty() ? "" : fmt::format("; {}: the kill lists freed in the memory, counted "
+                                                                 "when the backend's counts come", names(s, kept));
+            return "late kills taken in their place; the dead nobody reads freed onto the free stack" + memory;
+        }
     }
     return "";
 }
@@ -91,6 +106,7 @@ namespace detail {
 Schedule stepSchedule(const State& s) {
     Schedule out;
     for (const ir::Object& o : s.module.objects) out.types.push_back(o.name);
+    for (const TypeInfo& info : s.types) out.inMemory.push_back(info.rowsInMemory);
     auto add = [&](PhaseKind kind, int type, Parallelism parallelism) -> Phase& {
         Phase& p = out.phases.emplace_back();
         p.kind = kind;
@@ -111,10 +127,12 @@ Schedule stepSchedule(const State& s) {
         update.listed = listed;
         update.exports = info.exports != nullptr;
         update.render = info.render != nullptr && info.drawn[0];
+        update.inMemory = info.rowsInMemory;
         if (info.kills || info.late) {
             Phase& kills = add(PhaseKind::Kills, type, Parallelism::Ordered);
             kills.late = info.late;
             kills.listed = listed;
+            kills.inMemory = info.rowsInMemory;
         }
         std::vector<int> rated, targets;
         for (size_t site = 0; site < info.emitTarget.size(); ++site) {

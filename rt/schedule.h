@@ -40,12 +40,14 @@ struct Phase {
     bool listed = false;        // Kills: the update's chunks listed the killed rows (no scan of flags)
     bool exports = false;       // Update: the survivors' exports in the same chunk
     bool render = false;        // Update: the render in the same chunk, when the host draws every step
+    bool inMemory = false;      // Update, Kills: the type's rows are in the memory (Pool::keepRowsInMemory)
     std::vector<int> targets;   // Emissions, Create: the types created
     Parallelism parallelism = Parallelism::Host;
 };
 
 struct Schedule {
     std::vector<std::string> types;  // the object types' names, by index
+    std::vector<bool> inMemory;      // by index: the type's rows are in the memory
     std::vector<Phase> phases;
 };
 

@@ -77,6 +77,28 @@ TEST_CASE("under @step a type's update, kills and emissions repeat per sub-step 
     CHECK(run.stats("ball").live == 1);
 }
 
+TEST_CASE("the schedule says which types keep their rows in the memory, and where they are freed") {
+    // The fountain's drops only die: with their rows in the memory, their kills are listed
+    // there and freed there at the step's end; the fountain itself keeps its rows on the host.
+    std::string text = test::readFile(std::string(PSYS_SAMPLES_DIR) + "/fountain.psys");
+    rt::SystemOptions options;
+    options.rows = rt::SystemOptions::Rows::InMemory;
+    options.drawInStep = false;
+    interp::Interpreter backend, other;
+    rt::System kept(test::compileModule(text), backend, options), plain(test::compileModule(text), other);
+    const rt::Schedule& s = kept.schedule();
+    REQUIRE(s.inMemory.size() == 2);
+    CHECK(s.inMemory[static_cast<size_t>(kept.typeIndex("drop"))]);
+    CHECK_FALSE(s.inMemory[static_cast<size_t>(kept.typeIndex("fountain"))]);
+    CHECK(kept.pool(static_cast<size_t>(kept.typeIndex("drop"))).rowsInMemory());
+    std::string printed = rt::printSchedule(s);
+    CHECK(printed.find("its kills listed in the memory") != std::string::npos);
+    CHECK(printed.find("drop: the kill lists kept for the step's end, where the memory frees them") != std::string::npos);
+    CHECK(printed.find("(drop: rows, ids and creation times by the memory's operations)") != std::string::npos);
+    CHECK(printed.find("drop: the kill lists freed in the memory") != std::string::npos);
+    CHECK(rt::printSchedule(plain.schedule()).find("memory") == std::string::npos);  // the interpreter's own choice: the host
+}
+
 namespace {
 
 // The clocks of the update launches over creation batches (their clock is per row).
