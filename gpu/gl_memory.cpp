@@ -159,7 +159,9 @@ void GlMemory::resize(Buffer b, size_t rows) {
             c.zeroFrom = std::max(c.zeroFrom, rows);
         }
     }
-    c.hostCopy.resize(rows * rt::elemSize(c.elem), 0);
+    // A column on the GPU keeps no host copy of its rows' size: toHost makes one when asked
+    // (a pool that grows step after step would otherwise zero-fill host pages for nothing).
+    if (!c.device) c.hostCopy.resize(rows * rt::elemSize(c.elem), 0);
     c.rows = rows;
 }
 
@@ -189,6 +191,7 @@ void GlMemory::toHost(Column& c) const {
     if (!words.empty()) glGetNamedBufferSubData(c.gl, 0, static_cast<GLsizeiptr>(words.size() * 4), words.data());
     transferred += words.size() * 4;
     waits += !words.empty();
+    c.hostCopy.resize(c.rows * rt::elemSize(c.elem));
     fromWords(words.data(), c.elem, c.rows, c.hostCopy.data());
     c.device = false;
 }

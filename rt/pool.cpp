@@ -253,15 +253,20 @@ void Pool::released(size_t count) {
 
 void Pool::createdRows(Buffer rows, size_t count) { freshRows_.push_back({rows, count}); }
 
+// The smallest spare buffer that holds `n` rows, else the largest, grown: a step's kill
+// list of the whole pool and a batch's few rows do not trade buffers, so that none grows
+// step after step.
 Buffer Pool::scratchRows(size_t n) {
-    Buffer b;
-    if (spare_.empty()) {
-        b = memory_->create(Elem::U32, n);
-    } else {
-        b = spare_.back();
-        spare_.pop_back();
-        if (memory_->rows(b) < n) memory_->resize(b, n);
+    if (spare_.empty()) return memory_->create(Elem::U32, n);
+    size_t best = 0;
+    for (size_t i = 1; i < spare_.size(); ++i) {
+        size_t rows = memory_->rows(spare_[i]), bestRows = memory_->rows(spare_[best]);
+        bool fits = rows >= n, bestFits = bestRows >= n;
+        if (fits != bestFits ? fits : (fits ? rows < bestRows : rows > bestRows)) best = i;
     }
+    Buffer b = spare_[best];
+    spare_.erase(spare_.begin() + static_cast<std::ptrdiff_t>(best));
+    if (memory_->rows(b) < n) memory_->resize(b, n);
     return b;
 }
 
