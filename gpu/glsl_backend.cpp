@@ -412,8 +412,12 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
     std::vector<Slot> slots;
     std::vector<uint32_t> block = blockHeader(p.block, n, launch.clock, launch.seed, launch.draw);
     size_t words = n;  // the zeros first
+    bool zeros = false;  // some column reads them (else they are not written: n words a launch)
     auto place = [&](Buffer b) -> size_t {
-        if (!b.valid()) return 0;
+        if (!b.valid()) {
+            zeros = true;
+            return 0;
+        }
         for (const Slot& s : slots)
             if (s.buffer == b) return s.word;
         slots.push_back({b, words});
@@ -438,8 +442,11 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
     // Columns on the GPU are copied there; the others come from the host.
     std::optional<PassTimer::Scope> staging(std::in_place, &timer_, "staging", n);
     uint32_t zero = 0;
-    glClearNamedBufferSubData(words_, GL_R32UI, 0, static_cast<GLsizeiptr>(n * 4), GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
-    afterWrite(Write::Clear, kStorageBlock);
+    if (zeros) {
+        glClearNamedBufferSubData(words_, GL_R32UI, 0, static_cast<GLsizeiptr>(n * 4), GL_RED_INTEGER, GL_UNSIGNED_INT,
+                                  &zero);
+        afterWrite(Write::Clear, kStorageBlock);
+    }
     for (const Slot& s : slots) {
         Elem e = memory_.elem(s.buffer);
         size_t w = GlMemory::wordsPerRow(e);
