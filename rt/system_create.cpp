@@ -202,17 +202,26 @@ void Creation::identify(size_t type, Batch& b, size_t n) {
             s_.pools[static_cast<size_t>(info.parentType)].readers[run.parent.row] += static_cast<uint32_t>(kept);
         }
     // Into the pool rows through the memory (the pool's columns may live on a device).
+    s_.scatter(identityColumns(type, table), first, b.poolRows);
+    for (size_t s = 0; s < o.state.size(); ++s)
+        for (int c = 0; c < o.state[s].type.width; ++c)
+            s_.memory.clear(table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)], first, n);
+}
+
+// A batch's columns that identify its objects in their pool rows — creation times, ids,
+// kept parameters — each with the pool's column it goes to.
+std::vector<std::pair<Buffer, Buffer>> Creation::identityColumns(size_t type, const std::vector<Buffer>& table) const {
+    const Pool& pool = s_.pools[type];
+    const ir::Object& o = pool.object();
+    const ColumnLayout& layout = s_.types[type].updateLayout;
     std::vector<std::pair<Buffer, Buffer>> columns = {{table[ColumnLayout::kCreated], pool.created},
                                                       {table[ColumnLayout::kIds], pool.ids}};
     for (size_t p = 0; p < o.params.size(); ++p)
         if (pool.paramColumn[p] >= 0)
             for (int c = 0; c < o.params[p].type.width; ++c)
-                columns.push_back({table[static_cast<size_t>(info.updateLayout.paramOffset[p] + c)],
+                columns.push_back({table[static_cast<size_t>(layout.paramOffset[p] + c)],
                                    pool.params.column(static_cast<size_t>(pool.paramColumn[p]), static_cast<size_t>(c))});
-    s_.scatter(columns, first, b.poolRows);
-    for (size_t s = 0; s < o.state.size(); ++s)
-        for (int c = 0; c < o.state[s].type.width; ++c)
-            s_.memory.clear(table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)], first, n);
+    return columns;
 }
 
 // At creation: init (the state, the bursts' sizes) and the exports, at each object's

@@ -79,6 +79,7 @@ private:
     void launchInMemory(size_t type, Batch& b, size_t n, const ir::Kernel& kernel, const ColumnLayout& layout,
                         std::vector<Buffer>& table, const Clock& clock, LateKills* late);
     void identify(size_t type, Batch& b, size_t n);
+    std::vector<std::pair<Buffer, Buffer>> identityColumns(size_t type, const std::vector<Buffer>& table) const;
     void atCreation(size_t type, Batch& b, size_t n);
     // Counts the updates beyond the stability limit in `type`'s stats.
     // `late`: its kills taken at the end of the step, or later (LateKills), listed there.

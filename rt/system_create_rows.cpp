@@ -48,13 +48,7 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     Memory& memory = s_.memory;
     Buffer mask = b.columns.at(kMask, Elem::U8, first + n);
     memory.identify(runs, n, kept, table[ColumnLayout::kCreated], table[ColumnLayout::kIds], mask, first);
-    std::vector<std::pair<Buffer, Buffer>> columns = {{table[ColumnLayout::kCreated], pool.created},
-                                                      {table[ColumnLayout::kIds], pool.ids}};
-    for (size_t p = 0; p < o.params.size(); ++p)
-        if (pool.paramColumn[p] >= 0)
-            for (int c = 0; c < o.params[p].type.width; ++c)
-                columns.push_back({table[static_cast<size_t>(info.updateLayout.paramOffset[p] + c)],
-                                   pool.params.column(static_cast<size_t>(pool.paramColumn[p]), static_cast<size_t>(c))});
+    std::vector<std::pair<Buffer, Buffer>> columns = identityColumns(type, table);
     for (auto [from, to] : columns) memory.scatter(from, first, to, rows, 0, kept);
     for (size_t s = 0; s < o.state.size(); ++s)
         for (int c = 0; c < o.state[s].type.width; ++c)

@@ -54,6 +54,21 @@ struct LateBackend : rt::Backend {
     }
 };
 
+// Three systems hold the same objects in the same rows, drawn with the same ids in the same order.
+void sameObjects(rt::System& a, rt::System& b, rt::System& c) {
+    REQUIRE(test::poolRows(a) == test::poolRows(b));
+    REQUIRE(test::poolRows(a) == test::poolRows(c));
+    for (size_t t = 0; t < a.typeCount(); ++t) {
+        std::vector<rt::RenderPoint> pa = a.points(t), pb = b.points(t), pc = c.points(t);
+        REQUIRE(pa.size() == pb.size());
+        REQUIRE(pa.size() == pc.size());
+        for (size_t i = 0; i < pa.size(); ++i) {
+            REQUIRE(pa[i].id == pb[i].id);
+            REQUIRE(pa[i].id == pc[i].id);
+        }
+    }
+}
+
 }  // namespace
 
 TEST_CASE("kills taken at the end of the step free the rows, in the order, that kills taken at once free") {
@@ -94,16 +109,8 @@ TEST_CASE("kills taken at the end of the step free the rows, in the order, that 
             REQUIRE_FALSE(a.step(1.0 / 60));
             REQUIRE_FALSE(b.step(1.0 / 60));
             REQUIRE_FALSE(c.step(1.0 / 60));
-            REQUIRE(test::poolRows(a) == test::poolRows(b));
-            REQUIRE(test::poolRows(a) == test::poolRows(c));
-            for (size_t t = 0; t < a.typeCount(); ++t) {  // drawn every step (a and c as the step goes)
-                std::vector<rt::RenderPoint> pa = a.points(t), pb = b.points(t), pc = c.points(t);
-                REQUIRE(pa.size() == pb.size());
-                REQUIRE(pa.size() == pc.size());
-                for (size_t i = 0; i < pa.size(); ++i) {
-                    REQUIRE(pa[i].id == pb[i].id);
-                    REQUIRE(pa[i].id == pc[i].id);
-                }
+            sameObjects(a, b, c);  // drawn every step (a and c as the step goes)
+            for (size_t t = 0; t < a.typeCount(); ++t) {
                 CHECK(a.stats().types[t].killed == b.stats().types[t].killed);
                 CHECK(a.stats().types[t].unstable == b.stats().types[t].unstable);
             }
@@ -148,17 +155,10 @@ TEST_CASE("rows kept in the memory: the same objects in the same rows as rows ke
                     for (rt::System* s : {&a, &b, &c}) REQUIRE_FALSE(s->fire(t.name, std::vector<float>(width, 1.5f)));
                 }
             for (rt::System* s : {&a, &b, &c}) REQUIRE_FALSE(s->step(1.0 / 60));
-            REQUIRE(test::poolRows(a) == test::poolRows(b));
-            REQUIRE(test::poolRows(a) == test::poolRows(c));
+            sameObjects(a, b, c);
             for (size_t t = 0; t < a.typeCount(); ++t) {
-                std::vector<rt::RenderPoint> pa = a.points(t), pb = b.points(t), pc = c.points(t);
-                REQUIRE(pa.size() == pb.size());
-                REQUIRE(pa.size() == pc.size());
-                for (size_t i = 0; i < pa.size(); ++i) {
-                    REQUIRE(pa[i].id == pb[i].id);
-                    REQUIRE(pa[i].id == pc[i].id);
-                    REQUIRE(pa[i].position == pb[i].position);
-                }
+                std::vector<rt::RenderPoint> pa = a.points(t), pb = b.points(t);
+                for (size_t i = 0; i < pa.size(); ++i) REQUIRE(pa[i].position == pb[i].position);
                 const rt::TypeStats sa = a.stats().types[t], sb = b.stats().types[t], sc = c.stats().types[t];
                 CHECK(sa.live == sb.live);
                 CHECK(sa.live == sc.live);
