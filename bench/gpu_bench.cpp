@@ -33,6 +33,11 @@ int main(int argc, char** argv) {
     size_t hostRows = gpu::GlslBackend::kHostRows;
     app.add_option("--host-rows", hostRows,
                    "Launches over at most this many rows run on the host when their columns are there (64; 0: none)");
+    std::string rowsIn = "gpu";
+    app.add_option("--rows", rowsIn,
+                   "Where the pools of objects that only die keep their rows: gpu (their bookkeeping dispatches), or "
+                   "host (to compare)")
+        ->check(CLI::IsMember({"gpu", "host"}));
     std::string json;
     app.add_option("--json", json, "Also write the figures as JSON, a list of rows (bench/README.md names the fields)");
     bool stress = false;
@@ -59,7 +64,9 @@ int main(int argc, char** argv) {
             return 2;
         }
         for (double particles : sizes) {
-            bench::GpuFigures f = bench::measureGpu(*effect, particles, frames, *gpu);
+            bench::GpuFigures f = bench::measureGpu(*effect, particles, frames, *gpu,
+                                                    rowsIn == "host" ? rt::SystemOptions::Rows::OnHost
+                                                                     : rt::SystemOptions::Rows::AsBackend);
             std::string others;
             for (const auto& [pass, ms] : f.passMilliseconds)
                 if (pass != "update")
@@ -76,7 +83,7 @@ int main(int argc, char** argv) {
                             {"mups", f.perSecond / 1e6}, {"update_ms", f.updateMilliseconds},
                             {"update_gbs", gbs}, {"state_bytes", f.stateBytes}, {"transfer_bytes", f.transferBytes},
                             {"staged_bytes", f.stagedBytes}, {"waits", f.waits}, {"late_reads", f.lateReads},
-                            {"late_stalls", f.lateStalls}, {"renderer", renderer}});
+                            {"late_stalls", f.lateStalls}, {"rows", rowsIn}, {"renderer", renderer}});
             std::cout << fmt::format("| {} | {:.2g} | {:.2f} | {:.2f} | {:.1f} | {:.2f}{} | {} | {:.0f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} ({:.1f}) |\n", name,
                                      f.live, f.stepSeconds * 1e3, f.hostCpuSeconds * 1e3, f.perSecond / 1e6, f.updateMilliseconds,
                                      f.wallPasses ? " (wall)" : "", others,

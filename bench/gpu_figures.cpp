@@ -21,9 +21,11 @@ std::unique_ptr<gpu::GlslBackend> gpuBackend(const char* who, size_t hostRows) {
     return gpu;
 }
 
-GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::GlslBackend& gpu) {
+GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::GlslBackend& gpu,
+                      rt::SystemOptions::Rows rows) {
     double knob = calibrate(effect, gpu, particles);
     rt::SystemOptions options;
+    options.rows = rows;
     options.capacity = static_cast<size_t>(particles * 1.5) + 1024;
     rt::System system(compileEffect(effect.name), gpu, options);
     float value = static_cast<float>(knob);

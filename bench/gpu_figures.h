@@ -8,6 +8,7 @@
 
 #include "effects.h"
 #include "gpu/glsl_backend.h"
+#include "rt/system.h"
 
 namespace psys::bench {
 
@@ -34,6 +35,8 @@ struct GpuFigures {
 std::unique_ptr<gpu::GlslBackend> gpuBackend(const char* who, size_t hostRows = gpu::GlslBackend::kHostRows);
 
 // Runs `effect` to its steady population of about `particles` on `gpu`, then times `frames` steps.
-GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::GlslBackend& gpu);
+// `rows`: where the pools of objects that only die keep their rows (rt::SystemOptions::rows).
+GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::GlslBackend& gpu,
+                      rt::SystemOptions::Rows rows = rt::SystemOptions::Rows::AsBackend);
 
 }  // namespace psys::bench
