@@ -88,8 +88,11 @@ rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program
         // takes the kills, and sends them again: the same 0).
         std::optional<Compactor::Clear> clear;
         if (launch.aliveMask.valid()) {
-            bool mapped = !launch.aliveRows.empty();
-            clear = Compactor::Clear{memory_.deviceBuffer(launch.aliveMask), mapped ? memory_.rowList(launch.aliveRows) : 0u,
+            bool mapped = !launch.aliveRows.empty() || launch.aliveRowsBuffer.valid();
+            unsigned rows = launch.aliveRowsBuffer.valid() ? memory_.deviceBuffer(launch.aliveRowsBuffer)
+                            : mapped                        ? memory_.rowList(launch.aliveRows)
+                                                            : 0u;
+            clear = Compactor::Clear{memory_.deviceBuffer(launch.aliveMask), rows,
                                      static_cast<uint32_t>(begin),
                                      static_cast<uint32_t>(mapped ? begin - launch.aliveRowsFirst : 0)};
         }

@@ -51,6 +51,7 @@ struct RowsLaunch {
     Buffer aliveMask;
     std::span<const uint32_t> aliveRows;
     size_t aliveRowsFirst = 0;
+    Buffer aliveRowsBuffer;  // or those rows in a u32 buffer of the memory (a batch's rows kept there)
     // A late launch over a pool whose rows are in the memory (Pool::keepRowsInMemory): a
     // u32 buffer of end − begin + 1 rows for its kills — their count, then their rows less
     // `begin` — which the pool frees there (rt::Memory::releaseRows). A backend that lists

@@ -52,6 +52,18 @@ void Memory::releaseRows(const PoolRows& pool, Buffer killed, size_t killedAt, u
     top += count;
 }
 
+void Memory::clearRows(const PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
+                       size_t mapFirst) {
+    const auto* list = static_cast<const uint32_t*>(view(killed)) + killedAt;
+    const auto* rows = map.valid() ? static_cast<const uint32_t*>(view(map)) + mapFirst : nullptr;
+    auto* updatable = static_cast<uint8_t*>(host(pool.updatable));
+    auto* alive = static_cast<uint8_t*>(host(pool.alive));
+    for (uint32_t i = 0; i < list[0]; ++i) {
+        uint32_t r = list[1 + i], row = rows ? rows[r] : base + r;
+        updatable[row] = alive[row] = 0;
+    }
+}
+
 void Memory::markFresh(const PoolRows& pool, Buffer rows, size_t first, size_t count) {
     if (count == 0) return;
     const auto* list = static_cast<const uint32_t*>(view(rows)) + first;

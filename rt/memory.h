@@ -106,6 +106,10 @@ public:
     // on, its masks cleared; the top moves on.
     virtual void releaseRows(const PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
                              size_t mapFirst);
+    // The rows of a kill list (as releaseRows reads it) neither alive nor updatable, not
+    // freed yet: killed objects that wait for the step's end.
+    virtual void clearRows(const PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
+                           size_t mapFirst);
     // The rows rows[first, first + count) become updatable where they are alive (the rows a
     // step created, at the next step's start).
     virtual void markFresh(const PoolRows& pool, Buffer rows, size_t first, size_t count);

@@ -135,6 +135,7 @@ public:
     // the host counts them when it learns how many there were (released).
     void release(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst);
     void released(size_t count);
+    const PoolRows& memoryRows() const { return rows_; }
     // The rows of a batch just allocated (rows[0, count)), made updatable at the next step's
     // start; the buffer is the pool's from then on (a scratch one: scratchRows).
     void createdRows(Buffer rows, size_t count);

@@ -61,6 +61,7 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
                        {Clock::Source::PerRow, Clock::Source::Uniform, 0, 0, true}, nullptr);
     }
     LateKills late;
+    late.map = rows;
     launchInMemory(type, b, n, *info.update, info.updateLayout, table,
                    {Clock::Source::Uniform, Clock::Source::SinceCreated, t1, 0, false}, &late);
     columns.clear();
@@ -73,12 +74,14 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     late.at = s_.dying.size();
     late.t1 = t1;
     late.first = first;
-    late.map = rows;
     s_.late.push_back(std::move(late));
 }
 
 // A launch over the batch's objects (those kept: its mask), in chunks; `late`: its kills
-// listed, each chunk into a kill list of its own.
+// listed, each chunk into a kill list of its own, and cleared in the pool's alive mask
+// where the backend clearsKilled (through the batch's rows, late->map): until they are
+// freed, at the end of the step, nothing draws them and the next step does not update
+// them (a trigger's batch).
 void Creation::launchInMemory(size_t type, Batch& b, size_t n, const ir::Kernel& kernel, const ColumnLayout& layout,
                               std::vector<Buffer>& table, const Clock& clock, LateKills* late) {
     const size_t first = b.first, end = first + n;
@@ -105,7 +108,12 @@ void Creation::launchInMemory(size_t type, Batch& b, size_t n, const ir::Kernel&
         part.begin = begin;
         part.end = stop;
         part.late = late != nullptr;
-        if (late) part.killList = late->parts[c].killList;
+        if (late) {
+            part.killList = late->parts[c].killList;
+            part.aliveMask = s_.pools[type].alive.column;
+            part.aliveRowsBuffer = late->map;
+            part.aliveRowsFirst = first;
+        }
         RowsResult result = s_.backend.run(part);
         if (result.unstable) unstable += result.unstable;
         if (late) s_.latePart(late->parts[c], result, table[ColumnLayout::kKill], begin, stop);

@@ -144,38 +144,46 @@ void State::latePart(LateKills::Part& part, const RowsResult& result, Buffer fla
         listKilled(view<uint8_t>(flags), begin, end, part.rows);
 }
 
-void State::releaseInMemory(LateKills& l) {
-    if (l.released) return;
-    l.released = true;
+void State::listInMemory(LateKills& l) {
     Pool& pool = pools[l.type];
     std::vector<uint32_t> list;
     for (LateKills::Part& part : l.parts) {
-        if (!part.killList.valid()) continue;
-        if (!part.listed) {  // listed here, from the rows the backend gives
-            std::span<const uint32_t> rows = part.rows;
-            RowsResult result;
-            if (part.ticket) {
-                result = backend.collect(part.ticket);
-                part.ticket = 0;
-                rows = result.killedRows;
-                typeStats[l.type].unstable += result.unstable;
-            }
-            list.assign(1, static_cast<uint32_t>(rows.size()));
-            for (uint32_t row : rows) list.push_back(static_cast<uint32_t>(row - part.begin));
-            typeStats[l.type].killed += rows.size();
-            part.counted = true;
-            if (rows.empty()) {  // nothing to free
-                pool.recycle(part.killList);
-                part.killList = {};
-                continue;
-            }
-            memory.write(part.killList, 0, list.size(), list.data());
+        if (!part.killList.valid() || part.listed) continue;
+        std::span<const uint32_t> rows = part.rows;
+        RowsResult result;
+        if (part.ticket) {
+            result = backend.collect(part.ticket);
+            part.ticket = 0;
+            rows = result.killedRows;
+            typeStats[l.type].unstable += result.unstable;
         }
-        if (l.map.valid())
-            pool.release(part.killList, 0, 0, l.map, part.begin - l.first);
-        else
-            pool.release(part.killList, 0, static_cast<uint32_t>(part.begin), {}, 0);
-        if (part.counted) pool.released(list[0]);
+        list.assign(1, static_cast<uint32_t>(rows.size()));
+        for (uint32_t row : rows) list.push_back(static_cast<uint32_t>(row - part.begin));
+        memory.write(part.killList, 0, list.size(), list.data());
+        typeStats[l.type].killed += rows.size();
+        part.listed = part.counted = true;
+        part.count = rows.size();
+        if (!rows.empty() && !backend.clearsKilled())
+            memory.clearRows(pool.memoryRows(), part.killList, 0, static_cast<uint32_t>(part.begin), l.map,
+                             part.begin - l.first);
+    }
+}
+
+void State::releaseInMemory(LateKills& l) {
+    if (l.released) return;
+    listInMemory(l);
+    l.released = true;
+    Pool& pool = pools[l.type];
+    for (LateKills::Part& part : l.parts) {
+        if (!part.killList.valid()) continue;
+        bool none = part.counted && part.count == 0;  // listed here, nothing to free
+        if (!none) {
+            if (l.map.valid())
+                pool.release(part.killList, 0, 0, l.map, part.begin - l.first);
+            else
+                pool.release(part.killList, 0, static_cast<uint32_t>(part.begin), {}, 0);
+            if (part.counted) pool.released(part.count);
+        }
         pool.recycle(part.killList);
         part.killList = {};
     }
@@ -202,10 +210,12 @@ void State::settleLate(Deaths& dying, std::vector<LateKills>& late) {
     std::vector<LateKills> kept;  // those of types whose rows are in the memory, not freed yet
     for (LateKills& l : late) {
         if (types[l.type].rowsInMemory) {
-            if (l.released)
+            if (l.released) {
                 countInMemory(l);
-            else
+            } else {  // (outside a step: a trigger's) freed at the next step's end
+                listInMemory(l);
                 kept.push_back(std::move(l));
+            }
             continue;
         }
         for (; next < l.at; ++next) merged.push_back(dying[next]);

@@ -88,6 +88,7 @@ struct LateKills {
         size_t begin = 0;
         Buffer killList;
         bool listed = false, counted = false;
+        size_t count = 0;  // counted: how many
     };
     std::vector<Part> parts;
     // A type whose rows are in the memory: its kills freed there (State::releaseInMemory)
@@ -189,6 +190,10 @@ struct State {
     // counted once the backend gives their counts (settleLate, settleAndRelease).
     void releaseInMemory(LateKills& l);
     void countInMemory(LateKills& l);
+    // Its kills the backend did not list, listed by the run-time from the rows it gives
+    // (and, where the backend does not clear kills, cleared in the pool's masks: a trigger's
+    // dead wait, not updated, not drawn, for the next step's end).
+    void listInMemory(LateKills& l);
     // A launch's kills as a part of a LateKills: its ticket, or the rows it listed, else
     // those of [begin, end) its kill flags (`flags`) mark.
     void latePart(LateKills::Part& part, const RowsResult& result, Buffer flags, size_t begin, size_t end) const;

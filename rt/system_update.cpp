@@ -157,10 +157,9 @@ void runUpdate(State& s, size_t type, double dt, double t1, bool last) {
         part.begin = begin;
         part.end = end;
         part.late = late;
-        if (late && info.rowsInMemory)  // its kills listed, for the pool to free them where its rows are
+        if (late) part.aliveMask = pool.alive.column;  // its kills cleared there (Backend::clearsKilled)
+        if (late && info.rowsInMemory)  // and listed, for the pool to free them where its rows are
             part.killList = work.killed[c].killList;
-        else if (late)
-            part.aliveMask = pool.alive.column;  // its kills cleared there (Backend::clearsKilled)
         s.gatherParents(type, info.updateLayout, work.updateTable, updatable, part.begin, part.end, t1);
         RowsResult result = s.backend.run(part);
         if (result.unstable) unstable += result.unstable;

@@ -179,3 +179,20 @@ TEST_CASE("a pool of objects that only die keeps its rows on the GPU: what a ste
     CHECK(large <= 1.1 * small + 8);
     CHECK(large < 1024);
 }
+
+TEST_CASE("objects a trigger creates that die in their first update are not drawn before the next step") {
+    // Their kill lists are freed at the next step's end; until then the GPU has cleared
+    // them in the alive mask the draws read, as the interpreter has frozen them.
+    test::Pair p("object s(k: float) { point(vec3(k, 0, 0), white, 1); kill when k < 0.5; }\n"
+                 "trigger boom { emit s(rand()) count 5000; }");
+    p.steps(1, 1.0 / 60);
+    p.fire("boom");
+    size_t drawn = p.gl->points(0).size();
+    CHECK(drawn == p.cpu->points(0).size());
+    CHECK(drawn > 2000);
+    CHECK(drawn < 3000);
+    CHECK(p.gl->pool(0).rowsInMemory());
+    p.steps(2, 1.0 / 60);  // freed once, at the end of the first (they are not updated, nor killed, again)
+    p.compare();
+    CHECK(p.gl->stats().types[0].killed == p.cpu->stats().types[0].killed);
+}

@@ -135,6 +135,9 @@ TEST_CASE("rows kept in the memory: the same objects in the same rows as rows ke
                        "object e { emit s(rand()) count 5000; kill; }\nspawn e;");
     programs.push_back("object s { point(vec3(age), white, 1); kill when age > 0.5 * rand(); }\n"
                        "trigger boom { emit s count 20000; }");
+    // A trigger's objects half of which die at once: they wait for the next step's end.
+    programs.push_back("object s(k: float) { point(vec3(k, 0, 0), white, 1); kill when k < 0.5; }\n"
+                       "trigger boom { emit s(rand()) count 5000; }");
     size_t inMemory = 0;
     for (const std::string& text : programs) {
         INFO(text.substr(0, 200));
