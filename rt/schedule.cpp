@@ -126,7 +126,8 @@ Schedule stepSchedule(const State& s) {
         update.late = info.late;
         update.listed = listed;
         update.exports = info.exports != nullptr;
-        update.render = info.render != nullptr && info.drawn[0];
+        // (drawing as the step goes: where the backend's launches run on the host's memory)
+        update.render = info.render != nullptr && info.drawn[0] && s.options.drawInStep && s.backend.rendersInStep();
         update.inMemory = info.rowsInMemory;
         if (info.kills || info.late) {
             Phase& kills = add(PhaseKind::Kills, type, Parallelism::Ordered);
