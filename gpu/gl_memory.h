@@ -113,6 +113,7 @@ private:
     unsigned allocateProgram_ = 0, releaseProgram_ = 0, pushedProgram_ = 0, freshProgram_ = 0, identifyProgram_ = 0, runsBuffer_ = 0;
     unsigned bound(rt::Buffer b);  // deviceBuffer, for a column the dispatch writes
     bool allOnHost(std::initializer_list<rt::Buffer> buffers) const;
+    void dispatchRows(unsigned program, size_t invocations);
     mutable std::vector<uint32_t> rowsSent_;  // what rowsBuffer_ holds
 };
 

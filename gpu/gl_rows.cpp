@@ -134,6 +134,14 @@ bool GlMemory::allOnHost(std::initializer_list<Buffer> buffers) const {
     });
 }
 
+// The bound program over `invocations` invocations; what it wrote read by any reader of a column.
+void GlMemory::dispatchRows(unsigned program, size_t invocations) {
+    glUseProgram(program);
+    dispatchInvocations(invocations, 64);
+    ++dispatches;
+    afterWrite(Write::Dispatch, kColumnReaders);
+}
+
 unsigned GlMemory::bound(Buffer b) {
     unsigned gl = deviceBuffer(b);
     written(b);
@@ -153,12 +161,9 @@ void GlMemory::allocateRows(const rt::PoolRows& pool, size_t top, size_t highWat
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(pool.updatable));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, bound(pool.alive));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, bound(pool.counters));
-    glUseProgram(allocateProgram_);
     bindParams(paramsBuffer_, {static_cast<uint32_t>(n), static_cast<uint32_t>(top), static_cast<uint32_t>(highWater),
                                static_cast<uint32_t>(outFirst)});
-    dispatchInvocations(n, 64);
-    ++dispatches;
-    afterWrite(Write::Dispatch, kColumnReaders);
+    dispatchRows(allocateProgram_, n);
 }
 
 void GlMemory::releaseRows(const rt::PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
@@ -180,15 +185,10 @@ void GlMemory::releaseRows(const rt::PoolRows& pool, Buffer killed, size_t kille
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, bound(pool.updatable));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, bound(pool.alive));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, bound(pool.counters));
-    glUseProgram(releaseProgram_);
     bindParams(paramsBuffer_, {0u, static_cast<uint32_t>(killedAt), base, static_cast<uint32_t>(mapFirst),
                                map.valid() ? 1u : 0u, grid});
-    dispatchInvocations(grid, 64);
-    afterWrite(Write::Dispatch, kColumnReaders);
-    glUseProgram(pushedProgram_);  // the same bindings and parameters
-    dispatchInvocations(1, 64);
-    dispatches += 2;
-    afterWrite(Write::Dispatch, kColumnReaders);
+    dispatchRows(releaseProgram_, grid);
+    dispatchRows(pushedProgram_, 1);  // the same bindings and parameters
 }
 
 void GlMemory::markFresh(const rt::PoolRows& pool, Buffer rows, size_t first, size_t count) {
@@ -200,11 +200,8 @@ void GlMemory::markFresh(const rt::PoolRows& pool, Buffer rows, size_t first, si
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceBuffer(rows));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(pool.updatable));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, deviceBuffer(pool.alive));
-    glUseProgram(freshProgram_);
     bindParams(paramsBuffer_, {static_cast<uint32_t>(first), static_cast<uint32_t>(count)});
-    dispatchInvocations(count, 64);
-    ++dispatches;
-    afterWrite(Write::Dispatch, kColumnReaders);
+    dispatchRows(freshProgram_, count);
 }
 
 void GlMemory::identify(const rt::ObjectRuns& runs, size_t n, size_t kept, Buffer created, Buffer ids, Buffer mask,
@@ -232,12 +229,9 @@ void GlMemory::identify(const rt::ObjectRuns& runs, size_t n, size_t kept, Buffe
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, bound(created));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, bound(ids));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(mask));
-    glUseProgram(identifyProgram_);
     bindParams(paramsBuffer_, {static_cast<uint32_t>(n), static_cast<uint32_t>(kept),
                                static_cast<uint32_t>(runs.size()), static_cast<uint32_t>(first)});
-    dispatchInvocations(n, 64);
-    ++dispatches;
-    afterWrite(Write::Dispatch, kColumnReaders);
+    dispatchRows(identifyProgram_, n);
 }
 
 }  // namespace psys::gpu

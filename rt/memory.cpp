@@ -32,36 +32,43 @@ void Memory::allocateRows(const PoolRows& pool, size_t top, size_t highWater, si
     static_cast<uint32_t*>(host(pool.counters))[0] = static_cast<uint32_t>(top - std::min(n, top));
 }
 
+namespace {
+
+// The pool rows of a kill list (Memory::releaseRows), in order: `each(i, row)`.
+template <class Each>
+void eachKilled(const Memory& memory, Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst,
+                Each each) {
+    const auto* list = static_cast<const uint32_t*>(memory.view(killed)) + killedAt;
+    if (list[0] == 0) return;
+    const auto* rows = map.valid() ? static_cast<const uint32_t*>(memory.view(map)) + mapFirst : nullptr;
+    for (uint32_t i = 0; i < list[0]; ++i) each(i, rows ? rows[list[1 + i]] : base + list[1 + i]);
+}
+
+}  // namespace
+
 void Memory::releaseRows(const PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
                          size_t mapFirst) {
-    const auto* list = static_cast<const uint32_t*>(view(killed)) + killedAt;
-    uint32_t count = list[0];
-    if (count == 0) return;
     uint32_t& top = static_cast<uint32_t*>(host(pool.counters))[0];
-    const auto* rows = map.valid() ? static_cast<const uint32_t*>(view(map)) + mapFirst : nullptr;
     auto* stack = static_cast<uint32_t*>(host(pool.stack));
     auto* generation = static_cast<uint32_t*>(host(pool.generation));
     auto* updatable = static_cast<uint8_t*>(host(pool.updatable));
     auto* alive = static_cast<uint8_t*>(host(pool.alive));
-    for (uint32_t i = 0; i < count; ++i) {
-        uint32_t r = list[1 + i], row = rows ? rows[r] : base + r;
+    uint32_t pushed = 0;
+    eachKilled(*this, killed, killedAt, base, map, mapFirst, [&](uint32_t i, uint32_t row) {
         stack[top + i] = row;
         ++generation[row];
         updatable[row] = alive[row] = 0;
-    }
-    top += count;
+        pushed = i + 1;
+    });
+    top += pushed;
 }
 
 void Memory::clearRows(const PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
                        size_t mapFirst) {
-    const auto* list = static_cast<const uint32_t*>(view(killed)) + killedAt;
-    const auto* rows = map.valid() ? static_cast<const uint32_t*>(view(map)) + mapFirst : nullptr;
     auto* updatable = static_cast<uint8_t*>(host(pool.updatable));
     auto* alive = static_cast<uint8_t*>(host(pool.alive));
-    for (uint32_t i = 0; i < list[0]; ++i) {
-        uint32_t r = list[1 + i], row = rows ? rows[r] : base + r;
-        updatable[row] = alive[row] = 0;
-    }
+    eachKilled(*this, killed, killedAt, base, map, mapFirst,
+               [&](uint32_t, uint32_t row) { updatable[row] = alive[row] = 0; });
 }
 
 void Memory::markFresh(const PoolRows& pool, Buffer rows, size_t first, size_t count) {
