@@ -39,13 +39,36 @@ uint32_t valuesRead(const Kernel* kernel, Op op) {
 }
 uint32_t uniformValues(const Kernel& kernel) { return valuesRead(&kernel, Op::Uniform); }
 
+// The launch's block as a uniform block: its words and 4-word values.
+std::string blockAccessors(uint32_t blockWords) {
+    return fmt::format(R"(layout(std140, binding = 0) uniform Launch {{ uvec4 L[{}]; }};
+
+uint lw(uint k) {{ return L[k >> 2u][k & 3u]; }}
+vec4 lv(uint k) {{ return uintBitsToFloat(L[k >> 2u]); }}
+)",
+                       align4(blockWords) / 4);
+}
+
+// A block per emitter in the launch's words (LaunchRecords).
+std::string recordAccessors() {
+    return R"(layout(std140, binding = 0) uniform Launch { uvec4 L[1]; };
+
+uint psys_record = 0u;  // the first word of the invocation's emitter's block
+uint lw(uint k) { return w[psys_record + k]; }
+vec4 lv(uint k) { return uintBitsToFloat(uvec4(lw(k), lw(k + 1u), lw(k + 2u), lw(k + 3u))); }
+)";
+}
+
 // What every compute shader starts with: the bindings, the accessors and the helpers
 // that give GLSL built-ins core/lanes.h's results where GLSL leaves them undefined. A
 // column in `direct` is read and written in its own storage block (2 + its place there)
 // or, past kDirectSlots, read through a buffer texture (its unit: its place less
 // kDirectSlots); the others in the launch's words. The accessors' switch on a literal
-// column folds away.
-std::string preamble(const std::string& comment, uint32_t blockWords, const std::vector<int>& direct = {}) {
+// column folds away. `records`: the launch's words hold a block per emitter (a children
+// launch): `lw` reads the invocation's (psys_record, set by kRecordIndex), the uniform
+// block says where they are (LaunchRecords).
+std::string preamble(const std::string& comment, uint32_t blockWords, const std::vector<int>& direct = {},
+                     bool records = false) {
     std::string blocks, reads, writes;
     for (size_t k = 0; k < direct.size(); ++k) {
         if (k >= kDirectSlots) {
@@ -63,12 +86,8 @@ std::string preamble(const std::string& comment, uint32_t blockWords, const std:
 layout(local_size_x = {1}) in;
 layout(std430, binding = 0) buffer Words {{ uint w[]; }};
 layout(std430, binding = 1) buffer Counts {{ uint counts[]; }};
-{4}layout(std140, binding = 0) uniform Launch {{ uvec4 L[{2}]; }};
-
-uint lw(uint k) {{ return L[k >> 2u][k & 3u]; }}
-float lf(uint k) {{ return uintBitsToFloat(lw(k)); }}
+{4}{8}float lf(uint k) {{ return uintBitsToFloat(lw(k)); }}
 double ld(uint k) {{ return packDouble2x32(uvec2(lw(k), lw(k + 1u))); }}
-vec4 lv(uint k) {{ return uintBitsToFloat(L[k >> 2u]); }}
 uint col(uint c) {{ return lw({3}u + c); }}
 uint cw(uint c, uint o) {{ switch (c) {{ {5}default: return w[o]; }} }}
 void scw(uint c, uint o, uint x) {{ switch (c) {{ {6}default: w[o] = x; }} }}
@@ -139,13 +158,28 @@ float psys_pow(float x, float y) {{  // C's pow: defined for every base
 
 )",
                        comment, kWorkGroupSize, align4(blockWords) / 4, LaunchBlock::kColumns, blocks, reads, writes,
-                       LaunchBlock::kZero);
+                       LaunchBlock::kZero, records ? recordAccessors() : blockAccessors(blockWords));
 }
 
 const char* kIndex =
     "    uint i = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + "
     "gl_LocalInvocationID.x;\n"
     "    if (i >= lw(0u)) return;\n";
+
+// A children launch's invocation: its emitter's block found by a binary search of the
+// blocks' first invocations (LaunchBlock::kFirstInvocation), `i` its child's place among
+// that emitter's.
+const char* kRecordIndex =
+    "    uint i = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + "
+    "gl_LocalInvocationID.x;\n"
+    "    if (i >= L[0].x) return;\n"
+    "    uint lo = 0u, hi = L[0].y - 1u;\n"
+    "    while (lo < hi) {\n"
+    "        uint mid = (lo + hi + 1u) >> 1u;\n"
+    "        if (w[L[0].z + mid * L[0].w + 1u] <= i) lo = mid; else hi = mid - 1u;\n"
+    "    }\n"
+    "    psys_record = L[0].z + lo * L[0].w;\n"
+    "    i -= lw(1u);\n";
 
 // A value of `width` floats at block word `word`.
 std::string blockValue(uint32_t word, Type type) {
@@ -380,10 +414,11 @@ std::string rowsShader(const Object& object, const Kernel& kernel, rt::Clock::So
 std::string childrenShader(const Object& object, const Kernel& spawn) {
     ColumnLayout l = rt::columnLayout(object, spawn);
     LaunchBlock block = childrenBlock(object, spawn, l);
-    std::string text = preamble(fmt::format("object `{}`, kernel `spawn.{}` (creates `{}`): one invocation per child",
+    std::string text = preamble(fmt::format("object `{}`, kernel `spawn.{}` (creates `{}`): one invocation per child "
+                                            "of each emitter of the launch",
                                             object.name, spawn.site,
                                             object.emits.at(static_cast<size_t>(spawn.site)).target),
-                                block.words);
+                                block.words, {}, true);
     Statements out("t");
     using S = rt::Clock::Source;
     ClockNames clock = emitClock(out, S::Uniform, S::Uniform, false);
@@ -411,7 +446,7 @@ std::string childrenShader(const Object& object, const Kernel& spawn) {
         if (y.kind == YieldKind::EmitArg)
             storeColumns(out, static_cast<int>(first[static_cast<size_t>(y.sub)]), spawn.at(y.value).type.width,
                          values[y.value]);
-    return text + "void main() {\n" + kIndex + out.text() + "}\n";
+    return text + "void main() {\n" + kRecordIndex + out.text() + "}\n";
 }
 
 std::string drawVertexShader() {

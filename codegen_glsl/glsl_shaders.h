@@ -29,6 +29,7 @@ namespace psys::codegen_glsl {
 // the emitter's parameters, state and parent reads) take 4 words each, 16-byte aligned.
 struct LaunchBlock {
     static constexpr uint32_t kCount = 0;       // rows (children) in the launch
+    static constexpr uint32_t kFirstInvocation = 1;  // children: the emitter's first child in the launch
     static constexpr uint32_t kNow = 2;         // f64: now, for a uniform clock
     static constexpr uint32_t kDt = 4;          // f32: dt, for a uniform clock
     static constexpr uint32_t kFirst = 5;       // 1 while the rows are being created
@@ -79,7 +80,16 @@ LaunchBlock childrenBlock(const ir::Object& object, const ir::Kernel& spawn, con
 // in the shader for each row where the clock is per row (else its values come in the block).
 std::string rowsShader(const ir::Object& object, const ir::Kernel& kernel, rt::Clock::Source now,
                        rt::Clock::Source dt, const ir::Kernel* uniform);
-// A compute shader running a spawn kernel once per child of one emitter.
+// A children launch's uniform block (its emitters' blocks are in the launch's words):
+// children in all, emitters, the first word of the first emitter's block, words a block.
+struct LaunchRecords {
+    static constexpr uint32_t kChildren = 0, kEmitters = 1, kFirstWord = 2, kWords = 3;
+};
+// A compute shader running a spawn kernel once per child of each emitter of a launch:
+// a launch block per emitter (childrenBlock), one after the other in the launch's words
+// (LaunchRecords), each with its children's place among the launch's (kFirstInvocation)
+// and its own column words for their arguments.
+
 std::string childrenShader(const ir::Object& object, const ir::Kernel& spawn);
 
 // The vertex and fragment shaders that draw points straight from render columns

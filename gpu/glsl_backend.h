@@ -43,6 +43,9 @@ public:
     void forget(const ir::Module& module) override;
     rt::RowsResult run(const rt::RowsLaunch& launch) override;
     void run(const rt::ChildrenLaunch& launch) override;
+    // A spawn kernel's launches whose columns are on the GPU in one dispatch (a launch
+    // block per emitter in the words); small ones on the host side as run() does.
+    void runChildren(std::span<const rt::ChildrenLaunch> launches) override;
     rt::RowsResult collect(uint64_t ticket) override;
     bool ready(uint64_t ticket) override;
     bool clearsKilled() const override { return true; }
@@ -107,6 +110,8 @@ private:
     Program& rowsProgram(const ir::Object& object, const ir::Kernel& kernel, rt::Clock::Source now,
                          rt::Clock::Source dt);
     Program& childrenProgram(const ir::Object& object, const ir::Kernel& spawn);
+    // Launches of one spawn kernel as one dispatch (runChildren).
+    void dispatchChildren(std::span<const rt::ChildrenLaunch> launches);
     Program compile(const std::string& source, const std::string& what);
     struct Late;
     rt::RowsResult runRows(const rt::RowsLaunch& launch, Program& program, size_t begin, size_t end, Late* late);

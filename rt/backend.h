@@ -7,7 +7,7 @@
 //   - RowsLaunch: a kernel (init, update, exports, render) over a range of rows of a
 //     column table — buffers in the backend's memory, by handle (rt/memory.h);
 //   - ChildrenLaunch: a spawn kernel for the children one object emits at once, writing
-//     their arguments into buffers.
+//     their arguments into buffers (several objects' at once: runChildren).
 // A launch returns counts (how many rows it killed); every value stays in the buffers.
 // Before the first launch of a system, `prepare` lists every launch shape it will ask for,
 // so a compiling backend compiles them all at once.
@@ -161,6 +161,12 @@ public:
     virtual void forget(const ir::Module&) {}
     virtual RowsResult run(const RowsLaunch& launch) = 0;
     virtual void run(const ChildrenLaunch& launch) = 0;
+    // Children launches that may run together, in any order: each writes its own rows of
+    // the arguments and reads what none of them writes (a step's emitters of a type, a
+    // batch's bursts). A GPU runs a spawn kernel's launches as one dispatch.
+    virtual void runChildren(std::span<const ChildrenLaunch> launches) {
+        for (const ChildrenLaunch& l : launches) run(l);
+    }
     // The counts and kills of a late launch that answered with `ticket` (its killedRows
     // valid until the next launch or collect), once each ticket.
     virtual RowsResult collect(uint64_t ticket) {

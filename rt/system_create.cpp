@@ -95,6 +95,7 @@ void Creation::bindBatch(size_t type, Batch& b, const ColumnLayout& layout, Scra
 // its bursts, its death or its emissions. While an object emits, the rows allocated for
 // the objects after it count as free, as they would if each object were created alone.
 void Creation::createBatch(size_t type, size_t from, size_t to, double t1) {
+    runSpawns();  // the arguments of what the last batch queued (it reads its batch's columns)
     Pool& pool = s_.pools[type];
     const TypeInfo& info = s_.types[type];
     const ir::Object& o = pool.object();

@@ -44,6 +44,10 @@ public:
     void emitFromKernel(const ir::Trigger& trigger, std::span<const Value> params, uint32_t objectId);
     // Creates everything queued (and what that queues), each advanced to t1.
     void drain(double t1);
+    // Runs the spawn launches queued since the last call, together (Backend::runChildren):
+    // before anything they read changes — the end of a type's emissions, a batch's
+    // creation.
+    void runSpawns();
 
 private:
     // A run of objects queued together — one emitter's children at one site in one step,
@@ -94,13 +98,21 @@ private:
     void bindBatch(size_t type, Batch& b, const ColumnLayout& layout, Scratch& parents, std::vector<Buffer>& table,
                    bool atCreation);
 
+    // A spawn launch waiting for runSpawns, with the parent values it reads.
+    struct Spawn {
+        ChildrenLaunch launch;
+        std::vector<Value> parents;
+    };
+
     State& s_;
+    std::vector<Spawn> spawns_;
+    std::vector<ChildrenLaunch> launches_;  // runSpawns' list
     std::vector<Run> queue_;
     std::vector<size_t> queued_;   // per type: objects waiting in the queue
     std::vector<size_t> pending_;  // per type: rows a batch allocated for objects not yet created in order
     std::vector<Staging> staging_;
     std::vector<Batch> batches_;
-    std::vector<Value> yields_, parents_;
+    std::vector<Value> yields_;
     std::vector<float> rate_, count_;
 };
 

@@ -35,15 +35,15 @@ void Creation::queueChildren(const Emitter& e, int site, uint64_t count, uint64_
     size_t base = stage(target, static_cast<size_t>(kept));
     if (const ir::Kernel* spawn = info.spawn[static_cast<size_t>(site)]) {
         const ColumnLayout& layout = info.spawnLayout[static_cast<size_t>(site)];
-        s_.parentValues(e.type, e.row, layout, e.at, parents_);
-        ChildrenLaunch launch;
+        Spawn& queued = spawns_.emplace_back();
+        s_.parentValues(e.type, e.row, layout, e.at, queued.parents);
+        ChildrenLaunch& launch = queued.launch;
         launch.object = &s_.pools[e.type].object();
         launch.spawn = spawn;
         launch.layout = &layout;
         launch.columns = e.columns.empty() ? std::span<const Buffer>(s_.work[e.type].spawnTables[static_cast<size_t>(site)])
                                            : e.columns;
         launch.row = e.columns.empty() ? e.row : e.columnRow;
-        launch.parents = parents_.data();
         launch.clock.nowValue = e.at;
         launch.clock.dtValue = static_cast<float>(s_.lastDt);
         launch.clock.first = e.first;
@@ -54,7 +54,6 @@ void Creation::queueChildren(const Emitter& e, int site, uint64_t count, uint64_
         launch.count = static_cast<size_t>(kept);
         launch.args = staging_[target].args;
         launch.argsFirst = base;
-        s_.backend.run(launch);
     }
     enqueue({target, base, static_cast<size_t>(kept), parent, firstTime, spacing, perEvent, s_.nextId});
     s_.nextId += static_cast<uint32_t>(kept);
@@ -138,7 +137,19 @@ void Creation::emitFromKernel(const ir::Trigger& trigger, std::span<const Value>
     }
 }
 
+void Creation::runSpawns() {
+    if (spawns_.empty()) return;
+    launches_.clear();
+    for (Spawn& queued : spawns_) {
+        launches_.push_back(queued.launch);
+        launches_.back().parents = queued.parents.data();
+    }
+    s_.backend.runChildren(launches_);
+    spawns_.clear();
+}
+
 void Creation::drain(double t1) {
+    runSpawns();
     for (size_t i = 0; i < queue_.size();) {  // (creating queues more at its end)
         size_t type = queue_[i].type;
         size_t end = i + 1;

@@ -14,7 +14,8 @@
 
 namespace psys::rt::detail {
 
-// After an update of `type`: the survivors emit, in row order. A rate or count every
+// After an update of `type`: the survivors emit, in row order (their spawn launches run
+// together at the end). A rate or count every
 // row shares (ColumnLayout::sharedEmit) is taken from the externs or the launch's uniform
 // values, not from its column: a device need not send it back.
 void runEmissions(State& s, Creation& creation, size_t type, double dt, double t1) {
@@ -49,6 +50,7 @@ void runEmissions(State& s, Creation& creation, size_t type, double dt, double t
         }
         creation.emitAtRate({type, row, {}, row, t1, false}, rate, count, dt, t1);
     }
+    creation.runSpawns();  // before the next sub-step's update moves the emitters on
 }
 
 // The kills of the update pass just run: listed per chunk (objects that only die) and

@@ -222,6 +222,39 @@ TEST_CASE("a parent's children read it live on the GPU, then frozen after it die
 }
 
 
+TEST_CASE("the children of a type's emitters are computed in one dispatch a step, as the interpreter computes them") {
+    // 40 fans, each with its own parameter, state, id, rate and random numbers, their
+    // sparks' arguments reading all of them and the fans' parent: one spawn dispatch for
+    // all the fans that emit in a step (a launch block each), not one a fan.
+    Pair p(R"(
+        object hub {
+            swirl = sin(age * 3);
+            emit fan(rand() * 4 + 1) count 40;
+            object fan(k: float) {
+                pos = vec3(k, 0, 0) + integrate(vec3(0, k * 0.1, 0));
+                emit spark(pos + vec3(rand(), hub.swirl, k)) at 20 * k per second;
+                kill when age > 3;
+                object spark(p: vec3) {
+                    point(p + vec3(0, age, 0), white, 1);
+                    kill when age > 0.5;
+                }
+            }
+        }
+        spawn hub;)");
+    p.gpu->timePasses(true);
+    const int frames = 60;
+    for (int f = 0; f < frames; ++f) {
+        p.steps(1, 1.0 / 60);
+        p.compare();
+    }
+    const gpu::GlslBackend::PassTime& spawn = p.gpu->passTimes().at("spawn");
+    MESSAGE("spawn dispatches: " << spawn.launches << " for " << spawn.rows << " children in " << frames << " steps");
+    CHECK(p.stats("hub.fan.spark").created > 1000);
+    CHECK(spawn.rows == p.stats("hub.fan.spark").created + p.stats("hub.fan").created);  // nothing dropped
+    CHECK(spawn.launches <= frames + 1);  // the hub's burst, then a dispatch a step at most
+}
+
+
 TEST_CASE("an object's state stays on the GPU from step to step") {
     // The fountain's drops: 40 bytes of state each (position, velocity, colour), read and
     // written every step, their masks, creation times, ids and rows: all stay on the GPU
