@@ -411,6 +411,14 @@ std::string rowsShader(const Object& object, const Kernel& kernel, rt::Clock::So
     return text + "void main() {\n" + kIndex + out.text() + "}\n";
 }
 
+std::vector<int> directArguments(const Kernel& spawn) {
+    auto columns = static_cast<size_t>(rt::argumentColumns(spawn).total);
+    std::vector<int> direct;
+    if (columns <= kDirectSlots)
+        for (size_t c = 0; c < columns; ++c) direct.push_back(static_cast<int>(c));
+    return direct;
+}
+
 std::string childrenShader(const Object& object, const Kernel& spawn) {
     ColumnLayout l = rt::columnLayout(object, spawn);
     LaunchBlock block = childrenBlock(object, spawn, l);
@@ -418,7 +426,7 @@ std::string childrenShader(const Object& object, const Kernel& spawn) {
                                             "of each emitter of the launch",
                                             object.name, spawn.site,
                                             object.emits.at(static_cast<size_t>(spawn.site)).target),
-                                block.words, {}, true);
+                                block.words, directArguments(spawn), true);
     Statements out("t");
     using S = rt::Clock::Source;
     ClockNames clock = emitClock(out, S::Uniform, S::Uniform, false);

@@ -85,6 +85,9 @@ std::string rowsShader(const ir::Object& object, const ir::Kernel& kernel, rt::C
 struct LaunchRecords {
     static constexpr uint32_t kChildren = 0, kEmitters = 1, kFirstWord = 2, kWords = 3;
 };
+// The argument columns a children shader writes in place (storage blocks 2, 3, …): all
+// of them where they fit, else none (they go in the launch's words).
+std::vector<int> directArguments(const ir::Kernel& spawn);
 // A compute shader running a spawn kernel once per child of each emitter of a launch:
 // a launch block per emitter (childrenBlock), one after the other in the launch's words
 // (LaunchRecords), each with its children's place among the launch's (kFirstInvocation)

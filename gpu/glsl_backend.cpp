@@ -216,6 +216,7 @@ GlslBackend::Program& GlslBackend::childrenProgram(const ir::Object& object, con
             compile(codegen_glsl::childrenShader(object, spawn), object.name + ".spawn" + std::to_string(spawn.site)));
         p->layout = rt::columnLayout(object, spawn);
         p->block = codegen_glsl::childrenBlock(object, spawn, p->layout);
+        p->direct = codegen_glsl::directArguments(spawn);
         p->pass = "spawn";
         slot = std::move(p);
     }
@@ -511,10 +512,12 @@ void GlslBackend::runChildren(std::span<const rt::ChildrenLaunch> launches) {
     flush(launches.size());
 }
 
-// One dispatch for every child of the launches (all of one spawn kernel): emitter e's
-// launch block at word firstWord + e·W of the words, after the children's arguments
-// (component c of every child at c·N + its place); each invocation finds its emitter's
-// block (codegen_glsl::childrenShader).
+// One dispatch for every child of the launches (all of one spawn kernel, so all into the
+// same argument columns): emitter e's launch block at word firstWord + e·W of the words;
+// each invocation finds its emitter's block (codegen_glsl::childrenShader). The children
+// write their arguments in place, each column bound from the first launch's rows on
+// (codegen_glsl::directArguments); else into the words before the blocks (component c of
+// every child at c·N + its place), copied to the columns after.
 void GlslBackend::dispatchChildren(std::span<const rt::ChildrenLaunch> launches) {
     if (context_) context_->makeCurrent();
     memory_.flushPending();  // before anything is bound
@@ -522,9 +525,19 @@ void GlslBackend::dispatchChildren(std::span<const rt::ChildrenLaunch> launches)
     Program& p = childrenProgram(*front.object, *front.spawn);
     const ir::Object& o = *front.object;
     const ColumnLayout& l = *front.layout;
-    size_t total = 0, columns = front.args.size();
-    for (const rt::ChildrenLaunch& launch : launches) total += launch.count;
-    const size_t recordWords = (p.block.words + 4 + 3) & ~size_t{3}, firstWord = columns * total;
+    size_t total = 0, columns = front.args.size(), bound = SIZE_MAX, end = 0;
+    for (const rt::ChildrenLaunch& launch : launches) {
+        total += launch.count;
+        bound = std::min(bound, launch.argsFirst);
+        end = std::max(end, launch.argsFirst + launch.count);
+    }
+    const bool direct = !p.direct.empty();
+    bound = bound * 4 / storageAlignment_ * storageAlignment_ / 4;  // (f32 columns: a word a row)
+    if (direct)
+        for (size_t c = 0; c < columns; ++c)
+            glBindBufferRange(GL_SHADER_STORAGE_BUFFER, static_cast<GLuint>(2 + c), memory_.deviceBuffer(front.args[c]),
+                              static_cast<GLintptr>(bound * 4), static_cast<GLsizeiptr>((end - bound) * 4));
+    const size_t recordWords = (p.block.words + 4 + 3) & ~size_t{3}, firstWord = direct ? 0 : columns * total;
     std::vector<uint32_t> records;
     records.reserve(launches.size() * recordWords);
     // The emitter's creation time, id, parameters and state, from its row: copied into its
@@ -539,7 +552,8 @@ void GlslBackend::dispatchChildren(std::span<const rt::ChildrenLaunch> launches)
         block.resize(recordWords, 0);
         block[LaunchBlock::kFirstInvocation] = static_cast<uint32_t>(place);
         block[LaunchBlock::kFirstChild] = launch.firstChild;
-        for (size_t c = 0; c < columns; ++c) block[LaunchBlock::kColumns + c] = static_cast<uint32_t>(c * total + place);
+        for (size_t c = 0; c < columns; ++c)
+            block[LaunchBlock::kColumns + c] = static_cast<uint32_t>(direct ? launch.argsFirst - bound : c * total + place);
         for (uint32_t e = 0; e < p.block.externCount; ++e) putValue(block, p.block.externs + 4 * e, launch.externs[e]);
         auto fromRow = [&](Buffer b, uint32_t word) {
             if (!b.valid()) return;
@@ -583,7 +597,11 @@ void GlslBackend::dispatchChildren(std::span<const rt::ChildrenLaunch> launches)
     uniform[R::kWords] = static_cast<uint32_t>(recordWords);
     dispatch(p, uniform, total, p.pass);
     // The children's arguments stay on the GPU: creation scatters them into pool rows
-    // there. Launches whose rows follow each other in the same columns in one copy.
+    // there. From the words, launches whose rows follow each other in one copy.
+    if (direct) {
+        for (Buffer b : front.args) memory_.written(b);
+        return;
+    }
     place = 0;
     for (size_t k = 0; k < launches.size();) {
         const rt::ChildrenLaunch& a = launches[k];

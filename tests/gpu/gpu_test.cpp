@@ -252,6 +252,30 @@ TEST_CASE("the children of a type's emitters are computed in one dispatch a step
     CHECK(p.stats("hub.fan.spark").created > 1000);
     CHECK(spawn.rows == p.stats("hub.fan.spark").created + p.stats("hub.fan").created);  // nothing dropped
     CHECK(spawn.launches <= frames + 1);  // the hub's burst, then a dispatch a step at most
+    CHECK(p.gpu->passTimes().count("adopt") == 0);  // the arguments written in place
+}
+
+
+TEST_CASE("children with more argument components than storage blocks get them through the launch's words") {
+    // 16 components (codegen_glsl::kDirectSlots is 14): the spawn shader writes them into
+    // the launch's words, copied to the argument columns after; fewer are written in place.
+    Pair p(R"(
+        object fan(k: float) {
+            emit spark(vec4(k), vec4(k, 1, 2, 3) * age, vec4(rand()), vec4(k, k, 0, 1)) at 40 * k per second;
+            object spark(a: vec4, b: vec4, c: vec4, d: vec4) {
+                point(a.xyz + b.xyz + c.xyz, d, 1);
+                kill when age > 0.3;
+            }
+        }
+        object hub { emit fan(rand() + 1) count 8; }
+        spawn hub;)");
+    p.gpu->timePasses(true);
+    for (int f = 0; f < 30; ++f) {
+        p.steps(1, 1.0 / 60);
+        p.compare();
+    }
+    CHECK(p.stats("fan.spark").created > 100);
+    CHECK(p.gpu->passTimes().at("adopt").rows == 16 * p.stats("fan.spark").created);  // (the fans' one in place)
 }
 
 
