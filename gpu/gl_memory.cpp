@@ -79,6 +79,32 @@ const char* kScatter = R"(void main() {
 }
 )";
 
+// Up to kScatterColumns pairs of columns at once, by a row list in a buffer:
+// to_k[rows[rowsAt + i]] = from_k[first + i] for the pairs k < pairs, w_k words a row
+// (2 bits each of `widths`); kSkipRow: nothing.
+std::string scatterColumnsShader() {
+    std::string text = std::string("#version 450\nlayout(local_size_x = 64) in;\n") + kParamsBlock +
+                       "#define INVOCATION " + kInvocationIndex + "\n";
+    const size_t n = GlMemory::kScatterColumns;
+    for (size_t k = 0; k < n; ++k)
+        text += "layout(std430, binding = " + std::to_string(k) + ") readonly buffer From" + std::to_string(k) +
+                " { uint from" + std::to_string(k) + "[]; };\n" + "layout(std430, binding = " + std::to_string(n + k) +
+                ") buffer To" + std::to_string(k) + " { uint to" + std::to_string(k) + "[]; };\n";
+    text += "layout(std430, binding = " + std::to_string(2 * n) + ") readonly buffer Rows { uint rows[]; };\n";
+    text += R"(void main() {
+    uint i = INVOCATION;
+    if (i >= param(0u)) return;
+    uint row = rows[param(2u) + i], source = param(1u) + i, pairs = param(3u), widths = param(4u);
+    if (row == 0xFFFFFFFFu) return;
+)";
+    for (size_t k = 0; k < n; ++k) {
+        std::string K = std::to_string(k);
+        text += "    if (pairs > " + K + "u) { uint w = (widths >> " + std::to_string(2 * k) +
+                "u) & 3u; for (uint j = 0u; j < w; ++j) to" + K + "[row * w + j] = from" + K + "[source * w + j]; }\n";
+    }
+    return text + "}\n";
+}
+
 // to[first + i] = from[rows[i]], or 0 for kSkipRow.
 const char* kGather = R"(void main() {
     uint i = INVOCATION;
@@ -95,7 +121,7 @@ GlMemory::GlMemory() = default;
 GlMemory::~GlMemory() {
     for (auto& c : columns_)
         if (c && c->gl) glDeleteBuffers(1, &c->gl);
-    for (unsigned program : {scatterProgram_, gatherProgram_, allocateProgram_, releaseProgram_, pushedProgram_, freshProgram_,
+    for (unsigned program : {scatterProgram_, scatterColumnsProgram_, gatherProgram_, allocateProgram_, releaseProgram_, pushedProgram_, freshProgram_,
                              identifyProgram_})
         if (program) glDeleteProgram(program);
     if (runsBuffer_) glDeleteBuffers(1, &runsBuffer_);
@@ -313,28 +339,40 @@ void GlMemory::scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const
     t.device = true;
 }
 
-// With the rows already on the GPU (a pool's rows allocated there: Memory::allocateRows).
-void GlMemory::scatter(Buffer from, size_t fromFirst, Buffer to, Buffer rows, size_t rowsFirst, size_t count) {
-    if (count == 0) return;
-    if (!at(rows).device) return rt::Memory::scatter(from, fromFirst, to, rows, rowsFirst, count);  // the list's on the host
-    Column &f = at(from), &t = at(to);
-    flush(f);
-    flush(t);
-    uploadRows(f, fromFirst, count);  // only the rows scattered: the source stays on the host
-    upload(t);
-    unsigned list = deviceBuffer(rows);
-    if (!scatterProgram_) scatterProgram_ = computeProgram(rowsShader(kScatter), "scatter");
-    PassTimer::Scope timed(timer, "scatter", count);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.gl);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, t.gl);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, list);
-    glUseProgram(scatterProgram_);
-    bindParams(paramsBuffer_, {static_cast<uint32_t>(count), static_cast<uint32_t>(fromFirst),
-                               static_cast<uint32_t>(wordsPerRow(f.elem)), static_cast<uint32_t>(rowsFirst)});
-    dispatchInvocations(count, 64);
-    ++dispatches;
-    afterWrite(Write::Dispatch, kColumnReaders);
-    t.device = true;
+// With the rows already on the GPU (a pool's rows allocated there: Memory::allocateRows):
+// kScatterColumns pairs of columns a dispatch, each its own storage blocks.
+void GlMemory::scatter(std::span<const std::pair<Buffer, Buffer>> columns, size_t fromFirst, Buffer rows,
+                       size_t rowsFirst, size_t count) {
+    if (count == 0 || columns.empty()) return;
+    if (!at(rows).device) return rt::Memory::scatter(columns, fromFirst, rows, rowsFirst, count);  // the list's on the host
+    if (!scatterColumnsProgram_) scatterColumnsProgram_ = computeProgram(scatterColumnsShader(), "scatter");
+    for (size_t begin = 0; begin < columns.size(); begin += kScatterColumns) {
+        size_t pairs = std::min(kScatterColumns, columns.size() - begin);
+        uint32_t widths = 0;
+        for (size_t k = 0; k < pairs; ++k) {
+            Column &f = at(columns[begin + k].first), &t = at(columns[begin + k].second);
+            flush(f);
+            flush(t);
+            uploadRows(f, fromFirst, count);  // only the rows scattered: the source stays on the host
+            upload(t);
+            widths |= static_cast<uint32_t>(wordsPerRow(f.elem)) << (2 * k);
+        }
+        unsigned list = deviceBuffer(rows);
+        PassTimer::Scope timed(timer, "scatter", count * pairs);
+        for (size_t k = 0; k < pairs; ++k) {
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, static_cast<GLuint>(k), at(columns[begin + k].first).gl);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, static_cast<GLuint>(kScatterColumns + k),
+                             at(columns[begin + k].second).gl);
+        }
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, static_cast<GLuint>(2 * kScatterColumns), list);
+        glUseProgram(scatterColumnsProgram_);
+        bindParams(paramsBuffer_, {static_cast<uint32_t>(count), static_cast<uint32_t>(fromFirst),
+                                   static_cast<uint32_t>(rowsFirst), static_cast<uint32_t>(pairs), widths});
+        dispatchInvocations(count, 64);
+        ++dispatches;
+        afterWrite(Write::Dispatch, kColumnReaders);
+        for (size_t k = 0; k < pairs; ++k) at(columns[begin + k].second).device = true;
+    }
 }
 
 // The rows scattered into a column on the GPU while it stayed there, in one upload and

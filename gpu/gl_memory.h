@@ -46,8 +46,8 @@ public:
                      size_t mapFirst) override;
     void markFresh(const rt::PoolRows& pool, rt::Buffer rows, size_t first, size_t count) override;
     using rt::Memory::scatter;
-    void scatter(rt::Buffer from, size_t fromFirst, rt::Buffer to, rt::Buffer rows, size_t rowsFirst,
-                 size_t count) override;
+    void scatter(std::span<const std::pair<rt::Buffer, rt::Buffer>> columns, size_t fromFirst, rt::Buffer rows,
+                 size_t rowsFirst, size_t count) override;
     void identify(const rt::ObjectRuns& runs, size_t n, size_t kept, rt::Buffer created, rt::Buffer ids,
                   rt::Buffer mask, size_t first) override;
 
@@ -90,6 +90,9 @@ public:
     PassTimer* timer = nullptr;
 
     static size_t wordsPerRow(rt::Elem e) { return e == rt::Elem::F64 ? 2 : 1; }
+    // Pairs of columns one scatter dispatch moves (scatter by a row list in a buffer): two
+    // storage blocks each, and the list's, of the 16 a compute shader has.
+    static constexpr size_t kScatterColumns = 7;
 
 private:
     struct Column;
@@ -108,7 +111,8 @@ private:
     // Scatters from the host of at most this many rows into a column on the GPU wait, and
     // go with the next ones once this many rows are pending (or the column is used).
     static constexpr size_t kPendingScatter = 64, kPendingFlush = 65536;
-    mutable unsigned scatterProgram_ = 0, gatherProgram_ = 0, rowsBuffer_ = 0, paramsBuffer_ = 0, pendingBuffer_ = 0;
+    mutable unsigned scatterProgram_ = 0, gatherProgram_ = 0, rowsBuffer_ = 0, paramsBuffer_ = 0, pendingBuffer_ = 0,
+                     scatterColumnsProgram_ = 0;
     // gpu/gl_rows.cpp: its programs (made on first use) and the runs' buffer.
     unsigned allocateProgram_ = 0, releaseProgram_ = 0, pushedProgram_ = 0, freshProgram_ = 0, identifyProgram_ = 0, runsBuffer_ = 0;
     unsigned bound(rt::Buffer b);  // deviceBuffer, for a column the dispatch writes

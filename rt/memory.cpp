@@ -79,10 +79,11 @@ void Memory::markFresh(const PoolRows& pool, Buffer rows, size_t first, size_t c
     for (size_t i = 0; i < count; ++i) updatable[list[i]] = alive[list[i]];
 }
 
-void Memory::scatter(Buffer from, size_t fromFirst, Buffer to, Buffer rows, size_t rowsFirst, size_t count) {
+void Memory::scatter(std::span<const std::pair<Buffer, Buffer>> columns, size_t fromFirst, Buffer rows,
+                     size_t rowsFirst, size_t count) {
     if (count == 0) return;
     const auto* list = static_cast<const uint32_t*>(view(rows)) + rowsFirst;
-    scatter(from, fromFirst, to, std::span<const uint32_t>(list, count));
+    for (auto [from, to] : columns) scatter(from, fromFirst, to, std::span<const uint32_t>(list, count));
 }
 
 void Memory::identify(const ObjectRuns& runs, size_t n, size_t kept, Buffer created, Buffer ids, Buffer mask,

@@ -15,6 +15,7 @@
 #include <limits>
 #include <memory>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "rt/allocation.h"
@@ -113,8 +114,10 @@ public:
     // The rows rows[first, first + count) become updatable where they are alive (the rows a
     // step created, at the next step's start).
     virtual void markFresh(const PoolRows& pool, Buffer rows, size_t first, size_t count);
-    // to[rows[rowsFirst + i]] = from[fromFirst + i], i < count, with the rows in a buffer.
-    virtual void scatter(Buffer from, size_t fromFirst, Buffer to, Buffer rows, size_t rowsFirst, size_t count);
+    // For each pair (from, to) of `columns`: to[rows[rowsFirst + i]] = from[fromFirst + i],
+    // i < count, with the rows in a buffer (a batch's columns into its pool rows at once).
+    virtual void scatter(std::span<const std::pair<Buffer, Buffer>> columns, size_t fromFirst, Buffer rows,
+                         size_t rowsFirst, size_t count);
     // A creation batch's objects r < n from their runs (rt::ObjectRuns): created[first + r],
     // ids[first + r], and mask[first + r] = r < kept.
     virtual void identify(const ObjectRuns& runs, size_t n, size_t kept, Buffer created, Buffer ids, Buffer mask,

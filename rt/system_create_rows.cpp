@@ -49,7 +49,7 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     Buffer mask = b.columns.at(kMask, Elem::U8, first + n);
     memory.identify(runs, n, kept, table[ColumnLayout::kCreated], table[ColumnLayout::kIds], mask, first);
     std::vector<std::pair<Buffer, Buffer>> columns = identityColumns(type, table);
-    for (auto [from, to] : columns) memory.scatter(from, first, to, rows, 0, kept);
+    memory.scatter(columns, first, rows, 0, kept);
     for (size_t s = 0; s < o.state.size(); ++s)
         for (int c = 0; c < o.state[s].type.width; ++c)
             memory.clear(table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)], first, n);
@@ -69,7 +69,7 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
         for (int c = 0; c < o.state[s].type.width; ++c)
             columns.push_back({table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)],
                                pool.state.column(s, static_cast<size_t>(c))});
-    for (auto [from, to] : columns) memory.scatter(from, first, to, rows, 0, kept);
+    memory.scatter(columns, first, rows, 0, kept);
     late.type = type;
     late.at = s_.dying.size();
     late.t1 = t1;

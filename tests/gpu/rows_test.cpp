@@ -156,6 +156,60 @@ TEST_CASE("ids and creation times from a batch's runs: the same bits on the GPU 
     CHECK(mask[0][kept] == 0);
 }
 
+TEST_CASE("a scatter of several columns by a row list moves on the GPU what it moves on the host") {
+    // Nine pairs of columns (more than a dispatch takes: GlMemory::kScatterColumns) of
+    // every element type, by a list of distinct rows with skipped ones, from a batch's row
+    // 7 on: the targets' rows the list names get the batch's values, the others keep theirs.
+    auto gpu = gpuBackend();
+    rt::HostMemory hostMemory;
+    constexpr size_t kCount = 300, kRows = 1000, kFirst = 7;
+    const std::vector<rt::Elem> elems = {rt::Elem::F32, rt::Elem::F64, rt::Elem::U32, rt::Elem::U8, rt::Elem::F32,
+                                         rt::Elem::F32, rt::Elem::F64, rt::Elem::U8,  rt::Elem::F32};
+    std::mt19937 random(11);
+    std::vector<uint32_t> rows(kRows), list(kCount), identity(kCount);
+    for (uint32_t r = 0; r < kRows; ++r) rows[r] = r;
+    std::shuffle(rows.begin(), rows.end(), random);
+    for (uint32_t i = 0; i < kCount; ++i) {
+        list[i] = i % 13 == 0 ? rt::kSkipRow : rows[i];
+        identity[i] = i;
+    }
+    std::vector<std::vector<uint8_t>> values(2 * elems.size());  // from, to: random bytes
+    for (size_t c = 0; c < elems.size(); ++c) {
+        values[2 * c].resize((kFirst + kCount) * rt::elemSize(elems[c]));
+        values[2 * c + 1].resize(kRows * rt::elemSize(elems[c]));
+        for (auto* v : {&values[2 * c], &values[2 * c + 1]})
+            for (uint8_t& b : *v) b = static_cast<uint8_t>(random() % 200);  // (no NaN's payload to lose)
+    }
+    std::vector<std::vector<uint8_t>> after[2];
+    int which = 0;
+    for (rt::Memory* m : {static_cast<rt::Memory*>(&hostMemory), &gpu->memory()}) {
+        // The list where a device's operations leave it (on the GPU: scattered there).
+        rt::Buffer staged = m->create(rt::Elem::U32, kCount), listed = m->create(rt::Elem::U32, kCount);
+        m->write(staged, 0, kCount, list.data());
+        m->scatter(staged, 0, listed, identity);
+        std::vector<std::pair<rt::Buffer, rt::Buffer>> columns;
+        for (size_t c = 0; c < elems.size(); ++c) {
+            rt::Buffer from = m->create(elems[c], kFirst + kCount), to = m->create(elems[c], kRows);
+            m->write(from, 0, kFirst + kCount, values[2 * c].data());
+            m->write(to, 0, kRows, values[2 * c + 1].data());
+            columns.push_back({from, to});
+        }
+        uint64_t dispatches = gpu->dispatches();
+        m->scatter(columns, kFirst, listed, 0, kCount);
+        if (which == 1) CHECK(gpu->dispatches() - dispatches == 2);  // seven pairs, then two
+        for (size_t c = 0; c < elems.size(); ++c) {
+            after[which].emplace_back(kRows * rt::elemSize(elems[c]));
+            m->read(columns[c].second, 0, kRows, after[which].back().data());
+        }
+        ++which;
+    }
+    for (size_t c = 0; c < elems.size(); ++c) {
+        INFO("column " << c);
+        CHECK(after[0][c] == after[1][c]);
+        CHECK(after[0][c] != values[2 * c + 1]);  // it moved something
+    }
+}
+
 TEST_CASE("a pool of objects that only die keeps its rows on the GPU: what a step moves does not grow with them") {
     // The fountain at 2,000 and at 20,000 drops: the drops' rows — the free stack, the
     // generations, the masks — are on the GPU, and their rows, ids and creation times are
