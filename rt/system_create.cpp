@@ -168,7 +168,7 @@ void Creation::drawBatch(size_t type, Batch& b, size_t n, double t1) {
 }
 
 // The batch's objects in its columns and their pool rows: creation times, ids, parents
-// (and their readers), kept parameters; the state zeroed for init.
+// (and their readers), kept parameters; the state init does not set, zeroed.
 void Creation::identify(size_t type, Batch& b, size_t n) {
     Pool& pool = s_.pools[type];
     const TypeInfo& info = s_.types[type];
@@ -204,7 +204,7 @@ void Creation::identify(size_t type, Batch& b, size_t n) {
         }
     // Into the pool rows through the memory (the pool's columns may live on a device).
     s_.scatter(identityColumns(type, table), first, b.poolRows);
-    for (size_t s = 0; s < o.state.size(); ++s)
+    for (size_t s : info.zeroedState)  // (what init sets is not)
         for (int c = 0; c < o.state[s].type.width; ++c)
             s_.memory.clear(table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)], first, n);
 }

@@ -50,7 +50,7 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     memory.identify(runs, n, kept, table[ColumnLayout::kCreated], table[ColumnLayout::kIds], mask, first);
     std::vector<std::pair<Buffer, Buffer>> columns = identityColumns(type, table);
     memory.scatter(columns, first, rows, 0, kept);
-    for (size_t s = 0; s < o.state.size(); ++s)
+    for (size_t s : info.zeroedState)  // (what init sets is not)
         for (int c = 0; c < o.state[s].type.width; ++c)
             memory.clear(table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)], first, n);
     // Init at each object's creation time with dt 0; then one update to t1, dt each

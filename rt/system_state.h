@@ -56,6 +56,9 @@ struct TypeInfo {
     // Its pool keeps its rows in the memory (Pool::keepRowsInMemory): a type whose
     // kills are late, with no parent, no bursts and no sub-steps.
     bool rowsInMemory = false;
+    // The state slots a creation batch zeroes before init: those init does not set (every
+    // one where there is no init, or where it reads the state).
+    std::vector<size_t> zeroedState;
     std::vector<bool> counted, rated;  // per emit site: whether the update yields its count, its rate
     std::array<bool, 4> drawn{};       // visible, position, colour, size: whether render yields it
 };

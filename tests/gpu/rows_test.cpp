@@ -210,6 +210,23 @@ TEST_CASE("a scatter of several columns by a row list moves on the GPU what it m
     }
 }
 
+TEST_CASE("a creation batch zeroes only the state its init does not set") {
+    // The fountain's init sets every slot of a drop's state: its batches clear nothing.
+    // The fire's sets the velocity, not the two integrals, which start at zero: six
+    // components cleared a batch (and the objects are the interpreter's: gpu_test.cpp).
+    auto clears = [](const char* effect) {
+        auto gpu = gpuBackend();
+        rt::System system(test::compileModule(readFile(test::sample(effect))), *gpu);
+        for (int f = 0; f < 30; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
+        gpu->timePasses(true);
+        for (int f = 0; f < 5; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
+        auto clear = gpu->passTimes().find("clear");
+        return clear == gpu->passTimes().end() ? size_t{0} : clear->second.launches;
+    };
+    CHECK(clears("fountain") == 0);
+    CHECK(clears("fire") == 5 * 6);
+}
+
 TEST_CASE("a pool of objects that only die keeps its rows on the GPU: what a step moves does not grow with them") {
     // The fountain at 2,000 and at 20,000 drops: the drops' rows — the free stack, the
     // generations, the masks — are on the GPU, and their rows, ids and creation times are
