@@ -127,4 +127,9 @@ std::string ColumnLayout::signature() const {
     return s;
 }
 
+const ir::Kernel* initKernel(const ir::Object& object) {
+    const ir::Kernel* init = object.kernel(ir::KernelKind::Init);
+    return init && !init->yields.empty() ? init : nullptr;
+}
+
 }  // namespace psys::rt

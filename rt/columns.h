@@ -106,6 +106,10 @@ struct ColumnLayout {
 
 ColumnLayout columnLayout(const ir::Object& object, const ir::Kernel& kernel);
 
+// An object's init kernel where it sets anything (an object whose state starts at zero
+// and that bursts nothing has an empty one: creating it runs no init).
+const ir::Kernel* initKernel(const ir::Object& object);
+
 // The argument columns of a spawn kernel (ChildrenLaunch::args): one per component of each
 // argument (emit.arg #sub), arguments in order. `first[sub]` is where argument sub starts.
 struct ArgumentColumns {

@@ -45,7 +45,9 @@ Plan launchPlan(const ir::Module& module) {
         bool subSteps = o.attributes.step > 0;
         for (const ir::Kernel& k : o.kernels) {
             switch (k.kind) {
-                case KernelKind::Init: plan.rows.push_back({&o, &k, S::PerRow, S::Uniform, stream}); break;  // dt 0
+                case KernelKind::Init:  // dt 0; one that sets nothing does not run (initKernel)
+                    if (initKernel(o)) plan.rows.push_back({&o, &k, S::PerRow, S::Uniform, stream});
+                    break;
                 case KernelKind::Update:
                     plan.rows.push_back({&o, &k, S::Uniform, S::Uniform});
                     plan.rows.push_back({&o, &k, S::Uniform, S::SinceCreated, stream});

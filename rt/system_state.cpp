@@ -34,7 +34,7 @@ TypeInfo typeInfo(const ir::Module& module, const ir::Object& o) {
     TypeInfo t;
     t.parentType = o.parent.empty() ? -1 : module.objectIndex(o.parent);
     t.stepLimit = o.attributes.step;
-    t.init = o.kernel(KernelKind::Init);
+    t.init = initKernel(o);
     t.update = o.kernel(KernelKind::Update);
     t.exports = o.kernel(KernelKind::Exports);
     t.render = o.kernel(KernelKind::Render);

@@ -210,21 +210,25 @@ TEST_CASE("a scatter of several columns by a row list moves on the GPU what it m
     }
 }
 
-TEST_CASE("a creation batch zeroes only the state its init does not set") {
+TEST_CASE("a creation batch zeroes only the state its init does not set, and runs no init that sets nothing") {
     // The fountain's init sets every slot of a drop's state: its batches clear nothing.
     // The fire's sets the velocity, not the two integrals, which start at zero: six
     // components cleared a batch (and the objects are the interpreter's: gpu_test.cpp).
-    auto clears = [](const char* effect) {
+    // The fireworks' sparks start with their integrals at zero: their init is empty and
+    // does not run (the rockets' sets their velocity: a launch for each rocket's batch).
+    auto passes = [](const char* effect, const char* pass) {
         auto gpu = gpuBackend();
         rt::System system(test::compileModule(readFile(test::sample(effect))), *gpu);
         for (int f = 0; f < 30; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
         gpu->timePasses(true);
         for (int f = 0; f < 5; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
-        auto clear = gpu->passTimes().find("clear");
-        return clear == gpu->passTimes().end() ? size_t{0} : clear->second.launches;
+        auto time = gpu->passTimes().find(pass);
+        return time == gpu->passTimes().end() ? size_t{0} : time->second.launches;
     };
-    CHECK(clears("fountain") == 0);
-    CHECK(clears("fire") == 5 * 6);
+    CHECK(passes("fountain", "clear") == 0);
+    CHECK(passes("fire", "clear") == 5 * 6);
+    CHECK(passes("fountain", "init") == 5);
+    CHECK(passes("fireworks", "init") <= 1);  // (a rocket every sixth step)
 }
 
 TEST_CASE("a pool of objects that only die keeps its rows on the GPU: what a step moves does not grow with them") {
