@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
                      "GPU runs it\n";
     nlohmann::json rows = nlohmann::json::array();
     std::cout << "\n| effect | live | step (ms) | host CPU (ms) | M updates/s | update pass (ms) | other passes (ms, and how many a step) | state B/particle | "
-                 "update pass GB/s | host↔GPU B/particle/step | staged B/particle/step | waits/step | late/step (stalled) |\n|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|\n";
+                 "update pass GB/s | host↔GPU B/particle/step | staged B/particle/step | waits/step | late/step (stalled) | dispatches/step |\n|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const std::string& name : effects) {
         const bench::Effect* effect = bench::findEffect(name);
         if (!effect) {
@@ -83,18 +83,18 @@ int main(int argc, char** argv) {
                             {"mups", f.perSecond / 1e6}, {"update_ms", f.updateMilliseconds},
                             {"update_gbs", gbs}, {"state_bytes", f.stateBytes}, {"transfer_bytes", f.transferBytes},
                             {"staged_bytes", f.stagedBytes}, {"waits", f.waits}, {"late_reads", f.lateReads},
-                            {"late_stalls", f.lateStalls}, {"rows", rowsIn}, {"renderer", renderer}});
-            std::cout << fmt::format("| {} | {:.2g} | {:.2f} | {:.2f} | {:.1f} | {:.2f}{} | {} | {:.0f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} ({:.1f}) |\n", name,
+                            {"late_stalls", f.lateStalls}, {"dispatches", f.dispatches}, {"rows", rowsIn}, {"renderer", renderer}});
+            std::cout << fmt::format("| {} | {:.2g} | {:.2f} | {:.2f} | {:.1f} | {:.2f}{} | {} | {:.0f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} ({:.1f}) | {:.1f} |\n", name,
                                      f.live, f.stepSeconds * 1e3, f.hostCpuSeconds * 1e3, f.perSecond / 1e6, f.updateMilliseconds,
                                      f.wallPasses ? " (wall)" : "", others,
                                      f.stateBytes, gbs, f.transferBytes, f.stagedBytes, f.waits, f.lateReads,
-                                     f.lateStalls);
+                                     f.lateStalls, f.dispatches);
             std::cout.flush();
         }
     }
     if (!json.empty() && !bench::writeJson(json, rows.dump(2), "psys_gpu_bench")) return 1;
     std::cout << "\n(host CPU: the CPU time of the thread that steps, the GL driver's threads not counted; passes: GPU time from GL timer queries, or \"wall\": from a glFinish before the pass to one after, "
                  "where the GL's timer does not see compute work; state B/particle: what the update pass must read and "
-                 "write; update pass GB/s: that ÷ the pass's time; staged: copied on the GPU into and out of launches' words, beyond what the shaders move; waits/step: read-backs the host waited for mid-step; late/step: read-backs taken when the run-time needed them (kills at the step's end), and in brackets those the GPU had not finished by then)\n";
+                 "write; update pass GB/s: that ÷ the pass's time; staged: copied on the GPU into and out of launches' words, beyond what the shaders move; waits/step: read-backs the host waited for mid-step; late/step: read-backs taken when the run-time needed them (kills at the step's end), and in brackets those the GPU had not finished by then; dispatches/step: compute dispatches the host recorded, kernels and bookkeeping)\n";
     return 0;
 }

@@ -43,7 +43,7 @@ GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::G
     };
     double live = 0;
     uint64_t transferred = gpu.transferredBytes(), waits = gpu.waits(), staged = gpu.stagedBytes();
-    uint64_t lateReads = gpu.lateReads(), lateStalls = gpu.lateStalls();
+    uint64_t lateReads = gpu.lateReads(), lateStalls = gpu.lateStalls(), dispatches = gpu.dispatches();
     for (int f = 0; f < frames; ++f) {
         auto start = Clock::now();
         double cpuStart = threadSeconds();
@@ -58,6 +58,7 @@ GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::G
     out.lateReads = static_cast<double>(gpu.lateReads() - lateReads) / frames;
     out.lateStalls = static_cast<double>(gpu.lateStalls() - lateStalls) / frames;
     out.stagedBytes = static_cast<double>(gpu.stagedBytes() - staged) / frames / std::max(out.live, 1.0);
+    out.dispatches = static_cast<double>(gpu.dispatches() - dispatches) / frames;
     out.stepSeconds = median(times);
     out.hostCpuSeconds = median(cpu);
     out.perSecond = out.live / out.stepSeconds;

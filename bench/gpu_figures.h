@@ -27,6 +27,7 @@ struct GpuFigures {
     double waits = 0;              // per step: times the host waited for a read-back from the GPU
     double lateReads = 0, lateStalls = 0;  // per step: read-backs taken at the step's end; of them, not ready
     double stagedBytes = 0;        // per particle per step, copied on the GPU into and out of launches' words
+    double dispatches = 0;         // per step: compute dispatches the host recorded (kernels and bookkeeping)
 };
 
 // The GLSL backend as psysc and the viewer make it, its host side taking launches of at
