@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <unordered_set>
@@ -154,12 +155,13 @@ void GlMemory::resize(Buffer b, size_t rows) {
     Column& c = at(b);
     if (c.device) {  // grown or shrunk on the GPU: the column stays there
         if (rows < c.rows) flush(c);  // (rows pending past the end would land in rows to be zeroed)
-        PassTimer::Scope timed(timer, "grow", rows);
+        std::optional<PassTimer::Scope> timed;  // timed where there is GL work: a new buffer, rows zeroed
         size_t w = wordsPerRow(c.elem);
         // A pool grows a row at a time: the GL buffer doubles, and is zeroed past the rows
         // once then, not at each row.
         auto clear = [&](size_t from, size_t to) {
             if (to <= from) return;
+            if (!timed) timed.emplace(timer, "grow", rows);
             uint32_t zero = 0;
             glClearNamedBufferSubData(c.gl, GL_R32UI, static_cast<GLintptr>(from * w * 4),
                                       static_cast<GLsizeiptr>((to - from) * w * 4), GL_RED_INTEGER, GL_UNSIGNED_INT,
@@ -167,6 +169,7 @@ void GlMemory::resize(Buffer b, size_t rows) {
             afterWrite(Write::Clear, kColumnReaders);
         };
         if (rows > c.glRows) {
+            timed.emplace(timer, "grow", rows);
             size_t room = std::max(rows, 2 * c.glRows);
             GLuint grown = 0;
             glCreateBuffers(1, &grown);

@@ -21,6 +21,7 @@
 #include <doctest/doctest.h>
 #include <epoxy/gl.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -300,6 +301,36 @@ TEST_CASE("an object's state stays on the GPU from step to step") {
     double stagedPerDrop = static_cast<double>(gpu->stagedBytes() - staged) / 10 / static_cast<double>(live);
     MESSAGE("bytes copied on the GPU per drop per step: " << stagedPerDrop);
     CHECK(stagedPerDrop < 4);
+}
+
+TEST_CASE("a column on the GPU grows into its buffer's zeroed room without GL work, its new rows zero") {
+    // A pool grows every step while its population rises: the GL buffer doubles and is
+    // zeroed past the rows once; growing within it records nothing (no "grow" pass).
+    auto gpu = gpuBackend();
+    auto& memory = static_cast<gpu::GlMemory&>(gpu->memory());
+    rt::Buffer host = memory.create(rt::Elem::F32, 100), column = memory.create(rt::Elem::F32, 100);
+    std::vector<float> ones(100, 1);
+    std::vector<uint32_t> all(100);
+    for (uint32_t r = 0; r < 100; ++r) all[r] = r;
+    memory.write(host, 0, 100, ones.data());
+    memory.scatter(host, 0, column, all);
+    REQUIRE(memory.onDevice(column));
+    gpu->timePasses(true);
+    auto grown = [&] {
+        auto t = gpu->passTimes().find("grow");
+        return t == gpu->passTimes().end() ? size_t{0} : t->second.launches;
+    };
+    memory.resize(column, 101);  // a new GL buffer of 200 rows, zeroed past the 100
+    CHECK(grown() == 1);
+    memory.resize(column, 150);
+    memory.resize(column, 200);
+    CHECK(grown() == 1);
+    std::vector<float> out(200);
+    memory.read(column, 0, 200, out.data());
+    CHECK(std::all_of(out.begin(), out.begin() + 100, [](float x) { return x == 1; }));
+    CHECK(std::all_of(out.begin() + 100, out.end(), [](float x) { return x == 0; }));
+    memory.resize(column, 201);  // past it: a new buffer
+    CHECK(grown() == 2);
 }
 
 TEST_CASE("a gather reads rows of a column where it lives: on the GPU without a read-back, 0 for a skipped row") {
