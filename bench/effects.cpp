@@ -17,7 +17,7 @@ double median(std::vector<double> v) {
 
 const std::vector<Effect> kEffects = {
     {"fountain", "population", "drop", 200},
-    {"fire", "rate", "part", 540},
+    {"fire", "rate", "part", 900},  // (its first particles fall back below the ground at about 12 s)
     {"fireworks", "sparks", "spark", 420},
 };
 
