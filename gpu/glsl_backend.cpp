@@ -1,7 +1,6 @@
 #include "gpu/glsl_backend.h"
 
 #include <algorithm>
-#include <bit>
 #include <chrono>
 #include <optional>
 #include <cstring>
@@ -28,31 +27,6 @@ using rt::ColumnLayout;
 using rt::Elem;
 
 namespace {
-
-uint32_t bits(float x) { return std::bit_cast<uint32_t>(x); }
-
-void putDouble(std::vector<uint32_t>& block, uint32_t word, double x) {
-    auto b = std::bit_cast<uint64_t>(x);
-    block[word] = static_cast<uint32_t>(b);
-    block[word + 1] = static_cast<uint32_t>(b >> 32);
-}
-
-// The words every launch block starts with.
-std::vector<uint32_t> blockHeader(const LaunchBlock& layout, size_t count, const rt::Clock& clock, uint32_t seed,
-                                  uint32_t draw) {
-    std::vector<uint32_t> block(layout.words + 4, 0);
-    block[LaunchBlock::kCount] = static_cast<uint32_t>(count);
-    putDouble(block, LaunchBlock::kNow, clock.nowValue);
-    block[LaunchBlock::kDt] = bits(clock.dtValue);
-    block[LaunchBlock::kFirst] = clock.first ? 1 : 0;
-    block[LaunchBlock::kSeed] = seed;
-    block[LaunchBlock::kDraw] = draw;
-    return block;
-}
-
-void putValue(std::vector<uint32_t>& block, uint32_t word, const rt::Value& v) {
-    for (size_t c = 0; c < 4; ++c) block[word + c] = bits(v.f[c]);
-}
 
 // The table columns a kernel writes: what stays on the GPU (state, exports, what is drawn:
 // codegen_glsl::keptColumns) and what the host reads right after the launch (kill flags,
@@ -486,134 +460,6 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
             memory_.adopt(b, begin, n, words_, block[LaunchBlock::kColumns + static_cast<size_t>(c)]);
     }
     return readBack(launch, p, begin, n, block, late);
-}
-
-void GlslBackend::run(const rt::ChildrenLaunch& launch) { runChildren({&launch, 1}); }
-
-// In order, a run of launches of one spawn kernel on the GPU at a time; a launch small
-// enough for the host side (its columns there) runs there, after the launches before it.
-void GlslBackend::runChildren(std::span<const rt::ChildrenLaunch> launches) {
-    size_t from = 0;
-    auto flush = [&](size_t to) {
-        if (to > from) dispatchChildren(launches.subspan(from, to - from));
-        from = to;
-    };
-    for (size_t k = 0; k < launches.size(); ++k) {
-        const rt::ChildrenLaunch& l = launches[k];
-        if (k > from && l.spawn != launches[from].spawn) flush(k);
-        if (l.count == 0 || (onHost(l.columns, Buffer{}, l.count) && onHost(l.args, Buffer{}, l.count))) {
-            flush(k);
-            from = k + 1;
-            if (l.count == 0) continue;
-            ++hostLaunches_;
-            hostSide_->run(l);
-        }
-    }
-    flush(launches.size());
-}
-
-// One dispatch for every child of the launches (all of one spawn kernel, so all into the
-// same argument columns): emitter e's launch block at word firstWord + e·W of the words;
-// each invocation finds its emitter's block (codegen_glsl::childrenShader). The children
-// write their arguments in place, each column bound from the first launch's rows on
-// (codegen_glsl::directArguments); else into the words before the blocks (component c of
-// every child at c·N + its place), copied to the columns after.
-void GlslBackend::dispatchChildren(std::span<const rt::ChildrenLaunch> launches) {
-    if (context_) context_->makeCurrent();
-    memory_.flushPending();  // before anything is bound
-    const rt::ChildrenLaunch& front = launches.front();
-    Program& p = childrenProgram(*front.object, *front.spawn);
-    const ir::Object& o = *front.object;
-    const ColumnLayout& l = *front.layout;
-    size_t total = 0, columns = front.args.size(), bound = SIZE_MAX, end = 0;
-    for (const rt::ChildrenLaunch& launch : launches) {
-        total += launch.count;
-        bound = std::min(bound, launch.argsFirst);
-        end = std::max(end, launch.argsFirst + launch.count);
-    }
-    const bool direct = !p.direct.empty();
-    bound = bound * 4 / storageAlignment_ * storageAlignment_ / 4;  // (f32 columns: a word a row)
-    if (direct)
-        for (size_t c = 0; c < columns; ++c)
-            glBindBufferRange(GL_SHADER_STORAGE_BUFFER, static_cast<GLuint>(2 + c), memory_.deviceBuffer(front.args[c]),
-                              static_cast<GLintptr>(bound * 4), static_cast<GLsizeiptr>((end - bound) * 4));
-    const size_t recordWords = (p.block.words + 4 + 3) & ~size_t{3}, firstWord = direct ? 0 : columns * total;
-    std::vector<uint32_t> records;
-    records.reserve(launches.size() * recordWords);
-    // The emitter's creation time, id, parameters and state, from its row: copied into its
-    // block on the GPU where the column is there (the host does not wait for it), from the
-    // host's copy where it is not. A parameter the pool does not keep reads 0, as on every
-    // backend.
-    std::vector<BlockFill> fill;
-    size_t place = 0;
-    for (const rt::ChildrenLaunch& launch : launches) {
-        const auto base = static_cast<uint32_t>(firstWord + records.size());
-        std::vector<uint32_t> block = blockHeader(p.block, launch.count, launch.clock, launch.seed, launch.draw);
-        block.resize(recordWords, 0);
-        block[LaunchBlock::kFirstInvocation] = static_cast<uint32_t>(place);
-        block[LaunchBlock::kFirstChild] = launch.firstChild;
-        for (size_t c = 0; c < columns; ++c)
-            block[LaunchBlock::kColumns + c] = static_cast<uint32_t>(direct ? launch.argsFirst - bound : c * total + place);
-        for (uint32_t e = 0; e < p.block.externCount; ++e) putValue(block, p.block.externs + 4 * e, launch.externs[e]);
-        auto fromRow = [&](Buffer b, uint32_t word) {
-            if (!b.valid()) return;
-            size_t w = GlMemory::wordsPerRow(memory_.elem(b));
-            if (memory_.onDevice(b)) {
-                fill.push_back({memory_.deviceBuffer(b), launch.row * w * 4, base + word, static_cast<uint32_t>(w)});
-                return;
-            }
-            uint32_t words[2] = {0, 0};
-            memory_.read(b, launch.row, 1, words);  // on the host: no wait
-            for (size_t k = 0; k < w; ++k) block[word + k] = words[k];
-        };
-        fromRow(launch.columns[ColumnLayout::kCreated], LaunchBlock::kCreated);
-        fromRow(launch.columns[ColumnLayout::kIds], LaunchBlock::kObjectId);
-        auto fromColumns = [&](int column, int width, uint32_t word) {
-            for (int c = 0; c < width; ++c)
-                fromRow(launch.columns[static_cast<size_t>(column + c)], word + static_cast<uint32_t>(c));
-        };
-        for (size_t i = 0; i < o.params.size(); ++i)
-            fromColumns(l.paramOffset[i], o.params[i].type.width, p.block.params + 4 * static_cast<uint32_t>(i));
-        for (size_t i = 0; i < o.state.size(); ++i)
-            fromColumns(l.stateOffset[i], o.state[i].type.width, p.block.state + 4 * static_cast<uint32_t>(i));
-        for (size_t i = 0; i < l.parentColumns.size(); ++i)
-            putValue(block, p.block.parents + 4 * static_cast<uint32_t>(i), launch.parents[i]);
-        records.insert(records.end(), block.begin(), block.end());
-        place += launch.count;
-    }
-    ensureWords(firstWord + records.size());
-    glNamedBufferSubData(words_, static_cast<GLintptr>(firstWord * 4), static_cast<GLsizeiptr>(records.size() * 4),
-                         records.data());
-    afterWrite(Write::Upload, kStorageBlock);
-    for (const BlockFill& f : fill)
-        glCopyNamedBufferSubData(f.from, words_, static_cast<GLintptr>(f.byte), static_cast<GLintptr>(f.word) * 4,
-                                 static_cast<GLsizeiptr>(f.words) * 4);
-    if (!fill.empty()) afterWrite(Write::Copy, kStorageBlock);
-    using R = codegen_glsl::LaunchRecords;
-    std::vector<uint32_t> uniform(4, 0);
-    uniform[R::kChildren] = static_cast<uint32_t>(total);
-    uniform[R::kEmitters] = static_cast<uint32_t>(launches.size());
-    uniform[R::kFirstWord] = static_cast<uint32_t>(firstWord);
-    uniform[R::kWords] = static_cast<uint32_t>(recordWords);
-    dispatch(p, uniform, total, p.pass);
-    // The children's arguments stay on the GPU: creation scatters them into pool rows
-    // there. From the words, launches whose rows follow each other in one copy.
-    if (direct) {
-        for (Buffer b : front.args) memory_.written(b);
-        return;
-    }
-    place = 0;
-    for (size_t k = 0; k < launches.size();) {
-        const rt::ChildrenLaunch& a = launches[k];
-        size_t count = a.count, next = k + 1;
-        while (next < launches.size() && std::equal(a.args.begin(), a.args.end(), launches[next].args.begin(),
-                                                    launches[next].args.end()) &&
-               launches[next].argsFirst == a.argsFirst + count)
-            count += launches[next++].count;
-        for (size_t c = 0; c < columns; ++c) memory_.adopt(a.args[c], a.argsFirst, count, words_, c * total + place);
-        place += count;
-        k = next;
-    }
 }
 
 bool GlslBackend::parallelCompile() {

@@ -110,7 +110,7 @@ private:
     Program& rowsProgram(const ir::Object& object, const ir::Kernel& kernel, rt::Clock::Source now,
                          rt::Clock::Source dt);
     Program& childrenProgram(const ir::Object& object, const ir::Kernel& spawn);
-    // Launches of one spawn kernel as one dispatch (runChildren).
+    // Launches of one spawn kernel as one dispatch (runChildren, gpu/glsl_children.cpp).
     void dispatchChildren(std::span<const rt::ChildrenLaunch> launches);
     Program compile(const std::string& source, const std::string& what);
     struct Late;
@@ -128,6 +128,10 @@ private:
     };
     void dispatch(Program& program, const std::vector<uint32_t>& block, size_t count, const std::string& pass,
                   std::span<const BlockFill> fill = {});
+    // gpu/glsl_children.cpp: an emitter's block of a children launch, its row's values
+    // filled on the GPU from word `base` of the words (`fill`) where they are there.
+    static std::vector<uint32_t> emitterBlock(GlMemory& memory, const Program& program, const rt::ChildrenLaunch& launch,
+                                              uint32_t base, std::vector<BlockFill>& fill);
     // gpu/glsl_readback.cpp: what a launch sends back, into a region of one mapped buffer,
     // read at once (one wait) or, for a late launch, when the run-time collects it.
     rt::RowsResult readBack(const rt::RowsLaunch& launch, const Program& program, size_t begin, size_t n,

@@ -1,7 +1,10 @@
-// Internal to the GLSL backend (gpu/glsl_backend.cpp, gpu/glsl_readback.cpp): a compiled
-// shader and what a launch of it carries and gives back; a late launch's read-back.
+// Internal to the GLSL backend (gpu/glsl_backend.cpp, gpu/glsl_children.cpp,
+// gpu/glsl_readback.cpp): a compiled shader and what a launch of it carries and gives
+// back; a late launch's read-back; the words of a launch block.
 #pragma once
 
+#include <bit>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -39,5 +42,25 @@ struct GlslBackend::Late {
     rt::RowsResult counts;
     std::vector<uint32_t> rows;
 };
+
+// The words every launch block starts with (count, clock, seed, draw), and 4-word values in it.
+inline std::vector<uint32_t> blockHeader(const codegen_glsl::LaunchBlock& layout, size_t count, const rt::Clock& clock,
+                                         uint32_t seed, uint32_t draw) {
+    using codegen_glsl::LaunchBlock;
+    std::vector<uint32_t> block(layout.words + 4, 0);
+    block[LaunchBlock::kCount] = static_cast<uint32_t>(count);
+    auto now = std::bit_cast<uint64_t>(clock.nowValue);
+    block[LaunchBlock::kNow] = static_cast<uint32_t>(now);
+    block[LaunchBlock::kNow + 1] = static_cast<uint32_t>(now >> 32);
+    block[LaunchBlock::kDt] = std::bit_cast<uint32_t>(clock.dtValue);
+    block[LaunchBlock::kFirst] = clock.first ? 1 : 0;
+    block[LaunchBlock::kSeed] = seed;
+    block[LaunchBlock::kDraw] = draw;
+    return block;
+}
+
+inline void putValue(std::vector<uint32_t>& block, uint32_t word, const rt::Value& v) {
+    for (size_t c = 0; c < 4; ++c) block[word + c] = std::bit_cast<uint32_t>(v.f[c]);
+}
 
 }  // namespace psys::gpu
