@@ -16,6 +16,7 @@
 
 #include "gpu_figures.h"
 #include "gpu_stress.h"
+#include "host_cache.h"
 #include "interp/interpreter.h"
 
 using namespace psys;
@@ -43,8 +44,13 @@ int main(int argc, char** argv) {
     bool stress = false;
     app.add_flag("--stress", stress,
                  "The hostile shapes instead: burst chains and many types, against the interpreter (docs/gpu.md)");
+    bool hostCache = false;
+    app.add_flag("--host-cache", hostCache,
+                 "What sharing the caches with a software GPU costs the host's thread: its fixed work between waits "
+                 "for workers that stream 0 to 256 MB (bench/host_cache.h); no GL");
     CLI11_PARSE(app, argc, argv);
     if (stress) return bench::stressFigures(std::cout, frames);
+    if (hostCache) return bench::hostCacheFigures(std::cout, 10 * frames);
 
     auto gpu = bench::gpuBackend("psys_gpu_bench", hostRows);  // the emitters (few rows) on the host
     if (!gpu) return 1;
@@ -56,7 +62,7 @@ int main(int argc, char** argv) {
                      "GPU runs it\n";
     nlohmann::json rows = nlohmann::json::array();
     std::cout << "\n| effect | live | step (ms) | host CPU (ms) | M updates/s | update pass (ms) | other passes (ms, and how many a step) | state B/particle | "
-                 "update pass GB/s | host↔GPU B/particle/step | staged B/particle/step | waits/step | late/step (stalled) | dispatches/step |\n|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|\n";
+                 "update pass GB/s | host↔GPU B/particle/step | staged B/particle/step | waits/step | late/step (stalled) | dispatches/step | host sleeps/step |\n|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const std::string& name : effects) {
         const bench::Effect* effect = bench::findEffect(name);
         if (!effect) {
@@ -83,18 +89,19 @@ int main(int argc, char** argv) {
                             {"mups", f.perSecond / 1e6}, {"update_ms", f.updateMilliseconds},
                             {"update_gbs", gbs}, {"state_bytes", f.stateBytes}, {"transfer_bytes", f.transferBytes},
                             {"staged_bytes", f.stagedBytes}, {"waits", f.waits}, {"late_reads", f.lateReads},
-                            {"late_stalls", f.lateStalls}, {"dispatches", f.dispatches}, {"rows", rowsIn}, {"renderer", renderer}});
-            std::cout << fmt::format("| {} | {:.2g} | {:.2f} | {:.2f} | {:.1f} | {:.2f}{} | {} | {:.0f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} ({:.1f}) | {:.1f} |\n", name,
+                            {"late_stalls", f.lateStalls}, {"dispatches", f.dispatches},
+                            {"host_sleeps", f.hostSleeps}, {"rows", rowsIn}, {"renderer", renderer}});
+            std::cout << fmt::format("| {} | {:.2g} | {:.2f} | {:.2f} | {:.1f} | {:.2f}{} | {} | {:.0f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} ({:.1f}) | {:.1f} | {:.1f} |\n", name,
                                      f.live, f.stepSeconds * 1e3, f.hostCpuSeconds * 1e3, f.perSecond / 1e6, f.updateMilliseconds,
                                      f.wallPasses ? " (wall)" : "", others,
                                      f.stateBytes, gbs, f.transferBytes, f.stagedBytes, f.waits, f.lateReads,
-                                     f.lateStalls, f.dispatches);
+                                     f.lateStalls, f.dispatches, f.hostSleeps);
             std::cout.flush();
         }
     }
     if (!json.empty() && !bench::writeJson(json, rows.dump(2), "psys_gpu_bench")) return 1;
     std::cout << "\n(host CPU: the CPU time of the thread that steps, the GL driver's threads not counted; passes: GPU time from GL timer queries, or \"wall\": from a glFinish before the pass to one after, "
                  "where the GL's timer does not see compute work; state B/particle: what the update pass must read and "
-                 "write; update pass GB/s: that ÷ the pass's time; staged: copied on the GPU into and out of launches' words, beyond what the shaders move; waits/step: read-backs the host waited for mid-step; late/step: read-backs taken when the run-time needed them (kills at the step's end), and in brackets those the GPU had not finished by then; dispatches/step: compute dispatches the host recorded, kernels and bookkeeping)\n";
+                 "write; update pass GB/s: that ÷ the pass's time; staged: copied on the GPU into and out of launches' words, beyond what the shaders move; waits/step: read-backs the host waited for mid-step; late/step: read-backs taken when the run-time needed them (kills at the step's end), and in brackets those the GPU had not finished by then; dispatches/step: compute dispatches the host recorded, kernels and bookkeeping; host sleeps/step: times the host's thread blocked, on llvmpipe each dispatch among them — the same work costs its thread more CPU time when the software GPU's workers have streamed more through the caches it shares: --host-cache)\n";
     return 0;
 }

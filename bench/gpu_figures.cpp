@@ -1,5 +1,6 @@
 #include "gpu_figures.h"
 
+#include <sys/resource.h>
 #include <time.h>
 
 #include <iostream>
@@ -20,6 +21,16 @@ std::unique_ptr<gpu::GlslBackend> gpuBackend(const char* who, size_t hostRows) {
     if (hostRows > 0) gpu->setHostSide(std::make_unique<interp::Interpreter>(gpu->memory()), hostRows);
     return gpu;
 }
+
+namespace {
+
+long threadSleeps() {
+    rusage usage{};
+    getrusage(RUSAGE_THREAD, &usage);
+    return usage.ru_nvcsw;
+}
+
+}  // namespace
 
 GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::GlslBackend& gpu,
                       rt::SystemOptions::Rows rows) {
@@ -44,6 +55,7 @@ GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::G
     double live = 0;
     uint64_t transferred = gpu.transferredBytes(), waits = gpu.waits(), staged = gpu.stagedBytes();
     uint64_t lateReads = gpu.lateReads(), lateStalls = gpu.lateStalls(), dispatches = gpu.dispatches();
+    long sleeps = threadSleeps();
     for (int f = 0; f < frames; ++f) {
         auto start = Clock::now();
         double cpuStart = threadSeconds();
@@ -59,6 +71,7 @@ GpuFigures measureGpu(const Effect& effect, double particles, int frames, gpu::G
     out.lateStalls = static_cast<double>(gpu.lateStalls() - lateStalls) / frames;
     out.stagedBytes = static_cast<double>(gpu.stagedBytes() - staged) / frames / std::max(out.live, 1.0);
     out.dispatches = static_cast<double>(gpu.dispatches() - dispatches) / frames;
+    out.hostSleeps = static_cast<double>(threadSleeps() - sleeps) / frames;
     out.stepSeconds = median(times);
     out.hostCpuSeconds = median(cpu);
     out.perSecond = out.live / out.stepSeconds;

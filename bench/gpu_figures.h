@@ -28,6 +28,8 @@ struct GpuFigures {
     double lateReads = 0, lateStalls = 0;  // per step: read-backs taken at the step's end; of them, not ready
     double stagedBytes = 0;        // per particle per step, copied on the GPU into and out of launches' words
     double dispatches = 0;         // per step: compute dispatches the host recorded (kernels and bookkeeping)
+    double hostSleeps = 0;         // per step: times the host's thread blocked (voluntary context switches:
+                                   // on llvmpipe each dispatch, fence or mapped read it waits for)
 };
 
 // The GLSL backend as psysc and the viewer make it, its host side taking launches of at
