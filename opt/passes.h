@@ -1,34 +1,8 @@
-// The catalogue of IR passes, in pipeline order. Each lives in its own file, whose header
-// says why it exists; pipeline.cpp runs them in this order (thesis §4.3.1).
-//
-//   resolve-cycles   recursive references (`recur`) become the previous update's value;
-//                    a cycle through no integrate/prev/-> is an algebraic loop (§3.1.5,
-//                    §4.3.3–4.3.4)
-//   scoping          a child's `rocket.pos` becomes a value the parent exports once per
-//                    update; the child reads it through its parent handle (§4.3.5)
-//   lower-temporal   integrate, derive, prev, snapshot and `->` become state slots,
-//                    reads and next values (§4.3.6, §3.3.7); an object's integrals are
-//                    lowered together by its integration method
-//   key-random       every random draw is keyed by (object id, draw index) so that the
-//                    same seed gives the same particles on every backend (§3.1.4)
-//   split-kernels    the behaviour becomes the kernels init, update, render, exports and
-//                    spawn.N; what the post-update kernels need from before the update is
-//                    carried in state (§3.3.1: split stateful from stateless)
-//
-// and, unless optimisation is off, the optimizer (§4.3.8, docs/optimizer.md):
-//
-//   simplify         constant folding and exact identities to a fixpoint; snapshot of
-//                    what is fixed at creation needs no state (runs on the behaviour,
-//                    before lower-temporal, and as simplify-kernels after the split)
-//   reassociate      (relaxed only) sums and products in one canonical order, so
-//                    (a+b+c)·(a+b+d) computes a+b once
-//   recompute-state  (relaxed only) a slot whose next value the next step can compute
-//                    from the other slots and the clock (the fire's previous `acc`) is
-//                    not stored
-//   dead-state       slots nothing needs go, equal slots merge, unchanged slots are not
-//                    stored, parameters read only at creation are not kept
-//   hoist-uniform    what is the same for every object of a type (constants, dt, time,
-//                    externs) is computed once per step in a uniform kernel
+// The IR passes. Each lives in its own file, whose header says why it exists; the
+// registry (`passes()`, opt/pipeline.cpp) lists them in pipeline order (thesis §4.3.1)
+// with a line each, and is the one list: runPipeline runs it, `--print-after` and
+// `psysc --help` take their names from it, `psysc --list-passes` prints it, and
+// docs/optimizer.md's table of passes is checked against it (tests/unit/passes_test.cpp).
 #pragma once
 
 #include <iosfwd>
@@ -94,12 +68,21 @@ void hoistUniform(ir::Module& module, PassErrors& errors);
 void recomputeState(ir::Module& module, PassErrors& errors);
 void deadState(ir::Module& module, PassErrors& errors);
 
+// When a pass runs: always (the lowering to kernels), when optimising, or when optimising
+// with relaxed maths (PassOptions::relaxed).
+enum class PassRuns : uint8_t { Always, Optimizing, Relaxed };
+
 struct PassInfo {
-    const char* name;
-    const char* summary;
+    const char* name;     // as --print-after takes it
+    const char* summary;  // what it does, one line
+    PassRuns runs;
+    void (*run)(ir::Module& module, const PassOptions& options, PassErrors& errors);
 };
-// The catalogue above, for --print-after and --help.
-const std::vector<PassInfo>& passCatalogue();
+// Every pass, in the order the pipeline runs them.
+const std::vector<PassInfo>& passes();
+// The registry as docs/optimizer.md shows it (and `psysc --list-passes` prints): a
+// Markdown table, a row a pass.
+std::string passTable();
 
 struct PipelineOptions {
     PassOptions pass;

@@ -1,4 +1,4 @@
-// The pipeline: every pass in order, as one readable function (thesis §4.3.1). With
+// The pipeline: every pass in order, as one readable table (thesis §4.3.1). With
 // --print-after the IR is logged after the named passes; in debug builds (and with
 // verifyEach) the verifier checks the IR after every pass.
 #include <ostream>
@@ -11,20 +11,47 @@
 
 namespace psys::opt {
 
-const std::vector<PassInfo>& passCatalogue() {
-    static const std::vector<PassInfo> passes = {
-        {"resolve-cycles", "recursive references become the previous update's value"},
-        {"scoping", "parent references become values the parent exports"},
-        {"lower-temporal", "integrate, derive, prev, snapshot and -> become state"},
-        {"key-random", "random draws are keyed by (object id, draw index)"},
-        {"split-kernels", "the behaviour becomes init, update, render, exports and spawn kernels"},
-        {"simplify", "constant folding and exact identities (on the behaviour)"},
-        {"simplify-kernels", "constant folding and exact identities (on the split kernels)"},
-        {"reassociate", "(relaxed) sums and products in one canonical order, sharing common parts"},
-        {"recompute-state", "(relaxed) a slot the next step can compute from the other slots and the clock is not stored"},
-        {"dead-state", "unneeded slots go, equal slots merge, parameters used only at creation are not kept"},
+// The pipeline, in order. Lowering first: cycles resolved, parent references scoped,
+// then (optimising) the behaviour simplified while it is still one expression a value,
+// temporal operators lowered to state, random draws keyed, the behaviour split into
+// kernels; then the optimizer on the kernels.
+const std::vector<PassInfo>& passes() {
+    static const std::vector<PassInfo> all = {
+        {"resolve-cycles", "recursive references become the previous update's value; a cycle through no integrate, prev or -> is an algebraic loop (thesis §3.1.5, §4.3.3–4.3.4)",
+         PassRuns::Always, [](ir::Module& m, const PassOptions& o, PassErrors& e) { resolveCycles(m, o, e); }},
+        {"scoping", "a child's `rocket.pos` becomes a value the parent exports once an update, read through the child's parent handle (thesis §4.3.5)",
+         PassRuns::Always, [](ir::Module& m, const PassOptions&, PassErrors& e) { scoping(m, e); }},
+        {"simplify", "constant folding and exact identities to a fixpoint, on the behaviour; a snapshot of what is fixed at creation needs no state",
+         PassRuns::Optimizing, [](ir::Module& m, const PassOptions& o, PassErrors& e) { simplify(m, o, e); }},
+        {"lower-temporal", "integrate, derive, prev, snapshot and -> become state slots, reads and next values, an object's integrals lowered together by its integration method (thesis §4.3.6, §3.3.7)",
+         PassRuns::Always, [](ir::Module& m, const PassOptions& o, PassErrors& e) { lowerTemporal(m, o, e); }},
+        {"key-random", "every random draw is keyed by (object id, draw index): the same seed gives the same particles on every backend (thesis §3.1.4)",
+         PassRuns::Always, [](ir::Module& m, const PassOptions&, PassErrors& e) { keyRandom(m, e); }},
+        {"split-kernels", "the behaviour becomes the kernels init, update, render, exports and spawn.N; what a post-update kernel needs from before the update is carried in state (thesis §3.3.1)",
+         PassRuns::Always, [](ir::Module& m, const PassOptions&, PassErrors& e) { splitKernels(m, e); }},
+        {"reassociate", "sums and products in one canonical order, so (a+b+c)·(a+b+d) computes a+b once",
+         PassRuns::Relaxed, [](ir::Module& m, const PassOptions&, PassErrors& e) { reassociate(m, e); }},
+        {"simplify-kernels", "simplify again, on the split kernels",
+         PassRuns::Optimizing, [](ir::Module& m, const PassOptions& o, PassErrors& e) { simplify(m, o, e); }},
+        {"recompute-state", "a slot whose next value the next step can compute from the other slots and the clock is not stored",
+         PassRuns::Relaxed, [](ir::Module& m, const PassOptions&, PassErrors& e) { recomputeState(m, e); }},
+        {"dead-state", "slots nothing needs go, equal slots merge, unchanged slots are not stored, parameters read only at creation are not kept",
+         PassRuns::Optimizing, [](ir::Module& m, const PassOptions&, PassErrors& e) { deadState(m, e); }},
+        {"hoist-uniform", "what is the same for every object of a type (constants, dt, time, externs) is computed once a step in a uniform kernel",
+         PassRuns::Optimizing, [](ir::Module& m, const PassOptions&, PassErrors& e) { hoistUniform(m, e); }},
     };
-    return passes;
+    return all;
+}
+
+std::string passTable() {
+    std::string out = "| pass | runs | what it does |\n|---|---|---|\n";
+    for (const PassInfo& pass : passes()) {
+        const char* runs = pass.runs == PassRuns::Always       ? "always"
+                           : pass.runs == PassRuns::Optimizing ? "optimising"
+                                                               : "optimising, relaxed maths";
+        out += fmt::format("| {} | {} | {} |\n", pass.name, runs, pass.summary);
+    }
+    return out;
 }
 
 bool runPipeline(ir::Module& module, const PipelineOptions& options, PassErrors& errors) {
@@ -47,36 +74,14 @@ bool runPipeline(ir::Module& module, const PipelineOptions& options, PassErrors&
         for (const std::string& problem : ir::verify(module))
             errors.error({}, "internal error: the lowered IR is malformed: " + problem);
     if (errors.hasErrors()) return false;
-
-    resolveCycles(module, options.pass, errors);
-    if (!after("resolve-cycles")) return false;
-    scoping(module, errors);
-    if (!after("scoping")) return false;
-    if (options.optimize) {
-        simplify(module, options.pass, errors);
-        if (!after("simplify")) return false;
+    for (const PassInfo& pass : passes()) {
+        bool runs = pass.runs == PassRuns::Always || (options.optimize && (pass.runs == PassRuns::Optimizing ||
+                                                                           options.pass.relaxed));
+        if (!runs) continue;
+        pass.run(module, options.pass, errors);
+        if (!after(pass.name)) return false;
     }
-    lowerTemporal(module, options.pass, errors);
-    if (!after("lower-temporal")) return false;
-    keyRandom(module, errors);
-    if (!after("key-random")) return false;
-    splitKernels(module, errors);
-    if (!after("split-kernels")) return false;
-    if (!options.optimize) return true;
-    if (options.pass.relaxed) {
-        reassociate(module, errors);
-        if (!after("reassociate")) return false;
-    }
-    simplify(module, options.pass, errors);
-    if (!after("simplify-kernels")) return false;
-    if (options.pass.relaxed) {
-        recomputeState(module, errors);
-        if (!after("recompute-state")) return false;
-    }
-    deadState(module, errors);
-    if (!after("dead-state")) return false;
-    hoistUniform(module, errors);
-    return after("hoist-uniform");
+    return true;
 }
 
 }  // namespace psys::opt

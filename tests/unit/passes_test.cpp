@@ -1,13 +1,20 @@
 // Each lowering pass on its own (resolve-cycles, scoping, lower-temporal, key-random,
 // split-kernels): IR text in, one pass, IR text out (read and checked by hand). The
-// optimizing passes are optimizer_passes_test.cpp.
+// optimizing passes are optimizer_passes_test.cpp. At the end, the registry of passes
+// against the pipeline and the docs.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <set>
+#include <sstream>
+
+#include "driver/compile.h"
 #include "ir/parser.h"
 #include "ir/printer.h"
 #include "ir/verifier.h"
 #include "opt/passes.h"
 #include "pass_support.h"
+#include "test_support.h"
 
 using namespace psys;
 using namespace psys::ir;
@@ -355,4 +362,64 @@ TEST_CASE("lower-temporal: exact maths, or an integral used elsewhere, keeps c +
     twice.replace(twice.find("    yield size = %6"), 19, "    %7 = add.f32 %6, %5\n    yield size = %7");
     CHECK(after(twice, lowerTemporalRelaxed) ==
           kKeptApart + std::string("    %14 = add.f32 %12, %13\n    yield size = %14\n") + tail);
+}
+
+// The registry of passes (opt::passes()) is the one list: what the pipeline runs, in its
+// order, under each level, and what docs/optimizer.md shows.
+namespace {
+
+std::vector<std::string> passesPrinted(const std::string& file, bool optimize, bool relaxed) {
+    std::ostringstream log;
+    CompileOptions options;
+    options.pipeline.optimize = optimize;
+    options.pipeline.pass.relaxed = relaxed;
+    options.pipeline.printAfterAll = true;
+    options.pipeline.log = &log;
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    REQUIRE(compileFile(file, sources, diags, options).has_value());
+    std::vector<std::string> names;
+    std::istringstream lines(log.str());
+    for (std::string line; std::getline(lines, line);)
+        if (line.rfind("; IR after ", 0) == 0) names.push_back(line.substr(11));
+    return names;
+}
+
+// What --print-after-all prints: the AST lowered (the driver's), then each pass that runs.
+std::vector<std::string> registered(bool optimize, bool relaxed) {
+    std::vector<std::string> names = {"lowering"};
+    for (const opt::PassInfo& pass : opt::passes()) {
+        bool runs = pass.runs == opt::PassRuns::Always ||
+                    (optimize && (pass.runs == opt::PassRuns::Optimizing || relaxed));
+        if (runs) names.push_back(pass.name);
+    }
+    return names;
+}
+
+}  // namespace
+
+TEST_CASE("the pipeline runs the registry's passes in its order, at every level, each printable after") {
+    const std::string fire = PSYS_SAMPLES_DIR "/fire.psys";
+    std::vector<std::string> all = registered(true, true);
+    CHECK(all.size() == opt::passes().size() + 1);
+    CHECK(std::find(all.begin(), all.end(), "hoist-uniform") != all.end());
+    CHECK(passesPrinted(fire, true, true) == all);
+    CHECK(passesPrinted(fire, true, false) == registered(true, false));
+    CHECK(passesPrinted(fire, false, false) ==
+          std::vector<std::string>{"lowering", "resolve-cycles", "scoping", "lower-temporal", "key-random", "split-kernels"});
+    std::set<std::string> names;
+    for (const opt::PassInfo& pass : opt::passes()) {
+        CHECK(names.insert(pass.name).second);  // one name, one pass
+        CHECK(std::string(pass.summary).size() > 20);
+    }
+}
+
+TEST_CASE("docs/optimizer.md's table of passes is the registry's (psysc --list-passes)") {
+    std::string docs = test::readFile(PSYS_DOCS_DIR "/optimizer.md");
+    const std::string open = "<!-- psysc --list-passes -->\n", close = "<!-- end of psysc --list-passes -->";
+    size_t begin = docs.find(open), end = docs.find(close);
+    REQUIRE(begin != std::string::npos);
+    REQUIRE(end != std::string::npos);
+    begin += open.size();
+    CHECK(docs.substr(begin, end - begin) == opt::passTable());
 }

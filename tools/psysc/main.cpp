@@ -5,6 +5,7 @@
 //   psysc --emit=ast|ir FILE            print the checked AST, or the IR after the passes
 //   psysc --emit=glsl FILE              print the GLSL shaders the GPU backend runs
 //   psysc --stats FILE                  the cost of each object type, without and with the optimizer
+//   psysc --list-passes                 the passes in pipeline order (opt/passes.h: the registry)
 //   psysc lsp                           the language server, on stdin and stdout (editor-support/)
 //   psysc builtins                      the language's keywords and built-ins, as JSON
 //
@@ -116,10 +117,10 @@ int printAst(const std::string& file, bool colour) {
 int printIr(const std::string& file, psys::CompileOptions options, bool colour) {
     for (const std::string& pass : options.pipeline.printAfter) {
         bool known = false;
-        for (auto& info : psys::opt::passCatalogue()) known |= pass == info.name;
+        for (auto& info : psys::opt::passes()) known |= pass == info.name;
         if (!known) {
             std::cerr << "psysc: error: unknown pass `" << pass << "` for --print-after; the passes are:\n";
-            for (auto& info : psys::opt::passCatalogue()) std::cerr << "  " << info.name << ": " << info.summary << "\n";
+            for (auto& info : psys::opt::passes()) std::cerr << "  " << info.name << ": " << info.summary << "\n";
             return 2;
         }
     }
@@ -163,8 +164,14 @@ int realMain(int argc, char** argv) {
     app.add_option("files", emitFiles, "Source file for --emit")->type_name("FILE");
     std::vector<std::string> printAfter;
     bool printAfterAll = false;
-    app.add_option("--print-after", printAfter, "With --emit=ir: print the IR after this pass (repeatable)")
+    std::string passNames;
+    for (const auto& pass : psys::opt::passes()) passNames += std::string(passNames.empty() ? "" : ", ") + pass.name;
+    app.add_option("--print-after", printAfter,
+                   "With --emit=ir: print the IR after this pass (repeatable), one of: " + passNames +
+                       " (--list-passes says what each does)")
         ->type_name("PASS")->allow_extra_args(false);
+    bool listPasses = false;
+    app.add_flag("--list-passes", listPasses, "Print the passes in pipeline order, what each does and when it runs");
     app.add_flag("--print-after-all", printAfterAll, "With --emit=ir: print the IR after every pass");
     bool locations = false;
     app.add_flag("--locations", locations, "With --emit=ir: say where each instruction came from (file:line:column)");
@@ -221,6 +228,10 @@ int realMain(int argc, char** argv) {
     }
     if (builtins->parsed()) {
         std::cout << psys::lsp::vocabulary().dump(2) << "\n";
+        return 0;
+    }
+    if (listPasses) {
+        std::cout << psys::opt::passTable();
         return 0;
     }
     if (!statsFile.empty()) return psys::tools::printStats(statsFile, everyObject, colour);
