@@ -3,14 +3,14 @@
 #include <ostream>
 
 #include "frontend/frontend.h"
-#include "ir/lower.h"
+#include "lower/lower.h"
 
 namespace psys {
 
 std::optional<ir::Module> compileProgram(const ast::Program* program, SourceManager& sources, DiagnosticEngine& diags,
                                          const CompileOptions& options) {
     if (!program) return std::nullopt;
-    ir::Module module = ir::lower(*program, sources);
+    ir::Module module = lower::lowerProgram(*program, sources);
     const opt::PipelineOptions& pipeline = options.pipeline;
     if (pipeline.log && (pipeline.printAfterAll || !pipeline.printAfter.empty()))
         *pipeline.log << "; IR after lowering\n" << ir::print(module, pipeline.print);

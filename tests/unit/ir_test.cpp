@@ -10,7 +10,7 @@
 #include "core/lanes.h"
 #include "ir/evaluate.h"
 #include "ir/hash.h"
-#include "ir/lower.h"
+#include "lower/lower.h"
 #include "ir/parser.h"
 #include "ir/printer.h"
 #include "ir/verifier.h"
@@ -60,7 +60,7 @@ TEST_CASE("every sample's IR prints, parses back and prints the same, before and
         ++count;
         auto c = test::check(test::readFile(entry.path().string()), entry.path().string());
         REQUIRE_MESSAGE(c.ok(), c.output);
-        Module m = lower(*c.program, *c.sources);
+        Module m = psys::lower::lowerProgram(*c.program, *c.sources);
         INFO(entry.path().filename().string());
         std::string problems;
         for (auto& e : verify(m)) problems += e + "\n";
@@ -160,7 +160,7 @@ TEST_CASE("instructions carry the location of the source they come from, through
     auto c = test::check("object p {\n  v = integrate(vec3(0, -9.8, 0));\n  point(v * 2, white, age);\n}\nspawn p;",
                          "loc.psys");
     REQUIRE(c.ok());
-    Module m = lower(*c.program, *c.sources);
+    Module m = psys::lower::lowerProgram(*c.program, *c.sources);
     opt::PassErrors errors;
     REQUIRE(opt::runPipeline(m, {}, errors));
     const Kernel* update = m.objects[0].kernel(KernelKind::Update);

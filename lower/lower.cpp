@@ -18,7 +18,7 @@
 // Functions are inlined; every inlined `rand` gets its own call site. Broadcasts become
 // explicit `splat`s and the library functions (mix, clamp, rotate_y, normalize, …) become
 // arithmetic, so later passes see every operation.
-#include "ir/lower.h"
+#include "lower/lower.h"
 
 #include <fmt/format.h>
 
@@ -26,12 +26,16 @@
 #include <map>
 
 #include "frontend/consteval.h"
-#include "ir/object_lowering.h"
+#include "lower/object_lowering.h"
 
-namespace psys::ir {
+namespace psys::lower {
 namespace {
 
 using namespace ast;
+using namespace ir;
+using ir::Module;
+using ir::Param;
+using ir::Type;
 using detail::irType;
 using detail::Locator;
 using detail::ObjectLowering;
@@ -105,7 +109,7 @@ std::array<float, 4> constantValue(const Expr* e, Type t) {
 
 }  // namespace
 
-Module lower(const ast::Program& program, const SourceManager& sources) {
+ir::Module lowerProgram(const ast::Program& program, const SourceManager& sources) {
     Module m;
     for (int f = 0; f < sources.count(); ++f) m.files.push_back(sources.file(f).path());
     Locator locate(sources);
@@ -215,4 +219,4 @@ Module lower(const ast::Program& program, const SourceManager& sources) {
     return m;
 }
 
-}  // namespace psys::ir
+}  // namespace psys::lower

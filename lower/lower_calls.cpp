@@ -2,9 +2,9 @@
 // own), and the library's functions become arithmetic the passes can see through.
 #include "core/lanes.h"
 #include "frontend/builtins.h"
-#include "ir/object_lowering.h"
+#include "lower/object_lowering.h"
 
-namespace psys::ir::detail {
+namespace psys::lower::detail {
 
 Values ObjectLowering::lowerCall(const CallExpr& c) {
     if (c.fn) {
@@ -116,4 +116,4 @@ Values ObjectLowering::lowerCall(const CallExpr& c) {
 }
 
 
-}  // namespace psys::ir::detail
+}  // namespace psys::lower::detail

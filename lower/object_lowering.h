@@ -1,4 +1,4 @@
-// Internal to ir/: the lowering of one object (or trigger, or the start) to a kernel.
+// Internal to lower/: the lowering of one object (or trigger, or the start) to a kernel.
 // lower.cpp drives it per object and lowers commands; lower_expr.cpp holds the evaluation
 // order and expressions; lower_calls.cpp inlines functions and expands built-ins.
 #pragma once
@@ -12,9 +12,15 @@
 #include "frontend/source.h"
 #include "ir/ir.h"
 
-namespace psys::ir::detail {
+namespace psys::lower::detail {
 
+// Written against the IR's names: where the AST (or the front end's psys::Type) has one
+// of the same spelling, the IR's is meant.
 using namespace ast;
+using namespace ir;
+using ir::Module;
+using ir::Param;
+using ir::Type;
 
 // Source ranges as IR locations: file, line, column and the length on that line.
 class Locator {
@@ -175,4 +181,4 @@ private:
     std::vector<std::tuple<Values, const Expr*, std::vector<FnFrame>>> deferred_;  // prev: a slot per element
 };
 
-}  // namespace psys::ir::detail
+}  // namespace psys::lower::detail

@@ -2,9 +2,9 @@
 // rule at the top of lower.cpp).
 #include "frontend/builtins.h"
 #include "frontend/equation_graph.h"
-#include "ir/object_lowering.h"
+#include "lower/object_lowering.h"
 
-namespace psys::ir::detail {
+namespace psys::lower::detail {
 
 // ---------------------------------------------------------------- evaluation order
 
@@ -164,4 +164,4 @@ Values ObjectLowering::lower(const Expr& e) {
 }
 
 
-}  // namespace psys::ir::detail
+}  // namespace psys::lower::detail
