@@ -5,6 +5,7 @@
 // keeps the source range it came from, for diagnostics and for `--emit=ast`.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -22,6 +23,15 @@ struct ExternDecl;
 struct TriggerDecl;
 struct Equation;
 struct LetStmt;
+
+// A value the checker computed at compile time (frontend/consteval.h), kept on the AST
+// where the program needs it as a number (extern defaults and ranges, attributes, named
+// constants), so that lowering reads it rather than computing it again.
+struct ConstValue {
+    Type type;                 // bool, float or vecN
+    std::array<float, 4> v{};  // components; a bool is 0 or 1
+    bool isTrue() const { return v[0] != 0; }
+};
 
 // ---------------------------------------------------------------- names
 
@@ -166,6 +176,7 @@ struct Attribute {
     SourceRange range;  // the whole attribute
     SourceRange nameRange;
     std::vector<ExprPtr> args;
+    std::optional<ConstValue> value;  // set by the checker: its constant argument (@step, @capacity)
 };
 
 // ---------------------------------------------------------------- commands
@@ -221,6 +232,7 @@ struct ConstDecl : Decl {
     std::optional<TypeAnnotation> annotation;
     ExprPtr value;
     Type type = Type::unknown();
+    std::optional<ConstValue> evaluated;  // set by the checker where `value` is a constant bool, float or vector
 };
 
 struct LetStmt {
@@ -245,6 +257,9 @@ struct ExternDecl : Decl {
     TypeAnnotation type;
     ExprPtr defaultValue;  // null: zero
     ExprPtr rangeLow, rangeHigh;
+    // Set by the checker: the values of the three, every component (a float given for a
+    // vector extern spread to each); the default zero where there is none.
+    std::optional<ConstValue> defaultEvaluated, lowEvaluated, highEvaluated;
 };
 
 struct TriggerDecl : Decl {

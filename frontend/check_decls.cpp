@@ -67,15 +67,19 @@ void Checker::checkConst(ConstDecl& decl) {
         t = decl.annotation->type;
     }
     if (decl.type.isUnknown()) decl.type = t;
-    // As for an extern's default: a constant is a number a reader can rely on.
-    if (!t.isVague() && !t.isBool())
-        if (auto v = evaluateConstant(*decl.value))
-            for (int i = 0; i < std::max(1, t.width()); ++i)
+    // As for an extern's default: a constant is a number a reader can rely on. Its value,
+    // computed here, is what lowering makes of it (ConstDecl::evaluated).
+    if (!t.isVague())
+        if (auto v = evaluateConstant(*decl.value); v && v->type == t) {
+            bool finite = true;
+            for (int i = 0; i < std::max(1, t.width()) && !t.isBool() && finite; ++i)
                 if (!std::isfinite(v->v[static_cast<size_t>(i)])) {
                     diags_.error(decl.value->range, fmt::format("constant `{}` is not a finite number ({})", decl.name,
                                                                 numberText(v->v[static_cast<size_t>(i)])));
-                    break;
+                    finite = false;
                 }
+            if (finite) decl.evaluated = v;
+        }
     checking_.pop_back();
     progress_[&decl] = 2;
 }
@@ -166,6 +170,7 @@ void Checker::checkExtern(ExternDecl& decl) {
     };
     std::optional<ConstValue> value, low, high;
     if (decl.defaultValue) value = checkValue(*decl.defaultValue, "default value");
+    decl.defaultEvaluated = decl.defaultValue ? value : ConstValue{type, {}};
     if (decl.rangeLow) {
         if (type.isBool()) {
             diags_.error(SourceRange::join(decl.rangeLow->range, decl.rangeHigh->range),
@@ -174,6 +179,8 @@ void Checker::checkExtern(ExternDecl& decl) {
         }
         low = checkValue(*decl.rangeLow, "lower bound");
         high = checkValue(*decl.rangeHigh, "upper bound");
+        decl.lowEvaluated = low;
+        decl.highEvaluated = high;
     }
     if (!low || !high) return;
     for (int i = 0; i < type.width(); ++i) {

@@ -283,6 +283,7 @@ void Checker::checkAttributes(const std::vector<Attribute*>& attributes) {
             auto v = evaluateConstant(*a.args[0]);
             if (!a.args[0]->type.isError() && (!v || !(v->v[0] > 0)))
                 diags_.error(a.args[0]->range, "the step must be a positive constant number of seconds");
+            a.value = v;
         } else if (a.name == "capacity") {
             if (!wantOneArg("the most objects of this type alive at once")) continue;
             check(*a.args[0], ctx);
@@ -292,6 +293,7 @@ void Checker::checkAttributes(const std::vector<Attribute*>& attributes) {
             if (!a.args[0]->type.isError() &&
                 (!v || !(v->v[0] >= 1 && v->v[0] <= 4294967295.0) || v->v[0] != std::floor(v->v[0])))
                 diags_.error(a.args[0]->range, "the capacity must be a constant whole number from 1 to 4294967295");
+            a.value = v;
         } else {
             diags_.error(a.nameRange, fmt::format("unknown attribute `@{}`", a.name))
                 .notes.push_back({a.nameRange, "the attributes are " + attributeList()});

@@ -5,7 +5,8 @@
 // that is not a constant (an extern, `age`, `rand()`, a user function call, …).
 //
 // Values are floats computed by core/lanes.h, the arithmetic every backend runs, so a
-// constant checked here is the constant the program computes.
+// constant checked here is the constant the program computes. The checker keeps the
+// values it computes on the AST (ConstValue, frontend/ast.h) for lowering to read.
 #pragma once
 
 #include <string>
@@ -17,11 +18,7 @@
 
 namespace psys {
 
-struct ConstValue {
-    Type type;                      // bool, float or vecN
-    std::array<float, 4> v{};       // components; a bool is 0 or 1
-    bool isTrue() const { return v[0] != 0; }
-};
+using ast::ConstValue;
 
 std::optional<ConstValue> evaluateConstant(const ast::Expr& expr);
 

@@ -25,7 +25,6 @@
 #include <functional>
 #include <map>
 
-#include "frontend/consteval.h"
 #include "lower/object_lowering.h"
 
 namespace psys::lower {
@@ -97,12 +96,12 @@ struct CommandLowering {
     }
 };
 
-std::array<float, 4> constantValue(const Expr* e, Type t) {
+// An extern's value as the checker computed it (ExternDecl::*Evaluated), in the IR's four
+// lanes: a number spread over all four, a bool 0 or 1.
+std::array<float, 4> externLanes(const std::optional<ConstValue>& v, Type t) {
     std::array<float, 4> out{};
-    if (!e) return out;
-    auto v = evaluateConstant(*e);
     if (!v) return out;
-    for (int i = 0; i < 4; ++i) out[static_cast<size_t>(i)] = static_cast<float>(v->type.width() == 1 ? v->v[0] : v->v[static_cast<size_t>(i)]);
+    for (size_t i = 0; i < 4; ++i) out[i] = v->type.width() == 1 ? v->v[0] : v->v[i];
     if (t.isBool()) out = {v->isTrue() ? 1.0f : 0.0f, 0, 0, 0};
     return out;
 }
@@ -118,11 +117,11 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
         for (auto& d : module->decls)
             if (d->kind == DeclKind::Extern) {
                 auto& e = static_cast<const ExternDecl&>(*d);
-                Extern x{e.name, irType(e.type.type), {}, constantValue(e.defaultValue.get(), irType(e.type.type)), {}, {}};
+                Extern x{e.name, irType(e.type.type), {}, externLanes(e.defaultEvaluated, irType(e.type.type)), {}, {}};
                 if (e.type.spelling == "color" || e.type.spelling == "point") x.spelling = e.type.spelling;
                 if (e.rangeLow) {
-                    x.low = constantValue(e.rangeLow.get(), x.type);
-                    x.high = constantValue(e.rangeHigh.get(), x.type);
+                    x.low = externLanes(e.lowEvaluated, x.type);
+                    x.high = externLanes(e.highEvaluated, x.type);
                 }
                 m.externs.push_back(x);
             }
@@ -140,9 +139,9 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
         if (a.name == "integrator" && a.args[0]->kind == ExprKind::Name) {
             attributes.integrator = core::integratorFromName(static_cast<const NameExpr&>(*a.args[0]).name);
             attributes.integratorLoc = locate(a.args[0]->range);
-        } else if (auto v = evaluateConstant(*a.args[0])) {
-            if (a.name == "step") attributes.step = v->v[0];
-            if (a.name == "capacity") attributes.capacity = static_cast<uint64_t>(v->v[0]);
+        } else if (a.value) {  // the checker's value of @step or @capacity
+            if (a.name == "step") attributes.step = a.value->v[0];
+            if (a.name == "capacity") attributes.capacity = static_cast<uint64_t>(a.value->v[0]);
         }
     };
     std::vector<std::pair<const ObjectDecl*, Attributes>> decls;

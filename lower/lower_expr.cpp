@@ -69,7 +69,12 @@ Values ObjectLowering::lowerName(const NameExpr& n) {
             pendingRecurs_.push_back({recur, {r.equation, static_cast<size_t>(r.index)}});
             return {recur};
         }
-        case Ref::Kind::Const: return lower(*r.constant->value);
+        case Ref::Kind::Const: {  // the checker's value, where it could compute one
+            const auto& v = r.constant->evaluated;
+            if (!v) return lower(*r.constant->value);
+            if (t.isBool()) return {k_.boolean(v->isTrue())};
+            return {k_.constant(t, t.width == 1 ? std::array<float, 4>{v->v[0], 0, 0, 0} : v->v)};
+        }
         case Ref::Kind::Extern: return {input(Op::Extern, t, module_.externIndex(r.externVar->name))};
         case Ref::Kind::FnParam: return frames_.back().params.at(static_cast<size_t>(r.index));
         case Ref::Kind::Let: return frames_.back().lets.at(r.let);

@@ -10,10 +10,10 @@
 #include "core/lanes.h"
 #include "ir/evaluate.h"
 #include "ir/hash.h"
-#include "lower/lower.h"
 #include "ir/parser.h"
 #include "ir/printer.h"
 #include "ir/verifier.h"
+#include "lower/lower.h"
 #include "opt/passes.h"
 #include "test_support.h"
 
@@ -196,4 +196,45 @@ TEST_CASE("evaluate computes every componentwise op through core/lanes.h, on eve
         }
         CHECK(out.f[3] == 0);
     }
+}
+
+TEST_CASE("lowering reads the values the checker computed: named constants, extern values, attributes") {
+    auto c = test::check("extern rate: float = 2 * 3 range(0, 100 / 4);\nconst k = 1 / 4 + 2;\nconst up = vec3(0, k, 0);\n"
+                         "@capacity(2 * 8) object p {\n  point(up * k, white, rate);\n}\nspawn p;",
+                         "consts.psys");
+    REQUIRE_MESSAGE(c.ok(), c.output);
+    auto& k = const_cast<psys::ast::ConstDecl&>(static_cast<const psys::ast::ConstDecl&>(c.decl("k")));
+    auto& up = static_cast<const psys::ast::ConstDecl&>(c.decl("up"));
+    auto& rate = const_cast<psys::ast::ExternDecl&>(static_cast<const psys::ast::ExternDecl&>(c.decl("rate")));
+    // What the checker kept on the AST.
+    REQUIRE(k.evaluated);
+    CHECK(k.evaluated->v[0] == 2.25f);
+    REQUIRE(up.evaluated);
+    CHECK(up.evaluated->v == std::array<float, 4>{0, 2.25f, 0, 0});
+    REQUIRE(rate.defaultEvaluated);
+    CHECK(rate.defaultEvaluated->v[0] == 6);
+    REQUIRE(rate.highEvaluated);
+    CHECK(rate.highEvaluated->v[0] == 25);
+    const psys::ast::ObjectDecl& p = c.object("p");
+    REQUIRE(p.attributes.size() == 1);
+    REQUIRE(p.attributes[0].value);
+    CHECK(p.attributes[0].value->v[0] == 16);
+    // Lowering computes none of it again: a value changed on the AST is the value lowered.
+    k.evaluated->v[0] = 7;
+    rate.defaultEvaluated->v[0] = 5;
+    Module m = psys::lower::lowerProgram(*c.program, *c.sources);
+    CHECK(m.externs.at(0).defaultValue[0] == 5);
+    REQUIRE(m.externs.at(0).high);
+    CHECK((*m.externs.at(0).high)[0] == 25);
+    CHECK(m.objects.at(0).attributes.capacity == 16u);
+    const Kernel* behaviour = m.objects.at(0).kernel(KernelKind::Behaviour);
+    REQUIRE(behaviour);
+    bool seven = false, up3 = false;
+    for (const Inst& i : behaviour->insts()) {
+        CHECK(i.op != Op::Div);  // 1 / 4 and 100 / 4 were the checker's
+        seven |= i.op == Op::Const && i.type == Type::f32() && i.constant[0] == 7;
+        up3 |= i.op == Op::Const && i.type == Type::vec(3) && i.constant[1] == 2.25f;
+    }
+    CHECK(seven);
+    CHECK(up3);
 }
