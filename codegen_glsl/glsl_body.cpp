@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -139,8 +140,18 @@ private:
         return fmt::format("mix({}, {}, lessThan({}, {}))", other, pick, a, b);
     }
 
+    // An op core/ops.h spells for GLSL (OpSpelling): a GLSL function takes vectors as
+    // floats; a `psys_` helper of the preamble is applied lane by lane.
+    std::string spelled(const Inst& inst, std::string_view name) const {
+        if (name.starts_with("psys_")) return perLane(inst, std::string(name).c_str());
+        std::string call = std::string(name) + "(";
+        for (size_t o = 0; o < inst.operands.size(); ++o) call += (o ? ", " : "") + x(inst, o);
+        return call + ")";
+    }
+
     std::string pure(const Inst& inst) const {
         auto a = [&](size_t i) { return x(inst, i); };
+        if (const core::OpSpelling& s = opInfo(inst.op).spelling; s.mapped()) return spelled(inst, s.glsl);
         switch (inst.op) {
             case Op::Add: return a(0) + " + " + a(1);
             case Op::Sub: return a(0) + " - " + a(1);
@@ -151,22 +162,7 @@ private:
             case Op::Min: return perLane(inst, "psys_min");
             case Op::Max: return perLane(inst, "psys_max");
             case Op::Step: return choose(inst, a(1), a(0), vec(inst, "0.0"), vec(inst, "1.0"));  // y < x ? 0 : 1
-            case Op::Atan2: return perLane(inst, "psys_atan2");
-            case Op::Pow: return perLane(inst, "psys_pow");
-            case Op::Sin: return "sin(" + a(0) + ")";
-            case Op::Cos: return "cos(" + a(0) + ")";
-            case Op::Tan: return "tan(" + a(0) + ")";
-            case Op::Asin: return perLane(inst, "psys_asin");
-            case Op::Acos: return perLane(inst, "psys_acos");
-            case Op::Atan: return "atan(" + a(0) + ")";
-            case Op::Exp: return "exp(" + a(0) + ")";
-            case Op::Log: return perLane(inst, "psys_log");
-            case Op::Sqrt: return perLane(inst, "psys_sqrt");
-            case Op::Abs: return "abs(" + a(0) + ")";
             case Op::Sign: return perLane(inst, "psys_sign");
-            case Op::Floor: return "floor(" + a(0) + ")";
-            case Op::Ceil: return "ceil(" + a(0) + ")";
-            case Op::Round: return "roundEven(" + a(0) + ")";
             case Op::Fract: return a(0) + " - floor(" + a(0) + ")";
             case Op::Lt: return a(0) + " < " + a(1);
             case Op::Le: return a(0) + " <= " + a(1);
@@ -202,7 +198,7 @@ private:
                     s = fmt::format("({} + {} * {})", s, component(a(0), w, l), component(a(1), w, l));
                 return s;
             }
-            default: return "0";
+            default: throw std::runtime_error(unexpectedOp(inst, "the GLSL backend"));
         }
     }
 

@@ -109,9 +109,27 @@ private:
         return b_.CreateSelect(pickY, y, x);
     }
 
+    // An op core/ops.h spells for LLVM (OpSpelling): its libm function in exact maths, its
+    // intrinsic in fast maths or where it has no libm function (IEEE-exact operations).
+    Lanes spelled(const Inst& i, const core::OpSpelling& s) {
+        llvm::Intrinsic::ID id = s.intrinsic.empty() ? llvm::Intrinsic::not_intrinsic
+                                                     : llvm::Function::lookupIntrinsicID(llvm::StringRef(s.intrinsic.data(), s.intrinsic.size()));
+        if (!s.intrinsic.empty() && id == llvm::Intrinsic::not_intrinsic && s.libm.empty())
+            throw std::runtime_error("internal error: LLVM has no intrinsic `" + std::string(s.intrinsic) + "` for `" +
+                                     std::string(opInfo(i.op).name) + "`");
+        std::string libm(s.libm);
+        return map(i, [&](size_t l) -> llvm::Value* {
+            llvm::Value* x = values_[i.operands[0]][l];
+            llvm::Value* y = i.operands.size() > 1 ? values_[i.operands[1]][l] : nullptr;
+            if (libm.empty()) return y ? b_.CreateBinaryIntrinsic(id, x, y) : b_.CreateUnaryIntrinsic(id, x);
+            return math(id, libm.c_str(), x, y);
+        });
+    }
+
     Lanes emit(const Inst& i) {
         auto x = [&](size_t n, size_t l) { return values_[i.operands[n]][l]; };
         auto width = [&](size_t n) { return kernel_.at(i.operands[n]).type.width; };
+        if (const core::OpSpelling& s = opInfo(i.op).spelling; s.mapped()) return spelled(i, s);
         switch (i.op) {
             case Op::Const:
                 return map(i, [&](size_t l) -> llvm::Value* {
@@ -131,21 +149,6 @@ private:
             case Op::Min: return map(i, [&](size_t l) { return minMax(x(0, l), x(1, l), true); });
             case Op::Max: return map(i, [&](size_t l) { return minMax(x(0, l), x(1, l), false); });
             case Op::Step: return map(i, [&](size_t l) { return b_.CreateSelect(b_.CreateFCmpOLT(x(1, l), x(0, l)), f(0), f(1)); });
-            case Op::Atan2: return map(i, [&](size_t l) { return math(llvm::Intrinsic::not_intrinsic, "atan2f", x(0, l), x(1, l)); });
-            case Op::Pow: return map(i, [&](size_t l) { return math(llvm::Intrinsic::pow, "powf", x(0, l), x(1, l)); });
-            case Op::Sin: return map(i, [&](size_t l) { return math(llvm::Intrinsic::sin, "sinf", x(0, l)); });
-            case Op::Cos: return map(i, [&](size_t l) { return math(llvm::Intrinsic::cos, "cosf", x(0, l)); });
-            case Op::Tan: return map(i, [&](size_t l) { return math(llvm::Intrinsic::tan, "tanf", x(0, l)); });
-            case Op::Asin: return map(i, [&](size_t l) { return math(llvm::Intrinsic::asin, "asinf", x(0, l)); });
-            case Op::Acos: return map(i, [&](size_t l) { return math(llvm::Intrinsic::acos, "acosf", x(0, l)); });
-            case Op::Atan: return map(i, [&](size_t l) { return math(llvm::Intrinsic::atan, "atanf", x(0, l)); });
-            case Op::Exp: return map(i, [&](size_t l) { return math(llvm::Intrinsic::exp, "expf", x(0, l)); });
-            case Op::Log: return map(i, [&](size_t l) { return math(llvm::Intrinsic::log, "logf", x(0, l)); });
-            case Op::Sqrt: return map(i, [&](size_t l) { return b_.CreateUnaryIntrinsic(llvm::Intrinsic::sqrt, x(0, l)); });
-            case Op::Abs: return map(i, [&](size_t l) { return b_.CreateUnaryIntrinsic(llvm::Intrinsic::fabs, x(0, l)); });
-            case Op::Floor: return map(i, [&](size_t l) { return b_.CreateUnaryIntrinsic(llvm::Intrinsic::floor, x(0, l)); });
-            case Op::Ceil: return map(i, [&](size_t l) { return b_.CreateUnaryIntrinsic(llvm::Intrinsic::ceil, x(0, l)); });
-            case Op::Round: return map(i, [&](size_t l) { return b_.CreateUnaryIntrinsic(llvm::Intrinsic::nearbyint, x(0, l)); });
             case Op::Fract:
                 return map(i, [&](size_t l) { return b_.CreateFSub(x(0, l), b_.CreateUnaryIntrinsic(llvm::Intrinsic::floor, x(0, l))); });
             case Op::Sign:
@@ -192,7 +195,7 @@ private:
             }
             case Op::Rand: case Op::NRand: return random(i);
             default:
-                throw std::runtime_error("the LLVM backend cannot compile `" + std::string(opInfo(i.op).name) + "`");
+                throw std::runtime_error(unexpectedOp(i, "the LLVM backend"));
         }
     }
 

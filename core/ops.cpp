@@ -6,7 +6,7 @@ namespace psys::core {
 namespace {
 
 constexpr OpInfo kOps[] = {
-#define PSYS_OP_INFO(id, text, arity, kind, flags, delayed) {text, arity, OpKind::kind, flags, delayed},
+#define PSYS_OP_INFO(id, text, arity, kind, flags, delayed, spelling) {text, arity, OpKind::kind, flags, delayed, spelling},
     PSYS_OPS(PSYS_OP_INFO)
 #undef PSYS_OP_INFO
 };

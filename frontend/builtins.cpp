@@ -3,41 +3,22 @@
 #include "core/integrators.h"
 
 #include <array>
+#include <iterator>
+#include <vector>
 
 namespace psys {
 namespace {
 
 using R = BuiltinRule;
-// `op`: the one operation of core/ops.h a function is, where it is exactly one (lowering
-// emits it, constant evaluation computes it through core/lanes.h).
 
-constexpr BuiltinFunction kFunctions[] = {
-    // componentwise maths
-    {"sin", 1, 1, R::Componentwise, 0, "sin(x: T) -> T", core::Op::Sin},
-    {"cos", 1, 1, R::Componentwise, 0, "cos(x: T) -> T", core::Op::Cos},
-    {"tan", 1, 1, R::Componentwise, 0, "tan(x: T) -> T", core::Op::Tan},
-    {"asin", 1, 1, R::Componentwise, 0, "asin(x: T) -> T", core::Op::Asin},
-    {"acos", 1, 1, R::Componentwise, 0, "acos(x: T) -> T", core::Op::Acos},
-    {"atan", 1, 1, R::Componentwise, 0, "atan(x: T) -> T", core::Op::Atan},
-    {"atan2", 2, 2, R::Componentwise, 0, "atan2(y: T, x: T) -> T", core::Op::Atan2},
-    {"exp", 1, 1, R::Componentwise, 0, "exp(x: T) -> T", core::Op::Exp},
-    {"log", 1, 1, R::Componentwise, 0, "log(x: T) -> T", core::Op::Log},
-    {"pow", 2, 2, R::Componentwise, 0, "pow(x: T, y: T|float) -> T", core::Op::Pow},
-    {"sqrt", 1, 1, R::Componentwise, 0, "sqrt(x: T) -> T", core::Op::Sqrt},
-    {"abs", 1, 1, R::Componentwise, 0, "abs(x: T) -> T", core::Op::Abs},
-    {"sign", 1, 1, R::Componentwise, 0, "sign(x: T) -> T", core::Op::Sign},
-    {"floor", 1, 1, R::Componentwise, 0, "floor(x: T) -> T", core::Op::Floor},
-    {"ceil", 1, 1, R::Componentwise, 0, "ceil(x: T) -> T", core::Op::Ceil},
-    {"round", 1, 1, R::Componentwise, 0, "round(x: T) -> T", core::Op::Round},
-    {"fract", 1, 1, R::Componentwise, 0, "fract(x: T) -> T", core::Op::Fract},
-    {"mod", 2, 2, R::Componentwise, 0, "mod(x: T, y: T|float) -> T", core::Op::Mod},
-    {"min", 2, 2, R::Componentwise, 0, "min(a: T, b: T|float) -> T", core::Op::Min},
-    {"max", 2, 2, R::Componentwise, 0, "max(a: T, b: T|float) -> T", core::Op::Max},
+// The functions that are not one op of core/ops.h (those come from its rows: PSYS_BUILTIN,
+// PSYS_MAPS), each expanded by lowering (lower/lower_calls.cpp).
+constexpr BuiltinFunction kOwnFunctions[] = {
+    // componentwise maths (beside the ops')
     {"clamp", 1, 3, R::Componentwise, 0, "clamp(x: T, lo: T|float = 0, hi: T|float = 1) -> T"},
     {"saturate", 1, 1, R::Componentwise, 0, "saturate(x: T) -> T"},
     {"mix", 3, 3, R::Componentwise, 0, "mix(a: T, b: T, t: T|float) -> T"},
     {"lerp", 3, 3, R::Componentwise, 0, "lerp(a: T, b: T, t: T|float) -> T"},
-    {"step", 2, 2, R::Componentwise, 0, "step(edge: T|float, x: T) -> T", core::Op::Step},
     {"smoothstep", 3, 3, R::Componentwise, 0, "smoothstep(e0: T|float, e1: T|float, x: T) -> T"},
     {"radians", 1, 1, R::Componentwise, 0, "radians(degrees: T) -> T"},
     {"degrees", 1, 1, R::Componentwise, 0, "degrees(radians: T) -> T"},
@@ -113,15 +94,30 @@ std::string_view attributeDoc(std::string_view name) {
 
 std::span<const std::string_view> keywords() { return kKeywords; }
 
-std::span<const BuiltinFunction> builtinFunctions() { return kFunctions; }
+// The ops that are built-in functions, in the table's order, then the rest.
+std::span<const BuiltinFunction> builtinFunctions() {
+    static const std::vector<BuiltinFunction> all = [] {
+        std::vector<BuiltinFunction> out;
+        for (size_t i = 0; i < core::kOpCount; ++i) {
+            auto op = static_cast<core::Op>(i);
+            const core::OpInfo& info = core::opInfo(op);
+            if (!info.spelling.builtin.empty())
+                out.push_back({info.name, info.arity, info.arity, R::Componentwise, 0, info.spelling.builtin, op});
+        }
+        out.insert(out.end(), std::begin(kOwnFunctions), std::end(kOwnFunctions));
+        return out;
+    }();
+    return all;
+}
 
 int findBuiltinFunction(std::string_view name) {
-    for (size_t i = 0; i < std::size(kFunctions); ++i)
-        if (kFunctions[i].name == name) return static_cast<int>(i);
+    std::span<const BuiltinFunction> all = builtinFunctions();
+    for (size_t i = 0; i < all.size(); ++i)
+        if (all[i].name == name) return static_cast<int>(i);
     return -1;
 }
 
-const BuiltinFunction& builtinFunction(int index) { return kFunctions[index]; }
+const BuiltinFunction& builtinFunction(int index) { return builtinFunctions()[static_cast<size_t>(index)]; }
 
 bool isTemporal(BuiltinRule rule) {
     return rule == R::Integrate || rule == R::Snapshot || rule == R::Prev;

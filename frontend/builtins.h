@@ -1,7 +1,8 @@
 // The built-in functions, variables and constants of .psys, with their typing rules.
 //
-// One table, so the type checker, `--emit=ast`, the docs and (later) lowering agree on
-// what exists. Numeric functions work on float and vectors componentwise, and a float
+// One list, so the type checker, `--emit=ast`, the editor support and lowering agree on
+// what exists: the functions that are exactly one op come from core/ops.h's rows (their
+// signature there), the rest are this file's table. Numeric functions work on float and vectors componentwise, and a float
 // argument broadcasts to the width of the others (as the thesis's NOp class did).
 #pragma once
 

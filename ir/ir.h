@@ -21,6 +21,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 #include <vector>
 
@@ -251,5 +252,10 @@ struct Module {
 };
 
 const char* kernelName(KernelKind kind);
+
+// What every backend says, the same way, of an instruction it has no code for (it then
+// throws it): "internal error: the GLSL backend has no code for `recur` (the instruction
+// from line 4, column 9)". An op the table spells for it never gets here.
+std::string unexpectedOp(const Inst& inst, std::string_view backend);
 
 }  // namespace psys::ir

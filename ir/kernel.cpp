@@ -142,4 +142,12 @@ const char* kernelName(KernelKind kind) {
     return "?";
 }
 
+std::string unexpectedOp(const Inst& inst, std::string_view backend) {
+    std::string where = inst.loc.valid() ? " (the instruction from line " + std::to_string(inst.loc.line) + ", column " +
+                                               std::to_string(inst.loc.column) + ")"
+                                         : "";
+    return "internal error: " + std::string(backend) + " has no code for `" + std::string(opInfo(inst.op).name) + "`" +
+           where;
+}
+
 }  // namespace psys::ir
