@@ -17,18 +17,30 @@ bool equal(const Value& a, const Value& b, const Type& t) {
 
 // A componentwise op over the lanes, with the op known at compile time so that
 // core::lane's dispatch folds away (this is the interpreter's inner loop).
-template <Op op>
-Value unary(const Value& a, size_t width) {
+template <Op op, int arity>
+Value lanes(const Value* operands, size_t width) {
     Value out;
-    for (size_t l = 0; l < width; ++l) out.f[l] = core::lane(op, a.f[l]);
+    if constexpr (arity == 1)
+        for (size_t l = 0; l < width; ++l) out.f[l] = core::lane(op, operands[0].f[l]);
+    else if constexpr (arity == 2)
+        for (size_t l = 0; l < width; ++l) out.f[l] = core::lane(op, operands[0].f[l], operands[1].f[l]);
     return out;
 }
 
-template <Op op>
-Value binary(const Value& a, const Value& b, size_t width) {
-    Value out;
-    for (size_t l = 0; l < width; ++l) out.f[l] = core::lane(op, a.f[l], b.f[l]);
-    return out;
+// Every unary and binary componentwise op of core/ops.h's table, through core/lanes.h.
+bool laneWise(Op op) {
+    int arity = opInfo(op).arity;
+    return isPure(op) && isComponentwise(op) && (arity == 1 || arity == 2);
+}
+
+Value lanesOf(Op op, const Value* operands, size_t width) {
+    switch (op) {
+#define PSYS_LANES(id, text, arity, kind, flags, delayed, spelling) \
+    case Op::id: return lanes<Op::id, arity>(operands, width);
+        PSYS_OPS(PSYS_LANES)
+#undef PSYS_LANES
+    }
+    return {};
 }
 
 }  // namespace
@@ -37,18 +49,8 @@ Value evaluate(const Inst& inst, const Value* operands, const Type* operandTypes
     const auto w = static_cast<size_t>(inst.type.width);
     auto a = [&](size_t i) -> const Value& { return operands[i]; };
     Value out;
+    if (laneWise(inst.op)) return lanesOf(inst.op, operands, w);
     switch (inst.op) {
-#define PSYS_UNARY(op) \
-    case Op::op: return unary<Op::op>(a(0), w);
-#define PSYS_BINARY(op) \
-    case Op::op: return binary<Op::op>(a(0), a(1), w);
-        PSYS_BINARY(Add) PSYS_BINARY(Sub) PSYS_BINARY(Mul) PSYS_BINARY(Div) PSYS_BINARY(Mod) PSYS_BINARY(Min)
-        PSYS_BINARY(Max) PSYS_BINARY(Step) PSYS_BINARY(Atan2) PSYS_BINARY(Pow)
-        PSYS_UNARY(Neg) PSYS_UNARY(Sin) PSYS_UNARY(Cos) PSYS_UNARY(Tan) PSYS_UNARY(Asin) PSYS_UNARY(Acos)
-        PSYS_UNARY(Atan) PSYS_UNARY(Exp) PSYS_UNARY(Log) PSYS_UNARY(Sqrt) PSYS_UNARY(Abs) PSYS_UNARY(Sign)
-        PSYS_UNARY(Floor) PSYS_UNARY(Ceil) PSYS_UNARY(Round) PSYS_UNARY(Fract)
-#undef PSYS_UNARY
-#undef PSYS_BINARY
         case Op::Lt: case Op::Le: case Op::Gt: case Op::Ge:
             return Value::boolean(core::compare(inst.op, a(0).f[0], a(1).f[0]));
         case Op::Eq: return Value::boolean(equal(a(0), a(1), operandTypes[0]));

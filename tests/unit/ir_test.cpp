@@ -3,11 +3,13 @@
 
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include <cmath>
 
 #include "core/lanes.h"
+#include "driver/compile.h"
 #include "ir/evaluate.h"
 #include "ir/hash.h"
 #include "ir/parser.h"
@@ -237,4 +239,29 @@ TEST_CASE("lowering reads the values the checker computed: named constants, exte
     }
     CHECK(seven);
     CHECK(up3);
+}
+
+TEST_CASE("every op that is a built-in function is called in the program the backends are compared on") {
+    // tests/programs/every_operation.psys: the LLVM and GLSL backends' differential tests
+    // and the GLSL validation run it, so an op added to core/ops.h without a meaning on a
+    // backend fails there once this makes the program use it.
+    psys::SourceManager sources;
+    psys::DiagnosticEngine diags(sources);
+    psys::CompileOptions options;
+    options.pipeline.optimize = false;
+    auto module = psys::compileFile(PSYS_PROGRAMS_DIR "/every_operation.psys", sources, diags, options);
+    REQUIRE(module);
+    std::set<Op> used;
+    for (const Object& o : module->objects)
+        for (const Kernel& k : o.kernels)
+            for (const Inst& i : k.insts()) used.insert(i.op);
+    int builtins = 0;
+    for (size_t n = 0; n < psys::core::kOpCount; ++n) {
+        auto op = static_cast<Op>(n);
+        if (opInfo(op).spelling.builtin.empty()) continue;
+        ++builtins;
+        INFO(opInfo(op).name);
+        CHECK(used.count(op) == 1);
+    }
+    CHECK(builtins >= 22);
 }
