@@ -31,6 +31,7 @@ inline float lane(Op op, float x) {
         case Op::Asin: return std::asin(x);
         case Op::Acos: return std::acos(x);
         case Op::Atan: return std::atan(x);
+        case Op::Tanh: return std::tanh(x);
         case Op::Exp: return std::exp(x);
         case Op::Log: return std::log(x);
         case Op::Sqrt: return std::sqrt(x);

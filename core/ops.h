@@ -97,6 +97,7 @@ struct OpSpelling {
     X(Asin, "asin", 1, Pure, kComponentwise, 0, PSYS_MAPS("asin(x: T) -> T", "asinf", "llvm.asin", "psys_asin"))                                     \
     X(Acos, "acos", 1, Pure, kComponentwise, 0, PSYS_MAPS("acos(x: T) -> T", "acosf", "llvm.acos", "psys_acos"))                                     \
     X(Atan, "atan", 1, Pure, kComponentwise, 0, PSYS_MAPS("atan(x: T) -> T", "atanf", "llvm.atan", "atan"))                                          \
+    X(Tanh, "tanh", 1, Pure, kComponentwise, 0, PSYS_MAPS("tanh(x: T) -> T", "tanhf", "llvm.tanh", "tanh"))                                          \
     X(Exp, "exp", 1, Pure, kComponentwise, 0, PSYS_MAPS("exp(x: T) -> T", "expf", "llvm.exp", "exp"))                                                \
     X(Log, "log", 1, Pure, kComponentwise, 0, PSYS_MAPS("log(x: T) -> T", "logf", "llvm.log", "psys_log"))                                           \
     X(Sqrt, "sqrt", 1, Pure, kComponentwise, 0, PSYS_MAPS("sqrt(x: T) -> T", "", "llvm.sqrt", "psys_sqrt"))                                          \
