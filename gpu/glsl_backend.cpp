@@ -160,41 +160,37 @@ GlslBackend::Program GlslBackend::compile(const std::string& source, const std::
 
 GlslBackend::Program& GlslBackend::rowsProgram(const ir::Object& object, const ir::Kernel& kernel,
                                                rt::Clock::Source now, rt::Clock::Source dt) {
-    auto& slot = rows_[{&kernel, now, dt}];
-    if (!slot) {
-        const ir::Kernel* uniform = uniformKernelOf(object, kernel);
-        auto p = std::make_unique<Program>(compile(codegen_glsl::rowsShader(object, kernel, now, dt, uniform),
-                                                   object.name + "." + ir::kernelName(kernel.kind)));
-        p->layout = rt::columnLayout(object, kernel);
-        p->block = codegen_glsl::rowsBlock(kernel, uniform, p->layout);
-        writtenColumns(kernel, p->layout, p->resident, p->returned);
-        p->direct = codegen_glsl::directColumns(kernel, p->layout);
-        p->inPlace.assign(static_cast<size_t>(p->layout.total) + 1, false);
-        for (int c : p->direct) p->inPlace[static_cast<size_t>(c)] = true;
-        p->needed = neededColumns(kernel, p->layout, now, dt,
-                                  p->resident, p->returned);  // (a dt since creation: computed, no column)
-        p->pass = ir::kernelName(kernel.kind);
-        p->counts = kernel.kind == ir::KernelKind::Render ||
-                    std::any_of(kernel.yields.begin(), kernel.yields.end(), [](const ir::Yield& y) {
-                        return y.kind == ir::YieldKind::Kill || y.kind == ir::YieldKind::Unstable;
-                    });
-        slot = std::move(p);
-    }
-    return *slot;
+    // (built apart and then kept: a kernel the emitter refuses leaves no empty program)
+    RowsKey key{&kernel, now, dt};
+    if (auto it = rows_.find(key); it != rows_.end()) return *it->second;
+    const ir::Kernel* uniform = uniformKernelOf(object, kernel);
+    auto p = std::make_unique<Program>(compile(codegen_glsl::rowsShader(object, kernel, now, dt, uniform),
+                                               object.name + "." + ir::kernelName(kernel.kind)));
+    p->layout = rt::columnLayout(object, kernel);
+    p->block = codegen_glsl::rowsBlock(kernel, uniform, p->layout);
+    writtenColumns(kernel, p->layout, p->resident, p->returned);
+    p->direct = codegen_glsl::directColumns(kernel, p->layout);
+    p->inPlace.assign(static_cast<size_t>(p->layout.total) + 1, false);
+    for (int c : p->direct) p->inPlace[static_cast<size_t>(c)] = true;
+    p->needed = neededColumns(kernel, p->layout, now, dt,
+                              p->resident, p->returned);  // (a dt since creation: computed, no column)
+    p->pass = ir::kernelName(kernel.kind);
+    p->counts = kernel.kind == ir::KernelKind::Render ||
+                std::any_of(kernel.yields.begin(), kernel.yields.end(), [](const ir::Yield& y) {
+                    return y.kind == ir::YieldKind::Kill || y.kind == ir::YieldKind::Unstable;
+                });
+    return *(rows_[key] = std::move(p));
 }
 
 GlslBackend::Program& GlslBackend::childrenProgram(const ir::Object& object, const ir::Kernel& spawn) {
-    auto& slot = children_[&spawn];
-    if (!slot) {
-        auto p = std::make_unique<Program>(
-            compile(codegen_glsl::childrenShader(object, spawn), object.name + ".spawn" + std::to_string(spawn.site)));
-        p->layout = rt::columnLayout(object, spawn);
-        p->block = codegen_glsl::childrenBlock(object, spawn, p->layout);
-        p->direct = codegen_glsl::directArguments(spawn);
-        p->pass = "spawn";
-        slot = std::move(p);
-    }
-    return *slot;
+    if (auto it = children_.find(&spawn); it != children_.end()) return *it->second;
+    auto p = std::make_unique<Program>(
+        compile(codegen_glsl::childrenShader(object, spawn), object.name + ".spawn" + std::to_string(spawn.site)));
+    p->layout = rt::columnLayout(object, spawn);
+    p->block = codegen_glsl::childrenBlock(object, spawn, p->layout);
+    p->direct = codegen_glsl::directArguments(spawn);
+    p->pass = "spawn";
+    return *(children_[&spawn] = std::move(p));
 }
 
 // On the thread that has the GL context only: a host that prepares off its frame loop

@@ -1,5 +1,7 @@
 #include "interp/interpreter.h"
 
+#include <stdexcept>
+
 #include "rt/clock.h"
 
 namespace psys::interp {
@@ -39,6 +41,16 @@ struct Columns {
 };
 
 }  // namespace
+
+void Interpreter::prepare(const rt::Plan& plan) {
+    auto check = [](const Kernel* kernel) {
+        if (!kernel) return;
+        for (const Inst& i : kernel->insts())
+            if (!evaluates(i.op)) throw std::runtime_error(unexpectedOp(i, "the interpreter"));
+    };
+    for (const rt::Plan::Rows& r : plan.rows) check(r.kernel);
+    for (const rt::Plan::Children& c : plan.children) check(c.spawn);
+}
 
 rt::BackendReport Interpreter::report() const {
     rt::BackendReport r;

@@ -19,6 +19,8 @@ public:
     explicit Interpreter(rt::Memory& memory) : memory_(&memory) {}
     std::string name() const override { return "interp"; }
     rt::Memory& memory() override { return *memory_; }
+    // Refuses a kernel with an op it cannot run (ir::unexpectedOp), before any launch.
+    void prepare(const rt::Plan& plan) override;
     rt::RowsResult run(const rt::RowsLaunch& launch) override;
     void run(const rt::ChildrenLaunch& launch) override;
     rt::BackendReport report() const override;

@@ -1,5 +1,7 @@
 #include "ir/evaluate.h"
 
+#include <stdexcept>
+
 #include "core/hash.h"
 #include "core/lanes.h"
 
@@ -76,7 +78,7 @@ Value evaluate(const Inst& inst, const Value* operands, const Type* operandTypes
                 s += a(0).f[static_cast<size_t>(i)] * a(1).f[static_cast<size_t>(i)];
             return Value::scalar(s);
         }
-        default: return out;
+        default: throw std::runtime_error(unexpectedOp(inst, "the interpreter"));
     }
 }
 
@@ -110,21 +112,31 @@ void Evaluator::run(const Kernel& kernel, const KernelInputs& in, std::vector<Va
                 break;
             }
             default:
-                if (isPure(inst.op)) {
-                    operandValues_.clear();
-                    operandTypes_.clear();
-                    for (ValueId o : inst.operands) {
-                        operandValues_.push_back(r[o]);
-                        operandTypes_.push_back(kernel.at(o).type);
-                    }
-                    out = evaluate(inst, operandValues_.data(), operandTypes_.data());
+                if (!isPure(inst.op)) throw std::runtime_error(unexpectedOp(inst, "the interpreter"));
+                operandValues_.clear();
+                operandTypes_.clear();
+                for (ValueId o : inst.operands) {
+                    operandValues_.push_back(r[o]);
+                    operandTypes_.push_back(kernel.at(o).type);
                 }
+                out = evaluate(inst, operandValues_.data(), operandTypes_.data());
                 break;
         }
         r[v] = out;
     }
     yields.resize(kernel.yields.size());
     for (size_t i = 0; i < kernel.yields.size(); ++i) yields[i] = r[kernel.yields[i].value];
+}
+
+bool evaluates(Op op) {
+    switch (op) {
+        case Op::Const: case Op::Param: case Op::TriggerParam: case Op::StateRead: case Op::Extern:
+        case Op::Uniform: case Op::Age: case Op::Dt: case Op::Time: case Op::First: case Op::ParentExport:
+        case Op::ParentAlive: case Op::ParentAge: case Op::ObjectId: case Op::DrawIndex: case Op::Rand:
+        case Op::NRand:
+            return true;
+        default: return isPure(op);
+    }
 }
 
 std::vector<const Inst*> parentReads(const Kernel& kernel) {

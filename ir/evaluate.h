@@ -46,6 +46,10 @@ private:
     std::vector<Type> operandTypes_;
 };
 
+// Whether Evaluator::run computes `op` (constants, the inputs, random draws, every pure
+// op); for any other it throws ir::unexpectedOp's internal error, as every backend does.
+bool evaluates(Op op);
+
 // The parent reads of a kernel (parent.export, parent.alive, parent.age), in instruction
 // order: the order of KernelInputs::parents.
 std::vector<const Inst*> parentReads(const Kernel& kernel);

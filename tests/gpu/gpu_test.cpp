@@ -35,6 +35,7 @@
 #include "tests/differential.h"
 #include "tests/run_length.h"
 #include "tests/system_support.h"
+#include "tests/unexpected_op.h"
 #include "gpu_support.h"
 
 using namespace psys;
@@ -489,3 +490,8 @@ TEST_CASE("what is drawn is computed and marked on the GPU, and stays there") {
     CHECK(system.backend().memory().glBuffer(drawn.position[0]) != 0);
 }
 
+
+TEST_CASE("the GLSL backend refuses an op it has no code for with the located internal error every backend gives") {
+    GpuBackend gpu = gpuBackend();
+    CHECK(test::refusal(*gpu) == test::expectedRefusal("the GLSL backend"));
+}

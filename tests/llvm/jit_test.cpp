@@ -19,6 +19,7 @@
 #include "interp/interpreter.h"
 #include "rt/system.h"
 #include "tests/system_support.h"
+#include "tests/unexpected_op.h"
 
 using namespace psys;
 
@@ -298,4 +299,9 @@ TEST_CASE("the disk cache keeps at most 4096 objects, dropping the least recentl
     CHECK_FALSE(std::filesystem::exists(folder / "0.o"));
     CHECK(std::filesystem::exists(folder / "4099.o"));
     std::filesystem::remove_all(folder);
+}
+
+TEST_CASE("the JIT refuses an op it has no code for with the located internal error every backend gives") {
+    codegen_llvm::LlvmBackend jit;
+    CHECK(test::refusal(jit) == test::expectedRefusal("the LLVM backend"));
 }

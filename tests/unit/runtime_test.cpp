@@ -16,6 +16,7 @@
 #include "rt/memory.h"
 #include "rt/system.h"
 #include "tests/run_length.h"
+#include "tests/unexpected_op.h"
 #include "run.h"
 #include "test_support.h"
 
@@ -527,4 +528,9 @@ TEST_CASE("a render value that is a state value is drawn from the state column i
         CHECK(points[0].position[0] == (fromState ? 1.0f : 2.0f));
         CHECK(points[0].position[1] == doctest::Approx(2.05f));
     }
+}
+
+TEST_CASE("the interpreter refuses an op it has no code for with the located internal error every backend gives") {
+    interp::Interpreter interpreter;
+    CHECK(test::refusal(interpreter) == test::expectedRefusal("the interpreter"));
 }
