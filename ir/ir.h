@@ -101,6 +101,44 @@ enum class KernelKind {
 // The uniform kernel serving `kind`, if it can have one.
 std::optional<KernelKind> uniformFor(KernelKind kind);
 
+// What the run-time stores for a kernel beyond its object's declared columns (state,
+// parameters, exports), fixed by the last pass (opt/lower_storage.cpp) from the kernel's
+// values: rt::columnLayout turns it into column positions, and neither the run-time nor a
+// backend reads the instructions for it. Printed with the kernel as `storage` lines.
+struct KernelStorage {
+    bool fixed = false;  // lower-storage has run (a bare `storage` line)
+    // Per emit column — site s's rate at 2s, its count at 2s + 1 — a value every row of a
+    // launch at a uniform clock shares (a constant, an extern, a value of the uniform
+    // kernel), or none (its column).
+    struct Shared {
+        enum class From : uint8_t { Column, Constant, Extern, Uniform } from = From::Column;
+        int index = 0;    // Extern: the extern; Uniform: the uniform kernel's value
+        float value = 0;  // Constant
+    };
+    std::vector<Shared> emits;
+    // Render kernels, per render column (visible; position x y z; colour r g b a; size):
+    // drawn from the kernel's own column, from a lane of a state slot as it is, or a
+    // constant every row draws alike.
+    struct Drawn {
+        enum class From : uint8_t { Column, State, Constant } from = From::Column;
+        int slot = 0, lane = 0;  // State
+        float value = 0;         // Constant
+    };
+    std::vector<Drawn> drawn;
+    // The parent reads, in instruction order: the run-time gathers each into columns.
+    struct ParentRead {
+        Op op;
+        int depth;        // levels up
+        int exportIndex;  // parent.export: which export; else -1
+        int width;
+    };
+    std::vector<ParentRead> parents;
+};
+
+// The render columns as the IR's text names them (`position.y`, `size`), 0 … 8.
+const char* drawnColumnName(int column);
+constexpr int kDrawnColumns = 9;
+
 class Kernel {
 public:
     KernelKind kind = KernelKind::Behaviour;
@@ -112,6 +150,7 @@ public:
     size_t size() const { return insts_.size(); }
 
     std::vector<Yield> yields;
+    KernelStorage storage;
     // The values of the object's equations (and parameters) by name, for passes that look
     // them up (scoping) and for people reading the IR. Printed as `let name = %v`.
     std::map<std::string, ValueId> equations;

@@ -142,6 +142,12 @@ const char* kernelName(KernelKind kind) {
     return "?";
 }
 
+const char* drawnColumnName(int column) {
+    static const char* const names[kDrawnColumns] = {"visible", "position.x", "position.y", "position.z", "color.r",
+                                                     "color.g", "color.b", "color.a", "size"};
+    return column >= 0 && column < kDrawnColumns ? names[column] : "?";
+}
+
 std::string unexpectedOp(const Inst& inst, std::string_view backend) {
     std::string where = inst.loc.valid() ? " (the instruction from line " + std::to_string(inst.loc.line) + ", column " +
                                                std::to_string(inst.loc.column) + ")"

@@ -166,7 +166,13 @@ private:
         for (++pos_; pos_ < lines_.size(); ++pos_) {
             auto w = words(current());
             if (w.empty()) continue;
-            if (w[0] == "end") return o;
+            if (w[0] == "end") {
+                // A storage record prints only what is not a column: every emit column is there.
+                for (Kernel& k : o.kernels)
+                    if (k.storage.fixed && k.storage.emits.size() <= 2 * o.emits.size())
+                        k.storage.emits.resize(2 * o.emits.size());
+                return o;
+            }
             if (w[0] == "parent") o.parent = w.at(1);
             else if (w[0] == "attribute") attribute(o.attributes, w);
             else if (w[0] == "state") {
@@ -244,6 +250,7 @@ private:
                 return k;
             }
             if (w[0] == "yield") k.yields.push_back(yield(w));
+            else if (w[0] == "storage") storage(k, w);
             else if (w[0] == "let") {
                 if (w.size() != 4 || w[2] != "=") throw ParseError("expected `let name = %v`");
                 k.equations[w[1]] = valueRef(w[3]);
@@ -251,6 +258,55 @@ private:
             else instruction(k, line);
         }
         throw ParseError("a kernel has no `end`");
+    }
+
+    // `storage` (the record is fixed), or one fact of it (printer.cpp's storageText).
+    static void storage(Kernel& k, const std::vector<std::string>& w) {
+        KernelStorage& st = k.storage;
+        st.fixed = true;
+        if (w.size() == 1) return;
+        auto index = [](const std::string& t) {
+            if (t.empty() || t[0] != '#') throw ParseError("expected `#n`, found `" + t + "`");
+            return integer(t.substr(1));
+        };
+        if (w[1] == "emit.rate" || w[1] == "emit.count") {
+            // storage emit.rate #site = const V | extern #i | uniform #i
+            if (w.size() < 6 || w[3] != "=") throw ParseError("expected `storage emit.rate #site = …`");
+            size_t column = static_cast<size_t>(2 * index(w[2]) + (w[1] == "emit.count" ? 1 : 0));
+            if (st.emits.size() <= column) st.emits.resize(column + 1);
+            KernelStorage::Shared& e = st.emits[column];
+            using From = KernelStorage::Shared::From;
+            if (w[4] == "const") e = {From::Constant, 0, number(w[5])};
+            else if (w[4] == "extern") e = {From::Extern, index(w[5]), 0};
+            else if (w[4] == "uniform") e = {From::Uniform, index(w[5]), 0};
+            else throw ParseError("expected const, extern or uniform, found `" + w[4] + "`");
+        } else if (w[1] == "drawn") {
+            // storage drawn position.y = state #slot.lane | const V
+            if (w.size() < 6 || w[3] != "=") throw ParseError("expected `storage drawn column = …`");
+            int column = 0;
+            while (column < kDrawnColumns && w[2] != drawnColumnName(column)) ++column;
+            if (column == kDrawnColumns) throw ParseError("unknown render column `" + w[2] + "`");
+            if (st.drawn.size() < static_cast<size_t>(kDrawnColumns)) st.drawn.resize(kDrawnColumns);
+            KernelStorage::Drawn& d = st.drawn[static_cast<size_t>(column)];
+            using From = KernelStorage::Drawn::From;
+            if (w[4] == "const") {
+                d = {From::Constant, 0, 0, number(w[5])};
+            } else if (w[4] == "state") {
+                auto dot = w[5].find('.');
+                if (dot == std::string::npos) throw ParseError("expected `#slot.lane`, found `" + w[5] + "`");
+                d = {From::State, index(w[5].substr(0, dot)), integer(w[5].substr(dot + 1)), 0};
+            } else {
+                throw ParseError("expected state or const, found `" + w[4] + "`");
+            }
+        } else if (w[1] == "parent") {
+            // storage parent OP #export ^depth width
+            if (w.size() != 6 || w[4].empty() || w[4][0] != '^') throw ParseError("expected `storage parent op #e ^d width`");
+            auto op = opFromName(w[2]);
+            if (!op || !readsAncestor(*op)) throw ParseError("expected a parent read, found `" + w[2] + "`");
+            st.parents.push_back({*op, integer(w[4].substr(1)), index(w[3]), integer(w[5])});
+        } else {
+            throw ParseError("unknown storage fact `" + w[1] + "`");
+        }
     }
 
     static Yield yield(const std::vector<std::string>& w) {

@@ -29,6 +29,32 @@ std::string values(const std::array<float, 4>& v, Type t) {
     return s;
 }
 
+// A kernel's storage record (KernelStorage), a line a fact, after its yields.
+std::string storageText(const Kernel& kernel, const std::string& pad) {
+    const KernelStorage& st = kernel.storage;
+    if (!st.fixed) return "";
+    std::string out = pad + "  storage\n";
+    using Shared = KernelStorage::Shared;
+    for (size_t c = 0; c < st.emits.size(); ++c) {
+        const Shared& e = st.emits[c];
+        if (e.from == Shared::From::Column) continue;
+        out += fmt::format("{}  storage emit.{} #{} = ", pad, c % 2 ? "count" : "rate", c / 2);
+        if (e.from == Shared::From::Constant) out += "const " + number(e.value) + "\n";
+        if (e.from == Shared::From::Extern) out += fmt::format("extern #{}\n", e.index);
+        if (e.from == Shared::From::Uniform) out += fmt::format("uniform #{}\n", e.index);
+    }
+    using Drawn = KernelStorage::Drawn;
+    for (size_t c = 0; c < st.drawn.size(); ++c) {
+        const Drawn& d = st.drawn[c];
+        if (d.from == Drawn::From::Column) continue;
+        out += fmt::format("{}  storage drawn {} = ", pad, drawnColumnName(static_cast<int>(c)));
+        out += d.from == Drawn::From::State ? fmt::format("state #{}.{}\n", d.slot, d.lane) : "const " + number(d.value) + "\n";
+    }
+    for (const KernelStorage::ParentRead& p : st.parents)
+        out += fmt::format("{}  storage parent {} #{} ^{} {}\n", pad, opInfo(p.op).name, p.exportIndex, p.depth, p.width);
+    return out;
+}
+
 }  // namespace
 
 std::string yieldKindName(YieldKind kind) {
@@ -89,7 +115,7 @@ std::string print(const Kernel& kernel, int indent, PrintOptions options) {
         if (y.kind == YieldKind::EmitArg) line += fmt::format(" #{}", y.sub);
         out += line + fmt::format(" = %{}\n", y.value);
     }
-    return out + pad + "end\n";
+    return out + storageText(kernel, pad) + pad + "end\n";
 }
 
 std::string print(const Object& o, PrintOptions options) {

@@ -19,9 +19,35 @@ public:
         unkeyedDrawsAllowed_ = behaviour || k.kind == KernelKind::Trigger || k.kind == KernelKind::Start;
         for (ValueId v = 0; v < k.size(); ++v) inst(k, v, behaviour);
         for (const Yield& y : k.yields) yield(k, y);
+        if (k.storage.fixed) storage(k);
     }
 
 private:
+    // A storage record (lower-storage) that still fits its kernel: a pass after it that
+    // changed the instructions would leave it stale.
+    void storage(const Kernel& k) {
+        const KernelStorage& st = k.storage;
+        if (object_ && st.emits.size() != 2 * object_->emits.size())
+            fail(fmt::format("storage: {} emit columns for {} emit sites", st.emits.size(), object_->emits.size()));
+        for (size_t c = 0; c < st.drawn.size(); ++c) {
+            const KernelStorage::Drawn& d = st.drawn[c];
+            if (d.from != KernelStorage::Drawn::From::State) continue;
+            bool ok = object_ && d.slot >= 0 && static_cast<size_t>(d.slot) < object_->state.size() && d.lane >= 0 &&
+                      d.lane < object_->state[static_cast<size_t>(d.slot)].type.width;
+            if (!ok) fail(fmt::format("storage: {} drawn from a state lane that does not exist", drawnColumnName(static_cast<int>(c))));
+        }
+        size_t reads = 0;
+        for (const Inst& i : k.insts()) {
+            if (!readsAncestor(i.op)) continue;
+            const KernelStorage::ParentRead* p = reads < st.parents.size() ? &st.parents[reads] : nullptr;
+            if (!p || p->op != i.op || p->depth != i.attr2 || p->width != i.type.width ||
+                p->exportIndex != (i.op == Op::ParentExport ? i.attr : -1))
+                fail(fmt::format("storage: parent read {} is not the kernel's", reads));
+            ++reads;
+        }
+        if (reads != st.parents.size()) fail(fmt::format("storage: {} parent reads for {}", st.parents.size(), reads));
+    }
+
     void fail(ValueId v, const std::string& what) { errors_.push_back(fmt::format("{}, %{}: {}", where_, v, what)); }
     void fail(const std::string& what) { errors_.push_back(fmt::format("{}: {}", where_, what)); }
 

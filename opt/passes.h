@@ -67,6 +67,7 @@ void reassociate(ir::Module& module, PassErrors& errors);
 void hoistUniform(ir::Module& module, PassErrors& errors);
 void recomputeState(ir::Module& module, PassErrors& errors);
 void deadState(ir::Module& module, PassErrors& errors);
+void lowerStorage(ir::Module& module, PassErrors& errors);
 
 // When a pass runs: always (the lowering to kernels), when optimising, or when optimising
 // with relaxed maths (PassOptions::relaxed).

@@ -39,6 +39,8 @@ const std::vector<PassInfo>& passes() {
          PassRuns::Optimizing, [](ir::Module& m, const PassOptions&, PassErrors& e) { deadState(m, e); }},
         {"hoist-uniform", "what is the same for every object of a type (constants, dt, time, externs) is computed once a step in a uniform kernel",
          PassRuns::Optimizing, [](ir::Module& m, const PassOptions&, PassErrors& e) { hoistUniform(m, e); }},
+        {"lower-storage", "what the run-time stores for each kernel beyond the declared columns (shared emission values, render columns drawn from state or constants, parent reads) recorded on the kernel",
+         PassRuns::Always, [](ir::Module& m, const PassOptions&, PassErrors& e) { lowerStorage(m, e); }},
     };
     return all;
 }

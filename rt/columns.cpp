@@ -1,30 +1,10 @@
 #include "rt/columns.h"
 
+#include <stdexcept>
+
 #include <fmt/format.h>
 
 namespace psys::rt {
-
-namespace {
-
-// Lane `lane` of `v` when it is a constant: a constant, a splat of one, or a lane of a
-// compose that is.
-std::optional<float> constantLane(const ir::Kernel& k, ir::ValueId v, int lane) {
-    const ir::Inst& i = k.at(v);
-    switch (i.op) {
-        case ir::Op::Const: return i.type.isBool() ? std::nullopt : std::optional<float>(i.constant[static_cast<size_t>(lane)]);
-        case ir::Op::Splat: return constantLane(k, i.operands[0], 0);
-        case ir::Op::Compose:
-            for (ir::ValueId o : i.operands) {
-                int width = k.at(o).type.width;
-                if (lane < width) return constantLane(k, o, lane);
-                lane -= width;
-            }
-            return std::nullopt;
-        default: return std::nullopt;
-    }
-}
-
-}  // namespace
 
 ColumnLayout columnLayout(const ir::Object& object, const ir::Kernel& kernel) {
     ColumnLayout l;
@@ -47,43 +27,41 @@ ColumnLayout columnLayout(const ir::Object& object, const ir::Kernel& kernel) {
     l.parents = next;
     l.writes.assign(static_cast<size_t>(l.parents - l.emits), false);
     l.emitShared.assign(static_cast<size_t>(l.render - l.emits), {});
-    for (const ir::Yield& y : kernel.yields) {
-        if (y.kind != ir::YieldKind::EmitRate && y.kind != ir::YieldKind::EmitCount) continue;
-        auto at = static_cast<size_t>((y.kind == ir::YieldKind::EmitRate ? l.emitRate(y.index) : l.emitCount(y.index)) - l.emits);
-        l.writes[at] = true;
-        const ir::Inst& value = kernel.at(y.value);
-        using From = ColumnLayout::Shared::From;
-        if (value.op == ir::Op::Const) l.emitShared[at] = {From::Constant, 0, value.constant[0]};
-        if (value.op == ir::Op::Extern) l.emitShared[at] = {From::Extern, value.attr, 0};
-        if (value.op == ir::Op::Uniform) l.emitShared[at] = {From::Uniform, value.attr, 0};
+    // The rest is the compiler's record (ir::KernelStorage, opt/lower_storage.cpp).
+    const ir::KernelStorage& st = kernel.storage;
+    if (!st.fixed)
+        throw std::logic_error(fmt::format("internal error: the {} kernel of `{}` has no storage record (the module "
+                                           "was not compiled: opt's lower-storage)", ir::kernelName(kernel.kind),
+                                           object.name));
+    for (const ir::Yield& y : kernel.yields)
+        if (y.kind == ir::YieldKind::EmitRate || y.kind == ir::YieldKind::EmitCount)
+            l.writes[static_cast<size_t>((y.kind == ir::YieldKind::EmitRate ? l.emitRate(y.index) : l.emitCount(y.index)) - l.emits)] = true;
+    using From = ColumnLayout::Shared::From;
+    for (size_t c = 0; c < st.emits.size() && c < l.emitShared.size(); ++c) {
+        const ir::KernelStorage::Shared& e = st.emits[c];
+        switch (e.from) {
+            case ir::KernelStorage::Shared::From::Column: break;
+            case ir::KernelStorage::Shared::From::Constant: l.emitShared[c] = {From::Constant, 0, e.value}; break;
+            case ir::KernelStorage::Shared::From::Extern: l.emitShared[c] = {From::Extern, e.index, 0}; break;
+            case ir::KernelStorage::Shared::From::Uniform: l.emitShared[c] = {From::Uniform, e.index, 0}; break;
+        }
     }
     if (kernel.kind == ir::KernelKind::Render) {  // writes every render column (visible: drawn or not)…
-        l.renderFromState.assign(ColumnLayout::kRenderColumns, -1);
-        for (const ir::Yield& y : kernel.yields) {  // …but those that are state values as they are
-            const ir::Inst& value = kernel.at(y.value);
-            if (y.kind == ir::YieldKind::Visible || value.op != ir::Op::StateRead ||
-                (y.kind != ir::YieldKind::Position && y.kind != ir::YieldKind::Color && y.kind != ir::YieldKind::Size))
-                continue;
-            for (int c = 0; c < value.type.width; ++c)
-                l.renderFromState[static_cast<size_t>(ColumnLayout::renderColumn(y.kind) + c)] =
-                    l.stateOffset.at(static_cast<size_t>(value.attr)) + c;
-        }
+        l.renderFromState.assign(ColumnLayout::kRenderColumns, -1);  // …but those drawn from state or constants
         l.renderConstant.assign(ColumnLayout::kRenderColumns, {});
-        for (const ir::Yield& y : kernel.yields)
-            if (y.kind == ir::YieldKind::Position || y.kind == ir::YieldKind::Color || y.kind == ir::YieldKind::Size) {
-                int first = ColumnLayout::renderColumn(y.kind);
-                for (int c = 0; c < kernel.at(y.value).type.width; ++c)
-                    if (auto v = constantLane(kernel, y.value, c))
-                        l.renderConstant[static_cast<size_t>(first + c)] = {true, *v};
-            }
+        for (size_t c = 0; c < st.drawn.size() && c < static_cast<size_t>(ColumnLayout::kRenderColumns); ++c) {
+            const ir::KernelStorage::Drawn& d = st.drawn[c];
+            if (d.from == ir::KernelStorage::Drawn::From::State)
+                l.renderFromState[c] = l.stateOffset.at(static_cast<size_t>(d.slot)) + d.lane;
+            if (d.from == ir::KernelStorage::Drawn::From::Constant) l.renderConstant[c] = {true, d.value};
+        }
         for (int c = 0; c < ColumnLayout::kRenderColumns; ++c)
             l.writes[static_cast<size_t>(l.render - l.emits + c)] =
                 l.renderFromState[static_cast<size_t>(c)] < 0 && !l.renderConstant[static_cast<size_t>(c)].is;
     }
-    for (const ir::Inst& i : kernel.insts()) {
-        if (!ir::readsAncestor(i.op)) continue;
-        l.parentColumns.push_back({i.op, i.attr2, i.op == ir::Op::ParentExport ? i.attr : -1, i.type.width, next});
-        next += i.type.width;
+    for (const ir::KernelStorage::ParentRead& p : st.parents) {
+        l.parentColumns.push_back({p.op, p.depth, p.exportIndex, p.width, next});
+        next += p.width;
     }
     l.total = next;
     return l;

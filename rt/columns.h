@@ -1,6 +1,8 @@
 // The column table of a launch: where each column a kernel reads or writes sits, fixed by
-// the object's types and the kernel alone, so a backend can compile a kernel's loop once
-// and run it on any pool (or creation scratch) of that object type.
+// the object's types and the kernel's storage record alone (ir::KernelStorage, which the
+// compiler's lower-storage pass fixes: no IR pattern is read here), so a backend can
+// compile a kernel's loop once and run it on any pool (or creation scratch) of that
+// object type.
 //
 //   created  f64 per row: the creation time (age = ageAt(now, created), rt/clock.h)
 //   ids      u32 per row

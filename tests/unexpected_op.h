@@ -14,8 +14,10 @@ namespace psys::test {
 
 inline constexpr const char* kUnexpectedOpModule = R"(object a()
   kernel init
+    storage
   end
   kernel update
+    storage
   end
   kernel render
     %0 = age.f32  loc(a.psys:3:7)
@@ -27,6 +29,7 @@ inline constexpr const char* kUnexpectedOpModule = R"(object a()
     yield color = %3
     yield size = %1
     yield visible = %4
+    storage
   end
 end
 start

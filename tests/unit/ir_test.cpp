@@ -265,3 +265,12 @@ TEST_CASE("every op that is a built-in function is called in the program the bac
     }
     CHECK(builtins >= 22);
 }
+
+TEST_CASE("the verifier finds a storage record that no longer fits its kernel") {
+    const std::string head = "object a()\n  state s: vec3 zero\n  kernel render\n    %0 = parent.alive.bool ^1\n";
+    // A drawn lane of a slot that does not exist, and a parent read the kernel does not make.
+    std::string stale = verifyText(head + "    storage\n    storage drawn position.x = state #1.0\n  end\nend\n");
+    CHECK(stale.find("position.x drawn from a state lane that does not exist") != std::string::npos);
+    CHECK(stale.find("storage: 0 parent reads for 1") != std::string::npos);
+    CHECK(verifyText(head + "    storage\n    storage parent parent.alive #-1 ^1 1\n  end\nend\n").empty());
+}

@@ -14,6 +14,7 @@
 #include "ir/verifier.h"
 #include "opt/passes.h"
 #include "pass_support.h"
+#include "rt/columns.h"
 #include "test_support.h"
 
 using namespace psys;
@@ -406,7 +407,8 @@ TEST_CASE("the pipeline runs the registry's passes in its order, at every level,
     CHECK(passesPrinted(fire, true, true) == all);
     CHECK(passesPrinted(fire, true, false) == registered(true, false));
     CHECK(passesPrinted(fire, false, false) ==
-          std::vector<std::string>{"lowering", "resolve-cycles", "scoping", "lower-temporal", "key-random", "split-kernels"});
+          std::vector<std::string>{"lowering", "resolve-cycles", "scoping", "lower-temporal", "key-random", "split-kernels",
+                                   "lower-storage"});
     std::set<std::string> names;
     for (const opt::PassInfo& pass : opt::passes()) {
         CHECK(names.insert(pass.name).second);  // one name, one pass
@@ -422,4 +424,125 @@ TEST_CASE("docs/optimizer.md's table of passes is the registry's (psysc --list-p
     REQUIRE(end != std::string::npos);
     begin += open.size();
     CHECK(docs.substr(begin, end - begin) == opt::passTable());
+}
+
+TEST_CASE("lower-storage: what the run-time stores for each kernel is recorded on it, no instruction changed") {
+    std::string in = R"(extern rate: f32 = 30
+object comet()
+  state integrate@pos: vec3 zero
+  emit comet.tail rate
+  export pos: vec3
+  kernel update
+    %0 = const.f32 1
+    %1 = state.vec3 #0
+    %2 = extern.f32 #0
+    %3 = age.f32
+    yield emit.rate #0 = %2
+    yield emit.count #0 = %0
+    yield state #0 = %1
+  end
+  kernel render
+    %0 = state.vec3 #0
+    %1 = const.f32 1
+    %2 = age.f32
+    %3 = const.f32 0.5
+    %4 = compose.vec4 %1, %2, %3, %1
+    %5 = const.bool 1
+    yield position = %0
+    yield color = %4
+    yield size = %2
+    yield visible = %5
+  end
+end
+object comet.tail(k: f32)
+  parent comet
+  kernel render
+    %0 = parent.export.vec3 #0 ^1
+    %1 = parent.alive.bool ^1
+    %2 = const.vec4 1 1 1 1
+    %3 = param.f32 #0
+    yield position = %0
+    yield color = %2
+    yield size = %3
+    yield visible = %1
+  end
+end
+)";
+    // The rate is the extern, the count the constant 1: every row shares them. The
+    // comet's position is its state slot as it is (drawn from the slot's columns), its
+    // colour's lanes r, b and a constants (g is its age, a column); the tail's colour is
+    // constant, and it reads two values of its parent (gathered into columns, in order).
+    CHECK(after(in, opt::lowerStorage) == R"(extern rate: f32 = 30
+object comet()
+  state integrate@pos: vec3 zero
+  emit comet.tail rate
+  export pos: vec3
+  kernel update
+    %0 = const.f32 1
+    %1 = state.vec3 #0
+    %2 = extern.f32 #0
+    %3 = age.f32
+    yield emit.rate #0 = %2
+    yield emit.count #0 = %0
+    yield state #0 = %1
+    storage
+    storage emit.rate #0 = extern #0
+    storage emit.count #0 = const 1
+  end
+  kernel render
+    %0 = state.vec3 #0
+    %1 = const.f32 1
+    %2 = age.f32
+    %3 = const.f32 0.5
+    %4 = compose.vec4 %1, %2, %3, %1
+    %5 = const.bool 1
+    yield position = %0
+    yield color = %4
+    yield size = %2
+    yield visible = %5
+    storage
+    storage drawn position.x = state #0.0
+    storage drawn position.y = state #0.1
+    storage drawn position.z = state #0.2
+    storage drawn color.r = const 1
+    storage drawn color.b = const 0.5
+    storage drawn color.a = const 1
+  end
+end
+object comet.tail(k: f32)
+  parent comet
+  kernel render
+    %0 = parent.export.vec3 #0 ^1
+    %1 = parent.alive.bool ^1
+    %2 = const.vec4 1 1 1 1
+    %3 = param.f32 #0
+    yield position = %0
+    yield color = %2
+    yield size = %3
+    yield visible = %1
+    storage
+    storage drawn color.r = const 1
+    storage drawn color.g = const 1
+    storage drawn color.b = const 1
+    storage drawn color.a = const 1
+    storage parent parent.export #0 ^1 3
+    storage parent parent.alive #-1 ^1 1
+  end
+end
+)");
+    // The record reads back as it printed.
+    ir::Module m = test::parseIr(in);
+    opt::PassErrors errors;
+    opt::lowerStorage(m, errors);
+    std::string printed = ir::print(m);
+    CHECK(ir::print(test::parseIr(printed)) == printed);
+}
+
+TEST_CASE("a kernel without a storage record is refused by the run-time with an internal error") {
+    ir::Module m = test::parseIr("object a()\n  kernel update\n  end\nend\n");
+    const ir::Object& a = m.objects.at(0);
+    CHECK_THROWS_WITH_AS(rt::columnLayout(a, *a.kernel(ir::KernelKind::Update)),
+                         "internal error: the update kernel of `a` has no storage record (the module was not compiled: "
+                         "opt's lower-storage)",
+                         std::logic_error);
 }
