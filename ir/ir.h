@@ -133,6 +133,9 @@ struct KernelStorage {
         int width;
     };
     std::vector<ParentRead> parents;
+    // Init kernels: the state slots a new object's row must hold zero before it runs —
+    // those it does not set, or every one where it reads state.
+    std::vector<int> zeroed;
 };
 
 // The render columns as the IR's text names them (`position.y`, `size`), 0 … 8.

@@ -304,6 +304,9 @@ private:
             auto op = opFromName(w[2]);
             if (!op || !readsAncestor(*op)) throw ParseError("expected a parent read, found `" + w[2] + "`");
             st.parents.push_back({*op, integer(w[4].substr(1)), index(w[3]), integer(w[5])});
+        } else if (w[1] == "zeroed") {
+            // storage zeroed #slot …
+            for (size_t i = 2; i < w.size(); ++i) st.zeroed.push_back(index(w[i]));
         } else {
             throw ParseError("unknown storage fact `" + w[1] + "`");
         }

@@ -52,6 +52,11 @@ std::string storageText(const Kernel& kernel, const std::string& pad) {
     }
     for (const KernelStorage::ParentRead& p : st.parents)
         out += fmt::format("{}  storage parent {} #{} ^{} {}\n", pad, opInfo(p.op).name, p.exportIndex, p.depth, p.width);
+    if (!st.zeroed.empty()) {
+        out += pad + "  storage zeroed";
+        for (int slot : st.zeroed) out += fmt::format(" #{}", slot);
+        out += "\n";
+    }
     return out;
 }
 

@@ -46,6 +46,9 @@ private:
             ++reads;
         }
         if (reads != st.parents.size()) fail(fmt::format("storage: {} parent reads for {}", st.parents.size(), reads));
+        for (int slot : st.zeroed)
+            if (!object_ || slot < 0 || static_cast<size_t>(slot) >= object_->state.size())
+                fail(fmt::format("storage: zeroed slot #{} does not exist", slot));
     }
 
     void fail(ValueId v, const std::string& what) { errors_.push_back(fmt::format("{}, %{}: {}", where_, v, what)); }

@@ -5,7 +5,8 @@
 // a constant, an extern or a uniform value is the same in every row (the run-time takes
 // it from there, and a device need not send the column back); a drawn position that is a
 // state slot as it is is drawn from the state column, a colour lane that is a constant
-// needs no column at all; every parent read is a column the run-time gathers. This pass
+// needs no column at all; every parent read is a column the run-time gathers; a new
+// object's state that its init does not set must be zeroed before it runs. This pass
 // decides all of it once, as the last pass, and records it on the kernel
 // (ir::KernelStorage, printed as `storage` lines): rt::columnLayout turns the record into
 // column positions, and neither the run-time nor a backend looks at the instructions to
@@ -78,6 +79,15 @@ KernelStorage storageOf(const Object& object, const Kernel& kernel) {
     for (const Inst& i : kernel.insts())
         if (readsAncestor(i.op))
             st.parents.push_back({i.op, i.attr2, i.op == Op::ParentExport ? i.attr : -1, i.type.width});
+    if (kernel.kind == KernelKind::Init) {
+        std::vector<bool> set(object.state.size(), false);
+        bool readsState = false;
+        for (const Inst& i : kernel.insts()) readsState |= i.op == Op::StateRead;
+        for (const Yield& y : kernel.yields)
+            if (!readsState && y.kind == YieldKind::StateNext) set.at(static_cast<size_t>(y.index)) = true;
+        for (size_t slot = 0; slot < set.size(); ++slot)
+            if (!set[slot]) st.zeroed.push_back(static_cast<int>(slot));
+    }
     return st;
 }
 

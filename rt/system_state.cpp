@@ -50,13 +50,12 @@ TypeInfo typeInfo(const ir::Module& module, const ir::Object& o) {
             if (y.kind == YieldKind::Size) t.drawn[3] = true;
         }
     }
-    std::vector<bool> set(o.state.size(), false);
-    if (t.init && std::none_of(t.init->insts().begin(), t.init->insts().end(),
-                               [](const ir::Inst& i) { return i.op == ir::Op::StateRead; }))
-        for (const ir::Yield& y : t.init->yields)
-            if (y.kind == YieldKind::StateNext) set[static_cast<size_t>(y.index)] = true;
-    for (size_t s = 0; s < o.state.size(); ++s)
-        if (!set[s]) t.zeroedState.push_back(s);
+    // What a creation batch zeroes: the compiler's record of what init leaves (every slot
+    // where nothing runs at creation).
+    if (t.init)
+        for (int slot : t.init->storage.zeroed) t.zeroedState.push_back(static_cast<size_t>(slot));
+    else
+        for (size_t s = 0; s < o.state.size(); ++s) t.zeroedState.push_back(s);
     t.counted.assign(o.emits.size(), false);
     t.rated.assign(o.emits.size(), false);
     for (const ir::Yield& y : t.update->yields) {

@@ -546,3 +546,13 @@ TEST_CASE("a kernel without a storage record is refused by the run-time with an 
                          "opt's lower-storage)",
                          std::logic_error);
 }
+
+TEST_CASE("lower-storage: an init kernel records the slots a new row must hold zero before it runs") {
+    const std::string head = "object p(v: vec3)\n  state a: vec3 zero\n  state b: vec3 next\n  kernel init\n";
+    // Init sets b from the parameter: only a is zeroed.
+    std::string sets = after(head + "    %0 = param.vec3 #0\n    yield state #1 = %0\n  end\nend\n", opt::lowerStorage);
+    CHECK(sets.find("    storage\n    storage zeroed #0\n  end") != std::string::npos);
+    // Init reads a slot (before setting it): every slot is zeroed first.
+    std::string reads = after(head + "    %0 = state.vec3 #0\n    yield state #1 = %0\n  end\nend\n", opt::lowerStorage);
+    CHECK(reads.find("    storage\n    storage zeroed #0 #1\n  end") != std::string::npos);
+}
