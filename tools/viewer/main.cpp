@@ -14,6 +14,7 @@
 #include <CLI/CLI.hpp>
 
 #include "host/large_stack.h"
+#include "image_file.h"
 #include "viewer.h"
 
 using namespace psys;
@@ -36,6 +37,12 @@ int fail(const std::string& message) {
     return 2;
 }
 
+// A file or folder the run would write that cannot be: said before anything runs, exit 1.
+int cannotWrite(const std::string& path, const std::string& reason) {
+    std::cerr << "psys-view: error: cannot write `" << path << "`: " << reason << "\n";
+    return 1;
+}
+
 }  // namespace
 
 namespace {
@@ -51,7 +58,7 @@ int realMain(int argc, char** argv) {
     app.add_flag("--headless", o.headless, "No window: render offscreen (EGL surfaceless) and write PNGs");
     app.add_option("--frames", o.frames, "Frames to run, then exit (0: until the window closes; headless: 1)")
         ->check(CLI::Range(0, 1000000000));
-    app.add_option("--screenshot", o.screenshot, "Write the last frame to this PNG");
+    app.add_option("--screenshot", o.screenshot, "Write the last frame to this image (.png, .jpg, .bmp or .tga)");
     app.add_option("--record", o.record, "Write a PNG every --every frames into this folder");
     app.add_option("--every", o.every, "With --record: every Nth frame (1)")->check(CLI::Range(1, 1000000000));
     app.add_option("--camera", camera, "yaw,pitch,distance[,x,y,z]: degrees and units, looking at (x, y, z)");
@@ -111,6 +118,11 @@ int realMain(int argc, char** argv) {
     if (std::sscanf(size.c_str(), "%dx%d", &o.width, &o.height) != 2 || o.width < 16 || o.height < 16 ||
         o.width > 16384 || o.height > 16384)
         return fail("--size takes WIDTHxHEIGHT, such as 1280x720, not `" + size + "`");
+    if (!o.screenshot.empty())
+        if (auto problem = imageFormatProblem(o.screenshot))
+            return cannotWrite(o.screenshot, *problem);
+    if (!o.record.empty())
+        if (auto problem = folderProblem(o.record)) return cannotWrite(o.record, *problem);
     if (!script.empty()) {
         std::ifstream in(script);
         if (!in) return fail("cannot read `" + script + "`");

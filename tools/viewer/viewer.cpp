@@ -8,8 +8,8 @@
 
 #include <GLFW/glfw3.h>
 #include <fmt/format.h>
-#include <stb_image_write.h>
 
+#include "image_file.h"
 #include "input.h"
 #include "panel.h"
 
@@ -96,8 +96,11 @@ void Viewer::frame() {
         if (panel_) panel_->draw();
         surface_.present();
     }
-    if (!options_.record.empty() && frame_ % std::max(options_.every, 1) == 0)
-        screenshot(fmt::format("{}/frame_{:06}.png", options_.record, frame_));
+    if (!options_.record.empty() && frame_ % std::max(options_.every, 1) == 0 &&
+        !screenshot(fmt::format("{}/frame_{:06}.png", options_.record, frame_))) {
+        status_ = 1;  // a recording with a frame missing is no recording: stop
+        quit_ = true;
+    }
     if (reloadSaved_) {  // the first frame of a reloaded system is out
         lastReloadSeconds_ = secondsBetween(*reloadSaved_, Clock::now());
         say(fmt::format("first frame of the new system {:.1f} ms after the save", *lastReloadSeconds_ * 1e3));
@@ -234,13 +237,12 @@ std::optional<std::string> Viewer::fire(const std::string& trigger, const std::v
 }
 
 bool Viewer::screenshot(const std::string& path) {
-    std::filesystem::path p(path);
-    if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
-    std::vector<uint8_t> pixels = surface_.pixels();
-    bool ok = stbi_write_png(path.c_str(), surface_.width(), surface_.height(), 4, pixels.data(), surface_.width() * 4) != 0;
-    if (!ok) std::cerr << "psys-view: error: cannot write `" << path << "`\n";
-    else say("wrote " + path);
-    return ok;
+    if (auto problem = writeImage(path, surface_.width(), surface_.height(), surface_.pixels())) {
+        std::cerr << "psys-view: error: cannot write `" << path << "`: " << *problem << "\n";
+        return false;
+    }
+    say("wrote " + path);
+    return true;
 }
 
 void Viewer::restart(uint32_t seed) {
@@ -272,7 +274,7 @@ void Viewer::runScript() {
         else if (a.verb == "pan") pan(std::stof(w[0]), std::stof(w[1]));
         else if (a.verb == "zoom") zoom(std::stof(w[0]));
         else if (a.verb == "quit") quit_ = true;
-        else if (a.verb == "screenshot") screenshot(w[0]);
+        else if (a.verb == "screenshot" && !screenshot(w[0])) status_ = 1;
         else if (a.verb == "key") {
             const std::string& k = w[0];
             int code = k == "SPACE" ? GLFW_KEY_SPACE : k.size() == 1 ? static_cast<int>(std::toupper(k[0])) : 0;
