@@ -124,13 +124,15 @@ int realMain(int argc, char** argv) {
     if (!o.record.empty())
         if (auto problem = folderProblem(o.record)) return cannotWrite(o.record, *problem);
     if (!script.empty()) {
+        std::error_code folder;
+        if (std::filesystem::is_directory(script, folder)) return fail("cannot read `" + script + "`: it is a folder");
         std::ifstream in(script);
         if (!in) return fail("cannot read `" + script + "`");
         std::stringstream text;
         text << in.rdbuf();
         std::string error;
-        auto parsed = Script::parse(text.str(), error);
-        if (!parsed) return fail(script + ": " + error);
+        auto parsed = Script::parse(text.str(), script, error);
+        if (!parsed) return fail(error);
         o.script = *parsed;
     }
     o.blend = blend == "alpha" ? Blend::Alpha : Blend::Additive;

@@ -7,10 +7,12 @@
 //   FRAME key K            a key: F R B G H SPACE S 1…9 (docs/viewer.md)
 //   FRAME set NAME=V,…     an extern, as the panel sets it
 //   FRAME fire T[:A,…]     a trigger, as its button fires it
-//   FRAME screenshot PATH  a PNG of that frame
+//   FRAME screenshot PATH  an image of that frame (.png, .jpg, .bmp, .tga)
 //   FRAME quit
 //
-// `#` starts a comment. Actions run before the frame's step, in file order.
+// `#` starts a comment. Actions run before the frame's step, in file order. The whole
+// script is checked when it is read — frame numbers, numbers (finite), keys, the form of
+// settings and firings, image formats — and a bad line is named FILE:LINE.
 #pragma once
 
 #include <optional>
@@ -23,12 +25,14 @@ struct ScriptAction {
     int frame = 0;
     std::string verb;
     std::vector<std::string> words;
+    std::vector<float> numbers;  // orbit, pan, zoom: the words as numbers
 };
 
 struct Script {
     std::vector<ScriptAction> actions;
-    // Parses a script; on a bad line, nullopt and `error` says which and why.
-    static std::optional<Script> parse(const std::string& text, std::string& error);
+    // Parses a script read from `file`; on a bad line, nullopt and `error` says
+    // "FILE:LINE: why".
+    static std::optional<Script> parse(const std::string& text, const std::string& file, std::string& error);
 };
 
 }  // namespace psys::viewer

@@ -232,7 +232,7 @@ std::optional<std::string> Viewer::set(const host::ExternSetting& setting) { ret
 
 std::optional<std::string> Viewer::fire(const std::string& trigger, const std::vector<float>& args) {
     auto error = session_->system().fire(trigger, args);
-    if (error) say("psys-view: " + *error);
+    if (error) std::cerr << "psys-view: error: " << *error << "\n";
     return error;
 }
 
@@ -270,9 +270,10 @@ void Viewer::runScript() {
     for (const ScriptAction& a : options_.script.actions) {
         if (a.frame != frame_) continue;
         const auto& w = a.words;
-        if (a.verb == "orbit") orbit(std::stof(w[0]), std::stof(w[1]));
-        else if (a.verb == "pan") pan(std::stof(w[0]), std::stof(w[1]));
-        else if (a.verb == "zoom") zoom(std::stof(w[0]));
+        const auto& n = a.numbers;  // (checked when the script was read)
+        if (a.verb == "orbit") orbit(n[0], n[1]);
+        else if (a.verb == "pan") pan(n[0], n[1]);
+        else if (a.verb == "zoom") zoom(n[0]);
         else if (a.verb == "quit") quit_ = true;
         else if (a.verb == "screenshot" && !screenshot(w[0])) status_ = 1;
         else if (a.verb == "key") {
@@ -283,7 +284,7 @@ void Viewer::runScript() {
             auto setting = host::parseSet(w[0]);
             auto error = setting ? set(*setting) : std::optional<std::string>(setting.error);
             if (error) {
-                say("psys-view: script: " + *error);
+                std::cerr << "psys-view: error: script, frame " << a.frame << ": " << *error << "\n";
                 status_ = 1;
             }
         } else if (a.verb == "fire") {
