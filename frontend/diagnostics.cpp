@@ -59,10 +59,10 @@ const char* severityColour(Severity s) {
 // Prints `path:line:col: severity: message`, then the source line with the range
 // underlined: a caret at its start and tildes over the rest of it on that line.
 void printOne(std::ostream& out, const SourceManager& sources, Severity severity,
-              SourceRange range, const std::string& message, bool colour) {
+              SourceRange range, const std::string& message, bool colour, const std::string& program) {
     auto paint = [&](const char* code) { return colour ? code : ""; };
     if (!range.valid()) {
-        out << paint(kBold) << "psysc: " << paint(kReset) << paint(severityColour(severity))
+        out << paint(kBold) << program << ": " << paint(kReset) << paint(severityColour(severity))
             << severityWord(severity) << ": " << paint(kReset) << paint(kBold) << message
             << paint(kReset) << '\n';
         return;
@@ -138,9 +138,9 @@ Diagnostic& DiagnosticEngine::warning(SourceRange range, std::string message) {
 
 void DiagnosticEngine::print(std::ostream& out, bool colour) const {
     for (const Diagnostic& d : diagnostics_) {
-        printOne(out, sources_, d.severity, d.range, d.message, colour);
+        printOne(out, sources_, d.severity, d.range, d.message, colour, program_);
         for (const DiagnosticNote& n : d.notes)
-            printOne(out, sources_, Severity::Note, n.range, n.message, colour);
+            printOne(out, sources_, Severity::Note, n.range, n.message, colour, program_);
     }
     int hiddenErrors = std::max(0, errors_ - kMaxShown), hiddenWarnings = std::max(0, warnings_ - kMaxShown);
     if (hiddenErrors > 0 || hiddenWarnings > 0)

@@ -49,6 +49,10 @@ public:
     void setSuppressed(bool suppressed) { suppressed_ = suppressed; }
     bool suppressed() const { return suppressed_; }
 
+    // A diagnostic with no place in a source (a file that cannot be read) is labelled with
+    // the program that prints it: `psysc: error: …`, `psys-view: error: …`.
+    void setProgram(std::string program) { program_ = std::move(program); }
+
     void print(std::ostream& out, bool colour) const;
     std::string render(bool colour = false) const;
 
@@ -56,6 +60,7 @@ private:
     Diagnostic& add(Severity severity, SourceRange range, std::string message);
 
     const SourceManager& sources_;
+    std::string program_ = "psysc";
     std::vector<Diagnostic> diagnostics_;
     Diagnostic discarded_;
     int errors_ = 0;

@@ -58,7 +58,9 @@ Parsed<TriggerFiring> parseFire(const std::string& text) {
 
 Parsed<double> parseStep(const std::string& text) {
     auto dt = parseNumber(text);
-    if (!dt) return Parsed<double>::fail("--dt takes a number of seconds (such as 0.016 or 1/60), not `" + text + "`");
+    if (!dt || !std::isfinite(*dt) || *dt < 0)
+        return Parsed<double>::fail("--dt takes a number of seconds, finite and not negative (such as 0.016 or 1/60), not `" +
+                                    text + "`");
     return {*dt, {}};
 }
 

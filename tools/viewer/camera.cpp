@@ -43,6 +43,7 @@ void Camera::frame(glm::vec3 low, glm::vec3 high) {
 }
 
 std::optional<Camera> Camera::parse(const std::string& text) {
+    if (text.empty() || text.back() == ',') return std::nullopt;  // (getline drops a last empty item)
     std::vector<float> v;
     std::stringstream in(text);
     std::string item;

@@ -6,6 +6,7 @@
 //
 // Exit status: 0, 1 (the file does not compile, or a frame failed), 2 (bad usage or no
 // way to draw).
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -47,6 +48,15 @@ int cannotWrite(const std::string& path, const std::string& reason) {
 
 namespace {
 
+// CLI11's ranges let NaN through (it compares false with both bounds).
+const CLI::Validator kFinite(
+    [](std::string& text) {
+        char* end = nullptr;
+        double v = std::strtod(text.c_str(), &end);
+        return *end == '\0' && std::isfinite(v) ? std::string() : "`" + text + "` is not a finite number";
+    },
+    "FINITE");
+
 int realMain(int argc, char** argv) {
     CLI::App app{"psys-view: run a .psys system in real time, edit it live"};
     app.footer(kKeys);
@@ -73,7 +83,8 @@ int realMain(int argc, char** argv) {
                    "Integrate every object with this method, whatever its @integrator says (docs/accuracy.md)")
         ->check(CLI::IsMember(methods))->type_name("METHOD");
     app.add_option("--seed", o.session.system.seed, "Random seed (1)");
-    app.add_option("--threads", o.session.system.threads, "Threads for the simulation: 0 for every core (0)");
+    app.add_option("--threads", o.session.system.threads, "Threads for the simulation: 0 for every core (0)")
+        ->check(CLI::Range(0, 256));  // TBB's own limit
     app.add_option("--dt", dt, "Seconds per frame with a fixed step (1/60)");
     app.add_flag("--real-time", o.realTime, "Step by the time each frame really took (T switches)");
     app.add_option("--size", size, "Width x height of the window or image (1280x720)");
@@ -84,10 +95,11 @@ int realMain(int argc, char** argv) {
     app.add_flag("--ui", ui, "The panel in --headless images too");
     app.add_flag("--no-watch", noWatch, "Do not reload the file when it is saved");
     app.add_option("--script", script, "Scripted input, an action a line (docs/viewer.md)")->type_name("FILE");
-    app.add_option("--fps", o.fps, "At most this many frames a second (0: as many as it can)")->check(CLI::Range(0.0, 10000.0));
+    app.add_option("--fps", o.fps, "At most this many frames a second (0: as many as it can)")
+        ->check(kFinite & CLI::Range(0.0, 10000.0));
     app.add_option("--interim-after", o.interimAfter,
                    "Seconds a reload waits for the JIT before the new system runs on the interpreter meanwhile (0.05)")
-        ->check(CLI::Range(0.0, 3600.0));
+        ->check(kFinite & CLI::Range(0.0, 3600.0));
     app.add_option("--warmup", o.warmup, "Frames left out of the timing summary --log prints (0)")->check(CLI::Range(0, 1000000000));
     app.add_flag("--log", o.log, "Say on stdout what happens: reloads and their latency, images written");
     try {
@@ -115,7 +127,8 @@ int realMain(int argc, char** argv) {
         o.camera = Camera::parse(camera);
         if (!o.camera) return fail("--camera takes yaw,pitch,distance or yaw,pitch,distance,x,y,z, not `" + camera + "`");
     }
-    if (std::sscanf(size.c_str(), "%dx%d", &o.width, &o.height) != 2 || o.width < 16 || o.height < 16 ||
+    char extra = 0;
+    if (std::sscanf(size.c_str(), "%dx%d%c", &o.width, &o.height, &extra) != 2 || o.width < 16 || o.height < 16 ||
         o.width > 16384 || o.height > 16384)
         return fail("--size takes WIDTHxHEIGHT, such as 1280x720, not `" + size + "`");
     if (!o.screenshot.empty())
@@ -146,6 +159,7 @@ int realMain(int argc, char** argv) {
     if (!surface) return fail(error);
     host::CompileResult compiled;
     auto session = host::Session::open(o.file, o.session, compiled, error);
+    if (compiled.diagnostics) compiled.diagnostics->setProgram("psys-view");
     compiled.print(std::cerr, false);
     if (!compiled.ok) return 1;
     if (!session) return fail(error);
