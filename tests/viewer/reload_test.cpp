@@ -1,6 +1,7 @@
 // Hot reload as the viewer does it: a file is saved, the watcher sees it, the reloader
 // compiles it off the frame loop, and the new system takes over with the particles still
-// there; a broken edit — in the file or in a file it imports — keeps the old one running.
+// there; a broken edit — in the file or in a file it imports —, an empty save or a deleted
+// file keeps the old one running.
 #include <doctest/doctest.h>
 
 #include <filesystem>
@@ -111,6 +112,25 @@ TEST_CASE("a save is seen, compiled off the frame loop, and the particles stay")
         waitForSave(watcher);
         reloader.saved(Clock::now());
         CHECK(waitForReload(reloader, *session, frame).kind == Reloader::Outcome::Kind::Adopted);
+    }
+    SUBCASE("an empty save (an editor that truncates, then writes) keeps the system running") {
+        folder.save("main.psys", "  \n\n");
+        waitForSave(watcher);
+        reloader.saved(Clock::now());
+        CHECK(waitForReload(reloader, *session, frame).kind == Reloader::Outcome::Kind::Empty);
+        CHECK(session->system().stats().types[0].live >= live);  // nothing adopted: the particles stay
+        folder.save("main.psys", kMain);
+        waitForSave(watcher);
+        reloader.saved(Clock::now());
+        CHECK(waitForReload(reloader, *session, frame).kind == Reloader::Outcome::Kind::Adopted);
+    }
+    SUBCASE("a deleted file keeps the system running, and is picked up when it returns") {
+        fs::remove(folder.path / "main.psys");
+        waitForSave(watcher);  // (a deletion is seen as a change)
+        reloader.saved(Clock::now());
+        CHECK(waitForReload(reloader, *session, frame).kind == Reloader::Outcome::Kind::Vanished);
+        CHECK(session->system().stats().types[0].live >= live);
+        saveRedAndReload(folder, watcher, reloader, *session, frame, live);
     }
     SUBCASE("an edit that breaks an import keeps the old system running") {
         folder.save("lib.psys", "fn lift() -> vec3 = vec3(0, 1);\n");

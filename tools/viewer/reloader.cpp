@@ -1,5 +1,9 @@
 #include "reloader.h"
 
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+
 #include "host/large_stack.h"
 
 namespace psys::viewer {
@@ -22,6 +26,20 @@ void Reloader::saved(Clock::time_point when) {
     start(when);
 }
 
+namespace {
+
+// A file with nothing but white space, or none at all, is not a program to adopt.
+std::optional<Reloader::Outcome::Kind> emptyOrGone(const std::string& path) {
+    std::error_code error;
+    if (!std::filesystem::exists(path, error)) return Reloader::Outcome::Kind::Vanished;
+    std::ifstream in(path);
+    for (char c; in.get(c);)
+        if (!std::isspace(static_cast<unsigned char>(c))) return std::nullopt;
+    return in.bad() ? std::nullopt : std::optional(Reloader::Outcome::Kind::Empty);
+}
+
+}  // namespace
+
 void Reloader::start(Clock::time_point when) {
     savedAt_ = when;
     compiled_ = prepared_ = interim_ = false;
@@ -33,6 +51,12 @@ void Reloader::start(Clock::time_point when) {
 }
 
 int Reloader::work(const std::string& path, const host::SessionOptions& options, std::shared_ptr<rt::Backend> backend) {
+    if (auto kept = emptyOrGone(path)) {  // nothing to compile: the running system stays
+        std::lock_guard lock(mutex_);
+        kept_ = kept;
+        compiled_ = prepared_ = true;
+        return 0;
+    }
     {
         host::Session::Candidate candidate;
         candidate.compile = host::compile(path, options.compile, candidate.module);
@@ -67,6 +91,13 @@ void Reloader::finish() {
 std::optional<Reloader::Outcome> Reloader::poll() {
     if (!busy()) return std::nullopt;
     std::unique_lock lock(mutex_);
+    if (prepared_ && kept_) {
+        Outcome out{*kept_, {}, std::nullopt, secondsSince(savedAt_), 0};
+        kept_.reset();
+        lock.unlock();
+        finish();
+        return out;
+    }
     if (prepared_) {
         host::Session::Candidate candidate = std::move(candidate_);
         lock.unlock();

@@ -3,7 +3,9 @@
 // adopts the result at a frame boundary (host::Session::adopt: the objects carry over). If
 // the JIT is still compiling a while after the module is ready, the new system runs on the
 // interpreter meanwhile and moves to the JIT when its kernels are ready: the objects carry
-// over both times. A file that does not compile leaves the old system running.
+// over both times. A file that does not compile leaves the old system running, and so
+// does one that is empty (an editor that truncates, then writes, is seen in between) or
+// gone (deleted or renamed: its return is a save like any other).
 #pragma once
 
 #include <chrono>
@@ -29,7 +31,7 @@ public:
     bool busy() const { return worker_.joinable(); }
 
     struct Outcome {
-        enum class Kind { Adopted, Interim, Failed } kind;
+        enum class Kind { Adopted, Interim, Failed, Empty, Vanished } kind;
         host::CompileResult compile;
         std::optional<rt::ReloadReport> report;
         double latencySeconds = 0;  // from the save to the new system taking over
@@ -56,6 +58,7 @@ private:
     host::Session::Candidate candidate_;
     Clock::time_point savedAt_;
     bool interim_ = false;                      // the new system runs on the interpreter meanwhile
+    std::optional<Outcome::Kind> kept_;         // the file was empty or gone: nothing compiled
     std::optional<Clock::time_point> pending_;  // a save during the compile
 };
 

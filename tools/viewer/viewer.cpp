@@ -136,6 +136,13 @@ void Viewer::handleReload() {
     auto saved = Clock::now() - std::chrono::duration_cast<Clock::duration>(
                                     std::chrono::duration<double>(outcome->latencySeconds));
     watchSources(outcome->compile);
+    if (outcome->kind == Kind::Empty || outcome->kind == Kind::Vanished) {
+        reloadNote_ = "`" + session_->path() + "`" +
+                      (outcome->kind == Kind::Empty ? " is empty (a save under way?): the system keeps running"
+                                                    : " is gone (deleted or renamed): the system keeps running until it returns");
+        say("reload: " + reloadNote_);
+        return;
+    }
     if (outcome->kind == Kind::Failed) {
         diagnostics_ = outcome->compile.text();
         reloadNote_ = "the edit does not compile: the system keeps running";

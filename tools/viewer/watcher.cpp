@@ -30,7 +30,7 @@ void Watcher::watch(const std::vector<std::string>& files) {
         folders.insert(path.parent_path().string());
     }
     for (const std::string& folder : folders) {
-        int wd = inotify_add_watch(fd_, folder.c_str(), IN_CLOSE_WRITE | IN_MOVED_TO | IN_CREATE);
+        int wd = inotify_add_watch(fd_, folder.c_str(), IN_CLOSE_WRITE | IN_MOVED_TO | IN_CREATE | IN_DELETE | IN_MOVED_FROM);
         if (wd >= 0) folders_[wd] = folder;
     }
 }
