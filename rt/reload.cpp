@@ -9,7 +9,8 @@
 // not keep read 0); what the new type no longer has is dropped. Parents are kept when the
 // new child type's parent type is the old one's; readers are counted again, and a frozen
 // object nobody reads any more is freed. Time, the step count, ids and externs (by name
-// and type) continue.
+// and type) continue. The start does not run again, but for a `spawn` of a type the old
+// start did not spawn: the edit added it, and it runs at the next step.
 #include <algorithm>
 #include <map>
 #include <set>
@@ -160,6 +161,18 @@ ReloadReport System::carryOver(const System& oldSystem) {
     }
     reconnect(old, s, oldTypeOf);
     initNewSlots(report);
+    // A `spawn` of a type the old start did not spawn is one the edit added: it runs (at
+    // the next start()); those the old start had are not repeated, and a removed one
+    // removes nothing.
+    if (old.started)
+        for (size_t site = 0; site < s.module.start.emits.size(); ++site) {
+            const std::string& target = s.module.start.emits[site].target;
+            bool before = std::any_of(old.module.start.emits.begin(), old.module.start.emits.end(),
+                                      [&](const ir::EmitSite& e) { return e.target == target; });
+            if (before) continue;
+            s.reloadSpawns.push_back(site);
+            report.spawned.push_back(target);
+        }
     drawing_->invalidate();
     return report;
 }

@@ -5,6 +5,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <stdexcept>
@@ -105,9 +106,20 @@ int System::externHandle(std::string_view name) const { return state_->module.ex
 // The `spawn`s run when the system is first used, so externs set before that apply.
 void System::start() {
     detail::State& s = *state_;
-    if (s.started) return;
-    s.started = true;
-    creation_->emitFromKernel(s.module.start, {}, kStartObject);
+    if (s.started && s.reloadSpawns.empty()) return;
+    if (!s.started) {
+        s.started = true;
+        creation_->emitFromKernel(s.module.start, {}, kStartObject);
+    } else {  // a reload's added spawns: the start with the others' counts left out
+        ir::Trigger added = s.module.start;
+        std::erase_if(added.kernel.yields, [&](const ir::Yield& y) {
+            return y.kind == ir::YieldKind::EmitCount &&
+                   std::find(s.reloadSpawns.begin(), s.reloadSpawns.end(), static_cast<size_t>(y.index)) ==
+                       s.reloadSpawns.end();
+        });
+        s.reloadSpawns.clear();
+        creation_->emitFromKernel(added, {}, kStartObject);
+    }
     creation_->drain(s.now);
     if (!s.backend.clearsKilled()) s.settleLate();  // else at the end of the next step
 }

@@ -123,6 +123,7 @@ struct ReloadReport {
     std::vector<std::string> droppedTypes; // those types
     std::vector<std::string> newSlots;     // "type.slot": state the new module adds (started from init)
     std::vector<std::string> lostSlots;    // "type.slot": state the new module no longer has (or with another type)
+    std::vector<std::string> spawned;      // types the new `spawn`s name that the old ones did not: spawned
 };
 
 // Every launch shape a System of `module` uses: what its constructor hands

@@ -153,6 +153,9 @@ struct State {
     uint64_t step = 0;
     uint32_t nextId = 0;
     bool started = false;
+    // The start's emit sites a reload added — spawns of types the old start did not spawn —
+    // run at the next start() (rt/reload.cpp).
+    std::vector<size_t> reloadSpawns;
     using Deaths = std::vector<std::pair<size_t, uint32_t>>;
     Deaths dying;
     std::vector<LateKills> late;

@@ -323,3 +323,21 @@ TEST_CASE("a reload that changes the integrator carries the integrals — the ne
     run(fresh, 121);
     CHECK(exactAfter.points(0).at(0).position[1] == fresh.points(0).at(0).position[1]);
 }
+
+TEST_CASE("a reload that adds a spawn spawns it; one the old start had is not repeated, one removed removes nothing") {
+    const std::string types = "object a { point(vec3(age), white, 1); }\nobject b { point(vec3(-age), white, 1); }\n";
+    interp::Interpreter backend;
+    rt::System before(compile(types + "spawn a;"), backend);
+    run(before, 30);
+    rt::System added(compile(types + "spawn a; spawn b; spawn b;"), backend);
+    rt::ReloadReport report = added.carryOver(before);
+    CHECK(report.spawned == std::vector<std::string>{"b", "b"});
+    run(added, 1);
+    CHECK(added.pool(0).live() == 1);  // a's spawn is not repeated
+    CHECK(added.pool(1).live() == 2);
+    rt::System removed(compile(types + "spawn a;"), backend);
+    report = removed.carryOver(added);
+    CHECK(report.spawned.empty());
+    run(removed, 1);
+    CHECK(removed.pool(1).live() == 2);  // the b objects stay
+}

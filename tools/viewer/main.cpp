@@ -161,7 +161,17 @@ int realMain(int argc, char** argv) {
     auto session = host::Session::open(o.file, o.session, compiled, error);
     if (compiled.diagnostics) compiled.diagnostics->setProgram("psys-view");
     compiled.print(std::cerr, false);
-    if (!compiled.ok) return 1;
+    if (!compiled.ok) {
+        // Headless, or not watching, there is nothing to wait for. A window opens on an empty
+        // system with the errors shown, and the first save that compiles takes over.
+        if (o.headless || !o.watch) return 1;
+        o.startErrors = compiled.text();
+        static const std::string nothing;
+        host::CompileResult empty;
+        session = host::Session::open(o.file, o.session, empty, error, &nothing);
+        o.sets.clear();  // (for a program not there yet)
+        o.fires.clear();
+    }
     if (!session) return fail(error);
     for (const host::ExternSetting& s : o.sets)
         if (auto e = session->apply(s)) return fail("--set " + s.name + ": " + *e);

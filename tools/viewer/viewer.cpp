@@ -39,6 +39,10 @@ Viewer::Viewer(ViewerOptions options, Surface& surface, std::unique_ptr<host::Se
     if (surface_.window()) connectInput(surface_.window(), *this);  // before the panel's, which chain to them
     if (options_.ui) panel_ = std::make_unique<Panel>(*this, surface_);
     session_->schedule(options_.fires);  // checked by the caller (main.cpp) against this session
+    if (!options_.startErrors.empty()) {
+        diagnostics_ = options_.startErrors;
+        reloadNote_ = "the file does not compile: save a fix and it starts";
+    }
 }
 
 Viewer::~Viewer() = default;
@@ -155,6 +159,7 @@ void Viewer::handleReload() {
     if (r.dropped) what += fmt::format(", {} dropped", r.dropped);
     if (!r.newSlots.empty()) what += fmt::format(", {} new slots", r.newSlots.size());
     if (!r.lostSlots.empty()) what += fmt::format(", {} slots lost", r.lostSlots.size());
+    if (!r.spawned.empty()) what += fmt::format(", {} new spawns", r.spawned.size());
     if (outcome->kind == Kind::Interim) {
         reloadNote_ = what + "; on the interpreter until the JIT is ready";
         say(fmt::format("reload: the new system {:.1f} ms after the save, on the interpreter until the JIT is ready: {}",

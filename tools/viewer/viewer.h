@@ -28,6 +28,9 @@ class Panel;
 
 struct ViewerOptions {
     std::string file;
+    // The errors of a file that did not compile at the start: the window opens on an empty
+    // system showing them, and the first good save takes over.
+    std::string startErrors;
     bool headless = false;
     int frames = 0;              // 0: until the window is closed (headless: 1)
     std::string screenshot;      // a PNG of the last frame
