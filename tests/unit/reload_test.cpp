@@ -216,7 +216,7 @@ TEST_CASE("a reload keeps the externs' values where name and type match") {
     CHECK(v[1] == 1);
 }
 
-TEST_CASE("a reload that adds an object type starts it empty, and the spawns do not run again") {
+TEST_CASE("a reload that adds an object type starts it empty but for the spawns the edit added") {
     std::string old = "object a { point(vec3(age), white, 1); }\nspawn a;";
     std::string added = "object a { point(vec3(age), white, 1); emit b at 60 per second; }\n"
                         "object b { point(vec3(-age), white, 1); }\nspawn a; spawn b;";
@@ -227,10 +227,11 @@ TEST_CASE("a reload that adds an object type starts it empty, and the spawns do 
     rt::ReloadReport report = after.carryOver(before);
     CHECK(report.carried == 1);
     CHECK(report.dropped == 0);
+    CHECK(report.spawned == std::vector<std::string>{"b"});
     CHECK(after.stats().types[1].live == 0);
     run(after, 60);
-    CHECK(after.stats().types[0].live == 1);
-    CHECK(after.stats().types[1].created == 60);  // from the carried emitter; no `spawn b`
+    CHECK(after.stats().types[0].live == 1);  // `spawn a` is not repeated
+    CHECK(after.stats().types[1].created == 61);  // 60 from the carried emitter, 1 the added `spawn b`
 }
 
 TEST_CASE("a renamed object type is a removed type and a new one") {
@@ -324,7 +325,7 @@ TEST_CASE("a reload that changes the integrator carries the integrals — the ne
     CHECK(exactAfter.points(0).at(0).position[1] == fresh.points(0).at(0).position[1]);
 }
 
-TEST_CASE("a reload that adds a spawn spawns it; one the old start had is not repeated, one removed removes nothing") {
+TEST_CASE("a reload that adds a spawn spawns it, one the old start had is not repeated, one removed removes nothing") {
     const std::string types = "object a { point(vec3(age), white, 1); }\nobject b { point(vec3(-age), white, 1); }\n";
     interp::Interpreter backend;
     rt::System before(compile(types + "spawn a;"), backend);
