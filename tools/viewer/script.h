@@ -7,10 +7,11 @@
 //   FRAME key K            a key: F R B G H SPACE S 1…9 (docs/viewer.md)
 //   FRAME set NAME=V,…     an extern, as the panel sets it
 //   FRAME fire T[:A,…]     a trigger, as its button fires it
-//   FRAME screenshot PATH  an image of that frame (.png, .jpg, .bmp, .tga)
+//   FRAME screenshot PATH  an image of that frame, once drawn (.png, .jpg, .bmp, .tga)
 //   FRAME quit
 //
-// `#` starts a comment. Actions run before the frame's step, in file order. The whole
+// `#` starts a comment. Actions run before the frame's step, in file order (a screenshot
+// is taken when the frame has been drawn). The whole
 // script is checked when it is read — frame numbers, numbers (finite), keys, the form of
 // settings and firings, image formats — and a bad line is named FILE:LINE.
 #pragma once

@@ -92,7 +92,7 @@ void Viewer::frame() {
     stats_.after = session_->system().stats();
     // Offscreen, only the frames that are written are drawn (and, with the panel, every
     // frame: it lays itself out over a few).
-    bool shown = surface_.window() || panel_ || frame_ == options_.frames || options_.frames <= 0 ||
+    bool shown = surface_.window() || panel_ || frame_ == options_.frames || options_.frames <= 0 || !shots_.empty() ||
                  (!options_.record.empty() && frame_ % std::max(options_.every, 1) == 0);
     if (shown) {
         if (options_.fit) frameAlive();
@@ -100,6 +100,9 @@ void Viewer::frame() {
         if (panel_) panel_->draw();
         surface_.present();
     }
+    for (const std::string& shot : shots_)
+        if (!screenshot(shot)) status_ = 1;
+    shots_.clear();
     if (!options_.record.empty() && frame_ % std::max(options_.every, 1) == 0 &&
         !screenshot(fmt::format("{}/frame_{:06}.png", options_.record, frame_))) {
         status_ = 1;  // a recording with a frame missing is no recording: stop
@@ -287,7 +290,7 @@ void Viewer::runScript() {
         else if (a.verb == "pan") pan(n[0], n[1]);
         else if (a.verb == "zoom") zoom(n[0]);
         else if (a.verb == "quit") quit_ = true;
-        else if (a.verb == "screenshot" && !screenshot(w[0])) status_ = 1;
+        else if (a.verb == "screenshot") shots_.push_back(w[0]);  // once the frame is drawn
         else if (a.verb == "key") {
             const std::string& k = w[0];
             int code = k == "SPACE" ? GLFW_KEY_SPACE : k.size() == 1 ? static_cast<int>(std::toupper(k[0])) : 0;

@@ -114,6 +114,7 @@ private:
     std::optional<Clock::time_point> reloadSaved_;  // the save behind the system adopted this frame
     bool interim_ = false;                          // a reloaded system runs on the interpreter meanwhile
     std::string reloadNote_;        // what the last reload did
+    std::vector<std::string> shots_;  // a script's screenshots of this frame, written once it is drawn
     std::string diagnostics_;       // the last failed compile's errors, until a good one
     int status_ = 0;
     // Sums over the frames drawn, for the summary --log prints at the end.
