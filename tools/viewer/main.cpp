@@ -2,10 +2,11 @@
 //
 //   psys-view FILE                         a window (Xvfb or a desktop), the JIT, hot reload
 //   psys-view --headless FILE --frames N --screenshot out.png
-//                                          no display: EGL surfaceless, PNGs
+//                                          no display: EGL surfaceless, images
 //
-// Exit status: 0, 1 (the file does not compile, or a frame failed), 2 (bad usage or no
-// way to draw).
+// Exit status: 0, 1 (the file does not compile — headless or not watching; a window
+// waits for a fix —, a frame failed, or an image could not be written), 2 (bad usage or
+// no way to draw).
 #include <cmath>
 #include <filesystem>
 #include <fstream>
