@@ -221,12 +221,15 @@ void Panel::stats() {
     ImGui::End();
 }
 
-// An edit that does not compile: its errors, as psysc check prints them, until a good save.
+// An edit that does not compile: its errors, as psysc check prints them, until a good save
+// (at most 40% of the window's height; more scroll).
 void Panel::diagnostics() {
     if (viewer_.diagnostics_.empty()) return;
     ImGuiIO& io = ImGui::GetIO();
     ImGui::SetNextWindowPos(ImVec2(10, io.DisplaySize.y - 10), ImGuiCond_Always, ImVec2(0, 1));
-    ImGui::SetNextWindowSize(ImVec2(io.DisplaySize.x - 20, 0), ImGuiCond_Always);
+    // At most 40% of the window: many errors scroll rather than cover the scene.
+    ImGui::SetNextWindowSizeConstraints(ImVec2(io.DisplaySize.x - 20, 0),
+                                        ImVec2(io.DisplaySize.x - 20, std::max(80.0f, io.DisplaySize.y * 0.4f)));
     ImGui::PushStyleColor(ImGuiCol_WindowBg, ImVec4(0.25f, 0.05f, 0.05f, 0.92f));
     ImGui::Begin("the edit does not compile; the system keeps running", nullptr,
                  ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_AlwaysAutoResize);
