@@ -76,12 +76,13 @@ std::optional<std::string> Session::schedule(std::vector<TriggerFiring> firings,
 
 std::optional<std::string> Session::fire(const TriggerFiring& firing) { return system_->fire(firing.trigger, firing.args); }
 
-std::optional<std::string> Session::frame(int index, double dt) {
+std::optional<std::string> Session::frame(int index, double dt, int steps) {
     for (const TriggerFiring& f : scheduled_)
         if (f.frame == index)
             if (auto error = fire(f)) return "--fire " + f.trigger + ": " + *error;
     auto start = std::chrono::steady_clock::now();
-    auto error = system_->step(dt);
+    std::optional<std::string> error;
+    for (int s = 0; s < steps && !error; ++s) error = system_->step(dt);
     stepSeconds_ += secondsSince(start);
     return error;
 }

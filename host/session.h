@@ -61,8 +61,9 @@ public:
     // its number of values, at a frame from 1 to `lastFrame` (0: no last frame); else an
     // error names the first that does not, and nothing is scheduled.
     std::optional<std::string> schedule(std::vector<TriggerFiring> firings, int lastFrame = 0);
-    // Frame `index` (from 1): the triggers scheduled for it, then a step of `dt`.
-    std::optional<std::string> frame(int index, double dt);
+    // Frame `index` (from 1): the triggers scheduled for it, then `steps` steps of `dt`
+    // (a real-time host runs none, one or several a frame).
+    std::optional<std::string> frame(int index, double dt, int steps = 1);
     double stepSeconds() const { return stepSeconds_; }  // in frame(), so far
 
     struct Reload {

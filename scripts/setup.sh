@@ -13,6 +13,7 @@ packages=(
   doctest-dev libcli11-dev libfmt-dev nlohmann-json3-dev libstb-dev libtbb-dev
   glslang-tools xvfb xauth patchelf xz-utils libbenchmark-dev python3-matplotlib vim
   clang-19 libclang-rt-19-dev
+  ffmpeg fonts-dejavu-core
 )
 # Node.js 20 and npm (the editor extension's tests and package) come with the machine;
 # where they do not, Debian's are installed.

@@ -42,7 +42,7 @@ bool background(Pixel p) {
 // Runs `text` for `frames` frames offscreen, no grid, and returns the last frame; `check`
 // sees the viewer (its system and camera) before it goes.
 Frame render(const std::string& text, int frames, Blend blend, const std::function<void(Viewer&)>& check = {},
-             const std::string& backend = "llvm") {
+             const std::string& backend = "llvm", const std::function<void(Viewer&)>& setup = {}) {
     std::string error;
     auto surface = openOffscreen(kWidth, kHeight, error);
     REQUIRE_MESSAGE(surface, error);
@@ -60,6 +60,7 @@ Frame render(const std::string& text, int frames, Blend blend, const std::functi
     auto session = host::Session::open("test.psys", options.session, compiled, error, &text);
     REQUIRE_MESSAGE(session, compiled.text(), error);
     Viewer viewer(options, *surface, std::move(session), compiled);
+    if (setup) setup(viewer);
     CHECK(viewer.run() == 0);
     if (check) check(viewer);
     return {surface->pixels()};
@@ -93,6 +94,32 @@ TEST_CASE("a point is drawn in its colour where it projects, and nowhere else") 
     // A disc 8 pixels across at the reference distance, 16·(240/720)… at distance 10: a few dozen pixels.
     CHECK(lit > 4);
     CHECK(lit < 400);
+}
+
+TEST_CASE("a type hidden is not drawn, and a solo type is drawn alone") {
+    std::string text = "object a { point(vec3(0, 2, 0), red, 8); }\n"
+                       "object b { point(vec3(2, 2, 0), green, 8); }\nspawn a; spawn b;";
+    // (2, 2, 0) lies right of the middle, on the same row.
+    auto lit = [](const Frame& f, int x0, int x1) {
+        size_t n = 0;
+        for (int x = x0; x < x1; ++x) n += !background(f.at(x, kHeight / 2));
+        return n;
+    };
+    int middle = kWidth / 2, right = middle + 30;  // a's disc, b's disc: between them, the background
+    Frame both = render(text, 1, Blend::Additive);
+    REQUIRE(lit(both, middle - 3, middle + 4) > 0);
+    REQUIRE(lit(both, right, kWidth) > 0);
+    Frame hidden = render(text, 1, Blend::Additive, {}, "llvm", [](Viewer& v) { v.hide("b", true); });
+    CHECK(lit(hidden, middle - 3, middle + 4) > 0);
+    CHECK(lit(hidden, right, kWidth) == 0);
+    Frame solo = render(text, 1, Blend::Additive, {}, "llvm", [](Viewer& v) { v.solo("b"); });
+    CHECK(lit(solo, 0, right) == 0);
+    CHECK(lit(solo, right, kWidth) > 0);
+    Frame shownAgain = render(text, 1, Blend::Additive, {}, "llvm", [](Viewer& v) {
+        v.hide("b", true);
+        v.hide("b", false);
+    });
+    CHECK(shownAgain.rgba == both.rgba);
 }
 
 TEST_CASE("nothing is drawn for a system without objects") {

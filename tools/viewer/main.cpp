@@ -17,6 +17,7 @@
 
 #include "host/large_stack.h"
 #include "image_file.h"
+#include "keys.h"
 #include "viewer.h"
 
 using namespace psys;
@@ -24,15 +25,12 @@ using namespace psys::viewer;
 
 namespace {
 
-const char* kKeys = R"(
-Mouse: drag to orbit, right-drag or shift-drag to pan, the wheel to zoom.
-Keys:  F frame what is alive    R reset the camera    B additive / alpha blending
-       G the ground grid and axes   H hide the panel   SPACE pause    S one step
-       T fixed 1/60 s or real time   + and - time scale   1-9 fire trigger N
-       Q or ESC quit
-Hot reload: saving FILE (or a file it imports) compiles it in the background; the new
-system takes over with the particles still flying. An edit that does not compile leaves
-the old one running and shows why.)";
+std::string footer() {
+    return "\nMouse and keys (F1 or ? shows them over the frame):\n" + keysText() +
+           "Hot reload: saving FILE (or a file it imports) compiles it in the background; the new\n"
+           "system takes over with the particles still flying. An edit that does not compile, an\n"
+           "empty save or a vanished file leave the old one running and show why.";
+}
 
 int fail(const std::string& message) {
     std::cerr << "psys-view: error: " << message << "\n";
@@ -60,17 +58,21 @@ const CLI::Validator kFinite(
 
 int realMain(int argc, char** argv) {
     CLI::App app{"psys-view: run a .psys system in real time, edit it live"};
-    app.footer(kKeys);
+    app.footer(footer());
     ViewerOptions o;
     std::vector<std::string> sets, fires;
     std::string camera, dt = "1/60", script, size = "1280x720", blend = "additive";
     bool noUi = false, ui = false, noWatch = false, noGrid = false;
-    app.add_option("file", o.file, "The system to view")->required()->type_name("FILE");
+    bool keys = false, realTime = false, fixed = false;
+    app.add_option("file", o.file, "The system to view")->type_name("FILE");
+    app.add_flag("--keys", keys, "Print the mouse and keys as a Markdown table (docs/viewer.md) and exit");
     app.add_flag("--headless", o.headless, "No window: render offscreen (EGL surfaceless) and write PNGs");
     app.add_option("--frames", o.frames, "Frames to run, then exit (0: until the window closes; headless: 1)")
         ->check(CLI::Range(0, 1000000000));
     app.add_option("--screenshot", o.screenshot, "Write the last frame to this image (.png, .jpg, .bmp or .tga)");
-    app.add_option("--record", o.record, "Write a PNG every --every frames into this folder");
+    app.add_option("--record", o.record,
+                   "Record every --every frame: into a folder as PNGs, or an .mp4 or .gif (ffmpeg on the PATH); "
+                   "at --dt a frame, it plays at the simulation's speed");
     app.add_option("--every", o.every, "With --record: every Nth frame (1)")->check(CLI::Range(1, 1000000000));
     app.add_option("--camera", camera, "yaw,pitch,distance[,x,y,z]: degrees and units, looking at (x, y, z)");
     app.add_option("--set", sets, "Set an extern: NAME=VALUE or NAME=X,Y,Z (repeatable)")->allow_extra_args(false);
@@ -86,8 +88,13 @@ int realMain(int argc, char** argv) {
     app.add_option("--seed", o.session.system.seed, "Random seed (1)");
     app.add_option("--threads", o.session.system.threads, "Threads for the simulation: 0 for every core (0)")
         ->check(CLI::Range(0, 256));  // TBB's own limit
-    app.add_option("--dt", dt, "Seconds per frame with a fixed step (1/60)");
-    app.add_flag("--real-time", o.realTime, "Step by the time each frame really took (T switches)");
+    app.add_option("--dt", dt, "Seconds a step simulates (1/60)");
+    auto* realFlag = app.add_flag("--real-time", realTime,
+                                  "Headless: run steps of --dt as wall-clock time passes (a window's default)");
+    app.add_flag("--fixed", fixed, "A step of --dt a frame, however long the frame took (headless's default; T switches)")
+        ->excludes(realFlag);
+    app.add_option("--max-steps", o.maxSteps, "In real time, the most steps a frame runs after a stall (8)")
+        ->check(CLI::Range(1, 1000));
     app.add_option("--size", size, "Width x height of the window or image (1280x720)");
     app.add_option("--blend", blend, "additive (the default) or alpha (B switches)")->check(CLI::IsMember({"additive", "alpha"}));
     app.add_flag("--fit", o.fit, "The camera fits what is alive before each frame (as F does)");
@@ -110,6 +117,12 @@ int realMain(int argc, char** argv) {
         return e.get_exit_code() == 0 ? 0 : (code == 0 ? 0 : 2);
     }
 
+    if (keys) {
+        std::cout << keysMarkdown();
+        return 0;
+    }
+    if (o.file.empty()) return fail("a FILE to view is needed (psys-view --help)");
+    o.fixed = o.headless ? !realTime : fixed;
     if (!integrator.empty()) o.session.compile.pipeline.pass.everyObject = core::integratorFromName(integrator);
     for (const std::string& s : sets) {
         auto setting = host::parseSet(s);
@@ -136,7 +149,7 @@ int realMain(int argc, char** argv) {
         if (auto problem = imageFormatProblem(o.screenshot))
             return cannotWrite(o.screenshot, *problem);
     if (!o.record.empty())
-        if (auto problem = folderProblem(o.record)) return cannotWrite(o.record, *problem);
+        if (auto problem = Recorder::problem(o.record)) return cannotWrite(o.record, *problem);
     if (!script.empty()) {
         std::error_code folder;
         if (std::filesystem::is_directory(script, folder)) return fail("cannot read `" + script + "`: it is a folder");

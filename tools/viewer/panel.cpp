@@ -2,21 +2,55 @@
 
 #include <epoxy/gl.h>
 
+#include <cstdlib>
+#include <filesystem>
+
 #include <GLFW/glfw3.h>
 #include <fmt/format.h>
 #include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 
+#include "keys.h"
 #include "viewer.h"
 
 namespace psys::viewer {
+
+namespace {
+
+// What the panel writes beyond ASCII: Latin-1 (×, ÷, °), Greek, punctuation (…, –, “”),
+// arrows and mathematical operators (≤, ≈, √).
+const ImWchar kGlyphs[] = {0x0020, 0x00FF, 0x0370, 0x03FF, 0x2000, 0x206F, 0x2190, 0x21FF, 0x2200, 0x22FF, 0};
+
+// A font with those glyphs: PSYS_VIEW_FONT, else DejaVu Sans (fonts-dejavu-core, which
+// scripts/setup.sh installs); without one, ImGui's own font, ASCII only ("…" shows "?").
+void loadFont(ImGuiIO& io) {
+    std::vector<std::string> candidates;
+    if (const char* v = std::getenv("PSYS_VIEW_FONT"); v && *v) candidates.push_back(v);
+    candidates.push_back("/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf");
+    candidates.push_back("/usr/share/fonts/dejavu/DejaVuSans.ttf");
+    for (const std::string& path : candidates) {
+        std::error_code ignored;
+        if (std::filesystem::is_regular_file(path, ignored) &&
+            io.Fonts->AddFontFromFileTTF(path.c_str(), 15.0f, nullptr, kGlyphs))
+            return;
+    }
+    io.Fonts->AddFontDefault();
+}
+
+}  // namespace
+
+bool Panel::hasGlyph(unsigned codepoint) const {
+    ImFont* font = ImGui::GetIO().Fonts->Fonts.empty() ? nullptr : ImGui::GetIO().Fonts->Fonts[0];
+    return font && font->FindGlyphNoFallback(static_cast<ImWchar>(codepoint)) != nullptr;
+}
 
 Panel::Panel(Viewer& viewer, Surface& surface) : viewer_(viewer), surface_(surface) {
     IMGUI_CHECKVERSION();
     context_ = ImGui::CreateContext();
     ImGuiIO& io = ImGui::GetIO();
     io.IniFilename = nullptr;  // no imgui.ini next to the user's files
+    loadFont(io);
     ImGui::StyleColorsDark();
     ImGui::GetStyle().Alpha = 0.94f;
     // The window's input callbacks are installed first (tools/viewer/main.cpp): ImGui's
@@ -56,6 +90,7 @@ void Panel::draw() {
         controls();
         stats();
     }
+    help();
     diagnostics();
     ImGui::Render();
     surface_.bind();
@@ -72,10 +107,15 @@ void Panel::controls() {
     ImGui::Checkbox("pause (space)", &viewer_.paused_);
     ImGui::SameLine();
     if (ImGui::Button("step (S)")) viewer_.stepOnce_ = true;
-    float scale = static_cast<float>(viewer_.timeScale_);
-    if (ImGui::SliderFloat("time scale", &scale, 1.0f / 64, 16, "%.3g", ImGuiSliderFlags_Logarithmic))
-        viewer_.timeScale_ = scale;
-    ImGui::Checkbox("fixed dt of 1/60 s (T: real time)", &viewer_.fixedDt_);
+    SimClock::Settings& clock = viewer_.clock_.settings();
+    float scale = static_cast<float>(clock.scale);
+    if (ImGui::SliderFloat("time scale (+ -)", &scale, 1.0f / 64, 16, "%.3g", ImGuiSliderFlags_Logarithmic))
+        clock.scale = scale;
+    bool real = !clock.fixed;
+    if (ImGui::Checkbox("real time (T: a step a frame)", &real)) {
+        clock.fixed = !real;
+        viewer_.clock_.resetDebt();
+    }
     ImGui::InputInt("seed", &seed_);
     ImGui::SameLine();
     if (ImGui::Button("restart")) viewer_.restart(static_cast<uint32_t>(seed_));
@@ -181,6 +221,13 @@ void Panel::stats() {
                                         ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing);
     host::Session& session = viewer_.session();
     ImGui::Text("%.0f fps, frame %.2f ms (%s)", viewer_.fps_, f.frameSeconds * 1e3, session.backend().name().c_str());
+    const SimClock& clock = viewer_.clock_;
+    ImGui::Text("time %.3f s%s, %d step%s of %.2f ms this frame%s", viewer_.session().system().time(),
+                viewer_.paused_ ? " (paused)" : "", f.steps, f.steps == 1 ? "" : "s", clock.stepSeconds() * 1e3,
+                clock.settings().fixed ? " (a step a frame)" : "");
+    if (clock.cappedFrames())
+        ImGui::TextColored(ImVec4(1, 0.7f, 0.3f, 1), "behind real time: %llu frames capped at %d steps, %.2f s let go",
+                           static_cast<unsigned long long>(clock.cappedFrames()), clock.settings().maxSteps, clock.dropped());
     const rt::Stats &a = f.before, &b = f.after;
     ImGui::Text("step %.2f ms: loops %.2f, kills/emissions %.2f, creation %.2f", f.stepSeconds * 1e3,
                 (b.loopSeconds - a.loopSeconds) * 1e3, (b.emitSeconds - a.emitSeconds) * 1e3,
@@ -189,18 +236,25 @@ void Panel::stats() {
     ImGui::Text("drawing %.2f ms (draw() %.2f)", f.glSeconds * 1e3, (b.drawSeconds - a.drawSeconds) * 1e3);
     ImGui::Text("last build %.1f ms", viewer_.lastCompileSeconds_ * 1e3);
     if (viewer_.lastReloadSeconds_) ImGui::Text("last reload: %.1f ms from save", *viewer_.lastReloadSeconds_ * 1e3);
+    if (const auto& h = viewer_.lastHitch_)
+        ImGui::Text("its slowest frame %.1f ms, %.1fx a normal one (%.1f ms)", h->worstSeconds * 1e3,
+                    h->worstSeconds / std::max(h->normalSeconds, 1e-9), h->normalSeconds * 1e3);
+    if (!viewer_.shotNote_.empty()) ImGui::TextWrapped("%s", viewer_.shotNote_.c_str());
     if (!viewer_.reloadNote_.empty()) ImGui::TextWrapped("%s", viewer_.reloadNote_.c_str());
-    if (ImGui::BeginTable("types", 5, ImGuiTableFlags_SizingFixedFit)) {
-        for (const char* h : {"type", "live", "created", "killed", "dropped"}) ImGui::TableSetupColumn(h);
+    if (ImGui::BeginTable("types", 7, ImGuiTableFlags_SizingFixedFit)) {
+        for (const char* h : {"shown", "solo", "type", "live", "created", "killed", "dropped"}) ImGui::TableSetupColumn(h);
         ImGui::TableHeadersRow();
         for (const rt::TypeStats& t : b.types) {
+            ImGui::PushID(t.name.c_str());
             ImGui::TableNextRow();
+            typeVisibility(t.name);
             ImGui::TableNextColumn();
             ImGui::TextUnformatted(t.name.c_str());
             for (uint64_t n : {static_cast<uint64_t>(t.live), t.created, t.killed, t.dropped}) {
                 ImGui::TableNextColumn();
                 ImGui::Text("%llu", static_cast<unsigned long long>(n));
             }
+            ImGui::PopID();
         }
         ImGui::EndTable();
     }
@@ -218,6 +272,41 @@ void Panel::stats() {
     if (b.clampedEmissions)
         ImGui::TextColored(ImVec4(1, 0.7f, 0.3f, 1), "emissions asking for more than 1e18 objects (taken as 1e18): %llu",
                            static_cast<unsigned long long>(b.clampedEmissions));
+    ImGui::End();
+}
+
+// A type's row of the stats: drawn or hidden, and solo (only it drawn; again: all).
+void Panel::typeVisibility(const std::string& name) {
+    // Shown while it draws (hidden, or another solo: not).
+    ImGui::TableNextColumn();
+    bool shown = !viewer_.hidden_.count(name);
+    ImGui::BeginDisabled(!viewer_.solo_.empty());
+    if (ImGui::Checkbox("##shown", &shown)) viewer_.hide(name, !shown);
+    ImGui::EndDisabled();
+    ImGui::TableNextColumn();
+    bool solo = viewer_.solo_ == name;
+    if (ImGui::Checkbox("##solo", &solo)) viewer_.solo(solo ? name : "");
+}
+
+// F1 or ?: the keys (tools/viewer/keys.h), over the middle of the frame.
+void Panel::help() {
+    if (!viewer_.help_) return;
+    ImGuiIO& io = ImGui::GetIO();
+    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x * 0.5f, io.DisplaySize.y * 0.5f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+    ImGui::SetNextWindowBgAlpha(0.9f);
+    ImGui::Begin("keys (F1 or ? closes)", &viewer_.help_,
+                 ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_AlwaysAutoResize);
+    if (ImGui::BeginTable("keys", 2, ImGuiTableFlags_SizingFixedFit | ImGuiTableFlags_RowBg)) {
+        for (const KeyBinding& b : keyBindings()) {
+            ImGui::TableNextRow();
+            ImGui::TableNextColumn();
+            ImGui::TextUnformatted(b.keys.c_str());
+            ImGui::TableNextColumn();
+            ImGui::TextUnformatted(b.does.c_str());
+        }
+        ImGui::EndTable();
+    }
+    ImGui::TextUnformatted("Saving the file reloads it; the panel's table shows, hides or solos each type.");
     ImGui::End();
 }
 

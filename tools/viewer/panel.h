@@ -29,6 +29,8 @@ public:
     // Whether the panel has the mouse or the keyboard (the camera leaves them alone).
     bool wantsMouse() const;
     bool wantsKeyboard() const;
+    // Whether the panel's font draws this character (not ImGui's "?" for it).
+    bool hasGlyph(unsigned codepoint) const;
 
     bool visible = true;
 
@@ -38,6 +40,8 @@ private:
     void triggers();
     void stats();
     void diagnostics();
+    void help();
+    void typeVisibility(const std::string& name);
 
     Viewer& viewer_;
     Surface& surface_;

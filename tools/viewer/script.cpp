@@ -9,13 +9,10 @@
 
 #include "host/settings.h"
 #include "image_file.h"
+#include "keys.h"
 
 namespace psys::viewer {
 namespace {
-
-// The keys `key` presses (the viewer's, docs/viewer.md).
-const std::set<std::string> kKeys = {"F", "R", "B", "G", "H", "S", "T", "Q", "=", "-", "SPACE",
-                                     "1", "2", "3", "4", "5", "6", "7", "8", "9"};
 
 // A finite number, the whole word.
 std::optional<float> finite(const std::string& word) {
@@ -35,7 +32,7 @@ std::string problem(ScriptAction& a) {
             a.numbers.push_back(*v);
         }
     } else if (a.verb == "key") {
-        if (!kKeys.count(a.words[0])) return "unknown key `" + a.words[0] + "` (F R B G H S T Q = - SPACE 1…9)";
+        if (!keyPress(a.words[0])) return "unknown key `" + a.words[0] + "` (" + keyNames() + ")";
     } else if (a.verb == "set") {
         if (auto s = host::parseSet(a.words[0]); !s) return s.error;
     } else if (a.verb == "fire") {

@@ -4,7 +4,7 @@
 //   FRAME orbit DX DY      drag to orbit, in pixels
 //   FRAME pan DX DY        right-drag to pan
 //   FRAME zoom STEPS       the wheel (positive: closer)
-//   FRAME key K            a key: F R B G H SPACE S 1…9 (docs/viewer.md)
+//   FRAME key K            a key: F R B G H SPACE S T = - P V F1 ? 1…9 … (keys.h)
 //   FRAME set NAME=V,…     an extern, as the panel sets it
 //   FRAME fire T[:A,…]     a trigger, as its button fires it
 //   FRAME screenshot PATH  an image of that frame, once drawn (.png, .jpg, .bmp, .tga)

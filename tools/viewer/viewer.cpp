@@ -11,6 +11,7 @@
 
 #include "image_file.h"
 #include "input.h"
+#include "keys.h"
 #include "panel.h"
 
 namespace psys::viewer {
@@ -19,9 +20,8 @@ namespace {
 
 double secondsBetween(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
-// The longest step a real-time frame takes: a stall (a breakpoint, a dragged window) is not
-// a 10 s hitch for the particles.
-constexpr double kLongestRealStep = 0.1;
+// The rate of a recording: a frame every `every` steps of `dt` plays at the simulation's speed.
+double recordingFps(double dt, int every) { return 1 / (dt * std::max(every, 1)); }
 
 }  // namespace
 
@@ -33,7 +33,7 @@ Viewer::Viewer(ViewerOptions options, Surface& surface, std::unique_ptr<host::Se
     scene_ = std::make_unique<SceneRenderer>();
     reloader_ = std::make_unique<Reloader>(*session_);
     reloader_->interimAfterSeconds = options_.interimAfter;
-    fixedDt_ = !options_.realTime;
+    clock_ = SimClock({options_.dt, options_.fixed, 1, options_.maxSteps});
     lastCompileSeconds_ = compiled.seconds + session_->backend().report().compileSeconds;
     if (options_.watch) watchSources(compiled);
     if (surface_.window()) connectInput(surface_.window(), *this);  // before the panel's, which chain to them
@@ -60,9 +60,19 @@ void Viewer::watchSources(const host::CompileResult& compiled) {
 
 int Viewer::run() {
     int last = options_.frames > 0 ? options_.frames : (options_.headless ? 1 : 0);
-    lastFrame_ = Clock::now();
+    if (!options_.record.empty()) {
+        std::string error;
+        recorder_ = Recorder::open(options_.record, surface_.width(), surface_.height(),
+                                   recordingFps(options_.dt, options_.every), error);
+        if (!recorder_) {
+            std::cerr << "psys-view: error: " << error << "\n";
+            return 1;
+        }
+    }
+    lastFrame_ = now();
     while (!quit_ && !surface_.closed() && (last == 0 || frame_ < last)) frame();
     if (!options_.screenshot.empty() && !screenshot(options_.screenshot)) status_ = 1;
+    stopRecording();
     if (totals_.frames > 0) {
         size_t live = 0;
         for (const rt::TypeStats& t : session_->system().stats().types) live += t.live;
@@ -77,23 +87,31 @@ void Viewer::frame() {
     ++frame_;
     Clock::time_point start = Clock::now();
     if (surface_.window()) glfwPollEvents();
-    if (options_.watch && watcher_.changed()) reloader_->saved(Clock::now());
+    if (options_.watch && watcher_.changed()) {
+        reloader_->saved(Clock::now());
+        if (!hitch_) hitch_ = Hitch{0, normalFrame_, 0};
+    }
     handleReload();
     runScript();
-    double real = std::min(secondsBetween(lastFrame_, start), kLongestRealStep);
-    lastFrame_ = start;
+    Clock::time_point wall = now();
+    double real = secondsBetween(lastFrame_, wall);
+    lastFrame_ = wall;
     stats_.before = session_->system().stats();
     auto stepStart = Clock::now();
+    stats_.steps = 0;
+    if (paused_) clock_.resetDebt();  // a pause owes no catch-up
     if (!paused_ || stepOnce_) {
-        step(fixedDt_ ? options_.dt : real * timeScale_);
+        stats_.steps = paused_ ? clock_.stepOnce() : clock_.advance(real);
+        step(stats_.steps, clock_.stepSeconds());
         stepOnce_ = false;
     }
     stats_.stepSeconds = secondsBetween(stepStart, Clock::now());
     stats_.after = session_->system().stats();
     // Offscreen, only the frames that are written are drawn (and, with the panel, every
     // frame: it lays itself out over a few).
+    bool recorded = recorder_ && frame_ % std::max(clip_ ? 1 : options_.every, 1) == 0;
     bool shown = surface_.window() || panel_ || frame_ == options_.frames || options_.frames <= 0 || !shots_.empty() ||
-                 (!options_.record.empty() && frame_ % std::max(options_.every, 1) == 0);
+                 recorded;
     if (shown) {
         if (options_.fit) frameAlive();
         draw();
@@ -103,17 +121,24 @@ void Viewer::frame() {
     for (const std::string& shot : shots_)
         if (!screenshot(shot)) status_ = 1;
     shots_.clear();
-    if (!options_.record.empty() && frame_ % std::max(options_.every, 1) == 0 &&
-        !screenshot(fmt::format("{}/frame_{:06}.png", options_.record, frame_))) {
+    if (recorded && !record(surface_.pixels())) {
         status_ = 1;  // a recording with a frame missing is no recording: stop
-        quit_ = true;
+        if (!clip_) quit_ = true;
     }
+    stats_.frameSeconds = secondsBetween(start, Clock::now());
+    measureHitch(stats_.frameSeconds);
     if (reloadSaved_) {  // the first frame of a reloaded system is out
         lastReloadSeconds_ = secondsBetween(*reloadSaved_, Clock::now());
         say(fmt::format("first frame of the new system {:.1f} ms after the save", *lastReloadSeconds_ * 1e3));
         reloadSaved_.reset();
+        if (hitch_ && !interim_) {  // (after an interim, the move to the JIT is part of it)
+            lastHitch_ = hitch_;
+            hitch_.reset();
+            say(fmt::format("reload hitch: the slowest of its {} frames {:.1f} ms, a normal frame {:.1f} ms ({:.1f}x)",
+                            lastHitch_->frames, lastHitch_->worstSeconds * 1e3, lastHitch_->normalSeconds * 1e3,
+                            lastHitch_->worstSeconds / std::max(lastHitch_->normalSeconds, 1e-9)));
+        }
     }
-    stats_.frameSeconds = secondsBetween(start, Clock::now());
     if (shown && frame_ > options_.warmup) {
         ++totals_.frames;
         totals_.frame += stats_.frameSeconds;
@@ -127,9 +152,19 @@ void Viewer::frame() {
     fps_ = fps_ == 0 ? 1 / std::max(stats_.frameSeconds, 1e-6) : 0.9 * fps_ + 0.1 / std::max(stats_.frameSeconds, 1e-6);
 }
 
-void Viewer::step(double seconds) {
-    if (fixedDt_) seconds *= timeScale_;
-    if (auto error = session_->frame(frame_, seconds)) {
+// A frame's time, for the hitch of a reload: during one, the slowest; outside, a smoothed
+// normal frame to compare it with.
+void Viewer::measureHitch(double frameSeconds) {
+    if (hitch_) {
+        hitch_->worstSeconds = std::max(hitch_->worstSeconds, frameSeconds);
+        ++hitch_->frames;
+    } else {
+        normalFrame_ = normalFrame_ == 0 ? frameSeconds : 0.95 * normalFrame_ + 0.05 * frameSeconds;
+    }
+}
+
+void Viewer::step(int steps, double seconds) {
+    if (auto error = session_->frame(frame_, seconds, steps)) {
         say("psys-view: " + *error);
         status_ = 1;
     }
@@ -143,6 +178,7 @@ void Viewer::handleReload() {
     auto saved = Clock::now() - std::chrono::duration_cast<Clock::duration>(
                                     std::chrono::duration<double>(outcome->latencySeconds));
     watchSources(outcome->compile);
+    if (outcome->kind != Kind::Adopted && outcome->kind != Kind::Interim) hitch_.reset();  // nothing new to show
     if (outcome->kind == Kind::Empty || outcome->kind == Kind::Vanished) {
         reloadNote_ = "`" + session_->path() + "`" +
                       (outcome->kind == Kind::Empty ? " is empty (a save under way?): the system keeps running"
@@ -189,8 +225,9 @@ void Viewer::draw() {
     scene_->draw(view, projection, options_.grid);
     rt::System& system = session_->system();
     for (size_t t = 0; t < system.typeCount(); ++t)
-        points_->draw(system.draw(t), system.backend().memory(), view, projection,
-                      static_cast<float>(surface_.height()), options_.blend);
+        if (shows(system.module().objects[t].name))
+            points_->draw(system.draw(t), system.backend().memory(), view, projection,
+                          static_cast<float>(surface_.height()), options_.blend);
     stats_.glSeconds = secondsBetween(start, Clock::now());
 }
 
@@ -202,10 +239,19 @@ void Viewer::key(int key, bool shift) {
         case GLFW_KEY_G: options_.grid = !options_.grid; break;
         case GLFW_KEY_SPACE: paused_ = !paused_; break;
         case GLFW_KEY_S: stepOnce_ = true; break;
-        case GLFW_KEY_T: fixedDt_ = !fixedDt_; break;
-        case GLFW_KEY_EQUAL: case GLFW_KEY_KP_ADD: timeScale_ = std::min(timeScale_ * 2, 16.0); break;
-        case GLFW_KEY_MINUS: case GLFW_KEY_KP_SUBTRACT: timeScale_ = std::max(timeScale_ / 2, 1.0 / 64); break;
+        case GLFW_KEY_T:
+            clock_.settings().fixed = !clock_.settings().fixed;
+            clock_.resetDebt();
+            break;
+        case GLFW_KEY_EQUAL: case GLFW_KEY_KP_ADD: clock_.settings().scale = std::min(clock_.settings().scale * 2, 16.0); break;
+        case GLFW_KEY_MINUS: case GLFW_KEY_KP_SUBTRACT:
+            clock_.settings().scale = std::max(clock_.settings().scale / 2, 1.0 / 64);
+            break;
         case GLFW_KEY_H: if (panel_) panel_->visible = !panel_->visible; break;
+        case GLFW_KEY_F1: help_ = !help_; break;
+        case GLFW_KEY_SLASH: if (shift) help_ = !help_; break;
+        case GLFW_KEY_P: screenshotKey(); break;
+        case GLFW_KEY_V: clipKey(); break;
         case GLFW_KEY_ESCAPE: case GLFW_KEY_Q: quit_ = true; break;
         default:
             if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9) {
@@ -219,7 +265,6 @@ void Viewer::key(int key, bool shift) {
                 }
             }
     }
-    (void)shift;
 }
 
 // Fits what is alive in view: the box of the drawn points, without the farthest 2% on
@@ -228,7 +273,8 @@ void Viewer::frameAlive() {
     rt::System& system = session_->system();
     std::vector<float> axis[3];
     for (size_t t = 0; t < system.typeCount(); ++t)
-        for (const rt::RenderPoint& p : system.points(t))
+        if (shows(system.module().objects[t].name))
+            for (const rt::RenderPoint& p : system.points(t))
             for (int c = 0; c < 3; ++c) axis[c].push_back(p.position[static_cast<size_t>(c)]);
     if (axis[0].empty()) return;
     glm::vec3 low, high;
@@ -258,6 +304,82 @@ bool Viewer::screenshot(const std::string& path) {
     }
     say("wrote " + path);
     return true;
+}
+
+bool Viewer::shows(const std::string& name) const {
+    return solo_.empty() ? !hidden_.count(name) : name == solo_;
+}
+
+// P: FILE's name and the first number not taken, .png, in the current folder.
+void Viewer::screenshotKey() {
+    std::string stem = std::filesystem::path(session_->path()).stem().string();
+    std::string path;
+    std::error_code ignored;
+    do path = fmt::format("{}_{:03}.png", stem, ++shotNumber_);
+    while (std::filesystem::exists(path, ignored));
+    shots_.push_back(path);  // once the frame is drawn
+    shotNote_ = "screenshot " + path;
+}
+
+// V: a clip, from now to the next V: an .mp4 where ffmpeg is, else a folder of PNGs. While
+// it records, the clock runs a fixed step a frame, so the clip plays at the simulation's speed.
+void Viewer::clipKey() {
+    if (recorder_) {
+        if (!clip_) return;  // --record's recording runs to the end
+        stopRecording();
+        return;
+    }
+    std::string stem = std::filesystem::path(session_->path()).stem().string();
+    bool video = Recorder::haveFfmpeg();
+    std::string path;
+    std::error_code ignored;
+    for (int n = 1;; ++n) {
+        path = fmt::format("{}_clip_{:03}{}", stem, n, video ? ".mp4" : "");
+        if (!std::filesystem::exists(path, ignored)) break;
+    }
+    std::string error;
+    recorder_ = Recorder::open(path, surface_.width(), surface_.height(), recordingFps(options_.dt, 1), error);
+    if (!recorder_) {
+        shotNote_ = error;
+        std::cerr << "psys-view: error: " << error << "\n";
+        return;
+    }
+    clip_ = true;
+    fixedBeforeClip_ = clock_.settings().fixed;
+    clock_.settings().fixed = true;
+    shotNote_ = "recording " + path + " (V stops)";
+    say("recording " + path);
+}
+
+bool Viewer::record(const std::vector<uint8_t>& rgba) {
+    if (auto error = recorder_->add(frame_, rgba)) {
+        std::cerr << "psys-view: error: " << *error << "\n";
+        shotNote_ = *error;
+        recorder_->finish();
+        recorder_.reset();
+        if (clip_) clock_.settings().fixed = fixedBeforeClip_;
+        clip_ = false;
+        return false;
+    }
+    return true;
+}
+
+void Viewer::stopRecording() {
+    if (!recorder_) return;
+    if (auto error = recorder_->finish()) {
+        std::cerr << "psys-view: error: " << *error << "\n";
+        shotNote_ = *error;
+        status_ = 1;
+    } else {
+        shotNote_ = fmt::format("wrote {} ({} frames)", recorder_->path(), recorder_->frames());
+        say(shotNote_);
+    }
+    if (clip_) {
+        clock_.settings().fixed = fixedBeforeClip_;
+        clock_.resetDebt();
+    }
+    clip_ = false;
+    recorder_.reset();
 }
 
 void Viewer::restart(uint32_t seed) {
@@ -292,9 +414,8 @@ void Viewer::runScript() {
         else if (a.verb == "quit") quit_ = true;
         else if (a.verb == "screenshot") shots_.push_back(w[0]);  // once the frame is drawn
         else if (a.verb == "key") {
-            const std::string& k = w[0];
-            int code = k == "SPACE" ? GLFW_KEY_SPACE : k.size() == 1 ? static_cast<int>(std::toupper(k[0])) : 0;
-            key(code, false);
+            KeyPress press = *keyPress(w[0]);  // (a key of keys.h: checked when read)
+            key(press.code, press.shift);
         } else if (a.verb == "set") {
             auto setting = host::parseSet(w[0]);
             auto error = setting ? set(*setting) : std::optional<std::string>(setting.error);
