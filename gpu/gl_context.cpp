@@ -13,7 +13,7 @@
 
 namespace psys::gpu {
 
-std::unique_ptr<HeadlessContext> HeadlessContext::open(std::string& error) {
+std::unique_ptr<HeadlessContext> HeadlessContext::open(std::string& error, const HeadlessContext* share) {
     // eglGetPlatformDisplay (without EXT) aborts in libepoxy before a display exists, and
     // so does the EXT entry point where no EGL offers it (no vendor library at all).
     if (!epoxy_has_egl_extension(EGL_NO_DISPLAY, "EGL_EXT_platform_base") ||
@@ -37,7 +37,8 @@ std::unique_ptr<HeadlessContext> HeadlessContext::open(std::string& error) {
     EGLint contextAttributes[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
                                   EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
                                   EGL_CONTEXT_OPENGL_DEBUG, debugOutputRequested() ? EGL_TRUE : EGL_FALSE, EGL_NONE};
-    EGLContext context = eglCreateContext(display, configs ? config : EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, contextAttributes);
+    EGLContext context = eglCreateContext(display, configs ? config : EGL_NO_CONFIG_KHR,
+                                          share ? static_cast<EGLContext>(share->context_) : EGL_NO_CONTEXT, contextAttributes);
     if (context == EGL_NO_CONTEXT) {
         error = fmt::format("cannot make an OpenGL 4.5 core context on the EGL surfaceless display (EGL error 0x{:04x})",
                             eglGetError());
@@ -46,6 +47,7 @@ std::unique_ptr<HeadlessContext> HeadlessContext::open(std::string& error) {
     std::unique_ptr<HeadlessContext> c(new HeadlessContext);
     c->display_ = display;
     c->context_ = context;
+    if (share) return c;  // (made current by the thread that uses it)
     if (!c->makeCurrent()) {
         error = "cannot make the EGL surfaceless context current";
         return nullptr;
@@ -66,7 +68,17 @@ bool HeadlessContext::makeCurrent() {
     return eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_) == EGL_TRUE;
 }
 
+void HeadlessContext::release() { eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT); }
+
 bool contextCurrent() { return eglGetCurrentContext() != EGL_NO_CONTEXT; }
+
+namespace {
+thread_local int sharedScopes = 0;
+}
+
+SharedContextScope::SharedContextScope() { ++sharedScopes; }
+SharedContextScope::~SharedContextScope() { --sharedScopes; }
+bool sharedContextCurrent() { return sharedScopes > 0; }
 
 void checkAllocation(const char* what, size_t bytes) {
     bool outOfMemory = false;

@@ -12,13 +12,15 @@ namespace psys::gpu {
 
 class HeadlessContext {
 public:
-    // Null, and `error` set, when no such context can be made.
-    static std::unique_ptr<HeadlessContext> open(std::string& error);
+    // Null, and `error` set, when no such context can be made. With `share`: a context
+    // that shares its objects (programs, buffers), to be made current on another thread.
+    static std::unique_ptr<HeadlessContext> open(std::string& error, const HeadlessContext* share = nullptr);
     ~HeadlessContext();
     HeadlessContext(const HeadlessContext&) = delete;
     HeadlessContext& operator=(const HeadlessContext&) = delete;
-    // Makes it the calling thread's current context.
+    // Makes it the calling thread's current context; release: none.
     bool makeCurrent();
+    void release();
 
 private:
     HeadlessContext() = default;
@@ -28,6 +30,18 @@ private:
 
 // Whether the calling thread has a current EGL context (the viewer's, for one).
 bool contextCurrent();
+
+// A thread that has made current a context sharing the objects of a GLSL backend's (the
+// viewer's reloader, with its surface's worker context) says so while it is: the backend's
+// prepare then compiles a plan's programs there, off the backend's thread.
+class SharedContextScope {
+public:
+    SharedContextScope();
+    ~SharedContextScope();
+    SharedContextScope(const SharedContextScope&) = delete;
+    SharedContextScope& operator=(const SharedContextScope&) = delete;
+};
+bool sharedContextCurrent();
 
 
 // Throws std::runtime_error naming `what` when the GL could not give a buffer its storage

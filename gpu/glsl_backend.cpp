@@ -26,60 +26,6 @@ using rt::Buffer;
 using rt::ColumnLayout;
 using rt::Elem;
 
-namespace {
-
-// The table columns a kernel writes: what stays on the GPU (state, exports, what is drawn:
-// codegen_glsl::keptColumns) and what the host reads right after the launch (kill flags,
-// emissions).
-void writtenColumns(const ir::Kernel& kernel, const ColumnLayout& l, std::vector<int>& resident,
-                    std::vector<int>& returned) {
-    resident = codegen_glsl::keptColumns(kernel, l);
-    for (const ir::Yield& y : kernel.yields) {
-        switch (y.kind) {
-            case ir::YieldKind::Kill: returned.push_back(ColumnLayout::kKill); break;
-            case ir::YieldKind::EmitRate: returned.push_back(l.emitRate(y.index)); break;
-            case ir::YieldKind::EmitCount: returned.push_back(l.emitCount(y.index)); break;
-            default: break;
-        }
-    }
-    std::sort(returned.begin(), returned.end());
-    returned.erase(std::unique(returned.begin(), returned.end()), returned.end());
-}
-
-// The table columns a launch of `kernel` carries to the GPU: what its shader reads (a
-// per-row clock's columns, the creation times always), and what it writes where
-// rows keep their values (all but the kill flags, written for every row).
-std::vector<bool> neededColumns(const ir::Kernel& kernel, const ColumnLayout& l, rt::Clock::Source now,
-                                rt::Clock::Source dt, const std::vector<int>& resident, const std::vector<int>& returned) {
-    std::vector<bool> needed(static_cast<size_t>(l.total), false);
-    auto mark = [&needed](int first, int width) {
-        for (int c = 0; c < width; ++c) needed[static_cast<size_t>(first + c)] = true;
-    };
-    mark(ColumnLayout::kCreated, 1);
-    if (now == rt::Clock::Source::PerRow) mark(ColumnLayout::kNow, 1);
-    if (dt == rt::Clock::Source::PerRow) mark(ColumnLayout::kDt, 1);
-    for (const ir::Inst& i : kernel.insts()) {
-        switch (i.op) {
-            case ir::Op::Param: mark(l.paramOffset[static_cast<size_t>(i.attr)], i.type.width); break;
-            case ir::Op::StateRead: mark(l.stateOffset[static_cast<size_t>(i.attr)], i.type.width); break;
-            case ir::Op::ObjectId: mark(ColumnLayout::kIds, 1); break;
-            default: break;
-        }
-    }
-    for (const auto& p : l.parentColumns) mark(p.offset, p.width);
-    for (int c : resident) mark(c, 1);
-    for (int c : returned)
-        if (c != ColumnLayout::kKill) mark(c, 1);
-    return needed;
-}
-
-const ir::Kernel* uniformKernelOf(const ir::Object& object, const ir::Kernel& kernel) {
-    auto served = ir::uniformFor(kernel.kind);
-    return served ? object.kernel(*served) : nullptr;
-}
-
-}  // namespace
-
 std::unique_ptr<GlslBackend> GlslBackend::create(std::string& error) {
     std::unique_ptr<GlslBackend> b(new GlslBackend);
     b->owner_ = std::this_thread::get_id();
@@ -140,97 +86,6 @@ GlslBackend::~GlslBackend() {
     GLuint buffers[] = {words_, counts_, block_, readback_, params_};
     glDeleteBuffers(5, buffers);
     timer_.release();
-}
-
-// Begun, and finished at once unless a plan is being prepared: then every program of it
-// is begun first, so that a driver that compiles in parallel has them all (gl_programs.h).
-GlslBackend::Program GlslBackend::compile(const std::string& source, const std::string& what) {
-    auto start = std::chrono::steady_clock::now();
-    if (!compiler_) compiler_ = std::make_unique<ProgramCompiler>();
-    Program p;
-    p.program = compiler_->begin(source);
-    if (preparing_)
-        unfinished_.push_back({p.program, source, what});
-    else
-        compiler_->finish(p.program, source, what);
-    ++kernels_;
-    compileSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return p;
-}
-
-GlslBackend::Program& GlslBackend::rowsProgram(const ir::Object& object, const ir::Kernel& kernel,
-                                               rt::Clock::Source now, rt::Clock::Source dt) {
-    // (built apart and then kept: a kernel the emitter refuses leaves no empty program)
-    RowsKey key{&kernel, now, dt};
-    if (auto it = rows_.find(key); it != rows_.end()) return *it->second;
-    const ir::Kernel* uniform = uniformKernelOf(object, kernel);
-    auto p = std::make_unique<Program>(compile(codegen_glsl::rowsShader(object, kernel, now, dt, uniform),
-                                               object.name + "." + ir::kernelName(kernel.kind)));
-    p->layout = rt::columnLayout(object, kernel);
-    p->block = codegen_glsl::rowsBlock(kernel, uniform, p->layout);
-    writtenColumns(kernel, p->layout, p->resident, p->returned);
-    p->direct = codegen_glsl::directColumns(kernel, p->layout);
-    p->inPlace.assign(static_cast<size_t>(p->layout.total) + 1, false);
-    for (int c : p->direct) p->inPlace[static_cast<size_t>(c)] = true;
-    p->needed = neededColumns(kernel, p->layout, now, dt,
-                              p->resident, p->returned);  // (a dt since creation: computed, no column)
-    p->pass = ir::kernelName(kernel.kind);
-    p->counts = kernel.kind == ir::KernelKind::Render ||
-                std::any_of(kernel.yields.begin(), kernel.yields.end(), [](const ir::Yield& y) {
-                    return y.kind == ir::YieldKind::Kill || y.kind == ir::YieldKind::Unstable;
-                });
-    return *(rows_[key] = std::move(p));
-}
-
-GlslBackend::Program& GlslBackend::childrenProgram(const ir::Object& object, const ir::Kernel& spawn) {
-    if (auto it = children_.find(&spawn); it != children_.end()) return *it->second;
-    auto p = std::make_unique<Program>(
-        compile(codegen_glsl::childrenShader(object, spawn), object.name + ".spawn" + std::to_string(spawn.site)));
-    p->layout = rt::columnLayout(object, spawn);
-    p->block = codegen_glsl::childrenBlock(object, spawn, p->layout);
-    p->direct = codegen_glsl::directArguments(spawn);
-    p->pass = "spawn";
-    return *(children_[&spawn] = std::move(p));
-}
-
-// On the thread that has the GL context only: a host that prepares off its frame loop
-// (the viewer's reloader) gets nothing done there — GL calls on a thread without the
-// context abort, and making it current there would take it from the frame loop — and the
-// programs compile when the System is made, on the frame loop's thread.
-void GlslBackend::prepare(const rt::Plan& plan) {
-    if (std::this_thread::get_id() != owner_) return;
-    if (context_) context_->makeCurrent();
-    preparing_ = true;
-    try {
-        for (const auto& r : plan.rows) rowsProgram(*r.object, *r.kernel, r.now, r.dt);
-        for (const auto& c : plan.children) childrenProgram(*c.object, *c.spawn);
-    } catch (...) {
-        preparing_ = false;
-        throw;
-    }
-    preparing_ = false;
-    auto start = std::chrono::steady_clock::now();
-    std::vector<Unfinished> unfinished = std::move(unfinished_);
-    unfinished_.clear();
-    for (const Unfinished& u : unfinished) compiler_->finish(u.program, u.source, u.what);
-    compileSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-void GlslBackend::forget(const ir::Module& module) {
-    for (const ir::Object& o : module.objects)
-        for (const ir::Kernel& k : o.kernels) {
-            for (auto it = rows_.begin(); it != rows_.end();)
-                if (std::get<0>(it->first) == &k) {
-                    glDeleteProgram(it->second->program);
-                    it = rows_.erase(it);
-                } else {
-                    ++it;
-                }
-            if (auto it = children_.find(&k); it != children_.end()) {
-                glDeleteProgram(it->second->program);
-                children_.erase(it);
-            }
-        }
 }
 
 void GlslBackend::ensureWords(size_t words) {
@@ -473,7 +328,10 @@ size_t GlslBackend::programsLoaded() const { return compiler_ ? compiler_->loade
 rt::BackendReport GlslBackend::report() const {
     rt::BackendReport r;
     r.target = renderer_;
-    r.kernels = kernels_;
+    {
+        std::lock_guard lock(programsMutex_);
+        r.kernels = kernels_;
+    }
     r.compileSeconds = compileSeconds_;
     r.fromDisk = compiler_ ? compiler_->loaded : 0;
     r.device = true;

@@ -16,6 +16,8 @@
 #include <map>
 #include <span>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <tuple>
@@ -40,6 +42,9 @@ public:
     std::string name() const override { return "glsl"; }
     rt::Memory& memory() override { return memory_; }
     void prepare(const rt::Plan& plan) override;
+    // A program at a time, each compiled and linked at once (llvmpipe links on the calling
+    // thread), until `seconds` are spent.
+    bool prepareSome(const rt::Plan& plan, double seconds) override;
     void forget(const ir::Module& module) override;
     rt::RowsResult run(const rt::RowsLaunch& launch) override;
     void run(const rt::ChildrenLaunch& launch) override;
@@ -52,6 +57,11 @@ public:
     // Unless dispatches are limited (a launch's kills then come in several lists).
     bool keepsRowsInMemory() const override { return dispatchRows_ == std::numeric_limits<size_t>::max(); }
     rt::BackendReport report() const override;
+    // Programs compiled on another thread with a shared context (prepareShared), so far.
+    size_t sharedPrograms() const {
+        std::lock_guard lock(programsMutex_);
+        return sharedPrograms_;
+    }
     bool marksDrawn() const override { return true; }
     bool rendersInStep() const override { return false; }
     // One dispatch over every row (split only where a storage block cannot hold them).
@@ -110,9 +120,21 @@ private:
     Program& rowsProgram(const ir::Object& object, const ir::Kernel& kernel, rt::Clock::Source now,
                          rt::Clock::Source dt);
     Program& childrenProgram(const ir::Object& object, const ir::Kernel& spawn);
+    // What a launch needs besides the GL program (its layout, block, columns); the source.
+    std::unique_ptr<Program> describeRows(const ir::Object& object, const ir::Kernel& kernel, rt::Clock::Source now,
+                                          rt::Clock::Source dt, std::string& source, std::string& what) const;
+    std::unique_ptr<Program> describeChildren(const ir::Object& object, const ir::Kernel& spawn, std::string& source,
+                                              std::string& what) const;
+    void prepareShared(const rt::Plan& plan);
+    struct Made {  // a program prepareShared makes
+        std::optional<RowsKey> key;
+        const ir::Kernel* spawn = nullptr;
+        std::unique_ptr<Program> program;
+        std::string source, what;
+    };
     // Launches of one spawn kernel as one dispatch (runChildren, gpu/glsl_children.cpp).
     void dispatchChildren(std::span<const rt::ChildrenLaunch> launches);
-    Program compile(const std::string& source, const std::string& what);
+    unsigned compile(const std::string& source, const std::string& what);  // a GL program
     struct Late;
     rt::RowsResult runRows(const rt::RowsLaunch& launch, Program& program, size_t begin, size_t end, Late* late);
     void bindDirect(const rt::RowsLaunch& launch, const Program& program, size_t begin, size_t end,
@@ -149,8 +171,12 @@ private:
     std::thread::id owner_;  // the thread whose GL context the backend uses
     GlMemory memory_;
     Compactor compactor_;
+    // The programs, by kernel: found on the backend's thread, added there or by a thread
+    // with a shared context (prepareShared), under the lock.
     std::map<RowsKey, std::unique_ptr<Program>> rows_;
     std::map<const ir::Kernel*, std::unique_ptr<Program>> children_;
+    mutable std::mutex programsMutex_;
+    size_t sharedPrograms_ = 0;
     unsigned words_ = 0, counts_ = 0, block_ = 0, readback_ = 0, params_ = 0;
     const uint32_t* mappedReadback_ = nullptr;
     size_t readbackWords_ = 0;

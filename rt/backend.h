@@ -156,6 +156,12 @@ public:
     virtual Memory& memory() = 0;
     // Called once per system, before any of its launches.
     virtual void prepare(const Plan&) {}
+    // What `prepare` called on another thread could not do (a GL context is one thread's),
+    // a part at a time, on the thread that runs the systems: what it can in about `seconds`
+    // (at least one piece); true once all of `plan` is ready. A host that must not stall a
+    // frame (the viewer, reloading) calls it once a frame until then. The default: nothing
+    // is left (prepare works on any thread).
+    virtual bool prepareSome(const Plan&, double) { return true; }
     // The module's kernels are about to be destroyed: a backend that keeps anything by a
     // kernel's address drops it here (a later kernel may get the same address).
     virtual void forget(const ir::Module&) {}

@@ -8,7 +8,10 @@
 #include <fstream>
 #include <thread>
 
+#include "gpu/glsl_backend.h"
 #include "reloader.h"
+#include "rt/system.h"
+#include "surface.h"
 #include "watcher.h"
 
 using namespace psys;
@@ -204,4 +207,77 @@ TEST_CASE("a reload that waits too long for the JIT runs on the interpreter mean
     CHECK(session->backend().name() == "llvm");
     CHECK(session->system().points(0).at(0).color[1] == 1);
     (void)interim;  // the JIT may win the race on a fast machine: both orders are right
+}
+
+namespace {
+
+// A reload on the GLSL backend drawing into an offscreen surface's context: with the
+// surface's worker context, its programs are compiled on the reloader's thread; without,
+// a slice a frame (Backend::prepareSome). Either way the new system draws as the edit says.
+void glslReload(bool workerContext) {
+    std::string error;
+    auto surface = openOffscreen(64, 64, error);
+    REQUIRE_MESSAGE(surface, error);
+    std::unique_ptr<WorkerContext> worker = workerContext ? surface->workerContext() : nullptr;
+    if (workerContext) REQUIRE(worker);
+    Folder folder;
+    folder.save("lib.psys", kLib);
+    folder.save("main.psys", kMain);
+    host::SessionOptions options;
+    options.backend.name = "glsl";
+    host::CompileResult compiled;
+    auto session = host::Session::open((folder.path / "main.psys").string(), options, compiled, error);
+    REQUIRE_MESSAGE(session, compiled.text(), error);
+    auto* glsl = dynamic_cast<gpu::GlslBackend*>(&session->backend());
+    REQUIRE(glsl);
+    Watcher watcher;
+    watcher.watch({(folder.path / "main.psys").string(), (folder.path / "lib.psys").string()});
+    Reloader reloader(*session, worker.get());
+    reloader.sliceSeconds = 0;  // a program a frame
+    int frame = 0;
+    for (; frame < 60;) REQUIRE_FALSE(session->frame(++frame, 1.0 / 60));
+    size_t live = session->system().stats().types[0].live;
+    size_t programs = rt::launchPlan(session->system().module()).rows.size() +
+                      rt::launchPlan(session->system().module()).children.size();
+    saveRedAndReload(folder, watcher, reloader, *session, frame, live);
+    CHECK(glsl->sharedPrograms() == (workerContext ? programs : 0));
+}
+
+}  // namespace
+
+TEST_CASE("a GLSL reload compiles its programs on the reloader's thread, in a context sharing the viewer's") {
+    glslReload(true);
+}
+
+TEST_CASE("a GLSL reload without a worker context compiles a program a frame before the new system takes over") {
+    glslReload(false);
+}
+
+TEST_CASE("prepareSome with no time to spare: one program a call, true with the last") {
+    std::string error;
+    auto surface = openOffscreen(64, 64, error);
+    REQUIRE_MESSAGE(surface, error);
+    host::SessionOptions options;
+    options.backend.name = "glsl";
+    host::CompileResult compiled;
+    std::string text = std::string(kMain).substr(std::string(kMain).find('\n') + 1);
+    text.replace(text.find("lift()"), 6, "vec3(0, 1, 0)");
+    auto session = host::Session::open("slices.psys", options, compiled, error, &text);
+    REQUIRE_MESSAGE(session, compiled.text(), error);
+    // Another module of the same program: new kernels, none compiled yet.
+    std::optional<ir::Module> module;
+    REQUIRE(host::compile("slices.psys", options.compile, module, &text).ok);
+    rt::Plan plan = rt::launchPlan(*module);
+    size_t programs = plan.rows.size() + plan.children.size(), calls = 1;
+    REQUIRE(programs >= 3);
+    size_t before = session->backend().report().kernels;
+    while (!session->backend().prepareSome(plan, 0)) {
+        ++calls;
+        CHECK(session->backend().report().kernels == before + calls - 1);
+    }
+    CHECK(calls == programs);
+    CHECK(session->backend().report().kernels == before + programs);
+    CHECK(session->backend().prepareSome(plan, 0));  // nothing left: nothing compiled
+    CHECK(session->backend().report().kernels == before + programs);
+    session->backend().forget(*module);
 }

@@ -112,7 +112,7 @@ void Panel::controls() {
     if (ImGui::SliderFloat("time scale (+ -)", &scale, 1.0f / 64, 16, "%.3g", ImGuiSliderFlags_Logarithmic))
         clock.scale = scale;
     bool real = !clock.fixed;
-    if (ImGui::Checkbox("real time (T: a step a frame)", &real)) {
+    if (ImGui::Checkbox("real time (T)", &real)) {
         clock.fixed = !real;
         viewer_.clock_.resetDebt();
     }

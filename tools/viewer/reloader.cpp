@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "gpu/gl_context.h"
 #include "host/large_stack.h"
 
 namespace psys::viewer {
@@ -19,7 +20,7 @@ Reloader::~Reloader() {
 }
 
 void Reloader::saved(Clock::time_point when) {
-    if (busy()) {
+    if (worker_.joinable()) {  // (a candidate being prepared a slice a frame does not wait for it)
         if (!pending_) pending_ = when;
         return;
     }
@@ -69,7 +70,14 @@ int Reloader::work(const std::string& path, const host::SessionOptions& options,
         }
         if (candidate.module) {
             auto start = Clock::now();
-            backend->prepare(rt::launchPlan(*candidate.module));
+            // With a shared context current, a GLSL backend compiles its programs here.
+            if (context_ && backend->name() == "glsl" && context_->makeCurrent()) {
+                gpu::SharedContextScope shared;
+                backend->prepare(rt::launchPlan(*candidate.module));
+                context_->release();
+            } else {
+                backend->prepare(rt::launchPlan(*candidate.module));
+            }
             candidate.prepareSeconds = secondsSince(start);
         }
         std::lock_guard lock(mutex_);
@@ -98,16 +106,32 @@ std::optional<Reloader::Outcome> Reloader::poll() {
         finish();
         return out;
     }
-    if (prepared_) {
-        host::Session::Candidate candidate = std::move(candidate_);
+    if (prepared_ && !ready_) {
+        ready_ = std::move(candidate_);
+        readySaved_ = savedAt_;
+        prepared_ = false;
         lock.unlock();
         finish();
+        if (ready_->module) readyPlan_ = rt::launchPlan(*ready_->module);
+        lock.lock();
+    }
+    if (ready_) {
+        lock.unlock();
+        if (ready_->module) {  // the rest of its preparing, a slice this frame
+            auto start = Clock::now();
+            bool done = ready_->backend->prepareSome(readyPlan_, sliceSeconds);
+            ready_->prepareSeconds += secondsSince(start);
+            if (!done) return std::nullopt;
+        }
+        host::Session::Candidate candidate = std::move(*ready_);
+        ready_.reset();
+        Clock::time_point saved = readySaved_;
         Outcome out{candidate.module ? Outcome::Kind::Adopted : Outcome::Kind::Failed, {}, std::nullopt, 0,
                     candidate.prepareSeconds};
         host::Session::Reload r = session_.adopt(std::move(candidate));
         out.compile = std::move(r.compile);
         out.report = std::move(r.report);
-        out.latencySeconds = secondsSince(savedAt_);
+        out.latencySeconds = secondsSince(saved);
         return out;
     }
     // The JIT is still compiling: after a while, the new system runs on the interpreter.

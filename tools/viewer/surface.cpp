@@ -28,6 +28,31 @@ std::string Surface::renderer() const { return gpu::rendererName(); }
 
 namespace {
 
+class HeadlessWorker : public WorkerContext {
+public:
+    explicit HeadlessWorker(std::unique_ptr<gpu::HeadlessContext> context) : context_(std::move(context)) {}
+    bool makeCurrent() override { return context_->makeCurrent(); }
+    void release() override { context_->release(); }
+
+private:
+    std::unique_ptr<gpu::HeadlessContext> context_;
+};
+
+// A hidden window of GLFW's whose context shares the visible one's objects.
+class WindowWorker : public WorkerContext {
+public:
+    explicit WindowWorker(GLFWwindow* window) : window_(window) {}
+    ~WindowWorker() override { glfwDestroyWindow(window_); }
+    bool makeCurrent() override {
+        glfwMakeContextCurrent(window_);
+        return glfwGetCurrentContext() == window_;
+    }
+    void release() override { glfwMakeContextCurrent(nullptr); }
+
+private:
+    GLFWwindow* window_;
+};
+
 // An EGL surfaceless context (gpu/gl_context.h) drawing into a framebuffer object.
 class Offscreen : public Surface {
 public:
@@ -66,6 +91,12 @@ public:
         glViewport(0, 0, width_, height_);
     }
     void present() override { glFinish(); }
+    std::unique_ptr<WorkerContext> workerContext() override {
+        std::string error;
+        auto shared = gpu::HeadlessContext::open(error, context_.get());
+        if (!shared) return nullptr;
+        return std::make_unique<HeadlessWorker>(std::move(shared));
+    }
 
 private:
     std::unique_ptr<gpu::HeadlessContext> context_;
@@ -120,6 +151,15 @@ public:
     void present() override { glfwSwapBuffers(window_); }
     bool closed() const override { return glfwWindowShouldClose(window_); }
     GLFWwindow* window() const override { return window_; }
+    // (the hints of the visible window's context still hold: the same version and API)
+    std::unique_ptr<WorkerContext> workerContext() override {
+        glfwWindowHint(GLFW_VISIBLE, GLFW_FALSE);
+        GLFWwindow* hidden = glfwCreateWindow(1, 1, "psys-view worker", nullptr, window_);
+        glfwWindowHint(GLFW_VISIBLE, GLFW_TRUE);
+        glfwMakeContextCurrent(window_);
+        if (!hidden) return nullptr;
+        return std::make_unique<WindowWorker>(hidden);
+    }
 
 private:
     GLFWwindow* window_ = nullptr;

@@ -12,6 +12,15 @@ struct GLFWwindow;
 
 namespace psys::viewer {
 
+// A context sharing a surface's objects (programs, buffers), for another thread: the
+// reloader's worker compiles a GLSL backend's programs in it while frames go on.
+class WorkerContext {
+public:
+    virtual ~WorkerContext() = default;
+    virtual bool makeCurrent() = 0;  // on the thread that uses it
+    virtual void release() = 0;
+};
+
 class Surface {
 public:
     virtual ~Surface() = default;
@@ -26,6 +35,8 @@ public:
     // The last frame's pixels, RGBA8, top row first.
     std::vector<uint8_t> pixels();
     std::string renderer() const;  // "llvmpipe (LLVM 15.0.6, 256 bits)", …
+    // Made on the surface's thread; null where the platform gives none.
+    virtual std::unique_ptr<WorkerContext> workerContext() { return nullptr; }
 };
 
 // Null and `error` set when there is no way to open one.

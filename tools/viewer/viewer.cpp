@@ -29,9 +29,10 @@ Viewer::Viewer(ViewerOptions options, Surface& surface, std::unique_ptr<host::Se
                host::CompileResult compiled)
     : options_(std::move(options)), surface_(surface), session_(std::move(session)) {
     camera_ = options_.camera.value_or(Camera{});
+    workerContext_ = surface_.workerContext();
     points_ = std::make_unique<PointRenderer>();
     scene_ = std::make_unique<SceneRenderer>();
-    reloader_ = std::make_unique<Reloader>(*session_);
+    reloader_ = std::make_unique<Reloader>(*session_, workerContext_.get());
     reloader_->interimAfterSeconds = options_.interimAfter;
     clock_ = SimClock({options_.dt, options_.fixed, 1, options_.maxSteps});
     lastCompileSeconds_ = compiled.seconds + session_->backend().report().compileSeconds;
@@ -126,18 +127,10 @@ void Viewer::frame() {
         if (!clip_) quit_ = true;
     }
     stats_.frameSeconds = secondsBetween(start, Clock::now());
-    measureHitch(stats_.frameSeconds);
     if (reloadSaved_) {  // the first frame of a reloaded system is out
         lastReloadSeconds_ = secondsBetween(*reloadSaved_, Clock::now());
         say(fmt::format("first frame of the new system {:.1f} ms after the save", *lastReloadSeconds_ * 1e3));
         reloadSaved_.reset();
-        if (hitch_ && !interim_) {  // (after an interim, the move to the JIT is part of it)
-            lastHitch_ = hitch_;
-            hitch_.reset();
-            say(fmt::format("reload hitch: the slowest of its {} frames {:.1f} ms, a normal frame {:.1f} ms ({:.1f}x)",
-                            lastHitch_->frames, lastHitch_->worstSeconds * 1e3, lastHitch_->normalSeconds * 1e3,
-                            lastHitch_->worstSeconds / std::max(lastHitch_->normalSeconds, 1e-9)));
-        }
     }
     if (shown && frame_ > options_.warmup) {
         ++totals_.frames;
@@ -149,18 +142,28 @@ void Viewer::frame() {
         double rest = 1 / options_.fps - stats_.frameSeconds;
         if (rest > 0) std::this_thread::sleep_for(std::chrono::duration<double>(rest));
     }
+    measureHitch(secondsBetween(start, Clock::now()));  // as a person sees it: with the wait for the next
     fps_ = fps_ == 0 ? 1 / std::max(stats_.frameSeconds, 1e-6) : 0.9 * fps_ + 0.1 / std::max(stats_.frameSeconds, 1e-6);
 }
 
 // A frame's time, for the hitch of a reload: during one, the slowest; outside, a smoothed
 // normal frame to compare it with.
+// (a vsync or --fps), from the save to the frame that shows the system the reload ends on
+// (after an interim on the interpreter, the JIT's).
 void Viewer::measureHitch(double frameSeconds) {
-    if (hitch_) {
-        hitch_->worstSeconds = std::max(hitch_->worstSeconds, frameSeconds);
-        ++hitch_->frames;
-    } else {
+    if (!hitch_) {
         normalFrame_ = normalFrame_ == 0 ? frameSeconds : 0.95 * normalFrame_ + 0.05 * frameSeconds;
+        return;
     }
+    hitch_->worstSeconds = std::max(hitch_->worstSeconds, frameSeconds);
+    ++hitch_->frames;
+    if (!hitchEnds_) return;
+    hitchEnds_ = false;
+    lastHitch_ = hitch_;
+    hitch_.reset();
+    say(fmt::format("reload hitch: the slowest of its {} frames {:.1f} ms, a normal frame {:.1f} ms ({:.2f}x)",
+                    lastHitch_->frames, lastHitch_->worstSeconds * 1e3, lastHitch_->normalSeconds * 1e3,
+                    lastHitch_->worstSeconds / std::max(lastHitch_->normalSeconds, 1e-9)));
 }
 
 void Viewer::step(int steps, double seconds) {
@@ -179,6 +182,7 @@ void Viewer::handleReload() {
                                     std::chrono::duration<double>(outcome->latencySeconds));
     watchSources(outcome->compile);
     if (outcome->kind != Kind::Adopted && outcome->kind != Kind::Interim) hitch_.reset();  // nothing new to show
+    hitchEnds_ = outcome->kind == Kind::Adopted;
     if (outcome->kind == Kind::Empty || outcome->kind == Kind::Vanished) {
         reloadNote_ = "`" + session_->path() + "`" +
                       (outcome->kind == Kind::Empty ? " is empty (a save under way?): the system keeps running"
@@ -399,7 +403,7 @@ void Viewer::restart(uint32_t seed) {
             fresh->system().setExtern(e.name, std::span<const float>(v->f.data(), static_cast<size_t>(e.type.width)));
     reloader_.reset();
     session_ = std::move(fresh);
-    reloader_ = std::make_unique<Reloader>(*session_);
+    reloader_ = std::make_unique<Reloader>(*session_, workerContext_.get());
     frame_ = 0;
 }
 

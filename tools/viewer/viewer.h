@@ -126,6 +126,7 @@ private:
     std::unique_ptr<PointRenderer> points_;
     std::unique_ptr<SceneRenderer> scene_;
     Watcher watcher_;
+    std::unique_ptr<WorkerContext> workerContext_;  // the reloader's (outlives it)
     std::unique_ptr<Reloader> reloader_;
     std::unique_ptr<Panel> panel_;
 
@@ -153,6 +154,7 @@ private:
     // The hitch of reloads: frames from a save to the new system's first frame.
     double normalFrame_ = 0;        // a smoothed frame time outside reloads
     std::optional<Hitch> hitch_, lastHitch_;
+    bool hitchEnds_ = false;        // this frame shows the reload's last system
     int status_ = 0;
     // Sums over the frames drawn, for the summary --log prints at the end.
     struct Totals {
