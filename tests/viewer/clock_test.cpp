@@ -76,24 +76,40 @@ TEST_CASE("fixed: a step a frame, scaled, however long the frame took") {
     CHECK(clock.stepSeconds() == doctest::Approx(0.01));
 }
 
-TEST_CASE("the viewer in real time: 5 seconds of a fake wall clock at 144 frames a second are 5 simulated seconds") {
+namespace {
+
+// A viewer drawing offscreen (64×64) on `text`, headless, not watching; `options` says the rest.
+struct Offscreen {
+    std::unique_ptr<Surface> surface;
+    std::unique_ptr<Viewer> viewer;
+};
+
+Offscreen viewerOn(const std::string& text, ViewerOptions options) {
+    Offscreen out;
     std::string error;
-    auto surface = openOffscreen(64, 64, error);
-    REQUIRE_MESSAGE(surface, error);
-    ViewerOptions options;
-    options.file = "clock.psys";
+    out.surface = openOffscreen(64, 64, error);
+    REQUIRE_MESSAGE(out.surface, error);
+    options.file = "test.psys";
     options.headless = true;
+    options.watch = false;
+    host::CompileResult compiled;
+    auto session = host::Session::open(options.file, options.session, compiled, error, &text);
+    REQUIRE_MESSAGE(session, compiled.text(), error);
+    out.viewer = std::make_unique<Viewer>(options, *out.surface, std::move(session), compiled);
+    return out;
+}
+
+}  // namespace
+
+TEST_CASE("the viewer in real time: 5 seconds of a fake wall clock at 144 frames a second are 5 simulated seconds") {
+    ViewerOptions options;
     options.frames = 720;  // 5 s at 144 fps
     options.ui = false;
-    options.watch = false;
     options.fixed = false;
     Clock::time_point fake{};
     options.now = [&] { return fake += std::chrono::microseconds(6944); };  // 1/144 s a frame
-    std::string text = "object p { point(vec3(0), white, 1); }\nspawn p;";
-    host::CompileResult compiled;
-    auto session = host::Session::open("clock.psys", options.session, compiled, error, &text);
-    REQUIRE_MESSAGE(session, compiled.text(), error);
-    Viewer viewer(options, *surface, std::move(session), compiled);
+    Offscreen o = viewerOn("object p { point(vec3(0), white, 1); }\nspawn p;", options);
+    Viewer& viewer = *o.viewer;
     CHECK(viewer.run() == 0);
     double wall = 720 * 6944e-6;
     CHECK(viewer.session().system().time() <= wall + 1e-9);
@@ -127,18 +143,8 @@ TEST_CASE("every key a script names is a key of the table, and none is named twi
 }
 
 TEST_CASE("the panel's font draws the text it writes beyond ASCII") {
-    std::string error;
-    auto surface = openOffscreen(64, 64, error);
-    REQUIRE_MESSAGE(surface, error);
-    ViewerOptions options;
-    options.file = "font.psys";
-    options.headless = true;
-    options.watch = false;
-    std::string text = "object p { point(vec3(0), white, 1); }";
-    host::CompileResult compiled;
-    auto session = host::Session::open("font.psys", options.session, compiled, error, &text);
-    REQUIRE(session);
-    Viewer viewer(options, *surface, std::move(session), compiled);
+    Offscreen o = viewerOn("object p { point(vec3(0), white, 1); }", ViewerOptions{});
+    Viewer& viewer = *o.viewer;
     REQUIRE(viewer.panel());
     CHECK(viewer.run() == 0);  // a frame, so that the font atlas is built
     for (unsigned c : {0x2026u /* … */, 0x2013u /* – */, 0x00D7u /* × */, 0x00F7u /* ÷ */, 0x2264u /* ≤ */, 0x03BCu /* μ */})
