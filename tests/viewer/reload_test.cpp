@@ -62,8 +62,8 @@ const char* kMain = "import \"lib.psys\";\n"
 
 // Saves kMain drawing red points of size 3 and waits for the reload: adopted, the `live`
 // particles and their emitter carried over, drawn as the edit says.
-void saveRedAndReload(const Folder& folder, Watcher& watcher, Reloader& reloader, host::Session& session, int& frame,
-                      size_t live) {
+Reloader::Outcome saveRedAndReload(const Folder& folder, Watcher& watcher, Reloader& reloader, host::Session& session,
+                                   int& frame, size_t live) {
     std::string edited = kMain;
     edited.replace(edited.find("point(pos, white, 1)"), 20, "point(pos, red, 3)");
     folder.save("main.psys", edited);
@@ -77,6 +77,7 @@ void saveRedAndReload(const Folder& folder, Watcher& watcher, Reloader& reloader
     CHECK(points[0].size == 3);
     CHECK(points[0].color[1] == 0);
     CHECK(points[0].position[1] > 0.5f);  // the integral carried on from before the reload
+    return outcome;
 }
 
 }  // namespace
@@ -239,8 +240,10 @@ void glslReload(bool workerContext) {
     size_t live = session->system().stats().types[0].live;
     size_t programs = rt::launchPlan(session->system().module()).rows.size() +
                       rt::launchPlan(session->system().module()).children.size();
-    saveRedAndReload(folder, watcher, reloader, *session, frame, live);
+    Reloader::Outcome outcome = saveRedAndReload(folder, watcher, reloader, *session, frame, live);
     CHECK(glsl->sharedPrograms() == (workerContext ? programs : 0));
+    // Without a worker context, every program compiled in a frame of its own.
+    CHECK(outcome.frameSlices == (workerContext ? 0 : static_cast<int>(programs)));
 }
 
 }  // namespace

@@ -113,21 +113,24 @@ std::optional<Reloader::Outcome> Reloader::poll() {
         lock.unlock();
         finish();
         if (ready_->module) readyPlan_ = rt::launchPlan(*ready_->module);
+        readySlices_ = 0;
         lock.lock();
     }
     if (ready_) {
         lock.unlock();
         if (ready_->module) {  // the rest of its preparing, a slice this frame
             auto start = Clock::now();
+            size_t kernels = ready_->backend->report().kernels;
             bool done = ready_->backend->prepareSome(readyPlan_, sliceSeconds);
             ready_->prepareSeconds += secondsSince(start);
+            readySlices_ += ready_->backend->report().kernels != kernels;
             if (!done) return std::nullopt;
         }
         host::Session::Candidate candidate = std::move(*ready_);
         ready_.reset();
         Clock::time_point saved = readySaved_;
         Outcome out{candidate.module ? Outcome::Kind::Adopted : Outcome::Kind::Failed, {}, std::nullopt, 0,
-                    candidate.prepareSeconds};
+                    candidate.prepareSeconds, readySlices_};
         host::Session::Reload r = session_.adopt(std::move(candidate));
         out.compile = std::move(r.compile);
         out.report = std::move(r.report);

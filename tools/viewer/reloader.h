@@ -41,6 +41,7 @@ public:
         std::optional<rt::ReloadReport> report;
         double latencySeconds = 0;  // from the save to the new system taking over
         double prepareSeconds = 0;  // compiling its kernels
+        int frameSlices = 0;        // frames that compiled a part of them on the frame loop (prepareSome)
     };
     // Once per frame, on the frame loop's thread: what changed, if anything.
     std::optional<Outcome> poll();
@@ -73,6 +74,7 @@ private:
     // frame (Backend::prepareSome), and its plan.
     std::optional<host::Session::Candidate> ready_;
     rt::Plan readyPlan_;
+    int readySlices_ = 0;  // its frames that compiled something
     Clock::time_point readySaved_;
 };
 

@@ -213,8 +213,11 @@ void Viewer::handleReload() {
     }
     lastCompileSeconds_ = outcome->compile.seconds + outcome->prepareSeconds;
     reloadNote_ = what;
-    say(fmt::format("reload: the new system {:.1f} ms after the save (front end {:.1f} ms, kernels {:.1f} ms){}: {}",
-                    outcome->latencySeconds * 1e3, outcome->compile.seconds * 1e3, outcome->prepareSeconds * 1e3,
+    std::string where = outcome->frameSlices
+                            ? fmt::format(", {} frames of it on the frame loop", outcome->frameSlices)
+                            : "";
+    say(fmt::format("reload: the new system {:.1f} ms after the save (front end {:.1f} ms, kernels {:.1f} ms{}){}: {}",
+                    outcome->latencySeconds * 1e3, outcome->compile.seconds * 1e3, outcome->prepareSeconds * 1e3, where,
                     interim_ ? ", now on the JIT" : "", what));
     if (!interim_) reloadSaved_ = saved;  // after an interim, the new system is already showing
     interim_ = false;
@@ -329,7 +332,10 @@ void Viewer::screenshotKey() {
 // it records, the clock runs a fixed step a frame, so the clip plays at the simulation's speed.
 void Viewer::clipKey() {
     if (recorder_) {
-        if (!clip_) return;  // --record's recording runs to the end
+        if (!clip_) {
+            shotNote_ = "--record's recording runs to the end";
+            return;
+        }
         stopRecording();
         return;
     }
