@@ -141,6 +141,16 @@ struct KernelStorage {
 // The render columns as the IR's text names them (`position.y`, `size`), 0 … 8.
 const char* drawnColumnName(int column);
 constexpr int kDrawnColumns = 9;
+// The first render column of a drawn yield: visible 0, position 1, colour 4, size 8
+// (the one definition: the storage pass records by it, the run-time lays columns out by it).
+constexpr int firstDrawnColumn(YieldKind kind) {
+    switch (kind) {
+        case YieldKind::Position: return 1;
+        case YieldKind::Color: return 4;
+        case YieldKind::Size: return 8;
+        default: return 0;
+    }
+}
 
 class Kernel {
 public:

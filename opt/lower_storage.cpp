@@ -38,16 +38,6 @@ std::optional<float> constantLane(const Kernel& k, ValueId v, int lane) {
     }
 }
 
-// The first render column of a drawn yield (visible 0, position 1, colour 4, size 8).
-int firstDrawnColumn(YieldKind kind) {
-    switch (kind) {
-        case YieldKind::Position: return 1;
-        case YieldKind::Color: return 4;
-        case YieldKind::Size: return 8;
-        default: return 0;
-    }
-}
-
 KernelStorage storageOf(const Object& object, const Kernel& kernel) {
     KernelStorage st;
     st.fixed = true;

@@ -83,14 +83,12 @@ ArgumentColumns argumentColumns(const ir::Kernel& spawn) {
     return a;
 }
 
-int ColumnLayout::renderColumn(ir::YieldKind kind) {
-    switch (kind) {
-        case ir::YieldKind::Visible: return kVisible;
-        case ir::YieldKind::Position: return kPosition;
-        case ir::YieldKind::Color: return kColor;
-        default: return kSize;
-    }
-}
+int ColumnLayout::renderColumn(ir::YieldKind kind) { return ir::firstDrawnColumn(kind); }
+static_assert(ColumnLayout::kVisible == ir::firstDrawnColumn(ir::YieldKind::Visible) &&
+              ColumnLayout::kPosition == ir::firstDrawnColumn(ir::YieldKind::Position) &&
+              ColumnLayout::kColor == ir::firstDrawnColumn(ir::YieldKind::Color) &&
+              ColumnLayout::kSize == ir::firstDrawnColumn(ir::YieldKind::Size) &&
+              ColumnLayout::kRenderColumns == ir::kDrawnColumns);
 
 std::string ColumnLayout::signature() const {
     std::string s = fmt::format("state {} params {} exports {} emits {} render {} parents {} total {} |", state,
