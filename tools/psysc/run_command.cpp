@@ -117,9 +117,15 @@ void printSummary(const RunOptions& options, host::Session& session, double draw
 }  // namespace
 
 int runSystem(const RunOptions& options) {
+    // Bad usage (a flag, a setting, a firing the program does not take) is exit 2; a run
+    // that fails (a backend that cannot be made, a frame, a file that cannot be written) 1.
     auto fail = [](const std::string& message) {
         std::cerr << "psysc: error: " << message << "\n";
         return 2;
+    };
+    auto failed = [](const std::string& message) {
+        std::cerr << "psysc: error: " << message << "\n";
+        return 1;
     };
     auto dt = host::parseStep(options.dt);
     if (!dt) return fail(dt.error);
@@ -149,7 +155,7 @@ int runSystem(const RunOptions& options) {
     auto s = host::Session::open(options.file, session, compiled, error);
     compiled.print(std::cerr, options.colour);
     if (!compiled.ok) return 1;
-    if (!s) return fail(error);
+    if (!s) return failed(error);
     if (options.printSchedule) {
         std::cout << fmt::format("A step of {} ({} backend), phase by phase:\n", options.file, options.backend)
                   << rt::printSchedule(s->system().schedule());
@@ -165,11 +171,11 @@ int runSystem(const RunOptions& options) {
         if (auto e = s->apply(set)) return fail("--set " + set.name + ": " + *e);
     if (auto e = s->schedule(fires, options.frames)) return fail(*e);
     Dump dump(options.dump);
-    if (!dump.ok()) return fail("cannot write `" + options.dump + "`");
+    if (!dump.ok()) return failed("cannot write `" + options.dump + "`");
     rt::System& system = s->system();
     double drawSeconds = 0;
     for (int frame = 1; frame <= options.frames; ++frame) {
-        if (auto e = s->frame(frame, *dt)) return fail(*e);
+        if (auto e = s->frame(frame, *dt)) return failed(*e);
         if (!options.quiet) {
             std::string line = fmt::format("frame {:4}  t={:.4f}", frame, system.time());
             for (auto& t : system.stats().types) line += fmt::format("  {} {}", t.name, t.live);
@@ -182,10 +188,10 @@ int runSystem(const RunOptions& options) {
         drawSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (options.dumpEvery > 0 && frame % options.dumpEvery == 0) {
             dump.frame(frame, system);
-            if (!dump.ok()) return fail("cannot write `" + options.dump + "` (at frame " + std::to_string(frame) + ")");
+            if (!dump.ok()) return failed("cannot write `" + options.dump + "` (at frame " + std::to_string(frame) + ")");
         }
     }
-    if (!dump.finish()) return fail("cannot write `" + options.dump + "`");
+    if (!dump.finish()) return failed("cannot write `" + options.dump + "`");
     printSummary(options, *s, drawSeconds);
     return 0;
 }
