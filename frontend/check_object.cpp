@@ -281,7 +281,9 @@ void Checker::checkAttributes(const std::vector<Attribute*>& attributes) {
             check(*a.args[0], ctx);
             if (!expectType(*a.args[0], Type::scalar(), "the step")) continue;
             auto v = evaluateConstant(*a.args[0]);
-            if (!a.args[0]->type.isError() && (!v || !(v->v[0] > 0)))
+            if (!a.args[0]->type.isError() && v && !std::isfinite(v->v[0]))  // (1/0 was taken as no step at all)
+                diags_.error(a.args[0]->range, fmt::format("the step is not a finite number ({})", numberText(v->v[0])));
+            else if (!a.args[0]->type.isError() && (!v || !(v->v[0] > 0)))
                 diags_.error(a.args[0]->range, "the step must be a positive constant number of seconds");
             a.value = v;
         } else if (a.name == "capacity") {
