@@ -159,6 +159,28 @@ SourceRange SyntaxErrorReporter::afterPrevious(antlr4::Parser* parser) const {
     return tokenRange(current);
 }
 
+// Whether `found` comes right after an attribute (`@name` or `@name(…)`): then a
+// declaration that is not an object is an attribute in the wrong place, not a missing
+// declaration.
+bool followsAttribute(antlr4::Parser* parser, antlr4::Token* found) {
+    antlr4::TokenStream* stream = parser->getTokenStream();
+    std::vector<antlr4::Token*> before;  // default-channel tokens before `found`, nearest first
+    for (ssize_t i = static_cast<ssize_t>(found->getTokenIndex()) - 1; i >= 0 && before.size() < 4096; --i)
+        if (antlr4::Token* t = stream->get(static_cast<size_t>(i)); t->getChannel() == antlr4::Token::DEFAULT_CHANNEL)
+            before.push_back(t);
+    size_t at = 0;
+    if (at < before.size() && before[at]->getText() == ")") {  // back over the arguments
+        int depth = 0;
+        for (; at < before.size(); ++at) {
+            std::string text = before[at]->getText();
+            depth += text == ")" ? 1 : text == "(" ? -1 : 0;
+            if (depth == 0) break;
+        }
+        ++at;
+    }
+    return at + 1 < before.size() && before[at]->getType() == PsysParser::IDENT && before[at + 1]->getText() == "@";
+}
+
 void SyntaxErrorReporter::report(antlr4::Parser* parser, antlr4::Token* found,
                                  const antlr4::misc::IntervalSet& expected) {
     SourceRange where = tokenRange(found);
@@ -171,6 +193,13 @@ void SyntaxErrorReporter::report(antlr4::Parser* parser, antlr4::Token* found,
     std::string context = ruleWords(parser->getContext());
     std::string in = context.empty() ? "" : " in " + context;
     std::string foundLit = literal(parser, found->getType());
+    static const std::set<std::string> notObjects = {"'const'", "'fn'", "'extern'", "'trigger'", "'spawn'", "'import'"};
+    if (notObjects.count(foundLit) && followsAttribute(parser, found)) {
+        diags_.error(where, fmt::format("an attribute applies to an object: expected 'object' after it (or ';', to apply "
+                                        "it to every object of the file), found {}",
+                                        describeFound(found)));
+        return;
+    }
     if (expected.contains(static_cast<size_t>(PsysParser::IDENT)) && isKeyword(foundLit)) {
         diags_.error(where, fmt::format("expected a name{}, found the keyword {}, which is reserved", in,
                                         describeFound(found)));
