@@ -61,12 +61,16 @@ std::unique_ptr<Session> Session::open(const std::string& path, const SessionOpt
 Session::~Session() = default;
 
 std::optional<std::string> Session::apply(const ExternSetting& setting) {
+    // `true` and `false` are a bool's values only.
+    for (const ir::Extern& e : system_->module().externs)
+        if (e.name == setting.name && !e.type.isBool() && setting.words)
+            return fmt::format("extern `{}` is a {}: it takes numbers, not true or false", e.name, rt::languageName(e));
     return system_->setExtern(setting.name, setting.values);
 }
 
 std::optional<std::string> Session::schedule(std::vector<TriggerFiring> firings, int lastFrame) {
     for (const TriggerFiring& f : firings) {
-        if (auto error = system_->checkFiring(f.trigger, f.args.size())) return "--fire " + f.trigger + ": " + *error;
+        if (auto error = system_->checkFiring(f.trigger, std::span<const float>(f.args))) return "--fire " + f.trigger + ": " + *error;
         if (lastFrame > 0 && f.frame > lastFrame)
             return fmt::format("--fire {}@{}: the run ends after frame {}", f.trigger, f.frame, lastFrame);
     }

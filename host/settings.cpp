@@ -18,13 +18,23 @@ std::optional<double> parseNumber(const std::string& text) {
     return v;
 }
 
+namespace {
+
+// Without the spaces around it: `k = 1`, `k=1 ` and `1, 2` read as written without them.
+std::string trimmed(const std::string& text) {
+    size_t begin = text.find_first_not_of(" \t"), end = text.find_last_not_of(" \t");
+    return begin == std::string::npos ? "" : text.substr(begin, end - begin + 1);
+}
+
+}  // namespace
+
 std::optional<std::vector<float>> parseNumbers(const std::string& text) {
     std::vector<float> out;
     if (text.empty()) return out;
     size_t start = 0;
     while (start <= text.size()) {
         size_t comma = text.find(',', start);
-        std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+        std::string item = trimmed(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
         // A bool extern's values: true and false (or 1 and 0).
         auto v = item == "true" ? 1.0 : item == "false" ? 0.0 : parseNumber(item);
         if (!v) return std::nullopt;
@@ -38,8 +48,18 @@ std::optional<std::vector<float>> parseNumbers(const std::string& text) {
 Parsed<ExternSetting> parseSet(const std::string& text) {
     auto eq = text.find('=');
     auto values = eq == std::string::npos ? std::nullopt : parseNumbers(text.substr(eq + 1));
-    if (!values || eq == 0) return Parsed<ExternSetting>::fail("--set takes NAME=VALUE or NAME=X,Y,Z, not `" + text + "`");
-    return {ExternSetting{text.substr(0, eq), *values}, {}};
+    std::string name = eq == std::string::npos ? "" : trimmed(text.substr(0, eq));
+    if (!values || values->empty() || name.empty())
+        return Parsed<ExternSetting>::fail("--set takes NAME=VALUE or NAME=X,Y,Z, not `" + text + "`");
+    bool words = false;
+    for (size_t start = eq + 1; start <= text.size();) {
+        size_t comma = text.find(',', start);
+        std::string item = trimmed(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+        words |= item == "true" || item == "false";
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+    }
+    return {ExternSetting{name, *values, words}, {}};
 }
 
 Parsed<TriggerFiring> parseFire(const std::string& text) {

@@ -30,6 +30,7 @@ std::optional<std::vector<float>> parseNumbers(const std::string& text);
 struct ExternSetting {
     std::string name;
     std::vector<float> values;
+    bool words = false;  // a value was written `true` or `false` (a bool's only)
 };
 // NAME=VALUE or NAME=X,Y,Z
 Parsed<ExternSetting> parseSet(const std::string& text);

@@ -215,6 +215,13 @@ std::optional<std::string> System::step(double dt) {
     return std::nullopt;
 }
 
+// An extern's type as the program spells it: `float`, `vec3`, `bool`, `color`, `point`.
+std::string languageName(const ir::Extern& e) {
+    if (!e.spelling.empty()) return e.spelling;
+    if (e.type.isBool()) return "bool";
+    return e.type.width == 1 ? "float" : "vec" + std::to_string(e.type.width);
+}
+
 std::optional<std::string> System::setExtern(std::string_view name, std::span<const float> value) {
     int index = externHandle(name);
     if (index < 0) return fmt::format("there is no extern `{}`", name);
@@ -227,8 +234,11 @@ std::optional<std::string> System::setExtern(int index, std::span<const float> v
         return fmt::format("there is no extern with handle {}", index);
     const ir::Extern& e = s.module.externs[static_cast<size_t>(index)];
     if (value.size() != static_cast<size_t>(e.type.width))
-        return fmt::format("extern `{}` is {}: it takes {} value{}, not {}", e.name, e.type.str(), e.type.width,
+        return fmt::format("extern `{}` is a {}: it takes {} value{}, not {}", e.name, languageName(e), e.type.width,
                            e.type.width == 1 ? "" : "s", value.size());
+    if (e.type.isBool() && value[0] != 0 && value[0] != 1)
+        return fmt::format("extern `{}` is a bool: it takes true or false (or 1 or 0), not {}; it keeps its value", e.name,
+                           value[0]);
     Value v;
     for (size_t i = 0; i < value.size(); ++i) v.f[i] = value[i];
     // One bad value from the host must not poison every particle that reads it: it is
@@ -288,9 +298,17 @@ std::optional<std::string> System::checkFiring(std::string_view name, size_t val
     return std::nullopt;
 }
 
+std::optional<std::string> System::checkFiring(std::string_view name, std::span<const float> args) const {
+    if (auto error = checkFiring(name, args.size())) return error;
+    for (float a : args)
+        if (!std::isfinite(a))
+            return fmt::format("trigger `{}` takes finite numbers, not {}", name, a);
+    return std::nullopt;
+}
+
 std::optional<std::string> System::fire(std::string_view name, std::span<const float> args) {
     detail::State& s = *state_;
-    if (auto error = checkFiring(name, args.size())) return error;
+    if (auto error = checkFiring(name, args)) return error;
     const ir::Trigger* trigger = nullptr;
     for (const ir::Trigger& t : s.module.triggers)
         if (t.name == name) trigger = &t;

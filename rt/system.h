@@ -137,6 +137,9 @@ class Creation;
 class Drawing;
 }  // namespace detail
 
+// An extern's type as the program spells it (`float`, `vec3`, `bool`, `color`): for messages.
+std::string languageName(const ir::Extern& e);
+
 class System {
 public:
     System(ir::Module module, Backend& backend, SystemOptions options = {});
@@ -154,6 +157,8 @@ public:
     std::optional<std::string> fire(std::string_view trigger, std::span<const float> args);
     // Whether fire(trigger, `values` numbers) would be accepted: nullopt, or why not.
     std::optional<std::string> checkFiring(std::string_view trigger, size_t values) const;
+    // … and its values: finite numbers, as an extern's (a NaN would reach every object it creates).
+    std::optional<std::string> checkFiring(std::string_view trigger, std::span<const float> args) const;
     // Whether every type's capacity (its @capacity, else the options') fits in this
     // machine's memory at the pool's bytes a row: nullopt, or an error that names the bytes.
     static std::optional<std::string> checkCapacity(const ir::Module& module, const SystemOptions& options);

@@ -2,6 +2,7 @@
 // emission counts and times, kill frames, live parent reads, determinism, and the
 // extremes (docs/runtime.md, "The extremes, and what happens").
 #include <doctest/doctest.h>
+#include <fmt/format.h>
 
 #include <cmath>
 #include <cstring>
@@ -292,17 +293,32 @@ TEST_CASE("a point that is not finite is not drawn, and is counted") {
     CHECK(run.system->stats().nonFiniteRender == 1);
 }
 
+TEST_CASE("a bool extern takes 0 or 1 (true or false) only, and keeps its value otherwise") {
+    Run run("extern lit: bool = false;\nobject a { point(vec3(0), if lit then white else red, 1); }\nspawn a;");
+    for (float v : {2.0f, 0.5f, -1.0f})
+        CHECK(run.system->setExtern("lit", {&v, 1}).value() ==
+              fmt::format("extern `lit` is a bool: it takes true or false (or 1 or 0), not {}; it keeps its value", v));
+    float on = 1;
+    CHECK_FALSE(run.system->setExtern("lit", {&on, 1}).has_value());
+    CHECK(run.system->externValue("lit")->f[0] == 1);
+}
+
 TEST_CASE("host API misuse is an error value") {
     Run run("extern w: vec3 = 0;\nobject a(p: vec3) { point(p, white, 1); }\ntrigger go(at_pos: vec3) { emit a(at_pos) count 2; }");
     float one = 1;
     CHECK(run.system->setExtern("nope", {&one, 1}).value() == "there is no extern `nope`");
-    CHECK(run.system->setExtern("w", {&one, 1}).value() == "extern `w` is vec3: it takes 3 values, not 1");
+    CHECK(run.system->setExtern("w", {&one, 1}).value() == "extern `w` is a vec3: it takes 3 values, not 1");
     CHECK(run.system->setExtern(7, {&one, 1}).value() == "there is no extern with handle 7");
     CHECK(run.system->externHandle("nope") == -1);
     float wind[3] = {4, 5, 6};
     CHECK_FALSE(run.system->setExtern(run.system->externHandle("w"), wind).has_value());
     CHECK(run.system->fire("boom", {}).value() == "there is no trigger `boom` (the triggers are `go`)");
     CHECK(run.system->fire("go", {&one, 1}).value() == "trigger `go` takes 3 numbers, not 1");
+    // A trigger's values are finite numbers, as an extern's: a NaN would reach every object it makes.
+    float bad[3] = {0, NAN, 0}, huge[3] = {0, INFINITY, 0};
+    CHECK(run.system->fire("go", bad).value() == "trigger `go` takes finite numbers, not nan");
+    CHECK(run.system->fire("go", huge).value() == "trigger `go` takes finite numbers, not inf");
+    CHECK(run.system->stats().types[0].created == 0);
     float at[3] = {1, 2, 3};
     REQUIRE_FALSE(run.system->fire("go", at));
     const auto& p = run.points("a");
