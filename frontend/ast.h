@@ -177,6 +177,9 @@ struct Attribute {
     SourceRange nameRange;
     std::vector<ExprPtr> args;
     std::optional<ConstValue> value;  // set by the checker: its constant argument (@step, @capacity)
+    // @capacity's count, exact: a number as written is read as a double (4294967295 is not
+    // a float); an expression is its float value.
+    std::optional<double> whole;
 };
 
 // ---------------------------------------------------------------- commands

@@ -291,11 +291,14 @@ void Checker::checkAttributes(const std::vector<Attribute*>& attributes) {
             check(*a.args[0], ctx);
             if (!expectType(*a.args[0], Type::scalar(), "the capacity")) continue;
             auto v = evaluateConstant(*a.args[0]);
+            std::optional<double> n;
+            if (a.args[0]->kind == ExprKind::Number) n = static_cast<const NumberExpr&>(*a.args[0]).value;
+            else if (v) n = v->v[0];
             // Rows are numbered with 32 bits.
-            if (!a.args[0]->type.isError() &&
-                (!v || !(v->v[0] >= 1 && v->v[0] <= 4294967295.0) || v->v[0] != std::floor(v->v[0])))
+            if (!a.args[0]->type.isError() && (!n || !(*n >= 1 && *n <= 4294967295.0) || *n != std::floor(*n)))
                 diags_.error(a.args[0]->range, "the capacity must be a constant whole number from 1 to 4294967295");
             a.value = v;
+            a.whole = n;
         } else {
             diags_.error(a.nameRange, fmt::format("unknown attribute `@{}`", a.name))
                 .notes.push_back({a.nameRange, "the attributes are " + attributeList()});

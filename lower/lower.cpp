@@ -141,7 +141,7 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
             attributes.integratorLoc = locate(a.args[0]->range);
         } else if (a.value) {  // the checker's value of @step or @capacity
             if (a.name == "step") attributes.step = a.value->v[0];
-            if (a.name == "capacity") attributes.capacity = static_cast<uint64_t>(a.value->v[0]);
+            if (a.name == "capacity") attributes.capacity = static_cast<uint64_t>(a.whole.value_or(a.value->v[0]));
         }
     };
     std::vector<std::pair<const ObjectDecl*, Attributes>> decls;
