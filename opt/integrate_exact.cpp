@@ -58,9 +58,16 @@ struct Sum {
 
 struct NoClosedForm {
     std::string why;
+    ir::Loc at{};  // the part of the source that has none, where it is not the equation as a whole
 };
 // A derivative reads something that may change after creation: solve step by step.
 struct NotFixedAtCreation {};
+
+// The name a .psys program calls an operation by (`sin`), or "" where it has none.
+std::string_view builtinName(Op op) {
+    std::string_view signature = opInfo(op).spelling.builtin;
+    return signature.substr(0, signature.find('('));
+}
 
 class ClosedForm {
 public:
@@ -189,8 +196,11 @@ private:
             case Op::Compose: return compose(i);
             default: break;
         }
-        throw NoClosedForm{fmt::format("its derivative applies `{}` to a value that changes within the step",
-                                       opInfo(i.op).name)};
+        // An operation the user wrote by name is named; one the compiler made (`select`, from
+        // `derive`, `if` or a comparison) is shown where it comes from instead.
+        if (std::string_view fn = builtinName(i.op); !fn.empty())
+            throw NoClosedForm{fmt::format("its derivative applies `{}` to a value that changes within the step", fn)};
+        throw NoClosedForm{"this part of its derivative changes within the step in a way the exact method cannot follow", i.loc};
     }
 
     // Each coefficient (and self) through `f`, giving a value of type `t`; rates stay.
@@ -343,7 +353,7 @@ std::optional<std::vector<ValueId>> closedForm(StepBuilder& b, const std::string
         return form.solve();
     } catch (const NoClosedForm& e) {
         size_t j = form.failedAt();
-        errors.error(b.loc(j), fmt::format("object {}: @integrator(exact) has no closed form for `{}`: {}; use rk4 "
+        errors.error(e.at.valid() ? e.at : b.loc(j), fmt::format("object {}: @integrator(exact) has no closed form for `{}`: {}; use rk4 "
                                            "(or another method) for this object",
                                            object, names[j], e.why));
         return std::nullopt;
