@@ -182,6 +182,15 @@ std::optional<std::string> System::step(double dt) {
         ++s.stats.rejectedSteps;
         return fmt::format("a step must be a finite, non-negative number of seconds, not {}", dt);
     }
+    // Past kLatestTime a double's time has steps of more than a microsecond, and ages
+    // computed from it would lose the precision docs/runtime.md promises (at 1e308 it
+    // becomes infinite): such a step is refused like a non-finite one.
+    if (!(s.now + dt <= kLatestTime)) {
+        ++s.stats.rejectedSteps;
+        return fmt::format("a step of {} s from {} s would take the time past {} s (2^32 s, 136 years), where "
+                           "ages stop being exact to the microsecond",
+                           dt, s.now, kLatestTime);
+    }
     start();
     // What a device still owes, before anything is updated (the schedule's settle): the last
     // step's deaths (their rows freed), and those of triggers since (they are updated no more).

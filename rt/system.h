@@ -163,6 +163,8 @@ public:
     // machine's memory at the pool's bytes a row: nullopt, or an error that names the bytes.
     static std::optional<std::string> checkCapacity(const ir::Module& module, const SystemOptions& options);
     std::optional<std::string> step(double dt);
+    // The latest time a step may reach: 2^32 s, where a double still counts microseconds.
+    static constexpr double kLatestTime = 4294967296.0;
     // Threads for launches over pools from now on: 0 for every core. Results do not change.
     void setThreads(unsigned threads);
 

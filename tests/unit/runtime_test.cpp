@@ -293,6 +293,22 @@ TEST_CASE("a point that is not finite is not drawn, and is counted") {
     CHECK(run.system->stats().nonFiniteRender == 1);
 }
 
+TEST_CASE("a step that would take the time past 2^32 s is refused and counted, and up to it steps run") {
+    Run run("object a { point(vec3(age), white, 1); kill when age > 1e12; }\nspawn a;");
+    auto error = run.system->step(1e308);  // (the time was +inf from the second step)
+    REQUIRE(error);
+    CHECK(error->find("would take the time past 4294967296 s") != std::string::npos);
+    CHECK(run.system->stats().rejectedSteps == 1);
+    CHECK(run.system->time() == 0);
+    CHECK_FALSE(run.system->step(rt::System::kLatestTime - 1));
+    CHECK_FALSE(run.system->step(1));  // exactly the latest time
+    CHECK(run.system->time() == rt::System::kLatestTime);
+    CHECK(run.system->step(1.0 / 60).has_value());
+    CHECK(run.system->stats().rejectedSteps == 2);
+    CHECK(run.system->time() == rt::System::kLatestTime);
+    CHECK(run.points("a").size() == 1);
+}
+
 TEST_CASE("a bool extern takes 0 or 1 (true or false) only, and keeps its value otherwise") {
     Run run("extern lit: bool = false;\nobject a { point(vec3(0), if lit then white else red, 1); }\nspawn a;");
     for (float v : {2.0f, 0.5f, -1.0f})
