@@ -380,10 +380,15 @@ Type Checker::checkBuiltinCall(CallExpr& call, const std::vector<Type>& args, co
             }
         return true;
     };
+    // An argument not known yet (an equation that reads itself): the result's type where it
+    // does not depend on it — a constructor's width is its name's (`x = integrate(vec4(…,
+    // -x.w))` is a vec4), a length a float; the arguments are checked once they are known.
     for (const Type& a : args)
         if (a.isUnknown() && fn.rule != BuiltinRule::Componentwise && fn.rule != BuiltinRule::Integrate &&
             fn.rule != BuiltinRule::Snapshot && fn.rule != BuiltinRule::Prev)
-            return fn.rule == BuiltinRule::ToScalar ? Type::scalar() : Type::unknown();
+            return fn.rule == BuiltinRule::ToScalar    ? Type::scalar()
+                   : fn.rule == BuiltinRule::Construct ? Type::vec(fn.width)
+                                                       : Type::unknown();
 
     switch (fn.rule) {
         case BuiltinRule::Componentwise: {

@@ -51,6 +51,18 @@ TEST_CASE("a recursive equation that nothing widens is a float") {
     CHECK(typeOf(c, "a", "n") == Type::scalar());
 }
 
+TEST_CASE("a constructor fixes a self-referencing equation's width: no annotation needed") {
+    // (x.w read x before its type was known: "float has no components")
+    auto c = test::check("object a { x = integrate(vec4(1, age, age * age, -x.w)); point(x.xyz, red, 1); }");
+    REQUIRE_MESSAGE(c.ok(), c.output);
+    CHECK(typeOf(c, "a", "x") == Type::vec(4));
+    auto d = test::check("object a { v = vec2(1, 0) + 0 * prev(vec3(v, 0).xy); point(vec3(v, 0), red, 1); }");
+    REQUIRE_MESSAGE(d.ok(), d.output);
+    CHECK(typeOf(d, "a", "v") == Type::vec(2));
+    // The components are still checked once the type is known.
+    CHECK(hasError("object a { x = integrate(vec4(1, age, -x)); point(x.xyz, red, 1); }", "vec4"));
+}
+
 TEST_CASE("an annotation fixes a recursive equation's type") {
     auto c = test::check("object a { v: vec2 = 0 + prev(v); point(vec3(v, 0), red, 1); }");
     REQUIRE_MESSAGE(c.ok(), c.output);
