@@ -43,6 +43,7 @@ const char* severityWord(Severity s) {
         case Severity::Error: return "error";
         case Severity::Warning: return "warning";
         case Severity::Note: return "note";
+        case Severity::Remark: return "remark";
     }
     return "error";
 }
@@ -52,6 +53,7 @@ const char* severityColour(Severity s) {
         case Severity::Error: return kRed;
         case Severity::Warning: return kMagenta;
         case Severity::Note: return kCyan;
+        case Severity::Remark: return kGreen;
     }
     return kRed;
 }
@@ -116,7 +118,7 @@ Diagnostic& DiagnosticEngine::add(Severity severity, SourceRange range, std::str
         discarded_ = {};
         return discarded_;
     }
-    int& count = severity == Severity::Error ? errors_ : warnings_;
+    int& count = severity == Severity::Error ? errors_ : severity == Severity::Remark ? remarks_ : warnings_;
     ++count;
     // Past the limit they are counted, not kept: 50,000 errors of a broken generated file
     // would bury the first, which is the one to fix.
@@ -126,6 +128,10 @@ Diagnostic& DiagnosticEngine::add(Severity severity, SourceRange range, std::str
     }
     diagnostics_.push_back({severity, range, std::move(message), {}});
     return diagnostics_.back();
+}
+
+Diagnostic& DiagnosticEngine::remark(SourceRange range, std::string message) {
+    return add(Severity::Remark, range, std::move(message));
 }
 
 Diagnostic& DiagnosticEngine::error(SourceRange range, std::string message) {

@@ -16,7 +16,8 @@
 
 namespace psys {
 
-enum class Severity { Error, Warning, Note };
+// A remark says what the compiler did or found, asked for (`psysc check --remarks`): no fault.
+enum class Severity { Error, Warning, Note, Remark };
 
 struct DiagnosticNote {
     SourceRange range;
@@ -37,6 +38,7 @@ public:
     // Returns the diagnostic so a caller can attach notes.
     Diagnostic& error(SourceRange range, std::string message);
     Diagnostic& warning(SourceRange range, std::string message);
+    Diagnostic& remark(SourceRange range, std::string message);
 
     // At most this many errors and this many warnings are kept and printed; the rest are counted.
     static constexpr int kMaxShown = 50;
@@ -65,6 +67,7 @@ private:
     Diagnostic discarded_;
     int errors_ = 0;
     int warnings_ = 0;
+    int remarks_ = 0;
     bool suppressed_ = false;
 };
 

@@ -68,6 +68,9 @@ void hoistUniform(ir::Module& module, PassErrors& errors);
 void recomputeState(ir::Module& module, PassErrors& errors);
 void deadState(ir::Module& module, PassErrors& errors);
 void lowerStorage(ir::Module& module, PassErrors& errors);
+// Not a pass: where a large argument meets sin, cos or tan, which fast maths may round
+// differently (opt/large_arguments.cpp); for `psysc check --remarks`.
+std::vector<PassMessage> largeArgumentRemarks(const ir::Module& module);
 
 // When a pass runs: always (the lowering to kernels), when optimising, or when optimising
 // with relaxed maths (PassOptions::relaxed).

@@ -51,7 +51,7 @@ double millisecondsSince(std::chrono::steady_clock::time_point start) {
 // with `time`, how long each part took); returns the program when it is clean.
 std::unique_ptr<psys::ast::Program> checkOne(const std::string& path, psys::SourceManager& sources,
                                              const psys::CompileOptions* compile, bool colour, bool time,
-                                             bool* failed) {
+                                             bool* failed, bool remarks = false) {
     psys::DiagnosticEngine diags(sources);
     auto start = std::chrono::steady_clock::now();
     auto program = psys::loadProgram(path, sources, diags);
@@ -65,7 +65,13 @@ std::unique_ptr<psys::ast::Program> checkOne(const std::string& path, psys::Sour
     // The passes report too: an integral without a closed form under @integrator(exact),
     // a decay beyond the integrator's stability limit.
     start = std::chrono::steady_clock::now();
-    if (program && compile && !psys::compileProgram(program.get(), sources, diags, *compile)) program.reset();
+    if (program && compile) {
+        auto module = psys::compileProgram(program.get(), sources, diags, *compile);
+        if (!module) program.reset();
+        else if (remarks)
+            for (const psys::opt::PassMessage& m : psys::opt::largeArgumentRemarks(*module))
+                diags.remark(psys::sourceRange(sources, m.loc), m.text);
+    }
     double compileMs = millisecondsSince(start);
     diags.print(std::cerr, colour);
     if (time)
@@ -194,6 +200,9 @@ int realMain(int argc, char** argv) {
     check->add_option("files", checkFiles, "Files to check")->required()->type_name("FILE");
     bool time = false;
     check->add_flag("--time", time, "Print how long parsing and checking took");
+    bool remarks = false;
+    check->add_flag("--remarks", remarks, "Also say where a large argument meets sin, cos or tan (fast maths may round it "
+                    "differently: docs/accuracy.md)");
 
     auto* run = app.add_subcommand("run", "Compile FILE and run the system (JIT-compiled with LLVM, or interpreted)");
     psys::tools::RunOptions runOptions;
@@ -253,7 +262,7 @@ int realMain(int argc, char** argv) {
         options.pipeline.pass.everyObject = everyObject;
         for (const std::string& file : checkFiles) {
             psys::SourceManager sources;
-            checkOne(file, sources, &options, colour, time, &failed);
+            checkOne(file, sources, &options, colour, time, &failed, remarks);
         }
         return failed ? 1 : 0;
     }
