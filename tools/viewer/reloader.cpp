@@ -72,9 +72,12 @@ int Reloader::work(const std::string& path, const host::SessionOptions& options,
             auto start = Clock::now();
             // With a shared context current, a GLSL backend compiles its programs here.
             if (context_ && backend->name() == "glsl" && context_->makeCurrent()) {
+                struct Released {  // (whatever prepare does, the context goes back)
+                    WorkerContext* context;
+                    ~Released() { context->release(); }
+                } released{context_};
                 gpu::SharedContextScope shared;
                 backend->prepare(rt::launchPlan(*candidate.module));
-                context_->release();
             } else {
                 backend->prepare(rt::launchPlan(*candidate.module));
             }
