@@ -202,8 +202,14 @@ std::string lane(const std::string& value, int width, int c) {
     return width == 1 ? value : value + "." + "xyzw"[c];
 }
 
-void storeColumns(Statements& out, int column, int width, const std::string& value) {
-    for (int c = 0; c < width; ++c) out.line(fmt::format("sf({}u, i, {});", column + c, lane(value, width, c)));
+// Stores a value of `type` in float columns from `column` on (a bool as 1.0 or 0.0:
+// columnsValue reads it back).
+void storeColumns(Statements& out, int column, Type type, const std::string& value) {
+    if (type.isBool()) {
+        out.line(fmt::format("sf({}u, i, {} ? 1.0 : 0.0);", column, value));
+        return;
+    }
+    for (int c = 0; c < type.width; ++c) out.line(fmt::format("sf({}u, i, {});", column + c, lane(value, type.width, c)));
 }
 
 // The shader's clock: now, dt, time, first and the row's age.
@@ -256,20 +262,19 @@ std::vector<std::string> inlineUniforms(Statements& out, const Kernel& uniform,
 void storeRowsYields(Statements& out, const Kernel& kernel, const ColumnLayout& l, const std::vector<std::string>& v) {
     for (const Yield& y : kernel.yields) {
         const std::string& value = v[y.value];
-        int width = kernel.at(y.value).type.width;
+        Type type = kernel.at(y.value).type;
+        int width = type.width;
         switch (y.kind) {
-            case YieldKind::StateNext: storeColumns(out, l.stateOffset[static_cast<size_t>(y.index)], width, value); break;
-            case YieldKind::Export: storeColumns(out, l.exportOffset[static_cast<size_t>(y.index)], width, value); break;
+            case YieldKind::StateNext: storeColumns(out, l.stateOffset[static_cast<size_t>(y.index)], type, value); break;
+            case YieldKind::Export: storeColumns(out, l.exportOffset[static_cast<size_t>(y.index)], type, value); break;
             case YieldKind::Kill:
                 out.line(fmt::format("su({}u, i, {} ? 1u : 0u);", ColumnLayout::kKill, value));
                 out.line(fmt::format("if ({}) atomicAdd(counts[0], 1u);", value));
                 break;
             case YieldKind::Unstable: out.line(fmt::format("if ({}) atomicAdd(counts[1], 1u);", value)); break;
-            case YieldKind::EmitRate: storeColumns(out, l.emitRate(y.index), 1, value); break;
-            case YieldKind::EmitCount: storeColumns(out, l.emitCount(y.index), 1, value); break;
-            case YieldKind::Visible:
-                storeColumns(out, l.render + ColumnLayout::kVisible, 1, value + " ? 1.0 : 0.0");
-                break;
+            case YieldKind::EmitRate: storeColumns(out, l.emitRate(y.index), type, value); break;
+            case YieldKind::EmitCount: storeColumns(out, l.emitCount(y.index), type, value); break;
+            case YieldKind::Visible: storeColumns(out, l.render + ColumnLayout::kVisible, type, value); break;
             case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:
                 if (l.fromState(y.kind)) break;  // drawn from the state column itself
                 for (int c = 0; c < width; ++c)  // a constant lane has no column
@@ -452,8 +457,7 @@ std::string childrenShader(const Object& object, const Kernel& spawn) {
     std::vector<size_t> first = rt::argumentColumns(spawn).first;
     for (const Yield& y : spawn.yields)
         if (y.kind == YieldKind::EmitArg)
-            storeColumns(out, static_cast<int>(first[static_cast<size_t>(y.sub)]), spawn.at(y.value).type.width,
-                         values[y.value]);
+            storeColumns(out, static_cast<int>(first[static_cast<size_t>(y.sub)]), spawn.at(y.value).type, values[y.value]);
     return text + "void main() {\n" + kRecordIndex + out.text() + "}\n";
 }
 

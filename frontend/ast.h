@@ -184,7 +184,7 @@ struct Attribute {
 
 // ---------------------------------------------------------------- commands
 
-enum class CommandKind { Point, Kill, Emit, When };
+enum class CommandKind { Point, Kill, Emit, When, On };
 
 struct Command {
     CommandKind kind;
@@ -198,8 +198,11 @@ struct Command {
     const ObjectDecl* targetDecl = nullptr;
     ExprPtr rate;   // `at RATE per second`; null for a one-off emission at creation
     ExprPtr count;  // `count N`; null means 1
-    // when
+    // when, on: the commands it guards
     std::vector<std::unique_ptr<Command>> body;
+    // on: the event (`death`)
+    std::string event;
+    SourceRange eventRange;
 };
 using CommandPtr = std::unique_ptr<Command>;
 

@@ -111,6 +111,10 @@ private:
                 line(depth, "when " + expr(*c.cond), c.range);
                 for (auto& inner : c.body) command(*inner, depth + 1);
                 break;
+            case CommandKind::On:
+                line(depth, "on " + c.event, c.range);
+                for (auto& inner : c.body) command(*inner, depth + 1);
+                break;
         }
     }
 

@@ -79,7 +79,7 @@ constexpr BuiltinAttribute kAttributes[] = {
 };
 
 constexpr std::string_view kKeywords[] = {"import", "const", "fn", "let", "extern", "range", "trigger", "object",
-                                          "spawn", "point", "kill", "when", "emit", "at", "per", "second", "count",
+                                          "spawn", "point", "kill", "when", "on", "emit", "at", "per", "second", "count",
                                           "if", "then", "else", "true", "false"};
 
 }  // namespace

@@ -189,10 +189,52 @@ void Checker::checkEmit(Command& emit, const Context& ctx) {
     if (emit.rate) {
         if (ctx.where == Where::Trigger)
             diags_.error(emit.rate->range, "a trigger runs once when fired: it cannot emit at a rate; use `count N`");
+        else if (ctx.dying)
+            diags_.error(emit.rate->range, "an object dies once: `on death` cannot emit at a rate; use `count N`");
         else
             checkAmount(*emit.rate, "rate", "an emission rate (per second)");
     }
     if (emit.count) checkAmount(*emit.count, "count", "an emission count");
+    // What makes it never fire, where the program says so in constants.
+    for (Expr* amount : {emit.rate.get(), emit.count.get()}) {
+        if (!amount || amount->type.isError()) continue;
+        if (auto v = evaluateConstant(*amount); v && v->v[0] >= 0 && v->v[0] < 1)
+            diags_.warning(amount->range, fmt::format("this `emit` never creates anything: its {} is {}",
+                                                      amount == emit.rate.get() ? "rate" : "count", numberText(v->v[0])));
+    }
+}
+
+namespace {
+bool anyKill(const std::vector<CommandPtr>& commands) {
+    for (auto& c : commands)
+        if (c->kind == CommandKind::Kill || anyKill(c->body)) return true;
+    return false;
+}
+}  // namespace
+
+// `on death { … }`: bursts in the update that kills the object (docs/language.md).
+void Checker::checkOn(Command& on, const Context& ctx, const Command** point) {
+    if (ctx.where != Where::Object) {
+        diags_.error(on.keywordRange, "`on death` belongs in an object; a trigger has no death");
+        return;
+    }
+    if (ctx.block) {
+        diags_.error(on.keywordRange, fmt::format("`on {}` must be in the object's body, not inside `{}`", on.event,
+                                                  ctx.block->kind == CommandKind::On ? "on" : "when"))
+            .notes.push_back({ctx.block->keywordRange, "inside this"});
+        return;
+    }
+    if (on.event != "death") {
+        diags_.error(on.eventRange, fmt::format("unknown event `{}`: `on` takes `death`", on.event));
+        return;
+    }
+    if (!anyKill(ctx.object->commands))
+        diags_.warning(on.keywordRange, fmt::format("object `{}` never dies (it has no `kill`): `on death` never runs",
+                                                    ctx.object->name));
+    Context inner = ctx;
+    inner.block = &on;
+    inner.dying = true;
+    checkCommands(on.body, inner, point);
 }
 
 void Checker::checkCommands(std::vector<CommandPtr>& commands, const Context& ctx, const Command** point) {
@@ -201,6 +243,10 @@ void Checker::checkCommands(std::vector<CommandPtr>& commands, const Context& ct
             case CommandKind::Point: {
                 if (ctx.where != Where::Object) {
                     diags_.error(cmd->keywordRange, "`point` draws an object; a trigger can only emit objects");
+                    break;
+                }
+                if (ctx.dying) {
+                    diags_.error(cmd->keywordRange, "`on death` can only emit: the object is gone, it draws nothing");
                     break;
                 }
                 if (*point) {
@@ -232,17 +278,27 @@ void Checker::checkCommands(std::vector<CommandPtr>& commands, const Context& ct
                     diags_.error(cmd->keywordRange, "`kill` removes an object; a trigger can only emit objects");
                     break;
                 }
+                if (ctx.dying) {
+                    diags_.error(cmd->keywordRange, "`on death` can only emit: the object is already dying");
+                    break;
+                }
                 if (cmd->cond) {
                     check(*cmd->cond, ctx);
                     expectType(*cmd->cond, Type::boolean(), "the condition of `kill when`");
                 }
                 break;
             case CommandKind::Emit: checkEmit(*cmd, ctx); break;
-            case CommandKind::When:
+            case CommandKind::When: {
                 check(*cmd->cond, ctx);
-                expectType(*cmd->cond, Type::boolean(), "the condition of `when`");
-                checkCommands(cmd->body, ctx, point);
+                if (expectType(*cmd->cond, Type::boolean(), "the condition of `when`"))
+                    if (auto v = evaluateConstant(*cmd->cond); v && !v->isTrue())
+                        diags_.warning(cmd->cond->range, "this condition is always false: nothing in this `when` ever happens");
+                Context inner = ctx;
+                inner.block = cmd.get();
+                checkCommands(cmd->body, inner, point);
                 break;
+            }
+            case CommandKind::On: checkOn(*cmd, ctx, point); break;
         }
     }
 }

@@ -28,6 +28,8 @@ struct Context {
     const ast::FnDecl* fn = nullptr;
     size_t letsVisible = 0;  // lets of `fn` declared before the expression
     const ast::TriggerDecl* trigger = nullptr;
+    const ast::Command* block = nullptr;  // the `when` or `on` the commands are in
+    bool dying = false;                   // in `on death`
 };
 
 // The names an object declares: its parameters and equations.
@@ -72,6 +74,7 @@ private:
     void checkEquation(ast::Equation& eq, const Context& ctx, bool final);
     void checkCommands(std::vector<ast::CommandPtr>& commands, const Context& ctx, const ast::Command** point);
     void checkEmit(ast::Command& emit, const Context& ctx);
+    void checkOn(ast::Command& on, const Context& ctx, const ast::Command** point);
     void checkArguments(std::vector<ast::ExprPtr>& args, const ast::ObjectDecl& target, SourceRange callRange,
                         const Context& ctx);
     void checkAttributes(const std::vector<ast::Attribute*>& attributes);

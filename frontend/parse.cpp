@@ -231,6 +231,11 @@ private:
             if (e->argList()) c->args = args(e->argList());
             if (e->emitRate()) c->rate = expr(e->emitRate()->expr());
             if (e->emitCount()) c->count = expr(e->emitCount()->expr());
+        } else if (auto* on = dynamic_cast<PsysParser::OnCmdContext*>(ctx)) {
+            c->kind = CommandKind::On;
+            c->event = on->IDENT()->getText();
+            c->eventRange = range(on->IDENT());
+            for (auto* inner : on->command()) c->body.push_back(command(inner));
         } else {
             auto* w = static_cast<PsysParser::WhenCmdContext*>(ctx);
             c->kind = CommandKind::When;

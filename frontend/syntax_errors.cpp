@@ -54,6 +54,7 @@ std::string ruleWords(antlr4::ParserRuleContext* ctx) {
                 if (dynamic_cast<PsysParser::KillCmdContext*>(c)) return "kill command";
                 if (dynamic_cast<PsysParser::EmitCmdContext*>(c)) return "emit command";
                 if (dynamic_cast<PsysParser::WhenCmdContext*>(c)) return "when command";
+                if (dynamic_cast<PsysParser::OnCmdContext*>(c)) return "`on` block";
                 return "command";
             }
             case PsysParser::RuleTriggerDecl: return "trigger";
@@ -84,7 +85,7 @@ std::string describeExpected(antlr4::Parser* parser, const antlr4::misc::Interva
 
     std::vector<std::string> words;
     bool exprStart = types.count(PsysParser::NUMBER) && types.count(PsysParser::IDENT) && has({"("});
-    bool objectBody = has({"point", "kill", "emit", "when", "object"});
+    bool objectBody = has({"point", "kill", "emit", "when", "on", "object"});
     bool topLevel = has({"import", "const", "fn", "extern", "trigger", "object", "spawn"});
     if (topLevel) {
         words.push_back("a declaration (object, const, fn, extern, trigger, spawn or import)");
@@ -92,7 +93,7 @@ std::string describeExpected(antlr4::Parser* parser, const antlr4::misc::Interva
         types.erase(static_cast<size_t>(antlr4::Token::EOF));
     } else if (objectBody) {
         words.push_back("an equation, a command, a nested object");
-        drop({"point", "kill", "emit", "when", "object", "@", "("});
+        drop({"point", "kill", "emit", "when", "on", "object", "@", "("});
         types.erase(PsysParser::IDENT);
     } else if (exprStart) {
         words.push_back("an expression");
@@ -190,6 +191,7 @@ void SyntaxErrorReporter::report(antlr4::Parser* parser, antlr4::Token* found,
         else diags_.error(where, fmt::format("unexpected character {}", describeCharacter(text)));
         return;
     }
+    if (keywordTakenForName(parser, found)) return;
     std::string context = ruleWords(parser->getContext());
     std::string in = context.empty() ? "" : " in " + context;
     std::string foundLit = literal(parser, found->getType());
@@ -227,10 +229,22 @@ void SyntaxErrorReporter::reportFailedPredicate(antlr4::Parser* parser, const an
     report(parser, e.getOffendingToken(), parser->getExpectedTokens());
 }
 
+// `on = 1;`: a keyword that starts a command (`on death { … }`) taken for a name; said at
+// the keyword.
+bool SyntaxErrorReporter::keywordTakenForName(antlr4::Parser* parser, antlr4::Token* found) {
+    antlr4::Token* before = parser->getTokenStream()->LT(-1);
+    if (!before || (found->getText() != "=" && found->getText() != ":") || !isKeyword(literal(parser, before->getType())))
+        return false;
+    diags_.error(tokenRange(before), fmt::format("expected a name, found the keyword {}, which is reserved",
+                                                 describeFound(before)));
+    return true;
+}
+
 void SyntaxErrorReporter::reportUnwantedToken(antlr4::Parser* parser) {
     if (inErrorRecoveryMode(parser)) return;
     beginErrorCondition(parser);
     antlr4::Token* token = parser->getCurrentToken();
+    if (keywordTakenForName(parser, token)) return;
     if (token->getType() == PsysParser::UNKNOWN_CHAR) {
         report(parser, token, getExpectedTokens(parser));
         return;

@@ -23,6 +23,7 @@ protected:
     void reportInputMismatch(antlr4::Parser* parser, const antlr4::InputMismatchException& e) override;
     void reportFailedPredicate(antlr4::Parser* parser, const antlr4::FailedPredicateException& e) override;
     void reportUnwantedToken(antlr4::Parser* parser) override;
+    bool keywordTakenForName(antlr4::Parser* parser, antlr4::Token* found);
     void reportMissingToken(antlr4::Parser* parser) override;
     // Never skips a ';' or '}' to go on with the current rule: they end statements, and
     // skipping one glues two statements together and turns one error into several.

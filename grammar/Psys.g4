@@ -65,6 +65,7 @@ command     : 'point' '(' argList? ')' ';'                                      
             | 'kill' ( 'when' expr )? ';'                                       # killCmd
             | 'emit' IDENT ( '(' argList? ')' )? emitRate? emitCount? ';'        # emitCmd
             | 'when' expr '{' command* '}'                                      # whenCmd
+            | 'on' IDENT '{' command* '}'                                       # onCmd
             ;
 emitRate    : 'at' expr 'per' 'second' ;
 emitCount   : 'count' expr ;

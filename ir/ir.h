@@ -231,9 +231,28 @@ struct StateSlot {
 };
 
 struct EmitSite {
+    // When the site creates objects (docs/language.md, "Emitting").
+    enum class When : uint8_t {
+        Creation,  // `emit X count N` outside a `when`: N when the emitter is created
+        Rate,      // `emit X at R per second`: R a second, in every update
+        Edge,      // `emit X count N` in a `when`: N at creation if the condition holds then,
+                   // and N in each update where it becomes true (false before)
+        Death,     // in `on death`: N in the update that kills the emitter
+    };
     std::string target;  // the created object type
-    bool rate = false;   // `at R per second` (else a burst at creation)
+    When when = When::Creation;
+
+    bool rate() const { return when == When::Rate; }
+    // Its count (or rate) is the init kernel's: it creates as the emitter is created.
+    bool atCreation() const { return when == When::Creation || when == When::Edge; }
+    // Its count (or rate) is the update kernel's: it creates as the emitter is updated.
+    bool inUpdate() const { return when != When::Creation; }
+    // It creates in the update that kills the emitter (a rate emitter does not).
+    bool whenKilled() const { return when == When::Edge || when == When::Death; }
 };
+// Its name in the IR's text (`rate`, `burst`, `edge`, `death`) and back.
+std::string_view emitWhenName(EmitSite::When when);
+std::optional<EmitSite::When> emitWhenFromName(std::string_view name);
 
 struct Export {
     std::string name;  // the parent's equation (or parameter) children read

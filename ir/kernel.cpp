@@ -125,6 +125,27 @@ int Module::externIndex(const std::string& name) const {
     return -1;
 }
 
+namespace {
+constexpr std::pair<EmitSite::When, std::string_view> kEmitWhenNames[] = {
+    {EmitSite::When::Creation, "burst"},
+    {EmitSite::When::Rate, "rate"},
+    {EmitSite::When::Edge, "edge"},
+    {EmitSite::When::Death, "death"},
+};
+}  // namespace
+
+std::string_view emitWhenName(EmitSite::When when) {
+    for (auto& [w, name] : kEmitWhenNames)
+        if (w == when) return name;
+    return "?";
+}
+
+std::optional<EmitSite::When> emitWhenFromName(std::string_view name) {
+    for (auto& [w, n] : kEmitWhenNames)
+        if (n == name) return w;
+    return std::nullopt;
+}
+
 const char* kernelName(KernelKind kind) {
     switch (kind) {
         case KernelKind::Behaviour: return "behaviour";

@@ -212,8 +212,9 @@ private:
     }
 
     static EmitSite emitSite(const std::vector<std::string>& w) {
-        if (w.size() != 3 || (w[2] != "rate" && w[2] != "burst")) throw ParseError("expected `emit object rate|burst`");
-        return {w[1], w[2] == "rate"};
+        auto when = w.size() == 3 ? emitWhenFromName(w[2]) : std::nullopt;
+        if (!when) throw ParseError("expected `emit object rate|burst|edge|death`");
+        return {w[1], *when};
     }
 
     void triggerBody(Trigger& t) {

@@ -132,7 +132,7 @@ std::string print(const Object& o, PrintOptions options) {
     if (a.capacity) out += fmt::format("  attribute capacity {}\n", *a.capacity);
     for (auto& s : o.state)
         out += fmt::format("  state {}: {} {}\n", s.name, s.type.str(), s.init == StateInit::Zero ? "zero" : "next");
-    for (auto& e : o.emits) out += fmt::format("  emit {} {}\n", e.target, e.rate ? "rate" : "burst");
+    for (auto& e : o.emits) out += fmt::format("  emit {} {}\n", e.target, emitWhenName(e.when));
     for (auto& e : o.exports) out += fmt::format("  export {}: {}\n", e.name, e.type.str());
     for (auto& r : o.parentReads) out += fmt::format("  read {}: {} ^{}\n", r.member, r.type.str(), r.depth);
     for (auto& k : o.kernels) out += print(k, 2, options);
@@ -151,7 +151,7 @@ std::string print(const Module& m, PrintOptions options) {
     for (auto& o : m.objects) out += print(o, options);
     auto trigger = [&](const Trigger& t, const std::string& head) {
         out += head + "\n";
-        for (auto& e : t.emits) out += fmt::format("  emit {} {}\n", e.target, e.rate ? "rate" : "burst");
+        for (auto& e : t.emits) out += fmt::format("  emit {} {}\n", e.target, emitWhenName(e.when));
         out += print(t.kernel, 2, options);
         out += "end\n";
     };

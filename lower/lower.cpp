@@ -48,6 +48,19 @@ struct CommandLowering {
     std::vector<EmitSite>& emits;
     const ast::Program& program;
     std::function<std::string(const ObjectDecl*)> qualified;
+    bool object = false;  // an object's behaviour (a trigger's or the start's: bursts only)
+
+    // The commands of an object's body, then its `on death` blocks, guarded by the kill
+    // flag the body computed.
+    void runObject(const std::vector<CommandPtr>& commands, ValueId& kill) {
+        run(commands, {}, kill);
+        for (const Command* on : deaths_) {
+            LocScope at(k, lowering.locate(on->range));
+            dying_ = true;
+            run(on->body, {kill}, kill);
+            dying_ = false;
+        }
+    }
 
     void run(const std::vector<CommandPtr>& commands, std::vector<ValueId> conditions, ValueId& kill) {
         for (auto& cmd : commands) {
@@ -68,8 +81,16 @@ struct CommandLowering {
                 }
                 case CommandKind::Emit: {
                     int site = static_cast<int>(emits.size());
-                    emits.push_back({qualified(cmd->targetDecl), cmd->rate != nullptr});
+                    EmitSite::When when = cmd->rate              ? EmitSite::When::Rate
+                                          : dying_               ? EmitSite::When::Death
+                                          : object && !conditions.empty() ? EmitSite::When::Edge
+                                                                 : EmitSite::When::Creation;
+                    emits.push_back({qualified(cmd->targetDecl), when});
                     ValueId on = lowering.guard(conditions);
+                    // A burst in a `when` fires where the condition becomes true: it was
+                    // false at the previous update (`prev` is false at creation).
+                    if (when == EmitSite::When::Edge)
+                        on = k.op(Op::And, Type::boolean(), {on, k.op(Op::Not, Type::boolean(), {k.op(Op::Prev, Type::boolean(), {on})})});
                     ValueId zero = k.scalar(0);
                     ValueId count = cmd->count ? lowering.lowerOne(*cmd->count) : k.scalar(1);
                     if (cmd->rate) {
@@ -91,9 +112,14 @@ struct CommandLowering {
                     run(cmd->body, inner, kill);
                     break;
                 }
+                case CommandKind::On: deaths_.push_back(cmd.get()); break;  // (the checker allows `death` only)
             }
         }
     }
+
+    // (state of the walk)
+    std::vector<const Command*> deaths_;
+    bool dying_ = false;  // lowering an `on death` block
 };
 
 // An extern's value as the checker computed it (ExternDecl::*Evaluated), in the IR's four
@@ -176,8 +202,8 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
         ObjectLowering lowering(m, locate, k, &o, decl, nullptr, sites);
         lowering.lowerEquations();
         ValueId kill = k.boolean(false);
-        CommandLowering commands{lowering, k, o.emits, program, qualified};
-        commands.run(decl->commands, {}, kill);
+        CommandLowering commands{lowering, k, o.emits, program, qualified, true, {}, false};
+        commands.runObject(decl->commands, kill);
         lowering.flushDeferred();
         k.yields.push_back({YieldKind::Kill, 0, 0, kill});
         o.kernels.push_back(std::move(k));
@@ -195,7 +221,7 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
                 int sites = 0;
                 ObjectLowering lowering(m, locate, trigger.kernel, nullptr, nullptr, &t, sites);
                 ValueId kill = trigger.kernel.boolean(false);
-                CommandLowering commands{lowering, trigger.kernel, trigger.emits, program, qualified};
+                CommandLowering commands{lowering, trigger.kernel, trigger.emits, program, qualified, false, {}, false};
                 commands.run(t.commands, {}, kill);
                 m.triggers.push_back(std::move(trigger));
             }
@@ -209,7 +235,7 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
             if (d->kind == DeclKind::Spawn) {
                 auto& s = static_cast<const SpawnDecl&>(*d);
                 int site = static_cast<int>(m.start.emits.size());
-                m.start.emits.push_back({qualified(s.targetDecl), false});
+                m.start.emits.push_back({qualified(s.targetDecl), EmitSite::When::Creation});
                 m.start.kernel.yields.push_back({YieldKind::EmitCount, site, 0, m.start.kernel.scalar(1)});
                 for (size_t i = 0; i < s.args.size(); ++i)
                     m.start.kernel.yields.push_back(

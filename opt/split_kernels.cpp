@@ -2,9 +2,11 @@
 // §4.3.9: split the stateful from the stateless).
 //
 //   init       at creation (`first` true): the starting value of every slot that starts
-//              from its next value, and the size of each burst (`emit … count N`)
+//              from its next value, and the size of each burst at creation (`emit … count
+//              N`, and one in a `when` whose condition holds then)
 //   update     every update (`first` false): every slot's next value, the kill flag, the
-//              rate and count of each rate emitter, and whether the step was beyond the
+//              rate and count of each rate emitter, the size of each burst on an event
+//              (a `when` becoming true, `on death`), and whether the step was beyond the
 //              integration method's stability limit
 //   render     after an update: position, colour, size, visible
 //   exports    after an update: the values children read live
@@ -162,13 +164,13 @@ void splitKernels(Module& module, PassErrors&) {
         const auto& emits = object.emits;
         object.kernels.push_back(specialise(behaviour, KernelKind::Init, true, [&](const Yield& y) {
             if (y.kind == YieldKind::StateNext) return static_cast<bool>(startsFromNext[static_cast<size_t>(y.index)]);
-            return y.kind == YieldKind::EmitCount && !emits[static_cast<size_t>(y.index)].rate;
+            return y.kind == YieldKind::EmitCount && emits[static_cast<size_t>(y.index)].atCreation();
         }));
         object.kernels.push_back(specialise(behaviour, KernelKind::Update, false, [&](const Yield& y) {
             if (y.kind == YieldKind::StateNext || y.kind == YieldKind::Kill || y.kind == YieldKind::EmitRate ||
                 y.kind == YieldKind::Unstable)
                 return true;
-            return y.kind == YieldKind::EmitCount && emits[static_cast<size_t>(y.index)].rate;
+            return y.kind == YieldKind::EmitCount && emits[static_cast<size_t>(y.index)].inUpdate();
         }));
         for (Kernel& k : postKernels) {
             // Rebuild to fold and order; post kernels keep `first` as an input (they also

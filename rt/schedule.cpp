@@ -58,9 +58,11 @@ std::string describe(const Schedule& s, const Phase& p) {
             if (p.inMemory) return fmt::format("{}: the kill lists kept for the step's end, where the memory frees them", type);
             return p.late ? fmt::format("{}: the listed kills kept for the step's end (nobody looks at them before)", type)
                           : fmt::format("{}: the killed rows frozen, in row order", type);
-        case PhaseKind::Emissions:
-            return fmt::format("{}: rate emissions of the survivors ({}): events, times, ids, the queue", type,
+        case PhaseKind::Emissions: {
+            return fmt::format("{}: {} ({}): events, times, ids, the queue", type,
+                               p.events ? "rate emissions of the survivors, bursts on edges and deaths" : "rate emissions of the survivors",
                                names(s, p.targets));
+        }
         case PhaseKind::Create: {
             std::vector<int> kept;
             for (int t : p.targets)
@@ -121,7 +123,7 @@ Schedule stepSchedule(const State& s) {
         auto type = static_cast<int>(t);
         size_t group = out.phases.size();
         if (info.stepLimit > 0) add(PhaseKind::SubSteps, type, Parallelism::Host).stepLimit = info.stepLimit;
-        bool listed = info.kills && !info.rateEmits;
+        bool listed = info.kills && !info.updateEmits;
         Phase& update = add(PhaseKind::Update, type, Parallelism::Chunks);
         update.late = info.late;
         update.listed = listed;
@@ -138,12 +140,16 @@ Schedule stepSchedule(const State& s) {
         std::vector<int> rated, targets;
         for (size_t site = 0; site < info.emitTarget.size(); ++site) {
             auto target = static_cast<int>(info.emitTarget[site]);
-            if (s.module.objects[t].emits[site].rate) rated.push_back(target);
+            if (s.module.objects[t].emits[site].inUpdate()) rated.push_back(target);
             targets.push_back(target);
         }
-        if (info.rateEmits) add(PhaseKind::Emissions, type, Parallelism::Ordered).targets = rated;
+        if (info.updateEmits) {
+            Phase& emissions = add(PhaseKind::Emissions, type, Parallelism::Ordered);
+            emissions.targets = rated;
+            emissions.events = info.emitsWhenKilled;
+        }
         if (info.stepLimit > 0) out.phases[group].span = out.phases.size() - group - 1;
-        if (info.rateEmits) add(PhaseKind::Create, type, Parallelism::Ordered).targets = targets;
+        if (info.updateEmits) add(PhaseKind::Create, type, Parallelism::Ordered).targets = targets;
     }
     add(PhaseKind::Release, -1, Parallelism::Ordered);
     return out;

@@ -42,6 +42,7 @@ struct Phase {
     bool render = false;        // Update: the render in the same chunk, when the host draws every step
     bool inMemory = false;      // Update, Kills: the type's rows are in the memory (Pool::keepRowsInMemory)
     std::vector<int> targets;   // Emissions, Create: the types created
+    bool events = false;        // Emissions: bursts on edges and deaths too (ir::EmitSite::whenKilled)
     Parallelism parallelism = Parallelism::Host;
 };
 

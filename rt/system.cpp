@@ -36,7 +36,7 @@ Plan launchPlan(const ir::Module& module) {
     std::set<std::string> streams;
     for (const ir::Object& o : module.objects)
         for (const ir::EmitSite& e : o.emits)
-            if (e.rate) streams.insert(e.target);
+            if (e.rate()) streams.insert(e.target);
     Plan plan;
     for (const ir::Object& o : module.objects) {
         bool stream = streams.count(o.name) > 0;

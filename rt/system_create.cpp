@@ -49,7 +49,8 @@ Creation::~Creation() {
 // A table over the batch's scratch columns for `layout`: the staging columns as the
 // parameters, the state at creation (bursts) or the state being advanced.
 void Creation::bindBatch(size_t type, Batch& b, const ColumnLayout& layout, Scratch& parents,
-                         std::vector<Buffer>& table, bool atCreation) {
+                         std::vector<Buffer>& table, Table which) {
+    const bool atCreation = which == Table::Bursts;
     const ir::Object& o = s_.module.objects[type];
     size_t rows = staging_[type].used;
     size_t stateCount = components(o.state), exportCount = 0;
@@ -74,9 +75,10 @@ void Creation::bindBatch(size_t type, Batch& b, const ColumnLayout& layout, Scra
         for (int c = 0; c < o.exports[e].type.width; ++c, ++component)
             table[static_cast<size_t>(layout.exportOffset[e] + c)] =
                 b.columns.at(kFirstValue + 2 * stateCount + component, Elem::F32, rows);
+    size_t emitsAt = kFirstValue + 2 * stateCount + exportCount;
+    if (which == Table::Init) emitsAt += 2 * o.emits.size() + ColumnLayout::kRenderColumns;  // (after the render columns)
     for (size_t e = 0; e < 2 * o.emits.size(); ++e)
-        table[static_cast<size_t>(layout.emits) + e] =
-            b.columns.at(kFirstValue + 2 * stateCount + exportCount + e, Elem::F32, rows);
+        table[static_cast<size_t>(layout.emits) + e] = b.columns.at(emitsAt + e, Elem::F32, rows);
     for (int c = 0; c < ColumnLayout::kRenderColumns; ++c)  // what a render kernel writes
         if (layout.needs(layout.render + c))
             table[static_cast<size_t>(layout.render + c)] = b.columns.at(
@@ -121,13 +123,13 @@ void Creation::createBatch(size_t type, size_t from, size_t to, double t1) {
         return;
     }
     s_.typeStats[type].created += allocated;
-    if (info.init) bindBatch(type, b, b.initLayout, b.initParents, b.initTable, false);
-    bindBatch(type, b, info.updateLayout, b.updateParents, b.updateTable, false);
-    if (info.exports) bindBatch(type, b, info.exportsLayout, b.exportsParents, b.exportsTable, false);
+    if (info.init) bindBatch(type, b, b.initLayout, b.initParents, b.initTable, Table::Init);
+    bindBatch(type, b, info.updateLayout, b.updateParents, b.updateTable, Table::Advanced);
+    if (info.exports) bindBatch(type, b, info.exportsLayout, b.exportsParents, b.exportsTable, Table::Advanced);
     b.burstTables.resize(o.emits.size());
     for (size_t site = 0; site < o.emits.size(); ++site)
-        if (!o.emits[site].rate && info.spawn[site])
-            bindBatch(type, b, info.spawnLayout[site], b.initParents, b.burstTables[site], true);
+        if (o.emits[site].atCreation() && info.spawn[site])
+            bindBatch(type, b, info.spawnLayout[site], b.initParents, b.burstTables[site], Table::Bursts);
     identify(type, b, n);
     atCreation(type, b, n);
     firstUpdate(type, b, n, allocated, t1);
@@ -143,7 +145,7 @@ void Creation::drawBatch(size_t type, Batch& b, size_t n, double t1) {
     Pool& pool = s_.pools[type];
     TypeWork& work = s_.work[type];
     const size_t first = b.first, end = first + n;
-    bindBatch(type, b, layout, b.renderParents, b.renderTable, false);
+    bindBatch(type, b, layout, b.renderParents, b.renderTable, Table::Advanced);
     Buffer mask = b.columns.at(kRenderMask, Elem::U8, end);
     auto* shown = s_.host<uint8_t>(mask);
     s_.forRows(0, n, [&](size_t begin, size_t end) {  // not those dropped, nor those that died in their first update
@@ -336,7 +338,7 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
         // One update to t1: dt is each object's age then (Clock::Source::SinceCreated).
         advance(type, b, n, kMask, {Clock::Source::Uniform, Clock::Source::SinceCreated, t1, 0, false},
                 late ? &*late : nullptr);
-        if (info.bursts || info.rateEmits) {
+        if (info.bursts || info.updateEmits) {
             inOrder(true, [&](size_t r) {
                 queueBursts(type, b, r);
                 if (!late) killOrEmit(type, b, r, b.spans[r], t1);
@@ -446,7 +448,7 @@ void Creation::queueBursts(size_t type, Batch& b, size_t r) {
     size_t i = b.first + r;
     const auto* created = s_.view<double>(b.updateTable[ColumnLayout::kCreated]);
     for (size_t site = 0; site < o.emits.size(); ++site) {
-        if (o.emits[site].rate) continue;
+        if (!o.emits[site].atCreation()) continue;
         auto column = static_cast<size_t>(b.initLayout.emitCount(static_cast<int>(site)));
         float size = b.initTable.empty() ? 0 : s_.view<float>(b.initTable[column])[i];
         uint64_t count = wholeCount(validCount(size, s_.stats.invalidEmissions), s_.stats.clampedEmissions);
@@ -461,11 +463,9 @@ void Creation::killOrEmit(size_t type, Batch& b, size_t r, double dt, double t1)
     const ir::Object& o = s_.module.objects[type];
     size_t i = b.first + r;
     uint32_t row = b.poolRows[r];
-    if (info.kills && s_.view<uint8_t>(b.updateTable[ColumnLayout::kKill])[i]) {
-        s_.kill(type, row, t1 - dt);
-        return;
-    }
-    if (!info.rateEmits) return;
+    bool dying = info.kills && s_.view<uint8_t>(b.updateTable[ColumnLayout::kKill])[i];
+    if (dying) s_.kill(type, row, t1 - dt);
+    if (!info.updateEmits || (dying && !info.emitsWhenKilled)) return;
     rate_.assign(o.emits.size(), 0);
     count_.assign(o.emits.size(), 1);
     for (size_t s = 0; s < o.emits.size(); ++s) {
@@ -473,7 +473,7 @@ void Creation::killOrEmit(size_t type, Batch& b, size_t r, double dt, double t1)
         if (info.rated[s]) rate_[s] = s_.view<float>(b.updateTable[static_cast<size_t>(info.updateLayout.emitRate(site))])[i];
         if (info.counted[s]) count_[s] = s_.view<float>(b.updateTable[static_cast<size_t>(info.updateLayout.emitCount(site))])[i];
     }
-    emitAtRate({type, row, {}, row, t1, false}, rate_, count_, dt, t1);
+    emitInUpdate({type, row, {}, row, t1, false}, rate_, count_, dt, t1, dying);
 }
 
 }  // namespace psys::rt::detail

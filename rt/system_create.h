@@ -34,11 +34,13 @@ public:
     // the rest are dropped and counted, without work per dropped child.
     void queueChildren(const Emitter& emitter, int site, uint64_t count, uint64_t perEvent, double firstTime,
                        double spacing);
-    // Rate emitters after an update of `dt` ending at t1: events fall where the accumulated
-    // rate crosses a whole number, so a stream is smooth within a step and a rate of
-    // 0.25/s emits at 4 s, 8 s, …
-    void emitAtRate(const Emitter& emitter, std::span<const float> rate, std::span<const float> count, double dt,
-                    double t1);
+    // What an emitter creates in an update of `dt` ending at t1 (ir::EmitSite::inUpdate).
+    // Rate emitters: events fall where the accumulated rate crosses a whole number, so a
+    // stream is smooth within a step and a rate of 0.25/s emits at 4 s, 8 s, …; none from
+    // an object this update kills (`dying`). Bursts on an event (an edge, a death): their
+    // count, at t1 — a dying object's too (its death is this update's event).
+    void emitInUpdate(const Emitter& emitter, std::span<const float> rate, std::span<const float> count, double dt,
+                      double t1, bool dying);
     // A trigger's (or the start's) kernel, evaluated on the host: once for the counts,
     // then once per created object for its arguments, so each draws its own numbers.
     void emitFromKernel(const ir::Trigger& trigger, std::span<const Value> params, uint32_t objectId);
@@ -95,8 +97,13 @@ private:
     void advance(size_t type, Batch& b, size_t n, size_t maskColumn, const Clock& clock, LateKills* late = nullptr);
     void queueBursts(size_t type, Batch& b, size_t r);
     void killOrEmit(size_t type, Batch& b, size_t r, double dt, double t1);
+    // Which of a batch's tables bindBatch binds: one over the state being advanced; init's
+    // (that state, and emit counts of its own: a burst's count at creation is read after
+    // the first update wrote that site's count in update's); a burst's spawn table (the
+    // state at creation).
+    enum class Table { Advanced, Init, Bursts };
     void bindBatch(size_t type, Batch& b, const ColumnLayout& layout, Scratch& parents, std::vector<Buffer>& table,
-                   bool atCreation);
+                   Table which);
 
     // A spawn launch waiting for runSpawns, with the parent values it reads.
     struct Spawn {

@@ -32,8 +32,8 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     }
     s_.typeStats[type].created += kept;
     pool.createdRows(rows, kept);  // updatable from the next step on
-    if (info.init) bindBatch(type, b, b.initLayout, b.initParents, b.initTable, false);
-    bindBatch(type, b, info.updateLayout, b.updateParents, b.updateTable, false);
+    if (info.init) bindBatch(type, b, b.initLayout, b.initParents, b.initTable, Table::Init);
+    bindBatch(type, b, info.updateLayout, b.updateParents, b.updateTable, Table::Advanced);
     std::vector<Buffer>& table = b.updateTable;
     ObjectRuns runs;
     for (size_t u = 0; u < b.runs.size(); ++u) {

@@ -69,12 +69,17 @@ void Creation::enqueue(const Run& run) {
         queue_.push_back({run.type, run.staging + k, 1, run.parent, run.time(k), 0, 1, run.id + static_cast<uint32_t>(k)});
 }
 
-void Creation::emitAtRate(const Emitter& e, std::span<const float> rate, std::span<const float> count, double dt,
-                          double t1) {
+void Creation::emitInUpdate(const Emitter& e, std::span<const float> rate, std::span<const float> count, double dt,
+                            double t1, bool dying) {
     Pool& pool = s_.pools[e.type];
     const ir::Object& o = pool.object();
     for (size_t site = 0; site < o.emits.size(); ++site) {
-        if (!o.emits[site].rate) continue;
+        if (o.emits[site].whenKilled()) {
+            double size = validCount(count[site], s_.stats.invalidEmissions);
+            if (size >= 1) queueChildren(e, static_cast<int>(site), wholeCount(size, s_.stats.clampedEmissions), 1, t1, 0);
+            continue;
+        }
+        if (!o.emits[site].rate() || dying) continue;
         double r = validCount(rate[site], s_.stats.invalidEmissions);
         double size = validCount(count[site], s_.stats.invalidEmissions);
         double before = pool.emitted[site][e.row];

@@ -65,8 +65,9 @@ TypeInfo typeInfo(const ir::Module& module, const ir::Object& o) {
         if (y.kind == YieldKind::EmitRate) t.rated[static_cast<size_t>(y.index)] = true;
     }
     for (size_t s = 0; s < o.emits.size(); ++s) {
-        t.rateEmits |= o.emits[s].rate;
-        t.bursts |= !o.emits[s].rate;
+        t.updateEmits |= o.emits[s].inUpdate();
+        t.bursts |= o.emits[s].atCreation();
+        t.emitsWhenKilled |= o.emits[s].whenKilled();
         const ir::Kernel* spawn = o.kernel(KernelKind::Spawn, static_cast<int>(s));
         t.spawn.push_back(spawn);
         t.emitTarget.push_back(static_cast<size_t>(module.objectIndex(o.emits[s].target)));
@@ -88,7 +89,7 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     for (const TypeInfo& t : types)
         if (t.parentType >= 0) types[static_cast<size_t>(t.parentType)].read = true;
     for (TypeInfo& t : types)
-        t.late = options.lateKills && (t.kills || t.unstable) && !t.rateEmits && !t.exports && !t.read;
+        t.late = options.lateKills && (t.kills || t.unstable) && !t.updateEmits && !t.exports && !t.read;
     // Rows in the memory: where nothing but the type's own late kills frees them, and its
     // objects are created whole in a batch (no sub-steps, no bursts, not drawn as the step goes).
     bool inMemory = options.rows == SystemOptions::Rows::InMemory ||

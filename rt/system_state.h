@@ -46,7 +46,9 @@ struct TypeInfo {
     ColumnLayout updateLayout, exportsLayout, renderLayout;
     std::vector<ColumnLayout> spawnLayout;
     std::vector<size_t> emitTarget;    // per emit site: the type it creates
-    bool kills = false, rateEmits = false, bursts = false;
+    // kills; creates in its updates (ir::EmitSite::inUpdate); bursts at its creation
+    // (atCreation); creates in the update that kills an object (whenKilled)
+    bool kills = false, updateEmits = false, bursts = false, emitsWhenKilled = false;
     bool read = false;                 // a type's objects read this type's live (its parent type)
     bool unstable = false;             // its update counts updates beyond the stability limit
     // What its updates give back — kills, the unstable count — may be taken at the end of
@@ -119,6 +121,9 @@ struct TypeWork {
     struct Pass {
         bool ran = false, late = false, listed = false;
         size_t chunks = 0;
+        // Where the type creates as its objects die (TypeInfo::emitsWhenKilled): the rows
+        // this pass killed, in row order (no longer updatable when its emissions run).
+        std::vector<uint32_t> dying;
     } pass;
     std::vector<std::vector<Buffer>> spawnTables;  // per emit site: the pool's columns for its spawn kernel
 };

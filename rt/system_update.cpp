@@ -14,8 +14,9 @@
 
 namespace psys::rt::detail {
 
-// After an update of `type`: the survivors emit, in row order (their spawn launches run
-// together at the end). A rate or count every
+// After an update of `type`: the survivors emit, and the objects it killed their bursts
+// on events (ir::EmitSite::whenKilled), in row order (their spawn launches run together at
+// the end; a killed object's row keeps its last values until the step's end). A rate or count every
 // row shares (ColumnLayout::sharedEmit) is taken from the externs or the launch's uniform
 // values, not from its column: a device need not send it back.
 void runEmissions(State& s, Creation& creation, size_t type, double dt, double t1) {
@@ -26,7 +27,6 @@ void runEmissions(State& s, Creation& creation, size_t type, double dt, double t
     const ir::Object& o = pool.object();
     const Value* uniforms = s.uniforms(type, *info.update, static_cast<float>(dt), static_cast<float>(t1));
     const uint8_t* updatable = pool.mask();
-    const auto* kill = info.kills ? s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]) : nullptr;
     std::vector<float> rate(o.emits.size(), 0), count(o.emits.size(), 1);
     std::vector<const float*> rates(o.emits.size()), counts(o.emits.size());
     const ColumnLayout& layout = info.updateLayout;
@@ -42,13 +42,16 @@ void runEmissions(State& s, Creation& creation, size_t type, double dt, double t
         source(info.rated[site], layout.emitRate(i), rate[site], rates[site]);
         source(info.counted[site], layout.emitCount(i), count[site], counts[site]);
     }
+    auto dying = work.pass.dying.begin();  // (in row order)
     for (uint32_t row = 0; row < pool.rows(); ++row) {
-        if (!updatable[row] || (kill && kill[row])) continue;
+        bool died = dying != work.pass.dying.end() && *dying == row;
+        if (died) ++dying;
+        if (!updatable[row] && !died) continue;
         for (size_t site = 0; site < o.emits.size(); ++site) {
             if (rates[site]) rate[site] = rates[site][row];
             if (counts[site]) count[site] = counts[site][row];
         }
-        creation.emitAtRate({type, row, {}, row, t1, false}, rate, count, dt, t1);
+        creation.emitInUpdate({type, row, {}, row, t1, false}, rate, count, dt, t1, died);
     }
     creation.runSpawns();  // before the next sub-step's update moves the emitters on
 }
@@ -81,7 +84,10 @@ void runKills(State& s, size_t type, double dt, double t1) {
     const uint8_t* updatable = pool.mask();
     const auto* kill = s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]);
     for (uint32_t row = 0; row < pool.rows(); ++row)
-        if (updatable[row] && kill[row]) s.kill(type, row, t1 - dt);
+        if (updatable[row] && kill[row]) {
+            if (info.emitsWhenKilled) work.pass.dying.push_back(row);
+            s.kill(type, row, t1 - dt);
+        }
 }
 
 namespace {
@@ -145,10 +151,10 @@ void runUpdate(State& s, size_t type, double dt, double t1, bool last) {
     // Objects that only die (no rate emits) are found while their chunk is in cache; where
     // nobody looks at them before the end of the step (the last sub-step of a type whose
     // dead nobody reads), they are taken then (LateKills), and a device need not wait.
-    bool listKills = info.kills && !info.rateEmits;
+    bool listKills = info.kills && !info.updateEmits;
     bool late = info.late && last;
     size_t chunks = s.chunkCount(rows);
-    work.pass = {true, late, listKills && !late, chunks};
+    work.pass = {true, late, listKills && !late, chunks, {}};
     if (listKills || late) work.killed.resize(chunks);  // each chunk sets its own (State::latePart)
     if (late && info.rowsInMemory)
         for (size_t c = 0; c < chunks; ++c)
