@@ -276,6 +276,7 @@ void storeRowsYields(Statements& out, const Kernel& kernel, const ColumnLayout& 
             case YieldKind::EmitCount: storeColumns(out, l.emitCount(y.index), type, value); break;
             case YieldKind::Visible: storeColumns(out, l.render + ColumnLayout::kVisible, type, value); break;
             case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:
+            case YieldKind::Rotation: case YieldKind::Frame: case YieldKind::End:
                 if (l.fromState(y.kind)) break;  // drawn from the state column itself
                 for (int c = 0; c < width; ++c)  // a constant lane has no column
                     if (int column = ColumnLayout::renderColumn(y.kind) + c; !l.constant(column))

@@ -115,6 +115,7 @@ public:
                 case YieldKind::EmitRate: use(layout.emitRate(y.index)); break;
                 case YieldKind::EmitCount: use(layout.emitCount(y.index)); break;
                 case YieldKind::Visible: case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:
+                case YieldKind::Rotation: case YieldKind::Frame: case YieldKind::End:
                     if (!layout.fromState(y.kind))
                         for (int l = 0; l < width; ++l)
                             if (int c = ColumnLayout::renderColumn(y.kind) + l; !layout.constant(c)) use(layout.render + c);
@@ -302,6 +303,7 @@ private:
                     break;
                 }
                 case YieldKind::Visible: case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:
+                case YieldKind::Rotation: case YieldKind::Frame: case YieldKind::End:
                     for (int l = 0; l < t.width; ++l) {
                         int column = ColumnLayout::renderColumn(y.kind) + l;
                         render[column] = toFloat(v[static_cast<size_t>(l)], t);

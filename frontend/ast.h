@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/draw.h"
 #include "frontend/source.h"
 #include "frontend/types.h"
 
@@ -184,13 +185,14 @@ struct Attribute {
 
 // ---------------------------------------------------------------- commands
 
-enum class CommandKind { Point, Kill, Emit, When, On };
+enum class CommandKind { Draw, Kill, Emit, When, On };
 
 struct Command {
     CommandKind kind;
     SourceRange range;
     SourceRange keywordRange;
-    std::vector<ExprPtr> args;   // point: (pos, color, size); emit: the child's arguments
+    std::vector<ExprPtr> args;   // a draw command's (point: pos, colour, size); emit: the child's arguments
+    core::DrawKind draw = core::DrawKind::Point;  // a draw command's: point, sprite or streak
     ExprPtr cond;                // kill when / when; null for a bare `kill;`
     // emit
     std::string target;

@@ -90,8 +90,8 @@ private:
 
     void command(const Command& c, int depth) {
         switch (c.kind) {
-            case CommandKind::Point: {
-                std::string s = "point";
+            case CommandKind::Draw: {
+                std::string s(core::drawKindName(c.draw));
                 for (auto& a : c.args) s += " " + expr(*a);
                 line(depth, s, c.range);
                 break;

@@ -76,10 +76,13 @@ constexpr BuiltinAttribute kAttributes[] = {
     {"integrator", "@integrator(method)", "how `integrate` advances this object's equations (docs/accuracy.md)"},
     {"step", "@step(seconds)", "a fixed sub-step: updates run in steps of at most this many seconds"},
     {"capacity", "@capacity(count)", "the most objects of this type alive at once; emissions beyond it are dropped"},
+    {"shape", "@shape(soft|disc|ring|star|smoke)", "a sprite's shape (soft, the default: a disc with a soft edge)"},
+    {"blend", "@blend(add|alpha)", "how the type's colours combine with what is behind: added (light, the default) or "
+                                   "alpha-blended over it (smoke, dust; drawn back to front)"},
 };
 
 constexpr std::string_view kKeywords[] = {"import", "const", "fn", "let", "extern", "range", "trigger", "object",
-                                          "spawn", "point", "kill", "when", "on", "emit", "at", "per", "second", "count",
+                                          "spawn", "point", "sprite", "streak", "kill", "when", "on", "emit", "at", "per", "second", "count",
                                           "if", "then", "else", "true", "false"};
 
 }  // namespace

@@ -6,6 +6,7 @@
 // back), then check once more with diagnostics on. A recursive equation whose width
 // nothing fixes defaults to float.
 #include <cmath>
+#include <span>
 
 #include <fmt/format.h>
 
@@ -237,42 +238,73 @@ void Checker::checkOn(Command& on, const Context& ctx, const Command** point) {
     checkCommands(on.body, inner, point);
 }
 
+namespace {
+// A draw command's parameters: the first `required`, then the optional ones in order.
+struct DrawParams {
+    std::vector<std::pair<const char*, Type>> params;
+    size_t required;
+};
+DrawParams drawParams(core::DrawKind kind) {
+    switch (kind) {
+        case core::DrawKind::Point: return {{{"position", Type::vec(3)}, {"colour", Type::vec(4)}, {"size", Type::scalar()}}, 3};
+        case core::DrawKind::Sprite:
+            return {{{"position", Type::vec(3)}, {"colour", Type::vec(4)}, {"size", Type::scalar()},
+                     {"rotation", Type::scalar()}, {"frame", Type::scalar()}}, 3};
+        case core::DrawKind::Streak:
+            return {{{"start", Type::vec(3)}, {"end", Type::vec(3)}, {"colour", Type::vec(4)}, {"width", Type::scalar()}}, 4};
+    }
+    return {{}, 0};
+}
+}  // namespace
+
+// `point`, `sprite`, `streak`: how the object is drawn, at most one per object.
+void Checker::checkDraw(Command& cmd, const Context& ctx, const Command** point) {
+    std::string_view name = core::drawKindName(cmd.draw);
+    if (ctx.where != Where::Object) {
+        diags_.error(cmd.keywordRange, fmt::format("`{}` draws an object; a trigger can only emit objects", name));
+        return;
+    }
+    if (ctx.dying) {
+        diags_.error(cmd.keywordRange, "`on death` can only emit: the object is gone, it draws nothing");
+        return;
+    }
+    if (*point) {
+        std::string_view first = core::drawKindName((*point)->draw);
+        diags_.error(cmd.keywordRange, fmt::format("object `{}` already draws a {}; an object draws at most one",
+                                                   ctx.object->name, first))
+            .notes.push_back({(*point)->keywordRange, fmt::format("the first `{}` is here", first)});
+    } else {
+        *point = &cmd;
+    }
+    std::vector<Type> types;
+    for (auto& a : cmd.args) types.push_back(check(*a, ctx));
+    DrawParams p = drawParams(cmd.draw);
+    if (cmd.args.size() < p.required || cmd.args.size() > p.params.size()) {
+        std::string list;
+        for (size_t i = 0; i < p.params.size(); ++i)
+            list += fmt::format("{}{}: {}", i == 0 ? "" : i >= p.required ? "[, " : ", ", p.params[i].first,
+                                p.params[i].second.str());
+        for (size_t i = p.required; i < p.params.size(); ++i) list += "]";
+        std::string count = p.required == p.params.size() ? fmt::format("{}", p.required)
+                                                          : fmt::format("{} to {}", p.required, p.params.size());
+        diags_.error(cmd.range, fmt::format("`{}` takes {} arguments ({}), but {} {} given", name, count,
+                                            list, cmd.args.size(), cmd.args.size() == 1 ? "was" : "were"));
+        return;
+    }
+    for (size_t i = 0; i < cmd.args.size(); ++i) {
+        auto [param, type] = p.params[i];
+        if (type == Type::vec(4) && types[i] == Type::vec(3))
+            diags_.error(cmd.args[i]->range, fmt::format("the colour of a {} must be vec4 (color), found vec3", name))
+                .notes.push_back({cmd.args[i]->range, "add an alpha: `vec4(c, 1)`"});
+        else
+            expectType(*cmd.args[i], type, fmt::format("the {} of a {}", param, name));
+    }
+}
+
 void Checker::checkCommands(std::vector<CommandPtr>& commands, const Context& ctx, const Command** point) {
     for (auto& cmd : commands) {
         switch (cmd->kind) {
-            case CommandKind::Point: {
-                if (ctx.where != Where::Object) {
-                    diags_.error(cmd->keywordRange, "`point` draws an object; a trigger can only emit objects");
-                    break;
-                }
-                if (ctx.dying) {
-                    diags_.error(cmd->keywordRange, "`on death` can only emit: the object is gone, it draws nothing");
-                    break;
-                }
-                if (*point) {
-                    diags_.error(cmd->keywordRange, fmt::format("object `{}` already draws a point; an object draws "
-                                                                "at most one", ctx.object->name))
-                        .notes.push_back({(*point)->keywordRange, "the first `point` is here"});
-                } else {
-                    *point = cmd.get();
-                }
-                std::vector<Type> types;
-                for (auto& a : cmd->args) types.push_back(check(*a, ctx));
-                if (cmd->args.size() != 3) {
-                    diags_.error(cmd->range, fmt::format("`point` takes 3 arguments (position: vec3, colour: vec4, "
-                                                         "size: float), but {} {} given", cmd->args.size(),
-                                                         cmd->args.size() == 1 ? "was" : "were"));
-                    break;
-                }
-                expectType(*cmd->args[0], Type::vec(3), "the position of a point");
-                if (types[1] == Type::vec(3))
-                    diags_.error(cmd->args[1]->range, "the colour of a point must be vec4 (color), found vec3")
-                        .notes.push_back({cmd->args[1]->range, "add an alpha: `vec4(c, 1)`"});
-                else
-                    expectType(*cmd->args[1], Type::vec(4), "the colour of a point");
-                expectType(*cmd->args[2], Type::scalar(), "the size of a point");
-                break;
-            }
+            case CommandKind::Draw: checkDraw(*cmd, ctx, point); break;
             case CommandKind::Kill:
                 if (ctx.where != Where::Object) {
                     diags_.error(cmd->keywordRange, "`kill` removes an object; a trigger can only emit objects");
@@ -355,6 +387,19 @@ void Checker::checkAttributes(const std::vector<Attribute*>& attributes) {
                 diags_.error(a.args[0]->range, "the capacity must be a constant whole number from 1 to 4294967295");
             a.value = v;
             a.whole = n;
+        } else if (a.name == "shape" || a.name == "blend") {
+            bool shape = a.name == "shape";
+            std::string names;
+            auto all = shape ? std::span<const std::string_view>(core::kShapeNames) : std::span<const std::string_view>(core::kBlendNames);
+            for (size_t i = 0; i < all.size(); ++i)
+                names += (i == 0 ? "" : i + 1 == all.size() ? " and " : ", ") + std::string(all[i]);
+            if (!wantOneArg(shape ? "the sprite's shape" : "add or alpha")) continue;
+            auto* name = a.args[0]->kind == ExprKind::Name ? static_cast<NameExpr*>(a.args[0].get()) : nullptr;
+            bool known = name && (shape ? core::shapeFromName(name->name).has_value() : core::blendFromName(name->name).has_value());
+            if (!known)
+                diags_.error(a.args[0]->range, name ? fmt::format("unknown {} `{}`", shape ? "shape" : "blend", name->name)
+                                                    : fmt::format("the {} must be named", shape ? "shape" : "blend"))
+                    .notes.push_back({a.args[0]->range, fmt::format("the {} are {}", shape ? "shapes" : "blends", names)});
         } else {
             diags_.error(a.nameRange, fmt::format("unknown attribute `@{}`", a.name))
                 .notes.push_back({a.nameRange, "the attributes are " + attributeList()});
@@ -374,6 +419,13 @@ void Checker::checkObject(ObjectDecl& object) {
     ctx.object = &object;
     const Command* point = nullptr;
     checkCommands(object.commands, ctx, &point);
+    for (const Attribute& a : object.attributes)
+        if (a.name == "shape" && !(point && point->draw == core::DrawKind::Sprite))
+            diags_.error(a.nameRange, fmt::format("`@shape` is a sprite's: object `{}` {}", object.name,
+                                                  point ? fmt::format("draws with `{}`", core::drawKindName(point->draw))
+                                                        : std::string("draws nothing")))
+                .notes.push_back({point ? point->keywordRange : object.nameRange,
+                                  point ? "draw it with `sprite(position, colour, size)`" : "the object"});
     // Parents before children: a child reads its parent's equations, whose types are now known.
     for (auto& child : object.children) checkObject(*child);
 }

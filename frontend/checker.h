@@ -75,6 +75,7 @@ private:
     void checkCommands(std::vector<ast::CommandPtr>& commands, const Context& ctx, const ast::Command** point);
     void checkEmit(ast::Command& emit, const Context& ctx);
     void checkOn(ast::Command& on, const Context& ctx, const ast::Command** point);
+    void checkDraw(ast::Command& draw, const Context& ctx, const ast::Command** point);
     void checkArguments(std::vector<ast::ExprPtr>& args, const ast::ObjectDecl& target, SourceRange callRange,
                         const Context& ctx);
     void checkAttributes(const std::vector<ast::Attribute*>& attributes);

@@ -218,8 +218,9 @@ private:
         auto c = std::make_unique<Command>();
         c->range = range(ctx);
         c->keywordRange = range(ctx->getStart(), ctx->getStart());
-        if (auto* p = dynamic_cast<PsysParser::PointCmdContext*>(ctx)) {
-            c->kind = CommandKind::Point;
+        if (auto* p = dynamic_cast<PsysParser::DrawCmdContext*>(ctx)) {
+            c->kind = CommandKind::Draw;
+            c->draw = core::drawKindFromName(p->drawing->getText()).value_or(core::DrawKind::Point);
             if (p->argList()) c->args = args(p->argList());
         } else if (auto* k = dynamic_cast<PsysParser::KillCmdContext*>(ctx)) {
             c->kind = CommandKind::Kill;

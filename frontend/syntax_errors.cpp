@@ -50,7 +50,7 @@ std::string ruleWords(antlr4::ParserRuleContext* ctx) {
             case PsysParser::RuleEmitRate: case PsysParser::RuleEmitCount: return "emit command";
             case PsysParser::RuleCommand: {
                 auto* c = ctx;
-                if (dynamic_cast<PsysParser::PointCmdContext*>(c)) return "point command";
+                if (auto* d = dynamic_cast<PsysParser::DrawCmdContext*>(c)) return d->drawing->getText() + " command";
                 if (dynamic_cast<PsysParser::KillCmdContext*>(c)) return "kill command";
                 if (dynamic_cast<PsysParser::EmitCmdContext*>(c)) return "emit command";
                 if (dynamic_cast<PsysParser::WhenCmdContext*>(c)) return "when command";
@@ -93,7 +93,7 @@ std::string describeExpected(antlr4::Parser* parser, const antlr4::misc::Interva
         types.erase(static_cast<size_t>(antlr4::Token::EOF));
     } else if (objectBody) {
         words.push_back("an equation, a command, a nested object");
-        drop({"point", "kill", "emit", "when", "on", "object", "@", "("});
+        drop({"point", "sprite", "streak", "kill", "emit", "when", "on", "object", "@", "("});
         types.erase(PsysParser::IDENT);
     } else if (exprStart) {
         words.push_back("an expression");

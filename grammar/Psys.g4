@@ -61,7 +61,7 @@ equation    : IDENT ( ':' typeRef )? '=' expr ';'                  # singleEquat
             | '(' IDENT ( ',' IDENT )+ ')' '=' expr ';'            # tupleEquation
             ;
 
-command     : 'point' '(' argList? ')' ';'                                      # pointCmd
+command     : drawing=( 'point' | 'sprite' | 'streak' ) '(' argList? ')' ';'      # drawCmd
             | 'kill' ( 'when' expr )? ';'                                       # killCmd
             | 'emit' IDENT ( '(' argList? ')' )? emitRate? emitCount? ';'        # emitCmd
             | 'when' expr '{' command* '}'                                      # whenCmd

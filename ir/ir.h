@@ -25,6 +25,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "core/draw.h"
 #include "core/integrators.h"
 #include "ir/ops.h"
 #include "ir/types.h"
@@ -75,7 +76,10 @@ enum class YieldKind {
     Visible,    // render: whether the point is drawn
     Position,
     Color,
-    Size,
+    Size,       // a point's pixels, a sprite's size, a streak's width
+    Rotation,   // a sprite's turn, in radians (0 where the command gives none)
+    Frame,      // a sprite's frame of a flip-book (0 where the command gives none)
+    End,        // a streak's other end (0 for the others)
     EmitRate,   // index: emit site; objects per second (rate emitters)
     EmitCount,  // index: emit site; objects per event (rate emitters) or in all (bursts)
     EmitArg,    // index: emit site, sub: argument
@@ -138,19 +142,37 @@ struct KernelStorage {
     std::vector<int> zeroed;
 };
 
-// The render columns as the IR's text names them (`position.y`, `size`), 0 … 8.
+// The render columns as the IR's text names them (`position.y`, `size`, `end.z`), 0 … 13.
 const char* drawnColumnName(int column);
-constexpr int kDrawnColumns = 9;
-// The first render column of a drawn yield: visible 0, position 1, colour 4, size 8
-// (the one definition: the storage pass records by it, the run-time lays columns out by it).
+constexpr int kDrawnColumns = 14;
+// The first render column of a drawn yield: visible 0, position 1, colour 4, size 8,
+// rotation 9, frame 10, end 11 (the one definition: the storage pass records by it, the
+// run-time lays columns out by it).
 constexpr int firstDrawnColumn(YieldKind kind) {
     switch (kind) {
         case YieldKind::Position: return 1;
         case YieldKind::Color: return 4;
         case YieldKind::Size: return 8;
+        case YieldKind::Rotation: return 9;
+        case YieldKind::Frame: return 10;
+        case YieldKind::End: return 11;
         default: return 0;
     }
 }
+// The render yields: what a render kernel computes for the drawing.
+constexpr bool isDrawnYield(YieldKind kind) {
+    return kind == YieldKind::Visible || kind == YieldKind::Position || kind == YieldKind::Color ||
+           kind == YieldKind::Size || kind == YieldKind::Rotation || kind == YieldKind::Frame || kind == YieldKind::End;
+}
+// The drawn values beyond a point's (rotation, frame, end), where a render kernel yields
+// none of them: 0, a constant with no column.
+constexpr bool drawnDefaultsToZero(int column) { return column >= 9; }
+
+class Kernel;
+// A render kernel's storage record (fixed): the drawn columns past a point's that it
+// yields nothing for are the constant 0 (the storage pass and the IR's parser both apply
+// it; the printer leaves those lines out).
+void defaultDrawn(Kernel& render);
 
 class Kernel {
 public:
@@ -274,6 +296,8 @@ struct Attributes {
     Loc integratorLoc;
     float step = 0;                        // @step: the longest update, in seconds; 0: none
     std::optional<uint64_t> capacity;      // @capacity: most objects alive at once
+    std::optional<core::Shape> shape;      // @shape: a sprite's (none: soft)
+    std::optional<core::Blend> blend;      // @blend (none: core::defaultBlend)
     bool operator==(const Attributes&) const = default;
 };
 
@@ -281,6 +305,7 @@ struct Object {
     std::string name;
     Loc loc;             // its declaration
     std::string parent;  // the enclosing object type; empty at file level
+    core::DrawKind draw = core::DrawKind::Point;  // its render command (core/draw.h)
     std::vector<Param> params;
     std::vector<StateSlot> state;
     std::vector<EmitSite> emits;

@@ -165,7 +165,8 @@ const char* kernelName(KernelKind kind) {
 
 const char* drawnColumnName(int column) {
     static const char* const names[kDrawnColumns] = {"visible", "position.x", "position.y", "position.z", "color.r",
-                                                     "color.g", "color.b", "color.a", "size"};
+                                                     "color.g", "color.b", "color.a", "size", "rotation",
+                                                     "frame", "end.x", "end.y", "end.z"};
     return column >= 0 && column < kDrawnColumns ? names[column] : "?";
 }
 
@@ -175,6 +176,20 @@ std::string unexpectedOp(const Inst& inst, std::string_view backend) {
                                          : "";
     return "internal error: " + std::string(backend) + " has no code for `" + std::string(opInfo(inst.op).name) + "`" +
            where;
+}
+
+void defaultDrawn(Kernel& render) {
+    KernelStorage& st = render.storage;
+    if (render.kind != KernelKind::Render || !st.fixed) return;
+    st.drawn.resize(kDrawnColumns);
+    std::vector<bool> yielded(kDrawnColumns, false);
+    for (const Yield& y : render.yields)
+        if (isDrawnYield(y.kind))
+            for (int c = 0; c < render.at(y.value).type.width; ++c)
+                yielded[static_cast<size_t>(firstDrawnColumn(y.kind) + c)] = true;
+    for (int c = 0; c < kDrawnColumns; ++c)
+        if (drawnDefaultsToZero(c) && !yielded[static_cast<size_t>(c)])
+            st.drawn[static_cast<size_t>(c)] = {KernelStorage::Drawn::From::Constant, 0, 0, 0.0f};
 }
 
 }  // namespace psys::ir

@@ -73,7 +73,8 @@ std::string nameBeforeParen(const std::string& header, size_t skip) {
 
 std::optional<YieldKind> yieldKind(const std::string& name) {
     for (YieldKind k : {YieldKind::StateNext, YieldKind::Kill, YieldKind::Visible, YieldKind::Position,
-                        YieldKind::Color, YieldKind::Size, YieldKind::EmitRate, YieldKind::EmitCount,
+                        YieldKind::Color, YieldKind::Size, YieldKind::Rotation, YieldKind::Frame, YieldKind::End,
+                        YieldKind::EmitRate, YieldKind::EmitCount,
                         YieldKind::EmitArg, YieldKind::Export, YieldKind::Uniform, YieldKind::Unstable})
         if (yieldKindName(k) == name) return k;
     return std::nullopt;
@@ -175,6 +176,11 @@ private:
             }
             if (w[0] == "parent") o.parent = w.at(1);
             else if (w[0] == "attribute") attribute(o.attributes, w);
+            else if (w[0] == "draw") {
+                auto draw = w.size() == 2 ? core::drawKindFromName(w[1]) : std::nullopt;
+                if (!draw) throw ParseError("expected `draw point|sprite|streak`");
+                o.draw = *draw;
+            }
             else if (w[0] == "state") {
                 if (w.size() != 4 || w[1].back() != ':') throw ParseError("expected `state name: type zero|next`");
                 StateInit init = w[3] == "zero" ? StateInit::Zero : w[3] == "next" ? StateInit::Next
@@ -206,6 +212,12 @@ private:
             a.step = number(w[2]);
         } else if (w[1] == "capacity") {
             a.capacity = static_cast<uint64_t>(integer(w[2]));
+        } else if (w[1] == "shape") {
+            a.shape = core::shapeFromName(w[2]);
+            if (!a.shape) throw ParseError("unknown shape `" + w[2] + "`");
+        } else if (w[1] == "blend") {
+            a.blend = core::blendFromName(w[2]);
+            if (!a.blend) throw ParseError("unknown blend `" + w[2] + "`");
         } else {
             throw ParseError("unknown attribute `" + w[1] + "`");
         }
@@ -248,6 +260,7 @@ private:
                 for (auto& [name, v] : k.equations)
                     if (v >= k.size()) throw ParseError(fmt::format("value %{} is not defined", v));
                 k.rehash();
+                defaultDrawn(k);
                 return k;
             }
             if (w[0] == "yield") k.yields.push_back(yield(w));

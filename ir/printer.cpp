@@ -47,6 +47,11 @@ std::string storageText(const Kernel& kernel, const std::string& pad) {
     for (size_t c = 0; c < st.drawn.size(); ++c) {
         const Drawn& d = st.drawn[c];
         if (d.from == Drawn::From::Column) continue;
+        bool yielded = false;  // (unyielded, past a point's: 0 without saying so; ir::defaultDrawn)
+        for (const Yield& y : kernel.yields)
+            yielded |= isDrawnYield(y.kind) && static_cast<int>(c) >= firstDrawnColumn(y.kind) &&
+                       static_cast<int>(c) < firstDrawnColumn(y.kind) + kernel.at(y.value).type.width;
+        if (drawnDefaultsToZero(static_cast<int>(c)) && !yielded) continue;
         out += fmt::format("{}  storage drawn {} = ", pad, drawnColumnName(static_cast<int>(c)));
         out += d.from == Drawn::From::State ? fmt::format("state #{}.{}\n", d.slot, d.lane) : "const " + number(d.value) + "\n";
     }
@@ -70,6 +75,9 @@ std::string yieldKindName(YieldKind kind) {
         case YieldKind::Position: return "position";
         case YieldKind::Color: return "color";
         case YieldKind::Size: return "size";
+        case YieldKind::Rotation: return "rotation";
+        case YieldKind::Frame: return "frame";
+        case YieldKind::End: return "end";
         case YieldKind::EmitRate: return "emit.rate";
         case YieldKind::EmitCount: return "emit.count";
         case YieldKind::EmitArg: return "emit.arg";
@@ -130,6 +138,9 @@ std::string print(const Object& o, PrintOptions options) {
     if (a.integrator) out += fmt::format("  attribute integrator {}\n", core::integratorName(*a.integrator));
     if (a.step > 0) out += fmt::format("  attribute step {}\n", number(a.step));
     if (a.capacity) out += fmt::format("  attribute capacity {}\n", *a.capacity);
+    if (a.shape) out += fmt::format("  attribute shape {}\n", core::shapeName(*a.shape));
+    if (a.blend) out += fmt::format("  attribute blend {}\n", core::blendName(*a.blend));
+    if (o.draw != core::DrawKind::Point) out += fmt::format("  draw {}\n", core::drawKindName(o.draw));
     for (auto& s : o.state)
         out += fmt::format("  state {}: {} {}\n", s.name, s.type.str(), s.init == StateInit::Zero ? "zero" : "next");
     for (auto& e : o.emits) out += fmt::format("  emit {} {}\n", e.target, emitWhenName(e.when));

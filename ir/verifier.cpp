@@ -179,7 +179,8 @@ private:
                        "no state slot of this index and type");
                 break;
             case YieldKind::Kill: case YieldKind::Visible: case YieldKind::Unstable: expect(t.isBool(), "a bool"); break;
-            case YieldKind::Position: expect(t == Type::vec(3), "a vec3"); break;
+            case YieldKind::Position: case YieldKind::End: expect(t == Type::vec(3), "a vec3"); break;
+            case YieldKind::Rotation: case YieldKind::Frame: expect(t.isScalarFloat(), "an f32"); break;
             case YieldKind::Color: expect(t == Type::vec(4), "a vec4"); break;
             case YieldKind::Size: case YieldKind::EmitRate: case YieldKind::EmitCount:
                 expect(t.isScalarFloat(), "an f32");

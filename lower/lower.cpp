@@ -66,11 +66,17 @@ struct CommandLowering {
         for (auto& cmd : commands) {
             LocScope at(k, lowering.locate(cmd->range));
             switch (cmd->kind) {
-                case CommandKind::Point: {
-                    k.yields.push_back({YieldKind::Position, 0, 0, lowering.lowerOne(*cmd->args[0])});
-                    k.yields.push_back({YieldKind::Color, 0, 0, lowering.lowerOne(*cmd->args[1])});
-                    k.yields.push_back({YieldKind::Size, 0, 0, lowering.lowerOne(*cmd->args[2])});
+                case CommandKind::Draw: {
+                    // The render yields, by the command's parameters (frontend: drawParams).
+                    static const std::vector<YieldKind> point = {YieldKind::Position, YieldKind::Color, YieldKind::Size,
+                                                                 YieldKind::Rotation, YieldKind::Frame};
+                    static const std::vector<YieldKind> streak = {YieldKind::Position, YieldKind::End, YieldKind::Color,
+                                                                  YieldKind::Size};
+                    const auto& kinds = cmd->draw == core::DrawKind::Streak ? streak : point;
+                    for (size_t i = 0; i < cmd->args.size() && i < kinds.size(); ++i)
+                        k.yields.push_back({kinds[i], 0, 0, lowering.lowerOne(*cmd->args[i])});
                     k.yields.push_back({YieldKind::Visible, 0, 0, lowering.guard(conditions)});
+                    draw = cmd->draw;
                     break;
                 }
                 case CommandKind::Kill: {
@@ -117,6 +123,7 @@ struct CommandLowering {
         }
     }
 
+    core::DrawKind draw = core::DrawKind::Point;  // the object's draw command's
     // (state of the walk)
     std::vector<const Command*> deaths_;
     bool dying_ = false;  // lowering an `on death` block
@@ -165,6 +172,10 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
         if (a.name == "integrator" && a.args[0]->kind == ExprKind::Name) {
             attributes.integrator = core::integratorFromName(static_cast<const NameExpr&>(*a.args[0]).name);
             attributes.integratorLoc = locate(a.args[0]->range);
+        } else if ((a.name == "shape" || a.name == "blend") && a.args[0]->kind == ExprKind::Name) {
+            const std::string& name = static_cast<const NameExpr&>(*a.args[0]).name;
+            if (a.name == "shape") attributes.shape = core::shapeFromName(name);
+            else attributes.blend = core::blendFromName(name);
         } else if (a.value) {  // the checker's value of @step or @capacity
             if (a.name == "step") attributes.step = a.value->v[0];
             if (a.name == "capacity") attributes.capacity = static_cast<uint64_t>(a.whole.value_or(a.value->v[0]));
@@ -202,8 +213,9 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
         ObjectLowering lowering(m, locate, k, &o, decl, nullptr, sites);
         lowering.lowerEquations();
         ValueId kill = k.boolean(false);
-        CommandLowering commands{lowering, k, o.emits, program, qualified, true, {}, false};
+        CommandLowering commands{lowering, k, o.emits, program, qualified, true, core::DrawKind::Point, {}, false};
         commands.runObject(decl->commands, kill);
+        o.draw = commands.draw;
         lowering.flushDeferred();
         k.yields.push_back({YieldKind::Kill, 0, 0, kill});
         o.kernels.push_back(std::move(k));
@@ -221,7 +233,8 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
                 int sites = 0;
                 ObjectLowering lowering(m, locate, trigger.kernel, nullptr, nullptr, &t, sites);
                 ValueId kill = trigger.kernel.boolean(false);
-                CommandLowering commands{lowering, trigger.kernel, trigger.emits, program, qualified, false, {}, false};
+                CommandLowering commands{lowering, trigger.kernel, trigger.emits, program, qualified, false,
+                                         core::DrawKind::Point, {}, false};
                 commands.run(t.commands, {}, kill);
                 m.triggers.push_back(std::move(trigger));
             }

@@ -56,7 +56,7 @@ KernelStorage storageOf(const Object& object, const Kernel& kernel) {
         st.drawn.assign(kDrawnColumns, {});
         using From = KernelStorage::Drawn::From;
         for (const Yield& y : kernel.yields) {
-            if (y.kind != YieldKind::Position && y.kind != YieldKind::Color && y.kind != YieldKind::Size) continue;
+            if (!isDrawnYield(y.kind) || y.kind == YieldKind::Visible) continue;
             const Inst& value = kernel.at(y.value);
             int first = firstDrawnColumn(y.kind);
             for (int c = 0; c < value.type.width; ++c) {
@@ -85,7 +85,10 @@ KernelStorage storageOf(const Object& object, const Kernel& kernel) {
 
 void lowerStorage(Module& module, PassErrors&) {
     for (Object& object : module.objects)
-        for (Kernel& kernel : object.kernels) kernel.storage = storageOf(object, kernel);
+        for (Kernel& kernel : object.kernels) {
+            kernel.storage = storageOf(object, kernel);
+            defaultDrawn(kernel);
+        }
 }
 
 }  // namespace psys::opt

@@ -132,10 +132,7 @@ private:
     std::vector<std::pair<int, ValueId>> carried_;
 };
 
-bool isRender(const Yield& y) {
-    return y.kind == YieldKind::Position || y.kind == YieldKind::Color || y.kind == YieldKind::Size ||
-           y.kind == YieldKind::Visible;
-}
+bool isRender(const Yield& y) { return isDrawnYield(y.kind); }
 
 }  // namespace
 

@@ -30,7 +30,8 @@ namespace psys::rt {
 struct ColumnLayout {
     static constexpr int kCreated = 0, kIds = 1, kKill = 2, kNow = 3, kDt = 4, kFirstColumn = 5;
     int state = 0, params = 0, exports = 0, emits = 0, render = 0, parents = 0, total = 0;
-    static constexpr int kVisible = 0, kPosition = 1, kColor = 4, kSize = 8, kRenderColumns = 9;
+    static constexpr int kVisible = 0, kPosition = 1, kColor = 4, kSize = 8, kRotation = 9, kFrame = 10, kEnd = 11,
+                         kRenderColumns = 14;
     std::vector<int> stateOffset, paramOffset, exportOffset;
     struct ParentColumn {
         ir::Op op;

@@ -95,6 +95,8 @@ struct RenderPoint {
     std::array<float, 3> position;
     std::array<float, 4> color;
     float size;
+    float rotation = 0, frame = 0;       // a sprite's (0 for the others)
+    std::array<float, 3> end{};          // a streak's other end (0 for the others)
 };
 
 // What is drawn for one type after the latest step, as columns in the backend's memory:
@@ -110,10 +112,19 @@ struct DrawColumns {
     Buffer position[3];     // f32
     Buffer color[4];        // f32
     Buffer size;            // f32
+    Buffer rotation, frame; // f32: a sprite's
+    Buffer end[3];          // f32: a streak's other end
     Buffer ids;             // u32
+    // The drawn values in render-column order past `visible` (ColumnLayout::kPosition …):
+    // position x y z, colour r g b a, size, rotation, frame, end x y z.
+    static constexpr int kValues = 13;
+    std::array<Buffer, kValues> values() const {
+        return {position[0], position[1], position[2], color[0], color[1], color[2], color[3],
+                size,        rotation,    frame,       end[0],   end[1],   end[2]};
+    }
     // A component every row draws alike has no column (an invalid buffer above) and its
-    // value here: position x y z, colour r g b a, size (ColumnLayout::renderConstant).
-    std::array<float, 8> constant{};
+    // value here, in that order (ColumnLayout::renderConstant).
+    std::array<float, kValues> constant{};
 };
 
 // What hot reload kept and lost (rt/reload.cpp, docs/runtime.md).

@@ -8,14 +8,17 @@
 
 namespace psys::rt {
 
+static_assert(DrawColumns::kValues == ColumnLayout::kRenderColumns - ColumnLayout::kPosition &&
+              ColumnLayout::kEnd + 3 == ColumnLayout::kRenderColumns);
+
 void markDrawn(Memory& memory, const RowsLaunch& launch, const uint8_t* mask, size_t begin, size_t end,
                RowsResult& result) {
     const ColumnLayout& layout = *launch.layout;
     auto column = [&](int c) { return launch.columns[static_cast<size_t>(layout.drawnFrom(c))]; };
     float* visible = hostData<float>(memory, column(ColumnLayout::kVisible));
-    const float* values[8] = {};
+    const float* values[DrawColumns::kValues] = {};
     bool constantsFinite = true;  // the constant components: the same for every row
-    for (int c = 0; c < 8; ++c) {
+    for (int c = 0; c < DrawColumns::kValues; ++c) {
         if (auto k = layout.constant(ColumnLayout::kPosition + c)) constantsFinite &= std::isfinite(*k);
         else values[c] = viewData<float>(memory, column(ColumnLayout::kPosition + c));
     }
@@ -116,7 +119,10 @@ void Drawing::hand(size_t type, DrawColumns& out) {
     for (int c = 0; c < 3; ++c) out.position[c] = column(ColumnLayout::kPosition + c);
     for (int c = 0; c < 4; ++c) out.color[c] = column(ColumnLayout::kColor + c);
     out.size = column(ColumnLayout::kSize);
-    for (int c = 0; c < 8; ++c)
+    out.rotation = column(ColumnLayout::kRotation);
+    out.frame = column(ColumnLayout::kFrame);
+    for (int c = 0; c < 3; ++c) out.end[c] = column(ColumnLayout::kEnd + c);
+    for (int c = 0; c < DrawColumns::kValues; ++c)
         if (auto k = layout.constant(ColumnLayout::kPosition + c)) out.constant[static_cast<size_t>(c)] = *k;
 }
 
@@ -190,15 +196,15 @@ std::vector<RenderPoint> Drawing::points(size_t type) {
     std::vector<RenderPoint> out;
     if (c.rows == 0 || c.drawn == 0) return out;
     out.reserve(c.drawn);
-    std::vector<float> visible(c.rows), values[8];
+    std::vector<float> visible(c.rows), values[DrawColumns::kValues];
     std::vector<uint32_t> ids(c.rows);
     const Memory& memory = s_.memory;
     memory.read(c.visible, 0, c.rows, visible.data());
     memory.read(c.ids, 0, c.rows, ids.data());
-    Buffer columns[8] = {c.position[0], c.position[1], c.position[2], c.color[0], c.color[1], c.color[2], c.color[3], c.size};
-    for (int k = 0; k < 8; ++k) {
+    const std::array<Buffer, DrawColumns::kValues> columns = c.values();
+    for (size_t k = 0; k < columns.size(); ++k) {
         if (!columns[k].valid()) {  // a constant
-            values[k].assign(c.rows, c.constant[static_cast<size_t>(k)]);
+            values[k].assign(c.rows, c.constant[k]);
             continue;
         }
         values[k].resize(c.rows);
@@ -209,7 +215,10 @@ std::vector<RenderPoint> Drawing::points(size_t type) {
         out.push_back({ids[row],
                        {values[0][row], values[1][row], values[2][row]},
                        {values[3][row], values[4][row], values[5][row], values[6][row]},
-                       values[7][row]});
+                       values[7][row],
+                       values[8][row],
+                       values[9][row],
+                       {values[10][row], values[11][row], values[12][row]}});
     }
     return out;
 }

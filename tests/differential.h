@@ -18,7 +18,9 @@ namespace psys::test {
 
 inline bool samePoint(const rt::RenderPoint& a, const rt::RenderPoint& b) {
     return a.id == b.id && std::memcmp(&a.position, &b.position, sizeof a.position) == 0 &&
-           std::memcmp(&a.color, &b.color, sizeof a.color) == 0 && std::memcmp(&a.size, &b.size, sizeof a.size) == 0;
+           std::memcmp(&a.color, &b.color, sizeof a.color) == 0 && std::memcmp(&a.size, &b.size, sizeof a.size) == 0 &&
+           std::memcmp(&a.rotation, &b.rotation, sizeof a.rotation) == 0 &&
+           std::memcmp(&a.frame, &b.frame, sizeof a.frame) == 0 && std::memcmp(&a.end, &b.end, sizeof a.end) == 0;
 }
 
 // The largest difference between two points' values, relative to max(1, |value|); a NaN
@@ -32,6 +34,9 @@ inline double pointDifference(const rt::RenderPoint& a, const rt::RenderPoint& b
     for (size_t i = 0; i < 3; ++i) compare(a.position[i], b.position[i]);
     for (size_t i = 0; i < 4; ++i) compare(a.color[i], b.color[i]);
     compare(a.size, b.size);
+    compare(a.rotation, b.rotation);
+    compare(a.frame, b.frame);
+    for (size_t i = 0; i < 3; ++i) compare(a.end[i], b.end[i]);
     return worst;
 }
 

@@ -22,7 +22,7 @@ public:
     explicit Dump(const std::string& path) : path_(path), json_(path.ends_with(".json")) {
         if (path.empty()) return;
         out_.open(path, std::ios::binary);
-        out_ << (json_ ? "{\"frames\": [" : "frame,time,type,id,x,y,z,r,g,b,a,size\n");
+        out_ << (json_ ? "{\"frames\": [" : "frame,time,type,id,x,y,z,r,g,b,a,size,rotation,sprite_frame,end_x,end_y,end_z\n");
     }
     bool ok() const { return path_.empty() || out_.good(); }
 
@@ -36,12 +36,18 @@ public:
             for (const rt::RenderPoint& p : system.points(t)) {
                 if (json_) {
                     nlohmann::json o = {{"type", type}, {"id", p.id}, {"position", p.position}, {"color", p.color}, {"size", p.size}};
+                    if (system.module().objects[t].draw == core::DrawKind::Sprite) {
+                        o["rotation"] = p.rotation;
+                        o["frame"] = p.frame;
+                    }
+                    if (system.module().objects[t].draw == core::DrawKind::Streak) o["end"] = p.end;
                     out_ << (first ? "" : ", ") << o.dump();
                     first = false;
                 } else {
-                    out_ << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{}\n", frame, system.time(), type, p.id,
-                                        p.position[0], p.position[1], p.position[2], p.color[0], p.color[1],
-                                        p.color[2], p.color[3], p.size);
+                    out_ << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", frame, system.time(), type,
+                                        p.id, p.position[0], p.position[1], p.position[2], p.color[0], p.color[1],
+                                        p.color[2], p.color[3], p.size, p.rotation, p.frame, p.end[0], p.end[1],
+                                        p.end[2]);
                 }
             }
         }
