@@ -54,6 +54,7 @@ Frame render(const std::string& text, int frames, Blend blend, const std::functi
     options.ui = false;
     options.watch = false;
     options.blend = blend;
+    options.glow.on = false;  // colours as given (the glow's own tests turn it on)
     options.camera = Camera::parse("0,0,10,0,2,0");  // from +z, level, looking at (0, 2, 0)
     options.session.backend.name = backend;
     host::CompileResult compiled;

@@ -96,7 +96,11 @@ int realMain(int argc, char** argv) {
     app.add_option("--max-steps", o.maxSteps, "In real time, the most steps a frame runs after a stall (8)")
         ->check(CLI::Range(1, 1000));
     app.add_option("--size", size, "Width x height of the window or image (1280x720)");
-    app.add_option("--blend", blend, "additive (the default) or alpha (B switches)")->check(CLI::IsMember({"additive", "alpha"}));
+    app.add_option("--blend", blend, "How types whose program names no @blend are blended: additive (the default) or alpha (B switches)")
+        ->check(CLI::IsMember({"additive", "alpha"}));
+    bool noGlow = false;
+    app.add_flag("--no-glow", noGlow, "No glow and no tone mapping: light clipped at 1 (L switches)");
+    app.add_option("--glow", o.glow.strength, "How much the glow adds (0.6)")->check(CLI::Range(0.0, 10.0));
     app.add_flag("--fit", o.fit, "The camera fits what is alive before each frame (as F does)");
     app.add_flag("--no-grid", noGrid, "No ground grid and axes (G switches)");
     app.add_flag("--no-ui", noUi, "No panel");
@@ -164,6 +168,7 @@ int realMain(int argc, char** argv) {
     }
     o.blend = blend == "alpha" ? Blend::Alpha : Blend::Additive;
     o.grid = !noGrid;
+    o.glow.on = !noGlow;
     o.ui = o.headless ? ui : !noUi;
     o.watch = !noWatch;
 

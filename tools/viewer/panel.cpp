@@ -136,6 +136,12 @@ void Panel::controls() {
     if (ImGui::RadioButton("alpha (B)", !additive)) viewer_.options_.blend = Blend::Alpha;
     ImGui::SameLine();
     ImGui::Checkbox("grid (G)", &viewer_.options_.grid);
+    ImGui::Checkbox("glow (L)", &viewer_.options_.glow.on);
+    if (viewer_.options_.glow.on) {
+        ImGui::SameLine();
+        ImGui::SetNextItemWidth(120);
+        ImGui::SliderFloat("strength", &viewer_.options_.glow.strength, 0.0f, 2.0f, "%.2f");
+    }
     if (ImGui::Button("frame what is alive (F)")) viewer_.frameAlive();
     ImGui::SameLine();
     if (ImGui::Button("reset camera (R)")) viewer_.camera_.reset();

@@ -1,7 +1,5 @@
-// Drawing a frame: the points of every type straight from the run-time's draw columns
-// (rt::DrawColumns: uploaded column by column, never a per-point structure), as round,
-// soft-edged sprites sized by `size` (pixels at the reference distance, smaller with
-// depth), over a dark background with a faint ground grid and the axes.
+// Drawing a frame's scene: a dark background with a faint ground grid and the axes (the
+// objects: particles.h; the light and its glow: glow.h).
 #pragma once
 
 #include <epoxy/gl.h>
@@ -13,27 +11,8 @@
 
 namespace psys::viewer {
 
+// The blending of the types whose program names none (@blend): the viewer's B switch.
 enum class Blend { Additive, Alpha };
-
-// A point's `size` is its diameter in pixels seen from this distance (on a 720-pixel-high
-// view; scaled with the view's height).
-constexpr float kReferenceDistance = 20;
-
-class PointRenderer {
-public:
-    PointRenderer();
-    ~PointRenderer();
-    PointRenderer(const PointRenderer&) = delete;
-    PointRenderer& operator=(const PointRenderer&) = delete;
-    void draw(const rt::DrawColumns& columns, const rt::Memory& memory, const glm::mat4& view,
-              const glm::mat4& projection, float viewportHeight, Blend blend);
-
-private:
-    static constexpr int kColumns = 9;  // visible, x, y, z, r, g, b, a, size
-    GLuint program_ = 0, vao_ = 0, buffers_[kColumns] = {};
-    size_t capacity_[kColumns] = {};
-    std::vector<float> staging_;
-};
 
 class SceneRenderer {
 public:

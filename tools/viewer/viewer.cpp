@@ -30,8 +30,9 @@ Viewer::Viewer(ViewerOptions options, Surface& surface, std::unique_ptr<host::Se
     : options_(std::move(options)), surface_(surface), session_(std::move(session)) {
     camera_ = options_.camera.value_or(Camera{});
     workerContext_ = surface_.workerContext();
-    points_ = std::make_unique<PointRenderer>();
+    particles_ = std::make_unique<ParticleRenderer>();
     scene_ = std::make_unique<SceneRenderer>();
+    glow_ = std::make_unique<Glow>();
     reloader_ = std::make_unique<Reloader>(*session_, workerContext_.get());
     reloader_->interimAfterSeconds = options_.interimAfter;
     clock_ = SimClock({options_.dt, options_.fixed, 1, options_.maxSteps});
@@ -226,15 +227,25 @@ void Viewer::handleReload() {
 void Viewer::draw() {
     auto start = Clock::now();
     surface_.bind();
+    GLint target = 0;
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &target);
+    glow_->begin(surface_.width(), surface_.height());
     clearFrame();
     float aspect = static_cast<float>(surface_.width()) / static_cast<float>(std::max(surface_.height(), 1));
     glm::mat4 view = camera_.view(), projection = camera_.projection(aspect);
     scene_->draw(view, projection, options_.grid);
     rt::System& system = session_->system();
-    for (size_t t = 0; t < system.typeCount(); ++t)
-        if (shows(system.module().objects[t].name))
-            points_->draw(system.draw(t), system.backend().memory(), view, projection,
-                          static_cast<float>(surface_.height()), options_.blend);
+    // Alpha-blended matter first (each type back to front), then added light over it.
+    for (core::Blend pass : {core::Blend::Alpha, core::Blend::Add})
+        for (size_t t = 0; t < system.typeCount(); ++t) {
+            const ir::Object& o = system.module().objects[t];
+            DrawStyle style{o.draw, o.attributes.shape.value_or(core::Shape::Soft),
+                            o.attributes.blend.value_or(options_.blend == Blend::Alpha ? core::Blend::Alpha : core::Blend::Add)};
+            if (style.blend == pass && shows(o.name))
+                particles_->draw(system.draw(t), system.backend().memory(), style, view, projection,
+                                 static_cast<float>(surface_.height()));
+        }
+    glow_->finish(static_cast<GLuint>(target), options_.glow);
     stats_.glSeconds = secondsBetween(start, Clock::now());
 }
 
@@ -244,6 +255,7 @@ void Viewer::key(int key, bool shift) {
         case GLFW_KEY_R: camera_.reset(); break;
         case GLFW_KEY_B: options_.blend = options_.blend == Blend::Additive ? Blend::Alpha : Blend::Additive; break;
         case GLFW_KEY_G: options_.grid = !options_.grid; break;
+        case GLFW_KEY_L: options_.glow.on = !options_.glow.on; break;
         case GLFW_KEY_SPACE: paused_ = !paused_; break;
         case GLFW_KEY_S: stepOnce_ = true; break;
         case GLFW_KEY_T:

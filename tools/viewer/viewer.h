@@ -2,8 +2,10 @@
 //
 // The Viewer runs a host::Session frame by frame on a Surface (a window, or offscreen
 // when headless): it steps the system (real time in fixed steps, or a step a frame;
-// scaled, paused, one step at a time: tools/viewer/sim_clock.h), draws every type's points
-// from the run-time's draw columns (each type shown, hidden or solo), shows the panel
+// scaled, paused, one step at a time: tools/viewer/sim_clock.h), draws every type as its
+// render command says (points, sprites, streaks: tools/viewer/particles.h) from the
+// run-time's draw columns, in HDR with a glow (tools/viewer/glow.h; each type shown,
+// hidden or solo), shows the panel
 // (externs, triggers, time, backend), the stats and the keys, watches the file and
 // everything it imports and hot-reloads on save (tools/viewer/reloader.h), and writes
 // screenshots and recordings (tools/viewer/recorder.h).
@@ -22,6 +24,8 @@
 #include "host/session.h"
 #include "recorder.h"
 #include "reloader.h"
+#include "glow.h"
+#include "particles.h"
 #include "render.h"
 #include "script.h"
 #include "sim_clock.h"
@@ -51,7 +55,8 @@ struct ViewerOptions {
     int maxSteps = 8;            // the most steps a real-time frame runs (a stall's catch-up)
     std::function<Clock::time_point()> now;  // the wall clock (tests give a fake one)
     int width = 1280, height = 720;
-    Blend blend = Blend::Additive;
+    Blend blend = Blend::Additive;  // of the types that name none (@blend)
+    GlowSettings glow;
     bool ui = true;
     bool grid = true;
     bool fit = false;            // the camera fits what is alive before each frame is drawn
@@ -123,8 +128,9 @@ private:
     Surface& surface_;
     std::unique_ptr<host::Session> session_;
     Camera camera_;
-    std::unique_ptr<PointRenderer> points_;
+    std::unique_ptr<ParticleRenderer> particles_;
     std::unique_ptr<SceneRenderer> scene_;
+    std::unique_ptr<Glow> glow_;
     Watcher watcher_;
     std::unique_ptr<WorkerContext> workerContext_;  // the reloader's (outlives it)
     std::unique_ptr<Reloader> reloader_;

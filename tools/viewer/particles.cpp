@@ -1,0 +1,269 @@
+#include "particles.h"
+
+#include <algorithm>
+#include <numeric>
+
+#include <glm/gtc/type_ptr.hpp>
+
+#include "codegen_glsl/glsl_shaders.h"
+#include "render.h"
+
+namespace psys::viewer {
+
+namespace {
+
+// The attributes, one float each, in render-column order (rt::ColumnLayout): location i is
+// column i.
+const char* kAttributes = R"(
+layout(location = 0) in float visible;
+layout(location = 1) in float x;
+layout(location = 2) in float y;
+layout(location = 3) in float z;
+layout(location = 4) in float r;
+layout(location = 5) in float g;
+layout(location = 6) in float b;
+layout(location = 7) in float a;
+layout(location = 8) in float size;
+layout(location = 9) in float rotation;
+layout(location = 10) in float frame;
+layout(location = 11) in float ex;
+layout(location = 12) in float ey;
+layout(location = 13) in float ez;
+)";
+
+const char* kPointVertex = R"(
+uniform mat4 view;
+uniform mat4 projection;
+uniform float reference;  // pixels per unit of size at depth 1
+out vec4 colour;
+void main() {
+    if (visible == 0.0) {  // not drawn: outside the clip volume, no pixels
+        gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
+        gl_PointSize = 0.0;
+        colour = vec4(0.0);
+        return;
+    }
+    vec4 eye = view * vec4(x, y, z, 1.0);
+    gl_Position = projection * eye;
+    gl_PointSize = clamp(size * reference / max(-eye.z, 1e-3), 1.0, 256.0);
+    colour = vec4(r, g, b, a);
+}
+)";
+
+// Sprites and streaks: six vertices (two triangles) per row, the row an instance.
+const char* kQuadVertex = R"(
+uniform mat4 view;
+uniform mat4 projection;
+uniform int kind;  // 1: sprite, 2: streak
+out vec4 colour;
+out vec2 uv;        // the square's corner coordinates, −1 … 1
+out float seed;     // a sprite's frame
+out float halfLength;  // a streak's half length, in half widths
+const vec2 corners[6] = vec2[](vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, -1), vec2(1, 1), vec2(-1, 1));
+void main() {
+    vec2 c = corners[gl_VertexID % 6];
+    uv = c;
+    seed = frame;
+    halfLength = 0.0;
+    colour = vec4(r, g, b, a);
+    if (visible == 0.0) {
+        gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
+        return;
+    }
+    float halfWidth = 0.5 * size;
+    if (kind == 1) {
+        vec4 eye = view * vec4(x, y, z, 1.0);
+        float s = sin(rotation), k = cos(rotation);
+        eye.xy += vec2(k * c.x - s * c.y, s * c.x + k * c.y) * halfWidth;
+        gl_Position = projection * eye;
+        return;
+    }
+    // A streak: along the segment in the eye's space, across it in the view plane,
+    // extended by half a width at each end for its round caps.
+    vec3 p0 = (view * vec4(x, y, z, 1.0)).xyz, p1 = (view * vec4(ex, ey, ez, 1.0)).xyz;
+    vec3 d = p1 - p0;
+    float len = length(d);
+    vec3 dir = len > 1e-6 ? d / len : vec3(0.0, 1.0, 0.0);
+    vec3 side = cross(dir, normalize(-(p0 + p1) * 0.5 + vec3(0.0, 0.0, 1e-6)));
+    float sideLength = length(side);
+    side = sideLength > 1e-6 ? side / sideLength : vec3(1.0, 0.0, 0.0);
+    vec3 p = (c.x < 0.0 ? p0 - dir * halfWidth : p1 + dir * halfWidth) + side * c.y * halfWidth;
+    halfLength = halfWidth > 0.0 ? 0.5 * len / halfWidth : 0.0;
+    gl_Position = projection * vec4(p, 1.0);
+}
+)";
+
+const char* kQuadFragment = R"(#version 450 core
+in vec4 colour;
+in vec2 uv;
+in float seed;
+in float halfLength;
+uniform int kind;   // 1: sprite, 2: streak
+uniform int shape;  // core::Shape: soft, disc, ring, star, smoke
+out vec4 fragment;
+
+float hash(vec2 p) { return fract(sin(dot(p, vec2(127.1, 311.7))) * 43758.5453); }
+float noise(vec2 p) {
+    vec2 i = floor(p), f = fract(p);
+    vec2 u = f * f * (3.0 - 2.0 * f);
+    return mix(mix(hash(i), hash(i + vec2(1, 0)), u.x), mix(hash(i + vec2(0, 1)), hash(i + vec2(1, 1)), u.x), u.y);
+}
+float fbm(vec2 p) {
+    float sum = 0.0, amplitude = 0.5;
+    for (int octave = 0; octave < 4; ++octave) {
+        sum += amplitude * noise(p);
+        p *= 2.03;
+        amplitude *= 0.5;
+    }
+    return sum;
+}
+
+// How much of the colour a fragment of the square shows, 0 … 1, and how hot (> 1 in a
+// flare's or a streak's core: it glows).
+vec2 coverage() {
+    if (kind == 2) {  // a capsule: the distance to the segment, in half widths
+        float along = uv.x * (halfLength + 1.0);
+        float d = length(vec2(max(abs(along) - halfLength, 0.0), uv.y));
+        return vec2(1.0 - smoothstep(0.35, 1.0, d), 1.0 + 1.5 * (1.0 - smoothstep(0.0, 0.45, d)));
+    }
+    float radius = length(uv);
+    if (radius > 1.0) return vec2(0.0);
+    if (shape == 0) return vec2(pow(1.0 - radius * radius, 2.0), 1.0);            // soft
+    if (shape == 1) return vec2(1.0 - smoothstep(0.88, 1.0, radius), 1.0);       // disc
+    if (shape == 2) return vec2(1.0 - smoothstep(0.05, 0.2, abs(radius - 0.75)), 1.0);  // ring
+    if (shape == 3) {                                                               // star
+        float core = exp(-radius * radius * 14.0);
+        float rays = exp(-abs(uv.x) * 18.0) * (1.0 - abs(uv.y)) + exp(-abs(uv.y) * 18.0) * (1.0 - abs(uv.x));
+        float glow = (1.0 - radius) * 0.25;
+        return vec2(clamp(core + rays + glow, 0.0, 1.0), 1.0 + 2.0 * core);
+    }
+    float puff = fbm(uv * 2.2 + vec2(seed * 7.31, seed * 3.17));                   // smoke
+    return vec2(smoothstep(0.25, 0.75, puff) * (1.0 - smoothstep(0.35, 1.0, radius)), 1.0);
+}
+
+void main() {
+    vec2 c = coverage();
+    if (c.x <= 0.002) discard;
+    fragment = vec4(colour.rgb * c.y, colour.a * c.x);
+}
+)";
+
+std::string withAttributes(const char* body) { return std::string("#version 450 core\n") + kAttributes + body; }
+
+}  // namespace
+
+ParticleRenderer::ParticleRenderer() {
+    points_ = linkProgram(withAttributes(kPointVertex).c_str(), codegen_glsl::drawFragmentShader().c_str());
+    quads_ = linkProgram(withAttributes(kQuadVertex).c_str(), kQuadFragment);
+    glCreateVertexArrays(1, &vao_);
+    glCreateBuffers(kColumns, buffers_);
+    for (GLuint i = 0; i < kColumns; ++i) {
+        glVertexArrayVertexBuffer(vao_, i, buffers_[i], 0, sizeof(float));
+        glVertexArrayAttribFormat(vao_, i, 1, GL_FLOAT, GL_FALSE, 0);
+        glVertexArrayAttribBinding(vao_, i, i);
+        glEnableVertexArrayAttrib(vao_, i);
+    }
+}
+
+ParticleRenderer::~ParticleRenderer() {
+    glDeleteBuffers(kColumns, buffers_);
+    glDeleteVertexArrays(1, &vao_);
+    glDeleteProgram(points_);
+    glDeleteProgram(quads_);
+}
+
+// Binds every column as an attribute: a GL buffer where the backend computes in GL, else
+// uploaded from the host (in back-to-front order for an alpha-blended sprite or streak
+// type). Returns false when nothing is to be drawn.
+bool ParticleRenderer::bind(const rt::DrawColumns& c, const rt::Memory& memory, const DrawStyle& style,
+                            const glm::mat4& view) {
+    std::array<rt::Buffer, kColumns> columns;
+    columns[0] = c.visible;
+    const auto values = c.values();
+    std::copy(values.begin(), values.end(), columns.begin() + 1);
+    // Back to front: where the positions are on the host, each frame.
+    sorted_ = 0;
+    order_.clear();
+    bool sort = style.blend == core::Blend::Alpha && style.kind != core::DrawKind::Point;
+    for (int i = 1; i <= 3 && sort; ++i) sort = !columns[static_cast<size_t>(i)].valid() || memory.view(columns[static_cast<size_t>(i)]);
+    if (sort) {
+        const float* p[3];
+        for (int i = 0; i < 3; ++i)
+            p[i] = columns[static_cast<size_t>(i + 1)].valid() ? static_cast<const float*>(memory.view(columns[static_cast<size_t>(i + 1)]))
+                                                                : nullptr;
+        depth_.resize(c.rows);
+        for (size_t row = 0; row < c.rows; ++row) {
+            glm::vec4 at{p[0] ? p[0][row] : c.constant[0], p[1] ? p[1][row] : c.constant[1], p[2] ? p[2][row] : c.constant[2], 1};
+            depth_[row] = (view * at).z;  // more negative: farther
+        }
+        order_.resize(c.rows);
+        std::iota(order_.begin(), order_.end(), 0u);
+        std::stable_sort(order_.begin(), order_.end(), [&](uint32_t a, uint32_t b) { return depth_[a] < depth_[b]; });
+        sorted_ = c.rows;
+    }
+    for (int i = 0; i < kColumns; ++i) {
+        auto column = columns[static_cast<size_t>(i)];
+        auto attribute = static_cast<GLuint>(i);
+        // A component every row draws alike has no column: a constant attribute.
+        if (!column.valid()) {
+            glDisableVertexArrayAttrib(vao_, attribute);
+            glVertexAttrib1f(attribute, i == 0 ? 1.0f : c.constant[static_cast<size_t>(i - 1)]);
+            continue;
+        }
+        glEnableVertexArrayAttrib(vao_, attribute);
+        if (unsigned gl = memory.glBuffer(column); gl && order_.empty()) {
+            glVertexArrayVertexBuffer(vao_, attribute, gl, 0, sizeof(float));
+            continue;
+        }
+        glVertexArrayVertexBuffer(vao_, attribute, buffers_[i], 0, sizeof(float));
+        const auto* data = static_cast<const float*>(memory.view(column));
+        if (!data || !order_.empty()) {
+            staging_.resize(c.rows);
+            if (!data) memory.read(column, 0, c.rows, staging_.data());
+            else
+                for (size_t row = 0; row < c.rows; ++row) staging_[row] = data[order_[row]];
+            data = staging_.data();
+        }
+        auto bytes = static_cast<GLsizeiptr>(c.rows * sizeof(float));
+        if (c.rows > capacity_[i]) {
+            glNamedBufferData(buffers_[i], bytes, data, GL_STREAM_DRAW);
+            capacity_[i] = c.rows;
+        } else {
+            glNamedBufferSubData(buffers_[i], 0, bytes, data);
+        }
+    }
+    return true;
+}
+
+void ParticleRenderer::draw(const rt::DrawColumns& c, const rt::Memory& memory, const DrawStyle& style,
+                            const glm::mat4& view, const glm::mat4& projection, float viewportHeight) {
+    if (c.rows == 0 || (c.counted && c.drawn == 0)) return;
+    if (!bind(c, memory, style, view)) return;
+    bool points = style.kind == core::DrawKind::Point;
+    GLuint program = points ? points_ : quads_;
+    glUseProgram(program);
+    glUniformMatrix4fv(glGetUniformLocation(program, "view"), 1, GL_FALSE, glm::value_ptr(view));
+    glUniformMatrix4fv(glGetUniformLocation(program, "projection"), 1, GL_FALSE, glm::value_ptr(projection));
+    if (points) {
+        glUniform1f(glGetUniformLocation(program, "reference"), kReferenceDistance * viewportHeight / 720.0f);
+    } else {
+        glUniform1i(glGetUniformLocation(program, "kind"), style.kind == core::DrawKind::Sprite ? 1 : 2);
+        glUniform1i(glGetUniformLocation(program, "shape"), static_cast<int>(style.shape));
+    }
+    // Points are vertices; a sprite's or streak's row is an instance of six.
+    for (GLuint i = 0; i < kColumns; ++i) glVertexArrayBindingDivisor(vao_, i, points ? 0 : 1);
+    glEnable(GL_PROGRAM_POINT_SIZE);
+    glEnable(GL_BLEND);
+    if (style.blend == core::Blend::Add) glBlendFunc(GL_SRC_ALPHA, GL_ONE);
+    else glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    glEnable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);  // particles blend over each other; the ground still hides what is below it
+    glBindVertexArray(vao_);
+    if (points) glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(c.rows));
+    else glDrawArraysInstanced(GL_TRIANGLES, 0, 6, static_cast<GLsizei>(c.rows));
+    glBindVertexArray(0);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+}
+
+}  // namespace psys::viewer

@@ -1,0 +1,60 @@
+// Drawing a type's objects as its render command says (core/draw.h): points, sprites or
+// streaks, straight from the run-time's draw columns (rt::DrawColumns: bound where they
+// live in GL, else uploaded column by column — never a per-point structure).
+//
+//   point   a round, soft-rimmed dot `size` pixels across at the reference distance
+//   sprite  a camera-facing square `size` world units across, turned by `rotation`, its
+//           shape computed in the fragment shader (@shape: soft, disc, ring, star, smoke;
+//           `frame` picks the smoke's noise)
+//   streak  a band `size` world units wide from `position` to `end`, round-capped, with a
+//           hot core
+//
+// Blending is the type's (@blend; the viewer's B switch for types that name none): added,
+// or alpha-blended over what is behind; alpha-blended types whose columns are on the host
+// are drawn back to front (their rows sorted by depth each frame).
+#pragma once
+
+#include <epoxy/gl.h>
+
+#include <glm/glm.hpp>
+#include <vector>
+
+#include "core/draw.h"
+#include "rt/memory.h"
+#include "rt/system.h"
+
+namespace psys::viewer {
+
+// A point's `size` is its diameter in pixels seen from this distance (on a 720-pixel-high
+// view; scaled with the view's height).
+constexpr float kReferenceDistance = 20;
+
+struct DrawStyle {
+    core::DrawKind kind = core::DrawKind::Point;
+    core::Shape shape = core::Shape::Soft;
+    core::Blend blend = core::Blend::Add;
+};
+
+class ParticleRenderer {
+public:
+    ParticleRenderer();
+    ~ParticleRenderer();
+    ParticleRenderer(const ParticleRenderer&) = delete;
+    ParticleRenderer& operator=(const ParticleRenderer&) = delete;
+    void draw(const rt::DrawColumns& columns, const rt::Memory& memory, const DrawStyle& style, const glm::mat4& view,
+              const glm::mat4& projection, float viewportHeight);
+    // How many rows the last draw sorted back to front (0: not sorted).
+    size_t sortedRows() const { return sorted_; }
+
+private:
+    static constexpr int kColumns = 1 + rt::DrawColumns::kValues;  // visible, then the values in render order
+    bool bind(const rt::DrawColumns& c, const rt::Memory& memory, const DrawStyle& style, const glm::mat4& view);
+    GLuint points_ = 0, quads_ = 0, vao_ = 0, buffers_[kColumns] = {};
+    size_t capacity_[kColumns] = {};
+    std::vector<float> staging_;
+    std::vector<uint32_t> order_;
+    std::vector<float> depth_;
+    size_t sorted_ = 0;
+};
+
+}  // namespace psys::viewer
