@@ -29,7 +29,7 @@ TEST_CASE("a script is checked whole when it is read, each bad line named FILE:L
     CHECK(problem("2 orbit 10abc 5\n") == "s.script:1: `orbit` takes finite numbers, not `10abc`");
     CHECK(problem("2 zoom nan\n") == "s.script:1: `zoom` takes finite numbers, not `nan`");
     CHECK(problem("2 pan inf 0\n") == "s.script:1: `pan` takes finite numbers, not `inf`");
-    CHECK(problem("2 key FOO\n") == "s.script:1: unknown key `FOO` (F R B G H SPACE S T = - 1…9 P V F1 ? Q ESC)");
+    CHECK(problem("2 key FOO\n") == "s.script:1: unknown key `FOO` (F R B G L H SPACE S T = - 1…9 P V F1 ? Q ESC)");
     CHECK(problem("2 screenshot x.gif\n") ==
           "s.script:1: cannot write `x.gif`: an unknown image format `.gif` (it writes png, jpg, bmp or tga)");
     CHECK(problem("2 set =3\n").rfind("s.script:1: ", 0) == 0);
