@@ -58,7 +58,8 @@ void main() {
 )";
 
 // The scene plus its glow, tone mapped: unchanged up to 0.8, then compressed towards 1 (a
-// colour of 1 shows as 0.93); without the glow, clipped at 1 (the look of an 8-bit target).
+// colour of 1 shows as 0.93), hue kept; without the glow, clipped at 1 (the look of an
+// 8-bit target).
 const char* kComposite = R"(#version 450 core
 in vec2 uv;
 uniform sampler2D scene;
@@ -66,10 +67,14 @@ uniform sampler2D glow;
 uniform float strength;
 uniform int toneMapped;
 out vec4 fragment;
+// The brightest channel m is mapped (unchanged up to 0.8, then towards 1) and the colour
+// scaled with it: its hue is kept where clipping each channel would turn it yellow or white.
 vec3 toneMap(vec3 c) {
     const float k = 0.8;
-    vec3 over = max(c - k, 0.0);
-    return min(c, vec3(k)) + (1.0 - k) * (1.0 - exp(-over / (1.0 - k)));
+    float m = max(c.r, max(c.g, c.b));
+    if (m <= k) return c;
+    float mapped = k + (1.0 - k) * (1.0 - exp(-(m - k) / (1.0 - k)));
+    return c * (mapped / m);
 }
 void main() {
     vec3 c = texture(scene, uv).rgb + strength * texture(glow, uv).rgb;

@@ -1,8 +1,9 @@
 // HDR drawing and glow: the scene is drawn into a half-float target, so additive light may
 // add up past 1 instead of clipping to white; its bright part is blurred over a chain of
 // ever smaller targets and added back (a bloom), and the sum is tone mapped into the
-// surface: identical below 0.8, then compressed towards 1 per channel, so a hot orange
-// spark stays orange-yellow where it would have clipped to white. With the glow off, the
+// surface: identical below 0.8, then the brightest channel compressed towards 1 and the
+// others with it, so a hot orange spark stays orange where clipping each channel would
+// have turned it yellow or white. With the glow off, the
 // light is clipped at 1 instead (what an 8-bit target shows: colours exactly as given).
 #pragma once
 
