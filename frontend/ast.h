@@ -176,6 +176,8 @@ struct Attribute {
     std::string name;
     SourceRange range;  // the whole attribute
     SourceRange nameRange;
+    std::optional<std::string> text;  // a file name before the arguments (`@texture("a.png", 2, 2)`), unquoted
+    SourceRange textRange;
     std::vector<ExprPtr> args;
     std::optional<ConstValue> value;  // set by the checker: its constant argument (@step, @capacity)
     // @capacity's count, exact: a number as written is read as a double (4294967295 is not

@@ -77,6 +77,9 @@ constexpr BuiltinAttribute kAttributes[] = {
     {"step", "@step(seconds)", "a fixed sub-step: updates run in steps of at most this many seconds"},
     {"capacity", "@capacity(count)", "the most objects of this type alive at once; emissions beyond it are dropped"},
     {"shape", "@shape(soft|disc|ring|star|smoke)", "a sprite's shape (soft, the default: a disc with a soft edge)"},
+    {"texture", "@texture(\"file.png\"[, columns, rows])",
+     "a sprite's image (PNG, next to the program), or a flip-book of columns × rows frames that `frame` picks; "
+     "it takes the place of @shape"},
     {"blend", "@blend(add|alpha)", "how the type's colours combine with what is behind: added (light, the default) or "
                                    "alpha-blended over it (smoke, dust; drawn back to front)"},
 };

@@ -6,6 +6,7 @@
 // back), then check once more with diagnostics on. A recursive equation whose width
 // nothing fixes defaults to float.
 #include <cmath>
+#include <filesystem>
 #include <span>
 
 #include <fmt/format.h>
@@ -346,6 +347,10 @@ void Checker::checkAttributes(const std::vector<Attribute*>& attributes) {
             continue;
         }
         seen[a.name] = a.range;
+        if (a.text && a.name != "texture") {
+            diags_.error(a.textRange, fmt::format("`@{}` takes no file name", a.name));
+            continue;
+        }
         auto wantOneArg = [&](const char* what) {
             if (a.args.size() == 1) return true;
             diags_.error(a.range, fmt::format("`@{}` takes one argument: {}", a.name, what));
@@ -387,6 +392,8 @@ void Checker::checkAttributes(const std::vector<Attribute*>& attributes) {
                 diags_.error(a.args[0]->range, "the capacity must be a constant whole number from 1 to 4294967295");
             a.value = v;
             a.whole = n;
+        } else if (a.name == "texture") {
+            checkTexture(a, ctx);
         } else if (a.name == "shape" || a.name == "blend") {
             bool shape = a.name == "shape";
             std::string names;
@@ -407,6 +414,37 @@ void Checker::checkAttributes(const std::vector<Attribute*>& attributes) {
     }
 }
 
+// `@texture("file.png"[, columns, rows])`: a file next to the program (a warning where
+// there is none: the system runs, the viewer draws the shape), and a flip-book's grid of
+// frames (constant whole numbers).
+void Checker::checkTexture(Attribute& a, const Context& ctx) {
+    if (!a.text) {
+        diags_.error(a.range, "`@texture` takes a file name first: @texture(\"file.png\"[, columns, rows])");
+        return;
+    }
+    if (a.args.size() != 0 && a.args.size() != 2) {
+        diags_.error(a.range, "`@texture` takes a file name, then the flip-book's columns and rows (both or neither)");
+        return;
+    }
+    ConstValue grid{Type::vec(2), {1, 1, 0, 0}};  // columns, rows: for the lowering
+    for (size_t i = 0; i < a.args.size(); ++i) {
+        Expr& arg = *a.args[i];
+        check(arg, ctx);
+        if (!expectType(arg, Type::scalar(), "a flip-book's columns and rows")) continue;
+        auto v = evaluateConstant(arg);
+        if (!v || !(v->v[0] >= 1 && v->v[0] <= 64) || v->v[0] != std::floor(v->v[0]))
+            diags_.error(arg.range, "a flip-book's columns and rows must be constant whole numbers from 1 to 64");
+        else
+            grid.v[i] = v->v[0];
+    }
+    a.value = grid;
+    std::filesystem::path file = besideSource(diags_.sources(), a.textRange, *a.text);
+    std::error_code error;
+    if (!std::filesystem::is_regular_file(file, error))
+        diags_.warning(a.textRange, fmt::format("there is no texture file `{}` (looked for {}): the sprites are drawn "
+                                                "with their shape", *a.text, file.string()));
+}
+
 void Checker::checkObject(ObjectDecl& object) {
     std::vector<Attribute*> attributes;
     for (auto& a : object.attributes) attributes.push_back(&a);
@@ -419,13 +457,21 @@ void Checker::checkObject(ObjectDecl& object) {
     ctx.object = &object;
     const Command* point = nullptr;
     checkCommands(object.commands, ctx, &point);
-    for (const Attribute& a : object.attributes)
-        if (a.name == "shape" && !(point && point->draw == core::DrawKind::Sprite))
-            diags_.error(a.nameRange, fmt::format("`@shape` is a sprite's: object `{}` {}", object.name,
+    const Attribute* shape = nullptr;
+    for (const Attribute& a : object.attributes) {
+        if (a.name == "texture" && shape) {
+            diags_.error(a.nameRange, "`@texture` takes the place of `@shape`: give one of them")
+                .notes.push_back({shape->nameRange, "`@shape` is here"});
+            continue;
+        }
+        if (a.name == "shape" || a.name == "texture") shape = &a;
+        if ((a.name == "shape" || a.name == "texture") && !(point && point->draw == core::DrawKind::Sprite))
+            diags_.error(a.nameRange, fmt::format("`@{}` is a sprite's: object `{}` {}", a.name, object.name,
                                                   point ? fmt::format("draws with `{}`", core::drawKindName(point->draw))
                                                         : std::string("draws nothing")))
                 .notes.push_back({point ? point->keywordRange : object.nameRange,
                                   point ? "draw it with `sprite(position, colour, size)`" : "the object"});
+    }
     // Parents before children: a child reads its parent's equations, whose types are now known.
     for (auto& child : object.children) checkObject(*child);
 }

@@ -34,6 +34,7 @@ struct Diagnostic {
 class DiagnosticEngine {
 public:
     explicit DiagnosticEngine(const SourceManager& sources) : sources_(sources) {}
+    const SourceManager& sources() const { return sources_; }
 
     // Returns the diagnostic so a caller can attach notes.
     Diagnostic& error(SourceRange range, std::string message);

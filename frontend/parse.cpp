@@ -155,6 +155,10 @@ private:
         a.name = ctx->IDENT()->getText();
         a.range = range(ctx);
         a.nameRange = range(ctx->IDENT());
+        if (ctx->STRING()) {
+            a.text = unquote(ctx->STRING()->getText());
+            a.textRange = range(ctx->STRING());
+        }
         for (auto* e : ctx->expr()) a.args.push_back(expr(e));
         return a;
     }

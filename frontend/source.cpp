@@ -64,4 +64,9 @@ int SourceManager::add(std::string displayPath, std::string text) {
     return count() - 1;
 }
 
+std::filesystem::path besideSource(const SourceManager& sources, SourceRange where, const std::string& name) {
+    std::filesystem::path dir = where.valid() ? std::filesystem::path(sources.file(where.file).path()).parent_path() : "";
+    return (dir / name).lexically_normal();
+}
+
 }  // namespace psys

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -60,5 +61,9 @@ public:
 private:
     std::vector<std::unique_ptr<SourceFile>> files_;
 };
+
+// A file a program names (`@texture("flame.png")`), found beside the program that names
+// it, as an import is: relative to the directory of the file `where` is in.
+std::filesystem::path besideSource(const SourceManager& sources, SourceRange where, const std::string& name);
 
 }  // namespace psys

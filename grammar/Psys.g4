@@ -24,7 +24,8 @@ importDecl  : 'import' STRING ';' ;
 // `@integrator(rk4);` at file level applies to every object of the file.
 fileAttribute : attribute ';' ;
 
-attribute   : '@' IDENT ( '(' ( expr ( ',' expr )* )? ')' )? ;
+// `@texture("flame.png", 4, 4)`: a file name may come first.
+attribute   : '@' IDENT ( '(' ( ( STRING | expr ) ( ',' expr )* )? ')' )? ;
 
 constDecl   : 'const' IDENT ( ':' typeRef )? '=' expr ';' ;
 

@@ -298,6 +298,10 @@ struct Attributes {
     std::optional<uint64_t> capacity;      // @capacity: most objects alive at once
     std::optional<core::Shape> shape;      // @shape: a sprite's (none: soft)
     std::optional<core::Blend> blend;      // @blend (none: core::defaultBlend)
+    // @texture: a sprite's image, the file's path as the program's directory resolves it
+    // (empty: none), cut into columns × rows frames (a flip-book)
+    std::string texture;
+    int textureColumns = 1, textureRows = 1;
     bool operator==(const Attributes&) const = default;
 };
 

@@ -204,6 +204,14 @@ private:
     }
 
     static void attribute(Attributes& a, const std::vector<std::string>& w) {
+        if (w.size() >= 5 && w[1] == "texture") {  // attribute texture COLUMNS ROWS PATH…
+            a.textureColumns = integer(w[2]);
+            a.textureRows = integer(w[3]);
+            if (a.textureColumns < 1 || a.textureRows < 1) throw ParseError("a texture has at least one column and row");
+            a.texture = w[4];
+            for (size_t i = 5; i < w.size(); ++i) a.texture += " " + w[i];
+            return;
+        }
         if (w.size() != 3) throw ParseError("expected `attribute name value`");
         if (w[1] == "integrator") {
             a.integrator = core::integratorFromName(w[2]);

@@ -140,6 +140,8 @@ std::string print(const Object& o, PrintOptions options) {
     if (a.capacity) out += fmt::format("  attribute capacity {}\n", *a.capacity);
     if (a.shape) out += fmt::format("  attribute shape {}\n", core::shapeName(*a.shape));
     if (a.blend) out += fmt::format("  attribute blend {}\n", core::blendName(*a.blend));
+    if (!a.texture.empty())  // (the path last: it may hold spaces)
+        out += fmt::format("  attribute texture {} {} {}\n", a.textureColumns, a.textureRows, a.texture);
     if (o.draw != core::DrawKind::Point) out += fmt::format("  draw {}\n", core::drawKindName(o.draw));
     for (auto& s : o.state)
         out += fmt::format("  state {}: {} {}\n", s.name, s.type.str(), s.init == StateInit::Zero ? "zero" : "next");

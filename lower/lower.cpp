@@ -168,6 +168,14 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
     };
     // Attributes: the file's, then each enclosing object's, then the object's own.
     auto apply = [&](const ast::Attribute& a, Attributes& attributes) {
+        if (a.name == "texture" && a.text) {
+            attributes.texture = besideSource(sources, a.textRange, *a.text).string();
+            if (a.value) {  // the checker's columns and rows
+                attributes.textureColumns = static_cast<int>(a.value->v[0]);
+                attributes.textureRows = static_cast<int>(a.value->v[1]);
+            }
+            return;
+        }
         if (a.args.empty()) return;
         if (a.name == "integrator" && a.args[0]->kind == ExprKind::Name) {
             attributes.integrator = core::integratorFromName(static_cast<const NameExpr&>(*a.args[0]).name);

@@ -13,6 +13,7 @@
 #include <map>
 
 #include <fmt/format.h>
+#include <stb_image_write.h>
 
 #include "viewer.h"
 
@@ -63,7 +64,7 @@ Frame render(const std::string& text, int frames, Blend blend, const std::functi
     options.session.backend.name = backend;
     if (configure) configure(options);
     host::CompileResult compiled;
-    auto session = host::Session::open("test.psys", options.session, compiled, error, &text);
+    auto session = host::Session::open(options.file, options.session, compiled, error, &text);
     REQUIRE_MESSAGE(session, compiled.text(), error);
     Viewer viewer(options, *surface, std::move(session), compiled);
     if (setup) setup(viewer);
@@ -221,6 +222,7 @@ TEST_CASE("every sample is drawn: frame 600, fitted, lights its share of the fra
     // nothing blank, nothing lost off screen.
     const std::map<std::string, double> least = {
         {"bouncing", 0.04},     {"campfire", 0.02},  {"comet", 0.1},      {"composite_bounce", 0.002},
+        {"confetti", 0.01},
         {"emitter", 0.01},      {"fire", 0.02},      {"fireworks", 0.004}, {"first_particle", 0.02},
         {"follow_parent", 0.004}, {"fountain", 0.004}, {"galaxy", 0.01},   {"grinder", 0.004},
         {"rain", 0.002},        {"random", 0.02},    {"smoke", 0.05},     {"swamp", 0.002},
@@ -233,6 +235,7 @@ TEST_CASE("every sample is drawn: frame 600, fitted, lights its share of the fra
         REQUIRE_MESSAGE(least.count(name), "a new sample needs its share in this table");
         std::string text = readText(entry.path().string());
         auto configure = [&](ViewerOptions& o) {
+            o.file = entry.path().string();  // (its textures are beside it)
             o.fit = true;
             o.glow.on = true;
             std::string script = std::string(PSYS_DOCS_DIR) + "/gallery/" + name + ".script";
@@ -346,4 +349,27 @@ TEST_CASE("alpha-blended sprites are drawn back to front, whatever their rows' o
     Pixel middle = f.at(kWidth / 2, kHeight / 2);
     CHECK(middle.b > 200);
     CHECK(middle.r < 40);
+}
+
+TEST_CASE("a textured sprite draws its flip-book's frame, tinted by its colour") {
+    // A 2 × 2 flip-book of 2 × 2-pixel frames: red, green (top row), blue, white.
+    const uint8_t R[4] = {255, 0, 0, 255}, G[4] = {0, 255, 0, 255}, B[4] = {0, 0, 255, 255}, W[4] = {255, 255, 255, 255};
+    const uint8_t* layout[4][4] = {{R, R, G, G}, {R, R, G, G}, {B, B, W, W}, {B, B, W, W}};
+    std::vector<uint8_t> image;
+    for (auto& row : layout)
+        for (const uint8_t* p : row) image.insert(image.end(), p, p + 4);
+    std::filesystem::path file = std::filesystem::temp_directory_path() / "psys_viewer_test_atlas.png";
+    REQUIRE(stbi_write_png(file.string().c_str(), 4, 4, 4, image.data(), 16));
+    const Pixel expected[4] = {{255, 0, 0}, {0, 255, 0}, {0, 0, 255}, {255, 255, 255}};
+    for (int frame = 0; frame < 6; ++frame) {
+        INFO("frame " << frame);
+        std::string text = fmt::format("@texture(\"{}\", 2, 2) @blend(alpha) object s {{ sprite(vec3(0, 2, 0), {}, 2, 0, {}); }}\nspawn s;",
+                                       file.string(), frame == 5 ? "vec4(1, 0.5, 0.5, 1)" : "white", frame);
+        Pixel middle = render(text, 1, Blend::Additive).at(kWidth / 2, kHeight / 2);
+        Pixel want = expected[frame % 4];  // (frames wrap)
+        if (frame == 5) want = {0, 128, 0};  // green, tinted
+        CHECK(std::abs(middle.r - want.r) <= 2);
+        CHECK(std::abs(middle.g - want.g) <= 2);
+        CHECK(std::abs(middle.b - want.b) <= 2);
+    }
 }

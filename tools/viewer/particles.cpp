@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <numeric>
+#include <utility>
+
+#include <fmt/format.h>
+#include <stb_image.h>
 
 #include <glm/gtc/type_ptr.hpp>
 
@@ -100,6 +104,9 @@ in float seed;
 in float halfLength;
 uniform int kind;   // 1: sprite, 2: streak
 uniform int shape;  // core::Shape: soft, disc, ring, star, smoke
+uniform int textured;    // 1: the image's texel, tinted, in place of the shape
+uniform ivec2 tiles;     // the flip-book's columns and rows
+uniform sampler2D image;
 out vec4 fragment;
 
 float hash(vec2 p) { return fract(sin(dot(p, vec2(127.1, 311.7))) * 43758.5453); }
@@ -141,7 +148,23 @@ vec2 coverage() {
     return vec2(smoothstep(0.25, 0.75, puff) * (1.0 - smoothstep(0.35, 1.0, radius)), 1.0);
 }
 
+// The flip-book's frame `seed` (row by row from the top left, wrapping), at the square's
+// point uv; the image's first row is its top.
+vec4 texel() {
+    int frames = tiles.x * tiles.y;
+    int i = int(mod(floor(seed), float(frames)));
+    vec2 local = uv * 0.5 + 0.5;
+    vec2 at = vec2((float(i % tiles.x) + local.x) / float(tiles.x), (float(i / tiles.x) + 1.0 - local.y) / float(tiles.y));
+    return texture(image, at);
+}
+
 void main() {
+    if (kind == 1 && textured == 1) {
+        vec4 t = texel();
+        if (t.a <= 0.002) discard;
+        fragment = vec4(colour.rgb * t.rgb, colour.a * t.a);
+        return;
+    }
     vec2 c = coverage();
     if (c.x <= 0.002) discard;
     fragment = vec4(colour.rgb * c.y, colour.a * c.x);
@@ -166,11 +189,37 @@ ParticleRenderer::ParticleRenderer() {
 }
 
 ParticleRenderer::~ParticleRenderer() {
+    for (auto& [path, t] : textures_)
+        if (t) glDeleteTextures(1, &t);
     glDeleteBuffers(kColumns, buffers_);
     glDeleteVertexArrays(1, &vao_);
     glDeleteProgram(points_);
     glDeleteProgram(quads_);
 }
+
+GLuint ParticleRenderer::texture(const std::string& path) {
+    if (auto it = textures_.find(path); it != textures_.end()) return it->second;
+    int width = 0, height = 0, channels = 0;
+    unsigned char* pixels = stbi_load(path.c_str(), &width, &height, &channels, 4);
+    GLuint t = 0;
+    if (!pixels) {
+        problems_ += fmt::format("cannot load the texture {}: {}; drawn with its shape\n", path, stbi_failure_reason());
+    } else {
+        glCreateTextures(GL_TEXTURE_2D, 1, &t);
+        glTextureStorage2D(t, 1, GL_RGBA8, width, height);
+        glTextureSubImage2D(t, 0, 0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, pixels);
+        // Linear within a frame; clamped, so a frame's edge does not take its neighbour's.
+        glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTextureParameteri(t, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTextureParameteri(t, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        stbi_image_free(pixels);
+    }
+    textures_[path] = t;
+    return t;
+}
+
+std::string ParticleRenderer::takeProblems() { return std::exchange(problems_, {}); }
 
 // Binds every column as an attribute: a GL buffer where the backend computes in GL, else
 // uploaded from the host (in back-to-front order for an alpha-blended sprite or streak
@@ -249,6 +298,11 @@ void ParticleRenderer::draw(const rt::DrawColumns& c, const rt::Memory& memory, 
     } else {
         glUniform1i(glGetUniformLocation(program, "kind"), style.kind == core::DrawKind::Sprite ? 1 : 2);
         glUniform1i(glGetUniformLocation(program, "shape"), static_cast<int>(style.shape));
+        GLuint image = style.texture.empty() ? 0 : texture(style.texture);
+        glUniform1i(glGetUniformLocation(program, "textured"), image ? 1 : 0);
+        glUniform2i(glGetUniformLocation(program, "tiles"), std::max(style.columns, 1), std::max(style.rows, 1));
+        glUniform1i(glGetUniformLocation(program, "image"), 0);
+        glBindTextureUnit(0, image);
     }
     // Points are vertices; a sprite's or streak's row is an instance of six.
     for (GLuint i = 0; i < kColumns; ++i) glVertexArrayBindingDivisor(vao_, i, points ? 0 : 1);

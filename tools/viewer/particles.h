@@ -5,7 +5,8 @@
 //   point   a round, soft-rimmed dot `size` pixels across at the reference distance
 //   sprite  a camera-facing square `size` world units across, turned by `rotation`, its
 //           shape computed in the fragment shader (@shape: soft, disc, ring, star, smoke;
-//           `frame` picks the smoke's noise)
+//           `frame` picks the smoke's noise) or an image (@texture, a PNG; a flip-book
+//           of columns × rows frames, `frame` picking one), tinted by the colour
 //   streak  a band `size` world units wide from `position` to `end`, round-capped, with a
 //           hot core
 //
@@ -17,6 +18,8 @@
 #include <epoxy/gl.h>
 
 #include <glm/glm.hpp>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "core/draw.h"
@@ -33,6 +36,8 @@ struct DrawStyle {
     core::DrawKind kind = core::DrawKind::Point;
     core::Shape shape = core::Shape::Soft;
     core::Blend blend = core::Blend::Add;
+    std::string texture;  // a sprite's image (@texture), in place of the shape; empty: none
+    int columns = 1, rows = 1;  // its flip-book's frames: `frame` picks one (row by row, from the top left)
 };
 
 class ParticleRenderer {
@@ -45,10 +50,16 @@ public:
               const glm::mat4& projection, float viewportHeight);
     // How many rows the last draw sorted back to front (0: not sorted).
     size_t sortedRows() const { return sorted_; }
+    // Why a texture could not be loaded (its type is drawn with its shape instead), once
+    // per file; empty when every texture loaded.
+    std::string takeProblems();
 
 private:
     static constexpr int kColumns = 1 + rt::DrawColumns::kValues;  // visible, then the values in render order
     bool bind(const rt::DrawColumns& c, const rt::Memory& memory, const DrawStyle& style, const glm::mat4& view);
+    GLuint texture(const std::string& path);  // loaded once (0: it could not be)
+    std::map<std::string, GLuint> textures_;
+    std::string problems_;
     GLuint points_ = 0, quads_ = 0, vao_ = 0, buffers_[kColumns] = {};
     size_t capacity_[kColumns] = {};
     std::vector<float> staging_;

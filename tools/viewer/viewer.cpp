@@ -1,6 +1,7 @@
 #include "viewer.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -239,13 +240,19 @@ void Viewer::draw() {
     for (core::Blend pass : {core::Blend::Alpha, core::Blend::Add})
         for (size_t t = 0; t < system.typeCount(); ++t) {
             const ir::Object& o = system.module().objects[t];
-            DrawStyle style{o.draw, o.attributes.shape.value_or(core::Shape::Soft),
-                            o.attributes.blend.value_or(options_.blend == Blend::Alpha ? core::Blend::Alpha : core::Blend::Add)};
+            DrawStyle style{o.draw,
+                            o.attributes.shape.value_or(core::Shape::Soft),
+                            o.attributes.blend.value_or(options_.blend == Blend::Alpha ? core::Blend::Alpha : core::Blend::Add),
+                            o.attributes.texture,
+                            o.attributes.textureColumns,
+                            o.attributes.textureRows};
             if (style.blend == pass && shows(o.name))
                 particles_->draw(system.draw(t), system.backend().memory(), style, view, projection,
                                  static_cast<float>(surface_.height()));
         }
     glow_->finish(static_cast<GLuint>(target), options_.glow);
+    if (std::string problems = particles_->takeProblems(); !problems.empty())
+        std::fprintf(stderr, "psys-view: %s", problems.c_str());
     stats_.glSeconds = secondsBetween(start, Clock::now());
 }
 
