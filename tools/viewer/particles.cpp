@@ -178,6 +178,7 @@ std::string withAttributes(const char* body) { return std::string("#version 450 
 ParticleRenderer::ParticleRenderer() {
     points_ = linkProgram(withAttributes(kPointVertex).c_str(), codegen_glsl::drawFragmentShader().c_str());
     quads_ = linkProgram(withAttributes(kQuadVertex).c_str(), kQuadFragment);
+    sorter_ = std::make_unique<DepthSort>();
     glCreateVertexArrays(1, &vao_);
     glCreateBuffers(kColumns, buffers_);
     for (GLuint i = 0; i < kColumns; ++i) {
@@ -222,20 +223,29 @@ GLuint ParticleRenderer::texture(const std::string& path) {
 std::string ParticleRenderer::takeProblems() { return std::exchange(problems_, {}); }
 
 // Binds every column as an attribute: a GL buffer where the backend computes in GL, else
-// uploaded from the host (in back-to-front order for an alpha-blended sprite or streak
-// type). Returns false when nothing is to be drawn.
+// uploaded from the host. An alpha-blended sprite or streak type goes back to front: on
+// the GPU where its columns are there (DepthSort: nothing read back), else sorted on the
+// host and uploaded in that order.
 bool ParticleRenderer::bind(const rt::DrawColumns& c, const rt::Memory& memory, const DrawStyle& style,
                             const glm::mat4& view) {
     std::array<rt::Buffer, kColumns> columns;
     columns[0] = c.visible;
     const auto values = c.values();
     std::copy(values.begin(), values.end(), columns.begin() + 1);
-    // Back to front: where the positions are on the host, each frame.
+    std::array<GLuint, kColumns> gl{};
+    bool allOnGpu = true;
+    for (size_t i = 0; i < columns.size(); ++i)
+        if (columns[i].valid()) {
+            gl[i] = memory.glBuffer(columns[i]);
+            allOnGpu &= gl[i] != 0;
+        }
     sorted_ = 0;
     order_.clear();
-    bool sort = style.blend == core::Blend::Alpha && style.kind != core::DrawKind::Point;
-    for (int i = 1; i <= 3 && sort; ++i) sort = !columns[static_cast<size_t>(i)].valid() || memory.view(columns[static_cast<size_t>(i)]);
-    if (sort) {
+    bool sort = style.blend == core::Blend::Alpha && style.kind != core::DrawKind::Point && c.rows > 1;
+    if (sort && allOnGpu) {
+        sorter_->order(gl[0], {gl[1], gl[2], gl[3]}, {c.constant[0], c.constant[1], c.constant[2]}, c.rows, view);
+        sorted_ = c.rows;
+    } else if (sort) {
         const float* p[3];
         for (int i = 0; i < 3; ++i)
             p[i] = columns[static_cast<size_t>(i + 1)].valid() ? static_cast<const float*>(memory.view(columns[static_cast<size_t>(i + 1)]))
@@ -250,6 +260,7 @@ bool ParticleRenderer::bind(const rt::DrawColumns& c, const rt::Memory& memory, 
         std::stable_sort(order_.begin(), order_.end(), [&](uint32_t a, uint32_t b) { return depth_[a] < depth_[b]; });
         sorted_ = c.rows;
     }
+    auto bytes = static_cast<GLsizeiptr>(c.rows * sizeof(float));
     for (int i = 0; i < kColumns; ++i) {
         auto column = columns[static_cast<size_t>(i)];
         auto attribute = static_cast<GLuint>(i);
@@ -260,11 +271,19 @@ bool ParticleRenderer::bind(const rt::DrawColumns& c, const rt::Memory& memory, 
             continue;
         }
         glEnableVertexArrayAttrib(vao_, attribute);
-        if (unsigned gl = memory.glBuffer(column); gl && order_.empty()) {
-            glVertexArrayVertexBuffer(vao_, attribute, gl, 0, sizeof(float));
+        if (GLuint buffer = gl[static_cast<size_t>(i)]; buffer && !sorted_) {
+            glVertexArrayVertexBuffer(vao_, attribute, buffer, 0, sizeof(float));
             continue;
         }
         glVertexArrayVertexBuffer(vao_, attribute, buffers_[i], 0, sizeof(float));
+        if (c.rows > capacity_[i]) {
+            glNamedBufferData(buffers_[i], bytes, nullptr, GL_STREAM_DRAW);
+            capacity_[i] = c.rows;
+        }
+        if (sorted_ && allOnGpu) {
+            sorter_->gather(gl[static_cast<size_t>(i)], buffers_[i], c.rows);
+            continue;
+        }
         const auto* data = static_cast<const float*>(memory.view(column));
         if (!data || !order_.empty()) {
             staging_.resize(c.rows);
@@ -273,13 +292,7 @@ bool ParticleRenderer::bind(const rt::DrawColumns& c, const rt::Memory& memory, 
                 for (size_t row = 0; row < c.rows; ++row) staging_[row] = data[order_[row]];
             data = staging_.data();
         }
-        auto bytes = static_cast<GLsizeiptr>(c.rows * sizeof(float));
-        if (c.rows > capacity_[i]) {
-            glNamedBufferData(buffers_[i], bytes, data, GL_STREAM_DRAW);
-            capacity_[i] = c.rows;
-        } else {
-            glNamedBufferSubData(buffers_[i], 0, bytes, data);
-        }
+        glNamedBufferSubData(buffers_[i], 0, bytes, data);
     }
     return true;
 }

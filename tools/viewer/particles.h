@@ -11,18 +11,20 @@
 //           hot core
 //
 // Blending is the type's (@blend; the viewer's B switch for types that name none): added,
-// or alpha-blended over what is behind; alpha-blended types whose columns are on the host
-// are drawn back to front (their rows sorted by depth each frame).
+// or alpha-blended over what is behind, back to front (the rows sorted by depth each
+// frame: on the GPU where the columns are there, depth_sort.h; else on the host).
 #pragma once
 
 #include <epoxy/gl.h>
 
 #include <glm/glm.hpp>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "core/draw.h"
+#include "depth_sort.h"
 #include "rt/memory.h"
 #include "rt/system.h"
 
@@ -58,6 +60,7 @@ private:
     static constexpr int kColumns = 1 + rt::DrawColumns::kValues;  // visible, then the values in render order
     bool bind(const rt::DrawColumns& c, const rt::Memory& memory, const DrawStyle& style, const glm::mat4& view);
     GLuint texture(const std::string& path);  // loaded once (0: it could not be)
+    std::unique_ptr<DepthSort> sorter_;
     std::map<std::string, GLuint> textures_;
     std::string problems_;
     GLuint points_ = 0, quads_ = 0, vao_ = 0, buffers_[kColumns] = {};

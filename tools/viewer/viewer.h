@@ -85,6 +85,8 @@ public:
     std::optional<std::string> set(const host::ExternSetting& setting);
     std::optional<std::string> fire(const std::string& trigger, const std::vector<float>& args);
     bool screenshot(const std::string& path);
+    // Draws the system as it is into the surface (the frame loop's drawing; tests call it).
+    void draw();
     // Whether type `name` is drawn: not hidden, and the solo type if there is one.
     bool shows(const std::string& name) const;
     void hide(const std::string& type, bool hidden) { hidden ? (void)hidden_.insert(type) : (void)hidden_.erase(type); }
@@ -118,7 +120,6 @@ private:
     void stopRecording();
     void measureHitch(double frameSeconds);
     void handleReload();
-    void draw();
     void restart(uint32_t seed);
     void watchSources(const host::CompileResult& compiled);
     void say(const std::string& line) const;
