@@ -1,9 +1,8 @@
 #include "depth_sort.h"
 
-#include <stdexcept>
-#include <string>
-
 #include <glm/gtc/type_ptr.hpp>
+
+#include "render.h"
 
 namespace psys::viewer {
 
@@ -74,33 +73,14 @@ void main() {
 }
 )";
 
-GLuint computeProgram(const char* source) {
-    GLuint shader = glCreateShader(GL_COMPUTE_SHADER);
-    glShaderSource(shader, 1, &source, nullptr);
-    glCompileShader(shader);
-    GLint ok = 0;
-    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[2048];
-        glGetShaderInfoLog(shader, sizeof log, nullptr, log);
-        glDeleteShader(shader);
-        throw std::runtime_error(std::string("a viewer compute shader does not compile: ") + log);
-    }
-    GLuint program = glCreateProgram();
-    glAttachShader(program, shader);
-    glLinkProgram(program);
-    glDeleteShader(shader);
-    return program;
-}
-
 GLuint groups(size_t n) { return static_cast<GLuint>((n + 255) / 256); }
 
 }  // namespace
 
 DepthSort::DepthSort() {
-    keys_ = computeProgram(kKeys);
-    sort_ = computeProgram(kSort);
-    gather_ = computeProgram(kGather);
+    keys_ = linkComputeProgram(kKeys);
+    sort_ = linkComputeProgram(kSort);
+    gather_ = linkComputeProgram(kGather);
     glCreateBuffers(1, &keyBuffer_);
     glCreateBuffers(1, &indexBuffer_);
 }

@@ -1,5 +1,6 @@
 #include "render.h"
 
+#include <initializer_list>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -45,14 +46,14 @@ GLuint compile(GLenum kind, const char* source) {
 
 }  // namespace
 
-GLuint linkProgram(const char* vertex, const char* fragment) {
-    GLuint v = compile(GL_VERTEX_SHADER, vertex), f = compile(GL_FRAGMENT_SHADER, fragment);
+namespace {
+
+// Links the compiled shaders into a program (and lets them go); throws with the log.
+GLuint link(std::initializer_list<GLuint> shaders) {
     GLuint program = glCreateProgram();
-    glAttachShader(program, v);
-    glAttachShader(program, f);
+    for (GLuint shader : shaders) glAttachShader(program, shader);
     glLinkProgram(program);
-    glDeleteShader(v);
-    glDeleteShader(f);
+    for (GLuint shader : shaders) glDeleteShader(shader);
     GLint ok = 0;
     glGetProgramiv(program, GL_LINK_STATUS, &ok);
     if (!ok) {
@@ -62,6 +63,14 @@ GLuint linkProgram(const char* vertex, const char* fragment) {
     }
     return program;
 }
+
+}  // namespace
+
+GLuint linkProgram(const char* vertex, const char* fragment) {
+    return link({compile(GL_VERTEX_SHADER, vertex), compile(GL_FRAGMENT_SHADER, fragment)});
+}
+
+GLuint linkComputeProgram(const char* source) { return link({compile(GL_COMPUTE_SHADER, source)}); }
 
 void clearFrame() {
     glClearColor(0.035f, 0.04f, 0.055f, 1.0f);

@@ -33,5 +33,7 @@ void clearFrame();
 
 // A program from two shader sources; throws std::runtime_error with the log.
 GLuint linkProgram(const char* vertex, const char* fragment);
+// A compute program from its source; throws std::runtime_error with the log.
+GLuint linkComputeProgram(const char* source);
 
 }  // namespace psys::viewer
