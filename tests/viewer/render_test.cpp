@@ -399,3 +399,22 @@ TEST_CASE("a textured sprite draws its flip-book's frame, tinted by its colour")
         CHECK(std::abs(middle.b - want.b) <= 2);
     }
 }
+
+TEST_CASE("with the ground shown, a sprite fades where it crosses the ground plane") {
+    std::string text = "@shape(disc) @blend(alpha) object s { sprite(vec3(0, 0, 0), white, 2); }\nspawn s;";
+    auto level = [](bool ground) {
+        return [ground](ViewerOptions& o) {
+            o.grid = ground;
+            o.camera = Camera::parse("0,0,10,0,0,0");  // level with the ground: it is the middle row
+        };
+    };
+    Frame soft = render(text, 1, Blend::Additive, {}, "llvm", {}, level(true));
+    Frame hard = render(text, 1, Blend::Additive, {}, "llvm", {}, level(false));
+    Camera camera = *Camera::parse("0,0,10,0,0,0");
+    auto near = project(camera, {0.2f, 0.08f, 0}), far = project(camera, {0.2f, 0.8f, 0});
+    REQUIRE(near);
+    REQUIRE(far);
+    CHECK(hard.at(near->first, near->second).r == 255);
+    CHECK(soft.at(near->first, near->second).r < 40);   // 0.08 half widths above: nearly gone
+    CHECK(soft.at(far->first, far->second).r > 200);    // 0.8: nearly whole (smoothstep: 0.9)
+}

@@ -63,6 +63,8 @@ out vec4 colour;
 out vec2 uv;        // the square's corner coordinates, −1 … 1
 out float seed;     // a sprite's frame
 out float halfLength;  // a streak's half length, in half widths
+out float ground;      // the height above the ground plane (y = 0), in half widths
+uniform mat4 viewInverse;
 const vec2 corners[6] = vec2[](vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, -1), vec2(1, 1), vec2(-1, 1));
 void main() {
     vec2 c = corners[gl_VertexID % 6];
@@ -80,6 +82,7 @@ void main() {
         float s = sin(rotation), k = cos(rotation);
         eye.xy += vec2(k * c.x - s * c.y, s * c.x + k * c.y) * halfWidth;
         gl_Position = projection * eye;
+        ground = (viewInverse * eye).y / max(halfWidth, 1e-6);
         return;
     }
     // A streak: along the segment in the eye's space, across it in the view plane,
@@ -94,6 +97,7 @@ void main() {
     vec3 p = (c.x < 0.0 ? p0 - dir * halfWidth : p1 + dir * halfWidth) + side * c.y * halfWidth;
     halfLength = halfWidth > 0.0 ? 0.5 * len / halfWidth : 0.0;
     gl_Position = projection * vec4(p, 1.0);
+    ground = (viewInverse * vec4(p, 1.0)).y / max(halfWidth, 1e-6);
 }
 )";
 
@@ -102,6 +106,8 @@ in vec4 colour;
 in vec2 uv;
 in float seed;
 in float halfLength;
+in float ground;
+uniform int softGround;  // 1: fade where the square crosses the ground plane
 uniform int kind;   // 1: sprite, 2: streak
 uniform int shape;  // core::Shape: soft, disc, ring, star, smoke
 uniform int textured;    // 1: the image's texel, tinted, in place of the shape
@@ -159,15 +165,18 @@ vec4 texel() {
 }
 
 void main() {
+    // Soft against the ground: within half a width of the plane, fading to nothing at it,
+    // so a sprite resting on the ground shows no hard cut where it passes through.
+    float soft = softGround == 1 ? smoothstep(0.0, 1.0, abs(ground)) : 1.0;
     if (kind == 1 && textured == 1) {
         vec4 t = texel();
-        if (t.a <= 0.002) discard;
-        fragment = vec4(colour.rgb * t.rgb, colour.a * t.a);
+        if (t.a * soft <= 0.002) discard;
+        fragment = vec4(colour.rgb * t.rgb, colour.a * t.a * soft);
         return;
     }
     vec2 c = coverage();
-    if (c.x <= 0.002) discard;
-    fragment = vec4(colour.rgb * c.y, colour.a * c.x);
+    if (c.x * soft <= 0.002) discard;
+    fragment = vec4(colour.rgb * c.y, colour.a * c.x * soft);
 }
 )";
 
@@ -311,6 +320,9 @@ void ParticleRenderer::draw(const rt::DrawColumns& c, const rt::Memory& memory, 
     } else {
         glUniform1i(glGetUniformLocation(program, "kind"), style.kind == core::DrawKind::Sprite ? 1 : 2);
         glUniform1i(glGetUniformLocation(program, "shape"), static_cast<int>(style.shape));
+        glUniform1i(glGetUniformLocation(program, "softGround"), style.softGround ? 1 : 0);
+        glm::mat4 inverse = glm::inverse(view);
+        glUniformMatrix4fv(glGetUniformLocation(program, "viewInverse"), 1, GL_FALSE, glm::value_ptr(inverse));
         GLuint image = style.texture.empty() ? 0 : texture(style.texture);
         glUniform1i(glGetUniformLocation(program, "textured"), image ? 1 : 0);
         glUniform2i(glGetUniformLocation(program, "tiles"), std::max(style.columns, 1), std::max(style.rows, 1));

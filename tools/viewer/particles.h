@@ -40,6 +40,7 @@ struct DrawStyle {
     core::Blend blend = core::Blend::Add;
     std::string texture;  // a sprite's image (@texture), in place of the shape; empty: none
     int columns = 1, rows = 1;  // its flip-book's frames: `frame` picks one (row by row, from the top left)
+    bool softGround = false;    // sprites and streaks fade where they cross the ground (y = 0), shown
 };
 
 class ParticleRenderer {

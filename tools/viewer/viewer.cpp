@@ -245,7 +245,8 @@ void Viewer::draw() {
                             o.attributes.blend.value_or(options_.blend == Blend::Alpha ? core::Blend::Alpha : core::Blend::Add),
                             o.attributes.texture,
                             o.attributes.textureColumns,
-                            o.attributes.textureRows};
+                            o.attributes.textureRows,
+                            options_.grid};
             if (style.blend == pass && shows(o.name))
                 particles_->draw(system.draw(t), system.backend().memory(), style, view, projection,
                                  static_cast<float>(surface_.height()));
