@@ -276,10 +276,10 @@ void storeRowsYields(Statements& out, const Kernel& kernel, const ColumnLayout& 
             case YieldKind::EmitCount: storeColumns(out, l.emitCount(y.index), type, value); break;
             case YieldKind::Visible: storeColumns(out, l.render + ColumnLayout::kVisible, type, value); break;
             case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:
-            case YieldKind::Rotation: case YieldKind::Frame: case YieldKind::End:
-                if (l.fromState(y.kind)) break;  // drawn from the state column itself
+            case YieldKind::Rotation: case YieldKind::Frame: case YieldKind::End: case YieldKind::Trail:
+                if (l.fromState(y)) break;  // drawn from the state column itself
                 for (int c = 0; c < width; ++c)  // a constant lane has no column
-                    if (int column = ColumnLayout::renderColumn(y.kind) + c; !l.constant(column))
+                    if (int column = ColumnLayout::renderColumn(y.kind, y.index) + c; !l.constant(column))
                         out.line(fmt::format("sf({}u, i, {});", l.render + column, lane(value, width, c)));
                 break;
             default: break;
@@ -292,7 +292,7 @@ void storeRowsYields(Statements& out, const Kernel& kernel, const ColumnLayout& 
 void markDrawn(Statements& out, const ColumnLayout& l) {
     out.line("// drawn: visible, with a finite position, colour and size (counted)");
     std::string finite = "true";
-    for (int c = ColumnLayout::kPosition; c < ColumnLayout::kRenderColumns; ++c)
+    for (int c = ColumnLayout::kPosition; c < l.renderColumns; ++c)
         if (auto k = l.constant(c)) {
             if (!std::isfinite(*k)) finite = "false";  // every row's
         } else {
@@ -319,7 +319,7 @@ std::vector<int> keptColumns(const Kernel& kernel, const ColumnLayout& l) {
     // What is drawn stays on the GPU (the viewer draws from it): the render shader writes
     // `visible` for every row, and the render columns not drawn from the state's.
     if (kernel.kind == KernelKind::Render)
-        for (int c = 0; c < ColumnLayout::kRenderColumns; ++c)
+        for (int c = 0; c < l.renderColumns; ++c)
             if (l.drawnFrom(c) == l.render + c && !l.constant(c)) kept.push_back(l.render + c);
     for (const Yield& y : kernel.yields) {
         int width = kernel.at(y.value).type.width;

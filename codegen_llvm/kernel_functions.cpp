@@ -103,7 +103,7 @@ public:
         for (const auto& p : layout.parentColumns)
             for (int l = 0; l < p.width; ++l) use(p.offset + l);
         if (kernel.kind == KernelKind::Render)  // it marks what it draws (markDrawn): every render column
-            for (int c = 0; c < ColumnLayout::kRenderColumns; ++c)
+            for (int c = 0; c < layout.renderColumns; ++c)
                 if (!layout.constant(c)) use(layout.drawnFrom(c));
         for (const Yield& y : kernel.yields) {
             int width = kernel.at(y.value).type.width;
@@ -115,10 +115,10 @@ public:
                 case YieldKind::EmitRate: use(layout.emitRate(y.index)); break;
                 case YieldKind::EmitCount: use(layout.emitCount(y.index)); break;
                 case YieldKind::Visible: case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:
-                case YieldKind::Rotation: case YieldKind::Frame: case YieldKind::End:
-                    if (!layout.fromState(y.kind))
+                case YieldKind::Rotation: case YieldKind::Frame: case YieldKind::End: case YieldKind::Trail:
+                    if (!layout.fromState(y))
                         for (int l = 0; l < width; ++l)
-                            if (int c = ColumnLayout::renderColumn(y.kind) + l; !layout.constant(c)) use(layout.render + c);
+                            if (int c = ColumnLayout::renderColumn(y.kind, y.index) + l; !layout.constant(c)) use(layout.render + c);
                     break;
                 default: break;
             }
@@ -274,7 +274,7 @@ private:
         };
         llvm::Value* killed = killedSoFar;
         llvm::Value* unstable = unstableSoFar;
-        std::array<llvm::Value*, ColumnLayout::kRenderColumns> render{};  // the render values, by render column
+        std::vector<llvm::Value*> render(static_cast<size_t>(layout.renderColumns), nullptr);  // the render values, by render column
         for (const Yield& y : kernel.yields) {
             Type t = kernel.at(y.value).type;
             const Lanes& v = values[y.value];
@@ -303,12 +303,12 @@ private:
                     break;
                 }
                 case YieldKind::Visible: case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:
-                case YieldKind::Rotation: case YieldKind::Frame: case YieldKind::End:
+                case YieldKind::Rotation: case YieldKind::Frame: case YieldKind::End: case YieldKind::Trail:
                     for (int l = 0; l < t.width; ++l) {
-                        int column = ColumnLayout::renderColumn(y.kind) + l;
+                        int column = ColumnLayout::renderColumn(y.kind, y.index) + l;
                         render[column] = toFloat(v[static_cast<size_t>(l)], t);
                         // Else drawn from the state column itself, or a constant with no column.
-                        if (!layout.fromState(y.kind) && !layout.constant(column))
+                        if (!layout.fromState(y) && !layout.constant(column))
                             b_.CreateAlignedStore(render[column], columnAt(argOf, layout.render + column, f32),
                                                   llvm::Align(4));
                     }
@@ -325,17 +325,17 @@ private:
     // its position, colour and size all finite, else 0. Returns the counts so far of rows
     // drawn and of rows visible but not drawn for a NaN or an infinity.
     std::pair<llvm::Value*, llvm::Value*> markDrawn(const ColumnLayout& layout, const std::map<int, unsigned>& argOf,
-                                                    llvm::Value* mask, std::array<llvm::Value*, ColumnLayout::kRenderColumns>& render,
+                                                    llvm::Value* mask, std::vector<llvm::Value*>& render,
                                                     llvm::Value* drawnSoFar, llvm::Value* nonFiniteSoFar) {
         llvm::Type* f32 = b_.getFloatTy();
-        for (int column = 0; column < ColumnLayout::kRenderColumns; ++column)
+        for (int column = 0; column < layout.renderColumns; ++column)
             if (auto k = layout.constant(column))
                 render[column] = llvm::ConstantFP::get(f32, *k);
             else if (!render[column])
                 render[column] = b_.CreateAlignedLoad(f32, columnAt(argOf, layout.drawnFrom(column), f32), llvm::Align(4));
         llvm::Value* finite = b_.getTrue();
         llvm::Value* infinity = llvm::ConstantFP::getInfinity(f32);
-        for (int column = ColumnLayout::kPosition; column < ColumnLayout::kRenderColumns; ++column) {
+        for (int column = ColumnLayout::kPosition; column < layout.renderColumns; ++column) {
             llvm::Value* magnitude = b_.CreateUnaryIntrinsic(llvm::Intrinsic::fabs, render[column]);
             finite = b_.CreateAnd(finite, b_.CreateFCmpONE(magnitude, infinity));  // false for NaN too
         }

@@ -194,7 +194,8 @@ struct Command {
     SourceRange range;
     SourceRange keywordRange;
     std::vector<ExprPtr> args;   // a draw command's (point: pos, colour, size); emit: the child's arguments
-    core::DrawKind draw = core::DrawKind::Point;  // a draw command's: point, sprite or streak
+    core::DrawKind draw = core::DrawKind::Point;  // a draw command's: point, sprite, streak or trail
+    int trailPoints = 0;         // a trail's length, set by the checker where it is valid
     ExprPtr cond;                // kill when / when; null for a bare `kill;`
     // emit
     std::string target;

@@ -240,22 +240,7 @@ void Checker::checkOn(Command& on, const Context& ctx, const Command** point) {
 }
 
 namespace {
-// A draw command's parameters: the first `required`, then the optional ones in order.
-struct DrawParams {
-    std::vector<std::pair<const char*, Type>> params;
-    size_t required;
-};
-DrawParams drawParams(core::DrawKind kind) {
-    switch (kind) {
-        case core::DrawKind::Point: return {{{"position", Type::vec(3)}, {"colour", Type::vec(4)}, {"size", Type::scalar()}}, 3};
-        case core::DrawKind::Sprite:
-            return {{{"position", Type::vec(3)}, {"colour", Type::vec(4)}, {"size", Type::scalar()},
-                     {"rotation", Type::scalar()}, {"frame", Type::scalar()}}, 3};
-        case core::DrawKind::Streak:
-            return {{{"start", Type::vec(3)}, {"end", Type::vec(3)}, {"colour", Type::vec(4)}, {"width", Type::scalar()}}, 4};
-    }
-    return {{}, 0};
-}
+Type drawParamType(const core::DrawParam& p) { return p.width == 1 ? Type::scalar() : Type::vec(p.width); }
 }  // namespace
 
 // `point`, `sprite`, `streak`: how the object is drawn, at most one per object.
@@ -279,27 +264,42 @@ void Checker::checkDraw(Command& cmd, const Context& ctx, const Command** point)
     }
     std::vector<Type> types;
     for (auto& a : cmd.args) types.push_back(check(*a, ctx));
-    DrawParams p = drawParams(cmd.draw);
-    if (cmd.args.size() < p.required || cmd.args.size() > p.params.size()) {
+    const core::DrawSignature p = core::drawSignature(cmd.draw);
+    if (cmd.args.size() < p.required || cmd.args.size() > p.count) {
         std::string list;
-        for (size_t i = 0; i < p.params.size(); ++i)
-            list += fmt::format("{}{}: {}", i == 0 ? "" : i >= p.required ? "[, " : ", ", p.params[i].first,
-                                p.params[i].second.str());
-        for (size_t i = p.required; i < p.params.size(); ++i) list += "]";
-        std::string count = p.required == p.params.size() ? fmt::format("{}", p.required)
-                                                          : fmt::format("{} to {}", p.required, p.params.size());
+        for (size_t i = 0; i < p.count; ++i)
+            list += fmt::format("{}{}: {}", i == 0 ? "" : i >= p.required ? "[, " : ", ", p.params[i].name,
+                                drawParamType(p.params[i]).str());
+        for (size_t i = p.required; i < p.count; ++i) list += "]";
+        std::string count = p.required == p.count ? fmt::format("{}", p.required)
+                                                  : fmt::format("{} to {}", p.required, p.count);
         diags_.error(cmd.range, fmt::format("`{}` takes {} arguments ({}), but {} {} given", name, count,
                                             list, cmd.args.size(), cmd.args.size() == 1 ? "was" : "were"));
         return;
     }
     for (size_t i = 0; i < cmd.args.size(); ++i) {
-        auto [param, type] = p.params[i];
+        const core::DrawParam& param = p.params[i];
+        Type type = drawParamType(param);
         if (type == Type::vec(4) && types[i] == Type::vec(3))
             diags_.error(cmd.args[i]->range, fmt::format("the colour of a {} must be vec4 (color), found vec3", name))
                 .notes.push_back({cmd.args[i]->range, "add an alpha: `vec4(c, 1)`"});
-        else
-            expectType(*cmd.args[i], type, fmt::format("the {} of a {}", param, name));
+        else if (expectType(*cmd.args[i], type, fmt::format("the {} of a {}", param.name, name)) &&
+                 param.role == core::DrawRole::Length)
+            checkTrailLength(cmd, *cmd.args[i]);
     }
+}
+
+// A trail's length is how many points of history the object keeps (state the compiler
+// adds): a number the program fixes, not a value that changes.
+void Checker::checkTrailLength(Command& cmd, const Expr& length) {
+    auto v = evaluateConstant(length);
+    if (!v || !(v->v[0] >= 2 && v->v[0] <= core::kMaxTrail) || v->v[0] != std::floor(v->v[0])) {
+        std::string found = !v ? "it is not a constant" : fmt::format("it is {}", numberText(v->v[0]));
+        diags_.error(length.range, fmt::format("a trail's length must be a constant whole number from 2 to {} (the "
+                                               "points it keeps); {}", core::kMaxTrail, found));
+        return;
+    }
+    cmd.trailPoints = static_cast<int>(v->v[0]);
 }
 
 void Checker::checkCommands(std::vector<CommandPtr>& commands, const Context& ctx, const Command** point) {

@@ -76,6 +76,7 @@ private:
     void checkEmit(ast::Command& emit, const Context& ctx);
     void checkOn(ast::Command& on, const Context& ctx, const ast::Command** point);
     void checkDraw(ast::Command& draw, const Context& ctx, const ast::Command** point);
+    void checkTrailLength(ast::Command& trail, const ast::Expr& length);
     void checkTexture(ast::Attribute& texture, const Context& ctx);
     void checkArguments(std::vector<ast::ExprPtr>& args, const ast::ObjectDecl& target, SourceRange callRange,
                         const Context& ctx);

@@ -93,7 +93,7 @@ std::string describeExpected(antlr4::Parser* parser, const antlr4::misc::Interva
         types.erase(static_cast<size_t>(antlr4::Token::EOF));
     } else if (objectBody) {
         words.push_back("an equation, a command, a nested object");
-        drop({"point", "sprite", "streak", "kill", "emit", "when", "on", "object", "@", "("});
+        drop({"point", "sprite", "streak", "trail", "kill", "emit", "when", "on", "object", "@", "("});
         types.erase(PsysParser::IDENT);
     } else if (exprStart) {
         words.push_back("an expression");

@@ -62,7 +62,7 @@ equation    : IDENT ( ':' typeRef )? '=' expr ';'                  # singleEquat
             | '(' IDENT ( ',' IDENT )+ ')' '=' expr ';'            # tupleEquation
             ;
 
-command     : drawing=( 'point' | 'sprite' | 'streak' ) '(' argList? ')' ';'      # drawCmd
+command     : drawing=( 'point' | 'sprite' | 'streak' | 'trail' ) '(' argList? ')' ';'      # drawCmd
             | 'kill' ( 'when' expr )? ';'                                       # killCmd
             | 'emit' IDENT ( '(' argList? ')' )? emitRate? emitCount? ';'        # emitCmd
             | 'when' expr '{' command* '}'                                      # whenCmd

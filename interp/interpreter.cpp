@@ -127,14 +127,14 @@ rt::RowsResult Interpreter::run(const rt::RowsLaunch& launch) {
                 case YieldKind::EmitRate: columns.floats(l.emitRate(y.index))[row] = v.f[0]; break;
                 case YieldKind::EmitCount: columns.floats(l.emitCount(y.index))[row] = v.f[0]; break;
                 case YieldKind::Visible: case YieldKind::Position: case YieldKind::Color: case YieldKind::Size:
-                case YieldKind::Rotation: case YieldKind::Frame: case YieldKind::End:
-                    if (l.fromState(y.kind)) break;  // drawn from the state column itself
+                case YieldKind::Rotation: case YieldKind::Frame: case YieldKind::End: case YieldKind::Trail:
+                    if (l.fromState(y)) break;  // drawn from the state column itself
                     if (y.kind == YieldKind::Visible) {
                         columns.floats(l.render + ColumnLayout::kVisible)[row] = v.truth() ? 1.0f : 0.0f;
                         break;
                     }
                     for (int c = 0; c < width; ++c)  // a constant lane has no column
-                        if (int column = ColumnLayout::renderColumn(y.kind) + c; !l.constant(column))
+                        if (int column = ColumnLayout::renderColumn(y.kind, y.index) + c; !l.constant(column))
                             columns.floats(l.render + column)[row] = v.f[static_cast<size_t>(c)];
                     break;
                 default: break;

@@ -16,6 +16,7 @@
 // text form.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <map>
@@ -80,6 +81,7 @@ enum class YieldKind {
     Rotation,   // a sprite's turn, in radians (0 where the command gives none)
     Frame,      // a sprite's frame of a flip-book (0 where the command gives none)
     End,        // a streak's other end (0 for the others)
+    Trail,      // index k: a trail's point k + 1 updates back (its head is the position)
     EmitRate,   // index: emit site; objects per second (rate emitters)
     EmitCount,  // index: emit site; objects per event (rate emitters) or in all (bursts)
     EmitArg,    // index: emit site, sub: argument
@@ -142,13 +144,14 @@ struct KernelStorage {
     std::vector<int> zeroed;
 };
 
-// The render columns as the IR's text names them (`position.y`, `size`, `end.z`), 0 … 13.
-const char* drawnColumnName(int column);
+// The render columns as the IR's text names them (`position.y`, `size`, `end.z`, 0 … 13;
+// past them a trail's points, `trail.1.x` … : point k + 1 back at 14 + 3k).
+std::string drawnColumnName(int column);
 constexpr int kDrawnColumns = 14;
 // The first render column of a drawn yield: visible 0, position 1, colour 4, size 8,
-// rotation 9, frame 10, end 11 (the one definition: the storage pass records by it, the
-// run-time lays columns out by it).
-constexpr int firstDrawnColumn(YieldKind kind) {
+// rotation 9, frame 10, end 11, trail point k 14 + 3k (the one definition: the storage
+// pass records by it, the run-time lays columns out by it).
+constexpr int drawnColumn(YieldKind kind, int index = 0) {
     switch (kind) {
         case YieldKind::Position: return 1;
         case YieldKind::Color: return 4;
@@ -156,17 +159,19 @@ constexpr int firstDrawnColumn(YieldKind kind) {
         case YieldKind::Rotation: return 9;
         case YieldKind::Frame: return 10;
         case YieldKind::End: return 11;
+        case YieldKind::Trail: return kDrawnColumns + 3 * index;
         default: return 0;
     }
 }
 // The render yields: what a render kernel computes for the drawing.
 constexpr bool isDrawnYield(YieldKind kind) {
     return kind == YieldKind::Visible || kind == YieldKind::Position || kind == YieldKind::Color ||
-           kind == YieldKind::Size || kind == YieldKind::Rotation || kind == YieldKind::Frame || kind == YieldKind::End;
+           kind == YieldKind::Size || kind == YieldKind::Rotation || kind == YieldKind::Frame ||
+           kind == YieldKind::End || kind == YieldKind::Trail;
 }
 // The drawn values beyond a point's (rotation, frame, end), where a render kernel yields
 // none of them: 0, a constant with no column.
-constexpr bool drawnDefaultsToZero(int column) { return column >= 9; }
+constexpr bool drawnDefaultsToZero(int column) { return column >= 9 && column < kDrawnColumns; }
 
 class Kernel;
 // A render kernel's storage record (fixed): the drawn columns past a point's that it
@@ -310,6 +315,7 @@ struct Object {
     Loc loc;             // its declaration
     std::string parent;  // the enclosing object type; empty at file level
     core::DrawKind draw = core::DrawKind::Point;  // its render command (core/draw.h)
+    int trail = 0;  // a trail's points (its head and trail - 1 behind); 0 for the others
     std::vector<Param> params;
     std::vector<StateSlot> state;
     std::vector<EmitSite> emits;
@@ -321,6 +327,10 @@ struct Object {
     const Kernel* kernel(KernelKind kind, int site = -1) const;
     Kernel* kernel(KernelKind kind, int site = -1);
 };
+
+// The render columns of an object's tables: a point's 14, and 3 per point of a trail
+// behind its head.
+inline int renderColumns(const Object& o) { return kDrawnColumns + 3 * std::max(o.trail - 1, 0); }
 
 struct Extern {
     std::string name;

@@ -3,6 +3,8 @@
 
 #include "ir/ir.h"
 
+#include <fmt/format.h>
+
 namespace psys::ir {
 namespace {
 
@@ -163,11 +165,13 @@ const char* kernelName(KernelKind kind) {
     return "?";
 }
 
-const char* drawnColumnName(int column) {
+std::string drawnColumnName(int column) {
     static const char* const names[kDrawnColumns] = {"visible", "position.x", "position.y", "position.z", "color.r",
                                                      "color.g", "color.b", "color.a", "size", "rotation",
                                                      "frame", "end.x", "end.y", "end.z"};
-    return column >= 0 && column < kDrawnColumns ? names[column] : "?";
+    if (column >= kDrawnColumns)
+        return fmt::format("trail.{}.{}", (column - kDrawnColumns) / 3 + 1, "xyz"[(column - kDrawnColumns) % 3]);
+    return column >= 0 ? names[column] : "?";
 }
 
 std::string unexpectedOp(const Inst& inst, std::string_view backend) {
@@ -181,12 +185,13 @@ std::string unexpectedOp(const Inst& inst, std::string_view backend) {
 void defaultDrawn(Kernel& render) {
     KernelStorage& st = render.storage;
     if (render.kind != KernelKind::Render || !st.fixed) return;
-    st.drawn.resize(kDrawnColumns);
-    std::vector<bool> yielded(kDrawnColumns, false);
+    st.drawn.resize(std::max(st.drawn.size(), static_cast<size_t>(kDrawnColumns)));
+    std::vector<bool> yielded(st.drawn.size(), false);
     for (const Yield& y : render.yields)
         if (isDrawnYield(y.kind))
             for (int c = 0; c < render.at(y.value).type.width; ++c)
-                yielded[static_cast<size_t>(firstDrawnColumn(y.kind) + c)] = true;
+                if (auto column = static_cast<size_t>(drawnColumn(y.kind, y.index) + c); column < yielded.size())
+                    yielded[column] = true;
     for (int c = 0; c < kDrawnColumns; ++c)
         if (drawnDefaultsToZero(c) && !yielded[static_cast<size_t>(c)])
             st.drawn[static_cast<size_t>(c)] = {KernelStorage::Drawn::From::Constant, 0, 0, 0.0f};

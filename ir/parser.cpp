@@ -74,7 +74,7 @@ std::string nameBeforeParen(const std::string& header, size_t skip) {
 std::optional<YieldKind> yieldKind(const std::string& name) {
     for (YieldKind k : {YieldKind::StateNext, YieldKind::Kill, YieldKind::Visible, YieldKind::Position,
                         YieldKind::Color, YieldKind::Size, YieldKind::Rotation, YieldKind::Frame, YieldKind::End,
-                        YieldKind::EmitRate, YieldKind::EmitCount,
+                        YieldKind::Trail, YieldKind::EmitRate, YieldKind::EmitCount,
                         YieldKind::EmitArg, YieldKind::Export, YieldKind::Uniform, YieldKind::Unstable})
         if (yieldKindName(k) == name) return k;
     return std::nullopt;
@@ -177,9 +177,15 @@ private:
             if (w[0] == "parent") o.parent = w.at(1);
             else if (w[0] == "attribute") attribute(o.attributes, w);
             else if (w[0] == "draw") {
-                auto draw = w.size() == 2 ? core::drawKindFromName(w[1]) : std::nullopt;
-                if (!draw) throw ParseError("expected `draw point|sprite|streak`");
+                // draw point|sprite|streak, or draw trail POINTS
+                auto draw = w.size() >= 2 ? core::drawKindFromName(w[1]) : std::nullopt;
+                bool trail = draw == core::DrawKind::Trail;
+                if (!draw || w.size() != (trail ? 3u : 2u))
+                    throw ParseError("expected `draw point|sprite|streak` or `draw trail POINTS`");
                 o.draw = *draw;
+                if (trail) o.trail = integer(w[2]);
+                if (trail && (o.trail < 2 || o.trail > core::kMaxTrail))
+                    throw ParseError(fmt::format("a trail has 2 to {} points, not {}", core::kMaxTrail, o.trail));
             }
             else if (w[0] == "state") {
                 if (w.size() != 4 || w[1].back() != ':') throw ParseError("expected `state name: type zero|next`");
@@ -306,9 +312,11 @@ private:
             // storage drawn position.y = state #slot.lane | const V
             if (w.size() < 6 || w[3] != "=") throw ParseError("expected `storage drawn column = …`");
             int column = 0;
-            while (column < kDrawnColumns && w[2] != drawnColumnName(column)) ++column;
-            if (column == kDrawnColumns) throw ParseError("unknown render column `" + w[2] + "`");
-            if (st.drawn.size() < static_cast<size_t>(kDrawnColumns)) st.drawn.resize(kDrawnColumns);
+            const int columns = kDrawnColumns + 3 * (core::kMaxTrail - 1);
+            while (column < columns && w[2] != drawnColumnName(column)) ++column;
+            if (column == columns) throw ParseError("unknown render column `" + w[2] + "`");
+            if (st.drawn.size() <= static_cast<size_t>(column))
+                st.drawn.resize(std::max(static_cast<size_t>(column) + 1, static_cast<size_t>(kDrawnColumns)));
             KernelStorage::Drawn& d = st.drawn[static_cast<size_t>(column)];
             using From = KernelStorage::Drawn::From;
             if (w[4] == "const") {

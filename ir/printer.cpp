@@ -49,8 +49,8 @@ std::string storageText(const Kernel& kernel, const std::string& pad) {
         if (d.from == Drawn::From::Column) continue;
         bool yielded = false;  // (unyielded, past a point's: 0 without saying so; ir::defaultDrawn)
         for (const Yield& y : kernel.yields)
-            yielded |= isDrawnYield(y.kind) && static_cast<int>(c) >= firstDrawnColumn(y.kind) &&
-                       static_cast<int>(c) < firstDrawnColumn(y.kind) + kernel.at(y.value).type.width;
+            yielded |= isDrawnYield(y.kind) && static_cast<int>(c) >= drawnColumn(y.kind, y.index) &&
+                       static_cast<int>(c) < drawnColumn(y.kind, y.index) + kernel.at(y.value).type.width;
         if (drawnDefaultsToZero(static_cast<int>(c)) && !yielded) continue;
         out += fmt::format("{}  storage drawn {} = ", pad, drawnColumnName(static_cast<int>(c)));
         out += d.from == Drawn::From::State ? fmt::format("state #{}.{}\n", d.slot, d.lane) : "const " + number(d.value) + "\n";
@@ -78,6 +78,7 @@ std::string yieldKindName(YieldKind kind) {
         case YieldKind::Rotation: return "rotation";
         case YieldKind::Frame: return "frame";
         case YieldKind::End: return "end";
+        case YieldKind::Trail: return "trail";
         case YieldKind::EmitRate: return "emit.rate";
         case YieldKind::EmitCount: return "emit.count";
         case YieldKind::EmitArg: return "emit.arg";
@@ -123,7 +124,7 @@ std::string print(const Kernel& kernel, int indent, PrintOptions options) {
         std::string line = pad + "  yield " + yieldKindName(y.kind);
         bool indexed = y.kind == YieldKind::StateNext || y.kind == YieldKind::EmitRate ||
                        y.kind == YieldKind::EmitCount || y.kind == YieldKind::EmitArg || y.kind == YieldKind::Export ||
-                       y.kind == YieldKind::Uniform;
+                       y.kind == YieldKind::Uniform || y.kind == YieldKind::Trail;
         if (indexed) line += fmt::format(" #{}", y.index);
         if (y.kind == YieldKind::EmitArg) line += fmt::format(" #{}", y.sub);
         out += line + fmt::format(" = %{}\n", y.value);
@@ -142,7 +143,8 @@ std::string print(const Object& o, PrintOptions options) {
     if (a.blend) out += fmt::format("  attribute blend {}\n", core::blendName(*a.blend));
     if (!a.texture.empty())  // (the path last: it may hold spaces)
         out += fmt::format("  attribute texture {} {} {}\n", a.textureColumns, a.textureRows, a.texture);
-    if (o.draw != core::DrawKind::Point) out += fmt::format("  draw {}\n", core::drawKindName(o.draw));
+    if (o.draw == core::DrawKind::Trail) out += fmt::format("  draw trail {}\n", o.trail);
+    else if (o.draw != core::DrawKind::Point) out += fmt::format("  draw {}\n", core::drawKindName(o.draw));
     for (auto& s : o.state)
         out += fmt::format("  state {}: {} {}\n", s.name, s.type.str(), s.init == StateInit::Zero ? "zero" : "next");
     for (auto& e : o.emits) out += fmt::format("  emit {} {}\n", e.target, emitWhenName(e.when));

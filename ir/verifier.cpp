@@ -29,6 +29,9 @@ private:
         const KernelStorage& st = k.storage;
         if (object_ && st.emits.size() != 2 * object_->emits.size())
             fail(fmt::format("storage: {} emit columns for {} emit sites", st.emits.size(), object_->emits.size()));
+        if (object_ && st.drawn.size() > static_cast<size_t>(renderColumns(*object_)))
+            fail(fmt::format("storage: {} render columns for an object that has {}", st.drawn.size(),
+                             renderColumns(*object_)));
         for (size_t c = 0; c < st.drawn.size(); ++c) {
             const KernelStorage::Drawn& d = st.drawn[c];
             if (d.from != KernelStorage::Drawn::From::State) continue;
@@ -180,6 +183,10 @@ private:
                 break;
             case YieldKind::Kill: case YieldKind::Visible: case YieldKind::Unstable: expect(t.isBool(), "a bool"); break;
             case YieldKind::Position: case YieldKind::End: expect(t == Type::vec(3), "a vec3"); break;
+            case YieldKind::Trail:
+                expect(t == Type::vec(3), "a vec3");
+                expect(object_ && y.index >= 0 && y.index < object_->trail - 1, "no such point of the object's trail");
+                break;
             case YieldKind::Rotation: case YieldKind::Frame: expect(t.isScalarFloat(), "an f32"); break;
             case YieldKind::Color: expect(t == Type::vec(4), "a vec4"); break;
             case YieldKind::Size: case YieldKind::EmitRate: case YieldKind::EmitCount:

@@ -43,6 +43,10 @@ using detail::Values;
 // ---------------------------------------------------------------- commands
 
 struct CommandLowering {
+    CommandLowering(ObjectLowering& lowering, Kernel& k, std::vector<EmitSite>& emits, const ast::Program& program,
+                    std::function<std::string(const ObjectDecl*)> qualified, bool object)
+        : lowering(lowering), k(k), emits(emits), program(program), qualified(std::move(qualified)), object(object) {}
+
     ObjectLowering& lowering;
     Kernel& k;
     std::vector<EmitSite>& emits;
@@ -62,23 +66,54 @@ struct CommandLowering {
         }
     }
 
+    // The render yields, by the command's parameters (core::drawSignature).
+    void drawCommand(const Command& cmd, const std::vector<ValueId>& conditions) {
+        const core::DrawSignature signature = core::drawSignature(cmd.draw);
+        std::optional<ValueId> position;
+        for (size_t i = 0; i < cmd.args.size() && i < signature.count; ++i) {
+            if (signature.params[i].role == core::DrawRole::Length) continue;  // (the checker's cmd.trailPoints)
+            ValueId v = lowering.lowerOne(*cmd.args[i]);
+            YieldKind kind = drawnYield(signature.params[i].role);
+            if (kind == YieldKind::Position) position = v;
+            k.yields.push_back({kind, 0, 0, v});
+        }
+        if (cmd.draw == core::DrawKind::Trail && position) trailHistory(*position, cmd.trailPoints);
+        k.yields.push_back({YieldKind::Visible, 0, 0, lowering.guard(conditions)});
+        draw = cmd.draw;
+        trail = cmd.draw == core::DrawKind::Trail ? cmd.trailPoints : 0;
+    }
+
+    static YieldKind drawnYield(core::DrawRole role) {
+        switch (role) {
+            case core::DrawRole::Position: return YieldKind::Position;
+            case core::DrawRole::Color: return YieldKind::Color;
+            case core::DrawRole::Size: return YieldKind::Size;
+            case core::DrawRole::Rotation: return YieldKind::Rotation;
+            case core::DrawRole::Frame: return YieldKind::Frame;
+            case core::DrawRole::End: return YieldKind::End;
+            case core::DrawRole::Length: break;
+        }
+        return YieldKind::Visible;
+    }
+
+    // A trail's points behind its head: the position at each of the last `points - 1`
+    // updates, as the program would write them — `p1 = pos -> prev(pos)`, `p2 = pos ->
+    // prev(p1)`, … (a new object's trail starts collapsed at its head). They are state
+    // like any other: every backend computes them, hot reload carries them.
+    void trailHistory(ValueId head, int points) {
+        ValueId behind = head;
+        for (int p = 0; p + 1 < points; ++p) {
+            ValueId prev = lowering.temporal(Op::Prev, Type::vec(3), {behind});
+            behind = lowering.temporal(Op::FollowedBy, Type::vec(3), {head, prev});
+            k.yields.push_back({YieldKind::Trail, p, 0, behind});
+        }
+    }
+
     void run(const std::vector<CommandPtr>& commands, std::vector<ValueId> conditions, ValueId& kill) {
         for (auto& cmd : commands) {
             LocScope at(k, lowering.locate(cmd->range));
             switch (cmd->kind) {
-                case CommandKind::Draw: {
-                    // The render yields, by the command's parameters (frontend: drawParams).
-                    static const std::vector<YieldKind> point = {YieldKind::Position, YieldKind::Color, YieldKind::Size,
-                                                                 YieldKind::Rotation, YieldKind::Frame};
-                    static const std::vector<YieldKind> streak = {YieldKind::Position, YieldKind::End, YieldKind::Color,
-                                                                  YieldKind::Size};
-                    const auto& kinds = cmd->draw == core::DrawKind::Streak ? streak : point;
-                    for (size_t i = 0; i < cmd->args.size() && i < kinds.size(); ++i)
-                        k.yields.push_back({kinds[i], 0, 0, lowering.lowerOne(*cmd->args[i])});
-                    k.yields.push_back({YieldKind::Visible, 0, 0, lowering.guard(conditions)});
-                    draw = cmd->draw;
-                    break;
-                }
+                case CommandKind::Draw: drawCommand(*cmd, conditions); break;
                 case CommandKind::Kill: {
                     ValueId c = cmd->cond ? lowering.lowerOne(*cmd->cond) : k.boolean(true);
                     ValueId guarded = k.op(Op::And, Type::boolean(), {lowering.guard(conditions), c});
@@ -124,6 +159,7 @@ struct CommandLowering {
     }
 
     core::DrawKind draw = core::DrawKind::Point;  // the object's draw command's
+    int trail = 0;                                // a trail's points
     // (state of the walk)
     std::vector<const Command*> deaths_;
     bool dying_ = false;  // lowering an `on death` block
@@ -221,9 +257,10 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
         ObjectLowering lowering(m, locate, k, &o, decl, nullptr, sites);
         lowering.lowerEquations();
         ValueId kill = k.boolean(false);
-        CommandLowering commands{lowering, k, o.emits, program, qualified, true, core::DrawKind::Point, {}, false};
+        CommandLowering commands(lowering, k, o.emits, program, qualified, true);
         commands.runObject(decl->commands, kill);
         o.draw = commands.draw;
+        o.trail = commands.trail;
         lowering.flushDeferred();
         k.yields.push_back({YieldKind::Kill, 0, 0, kill});
         o.kernels.push_back(std::move(k));
@@ -241,8 +278,7 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
                 int sites = 0;
                 ObjectLowering lowering(m, locate, trigger.kernel, nullptr, nullptr, &t, sites);
                 ValueId kill = trigger.kernel.boolean(false);
-                CommandLowering commands{lowering, trigger.kernel, trigger.emits, program, qualified, false,
-                                         core::DrawKind::Point, {}, false};
+                CommandLowering commands(lowering, trigger.kernel, trigger.emits, program, qualified, false);
                 commands.run(t.commands, {}, kill);
                 m.triggers.push_back(std::move(trigger));
             }

@@ -142,15 +142,6 @@ private:
         inst.lanes = std::move(lanes);
         return k_.add(std::move(inst));
     }
-    ValueId temporal(Op op, Type t, std::vector<ValueId> operands) {
-        Inst inst;
-        inst.op = op;
-        inst.type = t;
-        inst.operands = std::move(operands);
-        inst.attr = site_++;
-        if ((op == Op::Rand || op == Op::NRand) && (perChild_ || !decl_)) inst.attr2 = 1;
-        return k_.addUnique(std::move(inst));
-    }
     ValueId input(Op op, Type t, int attr = 0, int attr2 = 0) {
         Inst inst;
         inst.op = op;
@@ -164,6 +155,16 @@ private:
 public:
     // While lowering emit arguments: random draws there are one per created object.
     bool perChild_ = false;
+    // A temporal op or random draw: its own call site (a trail's history is built of them).
+    ValueId temporal(Op op, Type t, std::vector<ValueId> operands) {
+        Inst inst;
+        inst.op = op;
+        inst.type = t;
+        inst.operands = std::move(operands);
+        inst.attr = site_++;
+        if ((op == Op::Rand || op == Op::NRand) && (perChild_ || !decl_)) inst.attr2 = 1;
+        return k_.addUnique(std::move(inst));
+    }
 
 private:
 

@@ -53,12 +53,12 @@ KernelStorage storageOf(const Object& object, const Kernel& kernel) {
         if (value.op == Op::Uniform) st.emits[column] = {From::Uniform, value.attr, 0};
     }
     if (kernel.kind == KernelKind::Render) {
-        st.drawn.assign(kDrawnColumns, {});
+        st.drawn.assign(static_cast<size_t>(renderColumns(object)), {});
         using From = KernelStorage::Drawn::From;
         for (const Yield& y : kernel.yields) {
             if (!isDrawnYield(y.kind) || y.kind == YieldKind::Visible) continue;
             const Inst& value = kernel.at(y.value);
-            int first = firstDrawnColumn(y.kind);
+            int first = drawnColumn(y.kind, y.index);
             for (int c = 0; c < value.type.width; ++c) {
                 KernelStorage::Drawn& d = st.drawn[static_cast<size_t>(first + c)];
                 if (value.op == Op::StateRead) d = {From::State, value.attr, c, 0};

@@ -23,7 +23,8 @@ ColumnLayout columnLayout(const ir::Object& object, const ir::Kernel& kernel) {
     l.emits = next;
     next += 2 * static_cast<int>(object.emits.size());
     l.render = next;
-    next += ColumnLayout::kRenderColumns;
+    l.renderColumns = ir::renderColumns(object);
+    next += l.renderColumns;
     l.parents = next;
     l.writes.assign(static_cast<size_t>(l.parents - l.emits), false);
     l.emitShared.assign(static_cast<size_t>(l.render - l.emits), {});
@@ -47,15 +48,16 @@ ColumnLayout columnLayout(const ir::Object& object, const ir::Kernel& kernel) {
         }
     }
     if (kernel.kind == ir::KernelKind::Render) {  // writes every render column (visible: drawn or not)…
-        l.renderFromState.assign(ColumnLayout::kRenderColumns, -1);  // …but those drawn from state or constants
-        l.renderConstant.assign(ColumnLayout::kRenderColumns, {});
-        for (size_t c = 0; c < st.drawn.size() && c < static_cast<size_t>(ColumnLayout::kRenderColumns); ++c) {
+        const auto columns = static_cast<size_t>(l.renderColumns);
+        l.renderFromState.assign(columns, -1);  // …but those drawn from state or constants
+        l.renderConstant.assign(columns, {});
+        for (size_t c = 0; c < st.drawn.size() && c < columns; ++c) {
             const ir::KernelStorage::Drawn& d = st.drawn[c];
             if (d.from == ir::KernelStorage::Drawn::From::State)
                 l.renderFromState[c] = l.stateOffset.at(static_cast<size_t>(d.slot)) + d.lane;
             if (d.from == ir::KernelStorage::Drawn::From::Constant) l.renderConstant[c] = {true, d.value};
         }
-        for (int c = 0; c < ColumnLayout::kRenderColumns; ++c)
+        for (int c = 0; c < l.renderColumns; ++c)
             l.writes[static_cast<size_t>(l.render - l.emits + c)] =
                 l.renderFromState[static_cast<size_t>(c)] < 0 && !l.renderConstant[static_cast<size_t>(c)].is;
     }
@@ -83,12 +85,13 @@ ArgumentColumns argumentColumns(const ir::Kernel& spawn) {
     return a;
 }
 
-int ColumnLayout::renderColumn(ir::YieldKind kind) { return ir::firstDrawnColumn(kind); }
-static_assert(ColumnLayout::kVisible == ir::firstDrawnColumn(ir::YieldKind::Visible) &&
-              ColumnLayout::kPosition == ir::firstDrawnColumn(ir::YieldKind::Position) &&
-              ColumnLayout::kColor == ir::firstDrawnColumn(ir::YieldKind::Color) &&
-              ColumnLayout::kSize == ir::firstDrawnColumn(ir::YieldKind::Size) &&
-              ColumnLayout::kRenderColumns == ir::kDrawnColumns);
+int ColumnLayout::renderColumn(ir::YieldKind kind, int index) { return ir::drawnColumn(kind, index); }
+static_assert(ColumnLayout::kVisible == ir::drawnColumn(ir::YieldKind::Visible) &&
+              ColumnLayout::kPosition == ir::drawnColumn(ir::YieldKind::Position) &&
+              ColumnLayout::kColor == ir::drawnColumn(ir::YieldKind::Color) &&
+              ColumnLayout::kSize == ir::drawnColumn(ir::YieldKind::Size) &&
+              ColumnLayout::kRenderColumns == ir::kDrawnColumns &&
+              ColumnLayout::kTrail == ir::drawnColumn(ir::YieldKind::Trail, 0));
 
 std::string ColumnLayout::signature() const {
     std::string s = fmt::format("state {} params {} exports {} emits {} render {} parents {} total {} |", state,

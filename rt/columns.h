@@ -11,7 +11,8 @@
 //   state, params, exports: one f32 column per component, in declaration order; a
 //     parameter the pool does not keep has no column (an invalid buffer)
 //   emits    per emit site, a rate and a count column (f32), written for every row
-//   render   visible (0 or 1), position x y z, colour r g b a, size: f32, written for
+//   render   visible (0 or 1), position x y z, colour r g b a, size, rotation, frame,
+//     end x y z, then a trail's points behind its head (x y z each): f32, written for
 //     every row by render kernels (but those drawn from a state column or constant)
 //   parents  per parent read of the kernel, in instruction order, one f32 column per
 //     component (gathered by the run-time; `alive` is 0 or 1)
@@ -31,7 +32,10 @@ struct ColumnLayout {
     static constexpr int kCreated = 0, kIds = 1, kKill = 2, kNow = 3, kDt = 4, kFirstColumn = 5;
     int state = 0, params = 0, exports = 0, emits = 0, render = 0, parents = 0, total = 0;
     static constexpr int kVisible = 0, kPosition = 1, kColor = 4, kSize = 8, kRotation = 9, kFrame = 10, kEnd = 11,
-                         kRenderColumns = 14;
+                         kRenderColumns = 14, kTrail = 14;
+    // This object's render columns: kRenderColumns, and a trail's 3 per point behind its
+    // head from kTrail on (ir::renderColumns).
+    int renderColumns = kRenderColumns;
     std::vector<int> stateOffset, paramOffset, exportOffset;
     struct ParentColumn {
         ir::Op op;
@@ -57,7 +61,10 @@ struct ColumnLayout {
                    ? render + c
                    : renderFromState[static_cast<size_t>(c)];
     }
-    bool fromState(ir::YieldKind kind) const { return drawnFrom(renderColumn(kind)) != render + renderColumn(kind); }
+    bool fromState(const ir::Yield& y) const {
+        int c = renderColumn(y.kind, y.index);
+        return drawnFrom(c) != render + c;
+    }
     // A position, colour or size component every row draws alike (`point(pos, col, 2)`:
     // the size is 2; `(0, 1 − age, 0, 1)`: three of the colour's four) has no column at
     // all: the drawing hands over its value. Per render column (kVisible … kSize); the
@@ -100,8 +107,8 @@ struct ColumnLayout {
 
     int emitRate(int site) const { return emits + 2 * site; }
     int emitCount(int site) const { return emits + 2 * site + 1; }
-    // The first render column of a render yield.
-    static int renderColumn(ir::YieldKind kind);
+    // The first render column of a render yield (a trail's point: its index).
+    static int renderColumn(ir::YieldKind kind, int index = 0);
     // Names every column position, so two kernels with the same text and signature can
     // share compiled code.
     std::string signature() const;

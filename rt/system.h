@@ -97,6 +97,7 @@ struct RenderPoint {
     float size;
     float rotation = 0, frame = 0;       // a sprite's (0 for the others)
     std::array<float, 3> end{};          // a streak's other end (0 for the others)
+    std::vector<std::array<float, 3>> trail;  // a trail's points behind its head, nearest first
 };
 
 // What is drawn for one type after the latest step, as columns in the backend's memory:
@@ -125,6 +126,12 @@ struct DrawColumns {
     // A component every row draws alike has no column (an invalid buffer above) and its
     // value here, in that order (ColumnLayout::renderConstant).
     std::array<float, kValues> constant{};
+    // A trail's points behind its head, nearest first, x y z each (point k + 1 back at
+    // 3k … 3k + 2); a component every row draws alike has no column and its value in
+    // trailConstant. Empty for the other commands.
+    std::vector<Buffer> trail;
+    std::vector<float> trailConstant;
+    size_t trailPoints() const { return trail.size() / 3; }
 };
 
 // What hot reload kept and lost (rt/reload.cpp, docs/runtime.md).

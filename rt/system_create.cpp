@@ -76,10 +76,10 @@ void Creation::bindBatch(size_t type, Batch& b, const ColumnLayout& layout, Scra
             table[static_cast<size_t>(layout.exportOffset[e] + c)] =
                 b.columns.at(kFirstValue + 2 * stateCount + component, Elem::F32, rows);
     size_t emitsAt = kFirstValue + 2 * stateCount + exportCount;
-    if (which == Table::Init) emitsAt += 2 * o.emits.size() + ColumnLayout::kRenderColumns;  // (after the render columns)
+    if (which == Table::Init) emitsAt += 2 * o.emits.size() + static_cast<size_t>(layout.renderColumns);  // (after the render columns)
     for (size_t e = 0; e < 2 * o.emits.size(); ++e)
         table[static_cast<size_t>(layout.emits) + e] = b.columns.at(emitsAt + e, Elem::F32, rows);
-    for (int c = 0; c < ColumnLayout::kRenderColumns; ++c)  // what a render kernel writes
+    for (int c = 0; c < layout.renderColumns; ++c)  // what a render kernel writes
         if (layout.needs(layout.render + c))
             table[static_cast<size_t>(layout.render + c)] = b.columns.at(
                 kFirstValue + 2 * stateCount + exportCount + 2 * o.emits.size() + static_cast<size_t>(c), Elem::F32, rows);
@@ -163,7 +163,7 @@ void Creation::drawBatch(size_t type, Batch& b, size_t n, double t1) {
     work.inStep.nonFinite += nonFinite;
     s_.bindPool(type, layout, work.render, work.renderTable);
     std::vector<std::pair<Buffer, Buffer>> columns;
-    for (int c = 0; c < ColumnLayout::kRenderColumns; ++c)
+    for (int c = 0; c < layout.renderColumns; ++c)
         if (int column = layout.render + c; layout.needs(column))
             columns.push_back({b.renderTable[static_cast<size_t>(column)], work.renderTable[static_cast<size_t>(column)]});
     s_.scatter(columns, first, b.poolRows);

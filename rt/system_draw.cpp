@@ -16,11 +16,11 @@ void markDrawn(Memory& memory, const RowsLaunch& launch, const uint8_t* mask, si
     const ColumnLayout& layout = *launch.layout;
     auto column = [&](int c) { return launch.columns[static_cast<size_t>(layout.drawnFrom(c))]; };
     float* visible = hostData<float>(memory, column(ColumnLayout::kVisible));
-    const float* values[DrawColumns::kValues] = {};
-    bool constantsFinite = true;  // the constant components: the same for every row
-    for (int c = 0; c < DrawColumns::kValues; ++c) {
-        if (auto k = layout.constant(ColumnLayout::kPosition + c)) constantsFinite &= std::isfinite(*k);
-        else values[c] = viewData<float>(memory, column(ColumnLayout::kPosition + c));
+    std::vector<const float*> values;  // every drawn value's column: position … a trail's last point
+    bool constantsFinite = true;       // the constant components: the same for every row
+    for (int c = ColumnLayout::kPosition; c < layout.renderColumns; ++c) {
+        if (auto k = layout.constant(c)) constantsFinite &= std::isfinite(*k);
+        else values.push_back(viewData<float>(memory, column(c)));
     }
     for (size_t row = begin; row < end; ++row) {
         if (!mask[row] || visible[row] == 0) {
@@ -124,6 +124,11 @@ void Drawing::hand(size_t type, DrawColumns& out) {
     for (int c = 0; c < 3; ++c) out.end[c] = column(ColumnLayout::kEnd + c);
     for (int c = 0; c < DrawColumns::kValues; ++c)
         if (auto k = layout.constant(ColumnLayout::kPosition + c)) out.constant[static_cast<size_t>(c)] = *k;
+    for (int c = ColumnLayout::kTrail; c < layout.renderColumns; ++c) {
+        auto k = layout.constant(c);
+        out.trail.push_back(k ? Buffer{} : column(c));
+        out.trailConstant.push_back(k.value_or(0.0f));
+    }
 }
 
 void Drawing::takeCounts(size_t type) {
@@ -210,6 +215,11 @@ std::vector<RenderPoint> Drawing::points(size_t type) {
         values[k].resize(c.rows);
         memory.read(columns[k], 0, c.rows, values[k].data());
     }
+    std::vector<std::vector<float>> trail(c.trail.size());
+    for (size_t k = 0; k < c.trail.size(); ++k) {
+        trail[k].assign(c.rows, c.trailConstant[k]);
+        if (c.trail[k].valid()) memory.read(c.trail[k], 0, c.rows, trail[k].data());
+    }
     for (size_t row = 0; row < c.rows; ++row) {
         if (visible[row] == 0) continue;
         out.push_back({ids[row],
@@ -218,7 +228,10 @@ std::vector<RenderPoint> Drawing::points(size_t type) {
                        values[7][row],
                        values[8][row],
                        values[9][row],
-                       {values[10][row], values[11][row], values[12][row]}});
+                       {values[10][row], values[11][row], values[12][row]},
+                       {}});
+        for (size_t k = 0; k + 2 < trail.size(); k += 3)
+            out.back().trail.push_back({trail[k][row], trail[k + 1][row], trail[k + 2][row]});
     }
     return out;
 }

@@ -31,13 +31,26 @@ inline ir::Module compileModule(const std::string& text, bool optimize = true,
     return std::move(*module);
 }
 
+// A drawn point as bytes: its values, then a trail's points.
+inline void appendPoint(std::string& out, const rt::RenderPoint& p) {
+    auto bytes = [&out](const void* at, size_t n) { out.append(static_cast<const char*>(at), n); };
+    bytes(&p.id, sizeof p.id);
+    bytes(p.position.data(), sizeof p.position);
+    bytes(p.color.data(), sizeof p.color);
+    bytes(&p.size, sizeof p.size);
+    bytes(&p.rotation, sizeof p.rotation);
+    bytes(&p.frame, sizeof p.frame);
+    bytes(p.end.data(), sizeof p.end);
+    for (const auto& q : p.trail) bytes(q.data(), sizeof q);
+}
+
 // Everything drawn after each of `frames` steps of 1/60 s, as bytes.
 inline std::string drawnBytes(rt::System& system, int frames) {
     std::string out;
     for (int f = 0; f < frames; ++f) {
         REQUIRE_FALSE(system.step(1.0 / 60));
         for (size_t t = 0; t < system.typeCount(); ++t)
-            for (const rt::RenderPoint& p : system.points(t)) out.append(reinterpret_cast<const char*>(&p), sizeof p);
+            for (const rt::RenderPoint& p : system.points(t)) appendPoint(out, p);
     }
     return out;
 }
@@ -90,7 +103,7 @@ inline std::string hostSees(const std::string& text, rt::Backend& backend, bool 
         for (size_t t = 0; t < system.typeCount(); ++t) {
             size_t drawn = system.draw(t).drawn;
             out.append(reinterpret_cast<const char*>(&drawn), sizeof drawn);
-            for (const rt::RenderPoint& p : system.points(t)) out.append(reinterpret_cast<const char*>(&p), sizeof p);
+            for (const rt::RenderPoint& p : system.points(t)) appendPoint(out, p);
         }
         uint64_t nonFinite = system.stats().nonFiniteRender;
         out.append(reinterpret_cast<const char*>(&nonFinite), sizeof nonFinite);

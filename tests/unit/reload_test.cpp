@@ -24,7 +24,7 @@ std::string run(rt::System& system, int frames) {
     for (int f = 0; f < frames; ++f) {
         REQUIRE_FALSE(system.step(1.0 / 60));
         for (size_t t = 0; t < system.typeCount(); ++t)
-            for (const rt::RenderPoint& p : system.points(t)) out.append(reinterpret_cast<const char*>(&p), sizeof p);
+            for (const rt::RenderPoint& p : system.points(t)) test::appendPoint(out, p);
         for (const rt::TypeStats& t : system.stats().types)
             out += std::to_string(t.live) + "/" + std::to_string(t.created) + "/" + std::to_string(t.killed) + "/" +
                    std::to_string(t.frozen) + ";";

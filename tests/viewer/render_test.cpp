@@ -227,7 +227,7 @@ TEST_CASE("every sample is drawn: frame 600, fitted, lights its share of the fra
         {"emitter", 0.01},      {"fire", 0.02},      {"fireworks", 0.004}, {"first_particle", 0.02},
         {"follow_parent", 0.004}, {"fountain", 0.004}, {"galaxy", 0.01},   {"grinder", 0.004},
         {"rain", 0.002},        {"random", 0.02},    {"smoke", 0.05},     {"swamp", 0.002},
-        {"triggered_explosion", 0.01}, {"two_streams", 0.01}, {"wind", 0.02}};
+        {"triggered_explosion", 0.01}, {"two_streams", 0.01}, {"wand", 0.1}, {"wind", 0.02}};
     size_t samples = 0;
     for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
         if (entry.path().extension() != ".psys") continue;
@@ -291,6 +291,58 @@ TEST_CASE("a streak is drawn from its start to its end, as wide as its width") {
         REQUIRE(at);
         CHECK(background(f.at(at->first, at->second)));
     }
+}
+
+TEST_CASE("a trail is a ribbon through the object's last positions, widest at its head, gone past its tail") {
+    // Moving along x at 6 units a second: after 60 updates of 1/60 s its head is at x = 3,
+    // its 31 points reach back 30 updates (0.5 s, 3 units) to x = 0.
+    Frame f = render("object s { trail(vec3(-3 + age * 6, 2, 0), white, 0.5, 31); }\nspawn s;", 60, Blend::Additive);
+    Camera camera = *Camera::parse("0,0,10,0,2,0");
+    auto pixel = [&](float x, float y) {
+        auto at = project(camera, {x, y, 0});
+        REQUIRE(at);
+        return f.at(at->first, at->second);
+    };
+    for (float x : {0.4f, 1.5f, 2.8f}) CHECK_FALSE(background(pixel(x, 2)));
+    for (float x : {-0.4f, 3.4f}) CHECK(background(pixel(x, 2)));
+    auto height = [&](float x) {  // the lit pixels across the ribbon at x
+        auto at = project(camera, {x, 2, 0});
+        int lit = 0;
+        for (int y = 0; y < kHeight; ++y) lit += !background(f.at(at->first, y));
+        return lit;
+    };
+    MESSAGE("lit pixels across the ribbon near its head " << height(2.8f) << ", near its tail " << height(0.4f));
+    CHECK(height(2.8f) > 2 * height(0.4f));
+    // Brighter at its head than near its tail: it fades.
+    CHECK(pixel(2.8f, 2).r > pixel(0.4f, 2).r);
+}
+
+TEST_CASE("trails draw the same pixels from the JIT and from the GLSL backend, sorted on the GPU with nothing read back") {
+    std::string text = R"(
+        object a(p: vec3, v: vec3) { pos = p + integrate(v + vec3(0, -2, 0) * age); trail(pos, vec4(1, 0.6, 0.2, 1), 0.2, 24); kill when age > 1.5; }
+        @blend(alpha) object b(p: vec3, v: vec3) { pos = p + integrate(v); trail(pos, vec4(0.3, 0.6, 1, 0.8), 0.4, 12); kill when age > 1.5; }
+        object g {
+            emit a(vec3(0, 2, 0), nrand3() * 3) at 40 per second;
+            emit b(nrand3() + vec3(0, 2, 0), nrand3() * 2) at 40 per second;
+        }
+        spawn g;)";
+    uint64_t waits = ~0ull, moved = 0;
+    Frame gpu = render(text, 60, Blend::Additive, [&](Viewer& v) {
+        // Drawing a frame more waits for nothing from the GPU: the points behind each head
+        // are packed there (what it sends are the rows created this step, not yet sent).
+        auto& gl = dynamic_cast<gpu::GlslBackend&>(v.session().backend());
+        uint64_t before = gl.waits(), sent = gl.transferredBytes();
+        v.draw();
+        waits = gl.waits() - before;
+        moved = gl.transferredBytes() - sent;
+    }, "glsl");
+    Frame jit = render(text, 60, Blend::Additive, {}, "llvm");
+    size_t lit = litPixels(jit), differ = differentPixels(gpu, jit);
+    MESSAGE(differ << " of " << lit << " lit pixels differ by more than 2 levels; drawing a frame waited " << waits
+                   << " times for the GPU and sent it " << moved << " bytes");
+    CHECK(lit > 3000);
+    CHECK(differ <= lit / 100);
+    CHECK(waits == 0);
 }
 
 TEST_CASE("sprites of every shape and streaks draw the same pixels from the JIT and from the GLSL backend") {

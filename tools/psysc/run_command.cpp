@@ -16,13 +16,14 @@ namespace {
 
 // `--dump`: every drawn point of the frames dumped, written as each frame ends (CSV rows,
 // or a JSON document {"frames": [...]} streamed one frame a line), so memory stays that of
-// one frame however long the run; the file is opened before the run starts.
+// one frame however long the run; the file is opened before the run starts. A trail's
+// points behind its head: JSON "trail": [[x, y, z], …], the CSV's last column `x y z x y z …`.
 class Dump {
 public:
     explicit Dump(const std::string& path) : path_(path), json_(path.ends_with(".json")) {
         if (path.empty()) return;
         out_.open(path, std::ios::binary);
-        out_ << (json_ ? "{\"frames\": [" : "frame,time,type,id,x,y,z,r,g,b,a,size,rotation,sprite_frame,end_x,end_y,end_z\n");
+        out_ << (json_ ? "{\"frames\": [" : "frame,time,type,id,x,y,z,r,g,b,a,size,rotation,sprite_frame,end_x,end_y,end_z,trail\n");
     }
     bool ok() const { return path_.empty() || out_.good(); }
 
@@ -41,13 +42,16 @@ public:
                         o["frame"] = p.frame;
                     }
                     if (system.module().objects[t].draw == core::DrawKind::Streak) o["end"] = p.end;
+                    if (system.module().objects[t].draw == core::DrawKind::Trail) o["trail"] = p.trail;
                     out_ << (first ? "" : ", ") << o.dump();
                     first = false;
                 } else {
-                    out_ << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", frame, system.time(), type,
+                    std::string trail;
+                    for (const auto& q : p.trail) trail += fmt::format("{}{} {} {}", trail.empty() ? "" : " ", q[0], q[1], q[2]);
+                    out_ << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", frame, system.time(), type,
                                         p.id, p.position[0], p.position[1], p.position[2], p.color[0], p.color[1],
                                         p.color[2], p.color[3], p.size, p.rotation, p.frame, p.end[0], p.end[1],
-                                        p.end[2]);
+                                        p.end[2], trail);
                 }
             }
         }

@@ -67,9 +67,15 @@ layout(std430, binding = 0) readonly buffer Source { float source[]; };
 layout(std430, binding = 5) readonly buffer Rows { uint rows[]; };
 layout(std430, binding = 6) writeonly buffer Target { float target[]; };
 uniform uint count;
+uniform uint sorted;    // 1: row i is rows[i]
+uniform uint stride;
+uniform uint offset;
+uniform uint constantOnly;  // 1: no source, `constant` for every row
+uniform float constant;
 void main() {
     uint i = gl_GlobalInvocationID.x;
-    if (i < count) target[i] = source[rows[i]];
+    if (i >= count) return;
+    target[i * stride + offset] = constantOnly == 1u ? constant : source[sorted == 1u ? rows[i] : i];
 }
 )";
 
@@ -130,12 +136,19 @@ void DepthSort::order(GLuint visible, const std::array<GLuint, 3>& position, con
         }
 }
 
-void DepthSort::gather(GLuint source, GLuint target, size_t rows) {
+void DepthSort::gather(GLuint source, GLuint target, size_t rows, bool sorted, size_t stride, size_t offset,
+                       float constant) {
+    reserve(1);  // (an unused binding still needs a buffer)
     glUseProgram(gather_);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, source);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, source ? source : target);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, indexBuffer_);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, target);
     glUniform1ui(glGetUniformLocation(gather_, "count"), static_cast<GLuint>(rows));
+    glUniform1ui(glGetUniformLocation(gather_, "sorted"), sorted ? 1u : 0u);
+    glUniform1ui(glGetUniformLocation(gather_, "stride"), static_cast<GLuint>(stride));
+    glUniform1ui(glGetUniformLocation(gather_, "offset"), static_cast<GLuint>(offset));
+    glUniform1ui(glGetUniformLocation(gather_, "constantOnly"), source ? 0u : 1u);
+    glUniform1f(glGetUniformLocation(gather_, "constant"), constant);
     glDispatchCompute(groups(rows), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT);
 }

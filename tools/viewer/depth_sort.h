@@ -24,8 +24,11 @@ public:
     // not drawn go last).
     void order(GLuint visible, const std::array<GLuint, 3>& position, const glm::vec3& constant, size_t rows,
                const glm::mat4& view);
-    // Writes `source`'s first `rows` floats in that order into `target` (at least as large).
-    void gather(GLuint source, GLuint target, size_t rows);
+    // Writes `source`'s first `rows` floats in that order (where `sorted`; else as they
+    // are) into `target`, row i at float i × stride + offset (a trail's points packed row
+    // by row); a `source` of 0 writes `constant` for every row.
+    void gather(GLuint source, GLuint target, size_t rows, bool sorted = true, size_t stride = 1, size_t offset = 0,
+                float constant = 0);
 
 private:
     void reserve(size_t padded);

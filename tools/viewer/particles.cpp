@@ -101,6 +101,53 @@ void main() {
 }
 )";
 
+// A trail: a ribbon through its head and the points behind it (packed row by row in the
+// `behind` buffer, in the order the instances are drawn), two triangles a segment, the
+// row an instance. Each point's corners lie across the curve's direction there (from its
+// neighbours), so segments meet without a gap or an overlap; the ribbon narrows and fades
+// from its head to nothing at its tail. Its cross-section is a streak's (the fragment
+// shader's kind 2, with no length).
+const char* kTrailVertex = R"(
+uniform mat4 view;
+uniform mat4 projection;
+uniform mat4 viewInverse;
+uniform int points;  // the head and points - 1 behind
+layout(std430, binding = 0) readonly buffer Behind { float behind[]; };
+out vec4 colour;
+out vec2 uv;
+out float seed;
+out float halfLength;
+out float ground;
+const vec2 corners[6] = vec2[](vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, -1), vec2(1, 1), vec2(-1, 1));
+vec3 at(int i) {  // point i of the instance's trail (0: its head), in the eye's space
+    if (i == 0) return (view * vec4(x, y, z, 1.0)).xyz;
+    int first = (gl_InstanceID * (points - 1) + i - 1) * 3;
+    return (view * vec4(behind[first], behind[first + 1], behind[first + 2], 1.0)).xyz;
+}
+void main() {
+    vec2 c = corners[gl_VertexID % 6];
+    int i = gl_VertexID / 6 + (c.x < 0.0 ? 0 : 1);
+    float along = float(i) / float(points - 1);  // 0 at the head, 1 at the tail
+    uv = vec2(0.0, c.y);
+    seed = 0.0;
+    halfLength = 0.0;
+    colour = vec4(r, g, b, a * (1.0 - along));
+    if (visible == 0.0) {
+        gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
+        return;
+    }
+    vec3 p = at(i);
+    vec3 direction = at(max(i - 1, 0)) - at(min(i + 1, points - 1));
+    vec3 side = cross(direction, normalize(-p + vec3(0.0, 0.0, 1e-6)));
+    float sideLength = length(side);
+    side = sideLength > 1e-9 ? side / sideLength : vec3(1.0, 0.0, 0.0);
+    float halfWidth = 0.5 * size;
+    vec3 corner = p + side * c.y * halfWidth * (1.0 - along);
+    gl_Position = projection * vec4(corner, 1.0);
+    ground = (viewInverse * vec4(corner, 1.0)).y / max(halfWidth, 1e-6);
+}
+)";
+
 const char* kQuadFragment = R"(#version 450 core
 in vec4 colour;
 in vec2 uv;
@@ -187,7 +234,9 @@ std::string withAttributes(const char* body) { return std::string("#version 450 
 ParticleRenderer::ParticleRenderer() {
     points_ = linkProgram(withAttributes(kPointVertex).c_str(), codegen_glsl::drawFragmentShader().c_str());
     quads_ = linkProgram(withAttributes(kQuadVertex).c_str(), kQuadFragment);
+    trails_ = linkProgram(withAttributes(kTrailVertex).c_str(), kQuadFragment);
     sorter_ = std::make_unique<DepthSort>();
+    glCreateBuffers(1, &behind_);
     glCreateVertexArrays(1, &vao_);
     glCreateBuffers(kColumns, buffers_);
     for (GLuint i = 0; i < kColumns; ++i) {
@@ -202,6 +251,8 @@ ParticleRenderer::~ParticleRenderer() {
     for (auto& [path, t] : textures_)
         if (t) glDeleteTextures(1, &t);
     glDeleteBuffers(kColumns, buffers_);
+    glDeleteBuffers(1, &behind_);
+    glDeleteProgram(trails_);
     glDeleteVertexArrays(1, &vao_);
     glDeleteProgram(points_);
     glDeleteProgram(quads_);
@@ -248,6 +299,7 @@ bool ParticleRenderer::bind(const rt::DrawColumns& c, const rt::Memory& memory, 
             gl[i] = memory.glBuffer(columns[i]);
             allOnGpu &= gl[i] != 0;
         }
+    for (rt::Buffer b : c.trail) allOnGpu &= !b.valid() || memory.glBuffer(b) != 0;
     sorted_ = 0;
     order_.clear();
     bool sort = style.blend == core::Blend::Alpha && style.kind != core::DrawKind::Point && c.rows > 1;
@@ -303,15 +355,43 @@ bool ParticleRenderer::bind(const rt::DrawColumns& c, const rt::Memory& memory, 
         }
         glNamedBufferSubData(buffers_[i], 0, bytes, data);
     }
+    if (style.kind == core::DrawKind::Trail) packTrail(c, memory, allOnGpu);
     return true;
+}
+
+// A trail's points behind its head, packed row by row (x y z of each point, nearest
+// first) into one buffer the trail shader reads, in the order the rows are drawn: by
+// the GPU's gathers where the columns are there, else on the host.
+void ParticleRenderer::packTrail(const rt::DrawColumns& c, const rt::Memory& memory, bool onGpu) {
+    const size_t stride = c.trail.size();
+    auto bytes = static_cast<GLsizeiptr>(std::max<size_t>(c.rows * stride, 1) * sizeof(float));
+    if (static_cast<size_t>(bytes) > behindCapacity_) {
+        glNamedBufferData(behind_, bytes, nullptr, GL_STREAM_DRAW);
+        behindCapacity_ = static_cast<size_t>(bytes);
+    }
+    if (onGpu) {
+        for (size_t k = 0; k < stride; ++k)
+            sorter_->gather(c.trail[k].valid() ? memory.glBuffer(c.trail[k]) : 0, behind_, c.rows, sorted_ != 0, stride,
+                            k, c.trailConstant[k]);
+        return;
+    }
+    staging_.resize(c.rows * stride);
+    std::vector<float> column(c.rows);
+    for (size_t k = 0; k < stride; ++k) {
+        if (c.trail[k].valid()) memory.read(c.trail[k], 0, c.rows, column.data());
+        else std::fill(column.begin(), column.end(), c.trailConstant[k]);
+        for (size_t row = 0; row < c.rows; ++row)
+            staging_[row * stride + k] = column[order_.empty() ? row : order_[row]];
+    }
+    glNamedBufferSubData(behind_, 0, static_cast<GLsizeiptr>(staging_.size() * sizeof(float)), staging_.data());
 }
 
 void ParticleRenderer::draw(const rt::DrawColumns& c, const rt::Memory& memory, const DrawStyle& style,
                             const glm::mat4& view, const glm::mat4& projection, float viewportHeight) {
     if (c.rows == 0 || (c.counted && c.drawn == 0)) return;
     if (!bind(c, memory, style, view)) return;
-    bool points = style.kind == core::DrawKind::Point;
-    GLuint program = points ? points_ : quads_;
+    bool points = style.kind == core::DrawKind::Point, trail = style.kind == core::DrawKind::Trail;
+    GLuint program = points ? points_ : trail ? trails_ : quads_;
     glUseProgram(program);
     glUniformMatrix4fv(glGetUniformLocation(program, "view"), 1, GL_FALSE, glm::value_ptr(view));
     glUniformMatrix4fv(glGetUniformLocation(program, "projection"), 1, GL_FALSE, glm::value_ptr(projection));
@@ -319,6 +399,8 @@ void ParticleRenderer::draw(const rt::DrawColumns& c, const rt::Memory& memory, 
         glUniform1f(glGetUniformLocation(program, "reference"), kReferenceDistance * viewportHeight / 720.0f);
     } else {
         glUniform1i(glGetUniformLocation(program, "kind"), style.kind == core::DrawKind::Sprite ? 1 : 2);
+        glUniform1i(glGetUniformLocation(program, "points"), static_cast<GLint>(c.trailPoints() + 1));
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, behind_);
         glUniform1i(glGetUniformLocation(program, "shape"), static_cast<int>(style.shape));
         glUniform1i(glGetUniformLocation(program, "softGround"), style.softGround ? 1 : 0);
         glm::mat4 inverse = glm::inverse(view);
@@ -329,7 +411,8 @@ void ParticleRenderer::draw(const rt::DrawColumns& c, const rt::Memory& memory, 
         glUniform1i(glGetUniformLocation(program, "image"), 0);
         glBindTextureUnit(0, image);
     }
-    // Points are vertices; a sprite's or streak's row is an instance of six.
+    // Points are vertices; a sprite's or streak's row is an instance of six, a trail's of
+    // six a segment.
     for (GLuint i = 0; i < kColumns; ++i) glVertexArrayBindingDivisor(vao_, i, points ? 0 : 1);
     glEnable(GL_PROGRAM_POINT_SIZE);
     glEnable(GL_BLEND);
@@ -339,7 +422,8 @@ void ParticleRenderer::draw(const rt::DrawColumns& c, const rt::Memory& memory, 
     glDepthMask(GL_FALSE);  // particles blend over each other; the ground still hides what is below it
     glBindVertexArray(vao_);
     if (points) glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(c.rows));
-    else glDrawArraysInstanced(GL_TRIANGLES, 0, 6, static_cast<GLsizei>(c.rows));
+    else glDrawArraysInstanced(GL_TRIANGLES, 0, trail ? static_cast<GLsizei>(6 * c.trailPoints()) : 6,
+                               static_cast<GLsizei>(c.rows));
     glBindVertexArray(0);
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);

@@ -9,6 +9,9 @@
 //           of columns × rows frames, `frame` picking one), tinted by the colour
 //   streak  a band `size` world units wide from `position` to `end`, round-capped, with a
 //           hot core
+//   trail   a ribbon through the position and the points behind it, `size` world units
+//           wide at its head, narrowing and fading to nothing at its tail; a streak's
+//           cross-section
 //
 // Blending is the type's (@blend; the viewer's B switch for types that name none): added,
 // or alpha-blended over what is behind, back to front (the rows sorted by depth each
@@ -60,11 +63,14 @@ public:
 private:
     static constexpr int kColumns = 1 + rt::DrawColumns::kValues;  // visible, then the values in render order
     bool bind(const rt::DrawColumns& c, const rt::Memory& memory, const DrawStyle& style, const glm::mat4& view);
+    void packTrail(const rt::DrawColumns& c, const rt::Memory& memory, bool onGpu);
     GLuint texture(const std::string& path);  // loaded once (0: it could not be)
     std::unique_ptr<DepthSort> sorter_;
     std::map<std::string, GLuint> textures_;
     std::string problems_;
-    GLuint points_ = 0, quads_ = 0, vao_ = 0, buffers_[kColumns] = {};
+    GLuint points_ = 0, quads_ = 0, trails_ = 0, vao_ = 0, buffers_[kColumns] = {};
+    GLuint behind_ = 0;  // a trail's points behind its heads, row by row
+    size_t behindCapacity_ = 0;
     size_t capacity_[kColumns] = {};
     std::vector<float> staging_;
     std::vector<uint32_t> order_;
