@@ -98,6 +98,13 @@ TEST_CASE("the parser reports what is wrong and where") {
     CHECK(error == "line 4: value %4 is not defined");
     CHECK_FALSE(parseModule("object a()\n", error));
     CHECK(error.find("has no `end`") != std::string::npos);
+    CHECK_FALSE(parseModule("object a()\n  draw trail\nend\n", error));
+    CHECK(error == "line 2: expected `draw point|sprite|streak` or `draw trail POINTS`");
+    CHECK_FALSE(parseModule("object a()\n  draw trail 1\nend\n", error));
+    CHECK(error == "line 2: a trail has 2 to 64 points, not 1");
+    CHECK_FALSE(parseModule("object a()\n  draw sprite 4\nend\n", error));
+    CHECK_FALSE(parseModule("object a()\n  kernel render\n    %0 = const.f32 0\n  storage\n  storage drawn trail.99.x = const 0\n  end\nend\n", error));
+    CHECK(error == "line 5: unknown render column `trail.99.x`");
 }
 
 TEST_CASE("the verifier finds broken invariants") {
@@ -112,6 +119,9 @@ TEST_CASE("the verifier finds broken invariants") {
     CHECK(verifyText("object a()\n  kernel render\n    %0 = age.f32\n    yield position = %0\n  end\nend\n")
               .find("a vec3") != std::string::npos);
     CHECK(verifyText("object a()\n  emit nothing rate\nend\n").find("emits unknown `nothing`") != std::string::npos);
+    // A trail's point past the object's trail.
+    CHECK(verifyText("object a()\n  draw trail 2\n  kernel render\n    %0 = const.vec3 0 0 0\n    yield trail #1 = %0\n  end\nend\n")
+              .find("no such point of the object's trail") != std::string::npos);
     // Found by fuzz_ir: a draw with one key operand (it takes none or two) read past its operands.
     CHECK(verifyText("object a()\n  kernel init\n    %0 = object.id.u32\n    %1 = nrand.vec2 %0 #0\n  end\nend\n")
               .find("keyed by two u32") != std::string::npos);

@@ -6,6 +6,8 @@
 #include <cstring>
 #include <filesystem>
 
+#include <fmt/format.h>
+
 #include "driver/compile.h"
 #include "interp/interpreter.h"
 #include "rt/system.h"
@@ -341,4 +343,31 @@ TEST_CASE("a reload that adds a spawn spawns it, one the old start had is not re
     CHECK(report.spawned.empty());
     run(removed, 1);
     CHECK(removed.pool(1).live() == 2);  // the b objects stay
+}
+
+TEST_CASE("a reload that lengthens or shortens a trail keeps its objects: the points it has carry on") {
+    auto text = [](int n) {
+        return fmt::format("object p {{ pos = integrate(vec3(1, 0, 0)); trail(pos, white, 0.1, {}); }}\nspawn p;", n);
+    };
+    for (auto [from, to] : {std::pair{4, 9}, std::pair{9, 4}}) {
+        INFO(from << " points to " << to);
+        interp::Interpreter backend;
+        rt::System before(compile(text(from)), backend);
+        run(before, 30);
+        auto was = before.points(0);
+        REQUIRE(was.size() == 1);
+        rt::System after(compile(text(to)), backend);
+        rt::ReloadReport report = after.carryOver(before);
+        CHECK(report.carried == 1);
+        REQUIRE_FALSE(after.step(1.0 / 60));
+        auto now = after.points(0);
+        REQUIRE(now.size() == 1);
+        CHECK(now[0].position[0] > was[0].position[0]);  // the integral carried over
+        REQUIRE(now[0].trail.size() == static_cast<size_t>(to - 1));
+        for (const auto& q : now[0].trail) {  // every point behind the head, on its path
+            CHECK(q[0] <= now[0].position[0]);
+            CHECK(q[0] >= 0.0f);
+            CHECK(q[1] == 0.0f);
+        }
+    }
 }
