@@ -452,6 +452,29 @@ TEST_CASE("a textured sprite draws its flip-book's frame, tinted by its colour")
     }
 }
 
+TEST_CASE("a texture changed on disk is drawn as it is now, with no reload of the program") {
+    auto write = [](const std::filesystem::path& file, Pixel p) {
+        std::vector<uint8_t> image;
+        for (int i = 0; i < 4; ++i) image.insert(image.end(), {uint8_t(p.r), uint8_t(p.g), uint8_t(p.b), 255});
+        REQUIRE(stbi_write_png(file.string().c_str(), 2, 2, 4, image.data(), 8));
+    };
+    std::filesystem::path file = std::filesystem::temp_directory_path() / "psys_viewer_test_changing.png";
+    write(file, {255, 0, 0});
+    std::string text = fmt::format("@texture(\"{}\") @blend(alpha) object s {{ sprite(vec3(0, 2, 0), white, 2); }}\nspawn s;",
+                                   file.string());
+    // The run draws the red image (and keeps it); then the file turns blue and a frame
+    // more is drawn.
+    Frame after = render(text, 1, Blend::Additive, [&](Viewer& v) {
+        write(file, {0, 0, 255});
+        // A later time than the first file's, whatever the file system's clock resolution.
+        std::filesystem::last_write_time(file, std::filesystem::last_write_time(file) + std::chrono::seconds(2));
+        v.draw();
+    });
+    Pixel now = after.at(kWidth / 2, kHeight / 2);
+    CHECK(now.b > 200);
+    CHECK(now.r < 40);
+}
+
 TEST_CASE("with the ground shown, a sprite fades where it crosses the ground plane") {
     std::string text = "@shape(disc) @blend(alpha) object s { sprite(vec3(0, 0, 0), white, 2); }\nspawn s;";
     auto level = [](bool ground) {

@@ -1,6 +1,7 @@
 #include "particles.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <numeric>
 #include <utility>
 
@@ -249,7 +250,7 @@ ParticleRenderer::ParticleRenderer() {
 
 ParticleRenderer::~ParticleRenderer() {
     for (auto& [path, t] : textures_)
-        if (t) glDeleteTextures(1, &t);
+        if (t.gl) glDeleteTextures(1, &t.gl);
     glDeleteBuffers(kColumns, buffers_);
     glDeleteBuffers(1, &behind_);
     glDeleteProgram(trails_);
@@ -258,8 +259,16 @@ ParticleRenderer::~ParticleRenderer() {
     glDeleteProgram(quads_);
 }
 
+// Loaded again when the file changes on disk (its modification time), so an image being
+// painted shows as it is saved, as the program does.
 GLuint ParticleRenderer::texture(const std::string& path) {
-    if (auto it = textures_.find(path); it != textures_.end()) return it->second;
+    std::error_code error;
+    auto modified = std::filesystem::last_write_time(path, error);
+    if (auto it = textures_.find(path); it != textures_.end()) {
+        if (error || modified == it->second.modified) return it->second.gl;
+        if (it->second.gl) glDeleteTextures(1, &it->second.gl);
+        textures_.erase(it);
+    }
     int width = 0, height = 0, channels = 0;
     unsigned char* pixels = stbi_load(path.c_str(), &width, &height, &channels, 4);
     GLuint t = 0;
@@ -276,7 +285,7 @@ GLuint ParticleRenderer::texture(const std::string& path) {
         glTextureParameteri(t, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
         stbi_image_free(pixels);
     }
-    textures_[path] = t;
+    textures_[path] = {t, error ? std::filesystem::file_time_type{} : modified};
     return t;
 }
 

@@ -20,6 +20,7 @@
 
 #include <epoxy/gl.h>
 
+#include <filesystem>
 #include <glm/glm.hpp>
 #include <map>
 #include <memory>
@@ -64,9 +65,13 @@ private:
     static constexpr int kColumns = 1 + rt::DrawColumns::kValues;  // visible, then the values in render order
     bool bind(const rt::DrawColumns& c, const rt::Memory& memory, const DrawStyle& style, const glm::mat4& view);
     void packTrail(const rt::DrawColumns& c, const rt::Memory& memory, bool onGpu);
-    GLuint texture(const std::string& path);  // loaded once (0: it could not be)
+    GLuint texture(const std::string& path);  // loaded once, again when it changes (0: it could not be)
     std::unique_ptr<DepthSort> sorter_;
-    std::map<std::string, GLuint> textures_;
+    struct Texture {
+        GLuint gl = 0;
+        std::filesystem::file_time_type modified;
+    };
+    std::map<std::string, Texture> textures_;
     std::string problems_;
     GLuint points_ = 0, quads_ = 0, trails_ = 0, vao_ = 0, buffers_[kColumns] = {};
     GLuint behind_ = 0;  // a trail's points behind its heads, row by row
