@@ -1,6 +1,7 @@
 #include "frontend/loader.h"
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -39,6 +40,19 @@ std::optional<std::string> readFile(const fs::path& path, std::string& error) {
         return std::nullopt;
     }
     return text;
+}
+
+// The file an import names: the library's for `std/…` (the first directory that has
+// it; else empty, with where it looked in `looked`), else beside its importer.
+fs::path importTarget(const std::string& path, const fs::path& importer, std::string& looked) {
+    if (!path.starts_with("std/")) return (importer.parent_path() / path).lexically_normal();
+    std::error_code ec;
+    for (const fs::path& dir : libraryDirectories()) {
+        fs::path file = (dir / path).lexically_normal();
+        if (fs::exists(file, ec)) return file;
+        looked += (looked.empty() ? "" : ", ") + dir.string();
+    }
+    return {};
 }
 
 class Loader {
@@ -80,7 +94,15 @@ private:
             diags_.error(import.pathRange, "an import needs a file name");
             return false;
         }
-        fs::path target = (importer.parent_path() / import.path).lexically_normal();
+        std::string looked;
+        fs::path target = importTarget(import.path, importer, looked);
+        if (target.empty()) {
+            diags_.error(import.pathRange,
+                         fmt::format("there is no `{}` in the standard library (looked in {})", import.path,
+                                     looked.empty() ? "no directory: none was found" : looked))
+                .notes.push_back({import.pathRange, "PSYS_LIBRARY names the directories that hold `std/`"});
+            return false;
+        }
         std::string key = canonicalKey(target);
         for (size_t i = 0; i < stack_.size(); ++i) {
             if (stack_[i].first != key) continue;
@@ -113,6 +135,29 @@ private:
 };
 
 }  // namespace
+
+std::vector<fs::path> libraryDirectories() {
+    std::vector<fs::path> dirs;
+    if (const char* env = std::getenv("PSYS_LIBRARY")) {
+        std::string list = env;
+        for (size_t start = 0; start <= list.size();) {
+            size_t end = std::min(list.find(':', start), list.size());
+            if (end > start) dirs.emplace_back(list.substr(start, end - start));
+            start = end + 1;
+        }
+    }
+    std::error_code ec;
+    fs::path self = fs::read_symlink("/proc/self/exe", ec);
+    if (!ec)
+        for (fs::path dir = self.parent_path(); !dir.empty(); dir = dir.parent_path()) {
+            if (fs::is_directory(dir / "share/psys/std", ec)) {
+                dirs.push_back(dir / "share/psys");
+                break;
+            }
+            if (dir == dir.root_path()) break;
+        }
+    return dirs;
+}
 
 std::unique_ptr<ast::Program> loadProgram(const std::string& mainPath, SourceManager& sources, DiagnosticEngine& diags) {
     std::string error;

@@ -1,17 +1,27 @@
 // Loading a program: the main file and, transitively, every file it imports.
 //
-// An import path is relative to the importing file. Each file is loaded once however
-// often it is imported (by its canonical path); an import cycle is an error that names
-// the chain of files.
+// An import path is relative to the importing file, but one that starts with `std/`: that
+// is the standard library's (library/std in the sources), found in the library
+// directories (libraryDirectories). Each file is loaded once however often it is imported
+// (by its canonical path); an import cycle is an error that names the chain of files.
 #pragma once
 
+#include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "frontend/ast.h"
 #include "frontend/diagnostics.h"
 
 namespace psys {
+
+// Where `import "std/…"` looks, in order: each directory of the environment variable
+// PSYS_LIBRARY (separated by `:`), then beside the running program — the first of its
+// directory and that directory's ancestors that holds share/psys/std (bin/../share/psys
+// where it is installed, build/share/psys from anywhere in a build tree). A directory
+// listed holds `std/`.
+std::vector<std::filesystem::path> libraryDirectories();
 
 // Returns null when the main file cannot be read or any file has syntax errors.
 std::unique_ptr<ast::Program> loadProgram(const std::string& mainPath, SourceManager& sources, DiagnosticEngine& diags);

@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "frontend/frontend.h"
+#include "frontend/loader.h"
 #include "test_support.h"
 
 using namespace psys;
@@ -109,4 +111,49 @@ TEST_CASE("only regular files are read, and none past 1 MiB") {
     DiagnosticEngine diags3(sources3);
     CHECK(checkText("x.psys", std::string(kMaxSourceBytes + 1, ' '), sources3, diags3) == nullptr);
     CHECK(diags3.render().find("this file is 1048577 bytes, more than the 1048576") != std::string::npos);
+}
+
+TEST_CASE("`std/…` is the standard library's, found beside the program, wherever the importer is") {
+    TempTree t;
+    t.write("deep/down/main.psys", "import \"std/shapes.psys\";\n"
+                                   "object p(q: vec3) { point(snapshot(q), white, 1); }\n"
+                                   "object e { emit p(in_sphere(1)) count 3; }\nspawn e;\n");
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    auto program = checkFile((t.root / "deep/down/main.psys").string(), sources, diags);
+    REQUIRE_MESSAGE(program, diags.render());
+    CHECK(fs::path(program->modules.front()->path).filename() == "shapes.psys");
+    auto dirs = libraryDirectories();
+    REQUIRE_FALSE(dirs.empty());
+    CHECK(fs::exists(dirs.back() / "std/shapes.psys"));  // beside the test binary (build/share/psys)
+}
+
+TEST_CASE("PSYS_LIBRARY comes first: its directories' std/ files take the place of the shipped ones") {
+    TempTree t;
+    t.write("mine/std/shapes.psys", "fn in_sphere(r: float) -> vec3 = vec3(r, 0, 0);\n");
+    struct Env {  // set for this test only
+        explicit Env(const std::string& value) { ::setenv("PSYS_LIBRARY", value.c_str(), 1); }
+        ~Env() { ::unsetenv("PSYS_LIBRARY"); }
+    } env((t.root / "nowhere").string() + ":" + (t.root / "mine").string());
+    auto dirs = libraryDirectories();
+    REQUIRE(dirs.size() >= 2);
+    CHECK(dirs[0] == t.root / "nowhere");
+    CHECK(dirs[1] == t.root / "mine");
+    t.write("main.psys", "import \"std/shapes.psys\";\nconst c = in_sphere(2);\n");
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    auto program = checkFile((t.root / "main.psys").string(), sources, diags);
+    REQUIRE_MESSAGE(program, diags.render());
+    CHECK(fs::path(program->modules.front()->path) == t.root / "mine/std/shapes.psys");
+}
+
+TEST_CASE("a `std/` file the library does not have is an error that says where it looked") {
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    auto program = checkText("main.psys", "import \"std/nothing.psys\";\n", sources, diags);
+    CHECK(program == nullptr);
+    std::string out = diags.render();
+    CHECK(out.find("there is no `std/nothing.psys` in the standard library (looked in ") != std::string::npos);
+    CHECK(out.find("share/psys") != std::string::npos);
+    CHECK(out.find("PSYS_LIBRARY names the directories that hold `std/`") != std::string::npos);
 }
