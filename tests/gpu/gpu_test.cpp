@@ -12,6 +12,9 @@
 // computes them with its own polynomials (its asin is good to about 1e-4).
 //   - The samples use sin, cos, exp, pow and sqrt gently: measured 7.1e-6 at worst
 //     (relative to max(1, |value|)) after 600 frames. Tolerance 1e-4.
+//   - Except marbles: a bounce off a sphere turns with the normal at the contact (a
+//     sqrt), and every later bounce multiplies a difference in it: measured 1.3e-4 after
+//     600 frames. Tolerance 1e-3.
 //   - The every-operation program feeds asin, acos and atan (their 4.9e-4) into pow as a
 //     base with exponents up to about 10, which multiplies a relative error by the
 //     exponent: measured 2.5e-3. Tolerance 1e-2.
@@ -47,7 +50,9 @@ TEST_CASE("every sample draws the same on the GPU as on the interpreter, for 600
     for (auto& entry : std::filesystem::directory_iterator(test::samplesDir())) {
         if (entry.path().extension() != ".psys") continue;
         INFO(entry.path().filename().string());
-        test::Comparison c = compareProgram(readFile(entry.path()), test::kLongRun, true, kSamplesTolerance);
+        // (marbles: bounces in a row amplify the GL's last bits, above)
+        double tolerance = entry.path().stem() == "marbles" ? 1e-3 : kSamplesTolerance;
+        test::Comparison c = compareProgram(readFile(entry.path()), test::kLongRun, true, tolerance);
         CHECK(c.points > 0);
         MESSAGE(entry.path().filename().string() << ": " << c.points << " points, " << c.differences
                                                  << " not bit for bit, worst " << c.worst);

@@ -163,7 +163,7 @@ TEST_CASE("std/color: ramps and curves go through their stops, linear between, h
          {1.5f, 1, 0, 0});
 }
 
-TEST_CASE("std/color: hue, saturation and value; sRGB and linear light, there and back") {
+TEST_CASE("std/color: hue, saturation and value, sRGB and linear light, there and back") {
     near(value("vec4(hsv(0, 1, 1), 1)"), {1, 0, 0, 1});
     near(value("vec4(hsv(1 / 3, 1, 1), 1)"), {0, 1, 0, 1});
     near(value("vec4(hsv(2 / 3, 1, 0.5), 1)"), {0, 0, 0.5f, 1});
