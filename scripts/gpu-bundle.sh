@@ -7,7 +7,8 @@
 #
 # Builds Release in build-release (reusing it where it exists; PSYS_BUNDLE_BUILD names
 # another build directory) and carries psys_gpu_tests, psys_gpu_bench, psysc, psys-view,
-# the samples and the test programs, and every shared library they load but the C
+# the samples, the test programs and the standard library (share/psys/std, found beside
+# bin/ as an installed psys finds it), and every shared library they load but the C
 # library's own — libstdc++ and the vendor-neutral GL dispatch (libglvnd's libEGL,
 # libOpenGL, libGLX, libGL, libGLdispatch, which libepoxy opens at run time) included;
 # a vendor's driver never: the machine's own is found through libglvnd.
@@ -25,7 +26,7 @@ cmake --build "$build" -j "$(nproc)" --target psys_gpu_tests psys_gpu_bench psys
 stage=$(mktemp -d)
 trap 'rm -rf "$stage"' EXIT
 top=$stage/psys-gpu
-mkdir -p "$top/bin/lib" "$top/samples" "$top/programs"
+mkdir -p "$top/bin/lib" "$top/samples" "$top/programs" "$top/share/psys/std"
 binaries=(tests/gpu/psys_gpu_tests bench/psys_gpu_bench tools/psysc/psysc tools/viewer/psys-view)
 for b in "${binaries[@]}"; do
   install -m 755 "$build/$b" "$top/bin/"
@@ -66,6 +67,7 @@ for l in "$top"/bin/lib/*; do
 done
 
 cp "$root"/samples/*.psys "$top/samples/"
+cp "$root"/library/std/*.psys "$top/share/psys/std/"
 cp "$root"/tests/programs/*.psys "$top/programs/"
 install -m 755 "$root/scripts/gpu-bundle-run.sh" "$top/run.sh"
 git -C "$root" rev-parse HEAD > "$top/COMMIT" 2>/dev/null || echo unknown > "$top/COMMIT"
