@@ -252,7 +252,17 @@ Type Checker::checkMember(MemberExpr& member, const Context& ctx) {
         bool isObject = false;
         if (auto it = globals_.find(base.name); it != globals_.end()) isObject = it->second->kind == DeclKind::Object;
         isObject |= nestedObjects_.count(base.name) > 0;
-        bool shadowed = ctx.where == Where::Object && ctx.object && objectScopes_[ctx.object].names.count(base.name);
+        // A name of the object's own, or a function's or trigger's parameter or `let`, is a
+        // value, whatever object has that name (`p.yxz` in a library function whose `p` is
+        // a parameter, imported by a program with an object `p`).
+        bool local = false;
+        if (ctx.fn) {
+            for (size_t i = 0; i < ctx.letsVisible; ++i) local |= ctx.fn->lets[i]->name == base.name;
+            for (const auto& p : ctx.fn->params) local |= p.name == base.name;
+        }
+        if (ctx.trigger)
+            for (const auto& p : ctx.trigger->params) local |= p.name == base.name;
+        bool shadowed = local || (ctx.where == Where::Object && ctx.object && objectScopes_[ctx.object].names.count(base.name));
         if (isObject && !shadowed) {
             diags_.error(base.range, ctx.where == Where::Object
                                          ? fmt::format("`{}` is not an enclosing object of `{}`; an object can read "

@@ -321,3 +321,75 @@ TEST_CASE("std/collide: nothing passes a plane, leaves a box or enters a sphere,
         }
     }
 }
+
+namespace {
+
+// Per object at a random point q in [-20, 20]³: its position and colour as `draw` says.
+std::vector<rt::RenderPoint> noiseAt(const std::string& equations, const std::string& draw, int n = 4000) {
+    Run run(fmt::format(R"(
+        import "std/noise.psys";
+        object p(q: vec3) {{ {} point({}, 1); }}
+        object e {{ emit p(nrand3() * 20) count {}; kill; }}
+        spawn e;)", equations, draw, n));
+    run.steps(1, 1.0 / 60);
+    auto points = run.points("p");
+    REQUIRE(points.size() == static_cast<size_t>(n));
+    return points;
+}
+
+}  // namespace
+
+TEST_CASE("std/noise: 0 at the lattice, within ±1.5, centred, and not flat") {
+    for (const auto& p : noiseAt("", "vec3(noise3(floor(q)), noise2(floor(q.xy)), 0), white")) {
+        CHECK(p.position[0] == 0.0f);
+    }
+    double sum = 0, squares = 0, largest = 0;
+    auto points = noiseAt("", "vec3(noise3(q), noise2(q.xz), noise4(vec4(q, q.x * 0.7))), white");
+    for (const auto& p : points)
+        for (float v : p.position) {
+            sum += v;
+            squares += double(v) * v;
+            largest = std::max(largest, std::abs(double(v)));
+        }
+    double n = 3.0 * points.size(), mean = sum / n, spread = std::sqrt(squares / n - mean * mean);
+    MESSAGE("noise: mean " << mean << ", standard deviation " << spread << ", largest " << largest);
+    CHECK(std::abs(mean) < 0.03);
+    CHECK(spread > 0.1);
+    CHECK(largest < 1.5);
+}
+
+TEST_CASE("std/noise: noise3_grad's gradient is the noise's (against central differences)") {
+    auto points = noiseAt(R"(
+        h = 0.001;
+        fd = vec3(noise3(q + vec3(h, 0, 0)) - noise3(q - vec3(h, 0, 0)),
+                  noise3(q + vec3(0, h, 0)) - noise3(q - vec3(0, h, 0)),
+                  noise3(q + vec3(0, 0, h)) - noise3(q - vec3(0, 0, h))) / (2 * h);)",
+                          "fd, noise3_grad(q)");
+    double worst = 0;
+    for (const auto& p : points)
+        for (size_t c = 0; c < 3; ++c) worst = std::max(worst, std::abs(double(p.position[c]) - p.color[c + 1]));
+    MESSAGE("the gradient's largest difference from central differences: " << worst);
+    CHECK(worst < 0.01);  // (float differences at h = 0.001: about 1e-4 / 0.002)
+}
+
+TEST_CASE("std/noise: curl noise has no divergence") {
+    auto points = noiseAt(R"(
+        h = 0.001;
+        c = curl_noise(q);
+        div = (curl_noise(q + vec3(h, 0, 0)).x - curl_noise(q - vec3(h, 0, 0)).x
+             + curl_noise(q + vec3(0, h, 0)).y - curl_noise(q - vec3(0, h, 0)).y
+             + curl_noise(q + vec3(0, 0, h)).z - curl_noise(q - vec3(0, 0, h)).z) / (2 * h);
+        ddx = (curl_noise(q + vec3(h, 0, 0)).y - curl_noise(q - vec3(h, 0, 0)).y) / (2 * h);)",
+                          "c, vec4(div, ddx, 0, 0)", 2000);
+    double worstDiv = 0, typical = 0, size = 0;
+    for (const auto& p : points) {
+        worstDiv = std::max(worstDiv, std::abs(double(p.color[0])));
+        typical += std::abs(double(p.color[1]));  // a derivative that is not 0: the scale
+        size += std::hypot(p.position[0], p.position[1], p.position[2]);
+    }
+    typical /= points.size();
+    size /= points.size();
+    MESSAGE("curl noise: mean size " << size << ", mean |∂c_y/∂x| " << typical << ", largest |divergence| " << worstDiv);
+    CHECK(size > 0.3);
+    CHECK(worstDiv < 0.02 * typical * 50);  // (central differences of floats: 1e-3 at worst where derivatives are ~1)
+}

@@ -211,3 +211,17 @@ TEST_CASE("cycles through integrate, prev or the next side of -> are legal — o
     auto c = test::check("object a { a1 = a2; a2 = a3; a3 = a1; b1 = b1 * 2; }");
     CHECK(c.diags->errorCount() == 2);
 }
+
+TEST_CASE("a function's parameter or `let`, or a trigger's parameter, is a value even where an object has its name") {
+    // (std/noise.psys's `p.yxz`, imported by a program with an object `p`)
+    auto c = test::check(R"(
+        fn f(p: vec3) -> vec3 { let q = p.yxz; q.zxy + p }
+        fn g(v: vec3) -> float { let p = v * 2; p.x }
+        trigger t(p: vec3) { emit p(p.xyz); }
+        object p(q: vec3) { point(f(q) * g(q), white, 1); }
+        spawn p(origin);)");
+    CHECK_MESSAGE(c.ok(), c.output);
+    // Where no local has the name, an object's name in a function is still an error.
+    CHECK(hasError("fn f(v: vec3) -> float = p.x;\nobject p { point(origin, white, 1); }\nspawn p;",
+                   "`p` is an object; only the objects declared inside it can read it"));
+}
