@@ -61,6 +61,10 @@ struct GlslAlgebra {
     Float toFloat(const Int& x) { return out.let("float", "float(" + x + ")", true); }
     Float fmul(const Float& x, const Float& y) { return out.let("float", x + " * " + y, true); }
     Float fsub(const Float& x, const Float& y) { return out.let("float", x + " - " + y, true); }
+    Int wholeToInt(const Float& x) {  // (NaN fails both comparisons: the low end)
+        return out.let("uint", fmt::format("uint(int({0} >= -2147483648.0 ? ({0} <= 2147483520.0 ? {0} : 2147483520.0) "
+                                           ": -2147483648.0))", x));
+    }
 };
 
 // rt/clock.h's time rule over GLSL doubles.
@@ -89,6 +93,7 @@ public:
             if (isConstant(inst.op)) expression = constant(inst);
             else if (isInput(inst.op)) expression = leaf_(inst, readsAncestor(inst.op) ? parentOrdinal++ : -1);
             else if (isRandom(inst.op)) expression = random(inst);
+            else if (inst.op == Op::Hash) expression = lattice(inst);
             else expression = pure(inst);
             names_.push_back(out_.define(prefix_ + std::to_string(v), glslType(inst.type), expression, inst.type.isFloat()));
         }
@@ -212,6 +217,18 @@ private:
                                             drawHash, static_cast<uint32_t>(l));
         }
         return width(inst) == 1 ? lanes : fmt::format("vec{}({})", width(inst), lanes);
+    }
+
+    // hash(x): core/hash.h's lattice hash, lane by lane.
+    std::string lattice(const Inst& inst) {
+        GlslAlgebra algebra{out_};
+        std::array<std::string, 4> x;
+        int w = width(inst);
+        for (int l = 0; l < w; ++l) x[static_cast<size_t>(l)] = component(this->x(inst, 0), w, l);
+        std::string lanes;
+        for (int l = 0; l < w; ++l)
+            lanes += (l ? ", " : "") + core::latticeLane(algebra, x, w, static_cast<uint32_t>(l));
+        return w == 1 ? lanes : fmt::format("vec{}({})", w, lanes);
     }
 
     Statements& out_;

@@ -1,5 +1,6 @@
 #include "codegen_llvm/lane_emitter.h"
 
+#include <array>
 #include <stdexcept>
 #include <string>
 
@@ -77,7 +78,24 @@ private:
         Float toFloat(Int x) { return b.CreateUIToFP(x, b.getFloatTy()); }
         Float fmul(Float x, Float y) { return b.CreateFMul(x, y); }
         Float fsub(Float x, Float y) { return b.CreateFSub(x, y); }
+        Int wholeToInt(Float x) {  // (NaN fails both comparisons: the low end)
+            llvm::Value* lo = llvm::ConstantFP::get(b.getFloatTy(), -2147483648.0);
+            llvm::Value* hi = llvm::ConstantFP::get(b.getFloatTy(), 2147483520.0);
+            llvm::Value* clamped = b.CreateSelect(b.CreateFCmpOGE(x, lo), b.CreateSelect(b.CreateFCmpOLE(x, hi), x, hi), lo);
+            return b.CreateFPToSI(clamped, b.getInt32Ty());
+        }
     };
+
+    // hash(x): core/hash.h's lattice hash, lane by lane.
+    Lanes lattice(const Inst& i) {
+        Integers algebra{b_};
+        std::array<llvm::Value*, 4> x{};
+        for (int l = 0; l < i.type.width; ++l) x[static_cast<size_t>(l)] = values_[i.operands[0]][static_cast<size_t>(l)];
+        Lanes out;
+        for (int l = 0; l < i.type.width; ++l)
+            out.push_back(core::latticeLane(algebra, x, i.type.width, static_cast<uint32_t>(l)));
+        return out;
+    }
 
     // rand / nrand, keyed by (object, draw), lane by lane.
     Lanes random(const Inst& i) {
@@ -194,6 +212,7 @@ private:
                 return {sum};
             }
             case Op::Rand: case Op::NRand: return random(i);
+            case Op::Hash: return lattice(i);
             default:
                 throw std::runtime_error(unexpectedOp(i, "the LLVM backend"));
         }

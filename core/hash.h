@@ -18,6 +18,8 @@
 //   Int add(Int, Int), mul(Int, Int), bitXor(Int, Int), shiftRight(Int, Int)  (mod 2^32)
 //   Float toFloat(Int)   (unsigned → float, exact below 2^24)
 //   Float fmul(Float, Float), fsub(Float, Float)
+//   Int wholeToInt(Float) (a float, clamped to [-2^31, 2^31 - 128] — NaN to -2^31 — and
+//                          truncated, as the bits of a 32-bit two's complement integer)
 #pragma once
 
 #include <cstdint>
@@ -73,6 +75,18 @@ constexpr typename A::Float drawLane(A& a, Op op, typename A::Int seed, typename
     return drawLaneFromDraw(a, op, seed, object, site, pcgHash(a, draw), component);
 }
 
+// `hash(x)`: lane `lane` of the lattice hash of a point of whole-number components (the
+// corners of a noise's lattice, std/noise.psys): uniform in [-1, 1), each lane a function
+// of every component, the same for every seed and object (a field, not a draw). Integer
+// arithmetic only, so every backend computes the same bits.
+template <class A, class Floats>
+constexpr typename A::Float latticeLane(A& a, const Floats& x, int width, uint32_t lane) {
+    auto h = a.constant(0x811C9DC5u);
+    for (int c = 0; c < width; ++c) h = pcgHash(a, a.bitXor(h, a.wholeToInt(x[static_cast<size_t>(c)])));
+    auto u = unitInterval(a, pcgHash(a, a.bitXor(h, a.constant(0x7F4A7C15u + lane * 0x9E3779B9u))));
+    return a.fsub(a.fmul(u, a.floatConstant(2.0f)), a.floatConstant(1.0f));
+}
+
 // The algebra of plain host integers and floats.
 struct HostAlgebra {
     using Int = uint32_t;
@@ -86,6 +100,10 @@ struct HostAlgebra {
     static constexpr Float toFloat(Int x) { return static_cast<float>(x); }
     static constexpr Float fmul(Float x, Float y) { return x * y; }
     static constexpr Float fsub(Float x, Float y) { return x - y; }
+    static constexpr Int wholeToInt(Float x) {
+        Float clamped = x >= -2147483648.0f ? (x <= 2147483520.0f ? x : 2147483520.0f) : -2147483648.0f;
+        return static_cast<uint32_t>(static_cast<int32_t>(clamped));
+    }
 };
 
 }  // namespace psys::core

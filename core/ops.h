@@ -122,6 +122,7 @@ struct OpSpelling {
     X(Extract, "extract", 1, Pure, 0, 0, PSYS_NONE)            /* attr: component */                                                                 \
     X(Shuffle, "shuffle", 1, Pure, 0, 0, PSYS_NONE)            /* lanes: components */                                                               \
     X(Dot, "dot", 2, Pure, kCommutative, 0, PSYS_NONE)                                                                                               \
+    X(Hash, "hash", 1, Pure, 0, 0, PSYS_BUILTIN("hash(x: T) -> T")) /* a lattice point's random lanes in [-1, 1): core/hash.h */                    \
     X(Rand, "rand", -1, Random, kOwnSite, 0, PSYS_NONE)        /* in [0, 1); keyed: (object.id, draw.index) */                                       \
     X(NRand, "nrand", -1, Random, kOwnSite, 0, PSYS_NONE)      /* in [-1, 1) */                                                                      \
     X(Integrate, "integrate", 1, Temporal, kOwnSite, 1, PSYS_NONE)                                                                                   \

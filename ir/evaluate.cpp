@@ -72,6 +72,11 @@ Value evaluate(const Inst& inst, const Value* operands, const Type* operandTypes
         case Op::Shuffle:
             for (size_t i = 0; i < inst.lanes.size(); ++i) out.f[i] = a(0).f[inst.lanes[i]];
             return out;
+        case Op::Hash: {
+            core::HostAlgebra host;
+            for (size_t l = 0; l < w; ++l) out.f[l] = core::latticeLane(host, a(0).f, inst.type.width, static_cast<uint32_t>(l));
+            return out;
+        }
         case Op::Dot: {  // ((0 + x0·y0) + x1·y1) + …
             float s = 0;
             for (int i = 0; i < operandTypes[0].width; ++i)

@@ -151,6 +151,7 @@ private:
                 expect(ok, "lanes of a vector");
                 break;
             }
+            case Op::Hash: expect(i.type.isFloat() && t(0) == i.type, "floats, as many as its operand's"); break;
             case Op::Dot: expect(i.type.isScalarFloat() && t(0) == t(1) && t(0).isFloat(), "f32 of two equal vectors"); break;
             case Op::Rand: case Op::NRand:
                 // No operands (a draw key-random has not keyed yet), or exactly the key's two.

@@ -14,6 +14,7 @@ size_t opsOf(const Kernel& kernel, const Inst& i) {
     switch (i.op) {
         case Op::Splat: case Op::Compose: case Op::Extract: case Op::Shuffle: return 0;
         case Op::Dot: return 2u * kernel.at(i.operands[0]).type.width - 1;
+        case Op::Hash: return 8u * (kernel.at(i.operands[0]).type.width + i.type.width);  // (a PCG round each, ~8 ops)
         case Op::Eq: case Op::Ne: return kernel.at(i.operands[0]).type.width;
         default: return i.type.width;
     }
