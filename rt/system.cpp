@@ -221,7 +221,21 @@ std::optional<std::string> System::step(double dt) {
     }
     drawing_->invalidate(true);
     ++s.stats.steps;
+    if (s.options.onFinished) {
+        bool now = finished();
+        if (now && !s.saidFinished) s.options.onFinished(*this);
+        s.saidFinished = now;
+    }
     return std::nullopt;
+}
+
+bool System::finished() const {
+    detail::State& s = *state_;
+    if (!s.started) return false;
+    if (s.owedReady()) s.settleOwed();  // without waiting: else a step late
+    for (const Pool& p : s.pools)
+        if (p.live() > 0) return false;
+    return true;
 }
 
 // An extern's type as the program spells it: `float`, `vec3`, `bool`, `color`, `point`.

@@ -20,6 +20,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -33,6 +34,8 @@
 #include "rt/schedule.h"
 
 namespace psys::rt {
+
+class System;
 
 struct SystemOptions {
     uint32_t seed = 1;
@@ -56,6 +59,9 @@ struct SystemOptions {
     // are) where the backend asks for it (Backend::keepsRowsInMemory: a device), always,
     // or never. Results are the same, rows included (tests compare them).
     enum class Rows : uint8_t { AsBackend, InMemory, OnHost } rows = Rows::AsBackend;
+    // Called at the end of the step after which the system is finished (System::finished),
+    // once each time it becomes so: a host may recycle the system there.
+    std::function<void(const System&)> onFinished;
 };
 
 struct TypeStats {
@@ -185,6 +191,13 @@ public:
     static constexpr double kLatestTime = 4294967296.0;
     // Threads for launches over pools from now on: 0 for every core. Results do not change.
     void setThreads(unsigned threads);
+
+    // Whether the system can produce nothing more of its own accord: it has started,
+    // nothing is alive and nothing waits to be created. A trigger fired later still
+    // creates objects (and the system is no longer finished). On a device whose kills come
+    // late (RowsLaunch::late) it is known once they are counted, without waiting for them:
+    // at worst a step after the last object died.
+    bool finished() const;
 
     double time() const;
     uint64_t stepCount() const;

@@ -158,6 +158,7 @@ struct State {
     uint64_t step = 0;
     uint32_t nextId = 0;
     bool started = false;
+    bool saidFinished = false;  // SystemOptions::onFinished was called, and nothing came alive since
     // The start's emit sites a reload added — spawns of types the old start did not spawn —
     // run at the next start() (rt/reload.cpp).
     std::vector<size_t> reloadSpawns;

@@ -152,7 +152,9 @@ TEST_CASE("a frozen parent is freed after its last reader dies") {
 TEST_CASE("the same seed gives the same run — another seed another") {
     std::string fireworks = test::readFile((std::filesystem::path(PSYS_SAMPLES_DIR) / "fireworks.psys").string());
     auto positions = [&](uint32_t seed) {
-        Run run(fireworks, {seed, 1 << 20});
+        rt::SystemOptions options;
+        options.seed = seed;
+        Run run(fireworks, options);
         run.steps(120, 1.0 / 60);
         std::vector<float> all;
         for (auto& p : run.points("spark")) all.insert(all.end(), p.position.begin(), p.position.end());
@@ -565,4 +567,43 @@ TEST_CASE("a render value that is a state value is drawn from the state column i
 TEST_CASE("the interpreter refuses an op it has no code for with the located internal error every backend gives") {
     interp::Interpreter interpreter;
     CHECK(test::refusal(interpreter) == test::expectedRefusal("the interpreter"));
+}
+
+TEST_CASE("a system is finished when nothing is alive and nothing waits to be created; a trigger revives it") {
+    int calls = 0;
+    rt::SystemOptions options;
+    options.onFinished = [&](const rt::System& s) {
+        ++calls;
+        CHECK(s.finished());
+    };
+    Run run(R"(
+        object p { point(origin, white, 1); kill when age > 0.5; }
+        object e { emit p count 3; kill when age > 0.2; }
+        trigger again { emit p count 2; }
+        spawn e;)", options);
+    CHECK_FALSE(run.system->finished());  // not started
+    int steps = 0;
+    while (!run.system->finished() && steps < 100) {
+        run.steps(1, 1.0 / 60);
+        ++steps;
+    }
+    CHECK(steps == 31);  // the burst's objects die in the update at age 31/60 > 0.5
+    CHECK(calls == 1);
+    run.steps(5, 1.0 / 60);
+    CHECK(calls == 1);  // once: it stays finished
+    REQUIRE_FALSE(run.system->fire("again", {}));
+    CHECK_FALSE(run.system->finished());
+    run.steps(40, 1.0 / 60);
+    CHECK(run.system->finished());
+    CHECK(calls == 2);
+}
+
+TEST_CASE("a system that keeps something alive, or keeps emitting, is never finished") {
+    for (const char* text : {"object p { point(origin, white, 1); }\nspawn p;",
+                             "object p { point(origin, white, 1); kill when age > 0.1; }\n"
+                             "object e { point(origin, white, 1); emit p at 10 per second; }\nspawn e;"}) {
+        Run run(text);
+        run.steps(300, 1.0 / 60);
+        CHECK_FALSE(run.system->finished());
+    }
 }

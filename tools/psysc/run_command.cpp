@@ -73,7 +73,7 @@ private:
     size_t frames_ = 0;
 };
 
-void printSummary(const RunOptions& options, host::Session& session, double drawSeconds) {
+void printSummary(const RunOptions& options, host::Session& session, double drawSeconds, int ran) {
     rt::System& system = session.system();
     system.finish();  // the last step's kills a GPU still owes: the summary is exact
     rt::Stats stats = system.stats();
@@ -83,7 +83,7 @@ void printSummary(const RunOptions& options, host::Session& session, double draw
             std::cout << fmt::format("compiled {} kernels in {:.1f} ms ({}, {} math{})\n", r.kernels,
                                      r.compileSeconds * 1e3, r.target, options.math,
                                      r.fromDisk ? fmt::format("; {} from the disk cache", r.fromDisk) : "");
-        int frames = std::max(options.frames, 1);
+        int frames = std::max(ran, 1);
         std::cout << fmt::format("stepping {:.3f} ms per frame (update loops {:.3f}, kills and emissions {:.3f}, "
                                  "creation {:.3f}), drawing {:.3f} ms per frame\n",
                                  session.stepSeconds() * 1e3 / frames, stats.loopSeconds * 1e3 / frames,
@@ -100,7 +100,8 @@ void printSummary(const RunOptions& options, host::Session& session, double draw
                                      static_cast<double>(r.stagedBytes) / 1024 / frames,
                                      static_cast<double>(r.hostLaunches) / frames);
     }
-    std::cout << fmt::format("after {} frames ({:.3f} s):\n", options.frames, system.time());
+    std::cout << fmt::format("after {} frames ({:.3f} s){}:\n", ran, system.time(),
+                             system.finished() ? ", finished (nothing alive, nothing to create)" : "");
     for (auto& t : stats.types)
         std::cout << fmt::format("  {:24} live {:8}  created {:10}  killed {:10}  frozen {:4}  dropped {}\n", t.name,
                                  t.live, t.created, t.killed, t.frozen, t.dropped);
@@ -184,7 +185,11 @@ int runSystem(const RunOptions& options) {
     if (!dump.ok()) return failed("cannot write `" + options.dump + "`");
     rt::System& system = s->system();
     double drawSeconds = 0;
+    int lastFire = 0;  // (--until-finished: not before the last firing)
+    for (const host::TriggerFiring& f : fires) lastFire = std::max(lastFire, f.frame);
+    int ran = 0;
     for (int frame = 1; frame <= options.frames; ++frame) {
+        ran = frame;
         if (auto e = s->frame(frame, *dt)) return failed(*e);
         if (!options.quiet) {
             std::string line = fmt::format("frame {:4}  t={:.4f}", frame, system.time());
@@ -200,9 +205,10 @@ int runSystem(const RunOptions& options) {
             dump.frame(frame, system);
             if (!dump.ok()) return failed("cannot write `" + options.dump + "` (at frame " + std::to_string(frame) + ")");
         }
+        if (options.untilFinished && frame >= lastFire && system.finished()) break;
     }
     if (!dump.finish()) return failed("cannot write `" + options.dump + "`");
-    printSummary(options, *s, drawSeconds);
+    printSummary(options, *s, drawSeconds, ran);
     return 0;
 }
 
