@@ -50,6 +50,9 @@ public:
                  size_t rowsFirst, size_t count) override;
     void identify(const rt::ObjectRuns& runs, size_t n, size_t kept, rt::Buffer created, rt::Buffer ids,
                   rt::Buffer mask, size_t first) override;
+    // The box around the drawn rows, reduced on the GPU (gpu/gl_bounds.cpp).
+    rt::Bounds bounds(rt::Buffer visible, const std::array<rt::Buffer, 3>& position, const std::array<float, 3>& constant,
+                      size_t rows) const override;
 
     // For the backend's launches. Whether the column's value is on the GPU.
     bool onDevice(rt::Buffer buffer) const;
@@ -119,6 +122,7 @@ private:
     bool allOnHost(std::initializer_list<rt::Buffer> buffers) const;
     void dispatchRows(unsigned program, size_t invocations);
     mutable std::vector<uint32_t> rowsSent_;  // what rowsBuffer_ holds
+    mutable unsigned boundsProgram_ = 0, boxBuffer_ = 0;  // gpu/gl_bounds.cpp
 };
 
 // Host rows to GPU words (u8 widened to a word) and back.

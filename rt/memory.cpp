@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <new>
 #include <stdexcept>
 
@@ -14,6 +15,27 @@ namespace psys::rt {
 void Memory::clear(Buffer buffer, size_t first, size_t count) {
     if (count == 0) return;  // an empty column has no address
     std::memset(static_cast<char*>(host(buffer)) + first * elemSize(elem(buffer)), 0, count * elemSize(elem(buffer)));
+}
+
+Bounds Memory::bounds(Buffer visible, const std::array<Buffer, 3>& position, const std::array<float, 3>& constant,
+                      size_t rows) const {
+    Bounds out;
+    if (rows == 0) return out;
+    const auto* shown = static_cast<const float*>(view(visible));
+    for (int c = 0; c < 3; ++c) {
+        const auto* x = position[static_cast<size_t>(c)].valid() ? static_cast<const float*>(view(position[static_cast<size_t>(c)])) : nullptr;
+        float low = std::numeric_limits<float>::infinity(), high = -low;
+        for (size_t r = 0; r < rows; ++r) {
+            if (shown[r] != 1.0f) continue;
+            float v = x ? x[r] : constant[static_cast<size_t>(c)];
+            low = std::min(low, v);
+            high = std::max(high, v);
+        }
+        out.low[static_cast<size_t>(c)] = low;
+        out.high[static_cast<size_t>(c)] = high;
+        out.empty = low > high;
+    }
+    return out;
 }
 
 // The bookkeeping of a pool's rows kept in a memory (Memory::allocateRows): the rules of

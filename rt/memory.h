@@ -10,6 +10,7 @@
 // creation).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -36,6 +37,14 @@ struct Buffer {
 
 // A pool's rows in a memory (Memory::allocateRows): its free stack, each row's generation
 // (u32 columns of the pool's rows) and its masks (u8).
+// The box around what is drawn: the least and greatest of each position component over
+// the drawn rows (empty where none is).
+struct Bounds {
+    std::array<float, 3> low{}, high{};
+    bool empty = true;
+    bool operator==(const Bounds&) const = default;
+};
+
 struct PoolRows {
     Buffer stack, generation, updatable, alive;
     Buffer counters;  // u32: the stack's top, where a release pushes (the memory's own count of it)
@@ -122,6 +131,13 @@ public:
     // ids[first + r], and mask[first + r] = r < kept.
     virtual void identify(const ObjectRuns& runs, size_t n, size_t kept, Buffer created, Buffer ids, Buffer mask,
                           size_t first);
+    // The box around rows [0, rows) whose `visible` (f32) is 1: each position component's
+    // least and greatest, from its column (f32), or `constant[c]` where it has none (an
+    // invalid buffer). Min and max are exact, so the box is the same whatever the order
+    // the rows are taken in (but for the sign of a zero; drawn values are finite). Written here through `view`; a device's memory reduces
+    // where the columns are (GlMemory: a dispatch, 24 bytes back).
+    virtual Bounds bounds(Buffer visible, const std::array<Buffer, 3>& position, const std::array<float, 3>& constant,
+                          size_t rows) const;
 };
 
 // Host RAM: buffers are arrays the host addresses directly (aligned to 64 bytes).

@@ -351,6 +351,13 @@ std::optional<std::string> System::fire(std::string_view name, std::span<const f
     return std::nullopt;
 }
 
+Bounds System::bounds(size_t type) {
+    const DrawColumns& c = draw(type);
+    if (c.rows == 0) return {};
+    return state_->memory.bounds(c.visible, {c.position[0], c.position[1], c.position[2]},
+                                 {c.constant[0], c.constant[1], c.constant[2]}, c.rows);
+}
+
 const DrawColumns& System::draw(size_t type) {
     start();
     return drawing_->draw(type);

@@ -213,6 +213,9 @@ public:
     // What is drawn for `type` after the latest step (or trigger), computed on first ask.
     // On a device the host does not wait for it: its count comes later (DrawColumns::counted).
     const DrawColumns& draw(size_t type);
+    // The box around what draw(type) draws (culling, a camera's fit): reduced where the
+    // columns are, only 24 bytes to the host (Memory::bounds).
+    Bounds bounds(size_t type);
     // The same read back to the host: the drawn points in row order (for dumps and tests).
     std::vector<RenderPoint> points(size_t type);
     // The counters (a device's render counts taken first: it may wait for the GPU). The

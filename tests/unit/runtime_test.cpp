@@ -607,3 +607,26 @@ TEST_CASE("a system that keeps something alive, or keeps emitting, is never fini
         CHECK_FALSE(run.system->finished());
     }
 }
+
+TEST_CASE("a type's box is the box of the points it draws, on every sample") {
+    for (const std::string& text : test::samplesAndPrograms()) {
+        Run run(text);
+        run.steps(90, 1.0 / 60);
+        for (size_t t = 0; t < run.system->typeCount(); ++t) {
+            auto points = run.system->points(t);
+            rt::Bounds box = run.system->bounds(t);
+            INFO(run.system->module().objects[t].name);
+            REQUIRE(box.empty == points.empty());
+            for (size_t c = 0; c < 3; ++c) {
+                float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+                for (const auto& p : points) {
+                    lo = std::min(lo, p.position[c]);
+                    hi = std::max(hi, p.position[c]);
+                }
+                if (points.empty()) continue;
+                CHECK(box.low[c] == lo);
+                CHECK(box.high[c] == hi);
+            }
+        }
+    }
+}
