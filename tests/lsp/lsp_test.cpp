@@ -134,6 +134,18 @@ TEST_CASE("definition across an import, and the imported file's diagnostics go t
     CHECK(byUri[uriFromPath((dir.path / "main.psys").string())].empty());
 }
 
+TEST_CASE("definition into the standard library: an `std/` import and its functions") {
+    TempDir dir;
+    std::string main = "import \"std/shapes.psys\";\nobject o(q: vec3) { point(snapshot(q), white, 1); }\n"
+                       "object e { emit o(in_sphere(2)) count 3; }\nspawn e;\n";
+    Analysis a = analyze(dir.write("main.psys", main), main);
+    REQUIRE(a.parsed);
+    json file = definition(a, at(main, "std/shapes.psys"));
+    CHECK(file["uri"].get<std::string>().find("/share/psys/std/shapes.psys") != std::string::npos);
+    json fn = definition(a, at(main, "in_sphere"));
+    CHECK(fn["uri"] == file["uri"]);
+}
+
 TEST_CASE("document symbols: objects with their parameters, equations and nested objects") {
     Analysis a = analyze("/tmp/fw.psys", kFireworks);
     json symbols = documentSymbols(a);
