@@ -49,7 +49,8 @@ fs::path importTarget(const std::string& path, const fs::path& importer, std::st
     std::error_code ec;
     for (const fs::path& dir : libraryDirectories()) {
         fs::path file = (dir / path).lexically_normal();
-        if (fs::exists(file, ec)) return file;
+        // Named by where it really is (a build tree links share/psys/std to library/std).
+        if (fs::exists(file, ec)) return fs::weakly_canonical(file, ec);
         looked += (looked.empty() ? "" : ", ") + dir.string();
     }
     return {};

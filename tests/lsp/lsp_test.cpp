@@ -141,7 +141,7 @@ TEST_CASE("definition into the standard library: an `std/` import and its functi
     Analysis a = analyze(dir.write("main.psys", main), main);
     REQUIRE(a.parsed);
     json file = definition(a, at(main, "std/shapes.psys"));
-    CHECK(file["uri"].get<std::string>().find("/share/psys/std/shapes.psys") != std::string::npos);
+    CHECK(file["uri"].get<std::string>().find("/std/shapes.psys") != std::string::npos);
     json fn = definition(a, at(main, "in_sphere"));
     CHECK(fn["uri"] == file["uri"]);
 }
