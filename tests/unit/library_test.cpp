@@ -216,7 +216,7 @@ TEST_CASE("std/forces: drag_step is stable for any k·dt and reaches the termina
     }
 }
 
-TEST_CASE("std/forces: quadratic drag's terminal speed is √(g / k); an orbit's period is 2π·√(r³ / strength)") {
+TEST_CASE("std/forces: quadratic drag gives the terminal speed √(g / k), and an orbit the period 2π·√(r³ / strength)") {
     Run fall(R"(
         import "std/forces.psys";
         object o { vel = integrate(earth_gravity + quadratic_drag(vel, 0.2)); point(origin, vec4(vel, 1), 1); }

@@ -569,7 +569,7 @@ TEST_CASE("the interpreter refuses an op it has no code for with the located int
     CHECK(test::refusal(interpreter) == test::expectedRefusal("the interpreter"));
 }
 
-TEST_CASE("a system is finished when nothing is alive and nothing waits to be created; a trigger revives it") {
+TEST_CASE("a system is finished when nothing is alive and nothing waits to be created, and a trigger revives it") {
     int calls = 0;
     rt::SystemOptions options;
     options.onFinished = [&](const rt::System& s) {
