@@ -385,7 +385,8 @@ void ParticleRenderer::packTrail(const rt::DrawColumns& c, const rt::Memory& mem
         return;
     }
     staging_.resize(c.rows * stride);
-    std::vector<float> column(c.rows);
+    std::vector<float>& column = trailColumn_;
+    column.resize(c.rows);
     for (size_t k = 0; k < stride; ++k) {
         if (c.trail[k].valid()) memory.read(c.trail[k], 0, c.rows, column.data());
         else std::fill(column.begin(), column.end(), c.trailConstant[k]);

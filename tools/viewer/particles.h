@@ -77,7 +77,7 @@ private:
     GLuint behind_ = 0;  // a trail's points behind its heads, row by row
     size_t behindCapacity_ = 0;
     size_t capacity_[kColumns] = {};
-    std::vector<float> staging_;
+    std::vector<float> staging_, trailColumn_;
     std::vector<uint32_t> order_;
     std::vector<float> depth_;
     size_t sorted_ = 0;
