@@ -91,7 +91,7 @@ public:
             const Inst& inst = kernel_.at(v);
             std::string expression;
             if (isConstant(inst.op)) expression = constant(inst);
-            else if (isInput(inst.op)) expression = leaf_(inst, readsAncestor(inst.op) ? parentOrdinal++ : -1);
+            else if (isInput(inst.op)) expression = leaf_(inst, isGathered(inst.op) ? parentOrdinal++ : -1);
             else if (isRandom(inst.op)) expression = random(inst);
             else if (inst.op == Op::Hash) expression = lattice(inst);
             else expression = pure(inst);

@@ -404,7 +404,7 @@ std::string rowsShader(const Object& object, const Kernel& kernel, rt::Clock::So
             case Op::Dt: return clock.dt;
             case Op::Time: return clock.time;
             case Op::First: return clock.first;
-            case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge:
+            case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge: case Op::Fold:
                 return columnsValue(l.parentColumns.at(static_cast<size_t>(parentOrdinal)).offset, inst.type, "i");
             case Op::ObjectId: return fmt::format("cu({}u, i)", ColumnLayout::kIds);
             case Op::DrawIndex: return fmt::format("lw({}u)", LaunchBlock::kDraw);
@@ -445,7 +445,7 @@ std::string childrenShader(const Object& object, const Kernel& spawn) {
             case Op::Dt: return clock.dt;
             case Op::Time: return clock.time;
             case Op::First: return clock.first;
-            case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge:
+            case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge: case Op::Fold:
                 return blockValue(block.parents + 4 * static_cast<uint32_t>(parentOrdinal), inst.type);
             case Op::ObjectId: return fmt::format("lw({}u)", LaunchBlock::kObjectId);
             case Op::DrawIndex:

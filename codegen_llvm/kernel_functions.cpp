@@ -205,7 +205,7 @@ private:
             switch (i.op) {
                 case Op::Param: return lanes(layout.paramOffset.at(static_cast<size_t>(i.attr)));
                 case Op::StateRead: return lanes(layout.stateOffset.at(static_cast<size_t>(i.attr)));
-                case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge:
+                case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge: case Op::Fold:
                     return lanes(layout.parentColumns.at(static_cast<size_t>(parent)).offset);
                 case Op::Extern: return loadValue(loop_->getArg(kExterns), i.attr, i.type);
                 case Op::Uniform:
@@ -382,7 +382,7 @@ public:
         int parentOrdinal = 0;
         for (const Inst& i : spawn.insts()) {
             if (!isInput(i.op) || (i.op == Op::DrawIndex && i.attr == 1)) continue;
-            emitter[&i] = read(layout, i, readsAncestor(i.op) ? parentOrdinal++ : 0);
+            emitter[&i] = read(layout, i, isGathered(i.op) ? parentOrdinal++ : 0);
         }
         const rt::ArgumentColumns arguments = rt::argumentColumns(spawn);
         std::vector<llvm::Value*> argColumns;
@@ -444,7 +444,7 @@ private:
         switch (i.op) {
             case Op::Param: return lanes(layout.paramOffset.at(static_cast<size_t>(i.attr)));
             case Op::StateRead: return lanes(layout.stateOffset.at(static_cast<size_t>(i.attr)));
-            case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge:
+            case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge: case Op::Fold:
                 return loadValue(fn_->getArg(kParents), parent, i.type);
             case Op::Extern: return loadValue(fn_->getArg(kExterns), i.attr, i.type);
             case Op::Age: return {age(fn_->getArg(kNow), load(b_.getDoubleTy(), ColumnLayout::kCreated, fn_->getArg(kRow)))};

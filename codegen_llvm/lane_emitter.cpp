@@ -35,7 +35,7 @@ public:
             const Inst& i = kernel_.at(v);
             if (isInput(i.op)) {
                 values_[v] = leaf(i, parentOrdinal);
-                if (readsAncestor(i.op)) ++parentOrdinal;
+                if (isGathered(i.op)) ++parentOrdinal;
             } else {
                 values_[v] = emit(i);
             }

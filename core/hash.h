@@ -18,6 +18,7 @@
 //   Int add(Int, Int), mul(Int, Int), bitXor(Int, Int), shiftRight(Int, Int)  (mod 2^32)
 //   Float toFloat(Int)   (unsigned → float, exact below 2^24)
 //   Float fmul(Float, Float), fsub(Float, Float)
+//   Int bitAnd(Int, Int)  (only where a grid's buckets are computed)
 //   Int wholeToInt(Float) (a float, clamped to [-2^31, 2^31 - 128] — NaN to -2^31 — and
 //                          truncated, as the bits of a 32-bit two's complement integer)
 #pragma once
@@ -87,6 +88,20 @@ constexpr typename A::Float latticeLane(A& a, const Floats& x, int width, uint32
     return a.fsub(a.fmul(u, a.floatConstant(2.0f)), a.floatConstant(1.0f));
 }
 
+// The neighbour grid's bucket of a cell (rt/neighbours.cpp): the cell's three whole
+// coordinates hashed, `mask` + 1 buckets (a power of two). Several cells may share a
+// bucket: a fold measures every candidate's distance anyway. The algebra needs bitAnd.
+template <class A>
+constexpr typename A::Int cellBucket(A& a, typename A::Int x, typename A::Int y, typename A::Int z, typename A::Int mask) {
+    auto h = pcgHash(a, a.bitXor(z, a.constant(0x2545F491u)));
+    h = pcgHash(a, a.bitXor(h, y));
+    return a.bitAnd(pcgHash(a, a.bitXor(h, x)), mask);
+}
+
+// A grid's cell is the radius and this much wider, so that no rounding in computing a
+// cell hides a pair at the radius from the 27 cells around an object.
+inline constexpr float kCellMargin = 1.0f + 1.0f / 1024;
+
 // The algebra of plain host integers and floats.
 struct HostAlgebra {
     using Int = uint32_t;
@@ -97,6 +112,7 @@ struct HostAlgebra {
     static constexpr Int mul(Int x, Int y) { return x * y; }
     static constexpr Int bitXor(Int x, Int y) { return x ^ y; }
     static constexpr Int shiftRight(Int x, Int y) { return x >> y; }
+    static constexpr Int bitAnd(Int x, Int y) { return x & y; }
     static constexpr Float toFloat(Int x) { return static_cast<float>(x); }
     static constexpr Float fmul(Float x, Float y) { return x * y; }
     static constexpr Float fsub(Float x, Float y) { return x - y; }

@@ -80,6 +80,9 @@ struct OpSpelling {
     X(ObjectId, "object.id", 0, Input, 0, 0, PSYS_NONE)        /* u32: this object's id */                                                           \
     X(DrawIndex, "draw.index", 0, Input, 0, 0, PSYS_NONE)      /* u32: which draw of every random site */                                            \
     X(Uniform, "uniform", 0, Input, 0, 0, PSYS_NONE)           /* attr: a value of the uniform kernel */                                             \
+    X(NeighbourRead, "neighbour.read", 0, Input, 0, 0, PSYS_NONE) /* pair kernels: attr: index into Object::neighbourReads */                        \
+    X(NeighbourExport, "neighbour.export", 0, Input, 0, 0, PSYS_NONE) /* pair kernels: attr: export; attr2: 0 this object, 1 the other */         \
+    X(Fold, "fold", 0, Input, 0, 0, PSYS_NONE)                 /* attr: fold (Object::folds): over the neighbours, this step */                     \
     X(Add, "add", 2, Pure, kCommutative | kComponentwise, 0, PSYS_NONE)                                                                              \
     X(Sub, "sub", 2, Pure, kComponentwise, 0, PSYS_NONE)                                                                                             \
     X(Mul, "mul", 2, Pure, kCommutative | kComponentwise, 0, PSYS_NONE)                                                                              \
@@ -167,6 +170,9 @@ inline bool isComponentwise(Op op) { return opInfo(op).flags & kComponentwise; }
 inline bool hasOwnSite(Op op) { return opInfo(op).flags & kOwnSite; }
 // The inputs that read an ancestor object (its exports, whether it is alive, its age).
 inline bool readsAncestor(Op op) { return op == Op::ParentExport || op == Op::ParentAlive || op == Op::ParentAge; }
+// The inputs the run-time gathers into columns before a kernel runs: the ancestor reads
+// and the neighbour folds (KernelStorage::parents, in instruction order).
+inline bool isGathered(Op op) { return readsAncestor(op) || op == Op::Fold; }
 // Operand `i` of `op` may refer to a value defined later (a recursive equation).
 inline bool mayReferForward(Op op, size_t operand) {
     return operand < 8 && (opInfo(op).delayedOperands >> operand & 1u);

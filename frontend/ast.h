@@ -103,6 +103,9 @@ struct CallExpr : Expr {
     std::vector<ExprPtr> args;
     const FnDecl* fn = nullptr;  // a user function; else a built-in (see builtins.h)
     int builtin = -1;            // index into the built-in function table
+    // A neighbour fold (`near_sum(boid, 2, other.vel)`): the type folded over and the radius.
+    const ObjectDecl* neighbours = nullptr;
+    float radius = 0;
 };
 
 // `base.name`: a swizzle (`v.xz`, `c.rgb`) or a live read of an enclosing object
@@ -117,6 +120,7 @@ struct MemberExpr : Expr {
     const ObjectDecl* parent = nullptr;    // the enclosing object when a parent read
     int parentDepth = 0;                   // 1: the direct parent, 2: its parent, …
     Ref parentRef;                         // what is read in the parent
+    bool neighbour = false;                // `other.vel` in a fold's term: `parent` is the other's type
 };
 
 enum class UnaryOp { Neg, Not, Plus };

@@ -42,6 +42,11 @@ constexpr BuiltinFunction kOwnFunctions[] = {
     {"derive", 1, 1, R::Integrate, 0, "derive(x: T) -> T"},
     {"snapshot", 1, 1, R::Snapshot, 0, "snapshot(x) -> x"},
     {"prev", 1, 1, R::Prev, 0, "prev(x) -> x"},
+    // neighbours (core/fold.h)
+    {"near_sum", 3, 3, R::Neighbours, 0, "near_sum(type, radius, term: T) -> T: the sum of the term over the objects of the type within the radius"},
+    {"near_min", 3, 3, R::Neighbours, 0, "near_min(type, radius, term: T) -> T: the least term (componentwise) over the objects within the radius"},
+    {"near_max", 3, 3, R::Neighbours, 0, "near_max(type, radius, term: T) -> T: the greatest term (componentwise) over the objects within the radius"},
+    {"near_count", 2, 2, R::Neighbours, 0, "near_count(type, radius) -> float: how many objects of the type lie within the radius"},
     // randomness
     {"rand", 0, 0, R::Random, 1, "rand() -> float in [0, 1]"},
     {"rand2", 0, 0, R::Random, 2, "rand2() -> vec2 in [0, 1]²"},

@@ -26,6 +26,9 @@ enum class BuiltinRule {
     Snapshot,        // snapshot(x) -> x, evaluated once at creation
     Prev,            // prev(x) -> x at the previous update
     Random,          // rand()/nrand() -> float, rand3() -> vec3, …
+    Neighbours,      // near_sum(type, radius, term) -> term's type, near_count(type, radius) -> float
+                     // (checked by frontend/check_near.cpp: its first argument is a type, its
+                     // third a term over two objects)
 };
 
 struct BuiltinFunction {

@@ -6,6 +6,7 @@
 // after a reported error: both are accepted everywhere, so one mistake gives one message.
 #include <fmt/format.h>
 
+#include "core/fold.h"
 #include "frontend/builtins.h"
 #include "frontend/checker.h"
 
@@ -165,6 +166,7 @@ Type Checker::check(Expr& expr, const Context& ctx) {
 
 Type Checker::checkName(NameExpr& name, const Context& ctx) {
     name.ref = lookupName(name.name, name.range, ctx);
+    if (ctx.fold && !checkFoldTermRef(name, ctx)) return Type::error();
     if (name.ref.kind == Ref::Kind::Equation) usedEquations_.insert(name.ref.equation);
     return typeOfRef(name.ref);
 }
@@ -220,11 +222,19 @@ Type Checker::checkBinary(BinaryExpr& binary, const Context& ctx) {
 }
 
 Type Checker::checkMember(MemberExpr& member, const Context& ctx) {
+    if (ctx.fold && member.base->kind == ExprKind::Name && static_cast<NameExpr&>(*member.base).name == "other")
+        return checkNeighbourMember(member, ctx);
     // `rocket.pos`: a live read of an enclosing object.
     if (member.base->kind == ExprKind::Name) {
         auto& base = static_cast<NameExpr&>(*member.base);
         int depth = 0;
         if (const ObjectDecl* parent = enclosingObject(base.name, ctx, &depth)) {
+            if (ctx.fold) {
+                diags_.error(member.range, fmt::format("the term of `{}` cannot read `{}`: it may read this object's "
+                                                       "equations, `other.NAME`, constants and externs",
+                                                       ctx.fold->callee, base.name));
+                return Type::error();
+            }
             member.parent = parent;
             member.parentDepth = depth;
             base.type = Type::error();  // an object is not a value of its own
@@ -306,6 +316,7 @@ Type Checker::checkMember(MemberExpr& member, const Context& ctx) {
 }
 
 Type Checker::checkCall(CallExpr& call, const Context& ctx) {
+    if (core::neighbourFold(call.callee) && !globals_.count(call.callee)) return checkNear(call, ctx);
     std::vector<Type> args;
     for (auto& a : call.args) args.push_back(check(*a, ctx));
 
@@ -367,6 +378,11 @@ Type Checker::checkBuiltinCall(CallExpr& call, const std::vector<Type>& args, co
     if (isTemporal(fn.rule) && ctx.where != Where::Object) {
         diags_.error(call.calleeRange, fmt::format("`{}` cannot be used in {}: only object equations have a history",
                                                    fn.name, placeWords(ctx.where)));
+        return Type::error();
+    }
+    if (ctx.fold && (isTemporal(fn.rule) || fn.rule == BuiltinRule::Random)) {
+        diags_.error(call.calleeRange, fmt::format("`{}` cannot be used in the term of `{}`: a term is a function of "
+                                                   "the two objects as they are", fn.name, ctx.fold->callee));
         return Type::error();
     }
     if (fn.rule == BuiltinRule::Random &&
@@ -462,6 +478,7 @@ Type Checker::checkBuiltinCall(CallExpr& call, const std::vector<Type>& args, co
             return args[0];
         case BuiltinRule::Random:
             return Type::vec(fn.width);
+        case BuiltinRule::Neighbours: break;  // (checkNear)
     }
     return Type::error();
 }

@@ -30,6 +30,10 @@ struct Context {
     const ast::TriggerDecl* trigger = nullptr;
     const ast::Command* block = nullptr;  // the `when` or `on` the commands are in
     bool dying = false;                   // in `on death`
+    // In a neighbour fold's term (`near_sum(boid, 2, other.vel)`): the call, and the type
+    // `other` is one of.
+    const ast::CallExpr* fold = nullptr;
+    const ast::ObjectDecl* other = nullptr;
 };
 
 // The names an object declares: its parameters and equations.
@@ -62,6 +66,12 @@ private:
     Type checkBuiltinCall(ast::CallExpr& call, const std::vector<Type>& args, const Context& ctx);
     Type checkUserCall(ast::CallExpr& call, const ast::FnDecl& fn, const std::vector<Type>& args);
     Type checkMember(ast::MemberExpr& member, const Context& ctx);
+
+    // check_near.cpp
+    Type checkNear(ast::CallExpr& call, const Context& ctx);
+    Type checkNeighbourMember(ast::MemberExpr& member, const Context& ctx);
+    bool checkFoldTermRef(const ast::NameExpr& name, const Context& ctx);
+    const ast::ObjectDecl* findObjectType(const std::string& name) const;
     Type checkUnary(ast::UnaryExpr& unary, const Context& ctx);
     Type checkBinary(ast::BinaryExpr& binary, const Context& ctx);
     Type typeOfRef(const ast::Ref& ref);

@@ -27,6 +27,8 @@ void collect(const Expr& e, const ObjectDecl& object, const std::map<const Equat
                 const BuiltinFunction& fn = builtinFunction(c.builtin);
                 delays = fn.rule == BuiltinRule::Prev || fn.name == "integrate";
             }
+            delays |= c.neighbours != nullptr;  // a fold reads what the last step left
+            // (its term's names are exports of the last update: no use in this one)
             for (auto& a : c.args) recurse(a, delayed || delays);
             return;
         }

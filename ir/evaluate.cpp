@@ -105,7 +105,8 @@ void Evaluator::run(const Kernel& kernel, const KernelInputs& in, std::vector<Va
             case Op::Dt: out = Value::scalar(in.dt); break;
             case Op::Time: out = Value::scalar(in.time); break;
             case Op::First: out = Value::boolean(in.first); break;
-            case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge: out = in.parents[parent++]; break;
+            case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge: case Op::Fold: out = in.parents[parent++]; break;
+            case Op::NeighbourExport: out = (inst.attr2 ? in.other : in.self)[inst.attr]; break;
             case Op::ObjectId: out.u = in.objectId; break;
             case Op::DrawIndex: out.u = inst.attr == 1 ? in.childDraw : in.draw; break;
             case Op::Rand: case Op::NRand: {
@@ -138,7 +139,7 @@ bool evaluates(Op op) {
         case Op::Const: case Op::Param: case Op::TriggerParam: case Op::StateRead: case Op::Extern:
         case Op::Uniform: case Op::Age: case Op::Dt: case Op::Time: case Op::First: case Op::ParentExport:
         case Op::ParentAlive: case Op::ParentAge: case Op::ObjectId: case Op::DrawIndex: case Op::Rand:
-        case Op::NRand:
+        case Op::NRand: case Op::Fold: case Op::NeighbourExport:
             return true;
         default: return isPure(op);
     }
@@ -147,7 +148,7 @@ bool evaluates(Op op) {
 std::vector<const Inst*> parentReads(const Kernel& kernel) {
     std::vector<const Inst*> reads;
     for (const Inst& i : kernel.insts())
-        if (readsAncestor(i.op)) reads.push_back(&i);
+        if (isGathered(i.op)) reads.push_back(&i);
     return reads;
 }
 

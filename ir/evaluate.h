@@ -23,7 +23,9 @@ struct KernelInputs {
     const Value* state = nullptr;     // the slots before this kernel
     const Value* externs = nullptr;
     const Value* uniforms = nullptr;  // the values of the kernel's uniform kernel
-    const Value* parents = nullptr;   // the kernel's parent reads, in instruction order
+    const Value* parents = nullptr;   // the kernel's parent reads and folds, in instruction order
+    const Value* self = nullptr;      // pair kernels: this object's exports, the other's
+    const Value* other = nullptr;
     float age = 0;
     float dt = 0;
     float time = 0;
@@ -50,8 +52,8 @@ private:
 // op); for any other it throws ir::unexpectedOp's internal error, as every backend does.
 bool evaluates(Op op);
 
-// The parent reads of a kernel (parent.export, parent.alive, parent.age), in instruction
-// order: the order of KernelInputs::parents.
+// What the run-time gathers for a kernel (parent.export, parent.alive, parent.age, fold),
+// in instruction order: the order of KernelInputs::parents.
 std::vector<const Inst*> parentReads(const Kernel& kernel);
 
 }  // namespace psys::ir

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "core/draw.h"
+#include "core/fold.h"
 #include "core/integrators.h"
 #include "ir/ops.h"
 #include "ir/types.h"
@@ -87,6 +88,7 @@ enum class YieldKind {
     EmitArg,    // index: emit site, sub: argument
     Export,     // index: export (a value children read live)
     Uniform,    // index: a value of a uniform kernel, the same for every object of the type
+    Fold,       // pair kernels, index: fold (Object::folds): this neighbour's term
     Unstable,   // update: whether this step is beyond the integration method's stability
                 // limit for a decay rate the compiler found (counted per type in the stats)
 };
@@ -100,6 +102,9 @@ struct Yield {
 
 enum class KernelKind {
     Behaviour, Init, Update, Render, Exports, Spawn, Trigger, Start,
+    // Once per pair of an object and a neighbour within a group's radius (site: the
+    // group, Object::neighbours): each fold's term, from both objects' exports.
+    Pair,
     // Once per step (and per distinct dt, time and externs) for a whole type: what the
     // kernel it serves computes identically for every object (opt/hoist_uniform).
     UniformUpdate, UniformRender, UniformExports,
@@ -182,7 +187,7 @@ void defaultDrawn(Kernel& render);
 class Kernel {
 public:
     KernelKind kind = KernelKind::Behaviour;
-    int site = -1;  // Spawn: the emit site it computes the arguments of
+    int site = -1;  // Spawn: the emit site it computes the arguments of; Pair: the group
 
     const std::vector<Inst>& insts() const { return insts_; }
     const Inst& at(ValueId v) const { return insts_.at(v); }
@@ -295,6 +300,30 @@ struct ParentRead {
 
 using core::Integrator;
 
+// `near_sum(boid, 2, other.vel)`: folds over the objects of a type within a radius of this
+// one (docs/language.md, "Neighbours"). The folds over one type and radius share a group:
+// one walk over the grid, one pair kernel yielding each fold's term.
+struct NeighbourGroup {
+    std::string target;  // the type folded over
+    float radius = 0;
+    // The exports holding the drawn positions: this object's and the target's (-1 until
+    // scoping makes them).
+    int selfPosition = -1, otherPosition = -1;
+};
+using core::Reduce;
+struct Fold {
+    int group = 0;
+    Reduce reduce = Reduce::Sum;
+    Type type;
+};
+// A member a pair kernel reads, before scoping makes it an export: this object's or the
+// other's.
+struct NeighbourRead {
+    bool other = false;
+    std::string member;
+    Type type;
+};
+
 // An object's @attributes (the object's own, else the file's, else none).
 struct Attributes {
     std::optional<Integrator> integrator;  // none: the pipeline's default
@@ -321,6 +350,9 @@ struct Object {
     std::vector<EmitSite> emits;
     std::vector<Export> exports;
     std::vector<ParentRead> parentReads;
+    std::vector<NeighbourGroup> neighbours;
+    std::vector<Fold> folds;
+    std::vector<NeighbourRead> neighbourReads;  // cleared by scoping
     Attributes attributes;
     std::vector<Kernel> kernels;
 

@@ -93,7 +93,7 @@ void Kernel::rehash() {
 
 const Kernel* Object::kernel(KernelKind kind, int site) const {
     for (const Kernel& k : kernels)
-        if (k.kind == kind && (kind != KernelKind::Spawn || k.site == site)) return &k;
+        if (k.kind == kind && ((kind != KernelKind::Spawn && kind != KernelKind::Pair) || k.site == site)) return &k;
     return nullptr;
 }
 
@@ -158,6 +158,7 @@ const char* kernelName(KernelKind kind) {
         case KernelKind::Spawn: return "spawn";
         case KernelKind::Trigger: return "trigger";
         case KernelKind::Start: return "start";
+        case KernelKind::Pair: return "pair";
         case KernelKind::UniformUpdate: return "uniform.update";
         case KernelKind::UniformRender: return "uniform.render";
         case KernelKind::UniformExports: return "uniform.exports";

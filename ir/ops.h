@@ -23,5 +23,6 @@ using core::isComponentwise;
 using core::hasOwnSite;
 using core::mayReferForward;
 using core::readsAncestor;
+using core::isGathered;
 
 }  // namespace psys::ir

@@ -67,6 +67,11 @@ std::vector<Param> params(const std::string& header) {
     return out;
 }
 
+int hashIndex(const std::string& t) {
+    if (t.size() < 2 || t[0] != '#') throw ParseError("expected `#n`, found `" + t + "`");
+    return integer(t.substr(1));
+}
+
 std::string nameBeforeParen(const std::string& header, size_t skip) {
     return header.substr(skip, header.find('(') - skip);
 }
@@ -75,14 +80,15 @@ std::optional<YieldKind> yieldKind(const std::string& name) {
     for (YieldKind k : {YieldKind::StateNext, YieldKind::Kill, YieldKind::Visible, YieldKind::Position,
                         YieldKind::Color, YieldKind::Size, YieldKind::Rotation, YieldKind::Frame, YieldKind::End,
                         YieldKind::Trail, YieldKind::EmitRate, YieldKind::EmitCount,
-                        YieldKind::EmitArg, YieldKind::Export, YieldKind::Uniform, YieldKind::Unstable})
+                        YieldKind::EmitArg, YieldKind::Export, YieldKind::Uniform, YieldKind::Unstable,
+                        YieldKind::Fold})
         if (yieldKindName(k) == name) return k;
     return std::nullopt;
 }
 
 std::optional<KernelKind> kernelKind(const std::string& name) {
     for (KernelKind k : {KernelKind::Behaviour, KernelKind::Init, KernelKind::Update, KernelKind::Render,
-                         KernelKind::Exports, KernelKind::Spawn, KernelKind::Trigger, KernelKind::Start,
+                         KernelKind::Exports, KernelKind::Spawn, KernelKind::Trigger, KernelKind::Start, KernelKind::Pair,
                          KernelKind::UniformUpdate, KernelKind::UniformRender, KernelKind::UniformExports})
         if (name == kernelName(k)) return k;
     return std::nullopt;
@@ -200,6 +206,25 @@ private:
             } else if (w[0] == "read") {
                 if (w.size() != 4 || w[1].back() != ':' || w[3][0] != '^') throw ParseError("expected `read name: type ^depth`");
                 o.parentReads.push_back({integer(w[3].substr(1)), w[1].substr(0, w[1].size() - 1), type(w[2])});
+            } else if (w[0] == "near") {
+                // near TARGET RADIUS [position #SELF #OTHER]
+                if (w.size() != 3 && !(w.size() == 6 && w[3] == "position"))
+                    throw ParseError("expected `near type radius [position #self #other]`");
+                NeighbourGroup g{w[1], number(w[2])};
+                if (w.size() == 6) {
+                    g.selfPosition = hashIndex(w[4]);
+                    g.otherPosition = hashIndex(w[5]);
+                }
+                o.neighbours.push_back(g);
+            } else if (w[0] == "fold") {
+                auto reduce = w.size() == 4 && w[1].back() == ':' ? core::reduceFromName(w[1].substr(0, w[1].size() - 1))
+                                                                  : std::nullopt;
+                if (!reduce) throw ParseError("expected `fold sum|min|max|count: type #group`");
+                o.folds.push_back({hashIndex(w[3]), *reduce, type(w[2])});
+            } else if (w[0] == "near.read") {
+                if (w.size() != 4 || w[1].back() != ':' || (w[3] != "self" && w[3] != "other"))
+                    throw ParseError("expected `near.read name: type self|other`");
+                o.neighbourReads.push_back({w[3] == "other", w[1].substr(0, w[1].size() - 1), type(w[2])});
             } else if (w[0] == "kernel") {
                 o.kernels.push_back(kernel(w));
             } else {
@@ -260,7 +285,7 @@ private:
         auto kind = kernelKind(header.at(1));
         if (!kind) throw ParseError("unknown kernel kind `" + header[1] + "`");
         k.kind = *kind;
-        if (k.kind == KernelKind::Spawn) k.site = integer(header.at(2).substr(1));
+        if (k.kind == KernelKind::Spawn || k.kind == KernelKind::Pair) k.site = integer(header.at(2).substr(1));
         for (++pos_; pos_ < lines_.size(); ++pos_) {
             std::string line = current();
             auto w = words(line);
@@ -332,7 +357,7 @@ private:
             // storage parent OP #export ^depth width
             if (w.size() != 6 || w[4].empty() || w[4][0] != '^') throw ParseError("expected `storage parent op #e ^d width`");
             auto op = opFromName(w[2]);
-            if (!op || !readsAncestor(*op)) throw ParseError("expected a parent read, found `" + w[2] + "`");
+            if (!op || !isGathered(*op)) throw ParseError("expected a parent read or a fold, found `" + w[2] + "`");
             st.parents.push_back({*op, integer(w[4].substr(1)), index(w[3]), integer(w[5])});
         } else if (w[1] == "zeroed") {
             // storage zeroed #slot …

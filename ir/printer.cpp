@@ -84,6 +84,7 @@ std::string yieldKindName(YieldKind kind) {
         case YieldKind::EmitArg: return "emit.arg";
         case YieldKind::Export: return "export";
         case YieldKind::Uniform: return "uniform";
+        case YieldKind::Fold: return "fold";
         case YieldKind::Unstable: return "unstable";
     }
     return "?";
@@ -92,7 +93,7 @@ std::string yieldKindName(YieldKind kind) {
 std::string print(const Kernel& kernel, int indent, PrintOptions options) {
     std::string pad(static_cast<size_t>(indent), ' ');
     std::string out = pad + "kernel " + kernelName(kernel.kind);
-    if (kernel.kind == KernelKind::Spawn) out += fmt::format(" #{}", kernel.site);
+    if (kernel.kind == KernelKind::Spawn || kernel.kind == KernelKind::Pair) out += fmt::format(" #{}", kernel.site);
     out += "\n";
     for (ValueId v = 0; v < kernel.size(); ++v) {
         const Inst& inst = kernel.at(v);
@@ -102,6 +103,7 @@ std::string print(const Kernel& kernel, int indent, PrintOptions options) {
         bool showAttr = inst.attr != 0 || inst.op == Op::Param || inst.op == Op::StateRead || inst.op == Op::Extern ||
                         inst.op == Op::TriggerParam || inst.op == Op::ParentRead || inst.op == Op::ParentExport ||
                         inst.op == Op::Extract || inst.op == Op::DrawIndex || inst.op == Op::Uniform ||
+                        inst.op == Op::NeighbourRead || inst.op == Op::NeighbourExport || inst.op == Op::Fold ||
                         hasOwnSite(inst.op);
         if (showAttr) line += fmt::format(" #{}", inst.attr);
         if (inst.attr2 != 0) line += fmt::format(" ^{}", inst.attr2);
@@ -124,7 +126,7 @@ std::string print(const Kernel& kernel, int indent, PrintOptions options) {
         std::string line = pad + "  yield " + yieldKindName(y.kind);
         bool indexed = y.kind == YieldKind::StateNext || y.kind == YieldKind::EmitRate ||
                        y.kind == YieldKind::EmitCount || y.kind == YieldKind::EmitArg || y.kind == YieldKind::Export ||
-                       y.kind == YieldKind::Uniform || y.kind == YieldKind::Trail;
+                       y.kind == YieldKind::Uniform || y.kind == YieldKind::Trail || y.kind == YieldKind::Fold;
         if (indexed) line += fmt::format(" #{}", y.index);
         if (y.kind == YieldKind::EmitArg) line += fmt::format(" #{}", y.sub);
         out += line + fmt::format(" = %{}\n", y.value);
@@ -150,6 +152,14 @@ std::string print(const Object& o, PrintOptions options) {
     for (auto& e : o.emits) out += fmt::format("  emit {} {}\n", e.target, emitWhenName(e.when));
     for (auto& e : o.exports) out += fmt::format("  export {}: {}\n", e.name, e.type.str());
     for (auto& r : o.parentReads) out += fmt::format("  read {}: {} ^{}\n", r.member, r.type.str(), r.depth);
+    for (auto& g : o.neighbours) {
+        out += fmt::format("  near {} {}", g.target, number(g.radius));
+        if (g.selfPosition >= 0) out += fmt::format(" position #{} #{}", g.selfPosition, g.otherPosition);
+        out += "\n";
+    }
+    for (auto& f : o.folds) out += fmt::format("  fold {}: {} #{}\n", core::reduceInfo(f.reduce).name, f.type.str(), f.group);
+    for (auto& r : o.neighbourReads)
+        out += fmt::format("  near.read {}: {} {}\n", r.member, r.type.str(), r.other ? "other" : "self");
     for (auto& k : o.kernels) out += print(k, 2, options);
     return out + "end\n";
 }

@@ -41,10 +41,10 @@ private:
         }
         size_t reads = 0;
         for (const Inst& i : k.insts()) {
-            if (!readsAncestor(i.op)) continue;
+            if (!isGathered(i.op)) continue;
             const KernelStorage::ParentRead* p = reads < st.parents.size() ? &st.parents[reads] : nullptr;
             if (!p || p->op != i.op || p->depth != i.attr2 || p->width != i.type.width ||
-                p->exportIndex != (i.op == Op::ParentExport ? i.attr : -1))
+                p->exportIndex != (i.op == Op::ParentExport || i.op == Op::Fold ? i.attr : -1))
                 fail(fmt::format("storage: parent read {} is not the kernel's", reads));
             ++reads;
         }
@@ -111,6 +111,30 @@ private:
                        "no export of this index and type in that ancestor");
                 break;
             }
+            case Op::NeighbourRead:
+                expect(kernel_->kind == KernelKind::Pair && object_ && i.attr >= 0 &&
+                           static_cast<size_t>(i.attr) < object_->neighbourReads.size() &&
+                           object_->neighbourReads[static_cast<size_t>(i.attr)].type == i.type,
+                       "no neighbour read of this index and type in a pair kernel");
+                break;
+            case Op::NeighbourExport: {
+                const NeighbourGroup* g = object_ && kernel_->site >= 0 &&
+                                                  static_cast<size_t>(kernel_->site) < object_->neighbours.size()
+                                              ? &object_->neighbours[static_cast<size_t>(kernel_->site)]
+                                              : nullptr;
+                const Object* from = !g ? nullptr : i.attr2 == 1 ? module_.object(g->target) : object_;
+                expect(kernel_->kind == KernelKind::Pair && (i.attr2 == 0 || i.attr2 == 1) && from && i.attr >= 0 &&
+                           static_cast<size_t>(i.attr) < from->exports.size() &&
+                           from->exports[static_cast<size_t>(i.attr)].type == i.type,
+                       "no export of this index and type in this object (^0) or the other (^1) of a pair kernel");
+                break;
+            }
+            case Op::Fold:
+                expect(kernel_->kind != KernelKind::Pair && object_ && i.attr >= 0 &&
+                           static_cast<size_t>(i.attr) < object_->folds.size() &&
+                           object_->folds[static_cast<size_t>(i.attr)].type == i.type,
+                       "no fold of this index and type (outside a pair kernel)");
+                break;
             case Op::ParentAlive: expect(i.type.isBool() && i.attr2 >= 1, "a bool, at least one level up"); break;
             case Op::ParentAge: expect(i.type.isScalarFloat() && i.attr2 >= 1, "an f32, at least one level up"); break;
             case Op::Age: case Op::Dt: case Op::Time: expect(i.type.isScalarFloat(), "an f32"); break;
@@ -204,6 +228,13 @@ private:
                 break;
             }
             case YieldKind::Uniform: expect(y.index >= 0, "a uniform index"); break;
+            case YieldKind::Fold:
+                expect(k.kind == KernelKind::Pair && object_ && y.index >= 0 &&
+                           static_cast<size_t>(y.index) < object_->folds.size() &&
+                           object_->folds[static_cast<size_t>(y.index)].type == t &&
+                           object_->folds[static_cast<size_t>(y.index)].group == k.site,
+                       "no fold of this index, type and group");
+                break;
             case YieldKind::Export:
                 expect(object_ && y.index >= 0 && static_cast<size_t>(y.index) < object_->exports.size() &&
                            object_->exports[static_cast<size_t>(y.index)].type == t,
@@ -231,6 +262,13 @@ std::vector<std::string> verify(const Module& module) {
             errors.push_back(fmt::format("object {}: its parent `{}` does not exist", o.name, o.parent));
         for (const EmitSite& e : o.emits)
             if (!module.object(e.target)) errors.push_back(fmt::format("object {}: emits unknown `{}`", o.name, e.target));
+        for (const NeighbourGroup& g : o.neighbours)
+            if (!module.object(g.target) || !(g.radius > 0))
+                errors.push_back(fmt::format("object {}: folds over unknown `{}` or within a radius not above 0", o.name,
+                                             g.target));
+        for (const Fold& f : o.folds)
+            if (f.group < 0 || static_cast<size_t>(f.group) >= o.neighbours.size())
+                errors.push_back(fmt::format("object {}: a fold of a group that does not exist", o.name));
         for (const Kernel& k : o.kernels) v.kernel(k, &o, nullptr, "object " + o.name);
     }
     for (const Trigger& t : module.triggers) v.kernel(t.kernel, nullptr, &t, "trigger " + t.name);

@@ -255,6 +255,7 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
         k.kind = KernelKind::Behaviour;
         int sites = 0;
         ObjectLowering lowering(m, locate, k, &o, decl, nullptr, sites);
+        lowering.qualify = qualified;
         lowering.lowerEquations();
         ValueId kill = k.boolean(false);
         CommandLowering commands(lowering, k, o.emits, program, qualified, true);

@@ -7,6 +7,7 @@
 namespace psys::lower::detail {
 
 Values ObjectLowering::lowerCall(const CallExpr& c) {
+    if (c.neighbours) return {lowerNear(c)};
     if (c.fn) {
         FnFrame frame{c.fn, {}, {}};
         for (auto& a : c.args) frame.params.push_back(lower(*a));
@@ -108,7 +109,8 @@ Values ObjectLowering::lowerCall(const CallExpr& c) {
         case BuiltinRule::Integrate:
             return {temporal(n == "integrate" ? Op::Integrate : Op::Derive, t, {a[0]})};
         case BuiltinRule::Snapshot:
-        case BuiltinRule::Prev: break;  // handled above
+        case BuiltinRule::Prev:
+        case BuiltinRule::Neighbours: break;  // handled above
         case BuiltinRule::Random:
             return {temporal(n.substr(0, 1) == "n" ? Op::NRand : Op::Rand, t, {})};
     }

@@ -1,5 +1,6 @@
 // Lowering expressions, and the order an object's equations are evaluated in (see the
 // rule at the top of lower.cpp).
+#include "core/fold.h"
 #include "frontend/builtins.h"
 #include "frontend/equation_graph.h"
 #include "lower/object_lowering.h"
@@ -54,6 +55,7 @@ ValueId ObjectLowering::arith(Op op, ValueId a, ValueId b) {
 Values ObjectLowering::lowerName(const NameExpr& n) {
     const Ref& r = n.ref;
     Type t = irType(n.type);
+    if (pair_ && (r.kind == Ref::Kind::Param || r.kind == Ref::Kind::Equation)) return {neighbourRead(false, n.name, t)};
     switch (r.kind) {
         case Ref::Kind::Param: {
             if (trigger_) return {input(Op::TriggerParam, t, r.index)};
@@ -102,6 +104,45 @@ ValueId ObjectLowering::parentRead(const MemberExpr& m) {
     return input(Op::ParentRead, t, static_cast<int>(reads.size() - 1));
 }
 
+ValueId ObjectLowering::neighbourRead(bool other, const std::string& member, Type t) {
+    auto& reads = object_->neighbourReads;
+    for (size_t i = 0; i < reads.size(); ++i)
+        if (reads[i].other == other && reads[i].member == member) return input(Op::NeighbourRead, t, static_cast<int>(i));
+    reads.push_back({other, member, t});
+    return input(Op::NeighbourRead, t, static_cast<int>(reads.size() - 1));
+}
+
+// `near_sum(T, r, term)`: a fold of the object's group for (T, r), its term a yield of the
+// group's pair kernel, its value a column the run-time fills before the update.
+ValueId ObjectLowering::lowerNear(const CallExpr& c) {
+    core::Reduce reduce = *core::neighbourFold(c.callee);
+    std::string target = qualify(c.neighbours);
+    auto& groups = object_->neighbours;
+    int group = 0;
+    while (static_cast<size_t>(group) < groups.size() &&
+           (groups[static_cast<size_t>(group)].target != target || groups[static_cast<size_t>(group)].radius != c.radius))
+        ++group;
+    if (static_cast<size_t>(group) == groups.size()) {
+        groups.push_back({target, c.radius});
+        Kernel pair;
+        pair.kind = KernelKind::Pair;
+        pair.site = group;
+        object_->kernels.push_back(std::move(pair));
+    }
+    Kernel& pair = *object_->kernel(KernelKind::Pair, group);
+    LocScope at(pair, k_.loc());
+    int sites = 0;
+    ObjectLowering term(module_, locate_, pair, object_, decl_, nullptr, sites);
+    term.qualify = qualify;
+    term.pair_ = true;
+    Type t = irType(c.type);
+    ValueId value = core::reduceInfo(reduce).term ? term.lowerOne(*c.args[2]) : pair.scalar(1);
+    int fold = static_cast<int>(object_->folds.size());
+    object_->folds.push_back({group, reduce, t});
+    pair.yields.push_back({YieldKind::Fold, fold, 0, value});
+    return input(Op::Fold, t, fold);
+}
+
 Values ObjectLowering::lower(const Expr& e) {
     LocScope at(k_, locate_(e.range));
     switch (e.kind) {
@@ -111,6 +152,7 @@ Values ObjectLowering::lower(const Expr& e) {
         case ExprKind::Call: return lowerCall(static_cast<const CallExpr&>(e));
         case ExprKind::Member: {
             auto& m = static_cast<const MemberExpr&>(e);
+            if (m.neighbour) return {neighbourRead(true, m.member, irType(m.type))};
             if (m.parent) return {parentRead(m)};
             ValueId base = lowerOne(*m.base);
             if (m.swizzle.size() == 1) return {extract(base, m.swizzle[0])};

@@ -3,6 +3,7 @@
 // order and expressions; lower_calls.cpp inlines functions and expands built-ins.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <set>
 #include <tuple>
@@ -151,8 +152,14 @@ private:
         return k_.add(std::move(inst));
     }
     ValueId parentRead(const MemberExpr& m);
+    ValueId lowerNear(const CallExpr& c);
+    ValueId neighbourRead(bool other, const std::string& member, Type t);
 
 public:
+    // Object types' names in the IR (nested ones qualified): what a fold names its type by.
+    std::function<std::string(const ObjectDecl*)> qualify;
+    // Lowering a fold's term into a pair kernel: the object's names read its exports.
+    bool pair_ = false;
     // While lowering emit arguments: random draws there are one per created object.
     bool perChild_ = false;
     // A temporal op or random draw: its own call site (a trail's history is built of them).

@@ -67,8 +67,8 @@ KernelStorage storageOf(const Object& object, const Kernel& kernel) {
         }
     }
     for (const Inst& i : kernel.insts())
-        if (readsAncestor(i.op))
-            st.parents.push_back({i.op, i.attr2, i.op == Op::ParentExport ? i.attr : -1, i.type.width});
+        if (isGathered(i.op))
+            st.parents.push_back({i.op, i.attr2, i.op == Op::ParentExport || i.op == Op::Fold ? i.attr : -1, i.type.width});
     if (kernel.kind == KernelKind::Init) {
         std::vector<bool> set(object.state.size(), false);
         bool readsState = false;

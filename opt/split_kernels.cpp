@@ -141,6 +141,9 @@ void splitKernels(Module& module, PassErrors&) {
         Kernel* found = object.kernel(KernelKind::Behaviour);
         if (!found) continue;
         Kernel behaviour = std::move(*found);
+        std::vector<Kernel> pairs;  // the fold terms' kernels stay as they are
+        for (Kernel& k : object.kernels)
+            if (k.kind == KernelKind::Pair) pairs.push_back(std::move(k));
         object.kernels.clear();
 
         // Post-update kernels first: they decide which values update must carry.
@@ -178,6 +181,7 @@ void splitKernels(Module& module, PassErrors&) {
             clean.site = k.site;
             object.kernels.push_back(std::move(clean));
         }
+        for (Kernel& k : pairs) object.kernels.push_back(std::move(k));
     }
 }
 

@@ -13,6 +13,7 @@
 // so a compiling backend compiles them all at once.
 #pragma once
 
+#include <array>
 #include <span>
 #include <string>
 #include <vector>
@@ -102,6 +103,33 @@ struct ChildrenLaunch {
     std::span<const Buffer> args;           // per component of the created type's parameters
     size_t argsFirst = 0;                   // child k's arguments at row argsFirst + k
 };
+
+// The folds of one neighbour group over every row of the folding type (rt/neighbours.cpp,
+// docs/language.md "Neighbours"): each fold of the group, for each object in self.mask,
+// over the objects in other.mask whose drawn position lies within the group's radius of
+// its own, in the grid's order (the same on every backend: core/hash.h cellBucket).
+struct FoldLaunch {
+    const ir::Object* object = nullptr;  // the folding type
+    const ir::Kernel* pair = nullptr;    // its group's pair kernel: the terms
+    const ir::NeighbourGroup* group = nullptr;
+    bool same = false;                   // over its own type: an object is not its own neighbour
+    struct Side {
+        size_t rows = 0;
+        Buffer mask;                                 // u8: the objects that fold, or are folded over
+        std::vector<std::array<Buffer, 4>> exports;  // per export, its components
+    } self, other;
+    // Per fold of the object (only the group's are written): self.rows + 1 rows, the last
+    // what the fold is over nothing (core::emptyFold), as are the rows not in self.mask.
+    std::vector<std::array<Buffer, 4>> results;
+    const Value* externs = nullptr;
+};
+
+// A group's terms for one object and its candidate neighbours, compiled: `self` and
+// `other` point at each side's export columns (export e's component c at 4e + c), `acc`
+// at the group's folds' components (in fold order), each combined with every candidate
+// within the radius (core/fold.h combine). `position` is the group's two position exports.
+using PairFunction = void (*)(const float* const* self, const float* const* other, uint32_t selfRow,
+                              const uint32_t* others, uint32_t count, const Value* externs, float* acc);
 
 // Every launch shape a system will use, listed before its first step.
 struct Plan {
@@ -207,6 +235,11 @@ public:
     // rows still in cache) when the host draws every step: true where launches run on the
     // host's memory; a GPU gains nothing from it and pays a dispatch per chunk.
     virtual bool rendersInStep() const { return true; }
+    // A neighbour group's folds, all on the backend's side; false: the run-time folds on
+    // the host (its grid and loop), asking pairFunction for the terms.
+    virtual bool fold(const FoldLaunch&) { return false; }
+    // A group's terms compiled (PairFunction); null: the run-time evaluates the pair kernel.
+    virtual PairFunction pairFunction(const ir::Object&, const ir::Kernel&) { return nullptr; }
     virtual BackendReport report() const { return {}; }
 };
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "core/fold.h"
+
 namespace psys::rt {
 
 void ValueColumns::define(Memory& memory, const std::vector<ir::Type>& types, size_t rows) {
@@ -97,6 +99,13 @@ Pool::Pool(const ir::Object& object, size_t capacity, Memory& memory)
     types.clear();
     for (auto& e : object.exports) types.push_back(e.type);
     exports.define(memory, types, 0);
+    types.clear();
+    for (auto& f : object.folds) types.push_back(f.type);
+    folds.define(memory, types, 1);  // row foldRows (0 until the first fold): the empty folds
+    for (size_t f = 0; f < object.folds.size(); ++f) {
+        float empty = core::emptyFold(object.folds[f].reduce);
+        for (int c = 0; c < object.folds[f].type.width; ++c) memory.write(folds.column(f, static_cast<size_t>(c)), 0, 1, &empty);
+    }
     emitted.assign(object.emits.size(), {});
 }
 
@@ -106,6 +115,7 @@ size_t Pool::rowBytes(const ir::Object& object) {
     for (auto& p : object.params)
         if (p.kept) floats += static_cast<size_t>(p.type.width);
     for (auto& e : object.exports) floats += static_cast<size_t>(e.type.width);
+    for (auto& f : object.folds) floats += static_cast<size_t>(f.type.width);
     size_t columns = sizeof(double) + sizeof(uint32_t) + 2 + 4 * floats;  // created, id, updatable, alive, values
     size_t host = sizeof(Status) + sizeof(uint32_t) + sizeof(Handle) + sizeof(uint32_t) + sizeof(double) + 2 +
                   sizeof(double) * object.emits.size();  // status, generation, parent, readers, diedAt, masks, emitted
@@ -114,7 +124,8 @@ size_t Pool::rowBytes(const ir::Object& object) {
 
 Pool::Pool(Pool&& other) noexcept
     : created(other.created), ids(other.ids), updatable(std::move(other.updatable)), alive(std::move(other.alive)), state(std::move(other.state)),
-      params(std::move(other.params)), exports(std::move(other.exports)), paramColumn(std::move(other.paramColumn)),
+      params(std::move(other.params)), exports(std::move(other.exports)), folds(std::move(other.folds)),
+      foldRows(other.foldRows), paramColumn(std::move(other.paramColumn)),
       parent(std::move(other.parent)), readers(std::move(other.readers)), fresh(std::move(other.fresh)),
       emitted(std::move(other.emitted)), object_(other.object_), capacity_(other.capacity_), memory_(other.memory_),
       status_(std::move(other.status_)), generation_(std::move(other.generation_)),
@@ -134,6 +145,7 @@ Pool::~Pool() {
     state.release(*memory_);
     params.release(*memory_);
     exports.release(*memory_);
+    folds.release(*memory_);
     for (Buffer b : {rows_.stack, rows_.generation, rows_.counters})
         if (b.valid()) memory_->release(b);
     for (const FreshRows& f : freshRows_) memory_->release(f.rows);

@@ -158,6 +158,11 @@ public:
     void syncMasks();
     void restoreMask(std::vector<uint8_t> mask);  // hot reload: the whole update mask
     ValueColumns state, params, exports;  // params: only the kept ones
+    // The neighbour folds (ir::Object::folds) of this step, per row below foldRows, and at
+    // row foldRows what a fold is over nothing: what an object created since reads
+    // (rt/neighbours.cpp).
+    ValueColumns folds;
+    size_t foldRows = 0;
     std::vector<int> paramColumn;    // per parameter: its value in `params`, or -1
 
     // Host bookkeeping.

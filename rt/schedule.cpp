@@ -2,6 +2,8 @@
 // printed.
 #include "rt/schedule.h"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "rt/system_state.h"
@@ -12,6 +14,7 @@ const char* phaseName(PhaseKind kind) {
     switch (kind) {
         case PhaseKind::Settle: return "settle";
         case PhaseKind::Ready: return "ready";
+        case PhaseKind::Neighbours: return "neighbours";
         case PhaseKind::SubSteps: return "sub-steps";
         case PhaseKind::Update: return "update";
         case PhaseKind::Kills: return "kills";
@@ -44,6 +47,12 @@ std::string describe(const Schedule& s, const Phase& p) {
     switch (p.kind) {
         case PhaseKind::Settle: return "what the last step owes: its late kills taken, its dead freed";
         case PhaseKind::Ready: return "the rows created during the last step become updatable";
+        case PhaseKind::Neighbours: {
+            std::string over;
+            for (int t : p.targets) over += (over.empty() ? "" : ", ") + s.types[static_cast<size_t>(t)];
+            return fmt::format("{}: its folds over the {} near each of its objects: a grid of their positions, then "
+                               "each object's neighbours in the grid's order", type, over);
+        }
         case PhaseKind::SubSteps:
             return fmt::format("{}: the next {} phases once per sub-step of @step({:g})", type, p.span, p.stepLimit);
         case PhaseKind::Update: {
@@ -118,6 +127,16 @@ Schedule stepSchedule(const State& s) {
     };
     add(PhaseKind::Settle, -1, Parallelism::Ordered);
     add(PhaseKind::Ready, -1, Parallelism::Ordered);
+    // Every type's folds before any update: each sees the others as the last step left them.
+    for (size_t t = 0; t < s.types.size(); ++t) {
+        const ir::Object& o = s.module.objects[t];
+        if (o.neighbours.empty()) continue;
+        Phase& p = add(PhaseKind::Neighbours, static_cast<int>(t), Parallelism::Chunks);
+        for (const ir::NeighbourGroup& g : o.neighbours) {
+            int target = s.module.objectIndex(g.target);
+            if (std::find(p.targets.begin(), p.targets.end(), target) == p.targets.end()) p.targets.push_back(target);
+        }
+    }
     for (size_t t = 0; t < s.types.size(); ++t) {
         const TypeInfo& info = s.types[t];
         auto type = static_cast<int>(t);

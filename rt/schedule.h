@@ -16,6 +16,7 @@ namespace psys::rt {
 enum class PhaseKind : unsigned char {
     Settle,     // what the last step still owes (a device's late kills) taken, its dead freed
     Ready,      // the rows created during the last step become updatable
+    Neighbours, // the type's neighbour folds, over every object as the last step left them
     SubSteps,   // the next `span` phases, once per sub-step of @step(stepLimit)
     Update,     // the update kernel over the pool; in the same chunk the survivors' exports, and the render when the host draws every step
     Kills,      // the rows the update killed, frozen in row order (or, `late`, at the step's end)

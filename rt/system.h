@@ -90,9 +90,11 @@ struct Stats {
     uint64_t clampedEmissions = 0;     // counts and rates asking for more than 1e18 objects (taken as 1e18)
     uint64_t nonFiniteRender = 0;      // points not drawn because a value was NaN or infinite
     uint64_t uniformEvaluations = 0;   // runs of uniform kernels (once per step per type, mostly)
+    uint64_t folds = 0;                // neighbour groups folded (once per step per group)
     // Where the time went: the update loops over pools, kills and emissions (with the
-    // emitters' spawn kernels), creating objects (init and their first update), drawing.
-    double loopSeconds = 0, emitSeconds = 0, createSeconds = 0, drawSeconds = 0;
+    // emitters' spawn kernels), creating objects (init and their first update), drawing,
+    // the neighbour folds.
+    double loopSeconds = 0, emitSeconds = 0, createSeconds = 0, drawSeconds = 0, foldSeconds = 0;
 };
 
 // One drawn point, read back (System::points).

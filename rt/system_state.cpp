@@ -404,6 +404,10 @@ void State::parentValues(size_t type, uint32_t row, const ColumnLayout& layout, 
         const Pool* parent = t < 0 ? nullptr : &pools[static_cast<size_t>(t)];
         Value v;
         if (p.op == ir::Op::ParentExport && parent) v = parent->exports.get(memory, static_cast<size_t>(p.exportIndex), r);
+        if (p.op == ir::Op::Fold) {  // this object's own
+            const Pool& self = pools[type];
+            v = self.folds.get(memory, static_cast<size_t>(p.exportIndex), std::min<size_t>(row, self.foldRows));
+        }
         if (p.op == ir::Op::ParentAlive) v = Value::boolean(parent && parent->status(r) == Status::Alive);
         if (p.op == ir::Op::ParentAge && parent) v = Value::scalar(ageAt(parent->ageClock(r, at), view<double>(parent->created)[r]));
         out.push_back(v);
@@ -430,6 +434,15 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
                 rows[i - begin] = t < 0 ? kSkipRow : r;
             }
             rowsDepth = p.depth;
+        }
+        if (p.op == ir::Op::Fold) {  // this object's own folds (rows: its own)
+            foldRowsOf(type, rows);
+            const Pool& pool = pools[type];
+            for (int c = 0; c < p.width; ++c)
+                memory.gather(pool.folds.column(static_cast<size_t>(p.exportIndex), static_cast<size_t>(c)),
+                              table[static_cast<size_t>(p.offset + c)], begin, rows);
+            rowsDepth = -1;
+            continue;
         }
         if (p.op == ir::Op::ParentExport) {
             for (int c = 0; c < p.width; ++c) {

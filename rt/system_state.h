@@ -225,6 +225,11 @@ struct State {
     void gatherParents(size_t type, const ColumnLayout& layout, std::span<const Buffer> table, const uint8_t* mask,
                        size_t begin, size_t end, double at, const double* atRows = nullptr,
                        const uint32_t* poolRows = nullptr, size_t poolRowsFirst = 0);
+    // The neighbour folds of a type's objects, for this step (rt/neighbours.cpp).
+    void foldNeighbours(size_t type);
+    void foldOnHost(const FoldLaunch& launch);
+    // Pool rows of `type` as the rows its fold columns are gathered from (in place).
+    void foldRowsOf(size_t type, std::span<uint32_t> rows) const;
     // Points `table` at a pool's columns, kill flags and the scratch columns of the rest.
     void bindPool(size_t type, const ColumnLayout& layout, Scratch& scratch, std::vector<Buffer>& table);
     // chunk(c, begin, end) for every chunk of rows [first, end) (Backend::chunkRows rows

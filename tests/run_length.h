@@ -3,6 +3,10 @@
 // for (memory errors, undefined behaviour) shows in the first frames.
 #pragma once
 
+#include <climits>
+
+#include "ir/ir.h"
+
 namespace psys::test {
 
 #ifdef PSYS_SANITIZED
@@ -10,5 +14,18 @@ constexpr int kLongRun = 200;
 #else
 constexpr int kLongRun = 600;
 #endif
+
+// A crowd — objects that fold over their neighbours (docs/language.md, "Neighbours") — is
+// chaotic: a difference in a last bit moves an object, which changes its neighbours'
+// pushes, step after step, growing about tenfold a second. Backends that round
+// differently (fast maths, the GPU) are compared object by object over a crowd's first
+// kCrowdRun frames; after that, by what is alive (the same objects in the same rows).
+// Backends that round alike (the JIT in exact maths) agree bit for bit over every frame.
+constexpr int kCrowdRun = 30;
+inline int closeFrames(const ir::Module& m) {
+    for (const ir::Object& o : m.objects)
+        if (!o.folds.empty()) return kCrowdRun;
+    return INT_MAX;
+}
 
 }  // namespace psys::test

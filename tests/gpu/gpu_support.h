@@ -129,7 +129,7 @@ inline test::Comparison compareProgram(const std::string& text, int frames, bool
     interp::Interpreter interpreter;
     auto gpu = gpuBackend(hostSide);
     rt::System a(test::compileModule(text, optimize), interpreter), b(test::compileModule(text, optimize), *gpu);
-    test::Comparison result = test::compareSystems(a, b, frames);
+    test::Comparison result = test::compareSystems(a, b, frames, test::closeFrames(a.module()));
     CHECK(result.worst <= tolerance);
     return result;
 }

@@ -2,6 +2,10 @@
 // the options a test names, and two runs compared side by side.
 #pragma once
 
+#include <climits>
+
+#include "tests/run_length.h"
+
 #include <doctest/doctest.h>
 
 #include <cstring>
@@ -70,7 +74,9 @@ inline bool bitwise(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 
 // Runs two systems side by side for `frames` frames, firing every trigger once, and
 // compares what is drawn: the same objects, and values compared by `close`. Returns the
 // number of points compared.
-inline size_t compareRuns(Run& a, Run& b, int frames, const std::function<bool(float, float)>& close) {
+// Values over the first `closeFrames` frames only (test::closeFrames), what is alive over all.
+inline size_t compareRuns(Run& a, Run& b, int frames, const std::function<bool(float, float)>& close,
+                          int closeFrames = INT_MAX) {
     for (const ir::Trigger& t : a.system->module().triggers) {
         size_t width = 0;
         for (auto& p : t.params) width += static_cast<size_t>(p.type.width);
@@ -87,6 +93,10 @@ inline size_t compareRuns(Run& a, Run& b, int frames, const std::function<bool(f
             const auto& pb = b.system->points(t);
             REQUIRE(pa.size() == pb.size());
             for (size_t i = 0; i < pa.size(); ++i) {
+                if (frame >= closeFrames) {
+                    CHECK(pa[i].id == pb[i].id);
+                    continue;
+                }
                 ++points;
                 bool same = pa[i].id == pb[i].id && close(pa[i].size, pb[i].size);
                 for (size_t c = 0; c < 3; ++c) same &= close(pa[i].position[c], pb[i].position[c]);
@@ -125,7 +135,9 @@ inline size_t compareWithUnoptimized(bool relaxed, std::optional<core::Integrato
         std::string text = readFile(entry.path().string());
         if (integrator && !compiles(text, integrator)) continue;
         Run plain(text, {}, false, false, integrator), optimized(text, {}, true, relaxed, integrator);
-        points += compareRuns(plain, optimized, frames, close);
+        // (relaxed maths rounds otherwise: a crowd is compared over its first frames)
+        points += compareRuns(plain, optimized, frames, close,
+                              relaxed ? test::closeFrames(plain.system->module()) : INT_MAX);
     }
     return points;
 }

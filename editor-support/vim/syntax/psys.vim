@@ -14,6 +14,7 @@ syn keyword psysType bool float scalar vector color
 syn match psysType "\<\%(point\|vec[234]\)\>\%(\s*(\)\@!"
 syn match psysKeyword "\<point\ze\s*("
 syn keyword psysBuiltin sin cos tan asin acos atan atan2 tanh exp log pow sqrt abs sign floor ceil round fract hash mod
+syn keyword psysBuiltin near_sum near_min near_max near_count
 syn keyword psysBuiltin min max clamp saturate mix lerp step smoothstep radians degrees length distance dot
 syn keyword psysBuiltin normalize reflect cross rotate_x rotate_y rotate_z rgba
 syn keyword psysBuiltin rand rand2 rand3 rand4 nrand nrand2 nrand3 nrand4

@@ -1,0 +1,126 @@
+// Checking the neighbour folds: `near_count(T, r)`, `near_sum(T, r, term)`, `near_min`,
+// `near_max` (docs/language.md, "Neighbours").
+//
+// A fold is over the objects of type T whose drawn position lies within `r` of this
+// object's, at the start of the step. Its term is computed once per pair from the two
+// objects' values as they were then, so it may read this object's equations and
+// parameters, `other.NAME` (the neighbour's), constants and externs — nothing with a
+// history of its own (age, prev, integrate, rand: a term is no equation of either
+// object) and nothing of a function's or an enclosing object's.
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/fold.h"
+#include "frontend/checker.h"
+#include "frontend/consteval.h"
+
+namespace psys::detail {
+
+using namespace ast;
+
+const ObjectDecl* Checker::findObjectType(const std::string& name) const {
+    if (auto it = globals_.find(name); it != globals_.end() && it->second->kind == DeclKind::Object)
+        return static_cast<const ObjectDecl*>(it->second);
+    auto [first, last] = nestedObjects_.equal_range(name);
+    if (first != last && std::next(first) == last) return first->second;
+    return nullptr;
+}
+
+Type Checker::checkNear(CallExpr& call, const Context& ctx) {
+    core::Reduce reduce = *core::neighbourFold(call.callee);
+    const core::ReduceInfo& info = core::reduceInfo(reduce);
+    std::string usage = info.term ? fmt::format("`{}(type, radius, term)`", call.callee)
+                                  : fmt::format("`{}(type, radius)`", call.callee);
+    if (ctx.where != Where::Object || !ctx.object) {
+        diags_.error(call.calleeRange, fmt::format("`{}` can be used only in an object's equations: it folds over the "
+                                                   "objects near this one", call.callee));
+        return Type::error();
+    }
+    if (ctx.fold) {
+        diags_.error(call.calleeRange, fmt::format("`{}` cannot be used in the term of `{}`", call.callee, ctx.fold->callee));
+        return Type::error();
+    }
+    size_t want = info.term ? 3 : 2;
+    if (call.args.size() != want) {
+        diags_.error(call.range, fmt::format("`{}` takes {} arguments, but {} {} given: {}", call.callee, want,
+                                             call.args.size(), call.args.size() == 1 ? "was" : "were", usage));
+        return Type::error();
+    }
+    // The type folded over: a name, not a value.
+    const Expr& typeArg = *call.args[0];
+    const ObjectDecl* target = nullptr;
+    if (typeArg.kind == ExprKind::Name) target = findObjectType(static_cast<const NameExpr&>(typeArg).name);
+    if (!target) {
+        diags_.error(typeArg.range, fmt::format("the first argument of `{}` must name an object type (the objects it "
+                                                "folds over): {}", call.callee, usage));
+        return Type::error();
+    }
+    if (target != ctx.object && !objectScopes_.count(target)) {
+        diags_.error(typeArg.range, fmt::format("`{}` is declared after `{}`: a fold reads the equations of its own "
+                                                "type or of one declared before it", target->name, ctx.object->name))
+            .notes.push_back({target->nameRange, fmt::format("`{}` declared here", target->name)});
+        return Type::error();
+    }
+    call.neighbours = target;
+    // The radius: the grid's cell, fixed for the program.
+    check(*call.args[1], ctx);
+    auto r = evaluateConstant(*call.args[1]);
+    if (!r || !(r->v[0] > 0) || !std::isfinite(r->v[0]) || !r->type.isFloat()) {
+        diags_.error(call.args[1]->range, fmt::format("the radius of `{}` must be a constant number above 0 (the "
+                                                      "objects within it are folded over); {}", call.callee,
+                                                      !r ? "it is not a constant" : "it is not"));
+        return Type::error();
+    }
+    call.radius = r->v[0];
+    if (!info.term) return Type::scalar();
+    Context inner = ctx;
+    inner.fold = &call;
+    inner.other = target;
+    Type t = check(*call.args[2], inner);
+    if (t.isVague()) return t;
+    if (!t.isNumeric()) {
+        diags_.error(call.args[2]->range, fmt::format("the term of `{}` must be a number or vector, found {}",
+                                                      call.callee, t.str()));
+        return Type::error();
+    }
+    return t;
+}
+
+// `other.vel`: the neighbour's equation or parameter.
+Type Checker::checkNeighbourMember(MemberExpr& member, const Context& ctx) {
+    const ObjectDecl* other = ctx.other;
+    member.parent = other;
+    member.neighbour = true;
+    member.base->type = Type::error();  // `other` is not a value of its own
+    auto& scope = objectScopes_[other];
+    auto it = scope.names.find(member.member);
+    if (it == scope.names.end()) {
+        std::vector<std::string> names;
+        for (auto& [n, _] : scope.names) names.push_back(n);
+        std::string suggestion = closestName(member.member, names);
+        diags_.error(member.memberRange,
+                     fmt::format("`{}` has no equation or parameter named `{}`{}", other->name, member.member,
+                                 suggestion.empty() ? "" : fmt::format("; did you mean `{}`?", suggestion)))
+            .notes.push_back({other->nameRange, fmt::format("`{}` declared here", other->name)});
+        return Type::error();
+    }
+    member.parentRef = it->second;
+    if (member.parentRef.kind == Ref::Kind::Equation) usedEquations_.insert(member.parentRef.equation);
+    return typeOfRef(member.parentRef);
+}
+
+// What a fold's term may read by name.
+bool Checker::checkFoldTermRef(const NameExpr& name, const Context& ctx) {
+    switch (name.ref.kind) {
+        case Ref::Kind::Param: case Ref::Kind::Equation: case Ref::Kind::Const: case Ref::Kind::Extern:
+        case Ref::Kind::BuiltinConst: case Ref::Kind::Unresolved:
+            return true;
+        default: break;
+    }
+    diags_.error(name.range, fmt::format("the term of `{}` cannot read `{}`: it may read this object's equations and "
+                                         "parameters, `other.NAME`, constants and externs", ctx.fold->callee, name.name));
+    return false;
+}
+
+}  // namespace psys::detail

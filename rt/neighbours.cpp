@@ -1,0 +1,280 @@
+// The neighbour folds (docs/language.md, "Neighbours"): once a step, before any update,
+// each type's folds over the objects near each of its objects — so that every object sees
+// the others as the last step left them, whatever order the types update in.
+//
+// A backend may fold on its own side (Backend::fold: the GPU); else the run-time folds
+// here, on the host: a grid of the other type's drawn positions — cells the radius (and a
+// little) wide, hashed into buckets (core/hash.h cellBucket), its rows counting-sorted by
+// bucket in row order — then, for each object, the buckets of the 27 cells around its
+// own in bucket order, each bucket's rows in row order. That is the order terms are
+// combined in, so the folds do not depend on the number of threads. The terms are the
+// backend's compiled pair kernel (Backend::pairFunction) or the IR evaluated.
+#include <algorithm>
+#include <cmath>
+
+#include "core/fold.h"
+#include "core/hash.h"
+#include "rt/system_state.h"
+
+namespace psys::rt::detail {
+
+namespace {
+
+constexpr size_t kFoldRows = 1024;  // objects a chunk of the host's fold
+
+// A side's export columns as host arrays: the memory's own where it is the host's, else
+// read (a device's memory: what the GPU does not fold itself).
+struct HostSide {
+    std::vector<const float*> columns;  // export e's component c at 4e + c
+    std::vector<std::vector<float>> owned;
+    const uint8_t* mask = nullptr;
+    std::vector<uint8_t> ownedMask;
+
+    HostSide(const Memory& memory, const FoldLaunch::Side& side) {
+        auto read = [&](Buffer b, size_t bytes) -> const void* {
+            if (const void* v = memory.view(b)) return v;
+            auto& data = owned.emplace_back((side.rows * bytes + 3) / 4);
+            if (side.rows) memory.read(b, 0, side.rows, data.data());
+            return data.data();
+        };
+        for (const auto& e : side.exports)
+            for (Buffer b : e) columns.push_back(b.valid() ? static_cast<const float*>(read(b, 4)) : nullptr);
+        mask = static_cast<const uint8_t*>(read(side.mask, 1));
+    }
+};
+
+// The other side's objects by bucket: rows and positions sorted by bucket, in row order
+// within one.
+struct Grid {
+    float inverse = 1;  // 1 / the cell's width
+    uint32_t mask = 0;  // buckets − 1
+    std::vector<uint32_t> start, rows;
+    std::vector<float> x, y, z;
+
+    uint32_t cell(float p) const { return core::HostAlgebra::wholeToInt(std::floor(p * inverse)); }
+    uint32_t bucket(uint32_t cx, uint32_t cy, uint32_t cz) const {
+        core::HostAlgebra a;
+        return core::cellBucket(a, cx, cy, cz, mask);
+    }
+};
+
+Grid buildGrid(const HostSide& other, size_t rows, int position, float radius) {
+    Grid g;
+    g.inverse = 1.0f / (radius * core::kCellMargin);
+    uint32_t buckets = 64;
+    while (buckets < 2 * rows && buckets < (1u << 30)) buckets *= 2;
+    g.mask = buckets - 1;
+    const float* px = other.columns[static_cast<size_t>(4 * position)];
+    const float* py = other.columns[static_cast<size_t>(4 * position + 1)];
+    const float* pz = other.columns[static_cast<size_t>(4 * position + 2)];
+    std::vector<uint32_t> bucketOf(rows);
+    g.start.assign(buckets + 1, 0);
+    for (size_t r = 0; r < rows; ++r) {
+        if (!other.mask[r]) continue;
+        bucketOf[r] = g.bucket(g.cell(px[r]), g.cell(py[r]), g.cell(pz[r]));
+        ++g.start[bucketOf[r] + 1];
+    }
+    for (uint32_t b = 0; b < buckets; ++b) g.start[b + 1] += g.start[b];
+    size_t n = g.start[buckets];
+    g.rows.resize(n);
+    g.x.resize(n);
+    g.y.resize(n);
+    g.z.resize(n);
+    std::vector<uint32_t> next(g.start.begin(), g.start.end() - 1);
+    for (size_t r = 0; r < rows; ++r) {
+        if (!other.mask[r]) continue;
+        uint32_t at = next[bucketOf[r]]++;
+        g.rows[at] = static_cast<uint32_t>(r);
+        g.x[at] = px[r];
+        g.y[at] = py[r];
+        g.z[at] = pz[r];
+    }
+    return g;
+}
+
+// The terms of a pair kernel, evaluated (a backend without a compiled one).
+class EvaluatedTerms {
+public:
+    EvaluatedTerms(const ir::Object& object, const ir::Kernel& pair, const Value* externs)
+        : pair_(pair), externs_(externs), self_(object.exports.size()) {
+        std::vector<size_t> offsets;
+        size_t at = 0;
+        for (const ir::Fold& f : object.folds) {
+            offsets.push_back(at);
+            if (f.group == pair.site) at += static_cast<size_t>(f.type.width);
+        }
+        for (const ir::Yield& y : pair.yields) {
+            const ir::Fold& f = object.folds.at(static_cast<size_t>(y.index));
+            folds_.push_back({offsets[static_cast<size_t>(y.index)], f.type.width, f.reduce});
+        }
+        for (const ir::Inst& i : pair.insts())
+            if (i.op == ir::Op::NeighbourExport) reads_.push_back({i.attr2 == 1, i.attr, i.type.width});
+        size_t otherExports = 0;
+        for (const Read& r : reads_)
+            if (r.other) otherExports = std::max(otherExports, static_cast<size_t>(r.exportIndex) + 1);
+        other_.resize(otherExports);
+    }
+
+    void operator()(const float* const* self, const float* const* other, uint32_t selfRow, const uint32_t* others,
+                    uint32_t count, float* acc) {
+        load(self, selfRow, false, self_);
+        ir::KernelInputs in;
+        in.externs = externs_;
+        in.self = self_.data();
+        in.other = other_.data();
+        for (uint32_t k = 0; k < count; ++k) {
+            load(other, others[k], true, other_);
+            evaluator_.run(pair_, in, values_);
+            for (size_t y = 0; y < folds_.size(); ++y)
+                for (int c = 0; c < folds_[y].width; ++c) {
+                    float& a = acc[folds_[y].offset + static_cast<size_t>(c)];
+                    a = core::combine(folds_[y].reduce, a, values_[y].f[static_cast<size_t>(c)]);
+                }
+        }
+    }
+
+private:
+    struct Read {
+        bool other;
+        int exportIndex, width;
+    };
+    void load(const float* const* columns, uint32_t row, bool other, std::vector<Value>& out) const {
+        for (const Read& r : reads_) {
+            if (r.other != other) continue;
+            for (int c = 0; c < r.width; ++c)
+                out[static_cast<size_t>(r.exportIndex)].f[static_cast<size_t>(c)] =
+                    columns[static_cast<size_t>(4 * r.exportIndex + c)][row];
+        }
+    }
+    struct Term {
+        size_t offset;
+        int width;
+        core::Reduce reduce;
+    };
+    const ir::Kernel& pair_;
+    const Value* externs_;
+    std::vector<Term> folds_;  // per yield
+    std::vector<Read> reads_;
+    std::vector<Value> self_, other_, values_;
+    ir::Evaluator evaluator_;
+};
+
+}  // namespace
+
+void State::foldOnHost(const FoldLaunch& launch) {
+    const ir::Object& object = *launch.object;
+    const ir::NeighbourGroup& group = *launch.group;
+    HostSide self(memory, launch.self), other(memory, launch.other);
+    Grid grid = buildGrid(other, launch.other.rows, group.otherPosition, group.radius);
+    const float radius2 = group.radius * group.radius;
+
+    // The group's folds: their components, in fold order, and where each fold's are.
+    std::vector<const ir::Fold*> folds;
+    std::vector<size_t> firstComponent;
+    size_t width = 0;
+    for (const ir::Fold& f : object.folds) {
+        if (f.group != launch.pair->site) continue;
+        folds.push_back(&f);
+        firstComponent.push_back(width);
+        width += static_cast<size_t>(f.type.width);
+    }
+    std::vector<float> empty;
+    for (const ir::Fold* f : folds) empty.insert(empty.end(), static_cast<size_t>(f->type.width), core::emptyFold(f->reduce));
+    const size_t rows = launch.self.rows;
+    std::vector<float> results((rows + 1) * width);  // row by row
+    for (size_t r = 0; r <= rows; ++r) std::copy(empty.begin(), empty.end(), results.begin() + static_cast<std::ptrdiff_t>(r * width));
+
+    PairFunction compiled = backend.pairFunction(object, *launch.pair);
+    const float* const* sx = self.columns.data();
+    const float* const* ox = other.columns.data();
+    const size_t sp = static_cast<size_t>(4 * group.selfPosition);
+    size_t chunks = (rows + kFoldRows - 1) / kFoldRows;
+    parallel->forEach(chunks, true, [&](size_t c) {
+        std::optional<EvaluatedTerms> evaluated;
+        if (!compiled) evaluated.emplace(object, *launch.pair, launch.externs);
+        std::vector<uint32_t> candidates;
+        uint32_t buckets[27];
+        for (size_t i = c * kFoldRows; i < std::min(rows, (c + 1) * kFoldRows); ++i) {
+            if (!self.mask[i]) continue;
+            float px = sx[sp][i], py = sx[sp + 1][i], pz = sx[sp + 2][i];
+            uint32_t cx = grid.cell(px), cy = grid.cell(py), cz = grid.cell(pz);
+            int n = 0;
+            for (uint32_t dz = 0; dz < 3; ++dz)
+                for (uint32_t dy = 0; dy < 3; ++dy)
+                    for (uint32_t dx = 0; dx < 3; ++dx) buckets[n++] = grid.bucket(cx + dx - 1, cy + dy - 1, cz + dz - 1);
+            std::sort(buckets, buckets + n);
+            n = static_cast<int>(std::unique(buckets, buckets + n) - buckets);
+            candidates.clear();
+            for (int b = 0; b < n; ++b)
+                for (uint32_t j = grid.start[buckets[b]]; j < grid.start[buckets[b] + 1]; ++j) {
+                    if (launch.same && grid.rows[j] == i) continue;
+                    float dx = grid.x[j] - px, dy = grid.y[j] - py, dz = grid.z[j] - pz;
+                    if (dx * dx + dy * dy + dz * dz <= radius2) candidates.push_back(grid.rows[j]);
+                }
+            float* acc = results.data() + i * width;
+            auto count = static_cast<uint32_t>(candidates.size());
+            if (compiled) compiled(sx, ox, static_cast<uint32_t>(i), candidates.data(), count, launch.externs, acc);
+            else (*evaluated)(sx, ox, static_cast<uint32_t>(i), candidates.data(), count, acc);
+        }
+    });
+    // Into the fold columns, component by component.
+    std::vector<float> column(rows + 1);
+    for (size_t k = 0; k < folds.size(); ++k) {
+        auto index = static_cast<size_t>(folds[k] - object.folds.data());
+        for (int comp = 0; comp < folds[k]->type.width; ++comp) {
+            for (size_t r = 0; r <= rows; ++r) column[r] = results[r * width + firstComponent[k] + static_cast<size_t>(comp)];
+            memory.write(launch.results[index][static_cast<size_t>(comp)], 0, rows + 1, column.data());
+        }
+    }
+}
+
+// Every group of a type's folds, over its objects alive before this step.
+void State::foldNeighbours(size_t type) {
+    Pool& pool = pools[type];
+    const ir::Object& object = pool.object();
+    size_t rows = pool.rows();
+    pool.folds.resize(memory, rows + 1);
+    pool.foldRows = rows;
+    auto side = [&](Pool& p) {
+        p.syncMasks();
+        FoldLaunch::Side s;
+        s.rows = p.rows();
+        s.mask = p.updatable.column;
+        for (size_t e = 0; e < p.exports.count(); ++e) {
+            std::array<Buffer, 4> components{};
+            for (int c = 0; c < p.exports.type(e).width; ++c) components[static_cast<size_t>(c)] = p.exports.column(e, static_cast<size_t>(c));
+            s.exports.push_back(components);
+        }
+        return s;
+    };
+    for (const ir::Kernel& pair : object.kernels) {
+        if (pair.kind != ir::KernelKind::Pair) continue;
+        const ir::NeighbourGroup& group = object.neighbours.at(static_cast<size_t>(pair.site));
+        auto target = static_cast<size_t>(module.objectIndex(group.target));
+        FoldLaunch launch;
+        launch.object = &object;
+        launch.pair = &pair;
+        launch.group = &group;
+        launch.same = target == type;
+        launch.self = side(pool);
+        launch.other = side(pools[target]);
+        for (size_t f = 0; f < pool.folds.count(); ++f) {
+            std::array<Buffer, 4> components{};
+            for (int c = 0; c < pool.folds.type(f).width; ++c) components[static_cast<size_t>(c)] = pool.folds.column(f, static_cast<size_t>(c));
+            launch.results.push_back(components);
+        }
+        launch.externs = externs.data();
+        if (!backend.fold(launch)) foldOnHost(launch);
+        ++stats.folds;
+    }
+}
+
+// The rows a launch's fold columns are gathered from: an object's own below foldRows,
+// else (created since the folds) the row of empty folds.
+void State::foldRowsOf(size_t type, std::span<uint32_t> rows) const {
+    const Pool& pool = pools[type];
+    for (uint32_t& r : rows)
+        if (r != kSkipRow && r >= pool.foldRows) r = static_cast<uint32_t>(pool.foldRows);
+}
+
+}  // namespace psys::rt::detail
