@@ -60,6 +60,8 @@ private:
             call->setDoesNotAccessMemory();
             call->setDoesNotThrow();
             call->addFnAttr(llvm::Attribute::WillReturn);
+        } else {  // the library's own result: LLVM would turn powf(x, 2) into x·x, which may round otherwise
+            call->addFnAttr(llvm::Attribute::NoBuiltin);
         }
         return call;
     }

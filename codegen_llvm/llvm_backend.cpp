@@ -57,7 +57,13 @@ struct LlvmBackend::Impl {
             if (auto served = uniformFor(k.kind)) uniform = o.kernel(*served);
         Hasher h;
         h.add(mode == MathMode::Exact).add(children).add(static_cast<uint64_t>(now)).add(static_cast<uint64_t>(dt));
-        h.add(many).add(structuralHash(k)).add(rt::columnLayout(o, k).signature());
+        h.add(many).add(structuralHash(k));
+        if (k.kind == KernelKind::Pair) {  // its folds: how each combines, where its components go
+            for (const Fold& f : o.folds)
+                h.add(static_cast<uint64_t>(f.group == k.site)).add(static_cast<uint64_t>(f.reduce)).add(static_cast<uint64_t>(f.type.width));
+        } else {
+            h.add(rt::columnLayout(o, k).signature());
+        }
         if (uniform) h.add(structuralHash(*uniform));
         return {&o, {&k, children, now, dt}, uniform, many, h.finish()};
     }
@@ -89,7 +95,9 @@ struct LlvmBackend::Impl {
         for (auto& [r, name] : missing) {
             JitEngine::Unit unit{engine.newContext(), nullptr, name};
             unit.module = engine.newModule(*unit.context);
-            if (r->shape.children)
+            if (r->shape.kernel->kind == KernelKind::Pair)
+                buildPairFunction(*unit.module, mode, *r->object, *r->shape.kernel, name);
+            else if (r->shape.children)
                 buildChildrenFunction(*unit.module, mode, *r->object, *r->shape.kernel, name);
             else
                 buildRowsFunction(*unit.module, mode, r->vectorize ? lanes : 0, *r->object, *r->shape.kernel,
@@ -174,6 +182,11 @@ rt::RowsResult LlvmBackend::run(const rt::RowsLaunch& l) {
         return drawn;
     }
     return {static_cast<size_t>(counts.killed), static_cast<size_t>(counts.unstable)};
+}
+
+rt::PairFunction LlvmBackend::pairFunction(const Object& object, const Kernel& pair) {
+    return reinterpret_cast<rt::PairFunction>(
+        impl_->function(object, pair, false, Clock::Source::Uniform, Clock::Source::Uniform));
 }
 
 void LlvmBackend::run(const rt::ChildrenLaunch& l) {

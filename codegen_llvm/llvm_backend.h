@@ -32,6 +32,9 @@ public:
     void forget(const ir::Module& module) override;
     rt::RowsResult run(const rt::RowsLaunch& launch) override;
     void run(const rt::ChildrenLaunch& launch) override;
+    // A neighbour group's terms as a loop over an object's candidates (pair_function.cpp),
+    // compiled at the first fold.
+    rt::PairFunction pairFunction(const ir::Object& object, const ir::Kernel& pair) override;
     bool concurrent() const override { return true; }
     bool marksDrawn() const override { return true; }  // render loops mark and count what they draw
     // Floats per vector register the loops over pools use (16 with AVX-512, 8 with AVX, else 4).
