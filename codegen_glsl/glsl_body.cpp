@@ -58,6 +58,7 @@ struct GlslAlgebra {
     Int mul(const Int& x, const Int& y) { return out.let("uint", x + " * " + y); }
     Int bitXor(const Int& x, const Int& y) { return out.let("uint", x + " ^ " + y); }
     Int shiftRight(const Int& x, const Int& y) { return out.let("uint", x + " >> " + y); }
+    Int bitAnd(const Int& x, const Int& y) { return out.let("uint", x + " & " + y); }
     Float toFloat(const Int& x) { return out.let("float", "float(" + x + ")", true); }
     Float fmul(const Float& x, const Float& y) { return out.let("float", x + " * " + y, true); }
     Float fsub(const Float& x, const Float& y) { return out.let("float", x + " - " + y, true); }
@@ -249,6 +250,17 @@ std::vector<std::string> emitBody(Statements& out, const Kernel& kernel, const s
 std::string emitAge(Statements& out, const std::string& now, const std::string& created) {
     GlslTimeAlgebra algebra{out};
     return rt::ageAt(algebra, now, created);
+}
+
+std::string emitCell(Statements& out, const std::string& p, const std::string& inverse) {
+    GlslAlgebra algebra{out};
+    return algebra.wholeToInt(out.let("float", "floor(" + p + " * " + inverse + ")", true));
+}
+
+std::string emitCellBucket(Statements& out, const std::string& x, const std::string& y, const std::string& z,
+                           const std::string& mask) {
+    GlslAlgebra algebra{out};
+    return core::cellBucket(algebra, x, y, z, mask);
 }
 
 }  // namespace psys::codegen_glsl

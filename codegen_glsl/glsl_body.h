@@ -55,6 +55,12 @@ using LeafReader = std::function<std::string(const ir::Inst& inst, int parentOrd
 std::vector<std::string> emitBody(Statements& out, const ir::Kernel& kernel, const std::string& seed,
                                   const LeafReader& leaf, const std::string& prefix = "v");
 
+// A neighbour grid's cell coordinate of a position component (uint: the whole number's
+// bits) and the bucket of a cell (core/hash.h cellBucket), as the host computes them.
+std::string emitCell(Statements& out, const std::string& p, const std::string& inverse);
+std::string emitCellBucket(Statements& out, const std::string& x, const std::string& y, const std::string& z,
+                           const std::string& mask);
+
 // `float(now − created)` by rt/clock.h's rule, for two double expressions.
 std::string emitAge(Statements& out, const std::string& now, const std::string& created);
 

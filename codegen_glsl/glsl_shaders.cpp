@@ -59,48 +59,16 @@ vec4 lv(uint k) { return uintBitsToFloat(uvec4(lw(k), lw(k + 1u), lw(k + 2u), lw
 )";
 }
 
-// What every compute shader starts with: the bindings, the accessors and the helpers
-// that give GLSL built-ins core/lanes.h's results where GLSL leaves them undefined. A
-// column in `direct` is read and written in its own storage block (2 + its place there)
-// or, past kDirectSlots, read through a buffer texture (its unit: its place less
-// kDirectSlots); the others in the launch's words. The accessors' switch on a literal
-// column folds away. `records`: the launch's words hold a block per emitter (a children
-// launch): `lw` reads the invocation's (psys_record, set by kRecordIndex), the uniform
-// block says where they are (LaunchRecords).
-std::string preamble(const std::string& comment, uint32_t blockWords, const std::vector<int>& direct = {},
-                     bool records = false) {
-    std::string blocks, reads, writes;
-    for (size_t k = 0; k < direct.size(); ++k) {
-        if (k >= kDirectSlots) {
-            size_t unit = k - kDirectSlots;
-            blocks += fmt::format("layout(binding = {0}) uniform usamplerBuffer t{0};\n", unit);
-            reads += fmt::format("case {}u: return texelFetch(t{}, int(o)).x; ", direct[k], unit);
-            continue;
-        }
-        blocks += fmt::format("layout(std430, binding = {0}) buffer Column{0} {{ uint d{0}[]; }};\n", k + 2);
-        reads += fmt::format("case {}u: return d{}[o]; ", direct[k], k + 2);
-        writes += fmt::format("case {}u: d{}[o] = x; return; ", direct[k], k + 2);
-    }
-    return fmt::format(R"(#version 450
-// {0}
-layout(local_size_x = {1}) in;
-layout(std430, binding = 0) buffer Words {{ uint w[]; }};
-layout(std430, binding = 1) buffer Counts {{ uint counts[]; }};
-{4}{8}float lf(uint k) {{ return uintBitsToFloat(lw(k)); }}
-double ld(uint k) {{ return packDouble2x32(uvec2(lw(k), lw(k + 1u))); }}
-uint col(uint c) {{ return lw({3}u + c); }}
-uint cw(uint c, uint o) {{ switch (c) {{ {5}default: return w[o]; }} }}
-void scw(uint c, uint o, uint x) {{ switch (c) {{ {6}default: w[o] = x; }} }}
-float cf(uint c, uint i) {{ return uintBitsToFloat(cw(c, col(c) + i)); }}
-uint cu(uint c, uint i) {{ return cw(c, col(c) + i); }}
-double cd(uint c, uint i) {{ uint o = col(c) + 2u * i; return packDouble2x32(uvec2(cw(c, o), cw(c, o + 1u))); }}
-void sf(uint c, uint i, float x) {{ scw(c, col(c) + i, floatBitsToUint(x)); }}
-void su(uint c, uint i, uint x) {{ scw(c, col(c) + i, x); }}
+}  // namespace
 
-// A zero the GL's compiler cannot see: GLSL does not ask it to keep NaN and infinity, and
+// What a shader's bodies (codegen_glsl/glsl_body.h) call: GLSL built-ins with
+// core/lanes.h's results where GLSL leaves them undefined, and the zero no compiler sees
+// through, read from word `zeroWord` of the shader's `lw` (which must hold 0).
+std::string mathHelpers(uint32_t zeroWord) {
+    return fmt::format(R"(// A zero the GL's compiler cannot see: GLSL does not ask it to keep NaN and infinity, and
 // drivers fold x · 0 to 0 even in `precise` code (Mesa does), where IEEE 754 and the
 // interpreter give NaN for x = ∞ or NaN. Every float constant 0 of a kernel is this.
-#define psys_zero uintBitsToFloat(lw({7}u))
+#define psys_zero uintBitsToFloat(lw({0}u))
 #define psys_nan uintBitsToFloat(0x7fc00000u)
 #define psys_inf uintBitsToFloat(0x7f800000u)
 float psys_sign(float x) {{ return x > 0.0 ? 1.0 : x < 0.0 ? -1.0 : 0.0; }}
@@ -155,10 +123,55 @@ float psys_pow(float x, float y) {{  // C's pow: defined for every base
     if (isinf(x)) return y < 0.0 ? 0.0 : psys_inf;
     return pow(x, y);
 }}
+)", zeroWord);
+}
+
+namespace {
+
+// What every compute shader starts with: the bindings, the accessors and the helpers
+// that give GLSL built-ins core/lanes.h's results where GLSL leaves them undefined. A
+// column in `direct` is read and written in its own storage block (2 + its place there)
+// or, past kDirectSlots, read through a buffer texture (its unit: its place less
+// kDirectSlots); the others in the launch's words. The accessors' switch on a literal
+// column folds away. `records`: the launch's words hold a block per emitter (a children
+// launch): `lw` reads the invocation's (psys_record, set by kRecordIndex), the uniform
+// block says where they are (LaunchRecords).
+std::string preamble(const std::string& comment, uint32_t blockWords, const std::vector<int>& direct = {},
+                     bool records = false) {
+    std::string blocks, reads, writes;
+    for (size_t k = 0; k < direct.size(); ++k) {
+        if (k >= kDirectSlots) {
+            size_t unit = k - kDirectSlots;
+            blocks += fmt::format("layout(binding = {0}) uniform usamplerBuffer t{0};\n", unit);
+            reads += fmt::format("case {}u: return texelFetch(t{}, int(o)).x; ", direct[k], unit);
+            continue;
+        }
+        blocks += fmt::format("layout(std430, binding = {0}) buffer Column{0} {{ uint d{0}[]; }};\n", k + 2);
+        reads += fmt::format("case {}u: return d{}[o]; ", direct[k], k + 2);
+        writes += fmt::format("case {}u: d{}[o] = x; return; ", direct[k], k + 2);
+    }
+    return fmt::format(R"(#version 450
+// {0}
+layout(local_size_x = {1}) in;
+layout(std430, binding = 0) buffer Words {{ uint w[]; }};
+layout(std430, binding = 1) buffer Counts {{ uint counts[]; }};
+{4}{8}float lf(uint k) {{ return uintBitsToFloat(lw(k)); }}
+double ld(uint k) {{ return packDouble2x32(uvec2(lw(k), lw(k + 1u))); }}
+uint col(uint c) {{ return lw({3}u + c); }}
+uint cw(uint c, uint o) {{ switch (c) {{ {5}default: return w[o]; }} }}
+void scw(uint c, uint o, uint x) {{ switch (c) {{ {6}default: w[o] = x; }} }}
+float cf(uint c, uint i) {{ return uintBitsToFloat(cw(c, col(c) + i)); }}
+uint cu(uint c, uint i) {{ return cw(c, col(c) + i); }}
+double cd(uint c, uint i) {{ uint o = col(c) + 2u * i; return packDouble2x32(uvec2(cw(c, o), cw(c, o + 1u))); }}
+void sf(uint c, uint i, float x) {{ scw(c, col(c) + i, floatBitsToUint(x)); }}
+void su(uint c, uint i, uint x) {{ scw(c, col(c) + i, x); }}
+
+{9}
 
 )",
                        comment, kWorkGroupSize, align4(blockWords) / 4, LaunchBlock::kColumns, blocks, reads, writes,
-                       LaunchBlock::kZero, records ? recordAccessors() : blockAccessors(blockWords));
+                       LaunchBlock::kZero, records ? recordAccessors() : blockAccessors(blockWords),
+                       mathHelpers(LaunchBlock::kZero));
 }
 
 const char* kIndex =

@@ -97,6 +97,10 @@ std::string childrenShader(const ir::Object& object, const ir::Kernel& spawn);
 
 // The vertex and fragment shaders that draw points straight from render columns
 // (visible, x y z, r g b a, size: DrawColumns), one vertex per row.
+// The helpers the statements of emitBody call (psys_div, psys_pow, psys_zero, …), for a
+// shader whose `lw(zeroWord)` holds 0.
+std::string mathHelpers(uint32_t zeroWord);
+
 std::string drawVertexShader();
 std::string drawFragmentShader();
 

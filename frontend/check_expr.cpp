@@ -222,8 +222,16 @@ Type Checker::checkBinary(BinaryExpr& binary, const Context& ctx) {
 }
 
 Type Checker::checkMember(MemberExpr& member, const Context& ctx) {
-    if (ctx.fold && member.base->kind == ExprKind::Name && static_cast<NameExpr&>(*member.base).name == "other")
-        return checkNeighbourMember(member, ctx);
+    if (member.base->kind == ExprKind::Name && static_cast<NameExpr&>(*member.base).name == "other") {
+        if (ctx.fold) return checkNeighbourMember(member, ctx);
+        bool declared = globals_.count("other") || (ctx.object && objectScopes_[ctx.object].names.count("other")) || ctx.fn ||
+                        ctx.trigger;
+        if (!declared) {
+            diags_.error(member.base->range, "`other` is the neighbour in the term of a fold (`near_sum(type, radius, "
+                                             "term)`); there is none here");
+            return Type::error();
+        }
+    }
     // `rocket.pos`: a live read of an enclosing object.
     if (member.base->kind == ExprKind::Name) {
         auto& base = static_cast<NameExpr&>(*member.base);

@@ -15,6 +15,7 @@
 #include "gpu/gl_debug.h"
 #include "gpu/gl_programs.h"
 #include "gpu/compact.h"
+#include "gpu/fold_work.h"
 #include "gpu/gl_memory.h"
 #include "gpu/glsl_program.h"
 #include "gpu/hazards.h"
@@ -80,6 +81,7 @@ GlslBackend::~GlslBackend() {
     if (context_) context_->makeCurrent();
     for (auto& [key, p] : rows_) glDeleteProgram(p->program);
     for (auto& [key, p] : children_) glDeleteProgram(p->program);
+    fold_.reset();  // (its GL objects, while the context is current)
     for (auto& [ticket, late] : late_) settle(*late);  // its fence deleted
     if (readback_) glUnmapNamedBuffer(readback_);
     glDeleteTextures(static_cast<GLsizei>(textures_.size()), textures_.data());

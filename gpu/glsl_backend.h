@@ -54,6 +54,9 @@ public:
     rt::RowsResult collect(uint64_t ticket) override;
     bool ready(uint64_t ticket) override;
     bool clearsKilled() const override { return true; }
+    // A neighbour group's folds on the GPU, grid and all (gpu/gl_fold.cpp); on the host
+    // where none of its columns is on the GPU.
+    bool fold(const rt::FoldLaunch& launch) override;
     // Unless dispatches are limited (a launch's kills then come in several lists).
     bool keepsRowsInMemory() const override { return dispatchRows_ == std::numeric_limits<size_t>::max(); }
     rt::BackendReport report() const override;
@@ -205,6 +208,9 @@ private:
     double compileSeconds_ = 0;
     std::string renderer_;
     PassTimer timer_;
+    struct FoldWork;  // the grid's buffers and programs, the folds' programs (gl_fold.cpp)
+    std::unique_ptr<FoldWork> fold_;
+    void forgetFold(const ir::Kernel& pair);
 };
 
 }  // namespace psys::gpu

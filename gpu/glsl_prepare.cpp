@@ -272,6 +272,7 @@ void GlslBackend::forget(const ir::Module& module) {
                 glDeleteProgram(it->second->program);
                 children_.erase(it);
             }
+            forgetFold(k);
         }
 }
 

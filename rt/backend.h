@@ -122,6 +122,7 @@ struct FoldLaunch {
     // what the fold is over nothing (core::emptyFold), as are the rows not in self.mask.
     std::vector<std::array<Buffer, 4>> results;
     const Value* externs = nullptr;
+    size_t externCount = 0;
 };
 
 // A group's terms for one object and its candidate neighbours, compiled: `self` and

@@ -264,6 +264,7 @@ void State::foldNeighbours(size_t type) {
             launch.results.push_back(components);
         }
         launch.externs = externs.data();
+        launch.externCount = externs.size();
         if (!backend.fold(launch)) foldOnHost(launch);
         ++stats.folds;
     }

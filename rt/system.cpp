@@ -148,7 +148,7 @@ void System::runPhases(size_t first, size_t end, double dt, double t1, bool last
             case PhaseKind::Neighbours:
                 s.foldNeighbours(type);
                 s.stats.foldSeconds += seconds(start, WallClock::now());
-                break;
+                continue;
             case PhaseKind::SubSteps: {
                 // Sub-steps of equal length, each a pass over the pool: an object killed in one
                 // takes no more, and what it emits in each is queued in (sub-step, row) order.

@@ -17,11 +17,11 @@ constexpr int kLongRun = 600;
 
 // A crowd — objects that fold over their neighbours (docs/language.md, "Neighbours") — is
 // chaotic: a difference in a last bit moves an object, which changes its neighbours'
-// pushes, step after step, growing about tenfold a second. Backends that round
+// pushes, step after step, growing from step to step. Backends that round
 // differently (fast maths, the GPU) are compared object by object over a crowd's first
 // kCrowdRun frames; after that, by what is alive (the same objects in the same rows).
 // Backends that round alike (the JIT in exact maths) agree bit for bit over every frame.
-constexpr int kCrowdRun = 30;
+constexpr int kCrowdRun = 20;
 inline int closeFrames(const ir::Module& m) {
     for (const ir::Object& o : m.objects)
         if (!o.folds.empty()) return kCrowdRun;

@@ -84,10 +84,11 @@ void printSummary(const RunOptions& options, host::Session& session, double draw
                                      r.compileSeconds * 1e3, r.target, options.math,
                                      r.fromDisk ? fmt::format("; {} from the disk cache", r.fromDisk) : "");
         int frames = std::max(ran, 1);
+        std::string folds = stats.folds ? fmt::format(", neighbour folds {:.3f}", stats.foldSeconds * 1e3 / frames) : "";
         std::cout << fmt::format("stepping {:.3f} ms per frame (update loops {:.3f}, kills and emissions {:.3f}, "
-                                 "creation {:.3f}), drawing {:.3f} ms per frame\n",
+                                 "creation {:.3f}{}), drawing {:.3f} ms per frame\n",
                                  session.stepSeconds() * 1e3 / frames, stats.loopSeconds * 1e3 / frames,
-                                 stats.emitSeconds * 1e3 / frames, stats.createSeconds * 1e3 / frames,
+                                 stats.emitSeconds * 1e3 / frames, stats.createSeconds * 1e3 / frames, folds,
                                  drawSeconds * 1e3 / frames);
         if (r.device)
             std::cout << fmt::format("on the GPU: the host waited for it {:.1f} times a frame, and took {:.1f} "

@@ -1,0 +1,31 @@
+// Internal to gpu/: what the GLSL backend keeps for neighbour folds (gpu/gl_fold.cpp) —
+// the grid's programs and buffers, and a program per pair kernel.
+#pragma once
+
+#include <epoxy/gl.h>
+
+#include <map>
+#include <utility>
+
+#include "codegen_glsl/glsl_fold.h"
+#include "gpu/glsl_backend.h"
+
+namespace psys::gpu {
+
+struct GlslBackend::FoldWork {
+    unsigned count = 0, scan = 0, scatter = 0, sort = 0;  // programs
+    std::map<const ir::Kernel*, std::pair<unsigned, codegen_glsl::FoldShader>> folds;
+    enum { kSelf, kOther, kBucketOf, kCounts, kStart, kGroups, kCursor, kSorted, kResults, kWords, kBuffers };
+    unsigned buffers[kBuffers] = {};
+    size_t capacity[kBuffers] = {};
+    unsigned params = 0;
+    ~FoldWork() {
+        for (unsigned p : {count, scan, scatter, sort})
+            if (p) glDeleteProgram(p);
+        for (auto& [k, f] : folds) glDeleteProgram(f.first);
+        glDeleteBuffers(kBuffers, buffers);
+        if (params) glDeleteBuffers(1, &params);
+    }
+};
+
+}  // namespace psys::gpu
