@@ -17,6 +17,7 @@
 #include "gpu_figures.h"
 #include "gpu_stress.h"
 #include "host_cache.h"
+#include "neighbours.h"
 #include "interp/interpreter.h"
 
 using namespace psys;
@@ -44,6 +45,10 @@ int main(int argc, char** argv) {
     bool stress = false;
     app.add_flag("--stress", stress,
                  "The hostile shapes instead: burst chains and many types, against the interpreter (docs/gpu.md)");
+    bool neighbours = false;
+    app.add_flag("--neighbours", neighbours,
+                 "Neighbour folds instead: a crowd of --particles (1e5 1e6 by default here), about 32 within reach of "
+                 "each (bench/neighbours.h)");
     bool hostCache = false;
     app.add_flag("--host-cache", hostCache,
                  "What sharing the caches with a software GPU costs the host's thread: its fixed work between waits "
@@ -54,6 +59,10 @@ int main(int argc, char** argv) {
 
     auto gpu = bench::gpuBackend("psys_gpu_bench", hostRows);  // the emitters (few rows) on the host
     if (!gpu) return 1;
+    if (neighbours) {
+        if (!app.count("--particles")) sizes = {1e5, 1e6};
+        return bench::crowdFigures(std::cout, *gpu, sizes, frames);
+    }
     std::string renderer = gpu->report().target;
     std::cout << fmt::format("# psys_gpu_bench on {}, {} timed steps per figure (median), host side: {}\n", renderer,
                              frames, hostRows > 0 ? fmt::format("launches of at most {} rows", hostRows) : "off");

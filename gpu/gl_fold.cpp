@@ -171,6 +171,7 @@ bool GlslBackend::fold(const rt::FoldLaunch& l) {
     PassTimer::Scope timed(&timer_, "fold", l.self.rows);
 
     // Each side packed: mask, position, the exports its terms read.
+    std::map<uint32_t, unsigned> deviceBuffers;
     auto pack = [&](const rt::FoldLaunch::Side& side, int position, const std::vector<std::pair<int, int>>& slots,
                     int which) {
         std::vector<rt::Buffer> columns = {side.mask};
@@ -178,9 +179,14 @@ bool GlslBackend::fold(const rt::FoldLaunch& l) {
         for (auto [e, c] : slots) columns.push_back(side.exports.at(static_cast<size_t>(e))[static_cast<size_t>(c)]);
         ensure(w.buffers[which], w.capacity[which], columns.size() * side.rows);
         if (side.rows == 0) return;
-        for (size_t s = 0; s < columns.size(); ++s)
-            glCopyNamedBufferSubData(memory_.deviceBuffer(columns[s]), w.buffers[which], 0,
-                                     static_cast<GLintptr>(s * side.rows * 4), static_cast<GLsizeiptr>(side.rows * 4));
+        for (size_t s = 0; s < columns.size(); ++s) {
+            // (a mask the host keeps is sent once a step, for both sides where they are one type)
+            auto sent = deviceBuffers.find(columns[s].id);
+            unsigned gl = sent != deviceBuffers.end() ? sent->second
+                                                      : deviceBuffers[columns[s].id] = memory_.deviceBuffer(columns[s]);
+            glCopyNamedBufferSubData(gl, w.buffers[which], 0, static_cast<GLintptr>(s * side.rows * 4),
+                                     static_cast<GLsizeiptr>(side.rows * 4));
+        }
         memory_.staged += columns.size() * side.rows * 4;
     };
     pack(l.self, group.selfPosition, shader.self, FoldWork::kSelf);

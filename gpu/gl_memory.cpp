@@ -296,7 +296,8 @@ void GlMemory::copy(Buffer from, size_t fromFirst, Buffer to, size_t toFirst, si
     flush(f);
     flush(t);
     uploadRows(f, fromFirst, count);  // only the rows copied: the source stays on the host
-    upload(t);
+    if (toFirst == 0 && count >= t.rows) uploadRows(t, 0, 0);  // all of it written here: nothing to send
+    else upload(t);
     PassTimer::Scope timed(timer, "copy", count);
     size_t w = wordsPerRow(f.elem) * 4;
     if (count)

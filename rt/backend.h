@@ -125,10 +125,11 @@ struct FoldLaunch {
     size_t externCount = 0;
 };
 
-// A group's terms for one object and its candidate neighbours, compiled: `self` and
-// `other` point at each side's export columns (export e's component c at 4e + c), `acc`
-// at the group's folds' components (in fold order), each combined with every candidate
-// within the radius (core/fold.h combine). `position` is the group's two position exports.
+// A group's terms for one object and its neighbours, compiled: `self` points at this
+// side's export columns (export e's component c at 4e + c; `selfRow` its row), `other` at
+// the other side's (the ones the terms read, in the grid's order: `others` are places
+// there), `acc` at the group's folds' components (in fold order), each combined with
+// every neighbour's terms in order (core/fold.h combine).
 using PairFunction = void (*)(const float* const* self, const float* const* other, uint32_t selfRow,
                               const uint32_t* others, uint32_t count, const Value* externs, float* acc);
 

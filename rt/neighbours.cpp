@@ -50,6 +50,10 @@ struct Grid {
     uint32_t mask = 0;  // buckets − 1
     std::vector<uint32_t> start, rows;
     std::vector<float> x, y, z;
+    // The other side's export columns the terms read, in the grid's order (export e's
+    // component c at 4e + c; null for the others): a bucket's terms read them in a row.
+    std::vector<std::vector<float>> sorted;
+    std::vector<const float*> columns;
 
     uint32_t cell(float p) const { return core::HostAlgebra::wholeToInt(std::floor(p * inverse)); }
     uint32_t bucket(uint32_t cx, uint32_t cy, uint32_t cz) const {
@@ -58,7 +62,7 @@ struct Grid {
     }
 };
 
-Grid buildGrid(const HostSide& other, size_t rows, int position, float radius) {
+Grid buildGrid(const HostSide& other, size_t rows, int position, float radius, const ir::Kernel& pair) {
     Grid g;
     g.inverse = 1.0f / (radius * core::kCellMargin);
     uint32_t buckets = 64;
@@ -88,6 +92,18 @@ Grid buildGrid(const HostSide& other, size_t rows, int position, float radius) {
         g.x[at] = px[r];
         g.y[at] = py[r];
         g.z[at] = pz[r];
+    }
+    g.columns.assign(other.columns.size(), nullptr);
+    for (const ir::Inst& i : pair.insts()) {
+        if (i.op != ir::Op::NeighbourExport || i.attr2 != 1) continue;
+        for (int c = 0; c < i.type.width; ++c) {
+            auto column = static_cast<size_t>(4 * i.attr + c);
+            if (g.columns[column]) continue;
+            std::vector<float>& to = g.sorted.emplace_back(n);
+            const float* from = other.columns[column];
+            for (size_t j = 0; j < n; ++j) to[j] = from[g.rows[j]];
+            g.columns[column] = to.data();
+        }
     }
     return g;
 }
@@ -165,7 +181,7 @@ void State::foldOnHost(const FoldLaunch& launch) {
     const ir::Object& object = *launch.object;
     const ir::NeighbourGroup& group = *launch.group;
     HostSide self(memory, launch.self), other(memory, launch.other);
-    Grid grid = buildGrid(other, launch.other.rows, group.otherPosition, group.radius);
+    Grid grid = buildGrid(other, launch.other.rows, group.otherPosition, group.radius, *launch.pair);
     const float radius2 = group.radius * group.radius;
 
     // The group's folds: their components, in fold order, and where each fold's are.
@@ -186,7 +202,7 @@ void State::foldOnHost(const FoldLaunch& launch) {
 
     PairFunction compiled = backend.pairFunction(object, *launch.pair);
     const float* const* sx = self.columns.data();
-    const float* const* ox = other.columns.data();
+    const float* const* ox = grid.columns.data();  // (by place in the grid, not by row)
     const size_t sp = static_cast<size_t>(4 * group.selfPosition);
     size_t chunks = (rows + kFoldRows - 1) / kFoldRows;
     parallel->forEach(chunks, true, [&](size_t c) {
@@ -209,7 +225,7 @@ void State::foldOnHost(const FoldLaunch& launch) {
                 for (uint32_t j = grid.start[buckets[b]]; j < grid.start[buckets[b] + 1]; ++j) {
                     if (launch.same && grid.rows[j] == i) continue;
                     float dx = grid.x[j] - px, dy = grid.y[j] - py, dz = grid.z[j] - pz;
-                    if (dx * dx + dy * dy + dz * dz <= radius2) candidates.push_back(grid.rows[j]);
+                    if (dx * dx + dy * dy + dz * dz <= radius2) candidates.push_back(j);
                 }
             float* acc = results.data() + i * width;
             auto count = static_cast<uint32_t>(candidates.size());

@@ -436,11 +436,16 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
             rowsDepth = p.depth;
         }
         if (p.op == ir::Op::Fold) {  // this object's own folds (rows: its own)
-            foldRowsOf(type, rows);
             const Pool& pool = pools[type];
-            for (int c = 0; c < p.width; ++c)
-                memory.gather(pool.folds.column(static_cast<size_t>(p.exportIndex), static_cast<size_t>(c)),
-                              table[static_cast<size_t>(p.offset + c)], begin, rows);
+            // A pool's launch over rows that all have folds: a copy (on a device, no list sent).
+            bool copy = !poolRows && end <= pool.foldRows;
+            if (!copy) foldRowsOf(type, rows);
+            for (int c = 0; c < p.width; ++c) {
+                Buffer from = pool.folds.column(static_cast<size_t>(p.exportIndex), static_cast<size_t>(c));
+                Buffer to = table[static_cast<size_t>(p.offset + c)];
+                if (copy) memory.copy(from, begin, to, begin, end - begin);
+                else memory.gather(from, to, begin, rows);
+            }
             rowsDepth = -1;
             continue;
         }

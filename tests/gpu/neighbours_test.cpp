@@ -1,0 +1,42 @@
+// Neighbour folds on the GPU (gpu/gl_fold.cpp): the grid built and walked there, the
+// results where the update reads them — no wait for the GPU, nothing read back — and the
+// interpreter's folds within tolerance; every fold, over its own type and another, with
+// deaths that free rows new objects take (tests/programs/neighbours.psys).
+#include <doctest/doctest.h>
+
+#include "gpu_support.h"
+
+using namespace psys;
+using namespace psys::test;
+
+TEST_CASE("a crowd's folds on the GPU add no wait to a step") {
+    // The beads of repel.psys once poured (after 2 s): nothing dies or is created, so a
+    // step decides nothing by what the GPU computes, and waits for nothing.
+    Pair p(readFile(test::sample("repel")));
+    p.steps(150, 1.0 / 60);
+    REQUIRE(p.stats("bead").live == 800);
+    uint64_t waits = p.gpu->waits(), moved = p.gpu->transferredBytes();
+    REQUIRE_FALSE(p.gl->step(1.0 / 60));
+    for (int f = 0; f < 10; ++f) REQUIRE_FALSE(p.gl->step(1.0 / 60));
+    CHECK(p.gpu->waits() == waits);
+    uint64_t perStep = (p.gpu->transferredBytes() - moved) / 11;
+    MESSAGE(perStep << " bytes a step between host and GPU for 800 beads");
+}
+
+TEST_CASE("every fold on the GPU, over its own type and another, with deaths and rows taken again, gives the interpreter's") {
+    Pair p(readFile(programsDir() + "/neighbours.psys"));
+    p.steps(60, 1.0 / 60);  // 80 grains by then, past the host side's few rows; 20 frames of them folded on the GPU
+    REQUIRE(p.stats("grain").live > 64);
+    CHECK(p.compare() <= kSamplesTolerance);
+    p.steps(240, 1.0 / 60);  // deaths (at 3 s) and rows taken again: then the same objects, in the same rows
+    p.compare();
+}
+
+TEST_CASE("a fold's grid on the GPU is the same every run: its buckets' rows sorted after the atomics scatter them") {
+    auto run = [] {
+        auto gpu = gpuBackend(false);
+        rt::System system(test::compileModule(readFile(test::sample("repel"))), *gpu);
+        return test::drawnBytes(system, 90);
+    };
+    CHECK(run() == run());
+}
