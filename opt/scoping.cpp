@@ -22,8 +22,8 @@ namespace {
 
 constexpr const char* kPositionExport = "(position)";
 
-// The export of `object` holding its equation `member` (made if there is none); -1 if the
-// object has no such equation.
+// The export of `object` holding its equation `member` (made if there is none, unless
+// another export holds the same value); -1 if the object has no such equation.
 int exportOf(Object& object, const std::string& member, Type type) {
     for (size_t e = 0; e < object.exports.size(); ++e)
         if (object.exports[e].name == member) return static_cast<int>(e);
@@ -37,6 +37,10 @@ int exportOf(Object& object, const std::string& member, Type type) {
         if (!k || !k->equations.count(member)) return -1;
         value = k->equations.at(member);
     }
+    // One value, one export (a position that is an equation: `point(pos, …)`).
+    for (const Yield& y : k->yields)
+        if (y.kind == YieldKind::Export && y.value == value && object.exports.at(static_cast<size_t>(y.index)).type == type)
+            return y.index;
     int index = static_cast<int>(object.exports.size());
     object.exports.push_back({member, type});
     k->yields.push_back({YieldKind::Export, index, 0, value});

@@ -105,6 +105,12 @@ TEST_CASE("the parser reports what is wrong and where") {
     CHECK_FALSE(parseModule("object a()\n  draw sprite 4\nend\n", error));
     CHECK_FALSE(parseModule("object a()\n  kernel render\n    %0 = const.f32 0\n  storage\n  storage drawn trail.99.x = const 0\n  end\nend\n", error));
     CHECK(error == "line 5: unknown render column `trail.99.x`");
+    CHECK_FALSE(parseModule("object a()\n  fold mean: f32 #0\nend\n", error));
+    CHECK(error == "line 2: expected `fold sum|min|max|count: type #group`");
+    CHECK_FALSE(parseModule("object a()\n  near a\nend\n", error));
+    CHECK(error == "line 2: expected `near type radius [position #self #other]`");
+    CHECK_FALSE(parseModule("object a()\n  near.read p: vec3 both\nend\n", error));
+    CHECK(error == "line 2: expected `near.read name: type self|other`");
 }
 
 TEST_CASE("the verifier finds broken invariants") {
@@ -125,6 +131,17 @@ TEST_CASE("the verifier finds broken invariants") {
     // Found by fuzz_ir: a draw with one key operand (it takes none or two) read past its operands.
     CHECK(verifyText("object a()\n  kernel init\n    %0 = object.id.u32\n    %1 = nrand.vec2 %0 #0\n  end\nend\n")
               .find("keyed by two u32") != std::string::npos);
+    // Neighbour folds: a fold of a group that is not there, a fold read of the wrong type, a
+    // pair kernel's export of the other side that the other has not, a term outside a pair kernel.
+    CHECK(verifyText("object a()\n  fold sum: f32 #0\nend\n").find("a fold of a group that does not exist") !=
+          std::string::npos);
+    CHECK(verifyText("object a()\n  draw point\n  near a 1\n  fold sum: f32 #0\n  kernel update\n    %0 = fold.vec3 #0\n  end\nend\n")
+              .find("no fold of this index and type") != std::string::npos);
+    CHECK(verifyText("object a()\n  near a 1\n  fold sum: f32 #0\n  kernel pair #0\n    %0 = neighbour.export.f32 #0 ^1\n    yield fold #0 = %0\n  end\nend\n")
+              .find("no export of this index and type") != std::string::npos);
+    CHECK(verifyText("object a()\n  near a 1\n  fold sum: f32 #0\n  kernel update\n    %0 = const.f32 1\n    yield fold #0 = %0\n  end\nend\n")
+              .find("no fold of this index, type and group") != std::string::npos);
+    CHECK(verifyText("object a()\n  near nowhere 1\nend\n").find("folds over unknown `nowhere`") != std::string::npos);
     // Forward references are allowed through delaying operands of a behaviour kernel.
     CHECK(verifyText("object a()\n  kernel behaviour\n    %0 = prev.f32 %1 #0\n    %1 = age.f32\n  end\nend\n").empty());
 }

@@ -105,6 +105,70 @@ end
 )");
 }
 
+TEST_CASE("scoping: a fold's reads become exports of both objects, and its group names their drawn positions") {
+    // bead folds `other.p - q` over the rocks within 2: rock exports p (its drawn position
+    // too: one value, one export), bead its drawn position (pos) and q.
+    CHECK(after(R"(object rock(p: vec3)
+  kernel behaviour
+    %0 = param.vec3 #0
+    let p = %0
+    yield position = %0
+  end
+end
+object bead(q: vec3)
+  near rock 2
+  fold sum: vec3 #0
+  near.read p: vec3 other
+  near.read q: vec3 self
+  kernel behaviour
+    %0 = param.vec3 #0
+    %1 = fold.vec3 #0
+    %2 = add.vec3 %0, %1  ; pos
+    let pos = %2
+    let q = %0
+    yield position = %2
+  end
+  kernel pair #0
+    %0 = neighbour.read.vec3 #0
+    %1 = neighbour.read.vec3 #1
+    %2 = sub.vec3 %0, %1
+    yield fold #0 = %2
+  end
+end
+)", opt::scoping) == R"(object rock(p: vec3)
+  export (position): vec3
+  kernel behaviour
+    %0 = param.vec3 #0
+    let p = %0
+    yield position = %0
+    yield export #0 = %0
+  end
+end
+object bead(q: vec3)
+  export (position): vec3
+  export q: vec3
+  near rock 2 position #0 #0
+  fold sum: vec3 #0
+  kernel behaviour
+    %0 = param.vec3 #0
+    %1 = fold.vec3 #0
+    %2 = add.vec3 %0, %1  ; pos
+    let pos = %2
+    let q = %0
+    yield position = %2
+    yield export #0 = %2
+    yield export #1 = %0
+  end
+  kernel pair #0
+    %0 = neighbour.export.vec3 #0 ^1
+    %1 = neighbour.export.vec3 #1
+    %2 = sub.vec3 %0, %1
+    yield fold #0 = %2
+  end
+end
+)");
+}
+
 TEST_CASE("lower-temporal: integrate, prev, snapshot, derive and -> become state") {
     CHECK(after(R"(object p(v: f32)
   kernel behaviour
