@@ -12,6 +12,21 @@ namespace psys::codegen_glsl {
 
 using namespace ir;
 
+namespace {
+
+// psys_cell (a position component's cell) and psys_bucket (a cell's bucket), as the host
+// computes them: `inverse` and `mask` are GLSL expressions of the shader's parameters.
+std::string gridFunctions(const std::string& inverse, const std::string& mask) {
+    Statements cell("c"), bucket("b");
+    std::string cellValue = emitCell(cell, "p", inverse);
+    std::string bucketValue = emitCellBucket(bucket, "x", "y", "z", mask);
+    return fmt::format("uint psys_cell(float p) {{\n{}    return {};\n}}\nuint psys_bucket(uint x, uint y, uint z) {{\n{}    "
+                       "return {};\n}}\n",
+                       cell.text(), cellValue, bucket.text(), bucketValue);
+}
+
+}  // namespace
+
 FoldShader foldShader(const Object& object, const Kernel& pair) {
     FoldShader f;
     auto slot = [&](std::vector<std::pair<int, int>>& slots, int e, int c) {
@@ -62,9 +77,6 @@ FoldShader foldShader(const Object& object, const Kernel& pair) {
             }
         }
     }
-    Statements cell("c"), bucket("b");
-    std::string cellValue = emitCell(cell, "p", "uintBitsToFloat(lw(3u))");
-    std::string bucketValue = emitCellBucket(bucket, "x", "y", "z", "lw(2u)");
     f.source = fmt::format(R"(#version 450
 // object `{0}`: its folds over `{1}` within {2} (group #{3})
 layout(local_size_x = 64) in;
@@ -78,17 +90,11 @@ uint lw(uint k) {{ return w[k]; }}
 {4}
 float sv(uint s, uint i) {{ return uintBitsToFloat(sw[s * lw(0u) + i]); }}
 float ov(uint s, uint r) {{ return uintBitsToFloat(ow[s * lw(1u) + r]); }}
-uint psys_cell(float p) {{
-{5}    return {6};
-}}
-uint psys_bucket(uint x, uint y, uint z) {{
-{7}    return {8};
-}}
-void main() {{
+{5}void main() {{
     uint i = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
     uint rows = lw(0u);
     if (i > rows) return;
-{9}    if (i < rows && sw[i] != 0u) {{
+{6}    if (i < rows && sw[i] != 0u) {{
         precise float px = sv(1u, i), py = sv(2u, i), pz = sv(3u, i);
         uint cx = psys_cell(px), cy = psys_cell(py), cz = psys_cell(pz);
         uint b[27];
@@ -108,21 +114,18 @@ void main() {{
                 precise float dx = ov(1u, r) - px, dy = ov(2u, r) - py, dz = ov(3u, r) - pz;
                 precise float d2 = dx * dx + dy * dy + dz * dz;
                 if (!(d2 <= radius2)) continue;
-{10}            }}
+{7}            }}
         }}
     }}
-{11}}}
+{8}}}
 )",
                            object.name, object.neighbours.at(static_cast<size_t>(pair.site)).target,
                            object.neighbours.at(static_cast<size_t>(pair.site)).radius, pair.site, mathHelpers(6),
-                           cell.text(), cellValue, bucket.text(), bucketValue, declare, body.text(), store);
+                           gridFunctions("uintBitsToFloat(lw(3u))", "lw(2u)"), declare, body.text(), store);
     return f;
 }
 
 std::string gridCountShader() {
-    Statements cell("c"), bucket("b");
-    std::string cellValue = emitCell(cell, "p", "uintBitsToFloat(param(2u))");
-    std::string bucketValue = emitCellBucket(bucket, "x", "y", "z", "param(1u)");
     return fmt::format(R"(#version 450
 layout(local_size_x = 256) in;
 layout(std140, binding = 1) uniform Params {{ uvec4 P[2]; }};
@@ -130,13 +133,7 @@ uint param(uint k) {{ return P[k >> 2u][k & 3u]; }}
 layout(std430, binding = 2) readonly buffer Other {{ uint ow[]; }};
 layout(std430, binding = 3) writeonly buffer BucketOf {{ uint bucketOf[]; }};
 layout(std430, binding = 4) buffer Counts {{ uint counts[]; }};
-uint psys_cell(float p) {{
-{0}    return {1};
-}}
-uint psys_bucket(uint x, uint y, uint z) {{
-{2}    return {3};
-}}
-void main() {{
+{0}void main() {{
     uint r = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
     uint rows = param(0u);
     if (r >= rows) return;
@@ -150,7 +147,7 @@ void main() {{
     atomicAdd(counts[b], 1u);
 }}
 )",
-                       cell.text(), cellValue, bucket.text(), bucketValue);
+                       gridFunctions("uintBitsToFloat(param(2u))", "param(1u)"));
 }
 
 }  // namespace psys::codegen_glsl

@@ -30,10 +30,8 @@ namespace {
 // Bucket counts to each bucket's first place: per group of 1024 buckets its sum (pass 0),
 // the groups' sums scanned in place by one group (pass 1), each group's buckets scanned
 // from its offset (pass 2), the total after the last bucket.
-const char* kScan = R"(#version 450
+const char* kScan = R"(
 layout(local_size_x = 256) in;
-layout(std140, binding = 1) uniform Params { uvec4 P[2]; };
-uint param(uint k) { return P[k >> 2u][k & 3u]; }
 layout(std430, binding = 4) readonly buffer Counts { uint counts[]; };
 layout(std430, binding = 5) buffer Start { uint start[]; };
 layout(std430, binding = 6) buffer Groups { uint groups[]; };
@@ -85,15 +83,13 @@ void main() {
 )";
 
 // Each row to a place in its bucket (the order within one set by the sort after).
-const char* kScatter = R"(#version 450
+const char* kScatter = R"(
 layout(local_size_x = 256) in;
-layout(std140, binding = 1) uniform Params { uvec4 P[2]; };
-uint param(uint k) { return P[k >> 2u][k & 3u]; }
 layout(std430, binding = 3) readonly buffer BucketOf { uint bucketOf[]; };
 layout(std430, binding = 4) buffer Cursor { uint cursor[]; };
 layout(std430, binding = 5) writeonly buffer Sorted { uint sorted[]; };
 void main() {
-    uint r = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
+    uint r = INVOCATION;
     if (r >= param(0u)) return;
     uint b = bucketOf[r];
     if (b != 0xffffffffu) sorted[atomicAdd(cursor[b], 1u)] = r;
@@ -101,14 +97,12 @@ void main() {
 )";
 
 // Each bucket's rows in row order (insertion sort: a bucket holds a few).
-const char* kSort = R"(#version 450
+const char* kSort = R"(
 layout(local_size_x = 256) in;
-layout(std140, binding = 1) uniform Params { uvec4 P[2]; };
-uint param(uint k) { return P[k >> 2u][k & 3u]; }
 layout(std430, binding = 4) readonly buffer Start { uint start[]; };
 layout(std430, binding = 5) buffer Sorted { uint sorted[]; };
 void main() {
-    uint b = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
+    uint b = INVOCATION;
     if (b >= param(0u)) return;
     uint first = start[b], end = start[b + 1u];
     for (uint j = first + 1u; j < end; ++j) {
@@ -121,6 +115,11 @@ void main() {
     }
 }
 )";
+
+// A utility shader's text: its parameters (kParamsBlock) and its invocation's index.
+std::string utility(const char* body) {
+    return std::string("#version 450\n") + kParamsBlock + "#define INVOCATION " + kInvocationIndex + "\n" + body;
+}
 
 // A buffer of at least `words` words (grown, never shrunk; its contents not kept).
 void ensure(unsigned& buffer, size_t& capacity, size_t words) {
@@ -155,9 +154,9 @@ bool GlslBackend::fold(const rt::FoldLaunch& l) {
     if (!fold_) {
         fold_ = std::make_unique<FoldWork>();
         fold_->count = computeProgram(codegen_glsl::gridCountShader(), "the neighbour grid's count");
-        fold_->scan = computeProgram(kScan, "the neighbour grid's scan");
-        fold_->scatter = computeProgram(kScatter, "the neighbour grid's scatter");
-        fold_->sort = computeProgram(kSort, "the neighbour grid's sort");
+        fold_->scan = computeProgram(utility(kScan), "the neighbour grid's scan");
+        fold_->scatter = computeProgram(utility(kScatter), "the neighbour grid's scatter");
+        fold_->sort = computeProgram(utility(kSort), "the neighbour grid's sort");
     }
     FoldWork& w = *fold_;
     auto found = w.folds.find(l.pair);

@@ -80,7 +80,7 @@ TEST_CASE("a fold sees the others as the last step left them, and a new object n
     CHECK(w[0].color[1] == 0.25f);  // (its value then, not this step's 0)
 }
 
-TEST_CASE("an object is not its own neighbour; another type's objects are folded over only where named") {
+TEST_CASE("an object is not its own neighbour, and another type's objects are folded over only where named") {
     Run run(R"(
         object rock(p: vec3) { point(p, white, 1); }
         object dust(p: vec3) {
