@@ -54,7 +54,8 @@ FoldShader foldShader(const Object& object, const Kernel& pair) {
             if (inst.op == Op::NeighbourExport) {
                 bool other = inst.attr2 == 1;
                 int s = slot(other ? f.other : f.self, inst.attr, c);
-                lanes += fmt::format("{}{}({}u, {})", c ? ", " : "", other ? "ov" : "sv", s, other ? "r" : "i");
+                std::string x = fmt::format("{}({}u, {})", other ? "ov" : "sv", s, other ? "r" : "i");
+                lanes += (c ? ", " : "") + (inst.type.isBool() ? "(" + x + " != 0.0)" : x);  // (a bool: 0 or 1)
             } else if (inst.op == Op::Extern) {
                 lanes += fmt::format("{}uintBitsToFloat(lw({}u))", c ? ", " : "", kFoldExterns + 4 * inst.attr + c);
             } else {

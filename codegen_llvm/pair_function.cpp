@@ -75,7 +75,9 @@ void buildPairFunction(llvm::Module& module, MathMode mode, const Object& object
             for (int c = 0; c < i.type.width; ++c) {
                 llvm::Value* column = b.CreateAlignedLoad(
                     ptr, b.CreateConstGEP1_32(ptr, columns, static_cast<unsigned>(4 * i.attr + c)), llvm::Align(8));
-                out.push_back(b.CreateAlignedLoad(f32, b.CreateGEP(f32, column, at), llvm::Align(4)));
+                llvm::Value* x = b.CreateAlignedLoad(f32, b.CreateGEP(f32, column, at), llvm::Align(4));
+                // (columns hold floats: a bool is 0 or 1)
+                out.push_back(i.type.isBool() ? b.CreateFCmpUNE(x, llvm::ConstantFP::get(f32, 0.0)) : x);
             }
             return out;
         }

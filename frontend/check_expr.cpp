@@ -333,6 +333,7 @@ Type Checker::checkCall(CallExpr& call, const Context& ctx) {
         if (decl->kind == DeclKind::Fn) {
             call.fn = static_cast<const FnDecl*>(decl);
             checkFn(*call.fn);
+            if (ctx.fold) checkFoldCall(call, ctx);
             return checkUserCall(call, *call.fn, args);
         }
         const char* hint = decl->kind == DeclKind::Object ? "; create one with `emit`" : "";

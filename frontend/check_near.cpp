@@ -11,7 +11,10 @@
 
 #include <fmt/format.h>
 
+#include <set>
+
 #include "core/fold.h"
+#include "frontend/builtins.h"
 #include "frontend/checker.h"
 #include "frontend/consteval.h"
 
@@ -108,6 +111,67 @@ Type Checker::checkNeighbourMember(MemberExpr& member, const Context& ctx) {
     member.parentRef = it->second;
     if (member.parentRef.kind == Ref::Kind::Equation) usedEquations_.insert(member.parentRef.equation);
     return typeOfRef(member.parentRef);
+}
+
+namespace {
+
+// Whether evaluating `e` draws a random number (through the functions it calls too).
+bool draws(const Expr& e, std::set<const FnDecl*>& seen);
+bool draws(const FnDecl& fn, std::set<const FnDecl*>& seen) {
+    if (!seen.insert(&fn).second) return false;
+    if (fn.body && draws(*fn.body, seen)) return true;
+    for (const auto& let : fn.lets)
+        if (draws(*let->value, seen)) return true;
+    return false;
+}
+bool draws(const Expr& e, std::set<const FnDecl*>& seen) {
+    auto any = [&](std::initializer_list<const Expr*> xs) {
+        for (const Expr* x : xs)
+            if (x && draws(*x, seen)) return true;
+        return false;
+    };
+    switch (e.kind) {
+        case ExprKind::Call: {
+            auto& c = static_cast<const CallExpr&>(e);
+            if (c.builtin >= 0 && builtinFunction(c.builtin).rule == BuiltinRule::Random) return true;
+            if (c.fn && draws(*c.fn, seen)) return true;
+            for (const ExprPtr& a : c.args)
+                if (draws(*a, seen)) return true;
+            return false;
+        }
+        case ExprKind::Member: return any({static_cast<const MemberExpr&>(e).base.get()});
+        case ExprKind::Unary: return any({static_cast<const UnaryExpr&>(e).operand.get()});
+        case ExprKind::Binary: {
+            auto& b = static_cast<const BinaryExpr&>(e);
+            return any({b.lhs.get(), b.rhs.get()});
+        }
+        case ExprKind::Conditional: {
+            auto& c = static_cast<const ConditionalExpr&>(e);
+            return any({c.cond.get(), c.thenExpr.get(), c.elseExpr.get()});
+        }
+        case ExprKind::Tuple:
+            for (const ExprPtr& x : static_cast<const TupleExpr&>(e).elements)
+                if (draws(*x, seen)) return true;
+            return false;
+        case ExprKind::FollowedBy: {
+            auto& f = static_cast<const FollowedByExpr&>(e);
+            return any({f.init.get(), f.next.get()});
+        }
+        default: return false;
+    }
+}
+
+}  // namespace
+
+// A function called in a fold's term: it must not draw random numbers (a term is a
+// function of the two objects, not a draw).
+void Checker::checkFoldCall(const CallExpr& call, const Context& ctx) {
+    std::set<const FnDecl*> seen;
+    if (ctx.fold && call.fn && draws(*call.fn, seen))
+        diags_.error(call.calleeRange, fmt::format("`{}` draws random numbers, so it cannot be used in the term of `{}`: "
+                                                   "a term is a function of the two objects as they are",
+                                                   call.callee, ctx.fold->callee))
+            .notes.push_back({call.fn->nameRange, fmt::format("`{}` declared here", call.callee)});
 }
 
 // What a fold's term may read by name.

@@ -71,6 +71,7 @@ private:
     Type checkNear(ast::CallExpr& call, const Context& ctx);
     Type checkNeighbourMember(ast::MemberExpr& member, const Context& ctx);
     bool checkFoldTermRef(const ast::NameExpr& name, const Context& ctx);
+    void checkFoldCall(const ast::CallExpr& call, const Context& ctx);
     const ast::ObjectDecl* findObjectType(const std::string& name) const;
     Type checkUnary(ast::UnaryExpr& unary, const Context& ctx);
     Type checkBinary(ast::BinaryExpr& binary, const Context& ctx);
