@@ -17,6 +17,8 @@ public:
         bool behaviour = k.kind == KernelKind::Behaviour;
         // Trigger and start kernels are written like behaviours: their draws are keyed later.
         unkeyedDrawsAllowed_ = behaviour || k.kind == KernelKind::Trigger || k.kind == KernelKind::Start;
+        if (k.kind == KernelKind::Pair && (!object || k.site < 0 || static_cast<size_t>(k.site) >= object->neighbours.size()))
+            fail(fmt::format("a pair kernel of group #{}, which the object does not have", k.site));
         for (ValueId v = 0; v < k.size(); ++v) inst(k, v, behaviour);
         for (const Yield& y : k.yields) yield(k, y);
         if (k.storage.fixed) storage(k);

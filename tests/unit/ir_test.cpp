@@ -142,6 +142,7 @@ TEST_CASE("the verifier finds broken invariants") {
     CHECK(verifyText("object a()\n  near a 1\n  fold sum: f32 #0\n  kernel update\n    %0 = const.f32 1\n    yield fold #0 = %0\n  end\nend\n")
               .find("no fold of this index, type and group") != std::string::npos);
     CHECK(verifyText("object a()\n  near nowhere 1\nend\n").find("folds over unknown `nowhere`") != std::string::npos);
+    CHECK(verifyText("object a()\n  kernel pair #3\n  end\nend\n").find("a pair kernel of group #3") != std::string::npos);
     // Forward references are allowed through delaying operands of a behaviour kernel.
     CHECK(verifyText("object a()\n  kernel behaviour\n    %0 = prev.f32 %1 #0\n    %1 = age.f32\n  end\nend\n").empty());
 }
