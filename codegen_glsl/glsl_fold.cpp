@@ -46,7 +46,7 @@ FoldShader foldShader(const Object& object, const Kernel& pair) {
             store += fmt::format("    res[{}u * (rows + 1u) + i] = floatBitsToUint(a{});\n", f.width, f.width);
         }
     }
-    // The terms, for neighbour `r` of object `i`.
+    // The terms, for object `i` and the neighbour at place `j` of the grid.
     Statements body("t");
     auto leaf = [&](const Inst& inst, int) -> std::string {
         std::string lanes;
@@ -54,7 +54,7 @@ FoldShader foldShader(const Object& object, const Kernel& pair) {
             if (inst.op == Op::NeighbourExport) {
                 bool other = inst.attr2 == 1;
                 int s = slot(other ? f.other : f.self, inst.attr, c);
-                std::string x = fmt::format("{}({}u, {})", other ? "ov" : "sv", s, other ? "r" : "i");
+                std::string x = fmt::format("{}({}u, {})", other ? "ov" : "sv", s, other ? "j" : "i");
                 lanes += (c ? ", " : "") + (inst.type.isBool() ? "(" + x + " != 0.0)" : x);  // (a bool: 0 or 1)
             } else if (inst.op == Op::Extern) {
                 lanes += fmt::format("{}uintBitsToFloat(lw({}u))", c ? ", " : "", kFoldExterns + 4 * inst.attr + c);
@@ -90,7 +90,7 @@ layout(std430, binding = 6) writeonly buffer Out {{ uint res[]; }};
 uint lw(uint k) {{ return w[k]; }}
 {4}
 float sv(uint s, uint i) {{ return uintBitsToFloat(sw[s * lw(0u) + i]); }}
-float ov(uint s, uint r) {{ return uintBitsToFloat(ow[s * lw(1u) + r]); }}
+float ov(uint s, uint j) {{ return uintBitsToFloat(ow[s * lw(1u) + j]); }}  // (by place in the grid)
 {5}void main() {{
     uint i = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
     uint rows = lw(0u);
@@ -110,9 +110,8 @@ float ov(uint s, uint r) {{ return uintBitsToFloat(ow[s * lw(1u) + r]); }}
         for (int s = 0; s < 27; ++s) {{
             if (s > 0 && b[s] == b[s - 1]) continue;
             for (uint j = start[b[s]]; j < start[b[s] + 1u]; ++j) {{
-                uint r = sorted[j];
-                if (lw(5u) != 0u && r == i) continue;
-                precise float dx = ov(1u, r) - px, dy = ov(2u, r) - py, dz = ov(3u, r) - pz;
+                if (lw(5u) != 0u && sorted[j] == i) continue;
+                precise float dx = ov(1u, j) - px, dy = ov(2u, j) - py, dz = ov(3u, j) - pz;
                 precise float d2 = dx * dx + dy * dy + dz * dz;
                 if (!(d2 <= radius2)) continue;
 {7}            }}

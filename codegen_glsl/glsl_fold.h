@@ -18,7 +18,7 @@ namespace psys::codegen_glsl {
 // cell's width, 4 the radius squared (float bits), 5 whether the two types are one, 6 a
 // zero; the externs from kFoldExterns, 4 words each. Each side's columns packed in slots of
 // its rows: slot 0 its mask, 1–3 its drawn position, then `self` / `other` (an export
-// and a component each).
+// and a component each) — this side's by row, the other's by place in the grid.
 constexpr unsigned kFoldExterns = 8;
 struct FoldShader {
     std::string source;

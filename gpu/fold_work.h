@@ -13,14 +13,14 @@
 namespace psys::gpu {
 
 struct GlslBackend::FoldWork {
-    unsigned count = 0, scan = 0, scatter = 0, sort = 0;  // programs
+    unsigned count = 0, scan = 0, scatter = 0, sort = 0, place = 0;  // programs
     std::map<const ir::Kernel*, std::pair<unsigned, codegen_glsl::FoldShader>> folds;
-    enum { kSelf, kOther, kBucketOf, kCounts, kStart, kGroups, kCursor, kSorted, kResults, kWords, kBuffers };
+    enum { kSelf, kOther, kBucketOf, kCounts, kStart, kGroups, kCursor, kSorted, kPlaced, kResults, kWords, kBuffers };
     unsigned buffers[kBuffers] = {};
     size_t capacity[kBuffers] = {};
     unsigned params = 0;
     ~FoldWork() {
-        for (unsigned p : {count, scan, scatter, sort})
+        for (unsigned p : {count, scan, scatter, sort, place})
             if (p) glDeleteProgram(p);
         for (auto& [k, f] : folds) glDeleteProgram(f.first);
         glDeleteBuffers(kBuffers, buffers);

@@ -7,7 +7,8 @@
 // counted into its bucket (atomics); the counts scanned into each bucket's first place
 // (prefix sums, as the compactor's); the rows scattered to their places (atomics: in no
 // set order) and each bucket's rows sorted by row — so the grid is the host's, the same
-// every run; then one invocation per object walks the 27 cells around it
+// every run; the other side's columns copied in that order (a bucket's read in a row);
+// then one invocation per object walks the 27 cells around it
 // (codegen_glsl::foldShader), and the results are adopted as the fold columns.
 #include <epoxy/gl.h>
 
@@ -116,6 +117,21 @@ void main() {
 }
 )";
 
+// The other side's slots in the grid's order: a bucket's rows read in a row by the fold.
+const char* kPlace = R"(
+layout(local_size_x = 256) in;
+layout(std430, binding = 2) readonly buffer Other { uint ow[]; };
+layout(std430, binding = 4) readonly buffer Start { uint start[]; };
+layout(std430, binding = 5) readonly buffer Sorted { uint sorted[]; };
+layout(std430, binding = 6) writeonly buffer Placed { uint placed[]; };
+void main() {
+    uint j = INVOCATION, rows = param(0u), slots = param(1u);
+    if (j >= start[param(2u)]) return;  // (the total, after the last bucket)
+    uint r = sorted[j];
+    for (uint s = 0u; s < slots; ++s) placed[s * rows + j] = ow[s * rows + r];
+}
+)";
+
 // A utility shader's text: its parameters (kParamsBlock) and its invocation's index.
 std::string utility(const char* body) {
     return std::string("#version 450\n") + kParamsBlock + "#define INVOCATION " + kInvocationIndex + "\n" + body;
@@ -157,6 +173,7 @@ bool GlslBackend::fold(const rt::FoldLaunch& l) {
         fold_->scan = computeProgram(utility(kScan), "the neighbour grid's scan");
         fold_->scatter = computeProgram(utility(kScatter), "the neighbour grid's scatter");
         fold_->sort = computeProgram(utility(kSort), "the neighbour grid's sort");
+        fold_->place = computeProgram(utility(kPlace), "the neighbour grid's placing");
     }
     FoldWork& w = *fold_;
     auto found = w.folds.find(l.pair);
@@ -235,6 +252,11 @@ bool GlslBackend::fold(const rt::FoldLaunch& l) {
     run(w.scatter, rows, 256, {rows});
     bind(4, FoldWork::kStart);
     run(w.sort, buckets, 256, {buckets});
+    auto slots = static_cast<uint32_t>(4 + shader.other.size());
+    ensure(w.buffers[FoldWork::kPlaced], w.capacity[FoldWork::kPlaced], static_cast<size_t>(slots) * rows);
+    bind(2, FoldWork::kOther);
+    bind(6, FoldWork::kPlaced);
+    run(w.place, rows, 256, {rows, slots, buckets});
 
     // The folds: the launch's words, then one invocation per object and one for the row of
     // empty folds.
@@ -257,7 +279,7 @@ bool GlslBackend::fold(const rt::FoldLaunch& l) {
            static_cast<size_t>(shader.width) * (selfRows + 1));
     bind(0, FoldWork::kWords);
     bind(2, FoldWork::kSelf);
-    bind(3, FoldWork::kOther);
+    bind(3, FoldWork::kPlaced);
     bind(4, FoldWork::kStart);
     bind(5, FoldWork::kSorted);
     bind(6, FoldWork::kResults);
