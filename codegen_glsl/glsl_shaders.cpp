@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "codegen_glsl/glsl_body.h"
+#include "codegen_glsl/glsl_fold.h"
 
 namespace psys::codegen_glsl {
 
@@ -532,6 +533,16 @@ std::vector<NamedShader> moduleShaders(const rt::Plan& plan) {
     for (const rt::Plan::Children& c : plan.children)
         shaders.push_back({fmt::format("{}.spawn{}.comp", c.object->name, c.spawn->site),
                            childrenShader(*c.object, *c.spawn)});
+    // The neighbour folds (gpu/gl_fold.cpp runs them): each group's, and the grid's count.
+    std::vector<const Object*> folding;
+    for (const rt::Plan::Rows& r : plan.rows)
+        if (!r.object->neighbours.empty() && std::find(folding.begin(), folding.end(), r.object) == folding.end())
+            folding.push_back(r.object);
+    for (const Object* o : folding)
+        for (const Kernel& k : o->kernels)
+            if (k.kind == KernelKind::Pair)
+                shaders.push_back({fmt::format("{}.fold{}.comp", o->name, k.site), foldShader(*o, k).source});
+    if (!folding.empty()) shaders.push_back({"grid.count.comp", gridCountShader()});
     shaders.push_back({"draw.vert", drawVertexShader()});
     shaders.push_back({"draw.frag", drawFragmentShader()});
     return shaders;
