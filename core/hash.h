@@ -23,6 +23,7 @@
 //                          truncated, as the bits of a 32-bit two's complement integer)
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 #include "core/ops.h"
@@ -96,6 +97,14 @@ constexpr typename A::Int cellBucket(A& a, typename A::Int x, typename A::Int y,
     auto h = pcgHash(a, a.bitXor(z, a.constant(0x2545F491u)));
     h = pcgHash(a, a.bitXor(h, y));
     return a.bitAnd(pcgHash(a, a.bitXor(h, x)), mask);
+}
+
+// A grid's buckets for `rows` objects: a power of two, at least 64 and twice the rows
+// (up to 2^30), so that a bucket holds few cells' objects.
+constexpr uint32_t gridBuckets(size_t rows) {
+    uint32_t buckets = 64;
+    while (buckets < 2 * rows && buckets < (1u << 30)) buckets *= 2;
+    return buckets;
 }
 
 // A grid's cell is the radius and this much wider, so that no rounding in computing a

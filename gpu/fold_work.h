@@ -12,7 +12,7 @@
 
 namespace psys::gpu {
 
-struct GlslBackend::FoldWork {
+struct FoldWork {
     unsigned count = 0, scan = 0, scatter = 0, sort = 0, place = 0;  // programs
     std::map<const ir::Kernel*, std::pair<unsigned, codegen_glsl::FoldShader>> folds;
     enum { kSelf, kOther, kBucketOf, kCounts, kStart, kGroups, kCursor, kSorted, kPlaced, kResults, kWords, kBuffers };

@@ -148,8 +148,82 @@ void ensure(unsigned& buffer, size_t& capacity, size_t words) {
     checkAllocation("a neighbour grid", capacity * 4);
 }
 
-}  // namespace
+// Each side's mask, position and the exports its terms read, packed into one buffer.
+void pack(FoldWork& w, GlMemory& memory, const rt::FoldLaunch& l, const codegen_glsl::FoldShader& shader) {
+    std::map<uint32_t, unsigned> sent;  // (a mask the host keeps goes up once, for both sides where they are one type)
+    auto packSide = [&](const rt::FoldLaunch::Side& side, int position, const std::vector<std::pair<int, int>>& slots,
+                        int which) {
+        std::vector<rt::Buffer> columns = {side.mask};
+        for (int c = 0; c < 3; ++c) columns.push_back(side.exports.at(static_cast<size_t>(position))[static_cast<size_t>(c)]);
+        for (auto [e, c] : slots) columns.push_back(side.exports.at(static_cast<size_t>(e))[static_cast<size_t>(c)]);
+        ensure(w.buffers[which], w.capacity[which], columns.size() * side.rows);
+        if (side.rows == 0) return;
+        for (size_t s = 0; s < columns.size(); ++s) {
+            auto found = sent.find(columns[s].id);
+            unsigned gl = found != sent.end() ? found->second : sent[columns[s].id] = memory.deviceBuffer(columns[s]);
+            glCopyNamedBufferSubData(gl, w.buffers[which], 0, static_cast<GLintptr>(s * side.rows * 4),
+                                     static_cast<GLsizeiptr>(side.rows * 4));
+        }
+        memory.staged += columns.size() * side.rows * 4;
+    };
+    packSide(l.self, l.group->selfPosition, shader.self, FoldWork::kSelf);
+    packSide(l.other, l.group->otherPosition, shader.other, FoldWork::kOther);
+    afterWrite(Write::Copy, kStorageBlock);
+}
 
+void bind(const FoldWork& w, GLuint binding, int buffer) {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, w.buffers[buffer]);
+}
+
+void dispatch(FoldWork& w, GlMemory& memory, unsigned program, size_t invocations,
+              std::initializer_list<uint32_t> params) {
+    glUseProgram(program);
+    bindParams(w.params, params);
+    dispatchInvocations(invocations, 256);
+    ++memory.dispatches;
+    afterWrite(Write::Dispatch, kStorageBlock | kCopy);
+}
+
+// The grid of the other side's rows: counted into buckets, scanned, scattered, each
+// bucket sorted, the other side's slots placed in its order.
+void buildGrid(FoldWork& w, GlMemory& memory, uint32_t rows, uint32_t buckets, uint32_t inverse,
+               uint32_t slots) {
+    using W = FoldWork;
+    ensure(w.buffers[W::kBucketOf], w.capacity[W::kBucketOf], rows);
+    ensure(w.buffers[W::kCounts], w.capacity[W::kCounts], buckets);
+    ensure(w.buffers[W::kStart], w.capacity[W::kStart], buckets + 1);
+    ensure(w.buffers[W::kGroups], w.capacity[W::kGroups], buckets / 1024 + 1);
+    ensure(w.buffers[W::kCursor], w.capacity[W::kCursor], buckets);
+    ensure(w.buffers[W::kSorted], w.capacity[W::kSorted], rows);
+    ensure(w.buffers[W::kPlaced], w.capacity[W::kPlaced], static_cast<size_t>(slots) * rows);
+    uint32_t zero = 0;
+    glClearNamedBufferSubData(w.buffers[W::kCounts], GL_R32UI, 0, buckets * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    afterWrite(Write::Clear, kStorageBlock);
+    bind(w, 2, W::kOther);
+    bind(w, 3, W::kBucketOf);
+    bind(w, 4, W::kCounts);
+    dispatch(w, memory, w.count, rows, {rows, buckets - 1, inverse});
+    bind(w, 5, W::kStart);
+    bind(w, 6, W::kGroups);
+    glUseProgram(w.scan);
+    for (uint32_t pass : {0u, 1u, 2u}) {
+        bindParams(w.params, {buckets, pass});
+        glDispatchCompute(pass == 1 ? 1 : (buckets + 1023) / 1024, 1, 1);
+        ++memory.dispatches;
+        afterWrite(Write::Dispatch, kStorageBlock | kCopy);
+    }
+    glCopyNamedBufferSubData(w.buffers[W::kStart], w.buffers[W::kCursor], 0, 0, buckets * 4);
+    afterWrite(Write::Copy, kStorageBlock);
+    bind(w, 4, W::kCursor);
+    bind(w, 5, W::kSorted);
+    dispatch(w, memory, w.scatter, rows, {rows});
+    bind(w, 4, W::kStart);
+    dispatch(w, memory, w.sort, buckets, {buckets});
+    bind(w, 6, W::kPlaced);
+    dispatch(w, memory, w.place, rows, {rows, slots, buckets});
+}
+
+}  // namespace
 
 void GlslBackend::forgetFold(const ir::Kernel& pair) {
     if (!fold_) return;
@@ -185,78 +259,11 @@ bool GlslBackend::fold(const rt::FoldLaunch& l) {
     auto& [program, shader] = found->second;
     const ir::NeighbourGroup& group = *l.group;
     PassTimer::Scope timed(&timer_, "fold", l.self.rows);
-
-    // Each side packed: mask, position, the exports its terms read.
-    std::map<uint32_t, unsigned> deviceBuffers;
-    auto pack = [&](const rt::FoldLaunch::Side& side, int position, const std::vector<std::pair<int, int>>& slots,
-                    int which) {
-        std::vector<rt::Buffer> columns = {side.mask};
-        for (int c = 0; c < 3; ++c) columns.push_back(side.exports.at(static_cast<size_t>(position))[static_cast<size_t>(c)]);
-        for (auto [e, c] : slots) columns.push_back(side.exports.at(static_cast<size_t>(e))[static_cast<size_t>(c)]);
-        ensure(w.buffers[which], w.capacity[which], columns.size() * side.rows);
-        if (side.rows == 0) return;
-        for (size_t s = 0; s < columns.size(); ++s) {
-            // (a mask the host keeps is sent once a step, for both sides where they are one type)
-            auto sent = deviceBuffers.find(columns[s].id);
-            unsigned gl = sent != deviceBuffers.end() ? sent->second
-                                                      : deviceBuffers[columns[s].id] = memory_.deviceBuffer(columns[s]);
-            glCopyNamedBufferSubData(gl, w.buffers[which], 0, static_cast<GLintptr>(s * side.rows * 4),
-                                     static_cast<GLsizeiptr>(side.rows * 4));
-        }
-        memory_.staged += columns.size() * side.rows * 4;
-    };
-    pack(l.self, group.selfPosition, shader.self, FoldWork::kSelf);
-    pack(l.other, group.otherPosition, shader.other, FoldWork::kOther);
-    afterWrite(Write::Copy, kStorageBlock);
-
-    // The grid: as many buckets as the host's (rt/neighbours.cpp).
-    uint32_t buckets = 64;
-    while (buckets < 2 * l.other.rows && buckets < (1u << 30)) buckets *= 2;
+    pack(w, memory_, l, shader);
     auto rows = static_cast<uint32_t>(l.other.rows);
+    uint32_t buckets = core::gridBuckets(l.other.rows);
     uint32_t inverse = std::bit_cast<uint32_t>(1.0f / (group.radius * core::kCellMargin));
-    ensure(w.buffers[FoldWork::kBucketOf], w.capacity[FoldWork::kBucketOf], rows);
-    ensure(w.buffers[FoldWork::kCounts], w.capacity[FoldWork::kCounts], buckets);
-    ensure(w.buffers[FoldWork::kStart], w.capacity[FoldWork::kStart], buckets + 1);
-    ensure(w.buffers[FoldWork::kGroups], w.capacity[FoldWork::kGroups], buckets / 1024 + 1);
-    ensure(w.buffers[FoldWork::kCursor], w.capacity[FoldWork::kCursor], buckets);
-    ensure(w.buffers[FoldWork::kSorted], w.capacity[FoldWork::kSorted], rows);
-    uint32_t zero = 0;
-    glClearNamedBufferSubData(w.buffers[FoldWork::kCounts], GL_R32UI, 0, buckets * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
-    afterWrite(Write::Clear, kStorageBlock);
-    auto bind = [&](GLuint binding, int buffer) { glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, w.buffers[buffer]); };
-    auto run = [&](unsigned prog, size_t invocations, unsigned group, std::initializer_list<uint32_t> params) {
-        glUseProgram(prog);
-        bindParams(w.params, params);
-        dispatchInvocations(invocations, group);
-        ++memory_.dispatches;
-        afterWrite(Write::Dispatch, kStorageBlock | kCopy);
-    };
-    bind(2, FoldWork::kOther);
-    bind(3, FoldWork::kBucketOf);
-    bind(4, FoldWork::kCounts);
-    run(w.count, rows, 256, {rows, buckets - 1, inverse});
-    bind(5, FoldWork::kStart);
-    bind(6, FoldWork::kGroups);
-    uint32_t groups = (buckets + 1023) / 1024;
-    glUseProgram(w.scan);
-    for (uint32_t pass : {0u, 1u, 2u}) {
-        bindParams(w.params, {buckets, pass});
-        glDispatchCompute(pass == 1 ? 1 : groups, 1, 1);
-        ++memory_.dispatches;
-        afterWrite(Write::Dispatch, kStorageBlock | kCopy);
-    }
-    glCopyNamedBufferSubData(w.buffers[FoldWork::kStart], w.buffers[FoldWork::kCursor], 0, 0, buckets * 4);
-    afterWrite(Write::Copy, kStorageBlock);
-    bind(4, FoldWork::kCursor);
-    bind(5, FoldWork::kSorted);
-    run(w.scatter, rows, 256, {rows});
-    bind(4, FoldWork::kStart);
-    run(w.sort, buckets, 256, {buckets});
-    auto slots = static_cast<uint32_t>(4 + shader.other.size());
-    ensure(w.buffers[FoldWork::kPlaced], w.capacity[FoldWork::kPlaced], static_cast<size_t>(slots) * rows);
-    bind(2, FoldWork::kOther);
-    bind(6, FoldWork::kPlaced);
-    run(w.place, rows, 256, {rows, slots, buckets});
+    buildGrid(w, memory_, rows, buckets, inverse, static_cast<uint32_t>(4 + shader.other.size()));
 
     // The folds: the launch's words, then one invocation per object and one for the row of
     // empty folds.
@@ -269,20 +276,20 @@ bool GlslBackend::fold(const rt::FoldLaunch& l) {
     words[4] = std::bit_cast<uint32_t>(group.radius * group.radius);
     words[5] = l.same ? 1 : 0;
     // (the externs: the module's every one; the shader reads those its terms name)
-    ensure(w.buffers[FoldWork::kWords], w.capacity[FoldWork::kWords], words.size() + 4 * l.externCount);
     for (size_t e = 0; e < l.externCount; ++e)
         for (int c = 0; c < 4; ++c) words.push_back(std::bit_cast<uint32_t>(l.externs[e].f[static_cast<size_t>(c)]));
+    ensure(w.buffers[FoldWork::kWords], w.capacity[FoldWork::kWords], words.size());
     glNamedBufferSubData(w.buffers[FoldWork::kWords], 0, static_cast<GLsizeiptr>(words.size() * 4), words.data());
     memory_.transferred += words.size() * 4;
     afterWrite(Write::Upload, kStorageBlock);
     ensure(w.buffers[FoldWork::kResults], w.capacity[FoldWork::kResults],
            static_cast<size_t>(shader.width) * (selfRows + 1));
-    bind(0, FoldWork::kWords);
-    bind(2, FoldWork::kSelf);
-    bind(3, FoldWork::kPlaced);
-    bind(4, FoldWork::kStart);
-    bind(5, FoldWork::kSorted);
-    bind(6, FoldWork::kResults);
+    bind(w, 0, FoldWork::kWords);
+    bind(w, 2, FoldWork::kSelf);
+    bind(w, 3, FoldWork::kPlaced);
+    bind(w, 4, FoldWork::kStart);
+    bind(w, 5, FoldWork::kSorted);
+    bind(w, 6, FoldWork::kResults);
     glUseProgram(program);
     dispatchInvocations(selfRows + 1, 64);
     ++memory_.dispatches;

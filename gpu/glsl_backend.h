@@ -32,6 +32,7 @@ namespace psys::gpu {
 
 class HeadlessContext;
 class ProgramCompiler;
+struct FoldWork;
 
 class GlslBackend final : public rt::Backend {
 public:
@@ -208,8 +209,7 @@ private:
     double compileSeconds_ = 0;
     std::string renderer_;
     PassTimer timer_;
-    struct FoldWork;  // the grid's buffers and programs, the folds' programs (gl_fold.cpp)
-    std::unique_ptr<FoldWork> fold_;
+    std::unique_ptr<FoldWork> fold_;  // the neighbour folds' programs and buffers (gl_fold.cpp)
     void forgetFold(const ir::Kernel& pair);
 };
 

@@ -65,8 +65,7 @@ struct Grid {
 Grid buildGrid(const HostSide& other, size_t rows, int position, float radius, const ir::Kernel& pair) {
     Grid g;
     g.inverse = 1.0f / (radius * core::kCellMargin);
-    uint32_t buckets = 64;
-    while (buckets < 2 * rows && buckets < (1u << 30)) buckets *= 2;
+    uint32_t buckets = core::gridBuckets(rows);
     g.mask = buckets - 1;
     const float* px = other.columns[static_cast<size_t>(4 * position)];
     const float* py = other.columns[static_cast<size_t>(4 * position + 1)];
