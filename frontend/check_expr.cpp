@@ -221,6 +221,23 @@ Type Checker::checkBinary(BinaryExpr& binary, const Context& ctx) {
     return Type::error();
 }
 
+std::optional<Ref> Checker::memberOf(const ObjectDecl& object, const MemberExpr& member,
+                                     std::vector<std::string> alsoNamed) {
+    auto& scope = objectScopes_[&object];
+    auto it = scope.names.find(member.member);
+    if (it == scope.names.end()) {
+        for (auto& [n, _] : scope.names) alsoNamed.push_back(n);
+        std::string suggestion = closestName(member.member, alsoNamed);
+        diags_.error(member.memberRange,
+                     fmt::format("`{}` has no equation or parameter named `{}`{}", object.name, member.member,
+                                 suggestion.empty() ? "" : fmt::format("; did you mean `{}`?", suggestion)))
+            .notes.push_back({object.nameRange, fmt::format("`{}` declared here", object.name)});
+        return std::nullopt;
+    }
+    if (it->second.kind == Ref::Kind::Equation) usedEquations_.insert(it->second.equation);
+    return it->second;
+}
+
 Type Checker::checkMember(MemberExpr& member, const Context& ctx) {
     if (member.base->kind == ExprKind::Name && static_cast<NameExpr&>(*member.base).name == "other") {
         if (ctx.fold) return checkNeighbourMember(member, ctx);
@@ -249,22 +266,8 @@ Type Checker::checkMember(MemberExpr& member, const Context& ctx) {
             Ref& ref = member.parentRef;
             if (member.member == "alive") ref.kind = Ref::Kind::Alive;
             else if (member.member == "age") ref.kind = Ref::Kind::Age;
-            else {
-                auto& scope = objectScopes_[parent];
-                auto it = scope.names.find(member.member);
-                if (it == scope.names.end()) {
-                    std::vector<std::string> names = {"alive", "age"};
-                    for (auto& [n, _] : scope.names) names.push_back(n);
-                    std::string suggestion = closestName(member.member, names);
-                    diags_.error(member.memberRange,
-                                 fmt::format("`{}` has no equation or parameter named `{}`{}", parent->name, member.member,
-                                             suggestion.empty() ? "" : fmt::format("; did you mean `{}`?", suggestion)))
-                        .notes.push_back({parent->nameRange, fmt::format("`{}` declared here", parent->name)});
-                    return Type::error();
-                }
-                ref = it->second;
-                if (ref.kind == Ref::Kind::Equation) usedEquations_.insert(ref.equation);
-            }
+            else if (auto found = memberOf(*parent, member, {"alive", "age"})) ref = *found;
+            else return Type::error();
             return typeOfRef(ref);
         }
         bool isObject = false;

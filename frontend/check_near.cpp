@@ -96,20 +96,9 @@ Type Checker::checkNeighbourMember(MemberExpr& member, const Context& ctx) {
     member.parent = other;
     member.neighbour = true;
     member.base->type = Type::error();  // `other` is not a value of its own
-    auto& scope = objectScopes_[other];
-    auto it = scope.names.find(member.member);
-    if (it == scope.names.end()) {
-        std::vector<std::string> names;
-        for (auto& [n, _] : scope.names) names.push_back(n);
-        std::string suggestion = closestName(member.member, names);
-        diags_.error(member.memberRange,
-                     fmt::format("`{}` has no equation or parameter named `{}`{}", other->name, member.member,
-                                 suggestion.empty() ? "" : fmt::format("; did you mean `{}`?", suggestion)))
-            .notes.push_back({other->nameRange, fmt::format("`{}` declared here", other->name)});
-        return Type::error();
-    }
-    member.parentRef = it->second;
-    if (member.parentRef.kind == Ref::Kind::Equation) usedEquations_.insert(member.parentRef.equation);
+    auto found = memberOf(*other, member, {});
+    if (!found) return Type::error();
+    member.parentRef = *found;
     return typeOfRef(member.parentRef);
 }
 

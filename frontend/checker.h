@@ -10,6 +10,7 @@
 
 #include <functional>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -66,6 +67,10 @@ private:
     Type checkBuiltinCall(ast::CallExpr& call, const std::vector<Type>& args, const Context& ctx);
     Type checkUserCall(ast::CallExpr& call, const ast::FnDecl& fn, const std::vector<Type>& args);
     Type checkMember(ast::MemberExpr& member, const Context& ctx);
+    // `object`'s equation or parameter `member.member` (marked used), or an error naming
+    // the closest of its names and `alsoNamed`.
+    std::optional<ast::Ref> memberOf(const ast::ObjectDecl& object, const ast::MemberExpr& member,
+                                     std::vector<std::string> alsoNamed);
 
     // check_near.cpp
     Type checkNear(ast::CallExpr& call, const Context& ctx);
