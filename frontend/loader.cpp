@@ -1,5 +1,7 @@
 #include "frontend/loader.h"
 
+#include <dlfcn.h>
+
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -147,9 +149,19 @@ std::vector<fs::path> libraryDirectories() {
             start = end + 1;
         }
     }
+    // The running program, then the shared object this code is in where that is another
+    // (libpsys.so in a host's process: lib/../share/psys where installed).
     std::error_code ec;
-    fs::path self = fs::read_symlink("/proc/self/exe", ec);
-    if (!ec)
+    std::vector<fs::path> selves;
+    fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+    if (!ec) selves.push_back(exe);
+    Dl_info info;
+    if (dladdr(reinterpret_cast<const void*>(&libraryDirectories), &info) && info.dli_fname &&
+        info.dli_fname[0] == '/') {
+        fs::path object = fs::weakly_canonical(info.dli_fname, ec);
+        if (!ec && object != exe) selves.push_back(object);
+    }
+    for (const fs::path& self : selves)
         for (fs::path dir = self.parent_path(); !dir.empty(); dir = dir.parent_path()) {
             if (fs::is_directory(dir / "share/psys/std", ec)) {
                 dirs.push_back(dir / "share/psys");

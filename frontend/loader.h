@@ -19,7 +19,8 @@ namespace psys {
 // Where `import "std/…"` looks, in order: each directory of the environment variable
 // PSYS_LIBRARY (separated by `:`), then beside the running program — the first of its
 // directory and that directory's ancestors that holds share/psys/std (bin/../share/psys
-// where it is installed, build/share/psys from anywhere in a build tree). A directory
+// where it is installed, build/share/psys from anywhere in a build tree) — then beside
+// libpsys.so where the compiler runs in a host's process (lib/../share/psys). A directory
 // listed holds `std/`.
 std::vector<std::filesystem::path> libraryDirectories();
 

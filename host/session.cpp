@@ -34,19 +34,29 @@ CompileResult compile(const std::string& path, const CompileOptions& options, st
     return result;
 }
 
-std::unique_ptr<Session> Session::open(const std::string& path, const SessionOptions& asked, CompileResult& result,
-                                       std::string& error, const std::string* text) {
+SessionOptions Session::resolved(const SessionOptions& asked) {
     SessionOptions options = asked;
     options.compile.pipeline.pass.relaxed |= options.backend.relaxesMaths();
+    return options;
+}
+
+std::unique_ptr<Session> Session::open(const std::string& path, const SessionOptions& asked, CompileResult& result,
+                                       std::string& error, const std::string* text) {
+    SessionOptions options = resolved(asked);
     std::optional<ir::Module> module;
     result = compile(path, options.compile, module, text);
     if (!module) return nullptr;
+    return start(path, options, std::move(*module), error);
+}
+
+std::unique_ptr<Session> Session::start(const std::string& path, const SessionOptions& options, ir::Module module,
+                                        std::string& error) {
     auto backend = makeBackend(options.backend);
     if (!backend) {
         error = backend.error;
         return nullptr;
     }
-    if (auto tooLarge = rt::System::checkCapacity(*module, options.system)) {
+    if (auto tooLarge = rt::System::checkCapacity(module, options.system)) {
         error = *tooLarge;
         return nullptr;
     }
@@ -54,7 +64,7 @@ std::unique_ptr<Session> Session::open(const std::string& path, const SessionOpt
     s->path_ = path;
     s->options_ = options;
     s->backend_ = *backend;
-    s->system_ = std::make_unique<rt::System>(std::move(*module), *s->backend_, options.system);
+    s->system_ = std::make_unique<rt::System>(std::move(module), *s->backend_, options.system);
     return s;
 }
 

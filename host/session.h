@@ -46,6 +46,12 @@ public:
     // backend; null when it does not compile or the backend cannot be made (`result`, `error`).
     static std::unique_ptr<Session> open(const std::string& path, const SessionOptions& options, CompileResult& result,
                                          std::string& error, const std::string* text = nullptr);
+    // The same in two halves, for a host that compiles on a thread of its own (a large
+    // stack) and runs on another (a GL context's): what `options` compile with, and a
+    // session started with a module compiled so.
+    static SessionOptions resolved(const SessionOptions& options);
+    static std::unique_ptr<Session> start(const std::string& path, const SessionOptions& resolved, ir::Module module,
+                                          std::string& error);
     ~Session();
 
     rt::System& system() { return *system_; }

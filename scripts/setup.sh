@@ -14,6 +14,7 @@ packages=(
   glslang-tools xvfb xauth patchelf xz-utils libbenchmark-dev python3-matplotlib vim
   clang-19 libclang-rt-19-dev
   ffmpeg fonts-dejavu-core
+  python3-dev python3-pybind11 python3-numpy python3-pytest
 )
 # Node.js 20 and npm (the editor extension's tests and package) come with the machine;
 # where they do not, Debian's are installed.

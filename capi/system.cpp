@@ -1,0 +1,318 @@
+// The C API (include/psys/psys.h) over host::Session: a system compiled from a file or a
+// string, on a backend chosen by name, run, reloaded and read by a C host. Every entry
+// point checks its arguments and turns what the layers below throw into an error value.
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "capi/error.h"
+#include "host/large_stack.h"
+#include "host/session.h"
+
+using psys::capi::guarded;
+using psys::capi::makeError;
+using psys::capi::nullArgument;
+using psys::capi::OwnedDiagnostic;
+namespace host = psys::host;
+namespace rt = psys::rt;
+
+struct psys_system {
+    std::unique_ptr<host::Session> session;
+    bool fromString = false;
+    std::vector<OwnedDiagnostic> warnings;  // of the latest compilation that took
+    // The spelled types of externs and triggers (psys_input::type), made at each compilation.
+    std::vector<std::string> externTypes, triggerTypes;
+
+    rt::System& system() { return session->system(); }
+    const rt::System& system() const { return session->system(); }
+};
+
+namespace {
+
+// The project's version (CMakeLists.txt), which the header's must be.
+constexpr const char* kVersion = PSYS_LIBRARY_VERSION;
+static_assert(PSYS_VERSION_MAJOR == PSYS_LIBRARY_MAJOR && PSYS_VERSION_MINOR == PSYS_LIBRARY_MINOR &&
+                  PSYS_VERSION_PATCH == PSYS_LIBRARY_PATCH,
+              "include/psys/psys.h's version is the project's (CMakeLists.txt)");
+
+std::string spelled(const psys::ir::Type& t) {
+    if (t.isBool()) return "bool";
+    return t.width == 1 ? "float" : fmt::format("vec{}", t.width);
+}
+
+void describe(psys_system& s) {
+    const psys::ir::Module& m = s.system().module();
+    s.externTypes.clear();
+    for (const psys::ir::Extern& e : m.externs) s.externTypes.push_back(rt::languageName(e));
+    s.triggerTypes.clear();
+    for (const psys::ir::Trigger& t : m.triggers) {
+        std::string types;
+        for (const psys::ir::Param& p : t.params) types += (types.empty() ? "" : ", ") + spelled(p.type);
+        s.triggerTypes.push_back(types);
+    }
+}
+
+// What the C options ask of a session, or why they cannot be.
+std::optional<std::string> sessionOptions(const psys_options* given, host::SessionOptions& out) {
+    psys_options o;
+    psys_options_init(&o);
+    if (given) o = *given;
+    out.backend.name = o.backend ? o.backend : "llvm";
+    out.backend.math = o.math ? o.math : "fast";
+    if (o.capacity == 0) return "the capacity is at least 1 object a type";
+    out.system.seed = o.seed;
+    out.system.capacity = o.capacity;
+    out.system.threads = o.threads;
+    out.compile.pipeline.optimize = o.optimize != 0;
+    out = host::Session::resolved(out);
+    return std::nullopt;
+}
+
+// Compiles on a thread with a large stack (the compiler recurses as deep as expressions
+// nest: host/large_stack.h); the module or the error with the diagnostics.
+psys_error* compileModule(const std::string& path, const psys::CompileOptions& options, const std::string* text,
+                          std::optional<psys::ir::Module>& module, std::vector<OwnedDiagnostic>& warnings) {
+    host::CompileResult result;
+    host::runWithLargeStack([&] {
+        result = host::compile(path, options, module, text);
+        return 0;
+    });
+    if (!module) return makeError(result.text(), psys::capi::diagnosticsOf(*result.diagnostics, true));
+    warnings = psys::capi::diagnosticsOf(*result.diagnostics, false);
+    return nullptr;
+}
+
+psys_error* open(const char* function, const std::string& path, const std::string* text, const psys_options* options,
+                 psys_system** out) {
+    if (!out) return nullArgument(function, "the place for the system (out)");
+    *out = nullptr;
+    host::SessionOptions so;
+    if (auto bad = sessionOptions(options, so)) return makeError(fmt::format("{}: {}", function, *bad));
+    auto s = std::make_unique<psys_system>();
+    std::optional<psys::ir::Module> module;
+    if (psys_error* e = compileModule(path, so.compile, text, module, s->warnings)) return e;
+    std::string error;
+    s->session = host::Session::start(path, so, std::move(*module), error);
+    if (!s->session) return makeError(fmt::format("{}: {}", function, error));
+    s->fromString = text != nullptr;
+    describe(*s);
+    *out = s.release();
+    return nullptr;
+}
+
+psys_error* orError(const char* function, const std::optional<std::string>& error) {
+    return error ? makeError(fmt::format("{}: {}", function, *error)) : nullptr;
+}
+
+psys_error* badType(const char* function, const psys_system* s, size_t type) {
+    return makeError(fmt::format("{}: there is no object type {} (the system has {})", function, type,
+                                 s->system().typeCount()));
+}
+
+psys_column column(const rt::Memory& memory, rt::Buffer b, float constant) {
+    if (!b.valid()) return {nullptr, 0, constant};
+    if (unsigned gl = memory.glBuffer(b)) return {nullptr, gl, 0};
+    return {memory.view(b), 0, 0};
+}
+
+}  // namespace
+
+extern "C" {
+
+const char* psys_version(void) { return kVersion; }
+
+void psys_options_init(psys_options* options) {
+    if (!options) return;
+    rt::SystemOptions defaults;
+    *options = psys_options{"llvm", "fast", defaults.seed, defaults.capacity, defaults.threads, 1};
+}
+
+psys_error* psys_compile_file(const char* path, const psys_options* options, psys_system** out) {
+    if (out) *out = nullptr;
+    if (!path) return nullArgument("psys_compile_file", "the path");
+    return guarded("psys_compile_file", [&] { return open("psys_compile_file", path, nullptr, options, out); });
+}
+
+psys_error* psys_compile_string(const char* source, const char* name, const psys_options* options, psys_system** out) {
+    if (out) *out = nullptr;
+    if (!source) return nullArgument("psys_compile_string", "the source");
+    return guarded("psys_compile_string", [&] {
+        std::string text = source;
+        return open("psys_compile_string", name ? name : "<string>", &text, options, out);
+    });
+}
+
+void psys_system_free(psys_system* system) { delete system; }
+
+psys_error* psys_reload(psys_system* s, const char* source) {
+    if (!s) return nullArgument("psys_reload", "the system");
+    if (!source && s->fromString)
+        return makeError("psys_reload: the system was compiled from a string: its new source is needed");
+    return guarded("psys_reload", [&]() -> psys_error* {
+        std::string text = source ? source : "";
+        host::Session::Candidate candidate;
+        std::vector<OwnedDiagnostic> warnings;
+        if (psys_error* e = compileModule(s->session->path(), s->session->options().compile, source ? &text : nullptr,
+                                          candidate.module, warnings))
+            return e;  // the running system goes on untouched
+        s->session->adopt(std::move(candidate));
+        s->warnings = std::move(warnings);
+        describe(*s);
+        return nullptr;
+    });
+}
+
+size_t psys_warning_count(const psys_system* s) { return s ? s->warnings.size() : 0; }
+
+int psys_warning(const psys_system* s, size_t index, psys_diagnostic* out) {
+    if (!s || !out || index >= s->warnings.size()) return -1;
+    *out = s->warnings[index].view();
+    return 0;
+}
+
+psys_error* psys_step(psys_system* s, double dt) {
+    if (!s) return nullArgument("psys_step", "the system");
+    return guarded("psys_step", [&] { return orError("psys_step", s->system().step(dt)); });
+}
+
+double psys_time(const psys_system* s) { return s ? s->system().time() : 0; }
+uint64_t psys_step_count(const psys_system* s) { return s ? s->system().stepCount() : 0; }
+
+int psys_finished(const psys_system* s) {
+    if (!s) return 0;
+    try {
+        return s->system().finished() ? 1 : 0;
+    } catch (...) {
+        return 0;
+    }
+}
+
+psys_error* psys_set_extern(psys_system* s, const char* name, const float* values, size_t count) {
+    if (!s) return nullArgument("psys_set_extern", "the system");
+    if (!name) return nullArgument("psys_set_extern", "the extern's name");
+    if (!values && count) return nullArgument("psys_set_extern", "the values");
+    return guarded("psys_set_extern", [&] {
+        return orError("psys_set_extern", s->system().setExtern(name, std::span<const float>(values, count)));
+    });
+}
+
+int psys_get_extern(const psys_system* s, const char* name, float values[4]) {
+    if (!s || !name) return -1;
+    int index = s->system().externHandle(name);
+    if (index < 0) return -1;
+    int width = s->system().module().externs[static_cast<size_t>(index)].type.width;
+    if (values) {
+        auto v = *s->system().externValue(name);
+        for (int c = 0; c < width; ++c) values[c] = v.f[static_cast<size_t>(c)];
+    }
+    return width;
+}
+
+psys_error* psys_fire(psys_system* s, const char* trigger, const float* args, size_t count) {
+    if (!s) return nullArgument("psys_fire", "the system");
+    if (!trigger) return nullArgument("psys_fire", "the trigger's name");
+    if (!args && count) return nullArgument("psys_fire", "the arguments");
+    return guarded("psys_fire", [&] {
+        return orError("psys_fire", s->system().fire(trigger, std::span<const float>(args, count)));
+    });
+}
+
+size_t psys_type_count(const psys_system* s) { return s ? s->system().typeCount() : 0; }
+
+const char* psys_type_name(const psys_system* s, size_t type) {
+    if (!s || type >= s->system().typeCount()) return nullptr;
+    return s->system().module().objects[type].name.c_str();
+}
+
+int psys_type_index(const psys_system* s, const char* name) { return s && name ? s->system().typeIndex(name) : -1; }
+
+size_t psys_extern_count(const psys_system* s) { return s ? s->system().module().externs.size() : 0; }
+
+int psys_extern_info(const psys_system* s, size_t index, psys_input* out) {
+    if (!s || !out || index >= psys_extern_count(s)) return -1;
+    const psys::ir::Extern& e = s->system().module().externs[index];
+    *out = {e.name.c_str(), s->externTypes[index].c_str(), static_cast<size_t>(e.type.width)};
+    return 0;
+}
+
+size_t psys_trigger_count(const psys_system* s) { return s ? s->system().module().triggers.size() : 0; }
+
+int psys_trigger_info(const psys_system* s, size_t index, psys_input* out) {
+    if (!s || !out || index >= psys_trigger_count(s)) return -1;
+    const psys::ir::Trigger& t = s->system().module().triggers[index];
+    size_t values = 0;
+    for (const psys::ir::Param& p : t.params) values += static_cast<size_t>(p.type.width);
+    *out = {t.name.c_str(), s->triggerTypes[index].c_str(), values};
+    return 0;
+}
+
+psys_error* psys_get_draw(psys_system* s, size_t type, psys_draw* out) {
+    if (!s) return nullArgument("psys_get_draw", "the system");
+    if (!out) return nullArgument("psys_get_draw", "the place for the columns (out)");
+    if (type >= s->system().typeCount()) return badType("psys_get_draw", s, type);
+    return guarded("psys_get_draw", [&]() -> psys_error* {
+        const rt::DrawColumns& c = s->system().draw(type);
+        const rt::Memory& m = s->system().backend().memory();
+        psys_draw d{};
+        d.rows = c.rows;
+        d.drawn = c.counted ? c.drawn : std::numeric_limits<size_t>::max();
+        d.visible = column(m, c.visible, 0);
+        d.ids = column(m, c.ids, 0);
+        const auto values = c.values();
+        psys_column* into[rt::DrawColumns::kValues] = {&d.position[0], &d.position[1], &d.position[2], &d.color[0],
+                                                       &d.color[1],    &d.color[2],    &d.color[3],    &d.size,
+                                                       &d.rotation,    &d.frame,       &d.end[0],      &d.end[1],
+                                                       &d.end[2]};
+        for (size_t k = 0; k < values.size(); ++k) *into[k] = column(m, values[k], c.constant[k]);
+        *out = d;
+        return nullptr;
+    });
+}
+
+psys_error* psys_read_points(psys_system* s, size_t type, psys_point* out, size_t max, size_t* count) {
+    if (!s) return nullArgument("psys_read_points", "the system");
+    if (!out && max) return nullArgument("psys_read_points", "the points (out)");
+    if (type >= s->system().typeCount()) return badType("psys_read_points", s, type);
+    return guarded("psys_read_points", [&]() -> psys_error* {
+        std::vector<rt::RenderPoint> points = s->system().points(type);
+        if (count) *count = points.size();
+        for (size_t i = 0; i < points.size() && i < max; ++i) {
+            const rt::RenderPoint& p = points[i];
+            out[i] = {p.id, {p.position[0], p.position[1], p.position[2]}, {p.color[0], p.color[1], p.color[2], p.color[3]},
+                      p.size};
+        }
+        return nullptr;
+    });
+}
+
+psys_error* psys_get_stats(const psys_system* s, psys_stats* out) {
+    if (!s) return nullArgument("psys_get_stats", "the system");
+    if (!out) return nullArgument("psys_get_stats", "the place for the stats (out)");
+    return guarded("psys_get_stats", [&]() -> psys_error* {
+        rt::Stats st = s->system().stats();
+        *out = {st.steps,          st.rejectedSteps,   st.nonFiniteExterns + st.outOfRangeExterns,
+                st.invalidEmissions, st.nonFiniteRender, st.loopSeconds,
+                st.emitSeconds,    st.createSeconds,   st.drawSeconds,
+                st.foldSeconds};
+        return nullptr;
+    });
+}
+
+psys_error* psys_get_type_stats(const psys_system* s, size_t type, psys_type_stats* out) {
+    if (!s) return nullArgument("psys_get_type_stats", "the system");
+    if (!out) return nullArgument("psys_get_type_stats", "the place for the stats (out)");
+    if (type >= s->system().typeCount()) return badType("psys_get_type_stats", s, type);
+    return guarded("psys_get_type_stats", [&]() -> psys_error* {
+        rt::Stats st = s->system().stats();
+        const rt::TypeStats& t = st.types.at(type);
+        *out = {t.live, t.created, t.killed, t.dropped, t.unstable};
+        return nullptr;
+    });
+}
+
+}  // extern "C"

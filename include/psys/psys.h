@@ -1,0 +1,237 @@
+/* psys: particle systems compiled from .psys programs, embedded in a C or C++ host.
+ *
+ *   psys_options o;
+ *   psys_options_init(&o);                       // the LLVM JIT, fast maths, seed 1
+ *   psys_system* sys = NULL;
+ *   psys_error* err = psys_compile_file("fountain.psys", &o, &sys);
+ *   if (err) { fprintf(stderr, "%s", psys_error_message(err)); psys_error_free(err); return 1; }
+ *   for (int frame = 0; frame < 600; ++frame) {
+ *       psys_step(sys, 1.0 / 60);                // an error only for a bad dt
+ *       psys_draw draw;
+ *       psys_get_draw(sys, 0, &draw);            // columns of what type 0 draws
+ *       ...
+ *   }
+ *   psys_system_free(sys);
+ *
+ * Errors. Every call that can fail returns a psys_error* (NULL: it succeeded) carrying a
+ * message and, for a compilation, its diagnostics (file, line, column, text); the caller
+ * frees it. Nothing is changed by a call that fails, and no call aborts the host on bad
+ * input: a null handle, an unknown name, the wrong number of values, a NaN.
+ *
+ * Structures. The structs below change only with the major version (libpsys.so.MAJOR):
+ * a host built against this header runs with any library of the same major version.
+ *
+ * Threads. A system is used by one thread at a time (any thread on the CPU backends; the
+ * thread whose GL context it was made in on the glsl backend). Systems are independent.
+ *
+ * GL state. On the glsl backend a call that runs the system (psys_step, psys_fire,
+ * psys_get_draw, psys_reload, ...) dispatches compute shaders in the current context: it
+ * may leave another program and other buffers bound. A host binds its own after it.
+ *
+ * docs/embedding.md has the whole story and a complete example.
+ */
+#ifndef PSYS_PSYS_H
+#define PSYS_PSYS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#if defined(__GNUC__)
+#define PSYS_API __attribute__((visibility("default")))
+#else
+#define PSYS_API
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define PSYS_VERSION_MAJOR 0
+#define PSYS_VERSION_MINOR 1
+#define PSYS_VERSION_PATCH 0
+
+/* The library's version as "MAJOR.MINOR.PATCH" (the header's may differ: a host built
+ * against one header and run with a later library of the same major version). */
+PSYS_API const char* psys_version(void);
+
+/* ---- Errors ------------------------------------------------------------------------- */
+
+typedef struct psys_error psys_error;
+
+typedef enum psys_severity {
+    PSYS_SEVERITY_ERROR = 0,
+    PSYS_SEVERITY_WARNING = 1,
+    PSYS_SEVERITY_NOTE = 2,
+    PSYS_SEVERITY_REMARK = 3
+} psys_severity;
+
+/* One diagnostic of a compilation. Its strings live as long as the error (or the system,
+ * for psys_warning). line and column count from 1 (column in bytes); 0 where the
+ * diagnostic has no place in a file (a limit, the command line). */
+typedef struct psys_diagnostic {
+    psys_severity severity;
+    const char* file;
+    uint32_t line;
+    uint32_t column;
+    uint32_t end_line; /* where its range ends (exclusive column) */
+    uint32_t end_column;
+    const char* message;
+} psys_diagnostic;
+
+/* The whole message: for a compilation, the diagnostics as psysc prints them (with the
+ * source lines); else one sentence. Never NULL for a non-null error. */
+PSYS_API const char* psys_error_message(const psys_error* error);
+/* A compilation's diagnostics (errors and warnings), 0 for other errors. */
+PSYS_API size_t psys_error_diagnostic_count(const psys_error* error);
+/* Fills *out with diagnostic `index`; returns 0, or -1 when there is none. */
+PSYS_API int psys_error_diagnostic(const psys_error* error, size_t index, psys_diagnostic* out);
+PSYS_API void psys_error_free(psys_error* error);
+
+/* ---- Compiling a system ------------------------------------------------------------- */
+
+typedef struct psys_system psys_system;
+
+typedef struct psys_options {
+    /* "llvm" (the JIT: the default), "interp" (the reference interpreter) or "glsl"
+     * (compute shaders on OpenGL 4.5: the GL context current on the calling thread, or a
+     * headless one of its own when none is). */
+    const char* backend;
+    /* "fast" (the default) or "exact": the llvm backend's maths (exact: the interpreter's
+     * bits). */
+    const char* math;
+    uint32_t seed;      /* of every random value: the same seed, the same run */
+    size_t capacity;    /* objects per type, unless its @capacity says otherwise */
+    unsigned threads;   /* for the CPU backends: 0 for every core; results do not depend on it */
+    int optimize;       /* nonzero (the default): the optimizer's passes */
+} psys_options;
+
+/* The defaults above: llvm, fast, seed 1, 2^20 objects a type, every core, optimized. */
+PSYS_API void psys_options_init(psys_options* options);
+
+/* Compiles a program and starts a system (nothing is created before the first step or
+ * trigger). On error *out is left NULL and the error has the diagnostics. `options` may
+ * be NULL (the defaults). */
+PSYS_API psys_error* psys_compile_file(const char* path, const psys_options* options, psys_system** out);
+/* The same from text; `name` stands for its file in diagnostics (NULL: "<string>"). */
+PSYS_API psys_error* psys_compile_string(const char* source, const char* name, const psys_options* options,
+                                         psys_system** out);
+/* NULL is ignored. On the glsl backend, call it with the system's GL context current. */
+PSYS_API void psys_system_free(psys_system* system);
+
+/* Compiles the system's file again (psys_compile_file's) or `source` (non-NULL: for a
+ * string's system, or to try an edit) and, if it compiles, the new program takes over the
+ * running objects by type name: ids, ages, state whose name and type still match (the
+ * viewer's hot reload, docs/runtime.md). If it does not compile, the running system is
+ * untouched and the error has the diagnostics. */
+PSYS_API psys_error* psys_reload(psys_system* system, const char* source);
+
+/* How many warnings the latest successful compilation (or reload) gave, and each. */
+PSYS_API size_t psys_warning_count(const psys_system* system);
+PSYS_API int psys_warning(const psys_system* system, size_t index, psys_diagnostic* out);
+
+/* ---- Running it --------------------------------------------------------------------- */
+
+/* Advances every object by dt seconds: finite and not negative (0 moves nothing). */
+PSYS_API psys_error* psys_step(psys_system* system, double dt);
+/* Seconds since the start, and steps taken. */
+PSYS_API double psys_time(const psys_system* system);
+PSYS_API uint64_t psys_step_count(const psys_system* system);
+/* 1 when the system can produce nothing more of its own accord (started, nothing alive,
+ * nothing waiting to be created), else 0. */
+PSYS_API int psys_finished(const psys_system* system);
+
+/* Sets an extern: `count` numbers, its width (1 for float and bool: 0 or 1, 3 for vec3
+ * and point, 4 for color), finite and within its declared range. */
+PSYS_API psys_error* psys_set_extern(psys_system* system, const char* name, const float* values, size_t count);
+/* Its current value (the default until set) into values[0 .. width); returns its width,
+ * or -1 when there is no such extern. */
+PSYS_API int psys_get_extern(const psys_system* system, const char* name, float values[4]);
+/* Fires a trigger with its arguments (`count` numbers: the widths of its parameters). */
+PSYS_API psys_error* psys_fire(psys_system* system, const char* trigger, const float* args, size_t count);
+
+/* ---- What it is made of ------------------------------------------------------------- */
+
+/* Object types, in the program's order (parents before children): index 0 .. count-1. */
+PSYS_API size_t psys_type_count(const psys_system* system);
+/* NULL for an index past the end. */
+PSYS_API const char* psys_type_name(const psys_system* system, size_t type);
+/* -1 when there is no such type. */
+PSYS_API int psys_type_index(const psys_system* system, const char* name);
+
+/* An extern or a trigger: its name, and its values' widths in order (an extern has one;
+ * a trigger one per parameter). `type` spells the type as the program does ("float",
+ * "vec3", "color", "point", "bool"; for a trigger the parameters', comma-separated). */
+typedef struct psys_input {
+    const char* name;
+    const char* type;
+    size_t values; /* numbers it takes in all */
+} psys_input;
+PSYS_API size_t psys_extern_count(const psys_system* system);
+PSYS_API int psys_extern_info(const psys_system* system, size_t index, psys_input* out);
+PSYS_API size_t psys_trigger_count(const psys_system* system);
+PSYS_API int psys_trigger_info(const psys_system* system, size_t index, psys_input* out);
+
+/* ---- What it draws ------------------------------------------------------------------ */
+
+/* One column of what a type draws: row r's value is data[r] (CPU backends: the system's
+ * own memory, no copy, valid until the next call on the system), or lies in the GL
+ * buffer `gl_buffer` at byte 4·r (the glsl backend: nothing is copied to the host), or
+ * is `constant` for every row (data NULL and gl_buffer 0). */
+typedef struct psys_column {
+    const void* data;  /* float, or uint32_t for ids */
+    unsigned gl_buffer;
+    float constant;
+} psys_column;
+
+/* Row r is drawn when visible[r] is 1 (alive, its point visible, every value finite). */
+typedef struct psys_draw {
+    size_t rows;
+    size_t drawn;   /* rows drawn; SIZE_MAX where a GPU has not counted them yet */
+    psys_column visible;
+    psys_column ids;
+    psys_column position[3];
+    psys_column color[4];
+    psys_column size;
+    psys_column rotation, frame; /* a sprite's */
+    psys_column end[3];          /* a streak's other end */
+} psys_draw;
+
+PSYS_API psys_error* psys_get_draw(psys_system* system, size_t type, psys_draw* out);
+
+/* The drawn points of a type copied out, in row order, on any backend (a GPU's are read
+ * back): at most `max` into out (NULL with max 0 to count them); *count gets how many
+ * there are. */
+typedef struct psys_point {
+    uint32_t id;
+    float position[3];
+    float color[4];
+    float size;
+} psys_point;
+PSYS_API psys_error* psys_read_points(psys_system* system, size_t type, psys_point* out, size_t max, size_t* count);
+
+/* ---- Counters ----------------------------------------------------------------------- */
+
+typedef struct psys_type_stats {
+    size_t live;
+    uint64_t created, killed;
+    uint64_t dropped;  /* spawns refused at capacity */
+    uint64_t unstable; /* updates past the integrator's stability limit */
+} psys_type_stats;
+
+typedef struct psys_stats {
+    uint64_t steps;
+    uint64_t rejected_steps;       /* NaN, infinite or negative dt */
+    uint64_t rejected_externs;     /* NaN, infinite or out-of-range values set */
+    uint64_t invalid_emissions;    /* NaN or negative rates (taken as 0) */
+    uint64_t non_finite_points;    /* points not drawn: a value was NaN or infinite */
+    double update_seconds, emit_seconds, create_seconds, draw_seconds, fold_seconds;
+} psys_stats;
+
+PSYS_API psys_error* psys_get_stats(const psys_system* system, psys_stats* out);
+PSYS_API psys_error* psys_get_type_stats(const psys_system* system, size_t type, psys_type_stats* out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PSYS_PSYS_H */

@@ -1,0 +1,285 @@
+// The Python module psys._psys over the C API (include/psys/psys.h): a System object per
+// psys_system; errors become psys.CompileError (with the diagnostics) or psys.Error; the
+// draw columns become NumPy arrays that view the system's own memory on the CPU backends.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "psys/psys.h"
+
+namespace py = pybind11;
+
+namespace {
+
+// The Python exceptions (psys/__init__.py defines them; set when the package imports us).
+py::object& compileErrorType() {
+    static py::object* type = new py::object();
+    return *type;
+}
+py::object& errorType() {
+    static py::object* type = new py::object();
+    return *type;
+}
+
+py::dict diagnostic(const psys_diagnostic& d) {
+    static const char* severities[] = {"error", "warning", "note", "remark"};
+    py::dict out;
+    out["severity"] = severities[d.severity];
+    out["file"] = d.file;
+    out["line"] = d.line;
+    out["column"] = d.column;
+    out["end_line"] = d.end_line;
+    out["end_column"] = d.end_column;
+    out["message"] = d.message;
+    return out;
+}
+
+// Raises the error (freed) as CompileError when it has diagnostics, else Error.
+void check(psys_error* e) {
+    if (!e) return;
+    std::string message = psys_error_message(e);
+    py::list diagnostics;
+    psys_diagnostic d;
+    for (size_t i = 0; psys_error_diagnostic(e, i, &d) == 0; ++i) diagnostics.append(diagnostic(d));
+    psys_error_free(e);
+    py::object type = py::len(diagnostics) ? compileErrorType() : errorType();
+    if (!type) throw std::runtime_error(message);
+    py::object error = type(message);
+    error.attr("diagnostics") = diagnostics;
+    PyErr_SetObject(type.ptr(), error.ptr());
+    throw py::error_already_set();
+}
+
+std::vector<float> floats(const py::object& values) {
+    if (py::isinstance<py::float_>(values) || py::isinstance<py::int_>(values) || py::isinstance<py::bool_>(values))
+        return {values.cast<float>()};
+    return values.cast<std::vector<float>>();
+}
+
+class System {
+public:
+    explicit System(psys_system* s) : s_(s) {}
+    ~System() { psys_system_free(s_); }
+    System(const System&) = delete;
+    System& operator=(const System&) = delete;
+
+    static std::unique_ptr<System> compile(const std::string& what, bool isSource, const std::string& name,
+                                           const std::string& backend, const std::string& math, uint32_t seed,
+                                           size_t capacity, unsigned threads, bool optimize) {
+        psys_options o;
+        psys_options_init(&o);
+        o.backend = backend.c_str();
+        o.math = math.c_str();
+        o.seed = seed;
+        if (capacity) o.capacity = capacity;
+        o.threads = threads;
+        o.optimize = optimize;
+        psys_system* s = nullptr;
+        psys_error* e = nullptr;
+        {
+            py::gil_scoped_release unlocked;  // compiling takes a while: other Python threads run
+            e = isSource ? psys_compile_string(what.c_str(), name.c_str(), &o, &s)
+                         : psys_compile_file(what.c_str(), &o, &s);
+        }
+        check(e);
+        return std::make_unique<System>(s);
+    }
+
+    void step(double dt, int steps) {
+        for (int i = 0; i < steps; ++i) check(psys_step(s_, dt));
+    }
+    void set(const std::string& name, const py::object& values) {
+        std::vector<float> v = floats(values);
+        check(psys_set_extern(s_, name.c_str(), v.data(), v.size()));
+    }
+    py::object get(const std::string& name) const {
+        float v[4];
+        int width = psys_get_extern(s_, name.c_str(), v);
+        if (width < 0) {
+            PyErr_SetString(PyExc_KeyError, ("there is no extern `" + name + "`").c_str());
+            throw py::error_already_set();
+        }
+        if (width == 1) return py::float_(v[0]);
+        return py::tuple(py::cast(std::vector<float>(v, v + width)));
+    }
+    void fire(const std::string& trigger, py::args args) {
+        std::vector<float> all;
+        for (py::handle a : args) {
+            std::vector<float> v = floats(py::reinterpret_borrow<py::object>(a));
+            all.insert(all.end(), v.begin(), v.end());
+        }
+        check(psys_fire(s_, trigger.c_str(), all.data(), all.size()));
+    }
+    void reload(std::optional<std::string> source) {
+        check(psys_reload(s_, source ? source->c_str() : nullptr));
+    }
+
+    std::vector<std::string> types() const {
+        std::vector<std::string> out;
+        for (size_t t = 0; t < psys_type_count(s_); ++t) out.push_back(psys_type_name(s_, t));
+        return out;
+    }
+    py::dict externs() const {
+        py::dict out;
+        psys_input in;
+        for (size_t i = 0; psys_extern_info(s_, i, &in) == 0; ++i) out[in.name] = in.type;
+        return out;
+    }
+    py::dict triggers() const {
+        py::dict out;
+        psys_input in;
+        for (size_t i = 0; psys_trigger_info(s_, i, &in) == 0; ++i) out[in.name] = in.type;
+        return out;
+    }
+    py::list warnings() const {
+        py::list out;
+        psys_diagnostic d;
+        for (size_t i = 0; psys_warning(s_, i, &d) == 0; ++i) out.append(diagnostic(d));
+        return out;
+    }
+
+    size_t typeOf(const py::object& type) const {
+        if (py::isinstance<py::str>(type)) {
+            int t = psys_type_index(s_, type.cast<std::string>().c_str());
+            if (t < 0) {
+                PyErr_SetString(PyExc_KeyError, ("there is no object type `" + type.cast<std::string>() + "`").c_str());
+                throw py::error_already_set();
+            }
+            return static_cast<size_t>(t);
+        }
+        return type.cast<size_t>();
+    }
+
+    // The draw columns as arrays that view the system's memory (`self` kept alive by
+    // each); a constant column as a read-only array of one value repeated (stride 0).
+    py::dict columns(py::object self, const py::object& type) {
+        psys_draw d;
+        check(psys_get_draw(s_, typeOf(type), &d));
+        py::dict out;
+        auto add = [&](const char* name, const psys_column& c, bool ids) {
+            auto rows = static_cast<py::ssize_t>(d.rows);
+            if (c.gl_buffer) {
+                PyErr_SetString(errorType().ptr(), "the columns are GL buffers on the glsl backend: points() copies them");
+                throw py::error_already_set();
+            }
+            py::array a;
+            if (c.data && ids)
+                a = py::array_t<uint32_t>({rows}, {sizeof(uint32_t)}, static_cast<const uint32_t*>(c.data), self);
+            else if (c.data)
+                a = py::array_t<float>({rows}, {sizeof(float)}, static_cast<const float*>(c.data), self);
+            else {
+                auto one = py::array_t<float>(1);
+                one.mutable_at(0) = c.constant;
+                a = py::array_t<float>({rows}, {py::ssize_t{0}}, one.data(), one);
+            }
+            a.attr("setflags")(py::arg("write") = false);  // the system's memory: read only
+            out[name] = a;
+        };
+        add("visible", d.visible, false);
+        add("id", d.ids, true);
+        const char* xyz[] = {"x", "y", "z"};
+        const char* rgba[] = {"r", "g", "b", "a"};
+        for (int k = 0; k < 3; ++k) add(xyz[k], d.position[k], false);
+        for (int k = 0; k < 4; ++k) add(rgba[k], d.color[k], false);
+        add("size", d.size, false);
+        return out;
+    }
+
+    // The drawn points copied out (any backend): id (n), position (n×3), color (n×4), size (n).
+    py::dict points(const py::object& type) {
+        size_t t = typeOf(type), n = 0;
+        check(psys_read_points(s_, t, nullptr, 0, &n));
+        std::vector<psys_point> p(n);
+        check(psys_read_points(s_, t, p.data(), p.size(), &n));
+        auto rows = static_cast<py::ssize_t>(n);
+        py::array_t<uint32_t> id(rows);
+        py::array_t<float> position({rows, py::ssize_t{3}}), color({rows, py::ssize_t{4}}), size(rows);
+        for (py::ssize_t i = 0; i < rows; ++i) {
+            const psys_point& q = p[static_cast<size_t>(i)];
+            id.mutable_at(i) = q.id;
+            for (py::ssize_t k = 0; k < 3; ++k) position.mutable_at(i, k) = q.position[k];
+            for (py::ssize_t k = 0; k < 4; ++k) color.mutable_at(i, k) = q.color[k];
+            size.mutable_at(i) = q.size;
+        }
+        py::dict out;
+        out["id"] = id;
+        out["position"] = position;
+        out["color"] = color;
+        out["size"] = size;
+        return out;
+    }
+
+    py::dict stats() const {
+        psys_stats st;
+        check(psys_get_stats(s_, &st));
+        py::dict out, types;
+        out["steps"] = st.steps;
+        out["rejected_steps"] = st.rejected_steps;
+        out["rejected_externs"] = st.rejected_externs;
+        out["invalid_emissions"] = st.invalid_emissions;
+        out["non_finite_points"] = st.non_finite_points;
+        out["update_seconds"] = st.update_seconds;
+        out["emit_seconds"] = st.emit_seconds;
+        out["create_seconds"] = st.create_seconds;
+        out["draw_seconds"] = st.draw_seconds;
+        out["fold_seconds"] = st.fold_seconds;
+        for (size_t t = 0; t < psys_type_count(s_); ++t) {
+            psys_type_stats ts;
+            check(psys_get_type_stats(s_, t, &ts));
+            py::dict d;
+            d["live"] = ts.live;
+            d["created"] = ts.created;
+            d["killed"] = ts.killed;
+            d["dropped"] = ts.dropped;
+            d["unstable"] = ts.unstable;
+            types[psys_type_name(s_, t)] = d;
+        }
+        out["types"] = types;
+        return out;
+    }
+
+    double time() const { return psys_time(s_); }
+    uint64_t stepCount() const { return psys_step_count(s_); }
+    bool finished() const { return psys_finished(s_) != 0; }
+
+private:
+    psys_system* s_;
+};
+
+}  // namespace
+
+PYBIND11_MODULE(_psys, m) {
+    m.doc() = "psys: particle systems compiled from .psys programs (docs/embedding.md)";
+    m.attr("version") = psys_version();
+    m.def("_set_errors", [](py::object compileError, py::object error) {
+        compileErrorType() = std::move(compileError);
+        errorType() = std::move(error);
+    });
+    m.def("_compile", &System::compile, py::arg("what"), py::arg("is_source"), py::arg("name"), py::arg("backend"),
+          py::arg("math"), py::arg("seed"), py::arg("capacity"), py::arg("threads"), py::arg("optimize"));
+    py::class_<System>(m, "System")
+        .def("step", &System::step, py::arg("dt") = 1.0 / 60, py::arg("steps") = 1,
+             "Advances every object by dt seconds, `steps` times.")
+        .def("set", &System::set, py::arg("extern"), py::arg("value"), "Sets an extern: a number or a sequence.")
+        .def("get", &System::get, py::arg("extern"), "An extern's value (a float or a tuple).")
+        .def("fire", &System::fire, py::arg("trigger"), "Fires a trigger with its arguments (numbers or sequences).")
+        .def("reload", &System::reload, py::arg("source") = py::none(),
+             "Compiles the file again (or `source`); the running objects carry over.")
+        .def("columns", [](py::object self, const py::object& type) { return self.cast<System&>().columns(self, type); },
+             py::arg("type"), "The draw columns as arrays viewing the system's memory (valid until the next call).")
+        .def("points", &System::points, py::arg("type"), "The drawn points, copied: id, position, color, size.")
+        .def("stats", &System::stats)
+        .def_property_readonly("types", &System::types)
+        .def_property_readonly("externs", &System::externs)
+        .def_property_readonly("triggers", &System::triggers)
+        .def_property_readonly("warnings", &System::warnings)
+        .def_property_readonly("time", &System::time)
+        .def_property_readonly("step_count", &System::stepCount)
+        .def_property_readonly("finished", &System::finished);
+}

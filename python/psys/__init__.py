@@ -1,0 +1,45 @@
+"""psys: particle systems compiled from .psys programs, run from Python.
+
+    import psys
+    fountain = psys.compile("samples/fountain.psys")          # or psys.compile(source=...)
+    fountain.step(1 / 60, steps=120)
+    drops = fountain.points("drop")                           # id, position (n×3), color, size
+    cols = fountain.columns("drop")                           # the system's own arrays, no copy
+
+Errors are exceptions: psys.CompileError carries the compiler's diagnostics (a list of
+dicts: severity, file, line, column, end_line, end_column, message); psys.Error the rest.
+docs/embedding.md has the whole story.
+"""
+
+from . import _psys
+
+
+class Error(Exception):
+    """A call the system refused: a bad step, an unknown extern or trigger, a wrong value."""
+
+    diagnostics = []
+
+
+class CompileError(Error):
+    """A program that does not compile; `diagnostics` says where and why."""
+
+
+_psys._set_errors(CompileError, Error)
+
+System = _psys.System
+version = _psys.version
+
+
+def compile(path=None, *, source=None, name="<string>", backend="llvm", math="fast", seed=1,
+            capacity=0, threads=0, optimize=True):
+    """Compiles a .psys file (or `source`, standing for a file called `name`) and starts a
+    system on `backend`: "llvm" (the JIT), "interp" or "glsl" (a GPU, through OpenGL 4.5).
+    capacity: objects per type (0: the default, 2^20); threads: 0 for every core."""
+    if (path is None) == (source is None):
+        raise TypeError("psys.compile takes a path or source=, one of them")
+    if source is not None:
+        return _psys._compile(source, True, name, backend, math, seed, capacity, threads, optimize)
+    return _psys._compile(str(path), False, "", backend, math, seed, capacity, threads, optimize)
+
+
+__all__ = ["compile", "System", "Error", "CompileError", "version"]

@@ -1,0 +1,146 @@
+"""The Python package as a notebook or a tool calls it: compile, step, set, fire, reload,
+read points and the system's own arrays; every bad input an exception that says why."""
+import math
+import os
+import pathlib
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import psys
+
+SAMPLES = pathlib.Path(os.environ.get("PSYS_SAMPLES_DIR", pathlib.Path(__file__).parents[2] / "samples"))
+EXAMPLES = pathlib.Path(os.environ.get("PSYS_EXAMPLES_DIR", pathlib.Path(__file__).parents[2] / "examples"))
+
+DOTS = """
+extern speed: float = 1 range(0, 10);
+extern tint: color = red;
+trigger burst(p: vec3, n: float) { emit bead(p) count n; }
+object bead(from: vec3) {
+    pos = from + integrate(vec3(speed, 0, 0));
+    point(pos, tint, 2);
+    kill when age > 1;
+}
+object source { emit bead(vec3(0, 1, 0)) at 60 per second; }
+spawn source;
+"""
+
+
+def test_a_sample_runs_and_its_points_come_back_as_arrays():
+    fountain = psys.compile(SAMPLES / "fountain.psys")
+    assert sorted(fountain.types) == ["drop", "fountain"]
+    fountain.step(1 / 60, steps=60)
+    assert fountain.step_count == 60
+    assert fountain.time == pytest.approx(1.0)
+    p = fountain.points("drop")
+    assert p["position"].shape == (len(p["id"]), 3) and len(p["id"]) > 500
+    assert p["color"].shape[1] == 4
+    assert (p["position"][:, 1] >= 0).all()  # drops bounce off the ground
+    st = fountain.stats()
+    assert st["steps"] == 60 and st["types"]["drop"]["live"] == len(p["id"])
+
+
+def test_columns_view_the_systems_memory_without_a_copy():
+    s = psys.compile(source=DOTS, math="exact")
+    s.step(1 / 60, steps=30)
+    c = s.columns("bead")
+    again = s.columns("bead")
+    assert np.shares_memory(c["x"], again["x"])  # the same memory both times
+    assert not c["x"].flags.writeable
+    seen = c["visible"] == 1
+    p = s.points("bead")
+    np.testing.assert_array_equal(c["id"][seen], p["id"])
+    np.testing.assert_array_equal(c["x"][seen], p["position"][:, 0])
+    assert c["size"].strides == (0,) and (c["size"] == 2).all()  # a constant: one value, no column
+    with pytest.raises(ValueError):
+        c["x"][0] = 5
+
+
+def test_the_jit_in_exact_maths_and_the_interpreter_give_the_same_bits():
+    a = psys.compile(SAMPLES / "fireworks.psys", math="exact")
+    b = psys.compile(SAMPLES / "fireworks.psys", backend="interp")
+    for _ in range(4):
+        a.step(1 / 60, steps=30)
+        b.step(1 / 60, steps=30)
+        for t in a.types:
+            p, q = a.points(t), b.points(t)
+            for k in p:
+                np.testing.assert_array_equal(p[k], q[k])
+
+
+def test_a_program_with_errors_raises_compile_error_with_its_diagnostics():
+    with pytest.raises(psys.CompileError) as e:
+        psys.compile(source="object a {\n    point(vec3(0), red, nope);\n}\nspawn a;\n", name="bad.psys")
+    d = e.value.diagnostics[0]
+    assert (d["file"], d["line"], d["column"], d["severity"]) == ("bad.psys", 2, 25, "error")
+    assert "nope" in d["message"] and "bad.psys:2:25" in str(e.value)
+    with pytest.raises(psys.Error, match="no/such"):
+        psys.compile("/no/such/file.psys")
+    with pytest.raises(TypeError):
+        psys.compile()
+
+
+def test_externs_and_triggers_by_name_and_every_bad_value_refused():
+    s = psys.compile(source=DOTS)
+    assert s.externs == {"speed": "float", "tint": "color"}
+    assert s.triggers == {"burst": "vec3, float"}
+    s.set("speed", 2)
+    assert s.get("speed") == 2
+    s.set("tint", (0, 1, 0, 1))
+    assert s.get("tint") == (0, 1, 0, 1)
+    with pytest.raises(psys.Error, match="no extern `sped`"):
+        s.set("sped", 1)
+    with pytest.raises(psys.Error, match="finite"):
+        s.set("speed", math.nan)
+    with pytest.raises(psys.Error, match="outside its range"):
+        s.set("speed", 11)
+    with pytest.raises(psys.Error, match="takes 1 value"):
+        s.set("speed", (1, 2))
+    with pytest.raises(KeyError):
+        s.get("sped")
+    assert s.get("speed") == 2
+    s.fire("burst", (0, 0, 0), 5)
+    assert s.stats()["types"]["bead"]["created"] == 5
+    with pytest.raises(psys.Error):
+        s.fire("burst", (0, 0, 0))
+    with pytest.raises(psys.Error, match="finite, non-negative"):
+        s.step(math.nan)
+    with pytest.raises(KeyError):
+        s.points("nothing")
+    with pytest.raises(psys.Error, match="no backend `vulkan`"):
+        psys.compile(source=DOTS, backend="vulkan")
+
+
+def test_a_reload_carries_the_objects_over_and_a_broken_one_changes_nothing():
+    s = psys.compile(source=DOTS)
+    s.step(1 / 60, steps=30)
+    s.reload(DOTS.replace("point(pos, tint, 2)", "point(pos, tint, 3)"))
+    p = s.points("bead")
+    assert len(p["id"]) == 30 and (p["size"] == 3).all()
+    with pytest.raises(psys.CompileError):
+        s.reload("object dot {")
+    s.step()
+    assert len(s.points("bead")["id"]) == 31
+    assert s.warnings == []
+
+
+def test_a_system_ends():
+    s = psys.compile(source="object a { point(vec3(0), red, 1); kill when age > 0.1; }\nspawn a;\n")
+    assert not s.finished
+    s.step(1 / 60, steps=20)
+    assert s.finished
+
+
+def test_the_examples_run(tmp_path):
+    out = subprocess.run([sys.executable, EXAMPLES / "python" / "integrators.py", "--plot", tmp_path / "i.png"],
+                         capture_output=True, text=True, check=True).stdout
+    rows = [line.split() for line in out.splitlines() if line.strip()[:1].isdigit()]
+    assert len(rows) == 5
+    assert float(rows[2][4]) == pytest.approx(4, abs=0.3)  # rk4's order (before float's rounding)
+    assert float(rows[-1][2]) == pytest.approx(1, abs=0.1)  # semi-implicit Euler's
+    assert (tmp_path / "i.png").stat().st_size > 0
+    subprocess.run([sys.executable, EXAMPLES / "python" / "snapshots.py", SAMPLES / "fountain.psys",
+                    tmp_path / "s.png"], capture_output=True, text=True, check=True)
+    assert (tmp_path / "s.png").stat().st_size > 0

@@ -1,0 +1,325 @@
+// The C API (include/psys/psys.h) as a host calls it: systems compiled from files and
+// strings, run on every backend, their draws read without a copy; every bad input an
+// error value with its message, nothing changed and nothing crashed.
+#define DOCTEST_CONFIG_IMPLEMENT_WITH_MAIN
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "psys/psys.h"
+
+namespace {
+
+const std::string kSamples = PSYS_SAMPLES_DIR;
+
+// The message of an error (freed), or "" for none.
+std::string take(psys_error* e) {
+    std::string m = e ? psys_error_message(e) : "";
+    psys_error_free(e);
+    return m;
+}
+
+struct System {
+    psys_system* s = nullptr;
+    ~System() { psys_system_free(s); }
+};
+
+psys_options options(const char* backend, const char* math = "fast") {
+    psys_options o;
+    psys_options_init(&o);
+    o.backend = backend;
+    o.math = math;
+    return o;
+}
+
+const char* kDots = R"(
+extern speed: float = 1 range(0, 10);
+extern tint: color = red;
+trigger burst(p: vec3, n: float) { emit bead(p) count n; }
+object bead(from: vec3) {
+    pos = from + integrate(vec3(speed, 0, 0));
+    point(pos, tint, 2);
+    kill when age > 1;
+}
+object source { emit bead(vec3(0, 1, 0)) at 60 per second; }
+spawn source;
+)";
+
+std::vector<psys_point> points(psys_system* s, size_t type) {
+    size_t n = 0;
+    REQUIRE(take(psys_read_points(s, type, nullptr, 0, &n)).empty());
+    std::vector<psys_point> out(n);
+    REQUIRE(take(psys_read_points(s, type, out.data(), out.size(), &n)).empty());
+    return out;
+}
+
+}  // namespace
+
+TEST_CASE("a system compiled from a string runs, and its draw columns are the points it draws, with no copy") {
+    System sys;
+    psys_options o = options("llvm", "exact");
+    REQUIRE(take(psys_compile_string(kDots, "dots.psys", &o, &sys.s)) == "");
+    CHECK(psys_type_count(sys.s) == 2);
+    int dot = psys_type_index(sys.s, "bead");
+    REQUIRE(dot >= 0);
+    CHECK(std::string(psys_type_name(sys.s, static_cast<size_t>(dot))) == "bead");
+    CHECK(psys_type_name(sys.s, 2) == nullptr);
+    CHECK(psys_type_index(sys.s, "nothing") == -1);
+    for (int f = 0; f < 30; ++f) REQUIRE(take(psys_step(sys.s, 1.0 / 60)) == "");
+    CHECK(psys_step_count(sys.s) == 30);
+    CHECK(psys_time(sys.s) == doctest::Approx(0.5));
+
+    psys_draw d;
+    REQUIRE(take(psys_get_draw(sys.s, static_cast<size_t>(dot), &d)) == "");
+    std::vector<psys_point> expected = points(sys.s, static_cast<size_t>(dot));
+    CHECK(expected.size() == 30);
+    CHECK(d.drawn == 30);
+    REQUIRE(d.visible.data);
+    REQUIRE(d.position[0].data);
+    CHECK(d.visible.gl_buffer == 0);
+    // The size is the same for every bead: a constant, not a column.
+    CHECK(d.size.data == nullptr);
+    CHECK(d.size.gl_buffer == 0);
+    CHECK(d.size.constant == 2.0f);
+    auto* visible = static_cast<const float*>(d.visible.data);
+    auto* x = static_cast<const float*>(d.position[0].data);
+    auto* ids = static_cast<const uint32_t*>(d.ids.data);
+    size_t k = 0;
+    for (size_t r = 0; r < d.rows; ++r) {
+        if (visible[r] != 1.0f) continue;
+        REQUIRE(k < expected.size());
+        CHECK(ids[r] == expected[k].id);
+        CHECK(x[r] == expected[k].position[0]);
+        ++k;
+    }
+    CHECK(k == expected.size());
+    // Read again: the same memory, not a copy made for the call.
+    psys_draw again;
+    REQUIRE(take(psys_get_draw(sys.s, static_cast<size_t>(dot), &again)) == "");
+    CHECK(again.position[0].data == d.position[0].data);
+
+    psys_stats st;
+    REQUIRE(take(psys_get_stats(sys.s, &st)) == "");
+    CHECK(st.steps == 30);
+    psys_type_stats ts;
+    REQUIRE(take(psys_get_type_stats(sys.s, static_cast<size_t>(dot), &ts)) == "");
+    CHECK(ts.created == 30);
+    CHECK(ts.live == 30);
+    CHECK(psys_finished(sys.s) == 0);
+}
+
+TEST_CASE("a sample runs the same through the C API on the JIT in exact maths and on the interpreter, bit for bit") {
+    System jit, interp;
+    psys_options a = options("llvm", "exact"), b = options("interp");
+    std::string path = kSamples + "/fountain.psys";
+    REQUIRE(take(psys_compile_file(path.c_str(), &a, &jit.s)) == "");
+    REQUIRE(take(psys_compile_file(path.c_str(), &b, &interp.s)) == "");
+    size_t compared = 0;
+    for (int f = 0; f < 120; ++f) {
+        REQUIRE(take(psys_step(jit.s, 1.0 / 60)) == "");
+        REQUIRE(take(psys_step(interp.s, 1.0 / 60)) == "");
+        if (f % 20 != 19) continue;
+        for (size_t t = 0; t < psys_type_count(jit.s); ++t) {
+            std::vector<psys_point> p = points(jit.s, t), q = points(interp.s, t);
+            REQUIRE(p.size() == q.size());
+            CHECK(std::memcmp(p.data(), q.data(), p.size() * sizeof(psys_point)) == 0);
+            compared += p.size();
+        }
+    }
+    CHECK(compared > 1000);
+}
+
+TEST_CASE("a program with errors gives every diagnostic with its file, line and column, and no system") {
+    psys_system* s = reinterpret_cast<psys_system*>(1);
+    psys_error* e = psys_compile_string("object a {\n    point(vec3(0), red, nope);\n}\nspawn a;\n", "bad.psys",
+                                        nullptr, &s);
+    REQUIRE(e);
+    CHECK(s == nullptr);
+    std::string m = psys_error_message(e);
+    CHECK(m.find("bad.psys:2:") != std::string::npos);
+    CHECK(m.find("nope") != std::string::npos);
+    REQUIRE(psys_error_diagnostic_count(e) >= 1);
+    psys_diagnostic d;
+    REQUIRE(psys_error_diagnostic(e, 0, &d) == 0);
+    CHECK(d.severity == PSYS_SEVERITY_ERROR);
+    CHECK(std::string(d.file) == "bad.psys");
+    CHECK(d.line == 2);
+    CHECK(d.column == 25);
+    CHECK(d.end_column == 29);
+    CHECK(std::string(d.message).find("nope") != std::string::npos);
+    CHECK(psys_error_diagnostic(e, 99, &d) == -1);
+    psys_error_free(e);
+
+    e = psys_compile_file("/no/such/file.psys", nullptr, &s);
+    REQUIRE(e);
+    CHECK(std::string(psys_error_message(e)).find("/no/such/file.psys") != std::string::npos);
+    psys_error_free(e);
+}
+
+TEST_CASE("a warning does not stop a system: it is kept with the system, located") {
+    System sys;
+    REQUIRE(take(psys_compile_string("object a {\n    unused = 1;\n    point(vec3(0), red, 1);\n}\nspawn a;\n", "w.psys",
+                                     nullptr, &sys.s)) == "");
+    REQUIRE(psys_warning_count(sys.s) == 1);
+    psys_diagnostic d;
+    REQUIRE(psys_warning(sys.s, 0, &d) == 0);
+    CHECK(d.severity == PSYS_SEVERITY_WARNING);
+    CHECK(d.line == 2);
+    CHECK(std::string(d.message).find("never used") != std::string::npos);
+    CHECK(psys_warning(sys.s, 1, &d) == -1);
+}
+
+TEST_CASE("externs and triggers: described, set and fired by name; a wrong name, count or value is refused and changes nothing") {
+    System sys;
+    REQUIRE(take(psys_compile_string(kDots, nullptr, nullptr, &sys.s)) == "");
+    REQUIRE(psys_extern_count(sys.s) == 2);
+    psys_input in;
+    REQUIRE(psys_extern_info(sys.s, 1, &in) == 0);
+    CHECK(std::string(in.name) == "tint");
+    CHECK(std::string(in.type) == "color");
+    CHECK(in.values == 4);
+    CHECK(psys_extern_info(sys.s, 2, &in) == -1);
+    REQUIRE(psys_trigger_count(sys.s) == 1);
+    REQUIRE(psys_trigger_info(sys.s, 0, &in) == 0);
+    CHECK(std::string(in.name) == "burst");
+    CHECK(std::string(in.type) == "vec3, float");
+    CHECK(in.values == 4);
+
+    float two = 2, nan = NAN, eleven = 11, v[4] = {};
+    CHECK(take(psys_set_extern(sys.s, "speed", &two, 1)) == "");
+    CHECK(psys_get_extern(sys.s, "speed", v) == 1);
+    CHECK(v[0] == 2);
+    CHECK(take(psys_set_extern(sys.s, "sped", &two, 1)) == "psys_set_extern: there is no extern `sped`");
+    CHECK(take(psys_set_extern(sys.s, "speed", v, 3)).find("takes 1 value, not 3") != std::string::npos);
+    CHECK(take(psys_set_extern(sys.s, "speed", &nan, 1)).find("finite") != std::string::npos);
+    CHECK(take(psys_set_extern(sys.s, "speed", &eleven, 1)).find("outside its range") != std::string::npos);
+    CHECK(psys_get_extern(sys.s, "speed", v) == 1);
+    CHECK(v[0] == 2);  // kept
+    CHECK(psys_get_extern(sys.s, "sped", v) == -1);
+    psys_stats st;
+    REQUIRE(take(psys_get_stats(sys.s, &st)) == "");
+    CHECK(st.rejected_externs == 2);
+
+    float args[4] = {0, 0, 0, 5};
+    CHECK(take(psys_fire(sys.s, "burst", args, 4)) == "");
+    CHECK(take(psys_fire(sys.s, "bust", args, 4)).find("bust") != std::string::npos);
+    CHECK(!take(psys_fire(sys.s, "burst", args, 2)).empty());
+    args[3] = NAN;
+    CHECK(!take(psys_fire(sys.s, "burst", args, 4)).empty());
+    psys_type_stats ts;
+    REQUIRE(take(psys_get_type_stats(sys.s, 0, &ts)) == "");
+    CHECK(ts.created == 5);  // the first burst alone
+}
+
+TEST_CASE("a step of NaN, an infinity or a negative time is refused and counted, and 0 moves nothing") {
+    System sys;
+    REQUIRE(take(psys_compile_string(kDots, nullptr, nullptr, &sys.s)) == "");
+    CHECK(take(psys_step(sys.s, NAN)).find("finite, non-negative") != std::string::npos);
+    CHECK(!take(psys_step(sys.s, INFINITY)).empty());
+    CHECK(!take(psys_step(sys.s, -1)).empty());
+    CHECK(take(psys_step(sys.s, 0)) == "");
+    CHECK(psys_time(sys.s) == 0);
+    psys_stats st;
+    REQUIRE(take(psys_get_stats(sys.s, &st)) == "");
+    CHECK(st.rejected_steps == 3);
+}
+
+TEST_CASE("NULL handles and arguments, an unknown type and bad options are errors that name the call, never a crash") {
+    float one = 1;
+    psys_draw d;
+    psys_stats st;
+    psys_type_stats ts;
+    psys_system* out = nullptr;
+    CHECK(take(psys_step(nullptr, 1)) == "psys_step: the system is NULL");
+    CHECK(take(psys_set_extern(nullptr, "a", &one, 1)) == "psys_set_extern: the system is NULL");
+    CHECK(take(psys_fire(nullptr, "a", &one, 1)) == "psys_fire: the system is NULL");
+    CHECK(take(psys_reload(nullptr, "")) == "psys_reload: the system is NULL");
+    CHECK(take(psys_get_draw(nullptr, 0, &d)) == "psys_get_draw: the system is NULL");
+    CHECK(take(psys_get_stats(nullptr, &st)) == "psys_get_stats: the system is NULL");
+    CHECK(take(psys_get_type_stats(nullptr, 0, &ts)) == "psys_get_type_stats: the system is NULL");
+    CHECK(take(psys_read_points(nullptr, 0, nullptr, 0, nullptr)) == "psys_read_points: the system is NULL");
+    CHECK(take(psys_compile_file(nullptr, nullptr, &out)) == "psys_compile_file: the path is NULL");
+    CHECK(take(psys_compile_string(nullptr, nullptr, nullptr, &out)) == "psys_compile_string: the source is NULL");
+    CHECK(!take(psys_compile_string(kDots, nullptr, nullptr, nullptr)).empty());
+    CHECK(psys_type_count(nullptr) == 0);
+    CHECK(psys_type_name(nullptr, 0) == nullptr);
+    CHECK(psys_time(nullptr) == 0);
+    CHECK(psys_finished(nullptr) == 0);
+    CHECK(psys_get_extern(nullptr, "a", nullptr) == -1);
+    CHECK(std::string(psys_error_message(nullptr)).empty());
+    psys_error_free(nullptr);
+    psys_system_free(nullptr);
+    psys_options_init(nullptr);
+
+    System sys;
+    REQUIRE(take(psys_compile_string(kDots, nullptr, nullptr, &sys.s)) == "");
+    CHECK(take(psys_get_draw(sys.s, 7, &d)) == "psys_get_draw: there is no object type 7 (the system has 2)");
+    CHECK(take(psys_get_draw(sys.s, 0, nullptr)).find("NULL") != std::string::npos);
+    CHECK(take(psys_set_extern(sys.s, nullptr, &one, 1)).find("NULL") != std::string::npos);
+    CHECK(take(psys_set_extern(sys.s, "speed", nullptr, 1)).find("NULL") != std::string::npos);
+
+    psys_options o = options("vulkan");
+    CHECK(take(psys_compile_string(kDots, nullptr, &o, &out)).find("there is no backend `vulkan`") != std::string::npos);
+    o = options("llvm", "sloppy");
+    CHECK(take(psys_compile_string(kDots, nullptr, &o, &out)).find("fast or exact") != std::string::npos);
+    o = options("llvm");
+    o.capacity = 0;
+    CHECK(take(psys_compile_string(kDots, nullptr, &o, &out)).find("capacity") != std::string::npos);
+    CHECK(out == nullptr);
+}
+
+TEST_CASE("a reload keeps the running objects, and one that does not compile changes nothing and says why") {
+    System sys;
+    REQUIRE(take(psys_compile_string(kDots, "dots.psys", nullptr, &sys.s)) == "");
+    for (int f = 0; f < 30; ++f) REQUIRE(take(psys_step(sys.s, 1.0 / 60)) == "");
+    CHECK(take(psys_reload(sys.s, nullptr)).find("compiled from a string") != std::string::npos);
+    std::string edited = kDots;
+    edited.replace(edited.find("point(pos, tint, 2)"), 19, "point(pos, tint, 3)");
+    REQUIRE(take(psys_reload(sys.s, edited.c_str())) == "");
+    std::vector<psys_point> p = points(sys.s, 0);
+    REQUIRE(p.size() == 30);  // the same dots, drawn by the new program
+    CHECK(p[0].size == 3);
+    CHECK(p[0].id == 1);
+    psys_error* e = psys_reload(sys.s, "object dot {");
+    REQUIRE(e);
+    CHECK(psys_error_diagnostic_count(e) >= 1);
+    psys_error_free(e);
+    REQUIRE(take(psys_step(sys.s, 1.0 / 60)) == "");
+    CHECK(points(sys.s, 0).size() == 31);
+    CHECK(psys_step_count(sys.s) == 31);
+}
+
+TEST_CASE("a system ends: finished once everything has died") {
+    System sys;
+    REQUIRE(take(psys_compile_string("object a { point(vec3(0), red, 1); kill when age > 0.1; }\nspawn a;\n", nullptr,
+                                     nullptr, &sys.s)) == "");
+    CHECK(psys_finished(sys.s) == 0);
+    for (int f = 0; f < 20; ++f) REQUIRE(take(psys_step(sys.s, 1.0 / 60)) == "");
+    CHECK(psys_finished(sys.s) == 1);
+}
+
+TEST_CASE("on the glsl backend the draw columns are GL buffers: nothing comes back to the host") {
+    System sys;
+    psys_options o = options("glsl");
+    std::string path = kSamples + "/fountain.psys";
+    psys_error* e = psys_compile_file(path.c_str(), &o, &sys.s);
+    if (e && std::string(psys_error_message(e)).find("cannot start") != std::string::npos) {
+        MESSAGE("no OpenGL 4.5 here: " << psys_error_message(e));
+        psys_error_free(e);
+        return;
+    }
+    REQUIRE(take(e) == "");
+    for (int f = 0; f < 30; ++f) REQUIRE(take(psys_step(sys.s, 1.0 / 60)) == "");
+    int drop = psys_type_index(sys.s, "drop");
+    REQUIRE(drop >= 0);
+    psys_draw d;
+    REQUIRE(take(psys_get_draw(sys.s, static_cast<size_t>(drop), &d)) == "");
+    CHECK(d.rows > 0);
+    CHECK(d.visible.gl_buffer != 0);
+    CHECK(d.visible.data == nullptr);
+    CHECK(d.position[0].gl_buffer != 0);
+    CHECK(points(sys.s, static_cast<size_t>(drop)).size() == 500);
+}

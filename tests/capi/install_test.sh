@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# The installed package as a host uses it: `cmake --install` into an empty prefix; the
+# library's soname and its exports (the C API's symbols and nothing else); the examples
+# built against the prefix with find_package(psys) and with pkg-config, run on a sample
+# and on a program that imports the standard library (found beside the installed library);
+# the GLFW example in a window where a display can be made (xvfb-run).
+#   install_test.sh BUILD_DIR SOURCE_DIR
+# It works outside the build tree (where the tools would find the tree's own library), in
+# a directory removed when it passes.
+set -euo pipefail
+build=$(realpath "$1") src=$(realpath "$2")
+work=$(mktemp -d /tmp/psys-installed.XXXXXX)
+trap 'status=$?; if [ $status = 0 ]; then rm -rf "$work"; else echo "(kept: $work)"; fi' EXIT
+prefix=$work/prefix
+
+cmake --install "$build" --prefix "$prefix" > "$work/install.log"
+lib=$prefix/lib/libpsys.so
+real=$(readlink -f "$lib")
+soname=$(objdump -p "$real" | awk '/SONAME/ {print $2}')
+[ "$soname" = libpsys.so.0 ] || { echo "soname: $soname, not libpsys.so.0"; exit 1; }
+# Exported: the global symbols (upper-case types, and u: unique), less the version node (A).
+exported() { nm -D --defined-only "$real" | awk '$2 != "A" && $2 ~ /^[A-Zu]$/ {print $3}'; }
+others=$(exported | grep -v '^psys_' || true)
+if [ -n "$others" ]; then
+  echo "libpsys.so exports more than the C API:"; echo "$others" | head -20; exit 1
+fi
+echo "libpsys.so: $(stat -c %s "$real") bytes, $(exported | wc -l) symbols exported, all psys_*"
+for f in include/psys/psys.h lib/cmake/psys/psysConfig.cmake lib/pkgconfig/psys.pc share/psys/std bin/psysc; do
+  [ -e "$prefix/$f" ] || { echo "not installed: $f"; exit 1; }
+done
+
+# find_package(psys)
+cmake -S "$src/examples" -B "$work/examples" -G Ninja -DCMAKE_PREFIX_PATH="$prefix" > "$work/examples.log"
+cmake --build "$work/examples" >> "$work/examples.log"
+"$work/examples/minimal" "$src/samples/fountain.psys" | tee "$work/minimal.out"
+grep -q "drops drawn: [1-9]" "$work/minimal.out"
+
+# pkg-config (the .pc file is relocatable: the prefix is where it lies)
+flags=$(PKG_CONFIG_PATH="$prefix/lib/pkgconfig" pkg-config --cflags --libs psys)
+cc -std=c99 -Wall -Wextra -Wpedantic -Werror -o "$work/minimal-pc" "$src/examples/c/minimal.c" $flags \
+   -Wl,-rpath,"$prefix/lib"
+cat > "$work/library.psys" <<'PSYS'
+import "std/shapes.psys";
+object bead(p: vec3) {
+    point(p, white, 1);
+}
+object source { emit bead(on_sphere(2)) count 50; }
+spawn source;
+PSYS
+"$work/minimal-pc" "$work/library.psys" | tee "$work/library.out"
+grep -q "beads drawn: 50" "$work/library.out"
+
+# In a window, where one can be made: the llvm backend's columns uploaded, the glsl
+# backend's GL buffers drawn as they are. Each picture must show the fountain's drops.
+if command -v xvfb-run > /dev/null; then
+  for backend in llvm glsl; do
+    xvfb-run -a -s "-screen 0 1280x720x24" "$work/examples/glfw_host" "$src/samples/fountain.psys" \
+      --backend $backend --frames 90 --png "$work/glfw_$backend.png"
+    lit=$(/usr/bin/python3 -c "import matplotlib.image as m, sys; p = m.imread(sys.argv[1]); print(int((p[:, :, :3].max(axis=2) > 0.3).sum()))" \
+          "$work/glfw_$backend.png")
+    echo "glfw_host on $backend: $lit pixels lit"
+    [ "$lit" -gt 1000 ] || { echo "glfw_host drew too little on $backend"; exit 1; }
+  done
+fi
+echo "installed package: ok"
