@@ -481,3 +481,25 @@ void buildChildrenFunction(llvm::Module& module, MathMode mode, const Object& ob
 }
 
 }  // namespace psys::codegen_llvm
+
+namespace psys::codegen_llvm {
+
+void buildFunction(llvm::Module& module, MathMode mode, unsigned lanes, const native::Request& r, const std::string& name) {
+    const Kernel& k = *r.shape.kernel;
+    if (k.kind == KernelKind::Pair)
+        buildPairFunction(module, mode, *r.object, k, name);
+    else if (r.shape.children)
+        buildChildrenFunction(module, mode, *r.object, k, name);
+    else
+        buildRowsFunction(module, mode, r.vectorize ? lanes : 0, *r.object, k, r.uniformKernel, r.shape.now, r.shape.dt,
+                          name);
+}
+
+std::string functionName(const native::Request& r, int counter) {
+    std::string name = r.object->name + "." + kernelName(r.shape.kernel->kind);
+    if (r.shape.children) name += ".children";
+    else if (rt::Clock::perRow(r.shape.now, r.shape.dt)) name += ".created";
+    return name + "." + std::to_string(counter);
+}
+
+}  // namespace psys::codegen_llvm

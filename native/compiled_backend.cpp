@@ -1,0 +1,111 @@
+#include "native/compiled_backend.h"
+
+#include "rt/system.h"
+
+namespace psys::native {
+
+using namespace ir;
+using rt::Clock;
+
+Request request(bool exact, const Object& o, const Kernel& k, bool children, Clock::Source now, Clock::Source dt,
+                bool many) {
+    const Kernel* uniform = nullptr;
+    if (!children && Clock::perRow(now, dt))
+        if (auto served = uniformFor(k.kind)) uniform = o.kernel(*served);
+    Hasher h;
+    h.add(exact).add(children).add(static_cast<uint64_t>(now)).add(static_cast<uint64_t>(dt));
+    h.add(many).add(structuralHash(k));
+    if (k.kind == KernelKind::Pair) {  // its folds: how each combines, where its components go
+        for (const Fold& f : o.folds)
+            h.add(static_cast<uint64_t>(f.group == k.site)).add(static_cast<uint64_t>(f.reduce)).add(static_cast<uint64_t>(f.type.width));
+    } else {
+        h.add(rt::columnLayout(o, k).signature());
+    }
+    if (uniform) h.add(structuralHash(*uniform));
+    return {&o, {&k, children, now, dt}, uniform, many, h.finish()};
+}
+
+std::vector<Request> requests(bool exact, const Module& module) {
+    std::vector<Request> out;
+    rt::Plan plan = rt::launchPlan(module);
+    for (const rt::Plan::Rows& r : plan.rows) out.push_back(request(exact, *r.object, *r.kernel, false, r.now, r.dt, r.many));
+    for (const rt::Plan::Children& c : plan.children)
+        out.push_back(request(exact, *c.object, *c.spawn, true, Clock::Source::Uniform, Clock::Source::Uniform));
+    for (const Object& o : module.objects)
+        for (const Kernel& k : o.kernels)
+            if (k.kind == KernelKind::Pair)
+                out.push_back(request(exact, o, k, false, Clock::Source::Uniform, Clock::Source::Uniform));
+    return out;
+}
+
+void CompiledBackend::prepare(const rt::Plan& plan) {
+    std::vector<Request> requests;
+    for (const rt::Plan::Rows& r : plan.rows)
+        requests.push_back(request(exact_, *r.object, *r.kernel, false, r.now, r.dt, r.many));
+    for (const rt::Plan::Children& c : plan.children)
+        requests.push_back(request(exact_, *c.object, *c.spawn, true, Clock::Source::Uniform, Clock::Source::Uniform));
+    provide(requests);
+}
+
+void CompiledBackend::record(const Shape& shape, void* code) {
+    std::lock_guard lock(mutex_);
+    functions_[shape] = code;
+}
+
+// Compiled code stays with its provider; only the kernels' addresses are dropped.
+void CompiledBackend::forget(const Module& module) {
+    std::lock_guard lock(mutex_);
+    for (const Object& o : module.objects)
+        for (const Kernel& k : o.kernels)
+            for (auto it = functions_.begin(); it != functions_.end();)
+                it = it->first.kernel == &k ? functions_.erase(it) : std::next(it);
+}
+
+void* CompiledBackend::function(const Object& o, const Kernel& k, bool children, Clock::Source now, Clock::Source dt) {
+    Shape shape{&k, children, now, dt};
+    {
+        std::lock_guard lock(mutex_);
+        auto it = functions_.find(shape);
+        if (it != functions_.end()) return it->second;
+    }
+    provide({request(exact_, o, k, children, now, dt)});
+    std::lock_guard lock(mutex_);
+    return functions_.at(shape);
+}
+
+std::vector<void*> CompiledBackend::addresses(std::span<const rt::Buffer> columns) {
+    std::vector<void*> out(columns.size(), nullptr);
+    for (size_t i = 0; i < columns.size(); ++i)
+        if (columns[i].valid()) out[i] = memory_.host(columns[i]);
+    return out;
+}
+
+rt::RowsResult CompiledBackend::run(const rt::RowsLaunch& l) {
+    auto fn = reinterpret_cast<RowsFn>(function(*l.object, *l.kernel, false, l.clock.now, l.clock.dt));
+    std::vector<void*> columns = addresses(l.columns);
+    const auto* mask = static_cast<const uint8_t*>(memory_.host(l.mask));
+    RowCounts counts = fn(columns.data(), mask, static_cast<int64_t>(l.begin), static_cast<int64_t>(l.end), l.externs,
+                          l.uniforms, l.clock.nowValue, l.clock.dtValue, l.clock.first ? 1u : 0u, l.seed, l.draw);
+    if (l.kernel->kind == KernelKind::Render) {  // a render loop counts what it drew instead (marksDrawn)
+        rt::RowsResult drawn;
+        drawn.drawn = static_cast<size_t>(counts.killed);
+        drawn.nonFinite = static_cast<size_t>(counts.unstable);
+        return drawn;
+    }
+    return {static_cast<size_t>(counts.killed), static_cast<size_t>(counts.unstable)};
+}
+
+rt::PairFunction CompiledBackend::pairFunction(const Object& object, const Kernel& pair) {
+    return reinterpret_cast<rt::PairFunction>(function(object, pair, false, Clock::Source::Uniform, Clock::Source::Uniform));
+}
+
+void CompiledBackend::run(const rt::ChildrenLaunch& l) {
+    auto fn = reinterpret_cast<ChildrenFn>(function(*l.object, *l.spawn, true, Clock::Source::Uniform, Clock::Source::Uniform));
+    std::vector<void*> columns = addresses(l.columns);
+    std::vector<void*> args = addresses(l.args);
+    fn(columns.data(), static_cast<int64_t>(l.row), l.parents, l.externs, l.clock.nowValue, l.clock.dtValue,
+       l.clock.first ? 1u : 0u, l.seed, l.draw, l.firstChild, static_cast<int64_t>(l.count),
+       reinterpret_cast<float* const*>(args.data()), static_cast<int64_t>(l.argsFirst));
+}
+
+}  // namespace psys::native
