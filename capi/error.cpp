@@ -2,43 +2,8 @@
 
 namespace psys::capi {
 
-namespace {
-
-psys_severity severityOf(Severity s) {
-    switch (s) {
-        case Severity::Error: return PSYS_SEVERITY_ERROR;
-        case Severity::Warning: return PSYS_SEVERITY_WARNING;
-        case Severity::Note: return PSYS_SEVERITY_NOTE;
-        case Severity::Remark: return PSYS_SEVERITY_REMARK;
-    }
-    return PSYS_SEVERITY_ERROR;
-}
-
-}  // namespace
-
 psys_diagnostic OwnedDiagnostic::view() const {
     return {severity, file.c_str(), line, column, endLine, endColumn, message.c_str()};
-}
-
-std::vector<OwnedDiagnostic> diagnosticsOf(const DiagnosticEngine& engine, bool errors) {
-    std::vector<OwnedDiagnostic> out;
-    for (const Diagnostic& d : engine.all()) {
-        if (d.severity != Severity::Warning && !(errors && d.severity == Severity::Error)) continue;
-        OwnedDiagnostic o;
-        o.severity = severityOf(d.severity);
-        o.message = d.message;
-        if (d.range.valid() && d.range.file < engine.sources().count()) {
-            const SourceFile& f = engine.sources().file(d.range.file);
-            LineColumn begin = f.lineColumn(d.range.begin), end = f.lineColumn(d.range.end);
-            o.file = f.path();
-            o.line = begin.line;
-            o.column = begin.column;
-            o.endLine = end.line;
-            o.endColumn = end.column;
-        }
-        out.push_back(std::move(o));
-    }
-    return out;
 }
 
 psys_error* makeError(std::string message, std::vector<OwnedDiagnostic> diagnostics) {

@@ -2,10 +2,10 @@
 // diagnostics as plain data (file, line, column, text) that outlive the compiler's own.
 #pragma once
 
+#include <stdexcept>
 #include <string>
 #include <vector>
 
-#include "frontend/diagnostics.h"
 #include "psys/psys.h"
 
 namespace psys::capi {
@@ -17,9 +17,6 @@ struct OwnedDiagnostic {
     uint32_t line = 0, column = 0, endLine = 0, endColumn = 0;
     psys_diagnostic view() const;
 };
-
-// The diagnostics an engine holds, of the given severities (errors and warnings; warnings only).
-std::vector<OwnedDiagnostic> diagnosticsOf(const DiagnosticEngine& engine, bool errors);
 
 // A new error (owned by the caller, freed with psys_error_free).
 psys_error* makeError(std::string message, std::vector<OwnedDiagnostic> diagnostics = {});

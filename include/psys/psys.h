@@ -129,6 +129,32 @@ PSYS_API psys_error* psys_reload(psys_system* system, const char* source);
 PSYS_API size_t psys_warning_count(const psys_system* system);
 PSYS_API int psys_warning(const psys_system* system, size_t index, psys_diagnostic* out);
 
+/* ---- Ahead of time ------------------------------------------------------------------ */
+
+/* What `psysc build FILE -o NAME` writes into NAME.o, declared by NAME.h as NAME_aot: the
+ * system's IR and its kernels' machine code for one CPU, found by key. A host links the
+ * object with libpsys_runtime (no compiler, no LLVM) or with libpsys. */
+#define PSYS_AOT_ABI 1
+typedef struct psys_aot_kernel {
+    uint64_t key_low, key_high;
+    void* code;
+} psys_aot_kernel;
+typedef struct psys_aot {
+    uint32_t abi;   /* PSYS_AOT_ABI when it was built */
+    uint32_t exact; /* 1: exact maths (the interpreter's bits), 0: fast */
+    const char* name;
+    const char* ir;     /* the system (psysc --emit=ir) */
+    size_t kernel_count;
+    const psys_aot_kernel* kernels;
+    const char* glsl;   /* its compute shaders (psysc --emit=glsl), for a host's own GL pipeline */
+    const char* target; /* the CPU the kernels were compiled for */
+} psys_aot;
+
+/* Starts an ahead-of-time compiled system. options->backend: "llvm" (the default) or "aot"
+ * run its compiled kernels; "interp" and "glsl" run its IR there. Its maths is the build's
+ * (options->math is not read). It does not reload: psys_reload says so. */
+PSYS_API psys_error* psys_open_aot(const psys_aot* aot, const psys_options* options, psys_system** out);
+
 /* ---- Running it --------------------------------------------------------------------- */
 
 /* Advances every object by dt seconds: finite and not negative (0 moves nothing). */

@@ -1,6 +1,6 @@
-// The C API (include/psys/psys.h) over host::Session: a system compiled from a file or a
-// string, on a backend chosen by name, run, reloaded and read by a C host. Every entry
-// point checks its arguments and turns what the layers below throw into an error value.
+// The C API (include/psys/psys.h) on a running system, however it was made (capi/handle.h):
+// stepped, set, fired, drawn and read by a C host. Every entry point checks its arguments
+// and turns what the layers below throw into an error value.
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -10,27 +10,13 @@
 
 #include <fmt/format.h>
 
-#include "capi/error.h"
-#include "host/large_stack.h"
-#include "host/session.h"
+#include "capi/handle.h"
 
 using psys::capi::guarded;
 using psys::capi::makeError;
 using psys::capi::nullArgument;
-using psys::capi::OwnedDiagnostic;
-namespace host = psys::host;
 namespace rt = psys::rt;
 
-struct psys_system {
-    std::unique_ptr<host::Session> session;
-    bool fromString = false;
-    std::vector<OwnedDiagnostic> warnings;  // of the latest compilation that took
-    // The spelled types of externs and triggers (psys_input::type), made at each compilation.
-    std::vector<std::string> externTypes, triggerTypes;
-
-    rt::System& system() { return session->system(); }
-    const rt::System& system() const { return session->system(); }
-};
 
 namespace {
 
@@ -43,66 +29,6 @@ static_assert(PSYS_VERSION_MAJOR == PSYS_LIBRARY_MAJOR && PSYS_VERSION_MINOR == 
 std::string spelled(const psys::ir::Type& t) {
     if (t.isBool()) return "bool";
     return t.width == 1 ? "float" : fmt::format("vec{}", t.width);
-}
-
-void describe(psys_system& s) {
-    const psys::ir::Module& m = s.system().module();
-    s.externTypes.clear();
-    for (const psys::ir::Extern& e : m.externs) s.externTypes.push_back(rt::languageName(e));
-    s.triggerTypes.clear();
-    for (const psys::ir::Trigger& t : m.triggers) {
-        std::string types;
-        for (const psys::ir::Param& p : t.params) types += (types.empty() ? "" : ", ") + spelled(p.type);
-        s.triggerTypes.push_back(types);
-    }
-}
-
-// What the C options ask of a session, or why they cannot be.
-std::optional<std::string> sessionOptions(const psys_options* given, host::SessionOptions& out) {
-    psys_options o;
-    psys_options_init(&o);
-    if (given) o = *given;
-    out.backend.name = o.backend ? o.backend : "llvm";
-    out.backend.math = o.math ? o.math : "fast";
-    if (o.capacity == 0) return "the capacity is at least 1 object a type";
-    out.system.seed = o.seed;
-    out.system.capacity = o.capacity;
-    out.system.threads = o.threads;
-    out.compile.pipeline.optimize = o.optimize != 0;
-    out = host::Session::resolved(out);
-    return std::nullopt;
-}
-
-// Compiles on a thread with a large stack (the compiler recurses as deep as expressions
-// nest: host/large_stack.h); the module or the error with the diagnostics.
-psys_error* compileModule(const std::string& path, const psys::CompileOptions& options, const std::string* text,
-                          std::optional<psys::ir::Module>& module, std::vector<OwnedDiagnostic>& warnings) {
-    host::CompileResult result;
-    host::runWithLargeStack([&] {
-        result = host::compile(path, options, module, text);
-        return 0;
-    });
-    if (!module) return makeError(result.text(), psys::capi::diagnosticsOf(*result.diagnostics, true));
-    warnings = psys::capi::diagnosticsOf(*result.diagnostics, false);
-    return nullptr;
-}
-
-psys_error* open(const char* function, const std::string& path, const std::string* text, const psys_options* options,
-                 psys_system** out) {
-    if (!out) return nullArgument(function, "the place for the system (out)");
-    *out = nullptr;
-    host::SessionOptions so;
-    if (auto bad = sessionOptions(options, so)) return makeError(fmt::format("{}: {}", function, *bad));
-    auto s = std::make_unique<psys_system>();
-    std::optional<psys::ir::Module> module;
-    if (psys_error* e = compileModule(path, so.compile, text, module, s->warnings)) return e;
-    std::string error;
-    s->session = host::Session::start(path, so, std::move(*module), error);
-    if (!s->session) return makeError(fmt::format("{}: {}", function, error));
-    s->fromString = text != nullptr;
-    describe(*s);
-    *out = s.release();
-    return nullptr;
 }
 
 psys_error* orError(const char* function, const std::optional<std::string>& error) {
@@ -122,6 +48,36 @@ psys_column column(const rt::Memory& memory, rt::Buffer b, float constant) {
 
 }  // namespace
 
+void psys_system::describe() {
+    const psys::ir::Module& m = system().module();
+    externTypes.clear();
+    for (const psys::ir::Extern& e : m.externs) externTypes.push_back(rt::languageName(e));
+    triggerTypes.clear();
+    for (const psys::ir::Trigger& t : m.triggers) {
+        std::string types;
+        for (const psys::ir::Param& p : t.params) types += (types.empty() ? "" : ", ") + spelled(p.type);
+        triggerTypes.push_back(types);
+    }
+}
+
+namespace psys::capi {
+
+psys_error* readOptions(const char* function, const psys_options* given, Options& out) {
+    psys_options o;
+    psys_options_init(&o);
+    if (given) o = *given;
+    out.backend = o.backend ? o.backend : "llvm";
+    out.math = o.math ? o.math : "fast";
+    if (o.capacity == 0) return makeError(fmt::format("{}: the capacity is at least 1 object a type", function));
+    out.system.seed = o.seed;
+    out.system.capacity = o.capacity;
+    out.system.threads = o.threads;
+    out.optimize = o.optimize != 0;
+    return nullptr;
+}
+
+}  // namespace psys::capi
+
 extern "C" {
 
 const char* psys_version(void) { return kVersion; }
@@ -132,39 +88,11 @@ void psys_options_init(psys_options* options) {
     *options = psys_options{"llvm", "fast", defaults.seed, defaults.capacity, defaults.threads, 1};
 }
 
-psys_error* psys_compile_file(const char* path, const psys_options* options, psys_system** out) {
-    if (out) *out = nullptr;
-    if (!path) return nullArgument("psys_compile_file", "the path");
-    return guarded("psys_compile_file", [&] { return open("psys_compile_file", path, nullptr, options, out); });
-}
-
-psys_error* psys_compile_string(const char* source, const char* name, const psys_options* options, psys_system** out) {
-    if (out) *out = nullptr;
-    if (!source) return nullArgument("psys_compile_string", "the source");
-    return guarded("psys_compile_string", [&] {
-        std::string text = source;
-        return open("psys_compile_string", name ? name : "<string>", &text, options, out);
-    });
-}
-
 void psys_system_free(psys_system* system) { delete system; }
 
 psys_error* psys_reload(psys_system* s, const char* source) {
     if (!s) return nullArgument("psys_reload", "the system");
-    if (!source && s->fromString)
-        return makeError("psys_reload: the system was compiled from a string: its new source is needed");
-    return guarded("psys_reload", [&]() -> psys_error* {
-        std::string text = source ? source : "";
-        host::Session::Candidate candidate;
-        std::vector<OwnedDiagnostic> warnings;
-        if (psys_error* e = compileModule(s->session->path(), s->session->options().compile, source ? &text : nullptr,
-                                          candidate.module, warnings))
-            return e;  // the running system goes on untouched
-        s->session->adopt(std::move(candidate));
-        s->warnings = std::move(warnings);
-        describe(*s);
-        return nullptr;
-    });
+    return guarded("psys_reload", [&] { return s->reload(source); });
 }
 
 size_t psys_warning_count(const psys_system* s) { return s ? s->warnings.size() : 0; }
