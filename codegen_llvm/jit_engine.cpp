@@ -33,6 +33,7 @@
 #include <llvm/TargetParser/Host.h>
 
 #include "codegen_llvm/link_observer.h"
+#include "codegen_llvm/optimize.h"
 #include "codegen_llvm/perf_map.h"
 #include "ir/hash.h"
 
@@ -170,30 +171,18 @@ private:
     std::filesystem::path folder_;
 };
 
-// Machine code for a module, with compile time linear in its size. Two parts of LLVM's code
-// generation grow faster than linearly: instruction selection with the size of a basic
-// block (so long blocks are cut, below), and register allocation at the higher levels with
-// the calls in a function (each call clobbers the registers every live value must avoid).
-// One equation of 2,000 `sin` terms took 14.6 s; cut and, past kLargeModule instructions,
-// compiled with the fast allocator, it takes about 1.3 s a thousand terms — slower code,
-// for kernels whose size, not their loop, is the cost.
+// Machine code for a module, with compile time linear in its size (optimize.h, "Code
+// generation"), read from the disk cache where it is there.
 class SizedCompiler : public llvm::orc::IRCompileLayer::IRCompiler {
 public:
-    static constexpr size_t kLargeModule = 4000;
-
     using Remarks = std::function<std::string(const llvm::Module&)>;
     SizedCompiler(llvm::orc::JITTargetMachineBuilder builder, const ObjectCache* cache, Remarks remarks)
         : IRCompiler(llvm::orc::irManglingOptionsFromTargetOptions(builder.getOptions())), builder_(std::move(builder)),
           cache_(cache), remarks_(std::move(remarks)) {}
 
     llvm::Expected<std::unique_ptr<llvm::MemoryBuffer>> operator()(llvm::Module& module) override {
-        size_t instructions = 0;
-        for (llvm::Function& f : module) {
-            instructions += f.getInstructionCount();
-            splitLongBlocks(f);
-        }
         llvm::orc::JITTargetMachineBuilder builder = builder_;
-        if (instructions > kLargeModule) builder.setCodeGenOptLevel(llvm::CodeGenOptLevel::None);
+        if (prepareForCodegen(module)) builder.setCodeGenOptLevel(llvm::CodeGenOptLevel::None);
         auto machine = builder.createTargetMachine();
         if (!machine) return machine.takeError();
         auto object = llvm::orc::SimpleCompiler(**machine)(module);
@@ -202,51 +191,12 @@ public:
     }
 
 private:
-    // Instruction selection works a basic block at a time and grows faster than linearly
-    // with a block's size; a loop body of thousands of instructions is cut into blocks of
-    // kBlock joined by plain branches (after the IR passes, which would merge them back).
-    static constexpr size_t kBlock = 256;
-    static void splitLongBlocks(llvm::Function& f) {
-        std::vector<llvm::BasicBlock*> blocks;
-        for (llvm::BasicBlock& b : f) blocks.push_back(&b);
-        for (llvm::BasicBlock* b : blocks) {
-            while (b->size() > 2 * kBlock) {
-                auto at = b->getFirstInsertionPt();
-                std::advance(at, kBlock);
-                b = b->splitBasicBlock(at);
-            }
-        }
-    }
-
     llvm::orc::JITTargetMachineBuilder builder_;
     const ObjectCache* cache_;
     Remarks remarks_;
 };
 
 }  // namespace
-
-// LLVM's libmvec list stops at 8 lanes; with AVX-512 the loops run 16 floats a register
-// (floatLanes), and a call without a 16-lane variant is made once per lane: the fire at
-// 16 lanes spent 57% of its time in scalar expf. glibc has the 16-lane (AVX-512) variants
-// of the same functions; these are they, for CPUs with AVX-512F.
-static llvm::ArrayRef<llvm::VecDesc> wideVectorMath() {
-    static const auto sixteen = llvm::ElementCount::getFixed(16);
-    static const llvm::VecDesc functions[] = {
-        {"sinf", "_ZGVeN16v_sinf", sixteen, false, "_ZGV_LLVM_N16v"},
-        {"llvm.sin.f32", "_ZGVeN16v_sinf", sixteen, false, "_ZGV_LLVM_N16v"},
-        {"cosf", "_ZGVeN16v_cosf", sixteen, false, "_ZGV_LLVM_N16v"},
-        {"llvm.cos.f32", "_ZGVeN16v_cosf", sixteen, false, "_ZGV_LLVM_N16v"},
-        {"tanf", "_ZGVeN16v_tanf", sixteen, false, "_ZGV_LLVM_N16v"},
-        {"llvm.tan.f32", "_ZGVeN16v_tanf", sixteen, false, "_ZGV_LLVM_N16v"},
-        {"expf", "_ZGVeN16v_expf", sixteen, false, "_ZGV_LLVM_N16v"},
-        {"llvm.exp.f32", "_ZGVeN16v_expf", sixteen, false, "_ZGV_LLVM_N16v"},
-        {"logf", "_ZGVeN16v_logf", sixteen, false, "_ZGV_LLVM_N16v"},
-        {"llvm.log.f32", "_ZGVeN16v_logf", sixteen, false, "_ZGV_LLVM_N16v"},
-        {"powf", "_ZGVeN16vv_powf", sixteen, false, "_ZGV_LLVM_N16vv"},
-        {"llvm.pow.f32", "_ZGVeN16vv_powf", sixteen, false, "_ZGV_LLVM_N16vv"},
-    };
-    return functions;
-}
 
 // Records the external symbols each linked graph refers to: which library functions the
 // compiled code calls (the vector maths it was meant to use, say).
@@ -309,30 +259,7 @@ struct JitEngine::Impl {
         module.getContext().setDiagnosticHandler(std::make_unique<RemarkCollector>(&remarks, &remarksMutex));
         auto made = llvm::orc::JITTargetMachineBuilder(*host).createTargetMachine();
         if (!made) throw std::runtime_error(llvm::toString(made.takeError()));
-        std::unique_ptr<llvm::TargetMachine> machine = std::move(*made);
-        llvm::LoopAnalysisManager lam;
-        llvm::FunctionAnalysisManager fam;
-        llvm::CGSCCAnalysisManager cgam;
-        llvm::ModuleAnalysisManager mam;
-        llvm::PipelineTuningOptions tuning;
-        tuning.LoopVectorization = true;
-        tuning.SLPVectorization = true;
-        // Interleaving adds code (and compile time) for loops that are bound by memory.
-        tuning.LoopInterleaving = false;
-        llvm::PassBuilder builder(machine.get(), tuning);
-        llvm::TargetLibraryInfoImpl library(llvm::Triple(module.getTargetTriple()));
-        if (mode == MathMode::Fast) {
-            library.addVectorizableFunctionsFromVecLib(llvm::TargetLibraryInfoImpl::LIBMVEC_X86,
-                                                       llvm::Triple(module.getTargetTriple()));
-            if (avx512) library.addVectorizableFunctions(wideVectorMath());
-        }
-        fam.registerPass([&] { return llvm::TargetLibraryAnalysis(library); });
-        builder.registerModuleAnalyses(mam);
-        builder.registerCGSCCAnalyses(cgam);
-        builder.registerFunctionAnalyses(fam);
-        builder.registerLoopAnalyses(lam);
-        builder.crossRegisterProxies(lam, fam, cgam, mam);
-        builder.buildPerModuleDefaultPipeline(llvm::OptimizationLevel::O3).run(module, mam);
+        optimizeModule(module, **made, mode, avx512);
     }
 };
 

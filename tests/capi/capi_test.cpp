@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "driver/compile.h"
+#include "ir/printer.h"
 #include "psys/psys.h"
 
 namespace {
@@ -322,4 +324,51 @@ TEST_CASE("on the glsl backend the draw columns are GL buffers: nothing comes ba
     CHECK(d.visible.data == nullptr);
     CHECK(d.position[0].gl_buffer != 0);
     CHECK(points(sys.s, static_cast<size_t>(drop)).size() == 500);
+}
+
+namespace {
+
+// An AOT build's description around IR text alone, as `psysc build` writes it but with no
+// compiled kernels.
+std::string irOf(const char* source) {
+    psys::SourceManager sources;
+    psys::DiagnosticEngine diags(sources);
+    psys::CompileOptions options;
+    auto module = psys::compileText("x.psys", source, sources, diags, options);
+    REQUIRE(module);
+    return psys::ir::print(*module);
+}
+
+}  // namespace
+
+TEST_CASE("an ahead-of-time build's IR runs on the interpreter, and a build that cannot run says why") {
+    std::string ir = irOf(kDots);
+    psys_aot aot{PSYS_AOT_ABI, 1, "dots", ir.c_str(), 0, nullptr, "", "none"};
+    System fromAot, compiled;
+    psys_options o = options("interp");
+    REQUIRE(take(psys_open_aot(&aot, &o, &fromAot.s)) == "");
+    REQUIRE(take(psys_compile_string(kDots, "x.psys", &o, &compiled.s)) == "");
+    for (int f = 0; f < 30; ++f) {
+        REQUIRE(take(psys_step(fromAot.s, 1.0 / 60)) == "");
+        REQUIRE(take(psys_step(compiled.s, 1.0 / 60)) == "");
+    }
+    std::vector<psys_point> p = points(fromAot.s, 0), q = points(compiled.s, 0);
+    REQUIRE(p.size() == 30);
+    REQUIRE(p.size() == q.size());
+    CHECK(std::memcmp(p.data(), q.data(), p.size() * sizeof(psys_point)) == 0);
+    CHECK(take(psys_reload(fromAot.s, kDots)).find("does not reload") != std::string::npos);
+
+    psys_system* out = nullptr;
+    // No code for its kernels: the compiled backend refuses it, naming what is missing.
+    CHECK(take(psys_open_aot(&aot, nullptr, &out)).find("has no code for a kernel of `") != std::string::npos);
+    CHECK(out == nullptr);
+    psys_aot old = aot;
+    old.abi = 99;
+    CHECK(take(psys_open_aot(&old, &o, &out)).find("format is 99") != std::string::npos);
+    psys_aot broken = aot;
+    broken.ir = "object {";
+    CHECK(take(psys_open_aot(&broken, &o, &out)).find("does not read back") != std::string::npos);
+    CHECK(take(psys_open_aot(nullptr, &o, &out)) == "psys_open_aot: the build is NULL");
+    o = options("vulkan");
+    CHECK(take(psys_open_aot(&aot, &o, &out)).find("no backend `vulkan`") != std::string::npos);
 }

@@ -14,18 +14,21 @@ trap 'status=$?; if [ $status = 0 ]; then rm -rf "$work"; else echo "(kept: $wor
 prefix=$work/prefix
 
 cmake --install "$build" --prefix "$prefix" > "$work/install.log"
-lib=$prefix/lib/libpsys.so
-real=$(readlink -f "$lib")
-soname=$(objdump -p "$real" | awk '/SONAME/ {print $2}')
-[ "$soname" = libpsys.so.0 ] || { echo "soname: $soname, not libpsys.so.0"; exit 1; }
 # Exported: the global symbols (upper-case types, and u: unique), less the version node (A).
-exported() { nm -D --defined-only "$real" | awk '$2 != "A" && $2 ~ /^[A-Zu]$/ {print $3}'; }
-others=$(exported | grep -v '^psys_' || true)
-if [ -n "$others" ]; then
-  echo "libpsys.so exports more than the C API:"; echo "$others" | head -20; exit 1
-fi
-echo "libpsys.so: $(stat -c %s "$real") bytes, $(exported | wc -l) symbols exported, all psys_*"
-for f in include/psys/psys.h lib/cmake/psys/psysConfig.cmake lib/pkgconfig/psys.pc share/psys/std bin/psysc; do
+exported() { nm -D --defined-only "$1" | awk '$2 != "A" && $2 ~ /^[A-Zu]$/ {print $3}'; }
+for name in psys psys_runtime; do
+  real=$(readlink -f "$prefix/lib/lib$name.so")
+  soname=$(objdump -p "$real" | awk '/SONAME/ {print $2}')
+  [ "$soname" = "lib$name.so.0" ] || { echo "soname: $soname, not lib$name.so.0"; exit 1; }
+  others=$(exported "$real" | grep -v '^psys_' || true)
+  if [ -n "$others" ]; then
+    echo "lib$name.so exports more than the C API:"; echo "$others" | head -20; exit 1
+  fi
+  echo "lib$name.so: $(stat -c %s "$real") bytes, $(exported "$real" | wc -l) symbols exported, all psys_*"
+done
+if ldd "$prefix/lib/libpsys_runtime.so" | grep -i llvm; then echo "libpsys_runtime loads LLVM"; exit 1; fi
+for f in include/psys/psys.h lib/cmake/psys/psysConfig.cmake lib/pkgconfig/psys.pc lib/pkgconfig/psys-runtime.pc \
+         share/psys/std bin/psysc; do
   [ -e "$prefix/$f" ] || { echo "not installed: $f"; exit 1; }
 done
 
@@ -34,6 +37,12 @@ cmake -S "$src/examples" -B "$work/examples" -G Ninja -DCMAKE_PREFIX_PATH="$pref
 cmake --build "$work/examples" >> "$work/examples.log"
 "$work/examples/minimal" "$src/samples/fountain.psys" | tee "$work/minimal.out"
 grep -q "drops drawn: [1-9]" "$work/minimal.out"
+
+# The ahead-of-time example: built by the package's psysc, linked with libpsys_runtime
+# alone: no LLVM in the process.
+"$work/examples/aot_host" 6000 | tee "$work/aot.out"
+grep -q "drops alive after 4 s" "$work/aot.out"
+if ldd "$work/examples/aot_host" | grep -i "llvm\|libpsys.so"; then echo "the AOT host loads the compiler"; exit 1; fi
 
 # pkg-config (the .pc file is relocatable: the prefix is where it lies)
 flags=$(PKG_CONFIG_PATH="$prefix/lib/pkgconfig" pkg-config --cflags --libs psys)

@@ -4,6 +4,7 @@
 //   psysc run FILE [options]            compile and run a system (host/: the host library)
 //   psysc --emit=ast|ir FILE            print the checked AST, or the IR after the passes
 //   psysc --emit=glsl FILE              print the GLSL shaders the GPU backend runs
+//   psysc build FILE -o NAME            NAME.a and NAME.h: the system compiled ahead of time
 //   psysc --stats FILE                  the cost of each object type, without and with the optimizer
 //   psysc --list-passes                 the passes in pipeline order (opt/passes.h: the registry)
 //   psysc lsp                           the language server, on stdin and stdout (editor-support/)
@@ -32,6 +33,7 @@
 #include "lsp/features.h"
 #include "lsp/server.h"
 #include "rt/system.h"
+#include "build_command.h"
 #include "run_command.h"
 
 namespace {
@@ -212,6 +214,18 @@ int realMain(int argc, char** argv) {
     addRunOptions(*run, runOptions);
     run->fallthrough();
 
+    auto* build = app.add_subcommand("build", "Compile FILE ahead of time: NAME.a (its kernels for a CPU) and NAME.h, for a "
+                                     "host that links libpsys_runtime (no compiler, no LLVM)");
+    psys::tools::BuildOptions buildOptions;
+    build->add_option("file", buildOptions.file, "The system to compile")->required()->type_name("FILE");
+    build->add_option("-o,--output", buildOptions.output, "Write NAME.a and NAME.h")->required()->type_name("NAME");
+    build->add_option("--math", buildOptions.math, "fast (the default) or exact (the interpreter's results bit for bit)")
+        ->check(CLI::IsMember({"fast", "exact"}));
+    build->add_option("--target", buildOptions.target, "The target triple (the host's by default)")->type_name("TRIPLE");
+    build->add_option("--cpu", buildOptions.cpu, "The CPU to compile for (the host's by default; generic for another "
+                      "triple)")->type_name("CPU");
+    build->fallthrough();
+
     auto* lsp = app.add_subcommand("lsp", "Serve the Language Server Protocol on stdin and stdout (for editors)");
     int debounceMs = 150;
     lsp->add_option("--debounce", debounceMs, "Milliseconds of quiet after an edit before it is checked (150)")
@@ -258,6 +272,13 @@ int realMain(int argc, char** argv) {
             std::cerr << "psysc: error: " << e.what() << "\n";
             return 1;
         }
+    }
+    if (build->parsed()) {
+        buildOptions.colour = colour;
+        buildOptions.relaxed = relaxedMath;
+        buildOptions.optimize = !noOptimize;
+        buildOptions.integrator = everyObject;
+        return psys::tools::buildSystem(buildOptions);
     }
     if (check->parsed()) {
         bool failed = false;

@@ -1,0 +1,181 @@
+#include "codegen_llvm/aot_object.h"
+
+#include <set>
+
+#include <fmt/format.h>
+#include <stdexcept>
+
+#include <llvm/ADT/SmallVector.h>
+#include <llvm/IR/Constants.h>
+#include <llvm/IR/LegacyPassManager.h>
+#include <llvm/IR/Verifier.h>
+#include <llvm/MC/MCSubtargetInfo.h>
+#include <llvm/MC/TargetRegistry.h>
+#include <llvm/Object/ArchiveWriter.h>
+#include <llvm/Object/ObjectFile.h>
+#include <llvm/Support/TargetSelect.h>
+#include <llvm/Support/raw_ostream.h>
+#include <llvm/Target/TargetMachine.h>
+#include <llvm/TargetParser/Host.h>
+
+#include "codegen_llvm/kernel_functions.h"
+#include "codegen_llvm/optimize.h"
+#include "native/compiled_backend.h"
+
+namespace psys::codegen_llvm {
+
+namespace {
+
+std::unique_ptr<llvm::TargetMachine> targetMachine(const AotTarget& target, std::string& triple, std::string& cpu) {
+    llvm::InitializeAllTargetInfos();
+    llvm::InitializeAllTargets();
+    llvm::InitializeAllTargetMCs();
+    llvm::InitializeAllAsmPrinters();
+    std::string host = llvm::sys::getProcessTriple();  // as the JIT's (JITTargetMachineBuilder::detectHost)
+    triple = target.triple.empty() ? host : target.triple;
+    std::string features;
+    if (!target.cpu.empty()) {
+        cpu = target.cpu;
+    } else if (triple == host) {  // the host's CPU and every feature it has
+        cpu = llvm::sys::getHostCPUName().str();
+        for (const auto& [name, on] : llvm::sys::getHostCPUFeatures())
+            features += (features.empty() ? "" : ",") + std::string(on ? "+" : "-") + name.str();
+    } else {
+        cpu = "generic";
+    }
+    std::string error;
+    const llvm::Target* found = llvm::TargetRegistry::lookupTarget(triple, error);
+    if (!found) throw std::runtime_error("target `" + triple + "`: " + error);
+    llvm::TargetOptions options;
+    std::unique_ptr<llvm::TargetMachine> machine(found->createTargetMachine(
+        triple, cpu, features, options, llvm::Reloc::PIC_, std::nullopt, llvm::CodeGenOptLevel::Aggressive));
+    if (!machine) throw std::runtime_error("LLVM cannot compile for `" + triple + "` (" + cpu + ")");
+    if (!machine->getMCSubtargetInfo()->isCPUStringValid(cpu))
+        throw std::runtime_error("`" + cpu + "` is not a CPU of " + triple);
+    return machine;
+}
+
+llvm::Constant* text(llvm::Module& module, const std::string& value, const std::string& name) {
+    llvm::Constant* data = llvm::ConstantDataArray::getString(module.getContext(), value, true);
+    auto* global = new llvm::GlobalVariable(module, data->getType(), true, llvm::GlobalValue::PrivateLinkage, data, name);
+    global->setUnnamedAddr(llvm::GlobalValue::UnnamedAddr::Global);
+    return global;
+}
+
+}  // namespace
+
+namespace {
+
+// One module's machine code, generated as the JIT generates it (optimize.h).
+std::string emitObject(llvm::Module& module, llvm::TargetMachine& machine, llvm::TargetMachine& large) {
+    llvm::TargetMachine& chosen = prepareForCodegen(module) ? large : machine;
+    llvm::SmallVector<char, 0> buffer;
+    llvm::raw_svector_ostream object(buffer);
+    llvm::legacy::PassManager passes;
+    if (chosen.addPassesToEmitFile(passes, object, nullptr, llvm::CodeGenFileType::ObjectFile))
+        throw std::runtime_error("LLVM cannot write an object file for " + chosen.getTargetTriple().str());
+    passes.run(module);
+    return std::string(buffer.begin(), buffer.end());
+}
+
+void verify(const llvm::Module& module) {
+    std::string problems;
+    llvm::raw_string_ostream stream(problems);
+    if (llvm::verifyModule(module, &stream)) throw std::runtime_error("the LLVM backend built invalid IR: " + problems);
+}
+
+// The undefined symbols of an object: what it needs from outside.
+void undefinedSymbols(const std::string& bytes, std::set<std::string>& out) {
+    auto file = llvm::object::ObjectFile::createObjectFile(llvm::MemoryBufferRef(llvm::StringRef(bytes), "kernel"));
+    if (!file) throw std::runtime_error(llvm::toString(file.takeError()));
+    for (const llvm::object::SymbolRef& s : (*file)->symbols()) {
+        auto flags = s.getFlags();
+        auto name = s.getName();
+        if (flags && name && (*flags & llvm::object::SymbolRef::SF_Undefined) && !name->empty())
+            out.insert(name->str());
+        if (!flags) llvm::consumeError(flags.takeError());
+        if (!name) llvm::consumeError(name.takeError());
+    }
+}
+
+}  // namespace
+
+AotObject buildAotObject(const ir::Module& module, const std::string& irText, const std::string& glsl, MathMode mode,
+                         const AotTarget& target, const std::string& symbol) {
+    AotObject out;
+    std::unique_ptr<llvm::TargetMachine> machine = targetMachine(target, out.triple, out.cpu);
+    std::unique_ptr<llvm::TargetMachine> large = targetMachine(target, out.triple, out.cpu);
+    large->setOptLevel(llvm::CodeGenOptLevel::None);
+    const llvm::MCSubtargetInfo& subtarget = *machine->getMCSubtargetInfo();
+    bool avx512 = subtarget.checkFeatures("+avx512f");
+    unsigned lanes = avx512 ? 16 : subtarget.checkFeatures("+avx") ? 8 : 4;
+    llvm::LLVMContext context;
+    auto newModule = [&](const std::string& name) {
+        auto m = std::make_unique<llvm::Module>(name, context);
+        m->setDataLayout(machine->createDataLayout());
+        m->setTargetTriple(out.triple);
+        return m;
+    };
+
+    // Every launch shape's code, once per key, in a module of its own as the JIT compiles
+    // it (the same code, bit for bit); hidden (two builds link into one host side by side).
+    auto table = newModule(symbol);
+    llvm::Type* i32 = llvm::Type::getInt32Ty(context);
+    llvm::Type* i64 = llvm::Type::getInt64Ty(context);
+    llvm::Type* ptr = llvm::PointerType::get(context, 0);
+    auto* kernelType = llvm::StructType::get(context, {i64, i64, ptr});
+    std::vector<llvm::Constant*> rows;
+    std::vector<std::pair<std::string, std::string>> objects;  // member name, bytes
+    std::set<std::pair<uint64_t, uint64_t>> seen;
+    std::set<std::string> calls;
+    for (const native::Request& r : native::requests(mode == MathMode::Exact, module)) {
+        if (!seen.insert({r.key.low, r.key.high}).second) continue;
+        std::string name = symbol + "." + functionName(r, static_cast<int>(rows.size()));
+        auto kernel = newModule(name);
+        buildFunction(*kernel, mode, lanes, r, name);
+        llvm::Function* f = kernel->getFunction(name);
+        f->setVisibility(llvm::GlobalValue::HiddenVisibility);
+        verify(*kernel);
+        optimizeModule(*kernel, *machine, mode, avx512);
+        objects.push_back({fmt::format("k{}.o", rows.size()), emitObject(*kernel, *machine, *large)});
+        undefinedSymbols(objects.back().second, calls);
+        auto* declared = llvm::Function::Create(f->getFunctionType(), llvm::GlobalValue::ExternalLinkage, name, *table);
+        declared->setVisibility(llvm::GlobalValue::HiddenVisibility);
+        rows.push_back(llvm::ConstantStruct::get(
+            kernelType, {llvm::ConstantInt::get(i64, r.key.low), llvm::ConstantInt::get(i64, r.key.high), declared}));
+    }
+    auto* tableType = llvm::ArrayType::get(kernelType, rows.size());
+    auto* kernels = new llvm::GlobalVariable(*table, tableType, true, llvm::GlobalValue::PrivateLinkage,
+                                             llvm::ConstantArray::get(tableType, rows), symbol + ".kernels");
+    // psys_aot: abi, exact, name, ir, kernel_count, kernels, glsl, target.
+    auto* aotType = llvm::StructType::get(context, {i32, i32, ptr, ptr, i64, ptr, ptr, ptr});
+    llvm::Constant* aot = llvm::ConstantStruct::get(
+        aotType, {llvm::ConstantInt::get(i32, 1), llvm::ConstantInt::get(i32, mode == MathMode::Exact ? 1 : 0),
+                  text(*table, symbol, symbol + ".name"), text(*table, irText, symbol + ".ir"),
+                  llvm::ConstantInt::get(i64, rows.size()), kernels, text(*table, glsl, symbol + ".glsl"),
+                  text(*table, out.cpu, symbol + ".target")});
+    new llvm::GlobalVariable(*table, aotType, true, llvm::GlobalValue::ExternalLinkage, aot, symbol);
+    verify(*table);
+    objects.insert(objects.begin(), {"system.o", emitObject(*table, *machine, *large)});
+    for (const std::string& c : calls)
+        if (!c.starts_with(symbol + ".")) out.calls.push_back(c);
+
+    // One archive: the table's member defines the psys_aot and pulls in every kernel's.
+    std::vector<llvm::NewArchiveMember> members;
+    for (auto& [name, bytes] : objects) {
+        llvm::NewArchiveMember member(llvm::MemoryBufferRef(bytes, name));
+        member.MemberName = name;
+        members.push_back(std::move(member));
+    }
+    std::string archive;
+    llvm::raw_string_ostream stream(archive);
+    if (llvm::Error e = llvm::writeArchiveToStream(stream, members, llvm::SymtabWritingMode::NormalSymtab,
+                                                   llvm::object::Archive::K_GNU, true, false))
+        throw std::runtime_error(llvm::toString(std::move(e)));
+    stream.flush();
+    out.bytes = std::move(archive);
+    out.kernels = rows.size();
+    return out;
+}
+
+}  // namespace psys::codegen_llvm

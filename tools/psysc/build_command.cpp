@@ -1,0 +1,147 @@
+#include "build_command.h"
+
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "codegen_glsl/glsl_shaders.h"
+#include "codegen_llvm/aot_object.h"
+#include "driver/compile.h"
+#include "ir/parser.h"
+#include "ir/printer.h"
+#include "rt/system.h"
+
+namespace psys::tools {
+namespace {
+
+// A C identifier from a file's name: `my-effect` → my_effect.
+std::string identifier(const std::string& name) {
+    std::string out;
+    for (char c : name) out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+    if (out.empty() || std::isdigit(static_cast<unsigned char>(out[0]))) out = "_" + out;
+    return out;
+}
+
+std::string spelled(const ir::Type& t) {
+    if (t.isBool()) return "bool";
+    return t.width == 1 ? "float" : fmt::format("vec{}", t.width);
+}
+
+// The C parameters of a value of type `t` called `name`, and the statement that packs them
+// into `float v[]`.
+void parameters(const ir::Type& t, const std::string& name, std::string& list, std::vector<std::string>& values) {
+    static const char* xyzw[] = {"x", "y", "z", "w"};
+    if (t.isBool()) {
+        list += ", int " + name;
+        values.push_back(name + " ? 1.0f : 0.0f");
+    } else if (t.width == 1) {
+        list += ", float " + name;
+        values.push_back(name);
+    } else {
+        for (int c = 0; c < t.width; ++c) {
+            list += fmt::format(", float {}_{}", name, xyzw[c]);
+            values.push_back(fmt::format("{}_{}", name, xyzw[c]));
+        }
+    }
+}
+
+std::string header(const ir::Module& m, const BuildOptions& o, const std::string& name,
+                   const codegen_llvm::AotObject& object) {
+    std::string guard = "PSYS_AOT_" + name + "_H";
+    std::string h = fmt::format(
+        "/* {name}.h: `{file}` compiled ahead of time by psysc build ({math} maths, for {cpu} {triple}).\n"
+        " * Link {name}.a with libpsys_runtime (pkg-config psys-runtime){libs}: no compiler, no LLVM.\n"
+        " * Written by psysc: edit the .psys file and build again. */\n"
+        "#ifndef {guard}\n#define {guard}\n\n#include <psys/psys.h>\n\n"
+        "#ifdef __cplusplus\nextern \"C\" {{\n#endif\n\n"
+        "extern const psys_aot {name}_aot;\n\n"
+        "/* Starts the system (options may be NULL: its compiled kernels). */\n"
+        "static inline psys_error* {name}_open(const psys_options* options, psys_system** out) {{\n"
+        "    return psys_open_aot(&{name}_aot, options, out);\n}}\n\n",
+        fmt::arg("name", name), fmt::arg("file", std::filesystem::path(o.file).filename().string()),
+        fmt::arg("math", o.math), fmt::arg("cpu", object.cpu), fmt::arg("triple", object.triple),
+        fmt::arg("libs", o.math == "fast" ? " and -lmvec -lm" : " and -lm"), fmt::arg("guard", guard));
+    h += "/* Object types: the `type` of psys_get_draw, psys_read_points, psys_get_type_stats. */\nenum {\n";
+    for (size_t t = 0; t < m.objects.size(); ++t) h += fmt::format("    {}_type_{} = {},\n", name, identifier(m.objects[t].name), t);
+    h += "};\n";
+    for (const ir::Extern& e : m.externs) {
+        std::string list;
+        std::vector<std::string> values;
+        parameters(e.type, e.name, list, values);
+        h += fmt::format("\n/* extern {}: {} */\nstatic inline psys_error* {}_set_{}(psys_system* system{}) {{\n"
+                         "    const float v[] = {{{}}};\n    return psys_set_extern(system, \"{}\", v, {});\n}}\n",
+                         e.name, rt::languageName(e), name, e.name, list, fmt::join(values, ", "), e.name, values.size());
+    }
+    for (const ir::Trigger& t : m.triggers) {
+        std::string list, types;
+        std::vector<std::string> values;
+        for (const ir::Param& p : t.params) {
+            parameters(p.type, p.name, list, values);
+            types += (types.empty() ? "" : ", ") + p.name + ": " + spelled(p.type);
+        }
+        if (values.empty())
+            h += fmt::format("\n/* trigger {}() */\nstatic inline psys_error* {}_fire_{}(psys_system* system) {{\n"
+                             "    return psys_fire(system, \"{}\", NULL, 0);\n}}\n",
+                             t.name, name, t.name, t.name);
+        else
+            h += fmt::format("\n/* trigger {}({}) */\nstatic inline psys_error* {}_fire_{}(psys_system* system{}) {{\n"
+                             "    const float v[] = {{{}}};\n    return psys_fire(system, \"{}\", v, {});\n}}\n",
+                             t.name, types, name, t.name, list, fmt::join(values, ", "), t.name, values.size());
+    }
+    h += fmt::format("\n#ifdef __cplusplus\n}}\n#endif\n\n#endif /* {} */\n", guard);
+    return h;
+}
+
+bool write(const std::string& path, const std::string& bytes) {
+    std::ofstream out(path, std::ios::binary);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    out.close();
+    if (!out) std::cerr << "psysc: error: cannot write `" << path << "`\n";
+    return static_cast<bool>(out);
+}
+
+}  // namespace
+
+int buildSystem(const BuildOptions& o) {
+    CompileOptions options;
+    options.pipeline.optimize = o.optimize;
+    options.pipeline.pass.relaxed = o.relaxed || o.math == "fast";  // as the JIT's fast maths compiles
+    options.pipeline.pass.everyObject = o.integrator;
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    std::optional<ir::Module> compiled = compileFile(o.file, sources, diags, options);
+    diags.print(std::cerr, o.colour);
+    if (!compiled) return 1;
+    // The build's keys are computed from the IR as the host will read it back.
+    std::string irText = ir::print(*compiled);
+    std::string error;
+    std::optional<ir::Module> module = ir::parseModule(irText, error);
+    if (!module || ir::print(*module) != irText) {
+        std::cerr << "psysc: internal error: the IR does not read back as it was printed" << (error.empty() ? "" : ": ")
+                  << error << "\n";
+        return 1;
+    }
+    std::string glsl;
+    for (const auto& shader : codegen_glsl::moduleShaders(rt::launchPlan(*module)))
+        glsl += "//// " + shader.name + "\n" + shader.source + "\n";
+    std::string name = identifier(std::filesystem::path(o.output).filename().string());
+    codegen_llvm::AotObject object;
+    try {
+        auto mode = o.math == "exact" ? codegen_llvm::MathMode::Exact : codegen_llvm::MathMode::Fast;
+        object = codegen_llvm::buildAotObject(*module, irText, glsl, mode, {o.target, o.cpu}, name + "_aot");
+    } catch (const std::exception& e) {
+        std::cerr << "psysc: error: " << e.what() << "\n";
+        return 1;
+    }
+    if (!write(o.output + ".a", object.bytes) || !write(o.output + ".h", header(*module, o, name, object))) return 1;
+    std::cout << fmt::format("wrote {0}.a ({1} kernels for {2} {3}, {4} bytes) and {0}.h\n", o.output, object.kernels,
+                             object.cpu, object.triple, object.bytes.size());
+    if (!object.calls.empty()) std::cout << fmt::format("it calls: {}\n", fmt::join(object.calls, " "));
+    return 0;
+}
+
+}  // namespace psys::tools
