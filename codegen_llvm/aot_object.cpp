@@ -46,12 +46,12 @@ std::unique_ptr<llvm::TargetMachine> targetMachine(const AotTarget& target, std:
     std::string error;
     const llvm::Target* found = llvm::TargetRegistry::lookupTarget(triple, error);
     if (!found) throw std::runtime_error("target `" + triple + "`: " + error);
+    std::unique_ptr<llvm::MCSubtargetInfo> known(found->createMCSubtargetInfo(triple, "", ""));
+    if (!known || !known->isCPUStringValid(cpu)) throw std::runtime_error("`" + cpu + "` is not a CPU of " + triple);
     llvm::TargetOptions options;
     std::unique_ptr<llvm::TargetMachine> machine(found->createTargetMachine(
         triple, cpu, features, options, llvm::Reloc::PIC_, std::nullopt, llvm::CodeGenOptLevel::Aggressive));
     if (!machine) throw std::runtime_error("LLVM cannot compile for `" + triple + "` (" + cpu + ")");
-    if (!machine->getMCSubtargetInfo()->isCPUStringValid(cpu))
-        throw std::runtime_error("`" + cpu + "` is not a CPU of " + triple);
     return machine;
 }
 
@@ -106,9 +106,11 @@ AotObject buildAotObject(const ir::Module& module, const std::string& irText, co
     std::unique_ptr<llvm::TargetMachine> machine = targetMachine(target, out.triple, out.cpu);
     std::unique_ptr<llvm::TargetMachine> large = targetMachine(target, out.triple, out.cpu);
     large->setOptLevel(llvm::CodeGenOptLevel::None);
+    // Floats a vector register holds, as the JIT's floatLanes() says for the host.
     const llvm::MCSubtargetInfo& subtarget = *machine->getMCSubtargetInfo();
-    bool avx512 = subtarget.checkFeatures("+avx512f");
-    unsigned lanes = avx512 ? 16 : subtarget.checkFeatures("+avx") ? 8 : 4;
+    bool x86 = machine->getTargetTriple().isX86();
+    bool avx512 = x86 && subtarget.checkFeatures("+avx512f");
+    unsigned lanes = avx512 ? 16 : x86 && subtarget.checkFeatures("+avx") ? 8 : 4;
     llvm::LLVMContext context;
     auto newModule = [&](const std::string& name) {
         auto m = std::make_unique<llvm::Module>(name, context);

@@ -44,7 +44,7 @@ void optimizeModule(llvm::Module& module, llvm::TargetMachine& machine, MathMode
     tuning.LoopInterleaving = false;
     llvm::PassBuilder builder(&machine, tuning);
     llvm::TargetLibraryInfoImpl library(llvm::Triple(module.getTargetTriple()));
-    if (mode == MathMode::Fast) {
+    if (mode == MathMode::Fast && llvm::Triple(module.getTargetTriple()).isX86()) {  // glibc's x86 libmvec
         library.addVectorizableFunctionsFromVecLib(llvm::TargetLibraryInfoImpl::LIBMVEC_X86,
                                                    llvm::Triple(module.getTargetTriple()));
         if (avx512) library.addVectorizableFunctions(wideVectorMath());

@@ -1,7 +1,7 @@
 // The optimization every compiled kernel goes through, the JIT's (jit_engine.cpp) and an
 // ahead-of-time build's (aot_object.cpp) alike: LLVM's O3 pipeline with loop and SLP
-// vectorization (no interleaving), and, in fast maths, glibc's vector maths (libmvec; its
-// 16-lane variants where the target has AVX-512F).
+// vectorization (no interleaving), and, in fast maths on x86, glibc's vector maths (libmvec;
+// its 16-lane variants where the target has AVX-512F).
 #pragma once
 
 #include <llvm/IR/Module.h>

@@ -7,8 +7,11 @@
 // an update is rendered right after it, while its rows are in cache, over the rows alive
 // at the end of the step, and objects created after their type's update are rendered in
 // their creation batch and scattered into the render columns. `draw` then hands over the
-// columns with no pass of its own. The values are the same bits either way: the render
-// kernel sees the same state, clock, uniforms and parents (a test compares the two).
+// columns with no pass of its own. The values are the same bits either way on the
+// interpreter and in exact maths: the render kernel sees the same state, clock, uniforms
+// and parents (a test compares the two). The JIT's fast maths may differ in a value's last
+// bit (3 values of the campfire's in 50 frames), as the rows of a batch and of a pool go
+// through loops of different shapes, which it may fuse or vectorize differently.
 #pragma once
 
 #include <atomic>

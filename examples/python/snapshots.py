@@ -42,14 +42,14 @@ def main():
 
     system = psys.compile(args.program, backend=args.backend)
     moments = [0.5, 1.0, 2.0, 4.0]
-    fig, axes = plt.subplots(1, len(moments), figsize=(12, 3.4), facecolor="black")
+    fig, axes = plt.subplots(1, len(moments), figsize=(12, 3.4), facecolor="black", sharex=True, sharey=True)
     for ax, at in zip(axes, moments):
         system.step(1 / 60, steps=round((at - system.time) * 60))
         x, y, rgba = drawn(system)
         ax.set_facecolor("black")
         ax.scatter(x, y, s=2, c=rgba, linewidths=0)
         ax.set_title(f"t = {system.time:.1f} s, {len(x)} points", color="white", fontsize=9)
-        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_aspect("equal", adjustable="box")  # one scale for the four (shared axes)
         ax.axis("off")
     fig.tight_layout()
     fig.savefig(args.out, dpi=100, facecolor="black")

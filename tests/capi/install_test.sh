@@ -59,6 +59,18 @@ PSYS
 "$work/minimal-pc" "$work/library.psys" | tee "$work/library.out"
 grep -q "beads drawn: 50" "$work/library.out"
 
+# The Python package, where the build made it: from the prefix, finding libpsys beside it.
+pydir=$(find "$prefix/lib" -maxdepth 3 -type d -name dist-packages | head -1)
+if [ -n "$pydir" ] && [ -e "$pydir/psys/__init__.py" ]; then
+  PYTHONPATH="$pydir" /usr/bin/python3 -c "
+import psys, sys
+s = psys.compile(sys.argv[1])
+s.step(1 / 60, steps=60)
+print('python from the prefix:', psys.version, len(s.points('drop')['id']), 'drops')" "$src/samples/fountain.psys" \
+    | tee "$work/python.out"
+  grep -q "python from the prefix: .* [1-9][0-9]* drops" "$work/python.out"
+fi
+
 # In a window, where one can be made: the llvm backend's columns uploaded, the glsl
 # backend's GL buffers drawn as they are. Each picture must show the fountain's drops.
 if command -v xvfb-run > /dev/null; then
