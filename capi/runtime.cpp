@@ -26,10 +26,6 @@ static_assert(PSYS_VERSION_MAJOR == PSYS_LIBRARY_MAJOR && PSYS_VERSION_MINOR == 
                   PSYS_VERSION_PATCH == PSYS_LIBRARY_PATCH,
               "include/psys/psys.h's version is the project's (CMakeLists.txt)");
 
-std::string spelled(const psys::ir::Type& t) {
-    if (t.isBool()) return "bool";
-    return t.width == 1 ? "float" : fmt::format("vec{}", t.width);
-}
 
 psys_error* orError(const char* function, const std::optional<std::string>& error) {
     return error ? makeError(fmt::format("{}: {}", function, *error)) : nullptr;
@@ -55,7 +51,7 @@ void psys_system::describe() {
     triggerTypes.clear();
     for (const psys::ir::Trigger& t : m.triggers) {
         std::string types;
-        for (const psys::ir::Param& p : t.params) types += (types.empty() ? "" : ", ") + spelled(p.type);
+        for (const psys::ir::Param& p : t.params) types += (types.empty() ? "" : ", ") + rt::languageName(p.type);
         triggerTypes.push_back(types);
     }
 }

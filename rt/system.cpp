@@ -243,11 +243,12 @@ bool System::finished() const {
 }
 
 // An extern's type as the program spells it: `float`, `vec3`, `bool`, `color`, `point`.
-std::string languageName(const ir::Extern& e) {
-    if (!e.spelling.empty()) return e.spelling;
-    if (e.type.isBool()) return "bool";
-    return e.type.width == 1 ? "float" : "vec" + std::to_string(e.type.width);
+std::string languageName(const ir::Type& t) {
+    if (t.isBool()) return "bool";
+    return t.width == 1 ? "float" : "vec" + std::to_string(t.width);
 }
+
+std::string languageName(const ir::Extern& e) { return e.spelling.empty() ? languageName(e.type) : e.spelling; }
 
 std::optional<std::string> System::setExtern(std::string_view name, std::span<const float> value) {
     int index = externHandle(name);

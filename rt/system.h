@@ -165,6 +165,8 @@ class Drawing;
 
 // An extern's type as the program spells it (`float`, `vec3`, `bool`, `color`): for messages.
 std::string languageName(const ir::Extern& e);
+// A value's type as the language spells it without more to go on (a trigger's parameter).
+std::string languageName(const ir::Type& t);
 
 class System {
 public:

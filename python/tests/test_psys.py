@@ -14,18 +14,7 @@ import psys
 SAMPLES = pathlib.Path(os.environ.get("PSYS_SAMPLES_DIR", pathlib.Path(__file__).parents[2] / "samples"))
 EXAMPLES = pathlib.Path(os.environ.get("PSYS_EXAMPLES_DIR", pathlib.Path(__file__).parents[2] / "examples"))
 
-DOTS = """
-extern speed: float = 1 range(0, 10);
-extern tint: color = red;
-trigger burst(p: vec3, n: float) { emit bead(p) count n; }
-object bead(from: vec3) {
-    pos = from + integrate(vec3(speed, 0, 0));
-    point(pos, tint, 2);
-    kill when age > 1;
-}
-object source { emit bead(vec3(0, 1, 0)) at 60 per second; }
-spawn source;
-"""
+DOTS = (pathlib.Path(__file__).parents[2] / "tests" / "programs" / "beads.psys").read_text()
 
 
 def test_a_sample_runs_and_its_points_come_back_as_arrays():

@@ -2,9 +2,11 @@
 # An ahead-of-time build of a sample, linked into a C host with libpsys_runtime alone,
 # draws bit for bit what the JIT draws in the same maths (300 frames, every 10th
 # compared); the host needs no LLVM (ldd), and the object refers to no LLVM symbol (nm).
-#   aot_test.sh PSYSC BUILD_DIR SOURCE_DIR SAMPLE.psys MATH
+# With BACKEND glsl, the build's IR runs on the GPU (llvmpipe in CI) and draws what
+# `psysc run --backend glsl` draws.
+#   aot_test.sh PSYSC BUILD_DIR SOURCE_DIR SAMPLE.psys MATH [BACKEND]
 set -euo pipefail
-psysc=$1 build=$2 src=$3 sample=$4 math=$5
+psysc=$1 build=$2 src=$3 sample=$4 math=$5 backend=${6:-llvm}
 work=$(mktemp -d /tmp/psys-aot.XXXXXX)
 trap 'status=$?; if [ $status = 0 ]; then rm -rf "$work"; else echo "(kept: $work)"; fi' EXIT
 name=$(basename "$sample" .psys)
@@ -16,7 +18,7 @@ cc -std=c99 -Wall -Wextra -Wpedantic -Werror -I"$src/include" -include "$work/$n
 if ldd "$work/host" | grep -i llvm; then echo "the host of an AOT build loads LLVM"; exit 1; fi
 if nm -u "$work/$name.a" | grep -i llvm; then echo "the AOT object refers to LLVM"; exit 1; fi
 
-"$work/host" 300 10 > "$work/aot.csv"
-"$psysc" run "$sample" --backend llvm --math "$math" --frames 300 --dump-every 10 --dump "$work/jit.csv" --quiet \
-  > /dev/null
+"$work/host" 300 10 "$backend" > "$work/aot.csv"
+"$psysc" run "$sample" --backend "$backend" --math "$math" --frames 300 --dump-every 10 --dump "$work/jit.csv" \
+  --quiet > /dev/null
 python3 "$src/tests/aot/compare_dumps.py" "$work/jit.csv" "$work/aot.csv"

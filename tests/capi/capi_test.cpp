@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -37,18 +39,13 @@ psys_options options(const char* backend, const char* math = "fast") {
     return o;
 }
 
-const char* kDots = R"(
-extern speed: float = 1 range(0, 10);
-extern tint: color = red;
-trigger burst(p: vec3, n: float) { emit bead(p) count n; }
-object bead(from: vec3) {
-    pos = from + integrate(vec3(speed, 0, 0));
-    point(pos, tint, 2);
-    kill when age > 1;
+// tests/programs/beads.psys, read once.
+std::string readBeads() {
+    std::ifstream in(std::string(PSYS_PROGRAMS_DIR) + "/beads.psys");
+    return {std::istreambuf_iterator<char>(in), {}};
 }
-object source { emit bead(vec3(0, 1, 0)) at 60 per second; }
-spawn source;
-)";
+const std::string kBeadsText = readBeads();
+const char* const kDots = kBeadsText.c_str();
 
 std::vector<psys_point> points(psys_system* s, size_t type) {
     size_t n = 0;
@@ -174,7 +171,7 @@ TEST_CASE("a warning does not stop a system: it is kept with the system, located
     CHECK(psys_warning(sys.s, 1, &d) == -1);
 }
 
-TEST_CASE("externs and triggers: described, set and fired by name; a wrong name, count or value is refused and changes nothing") {
+TEST_CASE("externs and triggers: described, set and fired by name, and a wrong name, count or value refused, changing nothing") {
     System sys;
     REQUIRE(take(psys_compile_string(kDots, nullptr, nullptr, &sys.s)) == "");
     REQUIRE(psys_extern_count(sys.s) == 2);
@@ -278,7 +275,7 @@ TEST_CASE("a reload keeps the running objects, and one that does not compile cha
     REQUIRE(take(psys_compile_string(kDots, "dots.psys", nullptr, &sys.s)) == "");
     for (int f = 0; f < 30; ++f) REQUIRE(take(psys_step(sys.s, 1.0 / 60)) == "");
     CHECK(take(psys_reload(sys.s, nullptr)).find("compiled from a string") != std::string::npos);
-    std::string edited = kDots;
+    std::string edited = kBeadsText;
     edited.replace(edited.find("point(pos, tint, 2)"), 19, "point(pos, tint, 3)");
     REQUIRE(take(psys_reload(sys.s, edited.c_str())) == "");
     std::vector<psys_point> p = points(sys.s, 0);

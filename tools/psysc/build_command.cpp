@@ -26,10 +26,6 @@ std::string identifier(const std::string& name) {
     return out;
 }
 
-std::string spelled(const ir::Type& t) {
-    if (t.isBool()) return "bool";
-    return t.width == 1 ? "float" : fmt::format("vec{}", t.width);
-}
 
 // The C parameters of a value of type `t` called `name`, and the statement that packs them
 // into `float v[]`.
@@ -81,7 +77,7 @@ std::string header(const ir::Module& m, const BuildOptions& o, const std::string
         std::vector<std::string> values;
         for (const ir::Param& p : t.params) {
             parameters(p.type, p.name, list, values);
-            types += (types.empty() ? "" : ", ") + p.name + ": " + spelled(p.type);
+            types += (types.empty() ? "" : ", ") + p.name + ": " + rt::languageName(p.type);
         }
         if (values.empty())
             h += fmt::format("\n/* trigger {}() */\nstatic inline psys_error* {}_fire_{}(psys_system* system) {{\n"
