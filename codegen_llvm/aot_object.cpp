@@ -55,11 +55,22 @@ std::unique_ptr<llvm::TargetMachine> targetMachine(const AotTarget& target, std:
     return machine;
 }
 
+// A constant global of `module` (made by the module: GCC's -Wmismatched-new-delete takes a
+// `new GlobalVariable` in this file for a mismatched allocation at -O1).
+llvm::GlobalVariable* global(llvm::Module& module, llvm::Constant* value, llvm::GlobalValue::LinkageTypes linkage,
+                             const std::string& name) {
+    auto* g = llvm::cast<llvm::GlobalVariable>(module.getOrInsertGlobal(name, value->getType()));
+    g->setInitializer(value);
+    g->setConstant(true);
+    g->setLinkage(linkage);
+    return g;
+}
+
 llvm::Constant* text(llvm::Module& module, const std::string& value, const std::string& name) {
     llvm::Constant* data = llvm::ConstantDataArray::getString(module.getContext(), value, true);
-    auto* global = new llvm::GlobalVariable(module, data->getType(), true, llvm::GlobalValue::PrivateLinkage, data, name);
-    global->setUnnamedAddr(llvm::GlobalValue::UnnamedAddr::Global);
-    return global;
+    llvm::GlobalVariable* g = global(module, data, llvm::GlobalValue::PrivateLinkage, name);
+    g->setUnnamedAddr(llvm::GlobalValue::UnnamedAddr::Global);
+    return g;
 }
 
 }  // namespace
@@ -147,8 +158,8 @@ AotObject buildAotObject(const ir::Module& module, const std::string& irText, co
             kernelType, {llvm::ConstantInt::get(i64, r.key.low), llvm::ConstantInt::get(i64, r.key.high), declared}));
     }
     auto* tableType = llvm::ArrayType::get(kernelType, rows.size());
-    auto* kernels = new llvm::GlobalVariable(*table, tableType, true, llvm::GlobalValue::PrivateLinkage,
-                                             llvm::ConstantArray::get(tableType, rows), symbol + ".kernels");
+    llvm::GlobalVariable* kernels =
+        global(*table, llvm::ConstantArray::get(tableType, rows), llvm::GlobalValue::PrivateLinkage, symbol + ".kernels");
     // psys_aot: abi, exact, name, ir, kernel_count, kernels, glsl, target.
     auto* aotType = llvm::StructType::get(context, {i32, i32, ptr, ptr, i64, ptr, ptr, ptr});
     llvm::Constant* aot = llvm::ConstantStruct::get(
@@ -156,7 +167,7 @@ AotObject buildAotObject(const ir::Module& module, const std::string& irText, co
                   text(*table, symbol, symbol + ".name"), text(*table, irText, symbol + ".ir"),
                   llvm::ConstantInt::get(i64, rows.size()), kernels, text(*table, glsl, symbol + ".glsl"),
                   text(*table, out.cpu, symbol + ".target")});
-    new llvm::GlobalVariable(*table, aotType, true, llvm::GlobalValue::ExternalLinkage, aot, symbol);
+    global(*table, aot, llvm::GlobalValue::ExternalLinkage, symbol);
     verify(*table);
     objects.insert(objects.begin(), {"system.o", emitObject(*table, *machine, *large)});
     for (const std::string& c : calls)

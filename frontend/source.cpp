@@ -4,6 +4,16 @@
 
 namespace psys {
 
+namespace {
+
+uint32_t unitsOf(char c) {
+    auto b = static_cast<unsigned char>(c);
+    return (b & 0xC0) == 0x80 ? 0 : b >= 0xF0 ? 2 : 1;
+}
+bool continuation(char c) { return (static_cast<unsigned char>(c) & 0xC0) == 0x80; }
+
+}  // namespace
+
 SourceRange SourceRange::join(SourceRange a, SourceRange b) {
     if (!a.valid()) return b;
     if (!b.valid() || a.file != b.file) return a;
@@ -17,6 +27,35 @@ SourceFile::SourceFile(std::string displayPath, std::string text)
     for (uint32_t i = 0; i < text_.size(); ++i)
         if (text_[i] == '\n' || (text_[i] == '\r' && (i + 1 == text_.size() || text_[i + 1] != '\n')))
             lineStarts_.push_back(i + 1);
+    uint32_t units = 0;
+    for (uint32_t i = 0; i <= text_.size(); ++i) {
+        if (i % kUnitStride == 0) unitsAt_.push_back(units);
+        if (i < text_.size()) units += unitsOf(text_[i]);
+    }
+}
+
+uint32_t SourceFile::utf16Before(uint32_t offset) const {
+    offset = std::min<uint32_t>(offset, static_cast<uint32_t>(text_.size()));
+    uint32_t k = offset / kUnitStride, units = unitsAt_[k];
+    for (uint32_t i = k * kUnitStride; i < offset; ++i) units += unitsOf(text_[i]);
+    return units;
+}
+
+uint32_t SourceFile::advanceUtf16(uint32_t from, uint64_t units, uint32_t limit) const {
+    limit = std::min<uint32_t>(limit, static_cast<uint32_t>(text_.size()));
+    if (from >= limit) return limit;
+    uint64_t target = utf16Before(from) + units;
+    // The last checkpoint in (from, limit] still short of the target: scan from there.
+    uint32_t first = from / kUnitStride + 1, last = limit / kUnitStride;
+    uint32_t p = from;
+    if (first <= last) {
+        auto begin = unitsAt_.begin() + first, end = unitsAt_.begin() + last + 1;
+        auto it = std::lower_bound(begin, end, target);  // the first checkpoint at or past it
+        if (it != begin) p = static_cast<uint32_t>(it - unitsAt_.begin() - 1) * kUnitStride;
+    }
+    uint64_t at = utf16Before(p);
+    while (p < limit && (at < target || continuation(text_[p]))) at += unitsOf(text_[p++]);
+    return p;
 }
 
 LineColumn SourceFile::lineColumn(uint32_t offset) const {

@@ -38,10 +38,20 @@ public:
     uint32_t offset(LineColumn at) const;  // the byte offset of a line and column (clamped to the text)
     std::string_view lineText(uint32_t line) const;  // without the line ending
 
+    // UTF-16 code units (the Language Server Protocol's columns) in the text before
+    // `offset`: a lead byte counts 1, or 2 from 0xF0 (a surrogate pair), a continuation byte
+    // 0. And the first sequence boundary p in [from, limit] with `units` more units before
+    // it than before `from` (else `limit`). Both cost at most kUnitStride bytes of scanning,
+    // however long the line: a file of one 1 MB line maps positions as fast as any.
+    uint32_t utf16Before(uint32_t offset) const;
+    uint32_t advanceUtf16(uint32_t from, uint64_t units, uint32_t limit) const;
+
 private:
+    static constexpr uint32_t kUnitStride = 64;
     std::string path_;
     std::string text_;
     std::vector<uint32_t> lineStarts_;
+    std::vector<uint32_t> unitsAt_;  // unitsAt_[k]: utf16Before(k · kUnitStride)
 };
 
 // The largest source file read or parsed (a limit in docs/language.md): a program is

@@ -6,21 +6,25 @@ namespace psys::lsp {
 
 namespace {
 
-// UTF-16 code units of the UTF-8 sequence that starts with `lead`.
-uint32_t utf16Units(unsigned char lead) { return lead >= 0xF0 ? 2 : 1; }
-bool continuation(unsigned char c) { return (c & 0xC0) == 0x80; }
+// A position's field as a count: a JSON integer, or a number past any file's lines or
+// columns (1e300, 2^64) clamped to the largest; a negative or non-numeric one is an error.
+uint64_t count(const nlohmann::json& at, const char* field) {
+    const nlohmann::json& v = at.at(field);
+    if (v.is_number_unsigned()) return v.get<uint64_t>();
+    if (v.is_number_integer() && v.get<int64_t>() >= 0) return static_cast<uint64_t>(v.get<int64_t>());
+    if (v.is_number_float() && v.get<double>() >= 0) return v.get<double>() >= 1e18 ? UINT64_MAX : static_cast<uint64_t>(v.get<double>());
+    throw nlohmann::json::other_error::create(501, std::string("a position's ") + field + " is a count from 0, not " + v.dump(),
+                                              nullptr);
+}
 
 }  // namespace
 
+// Columns in UTF-16 units from the line's start (SourceFile keeps a running count).
 nlohmann::json position(const SourceFile& file, uint32_t offset) {
     LineColumn lc = file.lineColumn(offset);
-    std::string_view line = file.lineText(lc.line);
-    uint32_t units = 0;
-    for (uint32_t i = 0; i + 1 < lc.column && i < line.size(); ++i) {
-        auto c = static_cast<unsigned char>(line[i]);
-        if (!continuation(c)) units += utf16Units(c);
-    }
-    return {{"line", lc.line - 1}, {"character", units}};
+    uint32_t start = file.offset({lc.line, 1});
+    uint32_t end = start + static_cast<uint32_t>(file.lineText(lc.line).size());
+    return {{"line", lc.line - 1}, {"character", file.utf16Before(std::min(offset, end)) - file.utf16Before(start)}};
 }
 
 nlohmann::json range(const SourceFile& file, uint32_t begin, uint32_t end) {
@@ -28,17 +32,12 @@ nlohmann::json range(const SourceFile& file, uint32_t begin, uint32_t end) {
 }
 
 uint32_t offsetOf(const SourceFile& file, const nlohmann::json& at) {
-    auto line = at.at("line").get<int64_t>(), character = at.at("character").get<int64_t>();
-    if (line < 0 || character < 0) throw nlohmann::json::other_error::create(501, "a negative position", nullptr);
-    uint32_t lineNo = static_cast<uint32_t>(std::min<int64_t>(line + 1, UINT32_MAX));
-    std::string_view text = file.lineText(lineNo);
-    uint32_t bytes = 0;
-    for (int64_t units = 0; bytes < text.size() && units < character;) {
-        units += utf16Units(static_cast<unsigned char>(text[bytes]));
-        ++bytes;
-        while (bytes < text.size() && continuation(static_cast<unsigned char>(text[bytes]))) ++bytes;
-    }
-    return file.offset({lineNo, bytes + 1});
+    uint64_t line = count(at, "line"), character = count(at, "character");
+    auto lineNo = static_cast<uint32_t>(std::min<uint64_t>(line + 1, UINT32_MAX));
+    if (line >= UINT32_MAX) lineNo = UINT32_MAX;
+    uint32_t start = file.offset({lineNo, 1});
+    uint32_t end = start + static_cast<uint32_t>(file.lineText(lineNo).size());
+    return file.advanceUtf16(start, character, end);
 }
 
 std::string pathFromUri(const std::string& uri) {

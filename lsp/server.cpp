@@ -109,11 +109,20 @@ json Server::dispatch(const std::string& method, const json& params, bool* found
 
 json Server::initialize(const json& params) {
     if (initialized_) throw RequestError{error::kInvalidRequest, "the server is already initialised"};
-    initialized_ = true;
+    // The options are checked first: an initialize that fails leaves the server as it was.
     if (params.contains("initializationOptions") && params["initializationOptions"].is_object()) {
         const json& o = params["initializationOptions"];
-        if (o.contains("debounceMs")) options_.debounce = std::chrono::milliseconds(o["debounceMs"].get<int64_t>());
+        if (o.contains("debounceMs")) {
+            const json& d = o["debounceMs"];
+            bool whole = d.is_number_unsigned() || (d.is_number_integer() && d.get<int64_t>() >= 0);
+            if (!whole || d.get<uint64_t>() > kMaxDebounceMs)
+                throw RequestError{error::kInvalidParams,
+                                   "initializationOptions.debounceMs is a whole number of milliseconds from 0 to " +
+                                       std::to_string(kMaxDebounceMs) + ", not " + d.dump()};
+            options_.debounce = std::chrono::milliseconds(d.get<int64_t>());
+        }
     }
+    initialized_ = true;
     return {{"capabilities",
              {{"textDocumentSync", {{"openClose", true}, {"change", 2}, {"save", true}}},
               {"hoverProvider", true},

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
@@ -17,6 +18,9 @@
 #include "lsp/analysis.h"
 
 namespace psys::lsp {
+
+// The longest debounce a client may ask for (initializationOptions.debounceMs): ten minutes.
+constexpr uint64_t kMaxDebounceMs = 600000;
 
 struct ServerOptions {
     std::chrono::milliseconds debounce{150};

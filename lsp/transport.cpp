@@ -34,6 +34,17 @@ std::optional<size_t> contentLength(const std::string& header) {
     return std::nullopt;
 }
 
+// Where the next `Content-Length:` header begins at or after `from` (any case), or npos.
+size_t nextHeader(const std::string& buffer, size_t from) {
+    static const std::string name = "content-length:";
+    for (size_t at = from; at + name.size() <= buffer.size(); ++at) {
+        size_t k = 0;
+        while (k < name.size() && std::tolower(static_cast<unsigned char>(buffer[at + k])) == name[k]) ++k;
+        if (k == name.size()) return at;
+    }
+    return std::string::npos;
+}
+
 }  // namespace
 
 bool Transport::fill(std::optional<std::chrono::steady_clock::time_point> deadline) {
@@ -66,8 +77,12 @@ std::optional<Incoming> Transport::take() {
     std::optional<size_t> length = contentLength(buffer_.substr(0, headerEnd));
     size_t body = headerEnd + 4;
     if (!length) {
-        buffer_.erase(0, body);
-        return Incoming{Incoming::Kind::Malformed, {}, "a message header without a Content-Length"};
+        // Out of step with the client (a stray newline or NUL between messages, a header
+        // without a length): what precedes the next Content-Length header is dropped and
+        // answered once, and the messages after it are read as ever.
+        size_t next = nextHeader(buffer_, 1);
+        buffer_.erase(0, next == std::string::npos ? body : next);
+        return Incoming{Incoming::Kind::Malformed, {}, "bytes that are not a message (no Content-Length before them)"};
     }
     if (*length > kMaxMessage) {
         size_t have = std::min(buffer_.size() - body, *length);

@@ -110,7 +110,7 @@ PSYS_API void psys_options_init(psys_options* options);
 
 /* Compiles a program and starts a system (nothing is created before the first step or
  * trigger). On error *out is left NULL and the error has the diagnostics. `options` may
- * be NULL (the defaults). */
+ * be NULL (the defaults). libpsys only: libpsys_runtime has no compiler. */
 PSYS_API psys_error* psys_compile_file(const char* path, const psys_options* options, psys_system** out);
 /* The same from text; `name` stands for its file in diagnostics (NULL: "<string>"). */
 PSYS_API psys_error* psys_compile_string(const char* source, const char* name, const psys_options* options,
@@ -122,7 +122,7 @@ PSYS_API void psys_system_free(psys_system* system);
  * string's system, or to try an edit) and, if it compiles, the new program takes over the
  * running objects by type name: ids, ages, state whose name and type still match (the
  * viewer's hot reload, docs/runtime.md). If it does not compile, the running system is
- * untouched and the error has the diagnostics. */
+ * untouched and the error has the diagnostics. An ahead-of-time system does not reload. */
 PSYS_API psys_error* psys_reload(psys_system* system, const char* source);
 
 /* How many warnings the latest successful compilation (or reload) gave, and each. */
@@ -131,9 +131,9 @@ PSYS_API int psys_warning(const psys_system* system, size_t index, psys_diagnost
 
 /* ---- Ahead of time ------------------------------------------------------------------ */
 
-/* What `psysc build FILE -o NAME` writes into NAME.o, declared by NAME.h as NAME_aot: the
+/* What `psysc build FILE -o NAME` writes into NAME.a, declared by NAME.h as NAME_aot: the
  * system's IR and its kernels' machine code for one CPU, found by key. A host links the
- * object with libpsys_runtime (no compiler, no LLVM) or with libpsys. */
+ * archive with libpsys_runtime (no compiler, no LLVM) or with libpsys. */
 #define PSYS_AOT_ABI 1
 typedef struct psys_aot_kernel {
     uint64_t key_low, key_high;

@@ -224,6 +224,37 @@ TEST_CASE("positions: UTF-16 columns to bytes and back — URIs with spaces") {
     CHECK(uriFromPath("/a b/c.psys") == "file:///a%20b/c.psys");
 }
 
+TEST_CASE("positions: on a long line of mixed widths, every column maps as a scan from the line's start maps it") {
+    // 10,000 characters of 1-, 2-, 3- and 4-byte sequences on the second line: SourceFile's
+    // running count (checkpoints every 64 bytes) against the plain scan, both ways.
+    const char* pieces[] = {"a", "é", "€", "𝄞"};
+    std::string line;
+    for (int i = 0; i < 10000; ++i) line += pieces[(i * 7 + i / 13) % 4];
+    SourceFile f("x", "first\n" + line + "\nlast\n");
+    uint32_t start = 6, units = 0;
+    for (uint32_t at = start; at <= start + line.size(); ++at) {
+        bool boundary = at == start + line.size() || (static_cast<unsigned char>(f.text()[at]) & 0xC0) != 0x80;
+        if (boundary) {
+            REQUIRE(position(f, at) == json{{"line", 1}, {"character", units}});
+            REQUIRE(offsetOf(f, json{{"line", 1}, {"character", units}}) == at);
+        }
+        if (at < start + line.size()) {
+            auto c = static_cast<unsigned char>(f.text()[at]);
+            units += (c & 0xC0) == 0x80 ? 0 : c >= 0xF0 ? 2 : 1;
+        }
+    }
+    CHECK(offsetOf(f, json{{"line", 1}, {"character", units + 5}}) == start + line.size());  // clamped to the line
+}
+
+TEST_CASE("positions: a line or column past any file (1e300, 2^64) is clamped, a negative or non-numeric one refused") {
+    SourceFile f("x", "ab\ncd\n");
+    CHECK(offsetOf(f, json{{"line", 1e300}, {"character", 0}}) == f.text().size());
+    CHECK(offsetOf(f, json{{"line", 18446744073709551615ull}, {"character", 18446744073709551615ull}}) == f.text().size());
+    CHECK(offsetOf(f, json{{"line", 0}, {"character", 1e300}}) == 2);
+    CHECK_THROWS_WITH(offsetOf(f, json{{"line", -1}, {"character", 0}}), doctest::Contains("a count from 0, not -1"));
+    CHECK_THROWS_WITH(offsetOf(f, json{{"line", "two"}, {"character", 0}}), doctest::Contains("not \"two\""));
+}
+
 namespace {
 
 struct Session {
@@ -243,6 +274,11 @@ struct Session {
 TEST_CASE("protocol: errors for requests before initialize, unknown methods, bad params, after shutdown") {
     Session s;
     CHECK(s.request(1, "textDocument/hover")["error"]["code"] == error::kServerNotInitialized);
+    // A debounce that is not a whole number of milliseconds in range: refused, and the
+    // server not initialised by it.
+    for (json bad : {json(1.5), json(-3), json(1e300), json("soon"), json(600001)})
+        CHECK(s.request(2, "initialize", {{"initializationOptions", {{"debounceMs", bad}}}})["error"]["code"] ==
+              error::kInvalidParams);
     CHECK(s.request(2, "initialize")["result"]["capabilities"]["hoverProvider"] == true);
     CHECK(s.request(3, "initialize")["error"]["code"] == error::kInvalidRequest);
     CHECK(s.request(4, "no/such/method")["error"]["code"] == error::kMethodNotFound);
@@ -317,6 +353,29 @@ TEST_CASE("transport: framing, a header without a length, text that is not JSON,
     CHECK(bad.kind == Incoming::Kind::Malformed);
     CHECK(bad.problem == "the message is not JSON");
     CHECK(t.read(std::nullopt).kind == Incoming::Kind::End);
+    close(fds[0]);
+}
+
+TEST_CASE("transport: a stray newline, a NUL or a header without a length between messages costs one error, not the rest") {
+    int fds[2];
+    REQUIRE(pipe(fds) == 0);
+    auto frame = [](const std::string& method) {
+        std::string body = R"({"jsonrpc":"2.0","method":")" + method + R"("})";
+        return "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body;
+    };
+    std::string input = frame("a") + "\n" + frame("b") + std::string(1, '\0') + frame("c") +
+                        "Content-Type: x\r\n\r\n" + frame("d") + "\r\n" + frame("e");
+    REQUIRE(write(fds[1], input.data(), input.size()) == static_cast<ssize_t>(input.size()));
+    close(fds[1]);
+    Transport t(fds[0], -1);
+    std::string methods;
+    int malformed = 0;
+    for (Incoming m = t.read(std::nullopt); m.kind != Incoming::Kind::End; m = t.read(std::nullopt)) {
+        if (m.kind == Incoming::Kind::Message) methods += m.json["method"].get<std::string>();
+        malformed += m.kind == Incoming::Kind::Malformed;
+    }
+    CHECK(methods == "abcde");
+    CHECK(malformed == 3);  // (a blank line before a header is no error)
     close(fds[0]);
 }
 

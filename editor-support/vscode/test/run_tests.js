@@ -97,7 +97,22 @@ function builtins(grammar) {
     console.log(`built-ins: ${n} names from psysc builtins`);
 }
 
+// The editor's idea of a word (double-click, word-based suggestions): a name or a number,
+// never the operator before it (`n-1` is `n`, `-`, `1`).
+function words() {
+    const config = JSON.parse(fs.readFileSync(path.join(__dirname, "..", "language-configuration.json"), "utf8"));
+    const pattern = new RegExp(config.wordPattern, "g");
+    const cases = { "n-1": ["n", "1"], "x = -2.5e-3": ["x", "2.5e-3"], "pos.y*0.5": ["pos", "y", "0.5"] };
+    for (const [text, expected] of Object.entries(cases)) {
+        const actual = text.match(pattern) || [];
+        check(JSON.stringify(actual) === JSON.stringify(expected),
+              `the words of \`${text}\` are ${JSON.stringify(actual)}, not ${JSON.stringify(expected)}`);
+    }
+    console.log(`words: ${Object.keys(cases).length} cases`);
+}
+
 loadGrammar().then((grammar) => {
+    words();
     goldens(grammar);
     keywords(grammar);
     if (psysc) builtins(grammar);
