@@ -124,7 +124,7 @@ TEST_CASE("a sample runs the same through the C API on the JIT in exact maths an
         for (size_t t = 0; t < psys_type_count(jit.s); ++t) {
             std::vector<psys_point> p = points(jit.s, t), q = points(interp.s, t);
             REQUIRE(p.size() == q.size());
-            CHECK(std::memcmp(p.data(), q.data(), p.size() * sizeof(psys_point)) == 0);
+            if (!p.empty()) CHECK(std::memcmp(p.data(), q.data(), p.size() * sizeof(psys_point)) == 0);
             compared += p.size();
         }
     }
