@@ -82,8 +82,6 @@ protected:
     // the lock held.
     virtual void provide(const std::vector<Request>& requests) = 0;
     void record(const Shape& shape, void* code);
-    bool exact() const { return exact_; }
-    mutable std::mutex mutex_;  // launches may come from several threads
 
 private:
     // The code for a launch shape (provided now if `prepare` did not list it).
@@ -92,6 +90,7 @@ private:
     std::vector<void*> addresses(std::span<const rt::Buffer> columns);
 
     bool exact_;
+    std::mutex mutex_;  // functions_: launches may come from several threads
     rt::HostMemory memory_;
     std::map<Shape, void*> functions_;  // the kernels of prepared modules
 };
