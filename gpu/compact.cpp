@@ -164,7 +164,7 @@ void Compactor::compact(unsigned words, size_t word, size_t n, unsigned out, siz
     if (n == 0) {  // nothing set: the total alone
         uint32_t zero = 0;
         glClearNamedBufferSubData(out, GL_R32UI, static_cast<GLintptr>(at * 4), 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
-        afterWrite(Write::Clear, kHostMap | kCopy);
+        afterWrite(Write::Clear, kCopy);
         return;
     }
     size_t groups = (n + kCompactGroup - 1) / kCompactGroup;
@@ -191,7 +191,7 @@ void Compactor::compact(unsigned words, size_t word, size_t n, unsigned out, siz
     glDispatchCompute(static_cast<GLuint>(groups), 1, 1);
     // The list: the host maps it (a read-back region) or reads it (flagged), a shader may
     // read it next; the mask: whatever reads a column (the draws).
-    afterWrite(Write::Dispatch, kHostMap | kCopy | kStorageBlock | (clear ? kColumnReaders : 0));
+    afterWrite(Write::Dispatch, kCopy | kStorageBlock | (clear ? kColumnReaders : 0));
 }
 
 }  // namespace psys::gpu

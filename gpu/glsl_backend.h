@@ -158,13 +158,15 @@ private:
     // filled on the GPU from word `base` of the words (`fill`) where they are there.
     static std::vector<uint32_t> emitterBlock(GlMemory& memory, const Program& program, const rt::ChildrenLaunch& launch,
                                               uint32_t base, std::vector<BlockFill>& fill);
-    // gpu/glsl_readback.cpp: what a launch sends back, into a region of one mapped buffer,
-    // read at once (one wait) or, for a late launch, when the run-time collects it.
+    // gpu/glsl_readback.cpp: what a launch sends back, into a region of one buffer, read
+    // at once (one wait) or, for a late launch, when the run-time collects it.
     rt::RowsResult readBack(const rt::RowsLaunch& launch, const Program& program, size_t begin, size_t n,
                             const std::vector<uint32_t>& block, Late* late);
     size_t reserveReadback(size_t words);  // a region's first word (late launches' regions kept)
     void ensureReadback(size_t words);
-    const uint32_t* awaitReadback();  // a fence, one wait: the read-back buffer as the GPU left it
+    // Words of the read-back buffer as the GPU left them (the GL waits for it where it must);
+    // valid until the next read.
+    std::span<const uint32_t> readRegion(size_t at, size_t words);
     uint64_t finishLate(std::unique_ptr<Late> late);  // its fence; its ticket
     void settle(Late& late);          // waits for it if it must, and reads its counts and kills
     void hostClearKilled(const rt::RowsLaunch& launch);
@@ -182,7 +184,7 @@ private:
     mutable std::mutex programsMutex_;
     size_t sharedPrograms_ = 0;
     unsigned words_ = 0, counts_ = 0, block_ = 0, readback_ = 0, params_ = 0;
-    const uint32_t* mappedReadback_ = nullptr;
+    std::vector<uint32_t> readCopy_;  // readRegion's words
     size_t readbackWords_ = 0;
     size_t wordsCapacity_ = 0;
     size_t maxWords_ = 0;  // the largest storage block the GL allows, in words

@@ -1,10 +1,16 @@
 // What a launch sends back to the host: its counts, the rows it killed (compacted on the
-// GPU) and its emission columns, copied on the GPU into a region of one buffer the host
-// has mapped (coherent: what the GPU wrote before a fence is there once the fence is
-// passed). The host reads the region after a fence: at once (one wait), or — a late
-// launch (rt::RowsLaunch::late), which sends back only counts and kills — when the
-// run-time collects it (at the next step's start), by which time the GPU has usually finished
-// it and the host does not wait at all.
+// GPU) and its emission columns, copied on the GPU into a region of one buffer. The host
+// reads a region with glGetNamedBufferSubData: at once (one wait), or — a late launch
+// (rt::RowsLaunch::late), which sends back only counts and kills — when the run-time
+// collects it (at the next step's start), by which time the GPU has usually finished it
+// (its fence says so) and the read does not wait.
+//
+// Not through a mapping: a persistent, coherent mapping is right once a fence after the
+// copies has passed (ARB_buffer_storage), and on Mesa 22.3's zink such a fence passed
+// before the copy of a draw's counts had run (the fluid sample at frame 32, the step its
+// pool's columns grow: 132 drops drawn, 0 read; the test "what a draw counts is read
+// back after the copy that carries it"). A read the GL itself makes is ordered after
+// every earlier command on any driver; the fence only says when it will not wait.
 //
 // Regions: an immediate read-back uses the words after those late launches hold; late
 // launches keep theirs until collected (or settled: read into host memory). When the
@@ -13,6 +19,7 @@
 #include <algorithm>
 #include <cstring>
 #include <optional>
+#include <span>
 #include <string>
 #include <stdexcept>
 
@@ -34,9 +41,6 @@ namespace {
 
 constexpr size_t kKillsAt = 4;  // in a region: counts at words 0–3, the kills' total and rows from word 4
 
-// (%s: the invocation's index, kInvocationIndex, and the parameters' block, kParamsBlock.)
-// mask[row of launch row i] = 0 where the kill flag words[flags + i] is set; the row is
-// rows[offset + i] where `mapped` (a creation batch's), else base + i.
 // Waits for `fence` (flushing what is queued), then deletes it.
 void waitFor(GLsync fence) {
     GLenum status = GL_TIMEOUT_EXPIRED;
@@ -79,7 +83,7 @@ rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program
     size_t at = reserveReadback(words);
     std::optional<PassTimer::Scope> timed(std::in_place, &timer_, "read-back", n);
     if (p.counts) glCopyNamedBufferSubData(counts_, readback_, 0, static_cast<GLintptr>(at * 4), 16);
-    if (p.counts) afterWrite(Write::Copy, kHostMap);
+    if (p.counts) afterWrite(Write::Copy, kCopy);
     timed.reset();
     if (kills) {
         // What is drawn before the run-time takes a late launch's kills (at the next step)
@@ -111,35 +115,39 @@ rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program
         glCopyNamedBufferSubData(words_, readback_, static_cast<GLintptr>(r.from * 4),
                                  static_cast<GLintptr>((at + r.at) * 4),
                                  static_cast<GLsizeiptr>(n * GlMemory::wordsPerRow(memory_.elem(r.buffer)) * 4));
-    if (!returned.empty()) afterWrite(Write::Copy, kHostMap);
+    if (!returned.empty()) afterWrite(Write::Copy, kCopy);
     timed.reset();
     if (late) {  // kept for collect(): no wait now
         readbackUsed_ = at + words;
         late->parts.push_back({begin, at, kills && !listed});
         return {};
     }
-    const uint32_t* back = awaitReadback() + at;
+    // One wait: the first read waits for the GPU, the others find their words written.
+    ++memory_.waits;
+    uint32_t head[kKillsAt + 1] = {};
+    std::span<const uint32_t> first = readRegion(at, kills ? kKillsAt + 1 : kKillsAt);
+    std::copy(first.begin(), first.end(), head);
     rt::RowsResult result;
     if (p.counts) {
-        result = {back[0], back[1], back[2], back[3]};
+        result = {head[0], head[1], head[2], head[3]};
         memory_.transferred += 16;
     }
     if (kills) {
         Buffer b = launch.columns[ColumnLayout::kKill];
-        uint32_t killed = back[kKillsAt];
+        uint32_t killed = head[kKillsAt];
         memory_.transferred += (1 + killed) * 4;
         auto* flags = static_cast<uint8_t*>(memory_.host(b)) + begin;
         std::memset(flags, 0, n);
-        for (uint32_t k = 0; k < killed; ++k) {
-            uint32_t row = back[kKillsAt + 1 + k];
+        for (uint32_t row : readRegion(at + kKillsAt + 1, killed)) {
             flags[row] = 1;
             killedRows_.push_back(static_cast<uint32_t>(begin) + row);
         }
     }
     for (const Returned& r : returned) {
         Elem e = memory_.elem(r.buffer);
-        memory_.transferred += n * GlMemory::wordsPerRow(e) * 4;
-        fromWords(back + r.at, e, n, static_cast<char*>(memory_.host(r.buffer)) + begin * rt::elemSize(e));
+        size_t w = n * GlMemory::wordsPerRow(e);
+        memory_.transferred += w * 4;
+        fromWords(readRegion(at + r.at, w).data(), e, n, static_cast<char*>(memory_.host(r.buffer)) + begin * rt::elemSize(e));
     }
     return result;
 }
@@ -159,29 +167,26 @@ size_t GlslBackend::reserveReadback(size_t words) {
     return readbackUsed_;
 }
 
-// A buffer of at least `words` words the host has mapped for reading, written by the GPU.
+// A buffer of at least `words` words, written by the GPU, read by the host (readRegion).
 void GlslBackend::ensureReadback(size_t words) {
     if (words <= readbackWords_) return;
-    if (readback_) {
-        glUnmapNamedBuffer(readback_);
-        glDeleteBuffers(1, &readback_);
-    }
+    if (readback_) glDeleteBuffers(1, &readback_);
     readbackWords_ = std::max(words, 2 * readbackWords_);
     auto bytes = static_cast<GLsizeiptr>(readbackWords_ * 4);
-    GLbitfield flags = GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT;
     glCreateBuffers(1, &readback_);
-    glNamedBufferStorage(readback_, bytes, nullptr, flags | GL_CLIENT_STORAGE_BIT);
+    glNamedBufferStorage(readback_, bytes, nullptr, GL_CLIENT_STORAGE_BIT);
     checkAllocation("reading back", static_cast<size_t>(bytes));
-    mappedReadback_ = static_cast<const uint32_t*>(glMapNamedBufferRange(readback_, 0, bytes, flags));
-    if (!mappedReadback_) throw std::runtime_error("the GL could not map a buffer for reading back");
 }
 
 // The regions were written by copies and the compaction's dispatch, each followed by its
-// barrier (gpu/hazards.h); what a host map needs besides is this fence.
-const uint32_t* GlslBackend::awaitReadback() {
-    waitFor(glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0));
-    ++memory_.waits;
-    return mappedReadback_;
+// barrier (gpu/hazards.h: a dispatch's for a copy, which a read by the GL is); the GL
+// orders the read after them, waiting for them where they have not run.
+std::span<const uint32_t> GlslBackend::readRegion(size_t at, size_t words) {
+    readCopy_.resize(words);
+    if (words)
+        glGetNamedBufferSubData(readback_, static_cast<GLintptr>(at * 4), static_cast<GLsizeiptr>(words * 4),
+                                readCopy_.data());
+    return readCopy_;
 }
 
 uint64_t GlslBackend::finishLate(std::unique_ptr<Late> late) {
@@ -200,17 +205,21 @@ void GlslBackend::settle(Late& late) {
     waitFor(late.fence);
     late.fence = nullptr;
     for (const Late::Part& part : late.parts) {
-        const uint32_t* back = mappedReadback_ + part.at;
-        late.counts.killed += back[0];
-        late.counts.unstable += back[1];
-        late.counts.drawn += back[2];
-        late.counts.nonFinite += back[3];
+        // The counts and the kills' total, then the rows killed (a region has room for
+        // every row of its dispatch).
+        uint32_t head[kKillsAt + 1] = {};
+        std::span<const uint32_t> first = readRegion(part.at, part.kills ? kKillsAt + 1 : kKillsAt);
+        std::copy(first.begin(), first.end(), head);
+        late.counts.killed += head[0];
+        late.counts.unstable += head[1];
+        late.counts.drawn += head[2];
+        late.counts.nonFinite += head[3];
         memory_.transferred += 16;
         if (!part.kills) continue;
-        uint32_t killed = back[kKillsAt];
+        uint32_t killed = head[kKillsAt];
         memory_.transferred += (1 + killed) * 4;
-        for (uint32_t k = 0; k < killed; ++k)
-            late.rows.push_back(static_cast<uint32_t>(part.begin) + back[kKillsAt + 1 + k]);
+        for (uint32_t row : readRegion(part.at + kKillsAt + 1, killed))
+            late.rows.push_back(static_cast<uint32_t>(part.begin) + row);
     }
 }
 

@@ -20,7 +20,6 @@ constexpr ReaderBit kAfterDispatch[] = {
     {kUniformBlock, GL_UNIFORM_BARRIER_BIT},
     {kVertexPull, GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT},
     {kCopy, GL_BUFFER_UPDATE_BARRIER_BIT},
-    {kHostMap, GL_CLIENT_MAPPED_BUFFER_BARRIER_BIT},
 };
 
 int& strict() {
@@ -34,7 +33,7 @@ int& strict() {
 }  // namespace
 
 uint32_t barrierBits(Write write, uint32_t readers) {
-    if (write != Write::Dispatch) return 0;  // the GL orders its own commands; a host map waits for a fence
+    if (write != Write::Dispatch) return 0;  // the GL orders its own commands
     GLbitfield bits = 0;
     for (const ReaderBit& r : kAfterDispatch)
         if (readers & r.reader) bits |= r.bit;

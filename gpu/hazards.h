@@ -4,8 +4,8 @@
 // writes made by shaders: what a dispatch stores into a buffer is not seen by a later
 // texture fetch, vertex pull, copy or host map unless a glMemoryBarrier with the bit of
 // that *reader* comes between (GL 4.5 §7.13.2). Writes made by GL commands themselves —
-// a copy, an upload, a clear — are ordered with every later command by the GL; only a
-// host map needs a fence after them. llvmpipe finishes each dispatch before the call
+// a copy, an upload, a clear — are ordered with every later command by the GL, the host's
+// reads (glGetNamedBufferSubData) among them: nothing reads through a mapping. llvmpipe finishes each dispatch before the call
 // returns and has one cache, so a missing bit passes there and fails on a GPU: hence
 // one table (below), every call site naming what it wrote and who may read it next, and
 // a strict mode that turns every write into a full barrier and a glFinish.
@@ -29,8 +29,7 @@ enum Reader : uint32_t {
     kBufferTexture = 1u << 1,  // a shader's texelFetch from a buffer texture
     kUniformBlock = 1u << 2,   // a shader's uniform block (UBO)
     kVertexPull = 1u << 3,     // vertex attributes (the viewer draws render columns)
-    kCopy = 1u << 4,           // a copy, upload or clear of the buffer, glGetNamedBufferSubData
-    kHostMap = 1u << 5,        // the host through a persistent mapping (after a fence)
+    kCopy = 1u << 4,           // a copy, upload or clear of the buffer; the host's read (glGetNamedBufferSubData)
 };
 
 // Every reader a column may have: kernels read it in place (storage block or buffer
