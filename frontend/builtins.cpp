@@ -3,6 +3,8 @@
 #include "core/integrators.h"
 
 #include <array>
+#include <cstdio>
+#include <string>
 #include <iterator>
 #include <vector>
 
@@ -153,5 +155,32 @@ bool isBuiltinVariable(std::string_view name) {
 }
 
 std::span<const std::string_view> integratorNames() { return core::kIntegratorNames; }
+
+std::string integratorDoc(std::string_view name) {
+    using core::Integrator;
+    auto method = core::integratorFromName(name);
+    if (!method) return "";
+    std::string what, order = "order 1";
+    switch (*method) {
+        case Integrator::Euler: what = "Euler's step: every integrand at the start of the update"; break;
+        case Integrator::SemiImplicit:
+            what = "the default: Euler's step with each integrand in equation order (a velocity, then the "
+                   "position from the new velocity)";
+            break;
+        case Integrator::Midpoint: what = "one more stage, at the middle of the update"; order = "order 2"; break;
+        case Integrator::Rk2: what = "Heun's method: the slopes at the start and at the end, averaged"; order = "order 2"; break;
+        case Integrator::Rk4: what = "the classical Runge–Kutta method: four stages"; order = "order 4"; break;
+        case Integrator::Exponential:
+            what = "Euler's step with each integral's linear decay (a − k·y) solved exactly";
+            order = "order 1, exact while a and k are fixed over the step";
+            break;
+        case Integrator::Exact: what = "the closed form (an error where there is none)"; order = "exact"; break;
+    }
+    double limit = core::stabilityLimit(*method);
+    char stable[96];
+    if (limit > 0) std::snprintf(stable, sizeof stable, "stable for y' = -k·y while k·h < %.4g", limit);
+    else std::snprintf(stable, sizeof stable, "stable for any decay");
+    return what + "; " + order + "; " + stable + ".";
+}
 
 }  // namespace psys

@@ -73,7 +73,9 @@ std::string_view attributeDoc(std::string_view name);  // "" for an unknown attr
 // The words of grammar/Psys.g4 (a test keeps the two in step).
 std::span<const std::string_view> keywords();
 
-// The integrators `@integrator(…)` accepts.
+// The integrators `@integrator(…)` accepts, and what one computes (docs/language.md's
+// table in a sentence, with its order and its stability limit): "" for an unknown name.
 std::span<const std::string_view> integratorNames();
+std::string integratorDoc(std::string_view name);
 
 }  // namespace psys

@@ -68,9 +68,10 @@ public:
         return ok && diags_.errorCount() == 0 ? std::move(program_) : nullptr;
     }
 
-    bool loadText(const fs::path& displayPath, std::string text) {
+    bool loadText(const fs::path& displayPath, std::string text, SourceRange importedAt = {}) {
         std::string key = canonicalKey(displayPath);
         int file = sources_.add(displayPath.string(), std::move(text));
+        sources_.setImportedAt(file, importedAt);
         auto module = parseModule(file, sources_, diags_);
         if (!module) return false;
         stack_.push_back({key, displayPath.string()});
@@ -125,7 +126,7 @@ private:
             diags_.error(import.pathRange, fmt::format("cannot open imported file `{}`: {}", target.string(), error));
             return false;
         }
-        bool ok = loadText(target, std::move(*text));
+        bool ok = loadText(target, std::move(*text), import.pathRange);
         if (auto it = loaded_.find(key); it != loaded_.end()) import.module = it->second;
         return ok;
     }

@@ -100,6 +100,7 @@ std::optional<uint32_t> firstInvalidUtf8(std::string_view text) {
 
 int SourceManager::add(std::string displayPath, std::string text) {
     files_.push_back(std::make_unique<SourceFile>(std::move(displayPath), std::move(text)));
+    importedAt_.emplace_back();
     return count() - 1;
 }
 

@@ -67,9 +67,14 @@ public:
     int add(std::string displayPath, std::string text);
     const SourceFile& file(int id) const { return *files_.at(static_cast<size_t>(id)); }
     int count() const { return static_cast<int>(files_.size()); }
+    // The import that first loaded file `id` (its path's range in the importer); invalid
+    // for the main file. Editors show an imported file's errors at the importer's line.
+    SourceRange importedAt(int id) const { return importedAt_.at(static_cast<size_t>(id)); }
+    void setImportedAt(int id, SourceRange where) { importedAt_.at(static_cast<size_t>(id)) = where; }
 
 private:
     std::vector<std::unique_ptr<SourceFile>> files_;
+    std::vector<SourceRange> importedAt_;
 };
 
 // A file a program names (`@texture("flame.png")`), found beside the program that names

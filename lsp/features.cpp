@@ -1,5 +1,7 @@
 #include "lsp/features.h"
 
+#include <fmt/format.h>
+
 #include "lsp/positions.h"
 
 namespace psys::lsp {
@@ -33,6 +35,21 @@ std::map<std::string, nlohmann::json> diagnosticsByUri(const Analysis& a) {
                                {"message", message}};
         if (!related.empty()) diag["relatedInformation"] = related;
         out[uriFromPath(f.path())].push_back(diag);
+        // An error in an imported file also shows at the main file's import that brings
+        // it in (the file that has it may not be open): `psysc check` of the main file fails.
+        if (d.severity == Severity::Error && r.file != a.mainFile) {
+            SourceRange at = r;
+            while (at.valid() && at.file != a.mainFile) at = a.sources->importedAt(at.file);
+            if (!at.valid()) continue;
+            const SourceFile& main = a.sources->file(a.mainFile);
+            LineColumn lc = f.lineColumn(r.begin);
+            nlohmann::json shown = {{"range", range(main, at.begin, at.end)},
+                                    {"severity", 1},
+                                    {"source", "psysc"},
+                                    {"message", fmt::format("an error in {}:{}:{}: {}", f.path(), lc.line, lc.column, d.message)},
+                                    {"relatedInformation", {{{"location", location(*a.sources, r)}, {"message", d.message}}}}};
+            out[uriFromPath(main.path())].push_back(shown);
+        }
     }
     return out;
 }

@@ -149,6 +149,12 @@ private:
     void attribute(const Attribute& a) {
         add(a.nameRange, code("@" + a.name) + "\n\n" + std::string(attributeDoc(a.name)));
         exprs(a.args);
+        // A method's name is no expression: its hover says what the method computes.
+        if (a.name == "integrator" && a.args.size() == 1 && a.args[0]->kind == ExprKind::Name) {
+            const std::string& method = static_cast<const NameExpr&>(*a.args[0]).name;
+            if (std::string doc = integratorDoc(method); !doc.empty())
+                add(a.args[0]->range, code("@integrator(" + method + ")") + "\n\n" + doc);
+        }
     }
 
     std::vector<Name> paramNames(const std::vector<Param>& params, const std::string& owner) {

@@ -83,8 +83,9 @@ json Server::dispatch(const std::string& method, const json& params, bool* found
         didClose(params);
         return nullptr;
     }
-    if (method == "textDocument/didSave") {
-        // A saved file may be imported by the others: they are analysed again.
+    if (method == "textDocument/didSave" || method == "workspace/didChangeWatchedFiles") {
+        // A saved file, or one changed on disk, may be imported by the open ones: they
+        // are analysed again.
         for (auto& [uri, doc] : docs_) doc.dirty = true, doc.changedAt = Clock::now() - options_.debounce;
         return nullptr;
     }

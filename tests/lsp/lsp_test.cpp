@@ -131,7 +131,56 @@ TEST_CASE("definition across an import, and the imported file's diagnostics go t
     json libDiagnostics = byUri[uriFromPath((dir.path / "lib.psys").string())];
     REQUIRE(libDiagnostics.size() == 1);
     CHECK(libDiagnostics[0]["message"].get<std::string>().find("nope") != std::string::npos);
-    CHECK(byUri[uriFromPath((dir.path / "main.psys").string())].empty());
+    // And at the main file's import line, where the editor is (psysc check of it fails).
+    json mainDiagnostics = byUri[uriFromPath((dir.path / "main.psys").string())];
+    REQUIRE(mainDiagnostics.size() == 1);
+    CHECK(mainDiagnostics[0]["range"]["start"] == json{{"line", 0}, {"character", 7}});
+    CHECK(mainDiagnostics[0]["severity"] == 1);
+    CHECK(mainDiagnostics[0]["message"].get<std::string>().find("lib.psys:1:45: unknown name `nope`") != std::string::npos);
+    CHECK(mainDiagnostics[0]["relatedInformation"][0]["location"]["uri"] == uriFromPath((dir.path / "lib.psys").string()));
+
+    // A syntax error two imports down shows at the main file's import of the first.
+    dir.write("lib.psys", "import \"deep.psys\";\nfn wobble(x: float) -> float = x;\nconst lift = 2;\n");
+    dir.write("deep.psys", "fn f(x: float) -> float = (x;\n");
+    Analysis deep = analyze((dir.path / "main.psys").string(), main);
+    json shown = diagnosticsByUri(deep)[uriFromPath((dir.path / "main.psys").string())];
+    REQUIRE(shown.size() == 1);
+    CHECK(shown[0]["range"]["start"] == json{{"line", 0}, {"character", 7}});
+    CHECK(shown[0]["message"].get<std::string>().find("deep.psys:1:29") != std::string::npos);
+}
+
+TEST_CASE("hover on an integrator's name says what the method computes, its order and its stability") {
+    std::string text = "@integrator(rk4)\nobject o { x = integrate(1); point(vec3(x), white, 1); }\n"
+                       "@integrator(semi_implicit)\nobject p { point(vec3(0), white, 1); }\nspawn o;\nspawn p;\n";
+    Analysis a = analyze("/tmp/int.psys", text);
+    REQUIRE(a.parsed);
+    std::string rk4 = hoverText(a, at(text, "rk4", 1, 1));
+    CHECK(rk4.find("@integrator(rk4)") != std::string::npos);
+    CHECK(rk4.find("order 4") != std::string::npos);
+    CHECK(rk4.find("2.785") != std::string::npos);
+    CHECK(hoverText(a, at(text, "semi_implicit", 1, 2)).find("the default") != std::string::npos);
+}
+
+TEST_CASE("an imported file changed on disk: the open documents are analysed again (didChangeWatchedFiles)") {
+    TempDir dir;
+    dir.write("lib.psys", "const lift = 2;\n");
+    std::string main = "import \"lib.psys\";\nobject o { point(vec3(0, lift, 0), white, 1); }\nspawn o;\n";
+    std::string path = dir.write("main.psys", main);
+    std::vector<json> out;
+    Server server({}, [&](const json& m) { out.push_back(m); });
+    server.handle({{"jsonrpc", "2.0"}, {"id", 1}, {"method", "initialize"}, {"params", json::object()}});
+    server.handle({{"jsonrpc", "2.0"}, {"method", "textDocument/didOpen"},
+                   {"params", {{"textDocument", {{"uri", uriFromPath(path)}, {"version", 1}, {"text", main}}}}}});
+    out.clear();
+    dir.write("lib.psys", "const lyft = 2;\n");
+    server.handle({{"jsonrpc", "2.0"}, {"method", "workspace/didChangeWatchedFiles"},
+                   {"params", {{"changes", {{{"uri", uriFromPath((dir.path / "lib.psys").string())}, {"type", 2}}}}}}});
+    server.idle();
+    size_t errors = 0;
+    for (const json& m : out)
+        if (m.value("method", "") == "textDocument/publishDiagnostics" && m["params"]["uri"] == uriFromPath(path))
+            errors += m["params"]["diagnostics"].size();
+    CHECK(errors == 1);  // `lift` is unknown now
 }
 
 TEST_CASE("definition into the standard library: an `std/` import and its functions") {
