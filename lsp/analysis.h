@@ -51,6 +51,9 @@ struct Analysis {
     std::unique_ptr<SourceManager> sources;
     int mainFile = -1;
     bool parsed = false;  // false: syntax errors (or no file); only the diagnostics are meaningful
+    // The index of an older text that parsed, moved into this one around the edit since
+    // (lsp/recover.h): this text has syntax errors, `diagnostics` are its own.
+    bool recovered = false;
     std::vector<Diagnostic> diagnostics;
     std::vector<Occurrence> occurrences;  // every file's, in the order found
     std::vector<Symbol> symbols;          // the main file's declarations

@@ -4,6 +4,7 @@
 
 #include "lsp/features.h"
 #include "lsp/positions.h"
+#include "lsp/recover.h"
 #include "lsp/transport.h"
 
 namespace psys::lsp {
@@ -182,8 +183,14 @@ Server::Document& Server::document(const json& params) {
 }
 
 void Server::analyse(Document& doc) {
-    doc.analysis = std::make_shared<const Analysis>(analyze(doc.path, doc.text));
-    if (doc.analysis->parsed) doc.lastParsed = doc.analysis;
+    auto fresh = std::make_shared<const Analysis>(analyze(doc.path, doc.text));
+    if (fresh->parsed) doc.lastParsed = fresh;
+    // A syntax error: hover, definition and symbols answer from the last text that parsed,
+    // everywhere the edit since has not touched.
+    if (!fresh->parsed && doc.lastParsed && doc.lastParsed->mainFile >= 0)
+        doc.analysis = std::make_shared<const Analysis>(recover(*doc.lastParsed, *fresh, doc.text));
+    else
+        doc.analysis = fresh;
     doc.dirty = false;
     publish(doc);
 }

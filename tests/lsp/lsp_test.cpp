@@ -11,6 +11,7 @@
 #include "lsp/analysis.h"
 #include "lsp/features.h"
 #include "lsp/positions.h"
+#include "lsp/recover.h"
 #include "lsp/server.h"
 #include "lsp/transport.h"
 
@@ -437,4 +438,59 @@ TEST_CASE("diagnostics: the passes' warnings, as psysc check reports them") {
     CHECK(d[0]["severity"] == 2);
     CHECK(d[0]["message"].get<std::string>().find("is stable only while") != std::string::npos);
     CHECK(d[0]["range"]["start"] == json{{"line", 1}, {"character", 27}});
+}
+
+TEST_CASE("a syntax error does not blank the file: hover, definition and symbols answer from the last text that parsed, away from the edit") {
+    // The fireworks with an unfinished line after `vel`'s equation (line 5).
+    std::string good = kFireworks;
+    std::string broken = good;
+    broken.insert(at(good, "    point(pos, white"), "    x = \n");
+    Session s;
+    s.request(1, "initialize", {{"initializationOptions", {{"debounceMs", 0}}}});
+    std::string uri = "file:///tmp/fw.psys";
+    auto open = [&](const std::string& text, int version) {
+        s.server.handle({{"jsonrpc", "2.0"}, {"method", "textDocument/didOpen"},
+                         {"params", {{"textDocument", {{"uri", uri}, {"version", version}, {"text", text}}}}}});
+    };
+    open(good, 1);
+    s.out.clear();
+    s.server.handle({{"jsonrpc", "2.0"}, {"method", "textDocument/didChange"},
+                     {"params", {{"textDocument", {{"uri", uri}, {"version", 2}}}, {"contentChanges", {{{"text", broken}}}}}}});
+    s.server.idle();
+    bool reported = false;  // the error is reported all the same
+    for (const json& m : s.out)
+        if (m.value("method", "") == "textDocument/publishDiagnostics" && m["params"]["version"] == 2)
+            reported = !m["params"]["diagnostics"].empty();
+    CHECK(reported);
+    auto position = [&](const std::string& text, uint32_t offset) {
+        SourceFile f("/tmp/fw.psys", text);
+        return lsp::position(f, offset);
+    };
+    // Before the edit: `gravity` on line 4; after it, the spark's `rocket.vel`, shifted a line.
+    json h = s.request(2, "textDocument/hover", {{"textDocument", {{"uri", uri}}}, {"position", position(broken, at(broken, "gravity", 2))}});
+    CHECK(h["result"]["contents"]["value"].get<std::string>().find("fn gravity") != std::string::npos);
+    json d = s.request(3, "textDocument/definition", {{"textDocument", {{"uri", uri}}}, {"position", position(broken, at(broken, "rocket.vel", 1, 8))}});
+    CHECK(d["result"]["range"]["start"] == position(broken, at(broken, "vel =")));
+    json symbols = s.request(4, "textDocument/documentSymbol", {{"textDocument", {{"uri", uri}}}});
+    json rocket;
+    for (const json& sym : symbols["result"])
+        if (sym["name"] == "rocket") rocket = sym;
+    REQUIRE(rocket.is_object());
+    CHECK(rocket["range"]["end"]["line"] == 14);  // the object's `}`, a line down
+    CHECK(rocket["children"].size() >= 4);        // its parameter and equations
+    // On the unfinished line itself: nothing known.
+    json none = s.request(5, "textDocument/hover", {{"textDocument", {{"uri", uri}}}, {"position", position(broken, at(broken, "x = ", 1, 1))}});
+    CHECK(none["result"].is_null());
+}
+
+TEST_CASE("edit map: offsets around one edit, both ways") {
+    EditMap m("abcXYZdef", "abcQdef");
+    CHECK(m.toOlder(2) == 2u);
+    CHECK(m.toOlder(3) == 3u);
+    CHECK(m.toOlder(4) == 6u);  // `d`, after the edit
+    CHECK(m.toCurrent(6) == 4u);
+    CHECK_FALSE(m.toCurrent(4).has_value());  // `Y`: replaced
+    EditMap same("abc", "abc");
+    CHECK(same.toCurrent(2) == 2u);
+    CHECK(same.toOlder(3) == 3u);
 }
