@@ -1,10 +1,12 @@
 #include "lsp/server.h"
 
 #include <csignal>
+#include <variant>
 
 #include "lsp/features.h"
 #include "lsp/positions.h"
 #include "lsp/recover.h"
+#include "lsp/references.h"
 #include "lsp/transport.h"
 
 namespace psys::lsp {
@@ -100,6 +102,23 @@ json Server::dispatch(const std::string& method, const json& params, bool* found
         return definition(*doc.analysis, offset(doc));
     }
     if (method == "textDocument/documentSymbol") return documentSymbols(*document(params).analysis);
+    if (method == "textDocument/references") {
+        Document& doc = document(params);
+        auto d = declarationAt(*doc.analysis, offset(doc));
+        if (!d) return nullptr;
+        bool withDeclaration = params.value("context", json::object()).value("includeDeclaration", true);
+        return withUris(references(analyses(), *d, withDeclaration));
+    }
+    if (method == "textDocument/documentHighlight") {
+        Document& doc = document(params);
+        return highlights(*doc.analysis, offset(doc));
+    }
+    if (method == "textDocument/rename") {
+        Document& doc = document(params);
+        auto edit = rename(analyses(), *doc.analysis, offset(doc), params.at("newName").get<std::string>());
+        if (auto* why = std::get_if<std::string>(&edit)) throw RequestError{error::kRequestFailed, *why};
+        return withUris(std::get<json>(std::move(edit)));
+    }
     if (method == "textDocument/completion") {
         Document& doc = document(params);
         const Analysis& scopes = doc.lastParsed ? *doc.lastParsed : *doc.analysis;
@@ -130,6 +149,9 @@ json Server::initialize(const json& params) {
               {"hoverProvider", true},
               {"definitionProvider", true},
               {"documentSymbolProvider", true},
+              {"referencesProvider", true},
+              {"documentHighlightProvider", true},
+              {"renameProvider", true},
               {"completionProvider", {{"triggerCharacters", {".", "@"}}}}}},
             {"serverInfo", {{"name", "psysc"}, {"version", options_.version}}}};
 }
@@ -172,6 +194,33 @@ void Server::didClose(const json& params) {
     for (const std::string& uri : it->second.publishedTo)
         notify("textDocument/publishDiagnostics", {{"uri", uri}, {"diagnostics", json::array()}});
     docs_.erase(it);
+}
+
+std::vector<const Analysis*> Server::analyses() {
+    std::vector<const Analysis*> out;
+    for (auto& [uri, doc] : docs_) {
+        if (doc.dirty) analyse(doc);
+        out.push_back(doc.analysis.get());
+    }
+    return out;
+}
+
+// An answer's URIs as the editor spells its open documents' (a path's own URI may differ).
+json Server::withUris(json answer) const {
+    std::map<std::string, std::string> spelling;
+    for (const auto& [uri, doc] : docs_) spelling[uriFromPath(doc.path)] = uri;
+    auto respell = [&](const std::string& uri) {
+        auto it = spelling.find(uri);
+        return it == spelling.end() ? uri : it->second;
+    };
+    if (answer.is_array()) {
+        for (json& location : answer) location["uri"] = respell(location["uri"]);
+    } else if (answer.is_object() && answer.contains("changes")) {
+        json changes = json::object();
+        for (auto& [uri, edits] : answer["changes"].items()) changes[respell(uri)] = edits;
+        answer["changes"] = changes;
+    }
+    return answer;
 }
 
 Server::Document& Server::document(const json& params) {

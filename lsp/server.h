@@ -12,6 +12,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -58,6 +59,8 @@ private:
     void didChange(const nlohmann::json& params);
     void didClose(const nlohmann::json& params);
     Document& document(const nlohmann::json& params);  // the open document a request names, analysed
+    std::vector<const Analysis*> analyses();  // every open document's, analysed
+    nlohmann::json withUris(nlohmann::json answer) const;
     void analyse(Document& doc);
     void publish(Document& doc);
     void notify(const std::string& method, nlohmann::json params);

@@ -19,6 +19,7 @@ constexpr int kMethodNotFound = -32601;
 constexpr int kInvalidParams = -32602;
 constexpr int kInternalError = -32603;
 constexpr int kServerNotInitialized = -32002;
+constexpr int kRequestFailed = -32803;  // a valid request the server declines (a rename refused), with the reason
 }  // namespace error
 
 // One message read: its JSON, or why it is not JSON (the server answers a parse error).

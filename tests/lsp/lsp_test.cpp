@@ -494,3 +494,93 @@ TEST_CASE("edit map: offsets around one edit, both ways") {
     CHECK(same.toCurrent(2) == 2u);
     CHECK(same.toOlder(3) == 3u);
 }
+
+namespace {
+
+// The uses a references answer lists, as "line:character" in the named file.
+std::vector<std::string> places(const json& locations, const std::string& uri) {
+    std::vector<std::string> out;
+    for (const json& l : locations)
+        if (l["uri"] == uri)
+            out.push_back(std::to_string(l["range"]["start"]["line"].get<int>()) + ":" +
+                          std::to_string(l["range"]["start"]["character"].get<int>()));
+    return out;
+}
+
+json at(Session& s, int id, const std::string& method, const std::string& uri, const std::string& text, uint32_t offset,
+        json extra = json::object()) {
+    SourceFile f("/x.psys", text);
+    json params = {{"textDocument", {{"uri", uri}}}, {"position", lsp::position(f, offset)}};
+    params.update(extra);
+    return s.request(id, method, params);
+}
+
+}  // namespace
+
+TEST_CASE("references: an equation read here, in a nested object's live read and in a swizzle's base; a function across an import") {
+    TempDir dir;
+    std::string lib = "fn wobble(x: float) -> float = sin(x * 3);\n";
+    std::string main = "import \"lib.psys\";\n"
+                       "object rocket {\n"
+                       "    vel = vec3(0, wobble(age), 0);\n"
+                       "    pos = integrate(vel);\n"
+                       "    point(pos, white, vel.y);\n"
+                       "    emit spark() count 1;\n"
+                       "    object spark { point(rocket.vel, white, 1); }\n"
+                       "}\nspawn rocket;\n";
+    std::string libPath = dir.write("lib.psys", lib), mainPath = dir.write("main.psys", main);
+    std::string libUri = uriFromPath(libPath), mainUri = uriFromPath(mainPath);
+    Session s;
+    s.request(1, "initialize");
+    for (auto [uri, text] : {std::pair{libUri, lib}, std::pair{mainUri, main}})
+        s.server.handle({{"jsonrpc", "2.0"}, {"method", "textDocument/didOpen"},
+                         {"params", {{"textDocument", {{"uri", uri}, {"version", 1}, {"text", text}}}}}});
+    json refs = at(s, 2, "textDocument/references", mainUri, main, at(main, "vel", 3, 1), {{"context", {{"includeDeclaration", true}}}});
+    CHECK(places(refs["result"], mainUri) == std::vector<std::string>{"2:4", "3:20", "4:22", "6:32"});
+    json noDecl = at(s, 3, "textDocument/references", mainUri, main, at(main, "vel", 1), {{"context", {{"includeDeclaration", false}}}});
+    CHECK(places(noDecl["result"], mainUri) == std::vector<std::string>{"3:20", "4:22", "6:32"});
+    // The library's function, asked for from the library's own document: its use in main too.
+    json fromLib = at(s, 4, "textDocument/references", libUri, lib, at(lib, "wobble"));
+    CHECK(places(fromLib["result"], libUri) == std::vector<std::string>{"0:3"});
+    CHECK(places(fromLib["result"], mainUri) == std::vector<std::string>{"2:18"});
+    // Highlight: this file's uses, the declaration as a write.
+    json hl = at(s, 5, "textDocument/documentHighlight", mainUri, main, at(main, "pos", 2));
+    REQUIRE(hl["result"].size() == 2);
+    CHECK(hl["result"][0]["kind"] == 3);
+    CHECK(hl["result"][1]["kind"] == 2);
+    // Nothing to find on a built-in or a number.
+    CHECK(at(s, 6, "textDocument/references", mainUri, main, at(main, "white"))["result"].is_null());
+}
+
+TEST_CASE("rename: every use across an import, and refused with the reason for a keyword, a built-in, a clash, the library") {
+    TempDir dir;
+    std::string lib = "const lift = 2;\n";
+    std::string main = "import \"lib.psys\";\nimport \"std/shapes.psys\";\n"
+                       "object o(h: float) {\n    y = lift * h;\n    z = y + 1;\n    point(vec3(0, y, z) + in_sphere(1), white, 1);\n}\n"
+                       "spawn o(2);\n";
+    std::string libPath = dir.write("lib.psys", lib), mainPath = dir.write("main.psys", main);
+    std::string libUri = uriFromPath(libPath), mainUri = uriFromPath(mainPath);
+    Session s;
+    s.request(1, "initialize");
+    s.server.handle({{"jsonrpc", "2.0"}, {"method", "textDocument/didOpen"},
+                     {"params", {{"textDocument", {{"uri", mainUri}, {"version", 1}, {"text", main}}}}}});
+    json r = at(s, 2, "textDocument/rename", mainUri, main, at(main, "lift"), {{"newName", "height"}});
+    REQUIRE(r.contains("result"));
+    CHECK(r["result"]["changes"][libUri].size() == 1);
+    CHECK(r["result"]["changes"][mainUri].size() == 1);
+    CHECK(r["result"]["changes"][mainUri][0]["newText"] == "height");
+    json eq = at(s, 3, "textDocument/rename", mainUri, main, at(main, "y = "), {{"newName", "up"}});
+    CHECK(eq["result"]["changes"][mainUri].size() == 3);  // its equation, `y + 1` and `vec3(0, y, z)`
+    auto refused = [&](uint32_t offset, const std::string& name) {
+        json e = at(s, 4, "textDocument/rename", mainUri, main, offset, {{"newName", name}});
+        CHECK(e["error"]["code"] == error::kRequestFailed);
+        return e["error"].value("message", std::string());
+    };
+    CHECK(refused(at(main, "y = "), "at").find("keyword") != std::string::npos);
+    CHECK(refused(at(main, "y = "), "sin").find("built-in function") != std::string::npos);
+    CHECK(refused(at(main, "y = "), "2y").find("not a name") != std::string::npos);
+    CHECK(refused(at(main, "y = "), "z").find("already declared") != std::string::npos);
+    CHECK(refused(at(main, "y = "), "h").find("already declared") != std::string::npos);
+    CHECK(refused(at(main, "in_sphere"), "ball").find("standard library") != std::string::npos);
+    CHECK(refused(at(main, "white"), "snow").find("no name to rename") != std::string::npos);
+}
