@@ -15,6 +15,7 @@ packages=(
   clang-19 libclang-rt-19-dev
   ffmpeg fonts-dejavu-core
   python3-dev python3-pybind11 python3-numpy python3-pytest
+  neovim
 )
 # Node.js 20 and npm (the editor extension's tests and package) come with the machine;
 # where they do not, Debian's are installed.

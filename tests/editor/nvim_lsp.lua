@@ -1,0 +1,108 @@
+-- Neovim (Debian's 0.7, headless) as the language server's client: its own LSP client
+-- starts `psysc lsp` (vim.lsp.start_client, as editor-support/README.md sets it up for
+-- 0.7), and each feature is asked for as a user's key would ask. Writes "ok <feature>"
+-- per feature and "done" to $PSYS_NVIM_OUT; any failure ends with exit status 1.
+local psysc = os.getenv("PSYSC")
+local dir = os.getenv("PSYS_NVIM_DIR")
+local out = assert(io.open(os.getenv("PSYS_NVIM_OUT"), "w"))
+
+local function fail(what)
+  out:write("FAIL " .. what .. "\n")
+  out:close()
+  vim.cmd("cquit 1")
+end
+local function ok(what) out:write("ok " .. what .. "\n") end
+local function check(cond, what) if not cond then fail(what) end end
+
+local text = {
+  "extern sparks: float = 50;",
+  "fn gravity(m: float) -> vec3 = vec3(0, -9.82 * m, 0);",
+  "@integrator(rk4)",
+  "object rocket(ivel: vec3) {",
+  "    pos = origin + integrate(vel);",
+  "    vel = snapshot(ivel) + integrate(gravity(0.3));",
+  "    point(pos, white, 2);",
+  "    kill when vel.y < 0;",
+  "}",
+  "spawn rocket(vec3(0, 15, 0));",
+}
+local file = dir .. "/fireworks.psys"
+vim.fn.writefile(text, file)
+vim.cmd("edit " .. file)
+vim.bo.filetype = "psys"
+local id = vim.lsp.start_client({ name = "psysc", cmd = { psysc, "lsp", "--debounce", "0" }, root_dir = dir })
+check(id, "the client starts")
+vim.lsp.buf_attach_client(0, id)
+check(vim.wait(10000, function()
+  local c = vim.lsp.get_client_by_id(id)
+  return c ~= nil and c.initialized
+end, 20), "the server initialises")
+ok("initialize")
+
+-- One request at the cursor (row 1-based, column 0-based), its first result.
+local function at(row, col, method, extra)
+  vim.api.nvim_win_set_cursor(0, { row, col })
+  local params = vim.lsp.util.make_position_params()
+  for k, v in pairs(extra or {}) do params[k] = v end
+  local answers = vim.lsp.buf_request_sync(0, method, params, 5000)
+  check(answers ~= nil, method .. " answered")
+  for _, a in pairs(answers) do
+    check(a.error == nil, method .. ": " .. vim.inspect(a.error))
+    return a.result
+  end
+end
+
+local hover = at(6, 40, "textDocument/hover")
+check(hover and hover.contents.value:find("fn gravity", 1, true), "hover on a function: " .. vim.inspect(hover))
+local integrator = at(3, 13, "textDocument/hover")
+check(integrator and integrator.contents.value:find("order 4", 1, true), "hover on an integrator")
+ok("hover")
+
+local def = at(5, 30, "textDocument/definition")
+def = def[1] or def
+check(def.range.start.line == 5 and def.range.start.character == 4, "definition: " .. vim.inspect(def))
+ok("definition")
+
+local refs = at(6, 4, "textDocument/references", { context = { includeDeclaration = true } })
+check(#refs == 3, "references to vel: " .. vim.inspect(refs))
+ok("references")
+
+local hl = at(5, 4, "textDocument/documentHighlight")
+check(#hl == 2 and hl[1].kind == 3, "highlights of pos: " .. vim.inspect(hl))
+ok("documentHighlight")
+
+local symbols = at(1, 0, "textDocument/documentSymbol")
+local names = {}
+for _, s in ipairs(symbols) do names[#names + 1] = s.name end
+check(vim.tbl_contains(names, "rocket") and vim.tbl_contains(names, "gravity"), "symbols: " .. vim.inspect(names))
+ok("documentSymbol")
+
+local items = at(7, 4, "textDocument/completion")
+items = items.items or items
+local labels = {}
+for _, i in ipairs(items) do labels[i.label] = true end
+check(labels["vel"] and labels["sparks"], "completion inside rocket")
+ok("completion")
+
+-- Rename `vel` to `speed`: the edit applied to the buffer as the client applies it.
+local edit = at(6, 4, "textDocument/rename", { newName = "speed" })
+vim.lsp.util.apply_workspace_edit(edit, "utf-16")
+local lines = vim.api.nvim_buf_get_lines(0, 0, -1, false)
+check(lines[5] == "    pos = origin + integrate(speed);", "renamed: " .. lines[5])
+check(lines[8] == "    kill when speed.y < 0;", "renamed: " .. lines[8])
+local refused = vim.lsp.buf_request_sync(0, "textDocument/rename",
+  vim.tbl_extend("force", vim.lsp.util.make_position_params(), { newName = "at" }), 5000)
+for _, a in pairs(refused) do check(a.error and a.error.message:find("keyword", 1, true), "a keyword refused") end
+ok("rename")
+
+-- Diagnostics: a typo is published, as the client shows it.
+vim.api.nvim_buf_set_lines(0, 6, 7, false, { "    point(pso, white, 2);" })
+check(vim.wait(10000, function() return #vim.diagnostic.get(0) > 0 end, 20), "a diagnostic arrives")
+local d = vim.diagnostic.get(0)[1]
+check(d.lnum == 6 and d.message:find("pso", 1, true), "the diagnostic: " .. vim.inspect(d))
+ok("diagnostics")
+
+out:write("done\n")
+out:close()
+vim.lsp.stop_client(id)
+vim.cmd("qa!")
