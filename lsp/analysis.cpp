@@ -1,11 +1,15 @@
 #include "lsp/analysis.h"
 
+#include <cmath>
 #include <exception>
+
+#include <fmt/format.h>
 
 #include "driver/compile.h"
 #include "frontend/frontend.h"
 #include "frontend/loader.h"
 #include "lsp/index_builder.h"
+#include "opt/passes.h"
 
 namespace psys::lsp {
 
@@ -17,6 +21,31 @@ const Occurrence* Analysis::at(int file, uint32_t offset) const {
     }
     return best;
 }
+
+namespace {
+
+// "1/240 s" where a step is a whole fraction of a second, else its seconds.
+std::string stepText(float step) {
+    double per = 1.0 / step;
+    if (std::abs(per - std::round(per)) < 1e-3 * per) return fmt::format("1/{:g} s", std::round(per));
+    return fmt::format("{:g} s", step);
+}
+
+// How each object of the main file that integrates is solved: its method (the one rule,
+// opt::methodOf) and its step, from the compiled module.
+void methodHints(const ir::Module& module, Analysis& a) {
+    for (const ir::Object& o : module.objects) {
+        SourceRange at = sourceRange(*a.sources, o.loc);
+        bool integrates = false;
+        for (SourceRange r : a.integrating) integrates |= r.file == at.file && r.begin == at.begin;
+        if (!integrates) continue;
+        std::string label = std::string(core::integratorName(opt::methodOf(o, {})));
+        label += o.attributes.step > 0 ? ", step " + stepText(o.attributes.step) : ", a step per update";
+        a.hints.push_back({at, label, 2});
+    }
+}
+
+}  // namespace
 
 Analysis analyze(const std::string& path, std::string text) {
     Analysis a;
@@ -32,7 +61,8 @@ Analysis analyze(const std::string& path, std::string text) {
             // What `psysc check` reports beyond the front end comes from the passes: an
             // integral with no closed form under @integrator(exact), a decay past the
             // integrator's stability limit. They run on a clean program only.
-            if (diags.errorCount() == 0) compileProgram(program.get(), *a.sources, diags);
+            if (diags.errorCount() == 0)
+                if (auto module = compileProgram(program.get(), *a.sources, diags)) methodHints(*module, a);
         }
     } catch (const std::exception& e) {
         // The front end's own failure must not end the editing session: it is reported

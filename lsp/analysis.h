@@ -34,6 +34,14 @@ struct Symbol {
     std::vector<Symbol> children;
 };
 
+// A note the editor shows inside the text (textDocument/inlayHint): an equation's or a
+// let's inferred type after its name, the integrator and step an object runs with.
+struct Hint {
+    SourceRange at;  // shown at at.end
+    std::string label;
+    int kind;        // the protocol's InlayHintKind: 1 a type, 2 a parameter (the method)
+};
+
 struct Name {
     std::string label, detail, documentation;
     CompletionKind kind;
@@ -59,6 +67,8 @@ struct Analysis {
     std::vector<Symbol> symbols;          // the main file's declarations
     std::vector<Name> globals;            // the file scope: every module's declarations
     std::vector<Scope> scopes;
+    std::vector<Hint> hints;              // the main file's
+    std::vector<SourceRange> integrating;  // the main file's objects that integrate (name ranges)
     std::vector<std::pair<std::string, std::vector<Name>>> members;  // per object: what `object.` reads
 
     // The innermost occurrence at `offset` of `file` (its end counts: the cursor just after a name).

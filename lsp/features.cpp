@@ -83,6 +83,17 @@ nlohmann::json symbolJson(const SourceFile& f, const Symbol& s) {
 
 }  // namespace
 
+nlohmann::json inlayHints(const Analysis& a, uint32_t begin, uint32_t end) {
+    nlohmann::json out = nlohmann::json::array();
+    if (!a.parsed) return out;
+    const SourceFile& f = a.sources->file(a.mainFile);
+    for (const Hint& h : a.hints) {
+        if (h.at.file != a.mainFile || h.at.end < begin || h.at.end > end) continue;
+        out.push_back({{"position", position(f, h.at.end)}, {"label", h.label}, {"kind", h.kind}, {"paddingLeft", h.kind == 2}});
+    }
+    return out;
+}
+
 nlohmann::json documentSymbols(const Analysis& a) {
     nlohmann::json out = nlohmann::json::array();
     if (!a.parsed) return out;

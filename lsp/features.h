@@ -19,6 +19,8 @@ std::map<std::string, nlohmann::json> diagnosticsByUri(const Analysis& a);
 nlohmann::json hover(const Analysis& a, uint32_t offset);
 nlohmann::json definition(const Analysis& a, uint32_t offset);
 nlohmann::json documentSymbols(const Analysis& a);
+// The hints whose place is in [begin, end] of the main file.
+nlohmann::json inlayHints(const Analysis& a, uint32_t begin, uint32_t end);
 
 // `text` is the document as it is now, `offset` the cursor's byte in it; `scopes` come from
 // the latest analysis that parsed (maybe of an older text: ranges are near enough).

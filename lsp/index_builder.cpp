@@ -38,6 +38,7 @@ public:
     Walker(const Program& program, Analysis& out) : program_(program), out_(out) {}
 
     void module(const Module& m, bool main) {
+        main_ = main;
         for (const DeclPtr& d : m.decls) decl(*d, main);
     }
 
@@ -88,6 +89,7 @@ private:
             }
             case ExprKind::Call: {
                 auto& c = static_cast<const CallExpr&>(e);
+                if (c.builtin >= 0 && builtinFunction(c.builtin).name == "integrate") integrates_ = true;
                 if (c.fn) add(c.calleeRange, code(signature(*c.fn)), c.fn->nameRange);
                 else if (c.builtin >= 0) add(c.calleeRange, code(std::string(builtinFunction(c.builtin).signature)) + "\n\nbuilt-in function");
                 for (const ExprPtr& a : c.args) expr(*a);
@@ -177,9 +179,12 @@ private:
             s.children.push_back({p.name, paramText(p), SymbolKind::Property, p.nameRange, p.nameRange, {}});
             members.push_back({p.name, paramText(p), "parameter of `" + o.name + "`", CompletionKind::Property});
         }
+        integrates_ = false;
         for (const EquationPtr& eq : o.equations) {
             for (size_t i = 0; i < eq->names.size(); ++i) {
                 std::string t = eq->names[i] + ": " + (i < eq->types.size() ? typeText(eq->types[i]) : "?");
+                if (main_ && i < eq->types.size() && !eq->types[i].isVague())
+                    out_.hints.push_back({eq->nameRanges[i], ": " + eq->types[i].str(), 1});
                 add(eq->nameRanges[i], code(t) + "\n\nequation of `" + o.name + "`", eq->nameRanges[i]);
                 s.children.push_back({eq->names[i], t, SymbolKind::Field, eq->range, eq->nameRanges[i], {}});
                 scope.names.push_back({eq->names[i], t, "equation of `" + o.name + "`", CompletionKind::Field});
@@ -187,6 +192,7 @@ private:
             }
             expr(*eq->value);
         }
+        if (main_ && integrates_) out_.integrating.push_back(o.nameRange);
         commands(o.commands);
         for (const ObjectDecl* e : enclosing)
             scope.names.push_back({e->name, signature(*e), "an enclosing object: read it live as `" + e->name + ".name`",
@@ -232,6 +238,7 @@ private:
                 Scope scope{f.range, paramNames(f.params, "`" + f.name + "`")};
                 for (const auto& let : f.lets) {
                     std::string t = "let " + let->name + ": " + typeText(let->type);
+                    if (main && !let->type.isVague()) out_.hints.push_back({let->nameRange, ": " + let->type.str(), 1});
                     add(let->nameRange, code(t), let->nameRange);
                     scope.names.push_back({let->name, t, "", CompletionKind::Variable});
                     expr(*let->value);
@@ -280,6 +287,8 @@ private:
 
     const Program& program_;
     Analysis& out_;
+    bool main_ = false;        // walking the main file
+    bool integrates_ = false;  // the object being walked calls integrate
 };
 
 }  // namespace

@@ -102,6 +102,11 @@ json Server::dispatch(const std::string& method, const json& params, bool* found
         return definition(*doc.analysis, offset(doc));
     }
     if (method == "textDocument/documentSymbol") return documentSymbols(*document(params).analysis);
+    if (method == "textDocument/inlayHint") {
+        Document& doc = document(params);
+        const SourceFile& f = doc.analysis->sources->file(doc.analysis->mainFile);
+        return inlayHints(*doc.analysis, offsetOf(f, params.at("range").at("start")), offsetOf(f, params.at("range").at("end")));
+    }
     if (method == "textDocument/references") {
         Document& doc = document(params);
         auto d = declarationAt(*doc.analysis, offset(doc));
@@ -152,6 +157,7 @@ json Server::initialize(const json& params) {
               {"referencesProvider", true},
               {"documentHighlightProvider", true},
               {"renameProvider", true},
+              {"inlayHintProvider", true},
               {"completionProvider", {{"triggerCharacters", {".", "@"}}}}}},
             {"serverInfo", {{"name", "psysc"}, {"version", options_.version}}}};
 }

@@ -584,3 +584,33 @@ TEST_CASE("rename: every use across an import, and refused with the reason for a
     CHECK(refused(at(main, "in_sphere"), "ball").find("standard library") != std::string::npos);
     CHECK(refused(at(main, "white"), "snow").find("no name to rename") != std::string::npos);
 }
+
+TEST_CASE("inlay hints: each equation's and let's type, and how each object that integrates is solved") {
+    std::string text = "@integrator(rk4)\n"
+                       "object rocket(ivel: vec3) {\n"
+                       "    pos = origin + integrate(vel);\n"
+                       "    vel = snapshot(ivel) + integrate(vec3(0, -9.8, 0));\n"
+                       "    point(pos, white, 2);\n"
+                       "}\n"
+                       "@step(1/240)\n"
+                       "object plain { c = 2; x = integrate(c); point(vec3(x), white, 1); }\n"
+                       "object still { s = 1; point(vec3(s), white, 1); }\n"
+                       "fn f(a: float) -> float {\n    let b = a * 2;\n    b\n}\n"
+                       "spawn rocket(vec3(0, 5, 0));\nspawn plain;\nspawn still;\n";
+    Analysis a = analyze("/tmp/hints.psys", text);
+    REQUIRE(a.parsed);
+    json hints = inlayHints(a, 0, static_cast<uint32_t>(text.size()));
+    std::map<std::string, std::string> byPlace;  // "line:character" → label
+    for (const json& h : hints)
+        byPlace[std::to_string(h["position"]["line"].get<int>()) + ":" + std::to_string(h["position"]["character"].get<int>())] =
+            h["label"].get<std::string>();
+    CHECK(byPlace["2:7"] == ": vec3");                      // pos
+    CHECK(byPlace["3:7"] == ": vec3");                      // vel
+    CHECK(byPlace["1:13"] == "rk4, a step per update");     // rocket: its @integrator
+    CHECK(byPlace["7:12"] == "semi_implicit, step 1/240 s");  // plain: the default method, its @step
+    CHECK(byPlace["8:16"] == ": float");                    // still's s …
+    CHECK(byPlace.count("8:12") == 0);                      // … and no method: it integrates nothing
+    CHECK(byPlace["10:9"] == ": float");                    // let b
+    // Only those in the range asked for.
+    CHECK(inlayHints(a, at(text, "object plain"), at(text, "object still")).size() == 3);
+}
