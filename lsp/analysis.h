@@ -53,6 +53,7 @@ struct Name {
 struct Scope {
     SourceRange range;
     std::vector<Name> names;
+    bool pure = false;  // a fn's body: no history, no age or time, no externs or objects
 };
 
 struct Analysis {

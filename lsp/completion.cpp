@@ -1,7 +1,8 @@
 // Completion: what may be written at the cursor. After `name.`, what an enclosing object
-// offers to be read live; after `@`, the attributes; inside `@integrator(`, the methods;
-// elsewhere the names in scope (the object's, fn's or trigger's own, then the file's),
-// the built-ins and the keywords.
+// offers to be read live, or a vector's components; after `@`, the attributes; inside
+// `@integrator(`, the methods; elsewhere the names in scope (the object's, fn's or
+// trigger's own, then the file's), the built-ins and the keywords — in a fn's body only
+// what a fn may read (no age, time or dt, no externs, objects or triggers, no history).
 #include <cctype>
 #include <set>
 
@@ -33,6 +34,46 @@ std::vector<Name> builtinNames() {
         names.push_back({std::string(v), "float", "built-in variable", CompletionKind::Variable});
     for (std::string_view t : Type::names()) names.push_back({std::string(t), "type", "", CompletionKind::TypeParameter});
     return names;
+}
+
+// What a fn's body may not name (the checker's errors there).
+bool impure(const Name& n) {
+    if (n.kind == CompletionKind::Class || n.kind == CompletionKind::Event) return true;
+    if (n.detail.starts_with("extern ")) return true;
+    if (n.kind == CompletionKind::Variable && isBuiltinVariable(n.label) && n.documentation == "built-in variable") return true;
+    int f = n.kind == CompletionKind::Function ? findBuiltinFunction(n.label) : -1;
+    return f >= 0 && n.documentation == "built-in function" && isTemporal(builtinFunction(f).rule);
+}
+
+// A vector's components and its common swizzles, for a value of `width` components.
+std::vector<Name> swizzles(int width) {
+    static const char* xyzw = "xyzw";
+    static const char* rgba = "rgba";
+    std::vector<Name> names;
+    auto add = [&](std::string s) { names.push_back({s, "swizzle", "", CompletionKind::Field}); };
+    for (int i = 0; i < width; ++i) add(std::string(1, xyzw[i]));
+    for (int i = 0; i < width; ++i) add(std::string(1, rgba[i]));
+    add("xy");
+    if (width >= 3) add("xz"), add("yz"), add("xyz"), add("rgb");
+    return names;
+}
+
+// The width of a vector a name in scope at `offset` holds (its detail ends in `: vecN`), or 0.
+int vectorWidth(const Analysis& a, const std::string& name, uint32_t offset) {
+    auto width = [](const Name& n) {
+        size_t colon = n.detail.rfind(": ");
+        std::string t = colon == std::string::npos ? n.detail : n.detail.substr(colon + 2);
+        return t == "vec2" ? 2 : t == "vec3" || t == "color" || t == "point" ? 3 : t == "vec4" ? 4 : 0;
+    };
+    for (const Scope& s : a.scopes)
+        if (s.range.file == a.mainFile && s.range.begin <= offset && offset <= s.range.end)
+            for (const Name& n : s.names)
+                if (n.label == name) return width(n);
+    for (const Name& n : a.globals)
+        if (n.label == name) return width(n);
+    for (const BuiltinConstant& c : builtinConstants())
+        if (c.name == name) return c.type.width() > 1 ? c.type.width() : 0;
+    return 0;
 }
 
 // The text before `offset` without trailing blanks.
@@ -74,19 +115,25 @@ nlohmann::json completion(const Analysis& a, const std::string& text, uint32_t o
         std::string base = text.substr(baseStart, start - 1 - baseStart);
         for (const auto& [object, members] : a.members)
             if (object == base) names = members;
+        if (names.empty())
+            if (int width = a.parsed ? vectorWidth(a, base, offset) : 0) names = swizzles(width);
     } else if (start > 0 && text[start - 1] == '@') {
         for (const BuiltinAttribute& at : builtinAttributes())
             names.push_back({std::string(at.name), std::string(at.signature), std::string(at.doc), CompletionKind::Property});
     } else if (lead.size() >= 1 && lead.back() == '(' && before(text, lead.size() - 1).ends_with("@integrator")) {
         for (std::string_view m : integratorNames()) names.push_back({std::string(m), "integrator", "", CompletionKind::Constant});
     } else {
+        bool pure = false;
         if (a.parsed)
             for (const Scope& s : a.scopes)
-                if (s.range.file == a.mainFile && s.range.begin <= offset && offset <= s.range.end)
+                if (s.range.file == a.mainFile && s.range.begin <= offset && offset <= s.range.end) {
                     names.insert(names.end(), s.names.begin(), s.names.end());
+                    pure |= s.pure;
+                }
         names.insert(names.end(), a.globals.begin(), a.globals.end());
         std::vector<Name> builtins = builtinNames();
         names.insert(names.end(), builtins.begin(), builtins.end());
+        if (pure) std::erase_if(names, impure);
     }
     nlohmann::json items = nlohmann::json::array();
     std::set<std::string> seen;  // the innermost declaration of a name wins

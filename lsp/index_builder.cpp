@@ -235,7 +235,7 @@ private:
             case DeclKind::Fn: {
                 auto& f = static_cast<const FnDecl&>(d);
                 add(f.nameRange, code(signature(f)), f.nameRange);
-                Scope scope{f.range, paramNames(f.params, "`" + f.name + "`")};
+                Scope scope{f.range, paramNames(f.params, "`" + f.name + "`"), true};
                 for (const auto& let : f.lets) {
                     std::string t = "let " + let->name + ": " + typeText(let->type);
                     if (main && !let->type.isVague()) out_.hints.push_back({let->nameRange, ": " + let->type.str(), 1});

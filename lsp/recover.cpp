@@ -87,7 +87,7 @@ Analysis recover(const Analysis& good, const Analysis& current, const std::strin
     for (Symbol s : good.symbols)
         if (move.symbol(s)) out.symbols.push_back(std::move(s));
     for (Scope s : good.scopes)
-        if (auto range = move.spanning(s.range)) out.scopes.push_back({*range, std::move(s.names)});
+        if (auto range = move.spanning(s.range)) out.scopes.push_back({*range, std::move(s.names), s.pure});
     for (const Hint& h : good.hints)
         if (auto at = move.strict(h.at)) out.hints.push_back({*at, h.label, h.kind});
     out.globals = good.globals;

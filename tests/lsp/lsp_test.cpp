@@ -614,3 +614,22 @@ TEST_CASE("inlay hints: each equation's and let's type, and how each object that
     // Only those in the range asked for.
     CHECK(inlayHints(a, at(text, "object plain"), at(text, "object still")).size() == 3);
 }
+
+TEST_CASE("completion: in a fn's body only what a fn may name; after a vector's name its components") {
+    std::string text = "const k = 2;\nextern e: float = 1;\n"
+                       "fn f(a: float) -> float = a + k;\n"
+                       "object o(ivel: vec3) {\n    pos = vec3(1, 2, 3) + ivel;\n    c = pos.x;\n    point(pos, white, 1);\n}\n"
+                       "spawn o(vec3(0));\n";
+    Analysis a = analyze("/tmp/c.psys", text);
+    REQUIRE(a.parsed);
+    std::vector<std::string> inFn = labels(completion(a, text, at(text, "a + k", 1, 4)));
+    for (const char* ok : {"a", "k", "sin", "rand", "pi"}) CHECK_MESSAGE(has(inFn, ok), ok);
+    for (const char* bad : {"age", "dt", "time", "e", "o", "integrate", "snapshot", "prev"}) CHECK_MESSAGE(!has(inFn, bad), bad);
+    // In an object, the same names are offered.
+    std::vector<std::string> inObject = labels(completion(a, text, at(text, "pos.x", 1, 0)));
+    for (const char* ok : {"age", "e", "integrate", "pos", "ivel"}) CHECK_MESSAGE(has(inObject, ok), ok);
+    // After `pos.`: its components and swizzles.
+    std::vector<std::string> members = labels(completion(a, text, at(text, "pos.x", 1, 4)));
+    for (const char* ok : {"x", "y", "z", "r", "g", "b", "xyz"}) CHECK_MESSAGE(has(members, ok), ok);
+    CHECK_FALSE(has(members, "w"));
+}
