@@ -5,6 +5,7 @@
 
 #include <map>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -25,6 +26,13 @@ nlohmann::json inlayHints(const Analysis& a, uint32_t begin, uint32_t end);
 // `text` is the document as it is now, `offset` the cursor's byte in it; `scopes` come from
 // the latest analysis that parsed (maybe of an older text: ranges are near enough).
 nlohmann::json completion(const Analysis& scopes, const std::string& text, uint32_t offset);
+
+// lsp/outline.cpp: folding ranges of the main file; the open documents' symbols whose
+// names hold the query's letters in order (workspace/symbol); the signature of the call
+// around the cursor with the argument it is in (`text` as now, as for completion).
+nlohmann::json foldingRanges(const Analysis& a);
+nlohmann::json workspaceSymbols(const std::vector<const Analysis*>& analyses, const std::string& query);
+nlohmann::json signatureHelp(const Analysis& a, const std::string& text, uint32_t offset);
 
 // The language's own words by category (keywords, functions, constants, variables,
 // types, attributes, integrators): `psysc builtins`, which the editor grammars' tests read.

@@ -102,6 +102,13 @@ json Server::dispatch(const std::string& method, const json& params, bool* found
         return definition(*doc.analysis, offset(doc));
     }
     if (method == "textDocument/documentSymbol") return documentSymbols(*document(params).analysis);
+    if (method == "textDocument/foldingRange") return foldingRanges(*document(params).analysis);
+    if (method == "workspace/symbol") return withUris(workspaceSymbols(analyses(), params.value("query", std::string())));
+    if (method == "textDocument/signatureHelp") {
+        Document& doc = document(params);
+        const Analysis& names = doc.lastParsed ? *doc.lastParsed : *doc.analysis;
+        return signatureHelp(names, doc.text, offset(doc));
+    }
     if (method == "textDocument/inlayHint") {
         Document& doc = document(params);
         const SourceFile& f = doc.analysis->sources->file(doc.analysis->mainFile);
@@ -158,6 +165,9 @@ json Server::initialize(const json& params) {
               {"documentHighlightProvider", true},
               {"renameProvider", true},
               {"inlayHintProvider", true},
+              {"foldingRangeProvider", true},
+              {"workspaceSymbolProvider", true},
+              {"signatureHelpProvider", {{"triggerCharacters", {"(", ","}}}},
               {"completionProvider", {{"triggerCharacters", {".", "@"}}}}}},
             {"serverInfo", {{"name", "psysc"}, {"version", options_.version}}}};
 }
@@ -220,7 +230,10 @@ json Server::withUris(json answer) const {
         return it == spelling.end() ? uri : it->second;
     };
     if (answer.is_array()) {
-        for (json& location : answer) location["uri"] = respell(location["uri"]);
+        for (json& entry : answer) {  // locations, or symbols with one
+            json& location = entry.contains("location") ? entry["location"] : entry;
+            location["uri"] = respell(location["uri"]);
+        }
     } else if (answer.is_object() && answer.contains("changes")) {
         json changes = json::object();
         for (auto& [uri, edits] : answer["changes"].items()) changes[respell(uri)] = edits;

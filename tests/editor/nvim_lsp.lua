@@ -96,6 +96,20 @@ check(vim.tbl_contains(labels, ": vec3") and vim.tbl_contains(labels, "rk4, a st
   "inlay hints: " .. vim.inspect(labels))
 ok("inlayHint")
 
+local help = at(6, 46, "textDocument/signatureHelp")
+check(help and help.signatures[1].label:find("fn gravity", 1, true) and help.activeParameter == 0, "signature help")
+ok("signatureHelp")
+local folds = vim.lsp.buf_request_sync(0, "textDocument/foldingRange", { textDocument = vim.lsp.util.make_text_document_params() }, 5000)
+local rocketFold = false
+for _, a in pairs(folds) do for _, f in ipairs(a.result or {}) do rocketFold = rocketFold or (f.startLine <= 3 and f.endLine == 8) end end
+check(rocketFold, "the object folds: " .. vim.inspect(folds))
+ok("foldingRange")
+local ws = vim.lsp.buf_request_sync(0, "workspace/symbol", { query = "grav" }, 5000)
+local found = false
+for _, a in pairs(ws) do for _, s in ipairs(a.result or {}) do found = found or s.name == "gravity" end end
+check(found, "workspace symbol")
+ok("workspaceSymbol")
+
 -- Rename `vel` to `speed`: the edit applied to the buffer as the client applies it.
 local edit = at(6, 4, "textDocument/rename", { newName = "speed" })
 vim.lsp.util.apply_workspace_edit(edit, "utf-16")

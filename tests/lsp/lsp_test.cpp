@@ -633,3 +633,44 @@ TEST_CASE("completion: in a fn's body only what a fn may name; after a vector's 
     for (const char* ok : {"x", "y", "z", "r", "g", "b", "xyz"}) CHECK_MESSAGE(has(members, ok), ok);
     CHECK_FALSE(has(members, "w"));
 }
+
+TEST_CASE("folding ranges, workspace symbols across open documents, signature help for a call") {
+    std::string text = "// A rocket.\n// Two lines of comment.\nfn lift(m: float, k: vec3) -> vec3 = k * m;\n"
+                       "/* a block\n   comment */\n"
+                       "object rocket {\n    vel = lift(2, vec3(0, clamp(age, 0, 1), 0));\n"
+                       "    point(vel, white, 1);\n}\nspawn rocket;\n";
+    Analysis a = analyze("/tmp/o.psys", text);
+    REQUIRE(a.parsed);
+    json folds = foldingRanges(a);
+    auto folded = [&](int first, int last, const char* kind) {
+        for (const json& f : folds)
+            if (f["startLine"] == first && f["endLine"] == last && f["kind"] == kind) return true;
+        return false;
+    };
+    CHECK(folded(0, 1, "comment"));  // two `//` lines
+    CHECK(folded(3, 4, "comment"));  // the block comment
+    CHECK(folded(5, 8, "region"));   // the object
+    CHECK(folds.size() == 3);         // (the one-line fn does not fold)
+
+    std::string other = "object puff { point(vec3(0), white, 1); }\nspawn puff;\n";
+    Analysis b = analyze("/tmp/p.psys", other);
+    REQUIRE(b.parsed);
+    json symbols = workspaceSymbols({&a, &b}, "rk");  // r…k: rocket, and not puff
+    REQUIRE(symbols.size() == 1);
+    CHECK(symbols[0]["name"] == "rocket");
+    CHECK(workspaceSymbols({&a, &b}, "").size() == 4);  // lift, rocket, vel, puff
+    json vel = workspaceSymbols({&a, &b}, "vel");
+    REQUIRE(vel.size() == 1);
+    CHECK(vel[0]["containerName"] == "rocket");
+
+    // In `lift(2, vec3(…))` at the second argument; inside clamp's first.
+    json help = signatureHelp(a, text, at(text, "vec3(0, clamp"));
+    CHECK(help["signatures"][0]["label"].get<std::string>().starts_with("fn lift(m: float, k: vec3)"));
+    CHECK(help["activeParameter"] == 1);
+    json p = help["signatures"][0]["parameters"][1]["label"];
+    CHECK(help["signatures"][0]["label"].get<std::string>().substr(p[0].get<size_t>(), p[1].get<size_t>() - p[0].get<size_t>()) == "k: vec3");
+    json inner = signatureHelp(a, text, at(text, "age, 0, 1", 1, 3));
+    CHECK(inner["signatures"][0]["label"].get<std::string>().starts_with("clamp("));
+    CHECK(inner["activeParameter"] == 0);
+    CHECK(signatureHelp(a, text, at(text, "spawn")).is_null());
+}
