@@ -517,7 +517,7 @@ json at(Session& s, int id, const std::string& method, const std::string& uri, c
 
 }  // namespace
 
-TEST_CASE("references: an equation read here, in a nested object's live read and in a swizzle's base; a function across an import") {
+TEST_CASE("references: an equation read here, in a nested object's live read and in a swizzle's base, a function across an import") {
     TempDir dir;
     std::string lib = "fn wobble(x: float) -> float = sin(x * 3);\n";
     std::string main = "import \"lib.psys\";\n"
@@ -615,7 +615,7 @@ TEST_CASE("inlay hints: each equation's and let's type, and how each object that
     CHECK(inlayHints(a, at(text, "object plain"), at(text, "object still")).size() == 3);
 }
 
-TEST_CASE("completion: in a fn's body only what a fn may name; after a vector's name its components") {
+TEST_CASE("completion: in a fn's body only what a fn may name, after a vector's name its components") {
     std::string text = "const k = 2;\nextern e: float = 1;\n"
                        "fn f(a: float) -> float = a + k;\n"
                        "object o(ivel: vec3) {\n    pos = vec3(1, 2, 3) + ivel;\n    c = pos.x;\n    point(pos, white, 1);\n}\n"
