@@ -14,18 +14,15 @@
 #include "frontend/parse.h"
 
 namespace psys {
-namespace {
 
-namespace fs = std::filesystem;
-
-std::optional<std::string> readFile(const fs::path& path, std::string& error) {
+std::optional<std::string> readSourceFile(const std::filesystem::path& path, std::string& error) {
     std::error_code ec;
-    if (fs::is_directory(path, ec)) {
+    if (std::filesystem::is_directory(path, ec)) {
         error = "it is a directory";
         return std::nullopt;
     }
     // Only a regular file has an end: a device or a pipe (`/dev/zero`) is not read.
-    if (fs::exists(path, ec) && !fs::is_regular_file(path, ec)) {
+    if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec)) {
         error = "it is not a regular file";
         return std::nullopt;
     }
@@ -43,6 +40,10 @@ std::optional<std::string> readFile(const fs::path& path, std::string& error) {
     }
     return text;
 }
+
+namespace {
+
+namespace fs = std::filesystem;
 
 // The file an import names: the library's for `std/…` (the first directory that has
 // it; else empty, with where it looked in `looked`), else beside its importer.
@@ -121,7 +122,7 @@ private:
             return true;
         }
         std::string error;
-        auto text = readFile(target, error);
+        auto text = readSourceFile(target, error);
         if (!text) {
             diags_.error(import.pathRange, fmt::format("cannot open imported file `{}`: {}", target.string(), error));
             return false;
@@ -175,7 +176,7 @@ std::vector<fs::path> libraryDirectories() {
 
 std::unique_ptr<ast::Program> loadProgram(const std::string& mainPath, SourceManager& sources, DiagnosticEngine& diags) {
     std::string error;
-    auto text = readFile(mainPath, error);
+    auto text = readSourceFile(mainPath, error);
     if (!text) {
         diags.error({}, fmt::format("cannot read `{}`: {}", mainPath, error));
         return nullptr;

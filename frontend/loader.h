@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,10 @@ namespace psys {
 // libpsys.so where the compiler runs in a host's process (lib/../share/psys). A directory
 // listed holds `std/`.
 std::vector<std::filesystem::path> libraryDirectories();
+
+// The text of a source file, or nullopt with why not in `error` (a directory, a device, a
+// file past kMaxSourceBytes, or what the system said).
+std::optional<std::string> readSourceFile(const std::filesystem::path& path, std::string& error);
 
 // Returns null when the main file cannot be read or any file has syntax errors.
 std::unique_ptr<ast::Program> loadProgram(const std::string& mainPath, SourceManager& sources, DiagnosticEngine& diags);

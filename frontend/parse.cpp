@@ -15,12 +15,7 @@
 #include "frontend/syntax_errors.h"
 
 namespace psys {
-namespace {
 
-using grammar::PsysParser;
-using namespace ast;
-
-// Character index (ANTLR decodes UTF-8 into code points) → byte offset, plus one past the end.
 std::vector<uint32_t> codePointOffsets(const std::string& text) {
     std::vector<uint32_t> offsets;
     offsets.reserve(text.size() + 1);
@@ -29,6 +24,11 @@ std::vector<uint32_t> codePointOffsets(const std::string& text) {
     offsets.push_back(static_cast<uint32_t>(text.size()));
     return offsets;
 }
+
+namespace {
+
+using grammar::PsysParser;
+using namespace ast;
 
 // Drops ANTLR's default "line 1:2 mismatched input" printing; the reporter words errors instead.
 class SilentListener : public antlr4::BaseErrorListener {};

@@ -34,6 +34,7 @@
 #include "lsp/server.h"
 #include "rt/system.h"
 #include "build_command.h"
+#include "fmt_command.h"
 #include "run_command.h"
 
 namespace {
@@ -232,6 +233,14 @@ int realMain(int argc, char** argv) {
         ->check(CLI::Range(0, 10000));
     bool stdio = true;  // what vscode-languageclient passes for its stdio transport
     lsp->add_flag("--stdio", stdio, "Use stdin and stdout (the default and only transport)");
+    auto* format = app.add_subcommand("fmt", "Print .psys files in the canonical layout (comments kept, meaning unchanged)");
+    psys::tools::FormatOptions formatOptions;
+    format->add_option("files", formatOptions.files, "Files to format (- reads standard input)")->required()
+        ->type_name("FILE");
+    auto* checkFlag = format->add_flag("--check", formatOptions.check, "Change nothing; list the files that are not formatted and exit 1 "
+                     "if there are any");
+    checkFlag->excludes(format->add_flag("-w,--write", formatOptions.write,
+                                         "Rewrite the files that are not formatted, in place"));
     auto* builtins = app.add_subcommand("builtins", "Print the language's keywords, built-ins and attributes as JSON");
 
     app.require_subcommand(0, 1);
@@ -251,6 +260,10 @@ int realMain(int argc, char** argv) {
         options.debounce = std::chrono::milliseconds(debounceMs);
         options.version = PSYS_VERSION;
         return psys::lsp::serve(STDIN_FILENO, STDOUT_FILENO, options);
+    }
+    if (format->parsed()) {
+        formatOptions.colour = colour;
+        return psys::tools::formatFiles(formatOptions);
     }
     if (builtins->parsed()) {
         std::cout << psys::lsp::vocabulary().dump(2) << "\n";

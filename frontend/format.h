@@ -1,0 +1,18 @@
+// The canonical layout of a .psys file: what `psysc fmt` prints and the language server's
+// formatting applies. The rules are in docs/language.md (§ Layout).
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "frontend/diagnostics.h"
+
+namespace psys {
+
+// The file laid out canonically, its comments kept where they were. Nullopt when it has
+// syntax errors (reported to `diags`: a file is formatted only when its every token is
+// known). The result has the same tokens in the same order, so the same meaning; the
+// formatter checks that before it answers, and formatting it again changes nothing.
+std::optional<std::string> formatSource(int file, const SourceManager& sources, DiagnosticEngine& diags);
+
+}  // namespace psys

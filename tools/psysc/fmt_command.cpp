@@ -1,0 +1,93 @@
+#include "fmt_command.h"
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "frontend/format.h"
+#include "frontend/loader.h"
+
+namespace psys::tools {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// The 1-based line where two texts first differ.
+size_t firstDifferentLine(const std::string& a, const std::string& b) {
+    size_t line = 1;
+    for (size_t i = 0; i < a.size() && i < b.size() && a[i] == b[i]; ++i) line += a[i] == '\n';
+    return line;
+}
+
+// Replaces `path` by `text` through a file beside it, so a failure leaves the old one whole.
+bool writeBack(const std::string& path, const std::string& text) {
+    fs::path temporary = path + ".psysfmt~";
+    {
+        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+        out << text;
+        if (!out.flush()) {
+            std::error_code ec;
+            fs::remove(temporary, ec);
+            return false;
+        }
+    }
+    std::error_code ec;
+    fs::permissions(temporary, fs::status(path, ec).permissions(), ec);
+    fs::rename(temporary, path, ec);
+    if (ec) fs::remove(temporary, ec);
+    return !ec;
+}
+
+std::optional<std::string> readInput(const std::string& path, std::string& error) {
+    if (path != "-") return readSourceFile(path, error);
+    return std::string(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
+}
+
+}  // namespace
+
+int formatFiles(const FormatOptions& options) {
+    bool failed = false;
+    for (const std::string& path : options.files) {
+        std::string error;
+        auto text = readInput(path, error);
+        if (!text) {
+            std::cerr << "psysc: error: cannot read `" << path << "`: " << error << "\n";
+            failed = true;
+            continue;
+        }
+        SourceManager sources;
+        DiagnosticEngine diags(sources);
+        int file = sources.add(path == "-" ? "<stdin>" : path, *text);
+        auto formatted = formatSource(file, sources, diags);
+        diags.print(std::cerr, options.colour);
+        if (!formatted) {
+            std::cerr << "psysc: `" << (path == "-" ? "<stdin>" : path) << "` is not formatted: fix its syntax first\n";
+            failed = true;
+            continue;
+        }
+        bool same = *formatted == *text;
+        if (options.check) {
+            if (!same) {
+                std::cout << fmt::format("{}: not formatted (from line {}; `psysc fmt --write` formats it)\n", path,
+                                         firstDifferentLine(*text, *formatted));
+                failed = true;
+            }
+        } else if (options.write && path != "-") {
+            if (!same && !writeBack(path, *formatted)) {
+                std::cerr << "psysc: error: cannot write `" << path << "`: " << std::strerror(errno) << "\n";
+                failed = true;
+            }
+        } else {
+            std::cout << *formatted;
+        }
+    }
+    return failed ? 1 : 0;
+}
+
+}  // namespace psys::tools
