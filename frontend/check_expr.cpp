@@ -228,10 +228,13 @@ std::optional<Ref> Checker::memberOf(const ObjectDecl& object, const MemberExpr&
     if (it == scope.names.end()) {
         for (auto& [n, _] : scope.names) alsoNamed.push_back(n);
         std::string suggestion = closestName(member.member, alsoNamed);
-        diags_.error(member.memberRange,
-                     fmt::format("`{}` has no equation or parameter named `{}`{}", object.name, member.member,
-                                 suggestion.empty() ? "" : fmt::format("; did you mean `{}`?", suggestion)))
-            .notes.push_back({object.nameRange, fmt::format("`{}` declared here", object.name)});
+        Diagnostic& d = diags_.error(member.memberRange,
+                                     fmt::format("`{}` has no equation or parameter named `{}`{}", object.name,
+                                                 member.member,
+                                                 suggestion.empty() ? "" : fmt::format("; did you mean `{}`?", suggestion)));
+        d.notes.push_back({object.nameRange, fmt::format("`{}` declared here", object.name)});
+        if (!suggestion.empty())
+            d.fixes.push_back({fmt::format("Change to `{}`", suggestion), member.memberRange, suggestion});
         return std::nullopt;
     }
     if (it->second.kind == Ref::Kind::Equation) usedEquations_.insert(it->second.equation);

@@ -55,6 +55,8 @@ private:
     bool checkDeclarableName(const std::string& name, SourceRange range, const char* what);
     ast::Ref lookupName(const std::string& name, SourceRange range, const Context& ctx);
     const ast::ObjectDecl* findEmitTarget(const std::string& name, SourceRange range, const Context& ctx);
+    // Where an `import` line goes in `file`: after its last import, else before its first declaration.
+    SourceRange importPoint(int file) const;
     void reportUnknown(const std::string& what, const std::string& name, SourceRange range,
                        const std::function<std::vector<std::string>()>& candidates);
     std::vector<std::string> namesInScope(const Context& ctx) const;

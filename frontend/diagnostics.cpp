@@ -126,7 +126,7 @@ Diagnostic& DiagnosticEngine::add(Severity severity, SourceRange range, std::str
         discarded_ = {};
         return discarded_;
     }
-    diagnostics_.push_back({severity, range, std::move(message), {}});
+    diagnostics_.push_back({severity, range, std::move(message), {}, {}});
     return diagnostics_.back();
 }
 

@@ -24,11 +24,19 @@ struct DiagnosticNote {
     std::string message;
 };
 
+// An edit that does what a diagnostic suggests: the editor offers it as a quick fix.
+struct FixIt {
+    std::string title;  // what the editor lists: "Change to `vel`"
+    SourceRange range;  // the text replaced (empty: an insertion)
+    std::string replacement;
+};
+
 struct Diagnostic {
     Severity severity = Severity::Error;
     SourceRange range;
     std::string message;
     std::vector<DiagnosticNote> notes;
+    std::vector<FixIt> fixes;
 };
 
 class DiagnosticEngine {

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <algorithm>
 #include <map>
 
 #include <fmt/format.h>
@@ -172,6 +173,38 @@ std::vector<fs::path> libraryDirectories() {
             if (dir == dir.root_path()) break;
         }
     return dirs;
+}
+
+std::string libraryFileDeclaring(const std::string& name) {
+    static const std::map<std::string, std::string> declared = [] {
+        std::map<std::string, std::string> names;
+        std::error_code ec;
+        for (const fs::path& dir : libraryDirectories()) {
+            std::vector<fs::path> files;
+            for (const auto& entry : fs::directory_iterator(dir / "std", ec))
+                if (entry.path().extension() == ".psys") files.push_back(entry.path());
+            std::sort(files.begin(), files.end());
+            for (const fs::path& file : files) {
+                std::string error;
+                auto text = readSourceFile(file, error);
+                if (!text) continue;
+                SourceManager sources;
+                DiagnosticEngine quiet(sources);
+                auto module = parseModule(sources.add(file.string(), std::move(*text)), sources, quiet);
+                if (!module) continue;
+                for (const auto& decl : module->decls) {
+                    std::string declName;
+                    if (auto* c = dynamic_cast<const ast::ConstDecl*>(decl.get())) declName = c->name;
+                    else if (auto* f = dynamic_cast<const ast::FnDecl*>(decl.get())) declName = f->name;
+                    else if (auto* o = dynamic_cast<const ast::ObjectDecl*>(decl.get())) declName = o->name;
+                    if (!declName.empty()) names.emplace(declName, "std/" + file.filename().string());
+                }
+            }
+        }
+        return names;
+    }();
+    auto it = declared.find(name);
+    return it == declared.end() ? std::string() : it->second;
 }
 
 std::unique_ptr<ast::Program> loadProgram(const std::string& mainPath, SourceManager& sources, DiagnosticEngine& diags) {

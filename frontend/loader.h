@@ -29,6 +29,10 @@ std::vector<std::filesystem::path> libraryDirectories();
 // file past kMaxSourceBytes, or what the system said).
 std::optional<std::string> readSourceFile(const std::filesystem::path& path, std::string& error);
 
+// The standard library's file (`std/forces.psys`) that declares `name` at its top level, or
+// empty: for the quick fix that imports it. The library is read once per process.
+std::string libraryFileDeclaring(const std::string& name);
+
 // Returns null when the main file cannot be read or any file has syntax errors.
 std::unique_ptr<ast::Program> loadProgram(const std::string& mainPath, SourceManager& sources, DiagnosticEngine& diags);
 

@@ -12,6 +12,7 @@
 
 #include "frontend/builtins.h"
 #include "frontend/checker.h"
+#include "frontend/loader.h"
 
 namespace psys::detail {
 
@@ -162,9 +163,39 @@ void Checker::reportUnknown(const std::string& what, const std::string& name, So
                             const std::function<std::vector<std::string>()>& candidates) {
     // A suggestion costs a search of the names in scope: none for errors no one will see.
     bool shown = diags_.errorCount() < DiagnosticEngine::kMaxShown && !diags_.suppressed();
-    std::string suggestion = shown ? closestName(name, candidates()) : std::string();
-    diags_.error(range, suggestion.empty() ? fmt::format("unknown {} `{}`", what, name)
-                                           : fmt::format("unknown {} `{}`; did you mean `{}`?", what, name, suggestion));
+    if (!shown) {
+        diags_.error(range, fmt::format("unknown {} `{}`", what, name));
+        return;
+    }
+    // A name of the standard library's that the file does not import.
+    if (std::string library = libraryFileDeclaring(name); !library.empty()) {
+        diags_.error(range, fmt::format("unknown {} `{}`; the standard library declares it in {}: add "
+                                        "`import \"{}\";`", what, name, library, library))
+            .fixes.push_back({fmt::format("Import \"{}\"", library), importPoint(range.file),
+                              fmt::format("import \"{}\";\n", library)});
+        return;
+    }
+    std::string suggestion = closestName(name, candidates());
+    if (suggestion.empty()) {
+        diags_.error(range, fmt::format("unknown {} `{}`", what, name));
+        return;
+    }
+    diags_.error(range, fmt::format("unknown {} `{}`; did you mean `{}`?", what, name, suggestion))
+        .fixes.push_back({fmt::format("Change to `{}`", suggestion), range, suggestion});
+}
+
+SourceRange Checker::importPoint(int file) const {
+    const ast::Module* module = nullptr;
+    for (const auto& m : program_.modules)
+        if (m->file == file) module = m.get();
+    if (!module) return {file, 0, 0};
+    const SourceFile& text = diags_.sources().file(file);
+    uint32_t at = 0;
+    for (const auto& decl : module->decls)
+        if (decl->kind == ast::DeclKind::Import) at = decl->range.end;
+    if (at == 0 && !module->decls.empty()) at = module->decls.front()->range.begin;
+    else if (at > 0) at = text.offset({text.lineColumn(at).line + 1, 1});  // the line after the last import
+    return {file, at, at};
 }
 
 Ref Checker::lookupName(const std::string& name, SourceRange range, const Context& ctx) {

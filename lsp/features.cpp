@@ -15,6 +15,23 @@ nlohmann::json location(const SourceManager& sources, SourceRange r) {
 
 }  // namespace
 
+nlohmann::json diagnosticJson(const Analysis& a, const Diagnostic& d) {
+    SourceRange r = d.range.valid() ? d.range : SourceRange{a.mainFile, 0, 0};
+    const SourceFile& f = a.sources->file(r.file);
+    nlohmann::json related = nlohmann::json::array();
+    for (const DiagnosticNote& n : d.notes)
+        if (n.range.valid()) related.push_back({{"location", location(*a.sources, n.range)}, {"message", n.message}});
+    std::string message = d.message;
+    for (const DiagnosticNote& n : d.notes)
+        if (!n.range.valid()) message += "\nnote: " + n.message;
+    nlohmann::json diag = {{"range", range(f, r.begin, r.end)},
+                           {"severity", d.severity == Severity::Error ? 1 : d.severity == Severity::Warning ? 2 : 3},
+                           {"source", "psysc"},
+                           {"message", message}};
+    if (!related.empty()) diag["relatedInformation"] = related;
+    return diag;
+}
+
 std::map<std::string, nlohmann::json> diagnosticsByUri(const Analysis& a) {
     std::map<std::string, nlohmann::json> out;
     if (a.mainFile >= 0) out[uriFromPath(a.sources->file(a.mainFile).path())] = nlohmann::json::array();
@@ -23,18 +40,7 @@ std::map<std::string, nlohmann::json> diagnosticsByUri(const Analysis& a) {
         SourceRange r = d.range.valid() ? d.range : SourceRange{a.mainFile, 0, 0};
         if (r.file < 0) continue;
         const SourceFile& f = a.sources->file(r.file);
-        nlohmann::json related = nlohmann::json::array();
-        for (const DiagnosticNote& n : d.notes)
-            if (n.range.valid()) related.push_back({{"location", location(*a.sources, n.range)}, {"message", n.message}});
-        std::string message = d.message;
-        for (const DiagnosticNote& n : d.notes)
-            if (!n.range.valid()) message += "\nnote: " + n.message;
-        nlohmann::json diag = {{"range", range(f, r.begin, r.end)},
-                               {"severity", d.severity == Severity::Error ? 1 : d.severity == Severity::Warning ? 2 : 3},
-                               {"source", "psysc"},
-                               {"message", message}};
-        if (!related.empty()) diag["relatedInformation"] = related;
-        out[uriFromPath(f.path())].push_back(diag);
+        out[uriFromPath(f.path())].push_back(diagnosticJson(a, d));
         // An error in an imported file also shows at the main file's import that brings
         // it in (the file that has it may not be open): `psysc check` of the main file fails.
         if (d.severity == Severity::Error && r.file != a.mainFile) {

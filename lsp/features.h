@@ -5,6 +5,7 @@
 
 #include <map>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -15,6 +16,14 @@ namespace psys::lsp {
 
 // Per file URI, the diagnostics to publish (the main file always has an entry, maybe empty).
 std::map<std::string, nlohmann::json> diagnosticsByUri(const Analysis& a);
+
+// One diagnostic as the protocol has it (its range in its own file).
+nlohmann::json diagnosticJson(const Analysis& a, const Diagnostic& d);
+
+// lsp/actions.cpp: the quick fixes of the main file's diagnostics that meet bytes [begin,
+// end] (CodeAction[]); the edits that lay `text` out canonically, or why not (syntax errors).
+nlohmann::json codeActions(const Analysis& a, uint32_t begin, uint32_t end);
+std::variant<nlohmann::json, std::string> formatting(const std::string& path, const std::string& text);
 
 // `offset` is a byte offset in the main file. Each returns the protocol's `null` when there is nothing.
 nlohmann::json hover(const Analysis& a, uint32_t offset);

@@ -131,6 +131,20 @@ json Server::dispatch(const std::string& method, const json& params, bool* found
         if (auto* why = std::get_if<std::string>(&edit)) throw RequestError{error::kRequestFailed, *why};
         return withUris(std::get<json>(std::move(edit)));
     }
+    if (method == "textDocument/codeAction") {
+        Document& doc = document(params);
+        const SourceFile& f = doc.analysis->sources->file(doc.analysis->mainFile);
+        json actions = codeActions(*doc.analysis, offsetOf(f, params.at("range").at("start")),
+                                   offsetOf(f, params.at("range").at("end")));
+        for (json& action : actions) action["edit"] = withUris(action["edit"]);
+        return actions;
+    }
+    if (method == "textDocument/formatting") {
+        Document& doc = document(params);
+        auto edits = formatting(doc.path, doc.text);
+        if (auto* why = std::get_if<std::string>(&edits)) throw RequestError{error::kRequestFailed, *why};
+        return std::get<json>(std::move(edits));
+    }
     if (method == "textDocument/completion") {
         Document& doc = document(params);
         const Analysis& scopes = doc.lastParsed ? *doc.lastParsed : *doc.analysis;
@@ -165,6 +179,8 @@ json Server::initialize(const json& params) {
               {"documentHighlightProvider", true},
               {"renameProvider", true},
               {"inlayHintProvider", true},
+              {"codeActionProvider", {{"codeActionKinds", {"quickfix"}}}},
+              {"documentFormattingProvider", true},
               {"foldingRangeProvider", true},
               {"workspaceSymbolProvider", true},
               {"signatureHelpProvider", {{"triggerCharacters", {"(", ","}}}},

@@ -40,7 +40,10 @@ void warnIfConstant(const std::string& object, core::Integrator method, float st
                                       "(updates shorter than {} ms); {}, so it oscillates and grows. Use "
                                       "@integrator(exponential) or @integrator(exact), or @step(1/{}) or shorter",
                                       object, r.equation, number(k), core::integratorName(method), number(limit),
-                                      number(limit / k * 1e3), at, std::ceil(k * 1.05 / limit)));
+                                      number(limit / k * 1e3), at, std::ceil(k * 1.05 / limit)),
+                   object,
+                   {"@integrator(exponential)", "@integrator(exact)",
+                    fmt::format("@step(1/{})", std::ceil(k * 1.05 / limit))});
 }
 
 }  // namespace

@@ -67,7 +67,7 @@ std::vector<PassMessage> largeArgumentRemarks(const ir::Module& module) {
                                                        "(exact maths rounds it as written), so the result may differ by "
                                                        "as much (docs/accuracy.md, \"Fast maths\")",
                                                        opInfo(i.op).name, m, ulp),
-                                           true});
+                                           true, {}, {}});
                         }
                         size[v] = 1;
                         break;

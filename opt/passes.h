@@ -36,12 +36,18 @@ struct PassMessage {
     ir::Loc loc;
     std::string text;
     bool warning = false;
+    // Attributes any of which would fix it on the object named (`@step(1/90)`): the
+    // editor's quick fixes.
+    std::string object;
+    std::vector<std::string> attributes;
 };
 
 class PassErrors {
 public:
-    void error(ir::Loc loc, std::string text) { all_.push_back({loc, std::move(text), false}); }
-    void warning(ir::Loc loc, std::string text) { all_.push_back({loc, std::move(text), true}); }
+    void error(ir::Loc loc, std::string text) { all_.push_back({loc, std::move(text), false, {}, {}}); }
+    void warning(ir::Loc loc, std::string text, std::string object = {}, std::vector<std::string> attributes = {}) {
+        all_.push_back({loc, std::move(text), true, std::move(object), std::move(attributes)});
+    }
     bool hasErrors() const {
         for (const PassMessage& m : all_)
             if (!m.warning) return true;

@@ -128,6 +128,28 @@ local d = vim.diagnostic.get(0)[1]
 check(d.lnum == 6 and d.message:find("pso", 1, true), "the diagnostic: " .. vim.inspect(d))
 ok("diagnostics")
 
+-- The quick fix of the typo's did-you-mean, chosen as a user picks it from the list.
+vim.api.nvim_win_set_cursor(0, { 7, 10 })
+local params = vim.lsp.util.make_range_params()
+params.context = { diagnostics = vim.lsp.diagnostic.get_line_diagnostics() }
+local actions = vim.lsp.buf_request_sync(0, "textDocument/codeAction", params, 5000)
+local fix
+for _, a in pairs(actions) do
+  check(a.error == nil, "codeAction: " .. vim.inspect(a.error))
+  fix = a.result and a.result[1]
+end
+check(fix and fix.title == "Change to `pos`" and fix.kind == "quickfix", "the quick fix: " .. vim.inspect(fix))
+vim.lsp.util.apply_workspace_edit(fix.edit, "utf-16")
+check(vim.api.nvim_buf_get_lines(0, 6, 7, false)[1] == "    point(pos, white, 2);", "the fix applied")
+ok("codeAction")
+
+-- Formatting (0.7's synchronous call): a line typed without spaces is laid out.
+vim.api.nvim_buf_set_lines(0, 9, 10, false, { "spawn rocket(vec3(0,15,0)) ;" })
+vim.lsp.buf.formatting_sync(nil, 5000)
+local formatted = vim.api.nvim_buf_get_lines(0, 9, 10, false)[1]
+check(formatted == "spawn rocket(vec3(0, 15, 0));", "formatted: " .. formatted)
+ok("formatting")
+
 out:write("done\n")
 out:close()
 vim.lsp.stop_client(id)

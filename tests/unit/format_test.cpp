@@ -77,12 +77,12 @@ TEST_CASE("format: operators, calls, unary signs, type colons and ternary colons
           "object a {\n    emit b(1) at 2 per second count 3;\n}\n");
 }
 
-TEST_CASE("format: each object attribute on a line; a file attribute keeps its semicolon") {
+TEST_CASE("format: each object attribute on a line, a file attribute keeps its semicolon") {
     CHECK(formatted("@integrator(rk4) ;\n@shape(disc) @blend(alpha) object a {}") ==
           "@integrator(rk4);\n@shape(disc)\n@blend(alpha)\nobject a {}\n");
 }
 
-TEST_CASE("format: comments stay where they were; trailing comments of consecutive lines line up") {
+TEST_CASE("format: comments stay where they were, trailing comments of consecutive lines line up") {
     std::string in = "// head\n\n\n\nconst a = 1; // one\nconst bb = 22;   // two\n\nconst c = 3;    // three\n"
                      "object o { /* inline */ x = 1;\n  // last\n}\n/* tail\n   spans */\n";
     CHECK(formatted(in) == "// head\n\nconst a = 1;    // one\nconst bb = 22;  // two\n\nconst c = 3;  // three\n"
@@ -91,7 +91,7 @@ TEST_CASE("format: comments stay where they were; trailing comments of consecuti
     CHECK(formatted("object a // why\n{\n}\n") == "object a  // why\n{}\n");
 }
 
-TEST_CASE("format: a statement keeps its line breaks; continuation lines indent past the line of the open bracket") {
+TEST_CASE("format: a statement keeps its line breaks, continuation lines indent past the line of the open bracket") {
     std::string in = "object o {\n  x = f(1,\n 2, g(3,\n4),\n  5\n);\n  y = 1 +\n2;\n}\n";
     CHECK(formatted(in) == "object o {\n    x = f(1,\n        2, g(3,\n            4),\n        5\n    );\n"
                            "    y = 1 +\n        2;\n}\n");

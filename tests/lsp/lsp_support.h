@@ -1,0 +1,91 @@
+// What the language server's tests share: a small fireworks program, offsets in a text,
+// a temporary directory, and a server session in-process.
+#pragma once
+
+#include <doctest/doctest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "lsp/analysis.h"
+#include "lsp/features.h"
+#include "lsp/server.h"
+
+namespace psys::lsp::test {
+
+using nlohmann::json;
+
+inline const char* kFireworks = R"(extern sparks: float = 50;
+fn gravity(m: float) -> vec3 = vec3(0, -9.82 * m, 0);
+object rocket(ivel: vec3) {
+    pos = origin + integrate(vel);
+    vel = snapshot(ivel) + integrate(gravity(0.3));
+    point(pos, white, 2);
+    emit spark(pos) at sparks per second;
+    kill when vel.y < 0;
+    object spark(ipos: vec3) {
+        pos = snapshot(ipos) + integrate(rocket.vel);
+        point(pos, mix(green, black, age), 2);
+        kill when age > 1;
+    }
+}
+spawn rocket(vec3(0, 15, 0));
+)";
+
+// The byte offset of the `n`-th occurrence of `needle` (plus `shift`).
+inline uint32_t at(const std::string& text, const std::string& needle, int n = 1, int shift = 0) {
+    size_t p = std::string::npos;
+    for (int i = 0; i < n; ++i) p = text.find(needle, p == std::string::npos ? 0 : p + 1);
+    REQUIRE(p != std::string::npos);
+    return static_cast<uint32_t>(p + static_cast<size_t>(shift));
+}
+
+inline std::string hoverText(const Analysis& a, uint32_t offset) {
+    json h = hover(a, offset);
+    return h.is_null() ? std::string() : h["contents"]["value"].get<std::string>();
+}
+
+inline std::vector<std::string> labels(const json& completion) {
+    std::vector<std::string> out;
+    for (const json& item : completion["items"]) out.push_back(item["label"]);
+    return out;
+}
+
+inline bool has(const std::vector<std::string>& list, const std::string& x) {
+    return std::find(list.begin(), list.end(), x) != list.end();
+}
+
+struct TempDir {
+    std::filesystem::path path;
+    TempDir() {
+        char name[] = "/tmp/psys_lsp_XXXXXX";
+        path = mkdtemp(name);
+    }
+    ~TempDir() { std::filesystem::remove_all(path); }
+    std::string write(const std::string& name, const std::string& text) const {
+        std::ofstream(path / name) << text;
+        return (path / name).string();
+    }
+};
+
+
+struct Session {
+    std::vector<json> out;
+    Server server{ServerOptions{}, [this](const json& m) { out.push_back(m); }};
+    json request(int id, const std::string& method, json params = json::object()) {
+        out.clear();
+        server.handle({{"jsonrpc", "2.0"}, {"id", id}, {"method", method}, {"params", params}});
+        for (const json& m : out)
+            if (m.contains("id") && m["id"] == id) return m;
+        return nullptr;
+    }
+};
+
+
+}  // namespace psys::lsp::test
