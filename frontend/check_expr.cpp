@@ -188,8 +188,9 @@ Type Checker::checkBinary(BinaryExpr& binary, const Context& ctx) {
     Type a = check(*binary.lhs, ctx);
     Type b = check(*binary.rhs, ctx);
     auto fail = [&](std::string message) {
-        diags_.error(binary.opRange, std::move(message))
-            .notes.push_back({binary.range, fmt::format("left is {}, right is {}", a.str(), b.str())});
+        // The operands that disagree, the caret on the operator (`~~~~^~~~`).
+        Diagnostic& d = diags_.error(binary.range, std::move(message));  // which names both types
+        d.focus = binary.opRange.begin;
         return Type::error();
     };
     switch (binary.op) {

@@ -1,6 +1,7 @@
 #include "frontend/diagnostics.h"
 
 #include <algorithm>
+#include <optional>
 #include <ostream>
 #include <sstream>
 
@@ -58,10 +59,52 @@ const char* severityColour(Severity s) {
     return kRed;
 }
 
-// Prints `path:line:col: severity: message`, then the source line with the range
-// underlined: a caret at its start and tildes over the rest of it on that line.
-void printOne(std::ostream& out, const SourceManager& sources, Severity severity,
-              SourceRange range, const std::string& message, bool colour, const std::string& program) {
+// Terminal cells a code point takes: 2 for East Asian wide characters and emoji, 0 for a
+// combining mark, else 1 (enough to keep a caret under its character).
+int cells(uint32_t c) {
+    if ((c >= 0x300 && c <= 0x36F) || (c >= 0x200B && c <= 0x200F) || c == 0xFE0F) return 0;
+    bool wide = (c >= 0x1100 && c <= 0x115F) || (c >= 0x2E80 && c <= 0xA4CF && c != 0x303F) ||
+                (c >= 0xAC00 && c <= 0xD7A3) || (c >= 0xF900 && c <= 0xFAFF) || (c >= 0xFE30 && c <= 0xFE4F) ||
+                (c >= 0xFF00 && c <= 0xFF60) || (c >= 0xFFE0 && c <= 0xFFE6) || (c >= 0x1F300 && c <= 0x1F64F) ||
+                (c >= 0x1F900 && c <= 0x1F9FF) || (c >= 0x20000 && c <= 0x3FFFD);
+    return wide ? 2 : 1;
+}
+
+// The code point at `line[i]` (printable() has made the line valid UTF-8) and its length.
+uint32_t decode(std::string_view line, size_t i, size_t* length) {
+    auto c = static_cast<unsigned char>(line[i]);
+    size_t n = c < 0x80 ? 1 : c < 0xE0 ? 2 : c < 0xF0 ? 3 : 4;
+    n = std::min(n, line.size() - i);
+    uint32_t cp = n == 1 ? c : c & (0xFF >> (n + 1));
+    for (size_t k = 1; k < n; ++k) cp = (cp << 6) | (static_cast<unsigned char>(line[i + k]) & 0x3F);
+    *length = n;
+    return cp;
+}
+
+// The marks under `line`: spaces (tabs where the line has them) up to byte `from`, then
+// `~` over bytes [from, to) and `^` on the character at byte `caret`, a cell per cell.
+std::string underline(std::string_view line, uint32_t from, uint32_t to, uint32_t caret) {
+    std::string marks;
+    size_t length = 1;
+    for (size_t i = 0; i < line.size() && i < std::max(to, caret + 1); i += length) {
+        int width = cells(decode(line, i, &length));
+        if (i < from && i != caret) {
+            marks += line[i] == '\t' ? std::string(1, '\t') : std::string(static_cast<size_t>(width), ' ');
+        } else {
+            marks += i == caret ? '^' : '~';
+            if (width > 1) marks += '~';
+        }
+    }
+    if (caret >= line.size()) marks += '^';  // the end of the line
+    while (!marks.empty() && marks.back() == ' ') marks.pop_back();
+    return marks;
+}
+
+// Prints `path:line:col: severity: message` (the column in bytes, as editors jump to it),
+// then the source line with the range underlined on the caret's line: a caret at `focus`
+// (the range's start unless given) and tildes over the rest of the range.
+void printOne(std::ostream& out, const SourceManager& sources, Severity severity, SourceRange range,
+              std::optional<uint32_t> focus, const std::string& message, bool colour, const std::string& program) {
     auto paint = [&](const char* code) { return colour ? code : ""; };
     if (!range.valid()) {
         out << paint(kBold) << program << ": " << paint(kReset) << paint(severityColour(severity))
@@ -70,7 +113,8 @@ void printOne(std::ostream& out, const SourceManager& sources, Severity severity
         return;
     }
     const SourceFile& file = sources.file(range.file);
-    LineColumn at = file.lineColumn(range.begin);
+    uint32_t caretAt = focus.value_or(range.begin);
+    LineColumn at = file.lineColumn(caretAt);
     out << paint(kBold) << file.path() << ':' << at.line << ':' << at.column << ": "
         << paint(kReset) << paint(severityColour(severity)) << severityWord(severity) << ": "
         << paint(kReset) << paint(kBold) << message << paint(kReset) << '\n';
@@ -79,36 +123,30 @@ void printOne(std::ostream& out, const SourceManager& sources, Severity severity
     std::string number = std::to_string(at.line);
     std::string gutter(number.size(), ' ');
 
-    uint32_t startCol = at.column - 1;
-    uint32_t endCol = startCol + 1;
-    if (range.end > range.begin) {
-        LineColumn last = file.lineColumn(range.end - 1);
-        endCol = last.line == at.line ? last.column : static_cast<uint32_t>(line.size());
-    }
-    endCol = std::max(endCol, startCol + 1);
+    // Byte columns on this line: the caret, and the range clipped to the line.
+    uint32_t lineStart = caretAt - (at.column - 1);
+    uint32_t caret = at.column - 1;
+    uint32_t from = range.begin > lineStart ? range.begin - lineStart : 0;
+    uint32_t to = range.end > lineStart ? std::min<uint32_t>(range.end - lineStart, static_cast<uint32_t>(line.size())) : 0;
+    from = std::min(from, caret);
+    to = std::max(to, caret + 1);
     // A line of a generated file may be 100,000 characters: show a window of it around the
-    // range, marked with `...` where it is cut.
+    // caret, marked with `...` where it is cut.
     constexpr uint32_t kBefore = 60, kWidth = 160;
     if (line.size() > kBefore + kWidth) {
-        uint32_t from = startCol > kBefore ? startCol - kBefore : 0;
-        while (from > 0 && (static_cast<unsigned char>(line[from]) & 0xC0) == 0x80) --from;  // whole characters
-        uint32_t to = std::min<uint32_t>(static_cast<uint32_t>(line.size()), from + kWidth);
-        while (to < line.size() && (static_cast<unsigned char>(line[to]) & 0xC0) == 0x80) ++to;
-        std::string head = from > 0 ? "..." : "", tail = to < line.size() ? "..." : "";
-        line = head + line.substr(from, to - from) + tail;
-        uint32_t shift = static_cast<uint32_t>(head.size()) - from;
-        startCol += shift;
-        endCol = std::min(endCol + shift, static_cast<uint32_t>(line.size() - tail.size()));
-        endCol = std::max(endCol, startCol + 1);
+        uint32_t begin = caret > kBefore ? caret - kBefore : 0;
+        while (begin > 0 && (static_cast<unsigned char>(line[begin]) & 0xC0) == 0x80) --begin;  // whole characters
+        uint32_t end = std::min<uint32_t>(static_cast<uint32_t>(line.size()), begin + kWidth);
+        while (end < line.size() && (static_cast<unsigned char>(line[end]) & 0xC0) == 0x80) ++end;
+        std::string head = begin > 0 ? "..." : "", tail = end < line.size() ? "..." : "";
+        line = head + line.substr(begin, end - begin) + tail;
+        auto shift = [&](uint32_t x) {
+            return std::clamp<uint32_t>(x, begin, end) - begin + static_cast<uint32_t>(head.size());
+        };
+        caret = shift(caret), from = shift(from), to = std::max(shift(to), caret + 1);
     }
     out << ' ' << number << " | " << line << '\n';
-
-    // Underline: tabs are copied from the source so the caret lines up.
-    std::string marks;
-    for (uint32_t i = 0; i < startCol; ++i) marks += (i < line.size() && line[i] == '\t') ? '\t' : ' ';
-    std::string underline = "^";
-    for (uint32_t i = startCol + 1; i < endCol; ++i) underline += '~';
-    out << ' ' << gutter << " | " << marks << paint(kGreen) << underline << paint(kReset) << '\n';
+    out << ' ' << gutter << " | " << paint(kGreen) << underline(line, from, to, caret) << paint(kReset) << '\n';
 }
 
 }  // namespace
@@ -126,7 +164,7 @@ Diagnostic& DiagnosticEngine::add(Severity severity, SourceRange range, std::str
         discarded_ = {};
         return discarded_;
     }
-    diagnostics_.push_back({severity, range, std::move(message), {}, {}});
+    diagnostics_.push_back({severity, range, std::move(message), {}, {}, std::nullopt});
     return diagnostics_.back();
 }
 
@@ -144,9 +182,9 @@ Diagnostic& DiagnosticEngine::warning(SourceRange range, std::string message) {
 
 void DiagnosticEngine::print(std::ostream& out, bool colour) const {
     for (const Diagnostic& d : diagnostics_) {
-        printOne(out, sources_, d.severity, d.range, d.message, colour, program_);
+        printOne(out, sources_, d.severity, d.range, d.focus, d.message, colour, program_);
         for (const DiagnosticNote& n : d.notes)
-            printOne(out, sources_, Severity::Note, n.range, n.message, colour, program_);
+            printOne(out, sources_, Severity::Note, n.range, std::nullopt, n.message, colour, program_);
     }
     int hiddenErrors = std::max(0, errors_ - kMaxShown), hiddenWarnings = std::max(0, warnings_ - kMaxShown);
     if (hiddenErrors > 0 || hiddenWarnings > 0)

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <iosfwd>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,9 @@ struct Diagnostic {
     std::string message;
     std::vector<DiagnosticNote> notes;
     std::vector<FixIt> fixes;
+    // The byte the caret marks and `line:column` names, inside `range` (nullopt: its
+    // start): the operator of a binary expression whose operands' types disagree.
+    std::optional<uint32_t> focus;
 };
 
 class DiagnosticEngine {

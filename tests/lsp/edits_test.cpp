@@ -130,3 +130,13 @@ TEST_CASE("formatting: one edit over what changes, nothing for a formatted file,
     CHECK(bad["error"]["message"].get<std::string>().find("fix the syntax first (line 1:") != std::string::npos);
     CHECK(s.request(4, "initialize")["error"]["code"] == error::kInvalidRequest);  // the session still answers
 }
+
+TEST_CASE("diagnostics: a type error covers the operands that disagree, in UTF-16 columns") {
+    std::string text = "object a {\n    /* é😀 */ x = vec3(1) + vec4(1);\n    point(vec3(x), white, 1);\n}\nspawn a;\n";
+    Analysis a = analyze("/tmp/t.psys", text);
+    json d = diagnosticsByUri(a)["file:///tmp/t.psys"];
+    REQUIRE(d.size() == 1);
+    CHECK(d[0]["message"].get<std::string>().find("cannot add vec3 and vec4") != std::string::npos);
+    // `/* é😀 */` is 9 UTF-16 units: `vec3(1)` starts at 18, `vec4(1)` ends at 35.
+    CHECK(d[0]["range"] == json{{"start", {{"line", 1}, {"character", 18}}}, {"end", {{"line", 1}, {"character", 35}}}});
+}

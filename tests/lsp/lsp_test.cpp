@@ -185,9 +185,10 @@ TEST_CASE("diagnostics: ranges in UTF-16, notes as related information, warnings
     REQUIRE(diags.size() == 1);
     CHECK(diags[0]["severity"] == 1);
     CHECK(diags[0]["message"] == "cannot add vec3 and vec2: vectors of different sizes");
-    uint32_t plus = at(text, "+");
-    CHECK(diags[0]["range"]["start"] == json{{"line", 0}, {"character", plus - 3}});
-    CHECK(diags[0]["range"]["end"] == json{{"line", 0}, {"character", plus - 2}});
+    // The operands that disagree: from `vec3(1)` to the end of `vec2(1)`.
+    uint32_t begin = at(text, "vec3(1)"), end = at(text, "vec2(1)") + 7;
+    CHECK(diags[0]["range"]["start"] == json{{"line", 0}, {"character", begin - 3}});
+    CHECK(diags[0]["range"]["end"] == json{{"line", 0}, {"character", end - 3}});
 
     Analysis unused = analyze("/tmp/u.psys", "object o { p = 1; point(vec3(0), white, 1); }\nspawn o;\n");
     json w = diagnosticsByUri(unused)["file:///tmp/u.psys"];

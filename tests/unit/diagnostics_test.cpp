@@ -90,14 +90,14 @@ TEST_CASE("past 50 errors and 50 warnings, the rest are counted and not kept") {
                     "70 errors and 3 warnings generated.\n") != std::string::npos);
 }
 
-TEST_CASE("a line with control characters or bytes that are not UTF-8 prints as spaces and '?'") {
+TEST_CASE("a line with control characters or bytes that are not UTF-8 prints as spaces and '?', the caret under its character") {
     SourceManager sources;
     int f = sources.add("x.psys", std::string("a\0b\x01 caf\xE9 \xE2\x86\x92 x\n", 15));
     DiagnosticEngine diags(sources);
     diags.error({f, 13, 14}, "here");
     CHECK(diags.render() == "x.psys:1:14: error: here\n"
                             " 1 | a b  caf? \xE2\x86\x92 x\n"
-                            "   |              ^\n"
+                            "   |            ^\n"  // under `x`: the arrow is 3 bytes and one character
                             "1 error generated.\n");
 }
 
