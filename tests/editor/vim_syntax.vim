@@ -2,7 +2,7 @@
 " Run: vim -Nu NONE -i NONE -es -S tests/editor/vim_syntax.vim -c 'qa!' (from the repository root);
 " it writes what it found to $PSYS_VIM_OUT and exits with an error if any place is wrong.
 set runtimepath^=editor-support/vim
-filetype plugin on
+filetype plugin indent on
 syntax on
 let s:failures = []
 let s:report = []
@@ -66,6 +66,51 @@ call s:Check('heat = 1 ->', '->', 'psysArrow')
 call s:Check('when age > 1 &&', '&&', 'psysOperator')
 call s:Check('c = if shell.alive', 'if', 'psysConditional')
 call s:Check('kill when age > 0.5', 'true', 'psysBoolean')
+
+" A built-in's name that is not called is an equation's name or a component.
+enew
+setfiletype psys
+call setline(1, ['@ integrator ( midpoint )', 'object o {', '    length = 2;', '    step = 1;',
+      \ '    sign = c.rgba;', '    d = length(c.xyz) + step(0.5, sign.x);', '}'])
+call s:Check('@ integrator', 'midpoint', 'psysIntegrator')
+call s:Check('    length = 2', 'length', '')
+call s:Check('    step = 1', 'step', '')
+call s:Check('    sign = c.rgba', 'sign', '')
+call s:Check('    sign = c.rgba', 'rgba', 'psysSwizzle')
+call s:Check('d = length(', 'length', 'psysBuiltin')
+call s:Check('d = length(', 'step', 'psysBuiltin')
+
+" Indentation (gg=G) is the layout psysc fmt prints: every sample and library file,
+" its lines' leading white space taken away, comes back as it was.
+for s:file in glob('samples/*.psys', 0, 1) + glob('library/std/*.psys', 0, 1)
+  execute 'edit! ' . s:file
+  let s:want = getline(1, '$')
+  silent %s/^\s\+//e
+  normal! gg=G
+  let s:got = getline(1, '$')
+  for s:i in range(len(s:want))
+    if s:got[s:i] !=# s:want[s:i]
+      call add(s:failures, printf('%s line %d indented as `%s`, psysc fmt has `%s`', s:file, s:i + 1, s:got[s:i], s:want[s:i]))
+      break
+    endif
+  endfor
+  call add(s:report, printf('indent %s: %d lines', fnamemodify(s:file, ':t'), len(s:want)))
+  set nomodified
+endfor
+" A typed-out statement: a label-like `pos: point` is no C label, the line after an
+" attribute is no continuation, and indents are spaces.
+enew
+setfiletype psys
+call setline(1, ['@capacity(100000)', 'object o {', 'pos: vec3 = origin +', 'vec3(1,', '2, 3);', '}'])
+normal! gg=G
+let s:typed = getline(1, '$')
+let s:expected = ['@capacity(100000)', 'object o {', '    pos: vec3 = origin +', '        vec3(1,', '            2, 3);', '}']
+if s:typed !=# s:expected
+  call add(s:failures, 'typed statement indented as ' . string(s:typed))
+endif
+if &shiftwidth != 4 || !&expandtab
+  call add(s:failures, printf('shiftwidth %d, expandtab %d', &shiftwidth, &expandtab))
+endif
 
 call writefile(s:report + map(copy(s:failures), '"FAIL: " . v:val'), $PSYS_VIM_OUT)
 if empty(s:failures)

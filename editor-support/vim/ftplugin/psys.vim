@@ -1,4 +1,4 @@
-" psys: comments, indentation, and `:make` through psysc check (compiler/psys.vim).
+" psys: comments, four-space indentation, and `:make` through psysc check (compiler/psys.vim).
 if exists('b:did_ftplugin')
   finish
 endif
@@ -7,9 +7,10 @@ let b:did_ftplugin = 1
 setlocal commentstring=//\ %s
 setlocal comments=s1:/*,mb:*,ex:*/,://
 setlocal formatoptions-=t formatoptions+=croql
-setlocal cindent cinoptions=(s,m1
+" Four spaces a level, as `psysc fmt` lays it out (indent/psys.vim indents so).
+setlocal shiftwidth=4 softtabstop=4 expandtab
 setlocal suffixesadd=.psys
 setlocal iskeyword=@,48-57,_
 compiler psys
 
-let b:undo_ftplugin = 'setlocal commentstring< comments< formatoptions< cindent< cinoptions< suffixesadd< iskeyword< makeprg< errorformat<'
+let b:undo_ftplugin = 'setlocal commentstring< comments< formatoptions< shiftwidth< softtabstop< expandtab< suffixesadd< iskeyword< makeprg< errorformat<'

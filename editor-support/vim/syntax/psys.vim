@@ -13,11 +13,13 @@ syn keyword psysBoolean true false
 syn keyword psysType bool float scalar vector color
 syn match psysType "\<\%(point\|vec[234]\)\>\%(\s*(\)\@!"
 syn match psysKeyword "\<point\ze\s*("
-syn keyword psysBuiltin sin cos tan asin acos atan atan2 tanh exp log pow sqrt abs sign floor ceil round fract hash mod
-syn keyword psysBuiltin near_sum near_min near_max near_count
-syn keyword psysBuiltin min max clamp saturate mix lerp step smoothstep radians degrees length distance dot
-syn keyword psysBuiltin normalize reflect cross rotate_x rotate_y rotate_z rgba
-syn keyword psysBuiltin rand rand2 rand3 rand4 nrand nrand2 nrand3 nrand4
+" A built-in function only where it is called: `length = 2;` names an equation, `c.rgba`
+" reads components.
+syn match psysBuiltin "\<\%(sin\|cos\|tan\|asin\|acos\|atan\|atan2\|tanh\|exp\|log\|pow\|sqrt\|abs\|sign\|floor\|ceil\|round\|fract\|hash\|mod\)\ze\s*("
+syn match psysBuiltin "\<\%(near_sum\|near_min\|near_max\|near_count\)\ze\s*("
+syn match psysBuiltin "\<\%(min\|max\|clamp\|saturate\|mix\|lerp\|step\|smoothstep\|radians\|degrees\|length\|distance\|dot\)\ze\s*("
+syn match psysBuiltin "\<\%(normalize\|reflect\|cross\|rotate_x\|rotate_y\|rotate_z\|rgba\)\ze\s*("
+syn match psysBuiltin "\<\%(rand\|rand2\|rand3\|rand4\|nrand\|nrand2\|nrand3\|nrand4\)\ze\s*("
 syn match psysBuiltin "\<vec[234]\ze\s*("
 syn keyword psysTemporal integrate derive snapshot prev
 syn keyword psysConstant pi tau origin red green blue white black grey gray yellow cyan magenta orange purple
@@ -30,7 +32,7 @@ syn match psysNumber "\<\d\+\%(\.\d*\)\=\%([eE][+-]\=\d\+\)\=\%(\w\)\@!"
 syn match psysNumber "\%(\w\)\@<!\.\d\+\%([eE][+-]\=\d\+\)\="
 
 syn match psysAttribute "@\s*\h\w*"
-syn match psysIntegrator "\%(@integrator\s*(\s*\)\@<=\h\w*"
+syn match psysIntegrator "\%(@\s*integrator\s*(\s*\)\@<=\h\w*"
 syn match psysDeclName "\%(\<\%(object\|fn\|trigger\)\s\+\)\@<=\h\w*"
 syn match psysObjectRef "\%(\<\%(emit\|spawn\)\s\+\)\@<=\h\w*"
 syn match psysOperator "==\|!=\|<=\|>=\|&&\|||\|[-+*/%<>=!?:]"
