@@ -20,11 +20,27 @@ enum class SymbolKind { Class = 5, Property = 7, Field = 8, Function = 12, Varia
 enum class CompletionKind { Function = 3, Field = 5, Variable = 6, Class = 7, Property = 10, Keyword = 14,
                             Snippet = 15, Constant = 21, Struct = 22, Event = 23, TypeParameter = 25 };
 
-// A name or expression in a file: what hover shows and where its declaration is.
+// Semantic tokens (textDocument/semanticTokens): what a name is, so an editor colours an
+// equation, a parameter, a live read of a parent, an extern and a trigger each its own
+// way. The types in the legend's order, and the modifiers as bits.
+enum class TokenType { None = -1, Variable, Parameter, Property, Function, Class, Macro, Event, EnumMember, Decorator };
+inline constexpr const char* kTokenTypes[] = {"variable", "parameter", "property", "function", "class",
+                                              "macro", "event", "enumMember", "decorator"};
+enum TokenModifier : unsigned { kDeclaration = 1, kReadonly = 2, kDefaultLibrary = 4 };
+inline constexpr const char* kTokenModifiers[] = {"declaration", "readonly", "defaultLibrary"};
+
+struct Token {
+    TokenType type = TokenType::None;
+    unsigned modifiers = 0;
+};
+
+// A name or expression in a file: what hover shows, where its declaration is, and (a
+// name) what kind of name it is.
 struct Occurrence {
     SourceRange range;
     std::string hover;  // Markdown
     std::optional<SourceRange> definition;
+    Token token;
 };
 
 struct Symbol {

@@ -42,6 +42,9 @@ nlohmann::json completion(const Analysis& scopes, const std::string& text, uint3
 nlohmann::json foldingRanges(const Analysis& a);
 nlohmann::json workspaceSymbols(const std::vector<const Analysis*>& analyses, const std::string& query);
 nlohmann::json signatureHelp(const Analysis& a, const std::string& text, uint32_t offset);
+// The main file's names as semantic tokens (SemanticTokens), and the legend that reads them.
+nlohmann::json semanticTokens(const Analysis& a);
+nlohmann::json semanticTokensLegend();
 
 // The language's own words by category (keywords, functions, constants, variables,
 // types, attributes, integrators): `psysc builtins`, which the editor grammars' tests read.

@@ -43,39 +43,53 @@ public:
     }
 
 private:
-    void add(SourceRange range, std::string hover, std::optional<SourceRange> definition = std::nullopt) {
-        if (range.valid()) out_.occurrences.push_back({range, std::move(hover), definition});
+    void add(SourceRange range, std::string hover, std::optional<SourceRange> definition = std::nullopt,
+             Token token = {}) {
+        if (range.valid()) out_.occurrences.push_back({range, std::move(hover), definition, token});
     }
 
-    // What a resolved name refers to: its hover text and its declaration.
-    std::pair<std::string, std::optional<SourceRange>> describe(const std::string& name, const Ref& ref, const Type& type) {
+    struct Described {
+        std::string hover;
+        std::optional<SourceRange> definition;
+        Token token;
+    };
+
+    // What a resolved name refers to: its hover text, its declaration, its kind.
+    Described describe(const std::string& name, const Ref& ref, const Type& type) {
         using K = Ref::Kind;
+        using T = TokenType;
         std::string t = name + ": " + typeText(type);
         switch (ref.kind) {
             case K::Param:
-                return {code(t) + "\n\nparameter of `" + ref.object->name + "`", ref.object->params[ref.index].nameRange};
+                return {code(t) + "\n\nparameter of `" + ref.object->name + "`", ref.object->params[ref.index].nameRange,
+                        {T::Parameter}};
             case K::Equation:
                 return {code(t) + "\n\nequation of `" + (ref.object ? ref.object->name : "?") + "`",
-                        ref.equation->nameRanges[static_cast<size_t>(ref.index)]};
-            case K::Const: return {code("const " + t), ref.constant->nameRange};
-            case K::Extern: return {code("extern " + t) + "\n\nset by the host", ref.externVar->nameRange};
-            case K::FnParam: return {code(t) + "\n\nparameter of `" + ref.fn->name + "`", ref.fn->params[ref.index].nameRange};
-            case K::Let: return {code("let " + t), ref.let->nameRange};
+                        ref.equation->nameRanges[static_cast<size_t>(ref.index)], {T::Variable}};
+            case K::Const: return {code("const " + t), ref.constant->nameRange, {T::Variable, kReadonly}};
+            case K::Extern: return {code("extern " + t) + "\n\nset by the host", ref.externVar->nameRange, {T::Macro}};
+            case K::FnParam:
+                return {code(t) + "\n\nparameter of `" + ref.fn->name + "`", ref.fn->params[ref.index].nameRange,
+                        {T::Parameter}};
+            case K::Let: return {code("let " + t), ref.let->nameRange, {T::Variable}};
             case K::TriggerParam:
                 return {code(t) + "\n\nparameter of trigger `" + ref.trigger->name + "`",
-                        ref.trigger->params[ref.index].nameRange};
+                        ref.trigger->params[ref.index].nameRange, {T::Parameter}};
             case K::Age: case K::Time: case K::Dt:
-                return {code(t) + "\n\nbuilt-in: " + builtinVariableDoc(name), std::nullopt};
-            case K::Alive: return {code(t) + "\n\nfalse once the object has died", std::nullopt};
+                return {code(t) + "\n\nbuilt-in: " + builtinVariableDoc(name), std::nullopt,
+                        {T::Variable, kDefaultLibrary}};
+            case K::Alive:
+                return {code(t) + "\n\nfalse once the object has died", std::nullopt, {T::Variable, kDefaultLibrary}};
             case K::BuiltinConst: {
                 const BuiltinConstant& c = builtinConstants()[static_cast<size_t>(findBuiltinConstant(name))];
                 std::string v;
                 for (int i = 0; i < std::max(1, c.type.width()); ++i) v += fmt::format("{}{:g}", i ? ", " : "", c.value[i]);
-                return {code(t) + "\n\nbuilt-in constant (" + v + ")", std::nullopt};
+                return {code(t) + "\n\nbuilt-in constant (" + v + ")", std::nullopt,
+                        {T::Variable, kReadonly | kDefaultLibrary}};
             }
             case K::Unresolved: break;
         }
-        return {type.isVague() ? std::string() : code(t), std::nullopt};
+        return {type.isVague() ? std::string() : code(t), std::nullopt, {}};
     }
 
     void expr(const Expr& e) {
@@ -83,24 +97,28 @@ private:
             case ExprKind::Number: case ExprKind::Bool: break;
             case ExprKind::Name: {
                 auto& n = static_cast<const NameExpr&>(e);
-                auto [hover, definition] = describe(n.name, n.ref, n.type);
-                if (!hover.empty()) add(n.range, hover, definition);
+                auto [hover, definition, token] = describe(n.name, n.ref, n.type);
+                if (!hover.empty()) add(n.range, hover, definition, token);
                 return;
             }
             case ExprKind::Call: {
                 auto& c = static_cast<const CallExpr&>(e);
                 if (c.builtin >= 0 && builtinFunction(c.builtin).name == "integrate") integrates_ = true;
-                if (c.fn) add(c.calleeRange, code(signature(*c.fn)), c.fn->nameRange);
-                else if (c.builtin >= 0) add(c.calleeRange, code(std::string(builtinFunction(c.builtin).signature)) + "\n\nbuilt-in function");
+                if (c.fn) add(c.calleeRange, code(signature(*c.fn)), c.fn->nameRange, {TokenType::Function});
+                else if (c.builtin >= 0)
+                    add(c.calleeRange, code(std::string(builtinFunction(c.builtin).signature)) + "\n\nbuilt-in function",
+                        std::nullopt, {TokenType::Function, kDefaultLibrary});
                 for (const ExprPtr& a : c.args) expr(*a);
                 break;
             }
             case ExprKind::Member: {
                 auto& m = static_cast<const MemberExpr&>(e);
                 if (m.parent) {
-                    add(m.base->range, code(signature(*m.parent)) + "\n\nan enclosing object, read live", m.parent->nameRange);
-                    auto [hover, definition] = describe(m.member, m.parentRef, m.type);
-                    add(m.memberRange, hover + "\n\nread live from `" + m.parent->name + "`", definition);
+                    add(m.base->range, code(signature(*m.parent)) + "\n\nan enclosing object, read live", m.parent->nameRange,
+                        {TokenType::Class});
+                    auto [hover, definition, token] = describe(m.member, m.parentRef, m.type);
+                    add(m.memberRange, hover + "\n\nread live from `" + m.parent->name + "`", definition,
+                        {TokenType::Property});
                     return;
                 }
                 expr(*m.base);
@@ -143,19 +161,22 @@ private:
             if (c->cond) expr(*c->cond);
             if (c->rate) expr(*c->rate);
             if (c->count) expr(*c->count);
-            if (c->targetDecl) add(c->targetRange, code(signature(*c->targetDecl)), c->targetDecl->nameRange);
+            if (c->targetDecl)
+                add(c->targetRange, code(signature(*c->targetDecl)), c->targetDecl->nameRange, {TokenType::Class});
             commands(c->body);
         }
     }
 
     void attribute(const Attribute& a) {
-        add(a.nameRange, code("@" + a.name) + "\n\n" + std::string(attributeDoc(a.name)));
+        add(a.nameRange, code("@" + a.name) + "\n\n" + std::string(attributeDoc(a.name)), std::nullopt,
+            {TokenType::Decorator});
         exprs(a.args);
         // A method's name is no expression: its hover says what the method computes.
         if (a.name == "integrator" && a.args.size() == 1 && a.args[0]->kind == ExprKind::Name) {
             const std::string& method = static_cast<const NameExpr&>(*a.args[0]).name;
             if (std::string doc = integratorDoc(method); !doc.empty())
-                add(a.args[0]->range, code("@integrator(" + method + ")") + "\n\n" + doc);
+                add(a.args[0]->range, code("@integrator(" + method + ")") + "\n\n" + doc, std::nullopt,
+                    {TokenType::EnumMember, kDefaultLibrary});
         }
     }
 
@@ -163,14 +184,15 @@ private:
         std::vector<Name> names;
         for (const Param& p : params) {
             names.push_back({p.name, paramText(p), "parameter of " + owner, CompletionKind::Variable});
-            add(p.nameRange, code(paramText(p)) + "\n\nparameter of " + owner, p.nameRange);
+            add(p.nameRange, code(paramText(p)) + "\n\nparameter of " + owner, p.nameRange,
+                {TokenType::Parameter, kDeclaration});
         }
         return names;
     }
 
     Symbol object(const ObjectDecl& o, std::vector<const ObjectDecl*>& enclosing) {
         Symbol s{o.name, o.params.empty() ? "" : "(" + paramList(o.params) + ")", SymbolKind::Class, o.range, o.nameRange, {}};
-        add(o.nameRange, code(signature(o)), o.nameRange);
+        add(o.nameRange, code(signature(o)), o.nameRange, {TokenType::Class, kDeclaration});
         for (const Attribute& a : o.attributes) attribute(a);
         Scope scope{o.range, paramNames(o.params, "`" + o.name + "`")};
         std::vector<Name> members = {{"alive", "bool", "false once the object has died", CompletionKind::Property},
@@ -185,7 +207,8 @@ private:
                 std::string t = eq->names[i] + ": " + (i < eq->types.size() ? typeText(eq->types[i]) : "?");
                 if (main_ && i < eq->types.size() && !eq->types[i].isVague())
                     out_.hints.push_back({eq->nameRanges[i], ": " + eq->types[i].str(), 1});
-                add(eq->nameRanges[i], code(t) + "\n\nequation of `" + o.name + "`", eq->nameRanges[i]);
+                add(eq->nameRanges[i], code(t) + "\n\nequation of `" + o.name + "`", eq->nameRanges[i],
+                    {TokenType::Variable, kDeclaration});
                 s.children.push_back({eq->names[i], t, SymbolKind::Field, eq->range, eq->nameRanges[i], {}});
                 scope.names.push_back({eq->names[i], t, "equation of `" + o.name + "`", CompletionKind::Field});
                 members.push_back({eq->names[i], t, "equation of `" + o.name + "`", CompletionKind::Property});
@@ -226,7 +249,7 @@ private:
             case DeclKind::Const: {
                 auto& c = static_cast<const ConstDecl&>(d);
                 std::string t = "const " + c.name + ": " + typeText(c.type);
-                add(c.nameRange, code(t), c.nameRange);
+                add(c.nameRange, code(t), c.nameRange, {TokenType::Variable, kDeclaration | kReadonly});
                 expr(*c.value);
                 global(t, "constant", CompletionKind::Constant);
                 symbol = Symbol{c.name, typeText(c.type), SymbolKind::Constant, c.range, c.nameRange, {}};
@@ -234,12 +257,12 @@ private:
             }
             case DeclKind::Fn: {
                 auto& f = static_cast<const FnDecl&>(d);
-                add(f.nameRange, code(signature(f)), f.nameRange);
+                add(f.nameRange, code(signature(f)), f.nameRange, {TokenType::Function, kDeclaration});
                 Scope scope{f.range, paramNames(f.params, "`" + f.name + "`"), true};
                 for (const auto& let : f.lets) {
                     std::string t = "let " + let->name + ": " + typeText(let->type);
                     if (main && !let->type.isVague()) out_.hints.push_back({let->nameRange, ": " + let->type.str(), 1});
-                    add(let->nameRange, code(t), let->nameRange);
+                    add(let->nameRange, code(t), let->nameRange, {TokenType::Variable, kDeclaration});
                     scope.names.push_back({let->name, t, "", CompletionKind::Variable});
                     expr(*let->value);
                 }
@@ -252,7 +275,7 @@ private:
             case DeclKind::Extern: {
                 auto& x = static_cast<const ExternDecl&>(d);
                 std::string t = "extern " + x.name + ": " + (x.type.spelling.empty() ? typeText(x.type.type) : x.type.spelling);
-                add(x.nameRange, code(t) + "\n\nset by the host", x.nameRange);
+                add(x.nameRange, code(t) + "\n\nset by the host", x.nameRange, {TokenType::Macro, kDeclaration});
                 for (const Expr* e : {x.defaultValue.get(), x.rangeLow.get(), x.rangeHigh.get()})
                     if (e) expr(*e);
                 global(t, "set by the host", CompletionKind::Variable);
@@ -261,7 +284,7 @@ private:
             }
             case DeclKind::Trigger: {
                 auto& t = static_cast<const TriggerDecl&>(d);
-                add(t.nameRange, code(signature(t)) + "\n\nfired by the host", t.nameRange);
+                add(t.nameRange, code(signature(t)) + "\n\nfired by the host", t.nameRange, {TokenType::Event, kDeclaration});
                 out_.scopes.push_back({t.range, paramNames(t.params, "trigger `" + t.name + "`")});
                 commands(t.commands);
                 global(signature(t), "fired by the host", CompletionKind::Event);
@@ -277,7 +300,8 @@ private:
             }
             case DeclKind::Spawn: {
                 auto& s = static_cast<const SpawnDecl&>(d);
-                if (s.targetDecl) add(s.nameRange, code(signature(*s.targetDecl)), s.targetDecl->nameRange);
+                if (s.targetDecl)
+                    add(s.nameRange, code(signature(*s.targetDecl)), s.targetDecl->nameRange, {TokenType::Class});
                 exprs(s.args);
                 return;
             }

@@ -154,4 +154,34 @@ json signatureHelp(const Analysis& a, const std::string& text, uint32_t offset) 
     return {{"signatures", {signature}}, {"activeSignature", 0}, {"activeParameter", active}};
 }
 
+nlohmann::json semanticTokens(const Analysis& a) {
+    std::vector<const Occurrence*> names;
+    for (const Occurrence& o : a.occurrences)
+        if (o.token.type != TokenType::None && o.range.file == a.mainFile && o.range.end > o.range.begin)
+            names.push_back(&o);
+    std::stable_sort(names.begin(), names.end(),
+                     [](const Occurrence* x, const Occurrence* y) { return x->range.begin < y->range.begin; });
+    // Five numbers a token, each place relative to the one before (the protocol's encoding).
+    const SourceFile& f = a.sources->file(a.mainFile);
+    nlohmann::json data = nlohmann::json::array();
+    uint32_t line = 0, character = 0, end = 0;
+    for (const Occurrence* o : names) {
+        if (o->range.begin < end) continue;  // a name met twice (a tuple equation's, say)
+        nlohmann::json from = position(f, o->range.begin), to = position(f, o->range.end);
+        auto l = from["line"].get<uint32_t>(), c = from["character"].get<uint32_t>();
+        if (to["line"].get<uint32_t>() != l) continue;
+        data.push_back(l - line);
+        data.push_back(l == line ? c - character : c);
+        data.push_back(to["character"].get<uint32_t>() - c);
+        data.push_back(static_cast<int>(o->token.type));
+        data.push_back(o->token.modifiers);
+        line = l, character = c, end = o->range.end;
+    }
+    return {{"data", data}};
+}
+
+nlohmann::json semanticTokensLegend() {
+    return {{"tokenTypes", kTokenTypes}, {"tokenModifiers", kTokenModifiers}};
+}
+
 }  // namespace psys::lsp

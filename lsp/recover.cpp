@@ -77,7 +77,7 @@ Analysis recover(const Analysis& good, const Analysis& current, const std::strin
     for (const Occurrence& o : good.occurrences) {
         auto range = move.strict(o.range);
         if (!range) continue;
-        Occurrence moved{*range, o.hover, std::nullopt};
+        Occurrence moved{*range, o.hover, std::nullopt, o.token};
         if (o.definition) {
             moved.definition = move.strict(*o.definition);
             if (!moved.definition) continue;  // its declaration is being edited

@@ -102,6 +102,7 @@ json Server::dispatch(const std::string& method, const json& params, bool* found
         return definition(*doc.analysis, offset(doc));
     }
     if (method == "textDocument/documentSymbol") return documentSymbols(*document(params).analysis);
+    if (method == "textDocument/semanticTokens/full") return semanticTokens(*document(params).analysis);
     if (method == "textDocument/foldingRange") return foldingRanges(*document(params).analysis);
     if (method == "workspace/symbol") return withUris(workspaceSymbols(analyses(), params.value("query", std::string())));
     if (method == "textDocument/signatureHelp") {
@@ -181,6 +182,7 @@ json Server::initialize(const json& params) {
               {"inlayHintProvider", true},
               {"codeActionProvider", {{"codeActionKinds", {"quickfix"}}}},
               {"documentFormattingProvider", true},
+              {"semanticTokensProvider", {{"legend", semanticTokensLegend()}, {"full", true}}},
               {"foldingRangeProvider", true},
               {"workspaceSymbolProvider", true},
               {"signatureHelpProvider", {{"triggerCharacters", {"(", ","}}}},

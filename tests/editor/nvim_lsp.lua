@@ -110,6 +110,14 @@ for _, a in pairs(ws) do for _, s in ipairs(a.result or {}) do found = found or 
 check(found, "workspace symbol")
 ok("workspaceSymbol")
 
+-- Semantic tokens (0.7 does not colour with them; a client that does asks so).
+local sem = vim.lsp.buf_request_sync(0, "textDocument/semanticTokens/full",
+  { textDocument = vim.lsp.util.make_text_document_params() }, 5000)
+for _, a in pairs(sem) do
+  check(a.result and #a.result.data >= 5 and #a.result.data % 5 == 0, "semantic tokens: " .. vim.inspect(a))
+end
+ok("semanticTokens")
+
 -- Rename `vel` to `speed`: the edit applied to the buffer as the client applies it.
 local edit = at(6, 4, "textDocument/rename", { newName = "speed" })
 vim.lsp.util.apply_workspace_edit(edit, "utf-16")
