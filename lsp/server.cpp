@@ -1,5 +1,6 @@
 #include "lsp/server.h"
 
+#include <algorithm>
 #include <csignal>
 #include <variant>
 
@@ -135,8 +136,14 @@ json Server::dispatch(const std::string& method, const json& params, bool* found
     if (method == "textDocument/codeAction") {
         Document& doc = document(params);
         const SourceFile& f = doc.analysis->sources->file(doc.analysis->mainFile);
-        json actions = codeActions(*doc.analysis, offsetOf(f, params.at("range").at("start")),
-                                   offsetOf(f, params.at("range").at("end")));
+        uint32_t begin = offsetOf(f, params.at("range").at("start")), end = offsetOf(f, params.at("range").at("end"));
+        // The diagnostics the client shows where the cursor is (its whole line, for some)
+        // count too, though the cursor is not on them.
+        for (const json& d : params.value("context", json::object()).value("diagnostics", json::array())) {
+            begin = std::min(begin, offsetOf(f, d.at("range").at("start")));
+            end = std::max(end, offsetOf(f, d.at("range").at("end")));
+        }
+        json actions = codeActions(*doc.analysis, begin, end);
         for (json& action : actions) action["edit"] = withUris(action["edit"]);
         return actions;
     }

@@ -16,6 +16,7 @@ packages=(
   ffmpeg fonts-dejavu-core
   python3-dev python3-pybind11 python3-numpy python3-pytest
   neovim
+  xterm x11-apps  # scripts/editor-screenshot.sh: Neovim in an xterm, captured with xwd
 )
 # Node.js 20 and npm (the editor extension's tests and package) come with the machine;
 # where they do not, Debian's are installed.

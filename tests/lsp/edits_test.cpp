@@ -45,6 +45,24 @@ TEST_CASE("quick fix: a did-you-mean changes the name, for a name and for a memb
     CHECK(actions[0]["title"] == "Change to `velo`");
     CHECK(actions[0]["kind"] == "quickfix");
     CHECK(actions[0]["isPreferred"] == true);
+    // Through the server, with the cursor past the typo on its line: the client's
+    // diagnostics at the cursor say which fixes it wants.
+    Session s;
+    s.request(1, "initialize");
+    s.server.handle({{"jsonrpc", "2.0"}, {"method", "textDocument/didOpen"},
+                     {"params", {{"textDocument", {{"uri", "file:///tmp/q.psys"}, {"languageId", "psys"},
+                                                   {"version", 1}, {"text", text}}}}}});
+    json cursor = {{"line", 2}, {"character", 25}};
+    json none = s.request(2, "textDocument/codeAction", {{"textDocument", {{"uri", "file:///tmp/q.psys"}}},
+                                                         {"range", {{"start", cursor}, {"end", cursor}}},
+                                                         {"context", {{"diagnostics", json::array()}}}});
+    CHECK(none["result"].empty());
+    json shown = actions[0]["diagnostics"][0];
+    json some = s.request(3, "textDocument/codeAction", {{"textDocument", {{"uri", "file:///tmp/q.psys"}}},
+                                                         {"range", {{"start", cursor}, {"end", cursor}}},
+                                                         {"context", {{"diagnostics", {shown}}}}});
+    REQUIRE(some["result"].size() == 1);
+    CHECK(some["result"][0]["title"] == "Change to `velo`");
     CHECK(actions[0]["diagnostics"][0]["message"].get<std::string>().find("did you mean `velo`") != std::string::npos);
     std::string once = fixed("/tmp/q.psys", text, actions[0]);
     CHECK(once.find("vec3(velo)") != std::string::npos);
