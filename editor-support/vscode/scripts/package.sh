@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Packages the extension as a .vsix with @vscode/vsce (installed by scripts/setup.sh from
-# package-lock.json) and checks that it holds what VS Code needs.
+# Packages the extension as a .vsix through the manifest's own `npm run package` (vsce, its
+# client bundled by esbuild into dist/extension.js; both installed by scripts/setup.sh from
+# package-lock.json) and checks that it holds what VS Code needs and nothing else.
 #   bash editor-support/vscode/scripts/package.sh [OUT.vsix]   (default: editor-support/vscode/psys.vsix)
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
@@ -10,17 +11,27 @@ if [ ! -x node_modules/.bin/vsce ]; then
   echo "package.sh: node_modules/.bin/vsce is missing: run scripts/setup.sh (npm ci in editor-support/vscode)" >&2
   exit 1
 fi
-node_modules/.bin/vsce package --skip-license --no-rewrite-relative-links --out "$out"
+npm run --silent package -- --out "$out" </dev/null
+# The bundle loads with only `vscode` from the host, and has the extension's entry points.
+node -e '
+const Module = require("module"), load = Module._load;
+Module._load = function (request) {
+    return request === "vscode" ? new Proxy({}, { get: () => function () {} }) : load.apply(this, arguments);
+};
+const extension = require(process.argv[1]);
+if (typeof extension.activate !== "function" || typeof extension.deactivate !== "function")
+    throw new Error("dist/extension.js has no activate and deactivate");' "$here/dist/extension.js"
 python3 - "$out" <<'PY'
 import sys, zipfile, json
 names = set(zipfile.ZipFile(sys.argv[1]).namelist())
 manifest = json.loads(zipfile.ZipFile(sys.argv[1]).read("extension/package.json"))
-need = ["extension/extension.js", "extension/language-configuration.json", "extension/syntaxes/psys.tmLanguage.json",
+need = ["extension/language-configuration.json", "extension/syntaxes/psys.tmLanguage.json",
         "extension/snippets/psys.json", "extension/icons/psys.png", "extension/icons/psys-file.svg",
         "extension/images/preview.png", "extension/readme.md",
-        "extension/node_modules/vscode-languageclient/node.js"]
+        "extension/dist/extension.js"]
 missing = [n for n in need if n not in names and n.replace("readme", "README") not in names]
-dev = [n for n in names if "/node_modules/vscode-textmate/" in n or "/node_modules/@vscode/vsce" in n or "/test/" in n]
+# The client is bundled: no node_modules, no sources beside the bundle, no tests.
+dev = [n for n in names if "/node_modules/" in n or "/test/" in n or n == "extension/extension.js"]
 if missing or dev:
     sys.exit(f"{sys.argv[1]}: missing {missing}; development files packaged: {dev[:5]}")
 print(f"{sys.argv[1]}: {len(names)} files, {manifest['name']} {manifest['version']}, everything VS Code needs")
