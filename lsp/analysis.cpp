@@ -47,12 +47,14 @@ void methodHints(const ir::Module& module, Analysis& a) {
 
 }  // namespace
 
-Analysis analyze(const std::string& path, std::string text) {
+Analysis analyze(const std::string& path, std::string text, const std::atomic<bool>* cancelled) {
+    auto stop = [&] { return cancelled && cancelled->load(std::memory_order_relaxed); };
     Analysis a;
     a.sources = std::make_unique<SourceManager>();
     DiagnosticEngine diags(*a.sources);
     try {
         std::unique_ptr<ast::Program> program = loadProgramFromText(path, std::move(text), *a.sources, diags);
+        if (program && stop()) return a;  // a newer text is on its way: this one is not wanted
         if (program) {
             checkProgram(*program, diags);
             a.parsed = true;
@@ -61,7 +63,7 @@ Analysis analyze(const std::string& path, std::string text) {
             // What `psysc check` reports beyond the front end comes from the passes: an
             // integral with no closed form under @integrator(exact), a decay past the
             // integrator's stability limit. They run on a clean program only.
-            if (diags.errorCount() == 0)
+            if (diags.errorCount() == 0 && !stop())
                 if (auto module = compileProgram(program.get(), *a.sources, diags)) methodHints(*module, a);
         }
     } catch (const std::exception& e) {

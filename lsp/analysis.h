@@ -5,6 +5,7 @@
 // current text does not).
 #pragma once
 
+#include <atomic>
 #include <memory>
 #include <optional>
 #include <string>
@@ -94,6 +95,8 @@ struct Analysis {
 
 // Runs the front end over `text` as the file `path` (imports are read from disk, relative
 // to it), and the compiler's passes when it is clean, for their warnings.
-Analysis analyze(const std::string& path, std::string text);
+// `cancelled`, when given and set (from another thread) while it runs, stops it early
+// between its phases; what it returns then is incomplete and only to be thrown away.
+Analysis analyze(const std::string& path, std::string text, const std::atomic<bool>* cancelled = nullptr);
 
 }  // namespace psys::lsp

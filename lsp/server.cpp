@@ -106,11 +106,16 @@ json Server::dispatch(const std::string& method, const json& params, bool* found
     if (method == "textDocument/semanticTokens/full") return semanticTokens(*document(params).analysis);
     if (method == "textDocument/foldingRange") return foldingRanges(*document(params).analysis);
     if (method == "workspace/symbol") return withUris(workspaceSymbols(analyses(), params.value("query", std::string())));
-    if (method == "textDocument/signatureHelp") {
-        Document& doc = document(params);
-        const Analysis& names = doc.lastParsed ? *doc.lastParsed : *doc.analysis;
-        return signatureHelp(names, doc.text, offset(doc));
-    }
+    // Completion and signature help read names from the last text that parsed and the
+    // cursor in the text as it is now: they need not wait for an analysis.
+    auto typing = [&](auto answer) -> json {
+        Document* doc = &openDocument(params);
+        if (!doc->lastParsed && !doc->analysis) doc = &document(params);
+        const Analysis& names = doc->lastParsed ? *doc->lastParsed : *doc->analysis;
+        return answer(names, doc->text, offsetOf(SourceFile(doc->path, doc->text), params.at("position")));
+    };
+    if (method == "textDocument/signatureHelp")
+        return typing([](const Analysis& a, const std::string& text, uint32_t at) { return signatureHelp(a, text, at); });
     if (method == "textDocument/inlayHint") {
         Document& doc = document(params);
         const SourceFile& f = doc.analysis->sources->file(doc.analysis->mainFile);
@@ -153,11 +158,8 @@ json Server::dispatch(const std::string& method, const json& params, bool* found
         if (auto* why = std::get_if<std::string>(&edits)) throw RequestError{error::kRequestFailed, *why};
         return std::get<json>(std::move(edits));
     }
-    if (method == "textDocument/completion") {
-        Document& doc = document(params);
-        const Analysis& scopes = doc.lastParsed ? *doc.lastParsed : *doc.analysis;
-        return completion(scopes, doc.text, offset(doc));
-    }
+    if (method == "textDocument/completion")
+        return typing([](const Analysis& a, const std::string& text, uint32_t at) { return completion(a, text, at); });
     *found = false;
     return nullptr;
 }
@@ -204,6 +206,9 @@ void Server::didOpen(const json& params) {
     doc.path = pathFromUri(doc.uri);
     doc.text = td.at("text").get<std::string>();
     doc.version = td.value("version", 0);
+    cancelPending(doc.uri);
+    auto old = docs_.find(doc.uri);
+    doc.edits = old == docs_.end() ? 0 : old->second.edits + 1;
     auto [it, _] = docs_.insert_or_assign(doc.uri, std::move(doc));
     analyse(it->second);
 }
@@ -227,11 +232,18 @@ void Server::didChange(const json& params) {
     doc.version = params["textDocument"].value("version", doc.version);
     doc.dirty = true;
     doc.changedAt = Clock::now();
+    ++doc.edits;
+    cancelPending(uri);
+}
+
+void Server::cancelPending(const std::string& uri) {
+    if (pending_ && pending_->uri == uri) pending_->cancelled->store(true);
 }
 
 void Server::didClose(const json& params) {
     auto it = docs_.find(params.at("textDocument").at("uri").get<std::string>());
     if (it == docs_.end()) return;
+    cancelPending(it->first);
     for (const std::string& uri : it->second.publishedTo)
         notify("textDocument/publishDiagnostics", {{"uri", uri}, {"diagnostics", json::array()}});
     docs_.erase(it);
@@ -239,6 +251,7 @@ void Server::didClose(const json& params) {
 
 std::vector<const Analysis*> Server::analyses() {
     std::vector<const Analysis*> out;
+    settle();
     for (auto& [uri, doc] : docs_) {
         if (doc.dirty) analyse(doc);
         out.push_back(doc.analysis.get());
@@ -267,16 +280,29 @@ json Server::withUris(json answer) const {
     return answer;
 }
 
+Server::Document& Server::openDocument(const json& params) {
+    std::string uri = params.at("textDocument").at("uri");
+    auto it = docs_.find(uri);
+    if (it == docs_.end()) throw RequestError{error::kInvalidParams, uri + " is not open"};
+    return it->second;
+}
+
 Server::Document& Server::document(const json& params) {
     std::string uri = params.at("textDocument").at("uri");
     auto it = docs_.find(uri);
     if (it == docs_.end()) throw RequestError{error::kInvalidParams, uri + " is not open"};
-    if (it->second.dirty) analyse(it->second);
+    if (pending_ && pending_->uri == uri) settle();
+    if (it->second.dirty) {
+        settle();  // one analysis at a time
+        analyse(it->second);
+    }
     return it->second;
 }
 
-void Server::analyse(Document& doc) {
-    auto fresh = std::make_shared<const Analysis>(analyze(doc.path, doc.text));
+void Server::analyse(Document& doc) { install(doc, analyze(doc.path, doc.text)); }
+
+void Server::install(Document& doc, Analysis analysis) {
+    auto fresh = std::make_shared<const Analysis>(std::move(analysis));
     if (fresh->parsed) doc.lastParsed = fresh;
     // A syntax error: hover, definition and symbols answer from the last text that parsed,
     // everywhere the edit since has not touched.
@@ -306,13 +332,34 @@ void Server::publish(Document& doc) {
     }
 }
 
+void Server::settle() {
+    if (!pending_) return;
+    Pending done = std::move(*pending_);
+    pending_.reset();
+    Analysis analysis = done.result.get();
+    auto it = docs_.find(done.uri);
+    // Published only if the text it analysed is still the document's.
+    if (it != docs_.end() && it->second.edits == done.edits && !done.cancelled->load()) install(it->second, std::move(analysis));
+}
+
 void Server::idle() {
+    if (pending_ && pending_->result.wait_for(std::chrono::seconds(0)) == std::future_status::ready) settle();
+    if (pending_) return;
     auto now = Clock::now();
-    for (auto& [uri, doc] : docs_)
-        if (doc.dirty && now - doc.changedAt >= options_.debounce) analyse(doc);
+    for (auto& [uri, doc] : docs_) {
+        if (!doc.dirty || now - doc.changedAt < options_.debounce) continue;
+        auto cancelled = std::make_shared<std::atomic<bool>>(false);
+        pending_ = Pending{uri, doc.edits, cancelled,
+                           std::async(std::launch::async, [path = doc.path, text = doc.text, cancelled] {
+                               return analyze(path, text, cancelled.get());
+                           })};
+        return;
+    }
 }
 
 std::optional<std::chrono::milliseconds> Server::nextDeadline() const {
+    // While an analysis runs in the background, the loop looks in on it every few milliseconds.
+    if (pending_) return std::chrono::milliseconds(2);
     std::optional<std::chrono::milliseconds> next;
     auto now = Clock::now();
     for (const auto& [uri, doc] : docs_) {

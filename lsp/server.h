@@ -2,11 +2,18 @@
 // analysed when opened and again once edits have paused for the debounce interval, and
 // its diagnostics are published then. Requests about a document analyse it first if it
 // has changed since, so an answer always matches the text it is asked about.
+//
+// A debounced analysis runs on a thread of its own, one at a time, so the server goes on
+// reading while it runs: edits, requests about the other documents, completion and
+// signature help (from the last text that parsed), shutdown. An edit to the document being
+// analysed cancels that analysis (it stops at its next phase and is never published).
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <future>
 #include <map>
 #include <memory>
 #include <optional>
@@ -32,11 +39,19 @@ class Server {
 public:
     using Send = std::function<void(const nlohmann::json&)>;
     Server(ServerOptions options, Send send) : options_(std::move(options)), send_(std::move(send)) {}
+    ~Server() {
+        if (pending_) pending_->cancelled->store(true);  // its future waits for it to stop
+    }
 
     // One message from the client: answers and notifications go out through `send`.
     void handle(const nlohmann::json& message);
-    // Analyses the documents whose debounce has run out, and publishes their diagnostics.
+    // Publishes the analysis that has finished in the background, if any, and starts the
+    // next of the documents whose debounce has run out.
     void idle();
+    // An analysis is running in the background.
+    bool busy() const { return pending_.has_value(); }
+    // Waits for the background analysis and publishes it (if its text is still current).
+    void settle();
     // How long until idle() has work (nullopt: none pending).
     std::optional<std::chrono::milliseconds> nextDeadline() const;
     // Set once `exit` arrives: the process's exit code (0 after `shutdown`, 1 without).
@@ -51,6 +66,13 @@ private:
         Clock::time_point changedAt;
         std::shared_ptr<const Analysis> analysis, lastParsed;
         std::set<std::string> publishedTo;  // URIs this document's diagnostics went to
+        uint64_t edits = 0;                 // counts changes: an analysis of an older text is stale
+    };
+    struct Pending {
+        std::string uri;
+        uint64_t edits;
+        std::shared_ptr<std::atomic<bool>> cancelled;
+        std::future<Analysis> result;
     };
 
     nlohmann::json dispatch(const std::string& method, const nlohmann::json& params, bool* found);
@@ -59,15 +81,19 @@ private:
     void didChange(const nlohmann::json& params);
     void didClose(const nlohmann::json& params);
     Document& document(const nlohmann::json& params);  // the open document a request names, analysed
+    Document& openDocument(const nlohmann::json& params);  // the same, as it is
     std::vector<const Analysis*> analyses();  // every open document's, analysed
     nlohmann::json withUris(nlohmann::json answer) const;
     void analyse(Document& doc);
+    void install(Document& doc, Analysis fresh);
+    void cancelPending(const std::string& uri);
     void publish(Document& doc);
     void notify(const std::string& method, nlohmann::json params);
 
     ServerOptions options_;
     Send send_;
     std::map<std::string, Document> docs_;  // by URI
+    std::optional<Pending> pending_;        // the analysis running in the background
     bool initialized_ = false, shutdown_ = false;
     std::optional<int> exitCode_;
 };

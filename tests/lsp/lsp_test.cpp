@@ -122,7 +122,8 @@ TEST_CASE("an imported file changed on disk: the open documents are analysed aga
     dir.write("lib.psys", "const lyft = 2;\n");
     server.handle({{"jsonrpc", "2.0"}, {"method", "workspace/didChangeWatchedFiles"},
                    {"params", {{"changes", {{{"uri", uriFromPath((dir.path / "lib.psys").string())}, {"type", 2}}}}}}});
-    server.idle();
+    server.idle();  // starts the analysis in the background
+    server.settle();
     size_t errors = 0;
     for (const json& m : out)
         if (m.value("method", "") == "textDocument/publishDiagnostics" && m["params"]["uri"] == uriFromPath(path))
@@ -389,6 +390,7 @@ TEST_CASE("a syntax error does not blank the file: hover, definition and symbols
     s.server.handle({{"jsonrpc", "2.0"}, {"method", "textDocument/didChange"},
                      {"params", {{"textDocument", {{"uri", uri}, {"version", 2}}}, {"contentChanges", {{{"text", broken}}}}}}});
     s.server.idle();
+    s.server.settle();
     bool reported = false;  // the error is reported all the same
     for (const json& m : s.out)
         if (m.value("method", "") == "textDocument/publishDiagnostics" && m["params"]["version"] == 2)

@@ -1,0 +1,87 @@
+// Analyses after an edit run in the background: the server answers the other documents,
+// completion and signature help meanwhile, and an analysis of a text edited since is never
+// published.
+#include <doctest/doctest.h>
+
+#include <thread>
+
+#include "lsp/positions.h"
+#include "lsp_support.h"
+
+using namespace psys;
+using namespace psys::lsp;
+using namespace psys::lsp::test;
+using nlohmann::json;
+
+namespace {
+
+// `n` objects: an analysis of a few hundred milliseconds.
+std::string many(int n, const std::string& tag) {
+    std::string text;
+    for (int i = 0; i < n; ++i)
+        text += "object o" + std::to_string(i) + " {\n    pos = origin + vec3(" + std::to_string(i) + ", 0, 0);\n" +
+                "    point(pos, " + tag + ", 1);\n    kill when age > 1;\n}\n";
+    return text;
+}
+
+json message(const std::string& method, json params) {
+    return {{"jsonrpc", "2.0"}, {"method", method}, {"params", std::move(params)}};
+}
+
+}  // namespace
+
+TEST_CASE("background analysis: requests are answered while it runs, and a stale one is never published") {
+    std::vector<json> out;
+    ServerOptions options;
+    options.debounce = std::chrono::milliseconds(0);
+    Server server(options, [&](const json& m) { out.push_back(m); });
+    server.handle({{"jsonrpc", "2.0"}, {"id", 1}, {"method", "initialize"}, {"params", json::object()}});
+    std::string small = kFireworks;
+    server.handle(message("textDocument/didOpen", {{"textDocument", {{"uri", "file:///tmp/small.psys"}, {"version", 1},
+                                                                     {"text", small}}}}));
+    server.handle(message("textDocument/didOpen", {{"textDocument", {{"uri", "file:///tmp/big.psys"}, {"version", 1},
+                                                                     {"text", many(3000, "white")}}}}));
+    auto publishedFor = [&](int version) {
+        int n = 0;
+        for (const json& m : out)
+            n += m.value("method", "") == "textDocument/publishDiagnostics" && m["params"]["uri"] == "file:///tmp/big.psys" &&
+                 m["params"]["version"] == version;
+        return n;
+    };
+    auto change = [&](int version, const std::string& text) {
+        server.handle(message("textDocument/didChange", {{"textDocument", {{"uri", "file:///tmp/big.psys"}, {"version", version}}},
+                                                         {"contentChanges", {{{"text", text}}}}}));
+    };
+    out.clear();
+    change(2, many(3000, "red"));
+    server.idle();
+    REQUIRE(server.busy());
+    // Another document's hover, and the big one's completion: answered, nothing waited for.
+    server.handle({{"jsonrpc", "2.0"}, {"id", 2}, {"method", "textDocument/hover"},
+                   {"params", {{"textDocument", {{"uri", "file:///tmp/small.psys"}}}, {"position", {{"line", 1}, {"character", 4}}}}}});
+    server.handle({{"jsonrpc", "2.0"}, {"id", 3}, {"method", "textDocument/completion"},
+                   {"params", {{"textDocument", {{"uri", "file:///tmp/big.psys"}}}, {"position", {{"line", 2}, {"character", 10}}}}}});
+    REQUIRE(out.size() == 2);
+    CHECK(out[0]["id"] == 2);
+    CHECK(out[0]["result"]["contents"]["value"].get<std::string>().find("fn gravity") != std::string::npos);
+    CHECK(out[1]["id"] == 3);
+    CHECK(out[1]["result"]["items"].size() > 10);
+    CHECK(server.busy());
+    // An edit while it runs: version 2 is cancelled and never published; version 3 is.
+    change(3, many(3000, "green"));
+    for (int i = 0; i < 100000 && (server.busy() || server.nextDeadline()); ++i) {
+        server.idle();
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    CHECK_FALSE(server.busy());
+    CHECK(publishedFor(2) == 0);
+    CHECK(publishedFor(3) == 1);
+    // A request about the document analysed in the background gets the analysis of its text.
+    json hover = [&] {
+        out.clear();
+        server.handle({{"jsonrpc", "2.0"}, {"id", 4}, {"method", "textDocument/hover"},
+                       {"params", {{"textDocument", {{"uri", "file:///tmp/big.psys"}}}, {"position", {{"line", 2}, {"character", 16}}}}}});
+        return out.back();
+    }();
+    CHECK(hover["result"]["contents"]["value"].get<std::string>().find("green") != std::string::npos);
+}
