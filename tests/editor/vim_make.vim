@@ -1,6 +1,6 @@
 " `:make` on a .psys file runs psysc check (compiler/psys.vim) and fills the quickfix list:
 " the error's file, line, column, type and message; the caret lines are not entries.
-" Run: PSYSC=… PSYS_VIM_OUT=… vim -Nu NONE -i NONE -es -S tests/editor/vim_make.vim (from the repository root).
+" Run: PSYSC=… PSYS_VIM_OUT=… vim -Nu NONE -i NONE -n -es -S tests/editor/vim_make.vim (from the repository root).
 set runtimepath^=editor-support/vim
 filetype plugin on
 let s:failures = []

@@ -1,5 +1,5 @@
 " Checks the syntax groups vim gives known places of a sample and of the showcase file.
-" Run: vim -Nu NONE -i NONE -es -S tests/editor/vim_syntax.vim -c 'qa!' (from the repository root);
+" Run: vim -Nu NONE -i NONE -n -es -S tests/editor/vim_syntax.vim -c 'qa!' (from the repository root);
 " it writes what it found to $PSYS_VIM_OUT and exits with an error if any place is wrong.
 set runtimepath^=editor-support/vim
 filetype plugin indent on
