@@ -24,6 +24,7 @@ STYLE = {
     "midpoint": ("tab:olive", "^"),
     "rk2": ("tab:green", "v"),
     "rk4": ("tab:blue", "D"),
+    "leapfrog": ("tab:cyan", "X"),
     "exponential": ("tab:purple", "P"),
     "exact": ("black", "*"),
 }

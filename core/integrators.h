@@ -11,10 +11,10 @@
 
 namespace psys::core {
 
-enum class Integrator : uint8_t { Euler, SemiImplicit, Midpoint, Rk2, Rk4, Exponential, Exact };
+enum class Integrator : uint8_t { Euler, SemiImplicit, Midpoint, Rk2, Rk4, Exponential, Exact, Leapfrog };
 
-constexpr std::array<std::string_view, 7> kIntegratorNames = {"euler", "semi_implicit", "midpoint", "rk2",
-                                                              "rk4",   "exponential",   "exact"};
+constexpr std::array<std::string_view, 8> kIntegratorNames = {"euler", "semi_implicit", "midpoint", "rk2",
+                                                              "rk4",   "exponential",   "exact",    "leapfrog"};
 
 constexpr std::string_view integratorName(Integrator i) { return kIntegratorNames[static_cast<size_t>(i)]; }
 
@@ -26,13 +26,15 @@ constexpr std::optional<Integrator> integratorFromName(std::string_view name) {
 
 // The largest k·h for which a method keeps y' = −k·y from growing, h being the update's
 // length: where the method's stability region meets the negative real axis. Euler, the
-// semi-implicit step and both second-order methods stop at 2; the classical RK4 at
-// 2.785293563405… (where its growth factor 1 − z + z²/2 − z³/6 + z⁴/24 comes back to
-// 1). `exponential`
-// and `exact` solve the linear decay exactly: no limit (0).
+// semi-implicit step, both second-order Runge–Kutta methods and leapfrog stop at 2
+// (leapfrog on a decay is Heun's method; on an oscillator x″ = −ω²x it is stable while
+// ω·h < 2); the classical RK4 at 2.785293563405… (where its growth factor
+// 1 − z + z²/2 − z³/6 + z⁴/24 comes back to 1). `exponential` and `exact` solve the
+// linear decay exactly: no limit (0).
 constexpr double stabilityLimit(Integrator i) {
     switch (i) {
-        case Integrator::Euler: case Integrator::SemiImplicit: case Integrator::Midpoint: case Integrator::Rk2: return 2.0;
+        case Integrator::Euler: case Integrator::SemiImplicit: case Integrator::Midpoint: case Integrator::Rk2:
+        case Integrator::Leapfrog: return 2.0;
         case Integrator::Rk4: return 2.785293563405282;
         case Integrator::Exponential: case Integrator::Exact: return 0.0;
     }

@@ -175,6 +175,11 @@ std::string integratorDoc(std::string_view name) {
             order = "order 1, exact while a and k are fixed over the step";
             break;
         case Integrator::Exact: what = "the closed form (an error where there is none)"; order = "exact"; break;
+        case Integrator::Leapfrog:
+            what = "velocity Verlet: half a kick, a drift, half a kick; keeps an orbit's or a spring's energy "
+                   "for any number of periods";
+            order = "order 2";
+            break;
     }
     double limit = core::stabilityLimit(*method);
     char stable[96];

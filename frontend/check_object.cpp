@@ -365,10 +365,16 @@ void Checker::checkAttributes(const std::vector<Attribute*>& attributes) {
             auto* name = a.args[0]->kind == ExprKind::Name ? static_cast<NameExpr*>(a.args[0].get()) : nullptr;
             bool known = false;
             for (auto n : integratorNames()) known |= name && name->name == n;
-            if (!known)
-                diags_.error(a.args[0]->range, name ? fmt::format("unknown integrator `{}`", name->name)
-                                                    : std::string("the integrator must be named"))
-                    .notes.push_back({a.args[0]->range, "the integrators are " + names});
+            if (known) continue;
+            // Velocity Verlet goes by several names; the language calls it leapfrog.
+            bool verlet = name && (name->name.find("verlet") != std::string::npos ||
+                                   name->name.find("Verlet") != std::string::npos);
+            Diagnostic& d = diags_.error(
+                a.args[0]->range, !name ? std::string("the integrator must be named")
+                                  : verlet ? fmt::format("unknown integrator `{}`; velocity Verlet is `leapfrog`", name->name)
+                                           : fmt::format("unknown integrator `{}`", name->name));
+            d.notes.push_back({a.args[0]->range, "the integrators are " + names});
+            if (verlet) d.fixes.push_back({"Change to `leapfrog`", a.args[0]->range, "leapfrog"});
         } else if (a.name == "step") {
             if (!wantOneArg("the fixed sub-step in seconds, such as 1/240")) continue;
             check(*a.args[0], ctx);

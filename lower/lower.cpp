@@ -7,7 +7,8 @@
 // semantics for recursive equations (docs/language.md, "Evaluation order"):
 //
 //   Equations are evaluated so that everything an equation reads in the same update is
-//   computed before it; where that leaves a choice, in source order. A reference that
+//   computed before it; where that leaves a choice, one whose every reference (delayed
+//   ones too) is computed already, then source order — so a cycle is cut once. A reference that
 //   must read an equation evaluated later in this order — one that closes a cycle, which
 //   the front end allows only through `integrate`, `prev` or the `next` side of `->` — is
 //   a `recur` instruction: opt/resolve_cycles makes it the value of the previous update.

@@ -1,5 +1,7 @@
 // Lowering expressions, and the order an object's equations are evaluated in (see the
 // rule at the top of lower.cpp).
+#include <optional>
+
 #include "core/fold.h"
 #include "frontend/builtins.h"
 #include "frontend/equation_graph.h"
@@ -19,20 +21,36 @@ std::vector<const Equation*> ObjectLowering::evaluationOrder() {
     });
     std::vector<const Equation*> result;
     for (const auto& members : components) {
-        // Inside a component: what an equation reads in the same update first, else
-        // source order (members are sorted).
+        // Inside a component: what an equation reads in the same update first. Where that
+        // leaves a choice, an equation whose every reference in the component — inside
+        // `integrate` too — is already computed, so each cycle is cut once, by the first
+        // equation placed (the semi-implicit step on `pos → vel → acc → pos`: one stale
+        // read, not two); else source order (members are sorted).
         std::set<size_t> component(members.begin(), members.end()), done;
+        auto readsDone = [&](size_t c, bool delayedToo) {
+            for (const EquationUse& u : graph.uses[c])
+                if ((delayedToo || !u.delayed) && u.target != c && component.count(u.target) && !done.count(u.target))
+                    return false;
+            return true;
+        };
         while (done.size() < component.size()) {
-            for (size_t c : members) {
-                if (done.count(c)) continue;
-                bool ready = true;
-                for (const EquationUse& u : graph.uses[c])
-                    if (!u.delayed && u.target != c && component.count(u.target) && !done.count(u.target)) ready = false;
-                if (!ready) continue;
-                done.insert(c);
-                result.push_back(graph.equations[c]);
-                break;
+            std::optional<size_t> pick;
+            for (bool delayedToo : {true, false}) {
+                for (size_t c : members)
+                    if (!done.count(c) && readsDone(c, delayedToo)) {
+                        pick = c;
+                        break;
+                    }
+                if (pick) break;
             }
+            if (!pick)  // an algebraic loop (the front end reported it): keep source order
+                for (size_t c : members)
+                    if (!done.count(c)) {
+                        pick = c;
+                        break;
+                    }
+            done.insert(*pick);
+            result.push_back(graph.equations[*pick]);
         }
     }
     return result;

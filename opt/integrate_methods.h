@@ -3,6 +3,8 @@
 //
 //   euler, midpoint, rk2, rk4   explicit Runge–Kutta methods: stages re-evaluate the
 //                               derivatives at instants inside the step (opt/integrate_methods.cpp)
+//   leapfrog                    velocity Verlet: a half kick, a drift, a half kick
+//                               (opt/integrate_methods.cpp)
 //   exponential                 Euler's step with each integral's linear decay solved
 //                               exactly over the step (opt/integrate_methods.cpp)
 //   exact                       closed forms over the step (opt/integrate_exact.cpp)
@@ -23,6 +25,19 @@ namespace psys::opt {
 
 // euler, midpoint, rk2 (Heun's method) or rk4: the classical Butcher tableaux.
 std::vector<ir::ValueId> rungeKutta(StepBuilder& b, core::Integrator method);
+
+// Velocity Verlet (Störmer–Verlet, "kick-drift-kick"), second order, symplectic on a
+// separable system (positions from velocities, velocities from forces of the positions).
+// The integrals split in two: a *drift* reads, at the same instant, only integrals that are
+// not drifts and is read by no drift (a position, integrated from a velocity); every other
+// integral is *kicked* (a velocity). With K the kicked and D the drifts:
+//   K½ = K + h/2·f_K(start)
+//   D' = D + h·f_D(middle, K½)
+//   K' = K½ + h/2·f_K(end, D', K + h·f_K(start))
+// When f_K does not read K (forces of positions) this is velocity Verlet exactly; where it
+// does (drag) the end's K is Euler's estimate, which keeps the order 2. A system with no
+// drift (a decay, a spin) is Heun's method.
+std::vector<ir::ValueId> leapfrog(StepBuilder& b);
 
 // Each integral y' = f with f = c·y + r (c its linear part, when it has one):
 // y + dt·φ1(−c·dt)·f, all at the start of the step; Euler's step where there is no c.

@@ -30,6 +30,24 @@ ValueId StepBuilder::resolve(ValueId old) const {
     return old;
 }
 
+std::set<size_t> StepBuilder::reads(size_t j) const {
+    std::set<size_t> found;
+    std::set<ValueId> seen;
+    std::vector<ValueId> work = {derivative(j)};
+    while (!work.empty()) {
+        ValueId v = resolve(work.back());
+        work.pop_back();
+        if (!dependent_[v] || !seen.insert(v).second) continue;
+        if (auto i = integralIndex_.find(v); i != integralIndex_.end()) {
+            found.insert(i->second);
+            continue;
+        }
+        if (from_.at(v).op == Op::Integrate) continue;  // not one of the system's
+        for (ValueId o : from_.at(v).operands) work.push_back(o);
+    }
+    return found;
+}
+
 bool StepBuilder::fixedAtCreation(ValueId old) const {
     const Inst& i = from_.at(old);
     if (i.op == Op::Param || i.op == Op::Const || snapshotsOfFixed_.count(old)) return true;

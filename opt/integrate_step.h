@@ -53,6 +53,9 @@ public:
     bool dependent(ir::ValueId old) const { return dependent_[old]; }
     // What a `recur` stands for.
     ir::ValueId resolve(ir::ValueId old) const;
+    // The integrals integral j's derivative reads at the same instant (through equations
+    // and `recur`, not through another integral's derivative).
+    std::set<size_t> reads(size_t j) const;
 
     // Building the new kernel.
     ir::Kernel& to() { return to_; }

@@ -327,6 +327,7 @@ private:
                 for (size_t j = 0; j < b.size(); ++j) unchanged.push_back(b.start(j));
                 return unchanged;
             }
+            case Integrator::Leapfrog: return leapfrog(b);
             default: return rungeKutta(b, method_);
         }
     }
