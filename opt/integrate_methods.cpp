@@ -109,17 +109,17 @@ std::vector<bool> driftIntegrals(const StepBuilder& b) {
 std::vector<ValueId> leapfrog(StepBuilder& b) {
     size_t n = b.size();
     std::vector<bool> drift = driftIntegrals(b);
-    std::vector<ValueId> out(n), half(n), middle(n), end(n);
+    std::vector<ValueId> out(n), first(n), middle(n), end(n);
     StepBuilder::Point& start = b.startPoint();
     for (size_t j = 0; j < n; ++j) {
         if (drift[j]) {
             middle[j] = b.start(j);  // a drift reads no drift: unread there
             continue;
         }
-        ValueId slope = b.at(start, b.derivative(j));
+        first[j] = b.at(start, b.derivative(j));
         LocScope at(b.to(), b.loc(j));
-        half[j] = middle[j] = b.add(b.start(j), b.mul(timesDt(b, 0.5f), slope));
-        end[j] = b.add(b.start(j), b.mul(b.dt(), slope));
+        middle[j] = b.add(b.start(j), b.mul(timesDt(b, 0.5f), first[j]));
+        end[j] = b.add(b.start(j), b.mul(b.dt(), first[j]));
     }
     StepBuilder::Point mid = b.pointAt(0.5f, middle);
     for (size_t j = 0; j < n; ++j) {
@@ -131,9 +131,11 @@ std::vector<ValueId> leapfrog(StepBuilder& b) {
     StepBuilder::Point last = b.pointAt(1, end);
     for (size_t j = 0; j < n; ++j) {
         if (drift[j]) continue;
+        // K½ + h/2·f_K(end), summed as K + h/2·(f_K(start) + f_K(end)): one rounding into
+        // K a step, not two (under constant forces, as few as Euler's).
         ValueId slope = b.at(last, b.derivative(j));
         LocScope at(b.to(), b.loc(j));
-        out[j] = b.add(half[j], b.mul(timesDt(b, 0.5f), slope));
+        out[j] = b.add(b.start(j), b.mul(timesDt(b, 0.5f), b.add(first[j], slope)));
     }
     return out;
 }

@@ -33,7 +33,7 @@ std::vector<ir::ValueId> rungeKutta(StepBuilder& b, core::Integrator method);
 // integral is *kicked* (a velocity). With K the kicked and D the drifts:
 //   K½ = K + h/2·f_K(start)
 //   D' = D + h·f_D(middle, K½)
-//   K' = K½ + h/2·f_K(end, D', K + h·f_K(start))
+//   K' = K½ + h/2·f_K(end, D', K + h·f_K(start)), summed as K + h/2·(f_K(start) + f_K(end))
 // When f_K does not read K (forces of positions) this is velocity Verlet exactly; where it
 // does (drag) the end's K is Euler's estimate, which keeps the order 2. A system with no
 // drift (a decay, a spin) is Heun's method.

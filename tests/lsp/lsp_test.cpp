@@ -98,7 +98,8 @@ TEST_CASE("definition across an import, and the imported file's diagnostics go t
 
 TEST_CASE("hover on an integrator's name says what the method computes, its order and its stability") {
     std::string text = "@integrator(rk4)\nobject o { x = integrate(1); point(vec3(x), white, 1); }\n"
-                       "@integrator(semi_implicit)\nobject p { point(vec3(0), white, 1); }\nspawn o;\nspawn p;\n";
+                       "@integrator(semi_implicit)\nobject p { point(vec3(0), white, 1); }\n"
+                       "@integrator(leapfrog)\nobject q { point(vec3(0), white, 1); }\nspawn o;\nspawn p;\n";
     Analysis a = analyze("/tmp/int.psys", text);
     REQUIRE(a.parsed);
     std::string rk4 = hoverText(a, at(text, "rk4", 1, 1));
@@ -106,6 +107,9 @@ TEST_CASE("hover on an integrator's name says what the method computes, its orde
     CHECK(rk4.find("order 4") != std::string::npos);
     CHECK(rk4.find("2.785") != std::string::npos);
     CHECK(hoverText(a, at(text, "semi_implicit", 1, 2)).find("the default") != std::string::npos);
+    std::string leapfrog = hoverText(a, at(text, "leapfrog", 1, 1));
+    CHECK(leapfrog.find("velocity Verlet") != std::string::npos);
+    CHECK(leapfrog.find("order 2") != std::string::npos);
 }
 
 TEST_CASE("an imported file changed on disk: the open documents are analysed again (didChangeWatchedFiles)") {

@@ -129,7 +129,7 @@ struct DragRecurrence {
                 // vel reads itself: kicked; pos reads only vel: drifted.
                 float half = yv + h2 * k1v, end = yv + dt * k1v;
                 yp = yp + dt * fp(half);
-                yv = half + h2 * fv(end);
+                yv = yv + h2 * (k1v + fv(end));
                 break;
             }
             default: FAIL("no recurrence written for this method");
