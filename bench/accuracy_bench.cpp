@@ -27,7 +27,9 @@
 #include "codegen_llvm/llvm_backend.h"
 #include "driver/compile.h"
 #include "frontend/source.h"
+#include "interp/interpreter.h"
 #include "rt/system.h"
+#include "tune/tolerance.h"
 
 using namespace psys;
 using core::Integrator;
@@ -41,6 +43,9 @@ struct Problem {
     double seconds;
     // The error of a drawn point at time t against the exact solution.
     std::function<double(const rt::RenderPoint&, double)> error;
+    // The distance of the whole drawn point from its exact place, where the point draws
+    // more than the position (the springs draw (x, v, 0)): what @tolerance bounds.
+    std::function<double(const rt::RenderPoint&, double)> drawn = nullptr;
 };
 
 double norm3(double x, double y, double z) { return std::sqrt(x * x + y * y + z * z); }
@@ -63,12 +68,21 @@ std::vector<Problem> problems() {
              return positionError(p, x, y, 0);
          }},
         {"spring", "mass", 10,
-         [](const rt::RenderPoint& p, double t) { return std::fabs(p.position[0] - std::cos(2 * kPi * t)); }},
+         [](const rt::RenderPoint& p, double t) { return std::fabs(p.position[0] - std::cos(2 * kPi * t)); },
+         [](const rt::RenderPoint& p, double t) {
+             return positionError(p, std::cos(2 * kPi * t), -2 * kPi * std::sin(2 * kPi * t), 0);
+         }},
         {"damped_spring", "mass", 10,
          [](const rt::RenderPoint& p, double t) {
              const double w = 2 * kPi, zeta = 0.1, wd = w * std::sqrt(1 - zeta * zeta);
              double x = std::exp(-zeta * w * t) * (std::cos(wd * t) + zeta * w / wd * std::sin(wd * t));
              return std::fabs(p.position[0] - x);
+         },
+         [](const rt::RenderPoint& p, double t) {
+             const double w = 2 * kPi, a = 0.1 * w, wd = w * std::sqrt(1 - 0.01);
+             double x = std::exp(-a * t) * (std::cos(wd * t) + a / wd * std::sin(wd * t));
+             double v = -std::exp(-a * t) * (a * a / wd + wd) * std::sin(wd * t);
+             return positionError(p, x, v, 0);
          }},
         {"orbit", "planet", 200 * kPi,  // 100 periods
          [](const rt::RenderPoint& p, double t) { return positionError(p, std::cos(t), std::sin(t), 0); }},
@@ -326,17 +340,84 @@ void fountainTable(Bench& bench, const std::string& dir, bool quick) {
     std::cout << "\n(ns of the update loops per live drop per frame, median of 5 rounds of 20 frames)\n";
 }
 
+// What @tolerance chose for each problem at 1e-2, 1e-3 and 1e-4 m over its time, measured
+// here on the JIT against the exact solution, and the cheapest method and sub-step that
+// meets the tolerance found by brute force over every method at 1, 2, 4, 8 and 16
+// sub-steps a frame of 1/60 s (the same measurements: largest error, ns per update).
+void toleranceTable(Bench& bench, const std::string& dir, bool quick) {
+    const double frame = 1.0 / 60;
+    std::cout << "\n### what @tolerance chooses, against the cheapest by brute force\n\n| problem | tolerance | chosen "
+                 "| its error | its cost (ns/frame) | cheapest that meets it | its error | its cost | chosen / cheapest |\n"
+                 "|---|---|---|---|---|---|---|---|---|\n";
+    for (Problem p : problems()) {
+        if (p.drawn) p.error = p.drawn;
+        std::string text = readFile(dir + "/" + p.file + ".psys");
+        // Every candidate measured once: its largest error and its cost.
+        struct Measure {
+            Integrator method;
+            int subSteps;
+            double error, cost;
+        };
+        std::vector<Measure> all;
+        auto withStep = [&](int s) {
+            return s > 1 ? fmt::format("@step({});\n", frame / s) + text : text;
+        };
+        const Step frames{"1/60", frame, false};
+        for (Integrator m : methods())
+            for (int s : {1, 2, 4, 8, 16}) {
+                if (m == Integrator::Exact && s > 1) break;
+                Measured r = bench.accuracy(p, withStep(s), m, frames);
+                if (!r.closedForm) break;
+                all.push_back({m, s, r.maxError, bench.cost(withStep(s), p.type, m, frames)});
+            }
+        for (double tolerance : {1e-2, 1e-3, 1e-4}) {
+            SourceManager sources;
+            DiagnosticEngine diags(sources);
+            CompileOptions options;
+            tune::TuneOptions tune;
+            tune.frame = frame;
+            std::vector<tune::Choice> choices;
+            tune.pipeline = options.pipeline;
+            options.beforePasses = [&](ir::Module& module, opt::PassErrors& messages) {
+                choices = tune::chooseMethods(module, bench.jit(), tune, messages);
+            };
+            double seconds = quick ? std::min(p.seconds, 1.0) : p.seconds;  // as accuracy() runs it
+            std::string stated = fmt::format("@tolerance({}, {});\n", tolerance, seconds) + text;
+            if (!compileText("problem.psys", stated, sources, diags, options) || choices.size() != 1) std::exit(1);
+            const tune::Choice& c = choices[0];
+            const Measure* chosen = nullptr;
+            const Measure* cheapest = nullptr;
+            for (const Measure& m : all) {
+                if (m.method == c.method && m.subSteps == c.subSteps) chosen = &m;
+                if (m.error <= tolerance && (!cheapest || m.cost < cheapest->cost)) cheapest = &m;
+            }
+            if (!chosen) std::exit(1);
+            std::cout << fmt::format("| {} | {:.0e} | {}{} | {} | {:.2f} |", p.file, tolerance,
+                                     tune::describe(c.method, c.subSteps, frame), c.met ? "" : " (warned: cannot meet)",
+                                     sci(chosen->error), chosen->cost);
+            if (cheapest)
+                std::cout << fmt::format(" {} | {} | {:.2f} | {:.2f} |\n", tune::describe(cheapest->method, cheapest->subSteps, frame),
+                                         sci(cheapest->error), cheapest->cost, chosen->cost / cheapest->cost);
+            else
+                std::cout << " none meets it | — | — | — |\n";
+        }
+    }
+    std::cout << "\n(errors: the largest distance of the drawn point over the problem's time from its exact place — the springs draw (x, v, 0) — on the JIT; cost: ns of one "
+                 "object's updates a frame of 1/60 s, one thread, 100 000 copies)\n";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     CLI::App app("psys_accuracy: error against cost for every integration method");
     std::string csvPath, dir = PSYS_ACCURACY_DIR;
     size_t copies = 100000;
-    bool quick = false;
+    bool quick = false, toleranceOnly = false;
     app.add_option("--csv", csvPath, "Write every measurement to FILE (for bench/plot_accuracy.py)");
     app.add_option("--copies", copies, "Objects per cost measurement (100000)");
     app.add_option("--problems", dir, "The folder of problem files (bench/accuracy)");
     app.add_flag("--quick", quick, "A smoke test: a second of each problem, few timed frames (the figures mean nothing)");
+    app.add_flag("--tolerance-only", toleranceOnly, "Only the table of what @tolerance chooses");
     CLI11_PARSE(app, argc, argv);
     std::ofstream csvFile;
     std::ofstream* csv = nullptr;
@@ -348,8 +429,11 @@ int main(int argc, char** argv) {
     Bench bench(copies, quick);
     std::cout << fmt::format("# psys_accuracy on {}\n", bench.jit().report().target.empty() ? "this CPU"
                                                                                           : bench.jit().report().target);
-    accuracyTables(bench, dir, csv);
-    stiffTable(bench, dir, csv);
-    fountainTable(bench, dir, quick);
+    if (!toleranceOnly) {
+        accuracyTables(bench, dir, csv);
+        stiffTable(bench, dir, csv);
+        fountainTable(bench, dir, quick);
+    }
+    toleranceTable(bench, dir, quick);
     return 0;
 }

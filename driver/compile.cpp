@@ -56,7 +56,8 @@ std::optional<ir::Module> compileProgram(const ast::Program* program, SourceMana
     if (pipeline.log && (pipeline.printAfterAll || !pipeline.printAfter.empty()))
         *pipeline.log << "; IR after lowering\n" << ir::print(module, pipeline.print);
     opt::PassErrors messages;
-    bool ok = opt::runPipeline(module, pipeline, messages);
+    if (options.beforePasses) options.beforePasses(module, messages);
+    bool ok = !messages.hasErrors() && opt::runPipeline(module, pipeline, messages);
     for (const opt::PassMessage& m : messages) {
         Diagnostic& d = m.warning ? diags.warning(sourceRange(sources, m.loc), m.text)
                                   : diags.error(sourceRange(sources, m.loc), m.text);

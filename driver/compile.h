@@ -2,6 +2,7 @@
 // host library (and through it the viewer and the benchmarks) and the tests.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -16,6 +17,9 @@ struct CompileOptions {
     // The passes, and what they print: with `printAfter` or `printAfterAll` and a `log`,
     // the IR right after lowering is printed first.
     opt::PipelineOptions pipeline;
+    // Called with the lowered module before the passes, and their messages: where the
+    // chooser of integrators and steps under @tolerance (tune/tolerance.h) sets them.
+    std::function<void(ir::Module&, opt::PassErrors&)> beforePasses;
 };
 
 // Returns the compiled module, or nullopt with the errors in `diags`. The passes' errors

@@ -82,6 +82,9 @@ const BuiltinConstant kConstants[] = {
 constexpr BuiltinAttribute kAttributes[] = {
     {"integrator", "@integrator(method)", "how `integrate` advances this object's equations (docs/accuracy.md)"},
     {"step", "@step(seconds)", "a fixed sub-step: updates run in steps of at most this many seconds"},
+    {"tolerance", "@tolerance(metres[, seconds])",
+     "the largest position error accepted over the first `seconds` (10 when not given): the compiler chooses the "
+     "cheapest integrator and sub-step that meet it (psysc check --explain; docs/accuracy.md)"},
     {"capacity", "@capacity(count)", "the most objects of this type alive at once; emissions beyond it are dropped"},
     {"shape", "@shape(soft|disc|ring|star|smoke)", "a sprite's shape (soft, the default: a disc with a soft edge)"},
     {"texture", "@texture(\"file.png\"[, columns, rows])",

@@ -385,6 +385,8 @@ void Checker::checkAttributes(const std::vector<Attribute*>& attributes) {
             else if (!a.args[0]->type.isError() && (!v || !(v->v[0] > 0)))
                 diags_.error(a.args[0]->range, "the step must be a positive constant number of seconds");
             a.value = v;
+        } else if (a.name == "tolerance") {
+            checkTolerance(a, ctx);
         } else if (a.name == "capacity") {
             if (!wantOneArg("the most objects of this type alive at once")) continue;
             check(*a.args[0], ctx);
@@ -449,6 +451,33 @@ void Checker::checkTexture(Attribute& a, const Context& ctx) {
     if (!std::filesystem::is_regular_file(file, error))
         diags_.warning(a.textRange, fmt::format("there is no texture file `{}` (looked for {}): the sprites are drawn "
                                                 "with their shape", *a.text, file.string()));
+}
+
+// `@tolerance(metres[, seconds])`: positive constant numbers; the compiler meets them by
+// choosing the integrator and sub-step (tune/tolerance.h).
+void Checker::checkTolerance(Attribute& a, const Context& ctx) {
+    if (a.args.empty() || a.args.size() > 2) {
+        diags_.error(a.range, "`@tolerance` takes the largest position error in metres, then, if wanted, the seconds "
+                              "over which it holds: @tolerance(1e-3) or @tolerance(1e-3, 60)");
+        return;
+    }
+    ConstValue value{Type::vec(2), {0, 0, 0, 0}};  // metres, seconds (0: the default time)
+    for (size_t i = 0; i < a.args.size(); ++i) {
+        Expr& arg = *a.args[i];
+        int errors = diags_.errorCount();
+        check(arg, ctx);
+        const char* what = i == 0 ? "the tolerance" : "the time a tolerance holds over";
+        if (!expectType(arg, Type::scalar(), what)) return;
+        auto v = evaluateConstant(arg);
+        if (diags_.errorCount() > errors) return;  // said already (an extern, say)
+        if (!v || !std::isfinite(v->v[0]) || !(v->v[0] > 0)) {
+            diags_.error(arg.range, i == 0 ? "the tolerance must be a positive constant number of metres"
+                                           : "the time must be a positive constant number of seconds");
+            return;
+        }
+        value.v[i] = v->v[0];
+    }
+    a.value = value;
 }
 
 void Checker::checkObject(ObjectDecl& object) {

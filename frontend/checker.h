@@ -96,6 +96,7 @@ private:
     void checkDraw(ast::Command& draw, const Context& ctx, const ast::Command** point);
     void checkTrailLength(ast::Command& trail, const ast::Expr& length);
     void checkTexture(ast::Attribute& texture, const Context& ctx);
+    void checkTolerance(ast::Attribute& tolerance, const Context& ctx);
     void checkArguments(std::vector<ast::ExprPtr>& args, const ast::ObjectDecl& target, SourceRange callRange,
                         const Context& ctx);
     void checkAttributes(const std::vector<ast::Attribute*>& attributes);

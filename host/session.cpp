@@ -5,6 +5,8 @@
 #include <chrono>
 #include <ostream>
 
+#include "interp/interpreter.h"
+
 namespace psys::host {
 
 namespace {
@@ -34,9 +36,27 @@ CompileResult compile(const std::string& path, const CompileOptions& options, st
     return result;
 }
 
+void chooseUnderTolerance(CompileOptions& options, tune::TuneOptions tune, const BackendChoice& runsOn,
+                          std::shared_ptr<std::vector<tune::Choice>> choices) {
+    tune.pipeline = options.pipeline;
+    tune.pipeline.pass.relaxed |= runsOn.relaxesMaths();
+    options.beforePasses = [tune, runsOn, choices](ir::Module& module, opt::PassErrors& messages) {
+        bool wanted = false;
+        for (const ir::Object& o : module.objects) wanted |= o.attributes.tolerance > 0;
+        if (!wanted && !(tune.tolerance > 0)) return;
+        std::shared_ptr<rt::Backend> trials;
+        if (runsOn.name == "llvm")
+            if (auto jit = makeBackend(runsOn)) trials = *jit;
+        if (!trials) trials = std::make_shared<interp::Interpreter>();
+        auto chosen = tune::chooseMethods(module, *trials, tune, messages);
+        if (choices) *choices = std::move(chosen);
+    };
+}
+
 SessionOptions Session::resolved(const SessionOptions& asked) {
     SessionOptions options = asked;
     options.compile.pipeline.pass.relaxed |= options.backend.relaxesMaths();
+    if (!options.compile.beforePasses) chooseUnderTolerance(options.compile, options.tune, options.backend);
     return options;
 }
 

@@ -16,6 +16,7 @@
 #include "host/backends.h"
 #include "host/settings.h"
 #include "rt/system.h"
+#include "tune/tolerance.h"
 
 namespace psys::host {
 
@@ -23,7 +24,16 @@ struct SessionOptions {
     BackendChoice backend;
     CompileOptions compile;
     rt::SystemOptions system;
+    // The chooser under @tolerance (tune/tolerance.h): its frame, a default tolerance.
+    tune::TuneOptions tune;
 };
+
+// Installs the chooser of integrators and steps under @tolerance in `options`, compiled
+// with `options`' passes; its trials run where the system will — the LLVM JIT with its
+// maths for `llvm` (fast maths rounds differently, and over a long run that is the error),
+// else the interpreter (the GPU's IEEE float). What it chose goes to `choices`.
+void chooseUnderTolerance(CompileOptions& options, tune::TuneOptions tune, const BackendChoice& runsOn,
+                          std::shared_ptr<std::vector<tune::Choice>> choices = {});
 
 // The outcome of one compilation: its diagnostics (errors and warnings, with their
 // sources), whether it produced a module, and how long it took.

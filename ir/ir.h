@@ -329,6 +329,9 @@ struct Attributes {
     std::optional<Integrator> integrator;  // none: the pipeline's default
     Loc integratorLoc;
     float step = 0;                        // @step: the longest update, in seconds; 0: none
+    // @tolerance: the largest position error accepted (metres; 0: none) over `over`
+    // seconds (0: the default time); the chooser (tune/) turns it into integrator and step.
+    float tolerance = 0, toleranceOver = 0;
     std::optional<uint64_t> capacity;      // @capacity: most objects alive at once
     std::optional<core::Shape> shape;      // @shape: a sprite's (none: soft)
     std::optional<core::Blend> blend;      // @blend (none: core::defaultBlend)

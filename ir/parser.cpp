@@ -243,6 +243,11 @@ private:
             for (size_t i = 5; i < w.size(); ++i) a.texture += " " + w[i];
             return;
         }
+        if (w.size() == 4 && w[1] == "tolerance") {  // attribute tolerance METRES SECONDS
+            a.tolerance = number(w[2]);
+            a.toleranceOver = number(w[3]);
+            return;
+        }
         if (w.size() != 3) throw ParseError("expected `attribute name value`");
         if (w[1] == "integrator") {
             a.integrator = core::integratorFromName(w[2]);

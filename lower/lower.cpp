@@ -223,6 +223,10 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
             else attributes.blend = core::blendFromName(name);
         } else if (a.value) {  // the checker's value of @step or @capacity
             if (a.name == "step") attributes.step = a.value->v[0];
+            if (a.name == "tolerance") {
+                attributes.tolerance = a.value->v[0];
+                attributes.toleranceOver = a.value->v[1];
+            }
             if (a.name == "capacity") attributes.capacity = static_cast<uint64_t>(a.whole.value_or(a.value->v[0]));
         }
     };

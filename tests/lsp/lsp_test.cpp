@@ -177,7 +177,7 @@ TEST_CASE("completion: names in scope inside an object, members after a dot, att
     auto members = labels(completion(a, dotted, cursor));
     CHECK(members == std::vector<std::string>{"alive", "age", "ivel", "pos", "vel"});
     std::string attr = "@\n" + text;
-    CHECK(labels(completion(a, attr, 1)) == std::vector<std::string>{"integrator", "step", "capacity", "shape", "texture", "blend"});
+    CHECK(labels(completion(a, attr, 1)) == std::vector<std::string>{"integrator", "step", "tolerance", "capacity", "shape", "texture", "blend"});
     std::string integrator = "@integrator(\n" + text;
     CHECK(has(labels(completion(a, integrator, 12)), "rk4"));
 }

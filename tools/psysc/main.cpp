@@ -30,6 +30,7 @@
 #include "stats_command.h"
 #include "driver/compile.h"
 #include "host/backends.h"
+#include "host/session.h"
 #include "lsp/features.h"
 #include "lsp/server.h"
 #include "rt/system.h"
@@ -197,6 +198,11 @@ int realMain(int argc, char** argv) {
                    "Integrate every object with this method, whatever its @integrator says (to try one without "
                    "editing the source)")
         ->check(CLI::IsMember(methods))->type_name("METHOD");
+    double tolerance = 0;
+    app.add_option("--tolerance", tolerance,
+                   "For check and run: the largest position error in metres an object without @tolerance may have "
+                   "over 10 s; the compiler chooses its integrator and sub-step (docs/accuracy.md)")
+        ->check(CLI::PositiveNumber)->type_name("METRES");
     std::string statsFile;
     app.add_option("--stats", statsFile, "Per object type: operations per update before and after optimization, "
                    "state bytes per object")->type_name("FILE");
@@ -207,6 +213,9 @@ int realMain(int argc, char** argv) {
     bool time = false;
     check->add_flag("--time", time, "Print how long parsing and checking took");
     bool remarks = false;
+    bool explain = false;
+    check->add_flag("--explain", explain, "Say what integrator and sub-step @tolerance (or --tolerance) chose for each "
+                    "object, what else was tried, and the error of each");
     check->add_flag("--remarks", remarks, "Also say where a large argument meets sin, cos or tan (fast maths may round it "
                     "differently: docs/accuracy.md)");
 
@@ -279,6 +288,7 @@ int realMain(int argc, char** argv) {
         runOptions.relaxed = relaxedMath;
         runOptions.optimize = !noOptimize;
         runOptions.integrator = everyObject;
+        runOptions.tolerance = tolerance;
         try {
             return psys::tools::runSystem(runOptions);
         } catch (const std::exception& e) {  // a backend that cannot go on (a GL that refuses a shader, …)
@@ -297,9 +307,19 @@ int realMain(int argc, char** argv) {
         bool failed = false;
         psys::CompileOptions options;
         options.pipeline.pass.everyObject = everyObject;
+        psys::tune::TuneOptions tune;
+        tune.tolerance = tolerance;
+        auto choices = std::make_shared<std::vector<psys::tune::Choice>>();
+        psys::host::BackendChoice jit;  // as `psysc run` runs it: the JIT, fast maths
+        psys::host::chooseUnderTolerance(options, tune, jit, choices);
         for (const std::string& file : checkFiles) {
             psys::SourceManager sources;
+            choices->clear();
             checkOne(file, sources, &options, colour, time, &failed, remarks);
+            if (explain)
+                std::cout << (checkFiles.size() > 1 ? file + ":\n" : "")
+                          << (choices->empty() ? "no object states a tolerance (@tolerance, or --tolerance)\n"
+                                               : psys::tune::explain(*choices));
         }
         return failed ? 1 : 0;
     }

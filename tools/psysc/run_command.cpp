@@ -159,6 +159,8 @@ int runSystem(const RunOptions& options) {
     session.compile.pipeline.optimize = options.optimize;
     session.compile.pipeline.pass.relaxed = options.relaxed;
     session.compile.pipeline.pass.everyObject = options.integrator;
+    session.tune.frame = *dt;
+    session.tune.tolerance = options.tolerance;
     session.system.seed = options.seed;
     session.system.capacity = options.capacity;
     session.system.threads = options.threads;

@@ -25,6 +25,7 @@ struct RunOptions {
     bool optimize = true;
     bool relaxed = false;
     std::optional<core::Integrator> integrator;  // every object's, whatever @integrator says
+    double tolerance = 0;            // for objects without @tolerance; 0: none
     std::string backend = "llvm";    // host/backends.h
     std::string math = "fast";       // or "exact" (llvm)
     unsigned threads = 0;            // 0: every core

@@ -1,0 +1,291 @@
+// How the chooser runs its trials: tune/tolerance.h says why it works by trial.
+#include "tune/tolerance.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "rt/system.h"
+
+namespace psys::tune {
+
+using core::Integrator;
+
+namespace {
+
+constexpr int kSubSteps[] = {1, 2, 4, 8, 16};
+
+// The drawn positions of one type, frame by frame, sorted by object id.
+using Frame = std::vector<std::pair<uint32_t, std::array<float, 3>>>;
+using Path = std::vector<Frame>;
+
+bool integrates(const ir::Object& object) {
+    const ir::Kernel* behaviour = object.kernel(ir::KernelKind::Behaviour);
+    if (!behaviour) return false;
+    for (const ir::Inst& inst : behaviour->insts())
+        if (inst.op == ir::Op::Integrate) return true;
+    return false;
+}
+
+std::string seconds(double s) {
+    double inverse = 1 / s;
+    if (std::fabs(inverse - std::round(inverse)) < 1e-6 * inverse && inverse >= 2) return fmt::format("1/{:.0f}", inverse);
+    return fmt::format("{:.4g}", s);
+}
+
+// A compiled candidate: the module with object `index` under `method`, and its cost.
+struct Compiled {
+    ir::Module module;
+    double costPerUpdate = 0;
+};
+
+class Chooser {
+public:
+    Chooser(const ir::Module& lowered, rt::Backend& backend, const TuneOptions& options)
+        : lowered_(lowered), backend_(backend), options_(options) {}
+
+    Choice choose(size_t index, double tolerance, double over, bool own) {
+        const ir::Object& object = lowered_.objects[index];
+        Choice c;
+        c.object = object.name;
+        c.loc = object.loc;
+        c.tolerance = tolerance;
+        c.over = over;
+        c.frame = options_.frame;
+        c.own = own;
+        std::optional<Integrator> fixed = options_.pipeline.pass.everyObject;
+        if (!fixed) fixed = object.attributes.integrator;
+        c.methodFixed = fixed.has_value();
+        index_ = index;
+        frames_ = std::max<long>(1, std::lround(std::ceil(over / options_.frame - 1e-9)));
+
+        Path reference = referencePath(c);
+        compared_ = 0;
+        for (const Frame& f : reference) compared_ += f.size();
+
+        for (size_t m = 0; m < core::kIntegratorNames.size(); ++m) {
+            auto method = static_cast<Integrator>(m);
+            if (fixed && method != *fixed) continue;
+            auto compiled = compile(method);
+            if (!compiled) continue;  // `exact` without a closed form
+            for (int s : kSubSteps) {
+                if (method == Integrator::Exact && s > 1) break;  // the same at any step
+                c.trials.push_back({method, s, compiled->costPerUpdate * s, std::nullopt});
+            }
+            modules_.emplace(method, std::move(*compiled));
+        }
+        std::stable_sort(c.trials.begin(), c.trials.end(),
+                         [](const Trial& a, const Trial& b) { return a.cost < b.cost; });
+        if (compared_ == 0 || c.trials.empty()) return c;  // nothing drawn to compare: no choice
+
+        const Trial* chosen = nullptr;
+        for (Trial& t : c.trials) {
+            double budget = tolerance - c.floor;
+            if (!(budget > 0)) break;
+            t.error = run(modules_.at(t.method).module, t.subSteps, &reference, budget).first + c.floor;
+            if (*t.error <= tolerance) {
+                chosen = &t;
+                break;
+            }
+        }
+        c.met = chosen != nullptr;
+        if (!chosen) {  // the best it can do: every candidate, each stopped once it is behind the best
+            double best = INFINITY;
+            for (Trial& t : c.trials) {
+                t.error = run(modules_.at(t.method).module, t.subSteps, &reference, best).first + c.floor;
+                if (*t.error < best || !chosen) {
+                    best = std::min(best, *t.error);
+                    chosen = &t;
+                }
+            }
+        }
+        c.method = chosen->method;
+        c.subSteps = chosen->subSteps;
+        c.error = *chosen->error;
+        c.cost = chosen->cost;
+        return c;
+    }
+
+    bool drewNothing() const { return compared_ == 0; }
+
+private:
+    // The closed form where `exact` has one (its error float's rounding of a formula).
+    // Else rk4 at 1, 2, 4 and 8 sub-steps a frame: the finer of the two neighbours that
+    // agree best, their distance the reference's own error (`floor`) — finer steps cut
+    // rk4's truncation by 16 each halving, while float's rounding grows with the steps,
+    // so the best pair is where the two meet.
+    Path referencePath(Choice& c) {
+        if (auto exact = compile(Integrator::Exact)) {
+            c.reference = "the closed form (exact)";
+            c.floor = 0;
+            return run(exact->module, 1, nullptr, INFINITY).second;
+        }
+        auto rk4 = compile(Integrator::Rk4);
+        Path coarser = run(rk4->module, 1, nullptr, INFINITY).second;
+        Path best;
+        c.floor = INFINITY;
+        for (int s = 2; s <= 8; s *= 2) {
+            Path finer = run(rk4->module, s, nullptr, INFINITY).second;
+            double apart = pathDistance(finer, coarser);
+            if (apart < c.floor) {
+                c.floor = apart;
+                c.reference = describe(Integrator::Rk4, s, options_.frame);
+                best = finer;
+            }
+            coarser = std::move(finer);
+        }
+        return best;
+    }
+
+    static double pathDistance(const Path& a, const Path& r) {
+        double worst = 0;
+        for (size_t f = 0; f < r.size(); ++f) worst = std::max(worst, distance(f < a.size() ? a[f] : Frame{}, r[f]));
+        return worst;
+    }
+
+    std::optional<Compiled> compile(Integrator method) {
+        ir::Module module = lowered_;
+        module.objects[index_].attributes.integrator = method;
+        // A trial's population stays small: the chooser looks at the first objects alone.
+        for (ir::Object& o : module.objects)
+            o.attributes.capacity = std::min<uint64_t>(o.attributes.capacity.value_or(options_.population), options_.population);
+        opt::PipelineOptions pipeline = options_.pipeline;
+        pipeline.log = nullptr;
+        pipeline.printAfter.clear();
+        pipeline.printAfterAll = false;
+        opt::PassErrors ignored;  // the real compile reports them
+        if (!opt::runPipeline(module, pipeline, ignored)) return std::nullopt;
+        Compiled c{std::move(module), 0};
+        const ir::Object& object = c.module.objects[index_];
+        for (const ir::Kernel& k : object.kernels)
+            if (k.kind == ir::KernelKind::Update || k.kind == ir::KernelKind::Exports) c.costPerUpdate += static_cast<double>(k.size());
+        return c;
+    }
+
+    // Runs a candidate at `subSteps` a frame: its largest distance from `reference` (0
+    // without one; stopped once past `stop`), and its path.
+    std::pair<double, Path> run(const ir::Module& compiled, int subSteps, const Path* reference, double stop) {
+        ir::Module module = compiled;
+        module.objects[index_].attributes.step = subSteps > 1 ? static_cast<float>(options_.frame / subSteps) : 0;
+        rt::SystemOptions system;
+        system.threads = 1;
+        system.capacity = options_.population;
+        rt::System s(std::move(module), backend_, system);
+        Path path;
+        double worst = 0;
+        const std::string& name = lowered_.objects[index_].name;
+        size_t type = static_cast<size_t>(s.typeIndex(name));
+        for (long f = 0; f < frames_; ++f) {
+            if (s.step(options_.frame)) return {INFINITY, path};
+            Frame frame;
+            for (const rt::RenderPoint& p : s.points(type)) frame.push_back({p.id, p.position});
+            std::sort(frame.begin(), frame.end(), [](auto& a, auto& b) { return a.first < b.first; });
+            if (reference) {
+                const Frame& r = f < static_cast<long>(reference->size()) ? (*reference)[f] : Frame{};
+                worst = std::max(worst, distance(frame, r));
+                if (worst > stop) return {worst, path};
+            } else {
+                path.push_back(std::move(frame));
+            }
+            if (s.finished()) break;
+        }
+        return {worst, path};
+    }
+
+    // The largest distance between the objects two frames both draw; an object the
+    // reference draws that the other does not (killed or not yet created by the method's
+    // error) is infinitely far.
+    static double distance(const Frame& a, const Frame& r) {
+        double worst = 0;
+        size_t i = 0;
+        for (const auto& [id, q] : r) {
+            while (i < a.size() && a[i].first < id) ++i;
+            if (i == a.size() || a[i].first != id) return INFINITY;
+            const auto& p = a[i].second;
+            double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+            double d = std::sqrt(dx * dx + dy * dy + dz * dz);
+            worst = std::isnan(d) ? INFINITY : std::max(worst, d);
+        }
+        return worst;
+    }
+
+    const ir::Module& lowered_;
+    rt::Backend& backend_;
+    const TuneOptions& options_;
+    size_t index_ = 0;
+    long frames_ = 0;
+    size_t compared_ = 0;
+    std::map<Integrator, Compiled> modules_;
+};
+
+}  // namespace
+
+std::string describe(Integrator method, int subSteps, double frame) {
+    std::string name(core::integratorName(method));
+    if (subSteps <= 1) return name;
+    return fmt::format("{} with {} sub-steps a frame (@step({}))", name, subSteps, seconds(frame / subSteps));
+}
+
+std::vector<Choice> chooseMethods(ir::Module& module, rt::Backend& backend, const TuneOptions& options,
+                                  opt::PassErrors& messages) {
+    std::vector<Choice> choices;
+    for (size_t i = 0; i < module.objects.size(); ++i) {
+        ir::Object& object = module.objects[i];
+        bool own = object.attributes.tolerance > 0;
+        double tolerance = own ? object.attributes.tolerance : options.tolerance;
+        if (!(tolerance > 0) || !integrates(object)) continue;
+        double over = own && object.attributes.toleranceOver > 0 ? object.attributes.toleranceOver : options.horizon;
+        Chooser chooser(module, backend, options);
+        Choice c = chooser.choose(i, tolerance, over, own);
+        if (chooser.drewNothing()) {
+            messages.warning(object.loc, fmt::format("`{}` draws nothing in its first {} s: its tolerance cannot be "
+                                                     "measured, and its integrator and step stay as written",
+                                                     object.name, fmt::format("{:.4g}", over)));
+            choices.push_back(std::move(c));
+            continue;
+        }
+        if (c.trials.empty()) continue;
+        object.attributes.integrator = c.method;
+        object.attributes.step = c.subSteps > 1 ? static_cast<float>(options.frame / c.subSteps) : 0;
+        if (!c.met)
+            messages.warning(
+                object.loc,
+                fmt::format("no integrator and sub-step keeps `{}` within {:.3g} m over {:.4g} s at frames of {} s: "
+                            "the closest, {}, is within {:.2g} m (the reference's own error, float rounding, is "
+                            "about {:.2g} m)",
+                            object.name, tolerance, over, seconds(options.frame),
+                            describe(c.method, c.subSteps, options.frame), c.error, c.floor),
+                object.name);
+        choices.push_back(std::move(c));
+    }
+    return choices;
+}
+
+std::string explain(const std::vector<Choice>& choices) {
+    std::string out;
+    for (const Choice& c : choices) {
+        out += fmt::format("{}: @tolerance({:.3g} m over {:.4g} s){}: ", c.object, c.tolerance, c.over,
+                           c.own ? "" : " (the default)");
+        if (c.trials.empty()) {
+            out += "nothing drawn to measure; integrator and step as written\n";
+            continue;
+        }
+        out += fmt::format("{} {}, error {:.2g} m, {:.0f} instructions a frame{}\n", c.met ? "chose" : "cannot meet it; closest",
+                           describe(c.method, c.subSteps, c.frame), c.error, c.cost,
+                           c.methodFixed ? " (the integrator as written; the sub-step chosen)" : "");
+        out += fmt::format("  reference: {}, its own error about {:.2g} m\n", c.reference, c.floor);
+        for (const Trial& t : c.trials) {
+            if (!t.error) continue;
+            std::string error = !std::isfinite(*t.error)     ? "unbounded"
+                                : *t.error > c.tolerance ? fmt::format("over {:.2g} m (stopped)", *t.error)
+                                                         : fmt::format("{:.2g} m", *t.error);
+            out += fmt::format("  tried {:<50} {:>4.0f} instructions a frame, error {}\n",
+                               describe(t.method, t.subSteps, c.frame), t.cost, error);
+        }
+    }
+    return out;
+}
+
+}  // namespace psys::tune

@@ -1,0 +1,75 @@
+// The chooser behind `@tolerance(metres[, seconds])`: for each object that states a
+// tolerance (or under a default one: `psysc --tolerance`), the cheapest integration method
+// and sub-step whose drawn position stays within it.
+//
+// Why by trial: the error of a method depends on the derivatives' derivatives along the
+// path an object takes, on its step and on float's rounding, none of which the compiler
+// can bound from the equations alone (a spring's error grows with the number of periods;
+// an orbit's with its phase). So each candidate — every method the object can use, at 1,
+// 2, 4, 8 and 16 sub-steps a frame — is compiled and run on a small population (the
+// system as written, at most `population` objects of each type alive), and its points
+// compared, object by object and frame by frame, with a reference: the closed form where
+// `exact` has one, else rk4 at the sub-step where it agrees best with rk4 at twice that
+// step (their distance is the reference's own error, `floor`). A candidate meets the
+// tolerance when its distance from the reference plus that floor is within it — the floor
+// is also what float state can certify at all. Candidates are
+// tried cheapest first (instructions of the object's update and exports kernels times
+// sub-steps: the cost the backends pay) and the first that meets the tolerance wins; a run
+// stops as soon as it misses. Deterministic: the same source gives the same choice.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ir/ir.h"
+#include "opt/passes.h"
+#include "rt/backend.h"
+
+namespace psys::tune {
+
+struct TuneOptions {
+    double frame = 1.0 / 60;  // the host's step the choice is made for
+    double tolerance = 0;     // for objects without @tolerance (psysc --tolerance); 0: none
+    double horizon = 10;      // seconds compared under a @tolerance that states no time
+    size_t population = 64;   // objects of each type alive at once in a trial
+    opt::PipelineOptions pipeline;  // the passes the trials are compiled with
+};
+
+struct Trial {
+    core::Integrator method;
+    int subSteps = 1;
+    double cost = 0;               // instructions an object runs a frame
+    std::optional<double> error;   // distance from the reference; none: not run
+};
+
+struct Choice {
+    std::string object;
+    ir::Loc loc;
+    double tolerance = 0, over = 0;  // metres, seconds compared
+    double frame = 1.0 / 60;         // the host's step it was chosen for
+    bool own = true;                 // its own @tolerance, else the default
+    bool methodFixed = false;        // @integrator (or --integrator) given: only the sub-step chosen
+    bool met = false;
+    core::Integrator method = core::Integrator::SemiImplicit;
+    int subSteps = 1;
+    double error = 0;  // the chosen candidate's distance from the reference plus the floor
+    double cost = 0;
+    double floor = 0;       // the reference's own error estimate
+    std::string reference;  // what the reference was
+    std::vector<Trial> trials;  // cheapest first
+};
+
+// Chooses for each object of `module` (lowered, before the passes) that has a tolerance,
+// and writes the choice into its attributes (integrator, step); a tolerance it cannot meet
+// is a warning in `messages` with the best it found. `backend` runs the trials.
+std::vector<Choice> chooseMethods(ir::Module& module, rt::Backend& backend, const TuneOptions& options,
+                                  opt::PassErrors& messages);
+
+// What was chosen and why, a paragraph an object (psysc check --explain).
+std::string explain(const std::vector<Choice>& choices);
+
+// "rk4 with 4 sub-steps (@step(1/240))", "exact".
+std::string describe(core::Integrator method, int subSteps, double frame);
+
+}  // namespace psys::tune
