@@ -7,9 +7,10 @@
 // every step: the largest and the last error. The cost of an update is measured in the
 // same run: the same problem with 100 000 copies, on one thread, ns per object update.
 // A stiff decay is run at k·dt from 0.1 to 100 to see which methods stay bounded, and
-// the fountain with integrals gives the cost of each method on a real effect.
+// the fountain with integrals gives the cost of each method on a real effect. Last, what
+// @tolerance chooses on each problem against the cheapest that meets it by brute force.
 //
-//   psys_accuracy [--csv FILE] [--copies N] [--quick]
+//   psys_accuracy [--csv FILE] [--copies N] [--quick] [--tolerance-only [--explain]]
 //
 // The CSV is what bench/plot_accuracy.py draws (docs/images/accuracy.png).
 #include <CLI/CLI.hpp>
@@ -178,12 +179,19 @@ public:
         rt::System system(std::move(*module), jit_, options);
         for (int f = 0; f < 3; ++f)
             if (system.step(step.frame)) std::exit(1);
-        double before = system.stats().loopSeconds;
-        int frames = quick_ ? 3 : 30;
-        for (int f = 0; f < frames; ++f)
-            if (system.step(step.frame)) std::exit(1);
-        size_t live = system.stats().types[static_cast<size_t>(system.typeIndex(type))].live;
-        return (system.stats().loopSeconds - before) * 1e9 / (static_cast<double>(live) * frames);
+        // The median of rounds: the machine drifts, and two methods that cost the same
+        // should read the same.
+        int frames = quick_ ? 3 : 10;
+        std::vector<double> rounds;
+        for (int r = 0; r < (quick_ ? 1 : 5); ++r) {
+            double before = system.stats().loopSeconds;
+            for (int f = 0; f < frames; ++f)
+                if (system.step(step.frame)) std::exit(1);
+            size_t live = system.stats().types[static_cast<size_t>(system.typeIndex(type))].live;
+            rounds.push_back((system.stats().loopSeconds - before) * 1e9 / (static_cast<double>(live) * frames));
+        }
+        std::sort(rounds.begin(), rounds.end());
+        return rounds[rounds.size() / 2];
     }
 
     codegen_llvm::LlvmBackend& jit() { return jit_; }
@@ -344,7 +352,7 @@ void fountainTable(Bench& bench, const std::string& dir, bool quick) {
 // here on the JIT against the exact solution, and the cheapest method and sub-step that
 // meets the tolerance found by brute force over every method at 1, 2, 4, 8 and 16
 // sub-steps a frame of 1/60 s (the same measurements: largest error, ns per update).
-void toleranceTable(Bench& bench, const std::string& dir, bool quick) {
+void toleranceTable(Bench& bench, const std::string& dir, bool quick, bool explain) {
     const double frame = 1.0 / 60;
     std::cout << "\n### what @tolerance chooses, against the cheapest by brute force\n\n| problem | tolerance | chosen "
                  "| its error | its cost (ns/frame) | cheapest that meets it | its error | its cost | chosen / cheapest |\n"
@@ -385,6 +393,7 @@ void toleranceTable(Bench& bench, const std::string& dir, bool quick) {
             std::string stated = fmt::format("@tolerance({}, {});\n", tolerance, seconds) + text;
             if (!compileText("problem.psys", stated, sources, diags, options) || choices.size() != 1) std::exit(1);
             const tune::Choice& c = choices[0];
+            if (explain) std::cerr << tune::explain(choices);
             const Measure* chosen = nullptr;
             const Measure* cheapest = nullptr;
             for (const Measure& m : all) {
@@ -412,12 +421,13 @@ int main(int argc, char** argv) {
     CLI::App app("psys_accuracy: error against cost for every integration method");
     std::string csvPath, dir = PSYS_ACCURACY_DIR;
     size_t copies = 100000;
-    bool quick = false, toleranceOnly = false;
+    bool quick = false, toleranceOnly = false, explain = false;
     app.add_option("--csv", csvPath, "Write every measurement to FILE (for bench/plot_accuracy.py)");
     app.add_option("--copies", copies, "Objects per cost measurement (100000)");
     app.add_option("--problems", dir, "The folder of problem files (bench/accuracy)");
     app.add_flag("--quick", quick, "A smoke test: a second of each problem, few timed frames (the figures mean nothing)");
     app.add_flag("--tolerance-only", toleranceOnly, "Only the table of what @tolerance chooses");
+    app.add_flag("--explain", explain, "Print on stderr why @tolerance chose what it did (psysc check --explain)");
     CLI11_PARSE(app, argc, argv);
     std::ofstream csvFile;
     std::ofstream* csv = nullptr;
@@ -434,6 +444,6 @@ int main(int argc, char** argv) {
         stiffTable(bench, dir, csv);
         fountainTable(bench, dir, quick);
     }
-    toleranceTable(bench, dir, quick);
+    toleranceTable(bench, dir, quick, explain);
     return 0;
 }

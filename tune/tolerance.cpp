@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 
+#include "rt/pool.h"
 #include "rt/system.h"
 
 namespace psys::tune {
@@ -33,6 +34,31 @@ std::string seconds(double s) {
     double inverse = 1 / s;
     if (std::fabs(inverse - std::round(inverse)) < 1e-6 * inverse && inverse >= 2) return fmt::format("1/{:.0f}", inverse);
     return fmt::format("{:.4g}", s);
+}
+
+// The cost of one pass of an object's update (and exports), in adds on one lane: its
+// arithmetic lane by lane — a library function (pow, sin, exp) 150, a division or a square
+// root 4, the rest 1 — or, where that is more, the bytes of its row read and written (2 a
+// byte): the JIT's vectorized loops are bound by one or the other. Calibrated on
+// docs/accuracy.md's costs: the projectile's methods all cost what its memory does (about
+// 1 ns for a row of 40 bytes), the orbit's what its pow does (3.5 ns an evaluation).
+double passCost(const ir::Object& object) {
+    double compute = 0;
+    for (const ir::Kernel& k : object.kernels) {
+        if (k.kind != ir::KernelKind::Update && k.kind != ir::KernelKind::Exports) continue;
+        for (const ir::Inst& inst : k.insts()) {
+            const core::OpInfo& info = core::opInfo(inst.op);
+            double lanes = std::max<int>(1, inst.type.width);
+            double weight = info.kind == core::OpKind::Random ? 10
+                            : info.kind != core::OpKind::Pure ? 0
+                            : inst.op == ir::Op::Div || inst.op == ir::Op::Sqrt ? 4
+                            : !info.spelling.libm.empty() ? 150
+                                                          : 1;
+            compute += weight * lanes;
+        }
+    }
+    double memory = 2.0 * 2 * static_cast<double>(rt::Pool::rowBytes(object));
+    return std::max(compute, memory);
 }
 
 // A compiled candidate: the module with object `index` under `method`, and its cost.
@@ -147,20 +173,23 @@ private:
 
     std::optional<Compiled> compile(Integrator method) {
         ir::Module module = lowered_;
-        module.objects[index_].attributes.integrator = method;
-        // A trial's population stays small: the chooser looks at the first objects alone.
-        for (ir::Object& o : module.objects)
-            o.attributes.capacity = std::min<uint64_t>(o.attributes.capacity.value_or(options_.population), options_.population);
         opt::PipelineOptions pipeline = options_.pipeline;
+        // A method for every object (--integrator) stays every other object's; this one
+        // takes the candidate's (the reference's: it is compared with the method asked).
+        for (ir::Object& o : module.objects) {
+            if (pipeline.pass.everyObject) o.attributes.integrator = pipeline.pass.everyObject;
+            // A trial's population stays small: the chooser looks at the first objects alone.
+            o.attributes.capacity = std::min<uint64_t>(o.attributes.capacity.value_or(options_.population), options_.population);
+        }
+        pipeline.pass.everyObject.reset();
+        module.objects[index_].attributes.integrator = method;
         pipeline.log = nullptr;
         pipeline.printAfter.clear();
         pipeline.printAfterAll = false;
         opt::PassErrors ignored;  // the real compile reports them
         if (!opt::runPipeline(module, pipeline, ignored)) return std::nullopt;
         Compiled c{std::move(module), 0};
-        const ir::Object& object = c.module.objects[index_];
-        for (const ir::Kernel& k : object.kernels)
-            if (k.kind == ir::KernelKind::Update || k.kind == ir::KernelKind::Exports) c.costPerUpdate += static_cast<double>(k.size());
+        c.costPerUpdate = passCost(c.module.objects[index_]);
         return c;
     }
 
@@ -249,15 +278,20 @@ std::vector<Choice> chooseMethods(ir::Module& module, rt::Backend& backend, cons
         if (c.trials.empty()) continue;
         object.attributes.integrator = c.method;
         object.attributes.step = c.subSteps > 1 ? static_cast<float>(options.frame / c.subSteps) : 0;
-        if (!c.met)
-            messages.warning(
-                object.loc,
-                fmt::format("no integrator and sub-step keeps `{}` within {:.3g} m over {:.4g} s at frames of {} s: "
-                            "the closest, {}, is within {:.2g} m (the reference's own error, float rounding, is "
-                            "about {:.2g} m)",
-                            object.name, tolerance, over, seconds(options.frame),
-                            describe(c.method, c.subSteps, options.frame), c.error, c.floor),
-                object.name);
+        if (!c.met) {
+            std::string why = c.floor * 2 >= tolerance
+                                  ? fmt::format("the reference itself is only good to about {:.2g} m here: float state's "
+                                                "rounding", c.floor)
+                              : c.methodFixed ? std::string("the integrator is the one written, by @integrator or "
+                                                            "--integrator, and only the sub-step was chosen")
+                                              : std::string("no finer sub-step than 1/16 of a frame is tried");
+            messages.warning(object.loc,
+                             fmt::format("no integrator and sub-step keeps `{}` within {:.3g} m over {:.4g} s at frames "
+                                         "of {} s: the closest, {}, is within {:.2g} m ({})",
+                                         object.name, tolerance, over, seconds(options.frame),
+                                         describe(c.method, c.subSteps, options.frame), c.error, why),
+                             object.name);
+        }
         choices.push_back(std::move(c));
     }
     return choices;
@@ -272,7 +306,7 @@ std::string explain(const std::vector<Choice>& choices) {
             out += "nothing drawn to measure; integrator and step as written\n";
             continue;
         }
-        out += fmt::format("{} {}, error {:.2g} m, {:.0f} instructions a frame{}\n", c.met ? "chose" : "cannot meet it; closest",
+        out += fmt::format("{} {}, error {:.2g} m, cost {:.0f} a frame{}\n", c.met ? "chose" : "cannot meet it; closest",
                            describe(c.method, c.subSteps, c.frame), c.error, c.cost,
                            c.methodFixed ? " (the integrator as written; the sub-step chosen)" : "");
         out += fmt::format("  reference: {}, its own error about {:.2g} m\n", c.reference, c.floor);
@@ -281,7 +315,7 @@ std::string explain(const std::vector<Choice>& choices) {
             std::string error = !std::isfinite(*t.error)     ? "unbounded"
                                 : *t.error > c.tolerance ? fmt::format("over {:.2g} m (stopped)", *t.error)
                                                          : fmt::format("{:.2g} m", *t.error);
-            out += fmt::format("  tried {:<50} {:>4.0f} instructions a frame, error {}\n",
+            out += fmt::format("  tried {:<50} cost {:>5.0f} a frame, error {}\n",
                                describe(t.method, t.subSteps, c.frame), t.cost, error);
         }
     }

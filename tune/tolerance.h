@@ -13,8 +13,8 @@
 // step (their distance is the reference's own error, `floor`). A candidate meets the
 // tolerance when its distance from the reference plus that floor is within it — the floor
 // is also what float state can certify at all. Candidates are
-// tried cheapest first (instructions of the object's update and exports kernels times
-// sub-steps: the cost the backends pay) and the first that meets the tolerance wins; a run
+// tried cheapest first (a pass's arithmetic or, where more, its memory traffic, times the
+// sub-steps: tolerance.cpp's passCost) and the first that meets the tolerance wins; a run
 // stops as soon as it misses. Deterministic: the same source gives the same choice.
 #pragma once
 
@@ -39,7 +39,7 @@ struct TuneOptions {
 struct Trial {
     core::Integrator method;
     int subSteps = 1;
-    double cost = 0;               // instructions an object runs a frame
+    double cost = 0;               // of an object's updates a frame, in adds on a lane (passCost)
     std::optional<double> error;   // distance from the reference; none: not run
 };
 
