@@ -6,10 +6,12 @@
 #include <fmt/format.h>
 
 #include "driver/compile.h"
+#include "interp/interpreter.h"
 #include "frontend/frontend.h"
 #include "frontend/loader.h"
 #include "lsp/index_builder.h"
 #include "opt/passes.h"
+#include "tune/tolerance.h"
 
 namespace psys::lsp {
 
@@ -41,6 +43,7 @@ void methodHints(const ir::Module& module, Analysis& a) {
         if (!integrates) continue;
         std::string label = std::string(core::integratorName(opt::methodOf(o, {})));
         label += o.attributes.step > 0 ? ", step " + stepText(o.attributes.step) : ", a step per update";
+        if (o.attributes.tolerance > 0) label += fmt::format(" (chosen for @tolerance({:g}))", o.attributes.tolerance);
         a.hints.push_back({at, label, 2});
     }
 }
@@ -63,8 +66,15 @@ Analysis analyze(const std::string& path, std::string text, const std::atomic<bo
             // What `psysc check` reports beyond the front end comes from the passes: an
             // integral with no closed form under @integrator(exact), a decay past the
             // integrator's stability limit. They run on a clean program only.
+            // Under @tolerance the chooser runs its trials on the interpreter (what the
+            // hints and warnings say is what `psysc check` says, give or take fast maths).
+            CompileOptions options;
+            interp::Interpreter trials;
+            options.beforePasses = [&](ir::Module& module, opt::PassErrors& messages) {
+                if (!stop()) tune::chooseMethods(module, trials, tune::TuneOptions{}, messages);
+            };
             if (diags.errorCount() == 0 && !stop())
-                if (auto module = compileProgram(program.get(), *a.sources, diags)) methodHints(*module, a);
+                if (auto module = compileProgram(program.get(), *a.sources, diags, options)) methodHints(*module, a);
         }
     } catch (const std::exception& e) {
         // The front end's own failure must not end the editing session: it is reported

@@ -3,7 +3,7 @@
 #   cmake -DROOT=<source dir> -P tests/check_layers.cmake
 set(allowed_core "")
 set(allowed_frontend "core;grammar")
-set(allowed_lsp "core;frontend;lower;ir;opt;driver")
+set(allowed_lsp "core;frontend;lower;ir;opt;driver;tune;rt;interp")
 set(allowed_ir "core")
 set(allowed_lower "core;frontend;ir")
 set(allowed_opt "core;ir")

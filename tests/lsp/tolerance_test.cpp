@@ -1,0 +1,44 @@
+// The language server under @tolerance: the chooser runs as `psysc check` runs it (its
+// trials on the interpreter), the inlay hint names the method and step it chose, and a
+// tolerance it cannot meet is a warning in the editor.
+#include <doctest/doctest.h>
+
+#include "lsp_support.h"
+
+using namespace psys;
+using namespace psys::lsp;
+using namespace psys::lsp::test;
+using nlohmann::json;
+
+namespace {
+
+// The labels of the hints on `line` (from 0).
+std::vector<std::string> hintsOn(const Analysis& a, const std::string& text, int line) {
+    std::vector<std::string> labels;
+    for (const json& h : inlayHints(a, 0, static_cast<uint32_t>(text.size())))
+        if (h["position"]["line"].get<int>() == line) labels.push_back(h["label"].get<std::string>());
+    return labels;
+}
+
+}  // namespace
+
+TEST_CASE("inlay hints say what @tolerance chose; a tolerance out of reach is a warning") {
+    std::string spring = "const w = 6.2831853;\n"
+                         "@tolerance(1e-3, 10) object mass {\n"
+                         "    x = 1 + integrate(v);\n"
+                         "    v = integrate(-w * w * x);\n"
+                         "    point(vec3(x, v, 0), white, 1);\n"
+                         "}\n"
+                         "spawn mass;\n";
+    Analysis a = analyze("/tmp/tolerance.psys", spring);
+    REQUIRE(a.parsed);
+    CHECK(a.diagnostics.empty());
+    CHECK(hintsOn(a, spring, 1) == std::vector<std::string>{"rk4, a step per update (chosen for @tolerance(0.001))"});
+
+    std::string tight = spring;
+    tight.replace(tight.find("@tolerance(1e-3, 10)"), 20, "@integrator(euler) @tolerance(1e-6, 10)");
+    Analysis b = analyze("/tmp/tolerance.psys", tight);
+    REQUIRE(b.diagnostics.size() == 1);
+    CHECK(b.diagnostics[0].severity == Severity::Warning);
+    CHECK(b.diagnostics[0].message.find("no integrator and sub-step keeps `mass` within 1e-06 m") != std::string::npos);
+}
