@@ -22,7 +22,7 @@ std::vector<std::string> hintsOn(const Analysis& a, const std::string& text, int
 
 }  // namespace
 
-TEST_CASE("inlay hints say what @tolerance chose; a tolerance out of reach is a warning") {
+TEST_CASE("inlay hints say what @tolerance chose, and a tolerance out of reach is a warning") {
     std::string spring = "const w = 6.2831853;\n"
                          "@tolerance(1e-3, 10) object mass {\n"
                          "    x = 1 + integrate(v);\n"

@@ -12,6 +12,8 @@
 
 #include "driver/compile.h"
 #include "interp/interpreter.h"
+#include "ir/parser.h"
+#include "ir/printer.h"
 #include "rt/system.h"
 #include "test_support.h"
 #include "tune/tolerance.h"
@@ -188,4 +190,26 @@ TEST_CASE("objects that integrate nothing, or state no tolerance, are left as wr
     REQUIRE(c.module);
     CHECK(c.choices.empty());
     CHECK_FALSE(c.module->objects[1].attributes.integrator.has_value());
+}
+
+TEST_CASE("@tolerance is carried into the IR, printed and parsed back") {
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    CompileOptions lowerOnly;
+    lowerOnly.pipeline.optimize = false;
+    auto module = compileText("t.psys", "@tolerance(1e-3, 30) object a { pos = integrate(vec3(1, 0, 0)); point(pos, white, 1); }\n"
+                                        "@tolerance(0.5) object b { pos = integrate(vec3(1, 0, 0)); point(pos, white, 1); }\n"
+                                        "spawn a; spawn b;", sources, diags, lowerOnly);
+    REQUIRE(module);
+    CHECK(module->objects[0].attributes.tolerance == doctest::Approx(1e-3));
+    CHECK(module->objects[0].attributes.toleranceOver == 30);
+    CHECK(module->objects[1].attributes.toleranceOver == 0);  // the default time
+    std::string text = ir::print(*module);
+    CHECK(text.find("  attribute tolerance 0.001 30\n") != std::string::npos);
+    std::string error;
+    auto back = ir::parseModule(text, error);
+    INFO(error);
+    REQUIRE(back);
+    CHECK(back->objects[0].attributes == module->objects[0].attributes);
+    CHECK(back->objects[1].attributes == module->objects[1].attributes);
 }
