@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <map>
 
@@ -94,13 +95,12 @@ public:
         for (size_t m = 0; m < core::kIntegratorNames.size(); ++m) {
             auto method = static_cast<Integrator>(m);
             if (fixed && method != *fixed) continue;
-            auto compiled = compile(method);
+            const Compiled* compiled = compile(method);
             if (!compiled) continue;  // `exact` without a closed form
             for (int s : kSubSteps) {
                 if (method == Integrator::Exact && s > 1) break;  // the same at any step
                 c.trials.push_back({method, s, compiled->costPerUpdate * s, std::nullopt});
             }
-            modules_.emplace(method, std::move(*compiled));
         }
         std::stable_sort(c.trials.begin(), c.trials.end(),
                          [](const Trial& a, const Trial& b) { return a.cost < b.cost; });
@@ -110,7 +110,7 @@ public:
         for (Trial& t : c.trials) {
             double budget = tolerance - c.floor;
             if (!(budget > 0)) break;
-            t.error = run(modules_.at(t.method).module, t.subSteps, &reference, budget).first + c.floor;
+            t.error = run(compile(t.method)->module, t.subSteps, &reference, budget).first + c.floor;
             if (*t.error <= tolerance) {
                 chosen = &t;
                 break;
@@ -120,7 +120,7 @@ public:
         if (!chosen) {  // the best it can do: every candidate, each stopped once it is behind the best
             double best = INFINITY;
             for (Trial& t : c.trials) {
-                t.error = run(modules_.at(t.method).module, t.subSteps, &reference, best).first + c.floor;
+                t.error = run(compile(t.method)->module, t.subSteps, &reference, best).first + c.floor;
                 if (*t.error < best || !chosen) {
                     best = std::min(best, *t.error);
                     chosen = &t;
@@ -143,12 +143,18 @@ private:
     // rk4's truncation by 16 each halving, while float's rounding grows with the steps,
     // so the best pair is where the two meet.
     Path referencePath(Choice& c) {
-        if (auto exact = compile(Integrator::Exact)) {
+        if (const Compiled* exact = compile(Integrator::Exact)) {
+            // A formula's few roundings: a handful of float's steps at the largest coordinate.
+            Path path = run(exact->module, 1, nullptr, INFINITY).second;
+            double largest = 0;
+            for (const Frame& f : path)
+                for (const auto& point : f)
+                    for (float x : point.second) largest = std::max(largest, std::fabs(static_cast<double>(x)));
             c.reference = "the closed form (exact)";
-            c.floor = 0;
-            return run(exact->module, 1, nullptr, INFINITY).second;
+            c.floor = 4 * FLT_EPSILON * largest;
+            return path;
         }
-        auto rk4 = compile(Integrator::Rk4);
+        const Compiled* rk4 = compile(Integrator::Rk4);
         Path coarser = run(rk4->module, 1, nullptr, INFINITY).second;
         Path best;
         c.floor = INFINITY;
@@ -171,7 +177,11 @@ private:
         return worst;
     }
 
-    std::optional<Compiled> compile(Integrator method) {
+    // The module with the object under `method` (compiled once), or null where the passes
+    // refuse it (`exact` without a closed form).
+    const Compiled* compile(Integrator method) {
+        if (auto it = modules_.find(method); it != modules_.end()) return it->second ? &*it->second : nullptr;
+        std::optional<Compiled>& slot = modules_[method];
         ir::Module module = lowered_;
         opt::PipelineOptions pipeline = options_.pipeline;
         // A method for every object (--integrator) stays every other object's; this one
@@ -187,10 +197,10 @@ private:
         pipeline.printAfter.clear();
         pipeline.printAfterAll = false;
         opt::PassErrors ignored;  // the real compile reports them
-        if (!opt::runPipeline(module, pipeline, ignored)) return std::nullopt;
-        Compiled c{std::move(module), 0};
-        c.costPerUpdate = passCost(c.module.objects[index_]);
-        return c;
+        if (!opt::runPipeline(module, pipeline, ignored)) return nullptr;
+        slot = Compiled{std::move(module), 0};
+        slot->costPerUpdate = passCost(slot->module.objects[index_]);
+        return &*slot;
     }
 
     // Runs a candidate at `subSteps` a frame: its largest distance from `reference` (0
@@ -246,7 +256,7 @@ private:
     size_t index_ = 0;
     long frames_ = 0;
     size_t compared_ = 0;
-    std::map<Integrator, Compiled> modules_;
+    std::map<Integrator, std::optional<Compiled>> modules_;
 };
 
 }  // namespace

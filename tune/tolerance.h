@@ -9,7 +9,7 @@
 // 2, 4, 8 and 16 sub-steps a frame — is compiled and run on a small population (the
 // system as written, at most `population` objects of each type alive), and its points
 // compared, object by object and frame by frame, with a reference: the closed form where
-// `exact` has one, else rk4 at the sub-step where it agrees best with rk4 at twice that
+// `exact` has one (its own error a few of float's steps at the largest coordinate), else rk4 at the sub-step where it agrees best with rk4 at twice that
 // step (their distance is the reference's own error, `floor`). A candidate meets the
 // tolerance when its distance from the reference plus that floor is within it — the floor
 // is also what float state can certify at all. Candidates are
