@@ -104,7 +104,8 @@ public:
         }
         std::stable_sort(c.trials.begin(), c.trials.end(),
                          [](const Trial& a, const Trial& b) { return a.cost < b.cost; });
-        if (compared_ == 0 || c.trials.empty()) return c;  // nothing drawn to compare: no choice
+        if (compared_ == 0) c.trials.clear();  // nothing drawn to compare: no choice
+        if (c.trials.empty()) return c;
 
         const Trial* chosen = nullptr;
         for (Trial& t : c.trials) {

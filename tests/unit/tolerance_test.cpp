@@ -213,3 +213,17 @@ TEST_CASE("@tolerance is carried into the IR, printed and parsed back") {
     CHECK(back->objects[0].attributes == module->objects[0].attributes);
     CHECK(back->objects[1].attributes == module->objects[1].attributes);
 }
+
+TEST_CASE("an object that draws nothing under a tolerance is a warning and keeps what it was written with") {
+    Chosen c = compileUnderTolerance(R"(
+        @tolerance(1e-3, 2) object hidden { pos = integrate(vec3(1, 0, 0)); kill when pos.x > 5; }
+        spawn hidden;)");
+    REQUIRE(c.module);
+    REQUIRE(c.choices.size() == 1);
+    CHECK(c.choices[0].trials.empty());
+    CHECK_FALSE(c.module->objects[0].attributes.integrator.has_value());
+    CHECK(c.diagnostics.find("warning: `hidden` draws nothing in its first 2 s: its tolerance cannot be measured") !=
+          std::string::npos);
+    CHECK(tune::explain(c.choices) == "hidden: @tolerance(0.001 m over 2 s): nothing drawn to measure; integrator and "
+                                      "step as written\n");
+}
