@@ -11,10 +11,10 @@
 
 namespace psys::core {
 
-enum class Integrator : uint8_t { Euler, SemiImplicit, Midpoint, Rk2, Rk4, Exponential, Exact, Leapfrog };
+enum class Integrator : uint8_t { Euler, SemiImplicit, Midpoint, Rk2, Rk4, Exponential, Exact, Leapfrog, Bs3 };
 
-constexpr std::array<std::string_view, 8> kIntegratorNames = {"euler", "semi_implicit", "midpoint", "rk2",
-                                                              "rk4",   "exponential",   "exact",    "leapfrog"};
+constexpr std::array<std::string_view, 9> kIntegratorNames = {"euler", "semi_implicit", "midpoint", "rk2", "rk4",
+                                                              "exponential", "exact", "leapfrog", "bs3"};
 
 constexpr std::string_view integratorName(Integrator i) { return kIntegratorNames[static_cast<size_t>(i)]; }
 
@@ -30,13 +30,14 @@ constexpr std::optional<Integrator> integratorFromName(std::string_view name) {
 // (leapfrog on a decay is Heun's method; on an oscillator x″ = −ω²x it is stable while
 // ω·h < 2); the classical RK4 at 2.785293563405… (where its growth factor
 // 1 − z + z²/2 − z³/6 + z⁴/24 comes back to 1). `exponential` and `exact` solve the
-// linear decay exactly: no limit (0).
+// linear decay exactly: no limit (0). `bs3` chooses its own steps, shrinking them where a
+// decay needs it: no fixed limit either (its error control is its stability check).
 constexpr double stabilityLimit(Integrator i) {
     switch (i) {
         case Integrator::Euler: case Integrator::SemiImplicit: case Integrator::Midpoint: case Integrator::Rk2:
         case Integrator::Leapfrog: return 2.0;
         case Integrator::Rk4: return 2.785293563405282;
-        case Integrator::Exponential: case Integrator::Exact: return 0.0;
+        case Integrator::Exponential: case Integrator::Exact: case Integrator::Bs3: return 0.0;
     }
     return 0.0;
 }

@@ -183,10 +183,17 @@ std::string integratorDoc(std::string_view name) {
                    "for any number of periods";
             order = "order 2";
             break;
+        case Integrator::Bs3:
+            what = "the Bogacki–Shampine 3(2) pair: each object's steps shrink and grow within the update to "
+                   "keep its error estimate within its @tolerance (else 1e-3 m over 10 s), up to four tries an "
+                   "update";
+            order = "order 3";
+            break;
     }
     double limit = core::stabilityLimit(*method);
     char stable[96];
     if (limit > 0) std::snprintf(stable, sizeof stable, "stable for y' = -k·y while k·h < %.4g", limit);
+    else if (*method == Integrator::Bs3) std::snprintf(stable, sizeof stable, "its steps shrink where a decay needs it");
     else std::snprintf(stable, sizeof stable, "stable for any decay");
     return what + "; " + order + "; " + stable + ".";
 }

@@ -177,7 +177,7 @@ private:
                 break;
             case Op::Age: case Op::Time: {
                 if (fromCreation_ && i.op == Op::Time) throw NotFixedAtCreation{};
-                ValueId start = fromCreation_ ? k_.scalar(0) : b_.clockAt(i.op, 0);
+                ValueId start = fromCreation_ ? k_.scalar(0) : b_.clockAt(i.op, b_.pointAt(0, {}));
                 return {i.type, {{start, 0, std::nullopt}, {one(i.type), 1, std::nullopt}}, std::nullopt};
             }
             case Op::Recur: return op(0);

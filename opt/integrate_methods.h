@@ -8,6 +8,8 @@
 //   exponential                 Euler's step with each integral's linear decay solved
 //                               exactly over the step (opt/integrate_methods.cpp)
 //   exact                       closed forms over the step (opt/integrate_exact.cpp)
+//   bs3                         the Bogacki–Shampine 3(2) pair, each object's steps its own
+//                               under error control (opt/integrate_adaptive.cpp)
 #pragma once
 
 #include <array>
@@ -38,6 +40,11 @@ std::vector<ir::ValueId> rungeKutta(StepBuilder& b, core::Integrator method);
 // does (drag) the end's K is Euler's estimate, which keeps the order 2. A system with no
 // drift (a decay, a spin) is Heun's method.
 std::vector<ir::ValueId> leapfrog(StepBuilder& b);
+
+// The Bogacki–Shampine 3(2) pair with error control, up to four attempted steps an update
+// (the file's header says how): `stepSlot` is the object's f32 slot for the step to try
+// next; a step is kept while its error estimate is at most tolerancePerSecond × its length.
+std::vector<ir::ValueId> bogackiShampine(StepBuilder& b, int stepSlot, float tolerancePerSecond);
 
 // Each integral y' = f with f = c·y + r (c its linear part, when it has one):
 // y + dt·φ1(−c·dt)·f, all at the start of the step; Euler's step where there is no c.

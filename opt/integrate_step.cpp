@@ -61,9 +61,11 @@ ValueId StepBuilder::dt() { return to_.add(Inst::make(Op::Dt, Type::f32())); }
 
 ValueId StepBuilder::start(size_t j) { return to_.add(Inst::make(Op::StateRead, type(j), {}, slots_[j])); }
 
-// The inputs hold the end of the update: back by (1 − c)·dt.
-ValueId StepBuilder::clockAt(Op input, float c) {
+// The inputs hold the end of the update: back by (1 − c)·dt, or by dt − since.
+ValueId StepBuilder::clockAt(Op input, const Point& point) {
     ValueId end = to_.add(Inst::make(input, Type::f32()));
+    if (point.since) return to_.op(Op::Sub, Type::f32(), {end, to_.op(Op::Sub, Type::f32(), {dt(), *point.since})});
+    float c = point.c;
     if (c == 1) return end;
     ValueId behind = c == 0 ? dt() : to_.op(Op::Mul, Type::f32(), {scalar(1 - c), dt()});
     return to_.op(Op::Sub, Type::f32(), {end, behind});
@@ -91,7 +93,7 @@ ValueId StepBuilder::at(Point& point, ValueId old) {
     ValueId v;
     const Inst& i = from_.at(old);
     if (auto seen = stageViews_.find(old); seen != stageViews_.end()) v = final(seen->second);
-    else if (i.op == Op::Age || i.op == Op::Time) v = clockAt(i.op, point.c);
+    else if (i.op == Op::Age || i.op == Op::Time) v = clockAt(i.op, point);
     else if (i.op == Op::Recur) v = at(point, i.operands[0]);
     else v = copy(old, [&](ValueId o) { return at(point, o); });
     return point.values[old] = v;

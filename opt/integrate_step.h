@@ -20,6 +20,7 @@
 
 #include <functional>
 #include <map>
+#include <optional>
 #include <set>
 #include <vector>
 
@@ -39,6 +40,9 @@ public:
         std::vector<ir::ValueId> y;
         float c = 0;  // 0: the start of the step, 1: its end
         std::map<ir::ValueId, ir::ValueId> values;  // what `at` built for it
+        // Where set, the instant instead of c: seconds since the update's start (an
+        // adaptive method's stages lie where its own steps put them).
+        std::optional<ir::ValueId> since;
     };
 
     // The system.
@@ -62,10 +66,12 @@ public:
     ir::ValueId dt();
     ir::ValueId start(size_t j);  // integral j before the update: its state slot
     // The point at fraction c of the step (0: its start, 1: its end) with integrals `y`.
-    Point pointAt(float c, std::vector<ir::ValueId> y) { return {std::move(y), c, {}}; }
+    Point pointAt(float c, std::vector<ir::ValueId> y) { return {std::move(y), c, {}, std::nullopt}; }
+    // The point `since` seconds (a value of the new kernel) after the update's start.
+    Point pointSince(ir::ValueId since, std::vector<ir::ValueId> y) { return {std::move(y), 0, {}, since}; }
     Point& startPoint();          // c = 0, every integral at its start value
-    // The age or the time at fraction c of the step.
-    ir::ValueId clockAt(ir::Op input, float c);
+    // The age or the time at a point.
+    ir::ValueId clockAt(ir::Op input, const Point& point);
     ir::ValueId at(Point& point, ir::ValueId old);
     ir::ValueId final(ir::ValueId old);
     // Stages see `old` as `seen` instead of re-evaluating it (a `derive`: its value at the

@@ -62,6 +62,14 @@ double passCost(const ir::Object& object) {
     return std::max(compute, memory);
 }
 
+// bs3 holds its error within the object's tolerance (opt/integrate_adaptive.cpp): the one
+// the chooser works to, stated where it came from --tolerance or the default time.
+void stateTolerance(ir::Object& object, Integrator method, double tolerance, double over) {
+    if (method != Integrator::Bs3) return;
+    object.attributes.tolerance = static_cast<float>(tolerance);
+    object.attributes.toleranceOver = static_cast<float>(over);
+}
+
 // A compiled candidate: the module with object `index` under `method`, and its cost.
 struct Compiled {
     ir::Module module;
@@ -78,6 +86,8 @@ public:
         Choice c;
         c.object = object.name;
         c.loc = object.loc;
+        tolerance_ = tolerance;
+        over_ = over;
         c.tolerance = tolerance;
         c.over = over;
         c.frame = options_.frame;
@@ -194,6 +204,7 @@ private:
         }
         pipeline.pass.everyObject.reset();
         module.objects[index_].attributes.integrator = method;
+        stateTolerance(module.objects[index_], method, tolerance_, over_);
         pipeline.log = nullptr;
         pipeline.printAfter.clear();
         pipeline.printAfterAll = false;
@@ -255,6 +266,7 @@ private:
     rt::Backend& backend_;
     const TuneOptions& options_;
     size_t index_ = 0;
+    double tolerance_ = 0, over_ = 0;
     long frames_ = 0;
     size_t compared_ = 0;
     std::map<Integrator, std::optional<Compiled>> modules_;
@@ -289,6 +301,7 @@ std::vector<Choice> chooseMethods(ir::Module& module, rt::Backend& backend, cons
         if (c.trials.empty()) continue;
         object.attributes.integrator = c.method;
         object.attributes.step = c.subSteps > 1 ? static_cast<float>(options.frame / c.subSteps) : 0;
+        stateTolerance(object, c.method, tolerance, over);
         if (!c.met) {
             std::string why = c.floor * 2 >= tolerance
                                   ? fmt::format("the reference itself is only good to about {:.2g} m here: float state's "

@@ -108,8 +108,9 @@ void printSummary(const RunOptions& options, host::Session& session, double draw
                                  t.live, t.created, t.killed, t.frozen, t.dropped);
     for (auto& t : stats.types)
         if (t.unstable)
-            std::cout << fmt::format("  {}: {} updates beyond its integration method's stability limit (a decay "
-                                     "rate k with k·dt too large: the integral oscillates and grows); use @step or "
+            std::cout << fmt::format("  {}: {} updates beyond what its integration method holds (a decay rate k "
+                                     "with k·dt past the stability limit: the integral oscillates and grows; or, "
+                                     "under bs3, an error past the tolerance in an update's last try); use @step or "
                                      "@integrator(exponential)\n",
                                      t.name, t.unstable);
     for (auto& t : stats.types)

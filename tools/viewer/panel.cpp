@@ -267,8 +267,8 @@ void Panel::stats() {
     for (const rt::TypeStats& t : b.types)
         if (t.unstable)
             ImGui::TextColored(ImVec4(1, 0.45f, 0.3f, 1),
-                               "%s: %llu updates beyond its integrator's stability limit (k*dt too large: use @step or "
-                               "@integrator(exponential))",
+                               "%s: %llu updates beyond what its integrator holds (k*dt past the stability limit, or "
+                               "bs3's tolerance in its last try): use @step or @integrator(exponential)",
                                t.name.c_str(), static_cast<unsigned long long>(t.unstable));
     if (b.rejectedSteps || b.nonFiniteExterns || b.invalidEmissions || b.nonFiniteRender)
         ImGui::TextColored(ImVec4(1, 0.7f, 0.3f, 1), "rejected steps %llu, non-finite externs %llu, invalid emissions %llu, "
