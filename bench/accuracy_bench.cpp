@@ -56,6 +56,22 @@ double positionError(const rt::RenderPoint& p, double x, double y, double z) {
     return norm3(p.position[0] - x, p.position[1] - y, p.position[2] - z);
 }
 
+// bench/accuracy/eccentric.psys: a = 0.625, e = 0.6, from the far end at t = 0. The mean
+// anomaly M = π + n·t (n = a^−1.5), Kepler's equation E − e·sin E = M by Newton's method,
+// then x = −a·(cos E − e), y = −b·sin E with b = a·√(1 − e²).
+constexpr double kEccentricA = 0.625, kEccentricE = 0.6;
+const double kEccentricPeriod = 2 * kPi * std::pow(kEccentricA, 1.5);
+std::pair<double, double> keplerPosition(double t) {
+    const double a = kEccentricA, e = kEccentricE, b = a * std::sqrt(1 - e * e);
+    double m = kPi + t * std::pow(a, -1.5), E = m;
+    for (int i = 0; i < 50; ++i) {
+        double dE = (E - e * std::sin(E) - m) / (1 - e * std::cos(E));
+        E -= dE;
+        if (std::fabs(dE) < 1e-15) break;
+    }
+    return {-a * (std::cos(E) - e), -b * std::sin(E)};
+}
+
 std::vector<Problem> problems() {
     const double g = -9.8;
     return {
@@ -87,6 +103,11 @@ std::vector<Problem> problems() {
          }},
         {"orbit", "planet", 200 * kPi,  // 100 periods
          [](const rt::RenderPoint& p, double t) { return positionError(p, std::cos(t), std::sin(t), 0); }},
+        {"eccentric", "planet", 2 * kEccentricPeriod,
+         [](const rt::RenderPoint& p, double t) {
+             auto [x, y] = keplerPosition(t);
+             return positionError(p, x, y, 0);
+         }},
     };
 }
 

@@ -17,7 +17,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-PROBLEMS = ["projectile", "drag", "damped_spring", "orbit"]
+PROBLEMS = ["projectile", "drag", "spring", "damped_spring", "orbit", "eccentric"]
 STYLE = {
     "euler": ("tab:red", "o"),
     "semi_implicit": ("tab:orange", "s"),
@@ -27,6 +27,7 @@ STYLE = {
     "leapfrog": ("tab:cyan", "X"),
     "exponential": ("tab:purple", "P"),
     "exact": ("black", "*"),
+    "bs3": ("tab:pink", "h"),
 }
 
 
@@ -39,7 +40,7 @@ def main(source, target):
             cost = float(r["ns_per_update"]) / float(r["frame"]) / 1000  # µs per simulated second
             error = max(float(r["max_error"]), 1e-9)
             rows[(r["problem"], r["method"])].append((cost, error))
-    fig, grid = plt.subplots(2, 2, figsize=(10, 8), constrained_layout=True)
+    fig, grid = plt.subplots(2, 3, figsize=(14, 8), constrained_layout=True)
     axes = grid.flatten()
     for ax, problem in zip(axes, PROBLEMS):
         for method, (colour, marker) in STYLE.items():

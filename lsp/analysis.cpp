@@ -41,8 +41,13 @@ void methodHints(const ir::Module& module, Analysis& a) {
         bool integrates = false;
         for (SourceRange r : a.integrating) integrates |= r.file == at.file && r.begin == at.begin;
         if (!integrates) continue;
-        std::string label = std::string(core::integratorName(opt::methodOf(o, {})));
-        label += o.attributes.step > 0 ? ", step " + stepText(o.attributes.step) : ", a step per update";
+        core::Integrator method = opt::methodOf(o, {});
+        std::string label = std::string(core::integratorName(method));
+        if (method == core::Integrator::Bs3)  // its own steps, up to four tries an update (or sub-step)
+            label += o.attributes.step > 0 ? ", adaptive, sub-steps of " + stepText(o.attributes.step)
+                                           : ", adaptive within each update";
+        else
+            label += o.attributes.step > 0 ? ", step " + stepText(o.attributes.step) : ", a step per update";
         if (o.attributes.tolerance > 0) label += fmt::format(" (chosen for @tolerance({:g}))", o.attributes.tolerance);
         a.hints.push_back({at, label, 2});
     }

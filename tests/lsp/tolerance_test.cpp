@@ -42,3 +42,21 @@ TEST_CASE("inlay hints say what @tolerance chose, and a tolerance out of reach i
     CHECK(b.diagnostics[0].severity == Severity::Warning);
     CHECK(b.diagnostics[0].message.find("no integrator and sub-step keeps `mass` within 1e-06 m") != std::string::npos);
 }
+
+TEST_CASE("the inlay hint of an object under bs3 says its steps are its own") {
+    std::string text = "@integrator(bs3) object drop {\n"
+                       "    pos = integrate(vel);\n"
+                       "    vel = integrate(vec3(0, -9.8, 0) - 3 * vel);\n"
+                       "    point(pos, white, 1);\n"
+                       "}\n"
+                       "@integrator(bs3) @step(1/240) object fine {\n"
+                       "    pos = integrate(vec3(1, 0, 0));\n"
+                       "    point(pos, white, 1);\n"
+                       "}\n"
+                       "spawn drop;\nspawn fine;\n";
+    Analysis a = analyze("/tmp/bs3.psys", text);
+    REQUIRE(a.parsed);
+    CHECK(a.diagnostics.empty());
+    CHECK(hintsOn(a, text, 0) == std::vector<std::string>{"bs3, adaptive within each update"});
+    CHECK(hintsOn(a, text, 5) == std::vector<std::string>{"bs3, adaptive, sub-steps of 1/240 s"});
+}
