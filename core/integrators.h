@@ -31,7 +31,8 @@ constexpr std::optional<Integrator> integratorFromName(std::string_view name) {
 // ω·h < 2); the classical RK4 at 2.785293563405… (where its growth factor
 // 1 − z + z²/2 − z³/6 + z⁴/24 comes back to 1). `exponential` and `exact` solve the
 // linear decay exactly: no limit (0). `bs3` chooses its own steps, shrinking them where a
-// decay needs it: no fixed limit either (its error control is its stability check).
+// decay needs it, within four tries an update: no fixed limit (its error control counts
+// the updates it cannot hold, opt/integrate_adaptive.cpp).
 constexpr double stabilityLimit(Integrator i) {
     switch (i) {
         case Integrator::Euler: case Integrator::SemiImplicit: case Integrator::Midpoint: case Integrator::Rk2:

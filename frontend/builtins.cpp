@@ -193,7 +193,8 @@ std::string integratorDoc(std::string_view name) {
     double limit = core::stabilityLimit(*method);
     char stable[96];
     if (limit > 0) std::snprintf(stable, sizeof stable, "stable for y' = -k·y while k·h < %.4g", limit);
-    else if (*method == Integrator::Bs3) std::snprintf(stable, sizeof stable, "its steps shrink where a decay needs it");
+    else if (*method == Integrator::Bs3)
+        std::snprintf(stable, sizeof stable, "stable while four tries an update suffice (k·h up to 1); beyond, counted");
     else std::snprintf(stable, sizeof stable, "stable for any decay");
     return what + "; " + order + "; " + stable + ".";
 }

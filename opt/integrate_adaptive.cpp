@@ -21,7 +21,7 @@
 // length), r the tolerance per second — the object's @tolerance(metres, seconds) as
 // metres / seconds, else 1e-3 m over 10 s — so the local errors let through add up to at
 // most the tolerance over its time. Since e/(r·h) grows as h², the next step is h times the
-// power of two nearest 0.9·(|e|/(r·h))^(−1/2), from ¼ to 4: comparisons alone, no library
+// power of two nearest 0.9·(|e|/(r·h))^(−1/2), from 1/16 to 4: comparisons alone, no library
 // function, the same decision on every backend. A kept step that was cut short by the
 // update's end does not shorten the next.
 #include <optional>
@@ -107,11 +107,14 @@ std::vector<ValueId> bogackiShampine(StepBuilder& b, int stepSlot, float toleran
         ValueId within = bounds.within(1);
         ValueId keep = last ? live : k.op(Op::And, boolean, {live, within});
         if (last) missed = k.op(Op::And, boolean, {live, k.op(Op::Not, boolean, {within})});
-        // 0.9·q^(−1/2) nearest 4, 2, 1, ½ at q = 0.101, 0.405, 1.62 (1 for a kept step), 6.48.
-        ValueId factor = select(bounds.within(0.101f), b.scalar(4),
-                                select(bounds.within(0.405f), b.scalar(2),
-                                       select(within, b.scalar(1),
-                                              select(bounds.within(6.48f), b.scalar(0.5f), b.scalar(0.25f)))));
+        // 0.9·q^(−1/2) nearest 4, 2, 1, ½, ¼, ⅛ at q = 0.101, 0.405, 1.62 (1 for a kept step),
+        // 6.48, 25.9, 104; else 1/16 (a first try over the whole update is often far off).
+        ValueId factor = b.scalar(1.0f / 16);
+        for (auto [q, f] : {std::pair{104.0f, 0.125f}, {25.9f, 0.25f}, {6.48f, 0.5f}})
+            factor = select(bounds.within(q), b.scalar(f), factor);
+        factor = select(within, b.scalar(1), factor);
+        factor = select(bounds.within(0.405f), b.scalar(2), factor);
+        factor = select(bounds.within(0.101f), b.scalar(4), factor);
         ValueId next = b.mul(tried, factor);
         next = select(within, k.op(Op::Max, f32, {h, next}), next);
         h = select(live, next, h);
