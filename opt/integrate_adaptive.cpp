@@ -7,9 +7,9 @@
 // other; in each, every object tries a step from where it got to, and a select keeps the
 // step where its error estimate is within bounds (a rejected attempt leaves the object
 // where it was, with a shorter step to try). The last attempt takes what is left of the
-// update, whatever its error, so that every object ends the update at its end (counted
-// as an update beyond what the method holds: the `unstable` yield and stats); a finer
-// @step gives an object more attempts a frame. The length to try next is state (slot
+// update, whatever its error, so that every object ends the update at its end; where that
+// error is past the bound, the update is counted as beyond what the method holds (the
+// `unstable` yield and stats). A finer @step gives an object more attempts a frame. The length to try next is state (slot
 // `bs3@step`), carried from update to update: 0 at creation, read as "the whole update".
 //
 // One step of length h from (s, y), s the seconds since the update's start, k1 = f(s, y):
