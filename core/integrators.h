@@ -24,6 +24,11 @@ constexpr std::optional<Integrator> integratorFromName(std::string_view name) {
     return std::nullopt;
 }
 
+// The time a @tolerance covers where it states none (seconds), and the tolerance bs3 holds
+// an object to where it states none (metres, over that time).
+constexpr double kToleranceSeconds = 10;
+constexpr double kBs3Tolerance = 1e-3;
+
 // The largest k·h for which a method keeps y' = −k·y from growing, h being the update's
 // length: where the method's stability region meets the negative real axis. Euler, the
 // semi-implicit step, both second-order Runge–Kutta methods and leapfrog stop at 2

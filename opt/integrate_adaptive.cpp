@@ -9,8 +9,9 @@
 // where it was, with a shorter step to try). The last attempt takes what is left of the
 // update, whatever its error, so that every object ends the update at its end; where that
 // error is past the bound, the update is counted as beyond what the method holds (the
-// `unstable` yield and stats). A finer @step gives an object more attempts a frame. The length to try next is state (slot
-// `bs3@step`), carried from update to update: 0 at creation, read as "the whole update".
+// `unstable` yield and stats). A finer @step gives an object more attempts a frame. The
+// length to try next is state (slot `bs3@step`), carried from update to update: 0 at
+// creation, read as "the whole update".
 //
 // One step of length h from (s, y), s the seconds since the update's start, k1 = f(s, y):
 //   k2 = f(s + h/2, y + h/2·k1)      k3 = f(s + 3h/4, y + 3h/4·k2)
@@ -19,7 +20,7 @@
 //   e  = h·(−5/72·k1 + 1/12·k2 + 1/9·k3 − 1/8·k4)                  (y' less the order-2 answer)
 // Error per unit step: a step is kept while |e| ≤ r·h for every integral (a vector's
 // length), r the tolerance per second — the object's @tolerance(metres, seconds) as
-// metres / seconds, else 1e-3 m over 10 s — so the local errors let through add up to at
+// metres / seconds, else core::kBs3Tolerance over core::kToleranceSeconds — so the local errors let through add up to at
 // most the tolerance over its time. Since e/(r·h) grows as h², the next step is h times the
 // power of two nearest 0.9·(|e|/(r·h))^(−1/2), from 1/16 to 4: comparisons alone, no library
 // function, the same decision on every backend. A kept step that was cut short by the
@@ -53,7 +54,7 @@ std::vector<ValueId> bogackiShampine(StepBuilder& b, int stepSlot, float toleran
     const Type f32 = Type::f32(), boolean = Type::boolean();
     auto select = [&](ValueId c, ValueId x, ValueId y) { return k.op(Op::Select, k.at(x).type, {c, x, y}); };
     auto sub = [&](ValueId x, ValueId y) { return k.op(Op::Sub, f32, {x, y}); };
-    // y + h·Σ w_i·k_i[j] (terms with weight 0 left out), and h·Σ w_i·k_i[j] alone.
+    // h·Σ w_i·k_i[j], integral j's share of a step (terms of weight 0 left out).
     using Slopes = std::vector<ValueId>;
     auto weighted = [&](ValueId h, std::initializer_list<std::pair<float, const Slopes*>> terms, size_t j) {
         ValueId sum = 0;

@@ -330,11 +330,12 @@ private:
             case Integrator::Leapfrog: return leapfrog(b);
             case Integrator::Bs3: {
                 // The step to try next, its own slot; the tolerance the object states, else
-                // 1e-3 m over 10 s (opt/integrate_adaptive.cpp).
+                // bs3's own (opt/integrate_adaptive.cpp).
                 object_.state.push_back({"bs3@step", Type::f32(), StateInit::Zero});
                 const Attributes& a = object_.attributes;
-                float metres = a.tolerance > 0 ? a.tolerance : 1e-3f;
-                float seconds = a.tolerance > 0 && a.toleranceOver > 0 ? a.toleranceOver : 10.0f;
+                float metres = a.tolerance > 0 ? a.tolerance : static_cast<float>(core::kBs3Tolerance);
+                float seconds = a.tolerance > 0 && a.toleranceOver > 0 ? a.toleranceOver
+                                                                       : static_cast<float>(core::kToleranceSeconds);
                 return bogackiShampine(b, static_cast<int>(object_.state.size() - 1), metres / seconds);
             }
             default: return rungeKutta(b, method_);

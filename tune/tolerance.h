@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "core/integrators.h"
 #include "ir/ir.h"
 #include "opt/passes.h"
 #include "rt/backend.h"
@@ -31,7 +32,7 @@ namespace psys::tune {
 struct TuneOptions {
     double frame = 1.0 / 60;  // the host's step the choice is made for
     double tolerance = 0;     // for objects without @tolerance (psysc --tolerance); 0: none
-    double horizon = 10;      // seconds compared under a @tolerance that states no time
+    double horizon = core::kToleranceSeconds;  // seconds compared under a @tolerance that states no time
     size_t population = 64;   // objects of each type alive at once in a trial
     opt::PipelineOptions pipeline;  // the passes the trials are compiled with
 };
