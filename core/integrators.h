@@ -48,4 +48,16 @@ constexpr double stabilityLimit(Integrator i) {
     return 0.0;
 }
 
+// How an object keeps its state, `@precision(…)`: floats, or pairs of floats (hi + lo, 48
+// significant bits) computed in pair arithmetic (opt/precision_double.cpp).
+enum class Precision : uint8_t { Float, Double };
+
+constexpr std::string_view precisionName(Precision p) { return p == Precision::Double ? "double" : "float"; }
+
+constexpr std::optional<Precision> precisionFromName(std::string_view name) {
+    if (name == "float") return Precision::Float;
+    if (name == "double") return Precision::Double;
+    return std::nullopt;
+}
+
 }  // namespace psys::core

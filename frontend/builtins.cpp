@@ -85,6 +85,9 @@ constexpr BuiltinAttribute kAttributes[] = {
     {"tolerance", "@tolerance(metres[, seconds])",
      "the largest position error accepted over the first `seconds` (10 when not given): the compiler chooses the "
      "cheapest integrator and sub-step that meet it (psysc check --explain; docs/accuracy.md)"},
+    {"precision", "@precision(float|double)",
+     "how the state is kept: float (the default), or double: pairs of floats, 48 significant bits, on every "
+     "backend (docs/accuracy.md); about 1e-13 m on a projectile where floats reach 1e-5 m"},
     {"capacity", "@capacity(count)", "the most objects of this type alive at once; emissions beyond it are dropped"},
     {"shape", "@shape(soft|disc|ring|star|smoke)", "a sprite's shape (soft, the default: a disc with a soft edge)"},
     {"texture", "@texture(\"file.png\"[, columns, rows])",

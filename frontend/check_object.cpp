@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "core/integrators.h"
 #include "frontend/builtins.h"
 #include "frontend/checker.h"
 #include "frontend/consteval.h"
@@ -387,6 +388,13 @@ void Checker::checkAttributes(const std::vector<Attribute*>& attributes) {
             a.value = v;
         } else if (a.name == "tolerance") {
             checkTolerance(a, ctx);
+        } else if (a.name == "precision") {
+            if (!wantOneArg("float or double")) continue;
+            auto* name = a.args[0]->kind == ExprKind::Name ? static_cast<NameExpr*>(a.args[0].get()) : nullptr;
+            if (name && core::precisionFromName(name->name)) continue;
+            diags_.error(a.args[0]->range, name ? fmt::format("unknown precision `{}`", name->name)
+                                                : std::string("the precision must be named"))
+                .notes.push_back({a.args[0]->range, "the precisions are float (the default) and double"});
         } else if (a.name == "capacity") {
             if (!wantOneArg("the most objects of this type alive at once")) continue;
             check(*a.args[0], ctx);

@@ -324,6 +324,10 @@ struct NeighbourRead {
     Type type;
 };
 
+using core::Precision;
+using core::precisionName;
+using core::precisionFromName;
+
 // An object's @attributes (the object's own, else the file's, else none).
 struct Attributes {
     std::optional<Integrator> integrator;  // none: the pipeline's default
@@ -332,6 +336,7 @@ struct Attributes {
     // @tolerance: the largest position error accepted (metres; 0: none) over `over`
     // seconds (0: the default time); the chooser (tune/) turns it into integrator and step.
     float tolerance = 0, toleranceOver = 0;
+    Precision precision = Precision::Float;  // @precision
     std::optional<uint64_t> capacity;      // @capacity: most objects alive at once
     std::optional<core::Shape> shape;      // @shape: a sprite's (none: soft)
     std::optional<core::Blend> blend;      // @blend (none: core::defaultBlend)

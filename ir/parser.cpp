@@ -254,6 +254,10 @@ private:
             if (!a.integrator) throw ParseError("unknown integrator `" + w[2] + "`");
         } else if (w[1] == "step") {
             a.step = number(w[2]);
+        } else if (w[1] == "precision") {
+            auto precision = precisionFromName(w[2]);
+            if (!precision) throw ParseError("unknown precision `" + w[2] + "` (float or double)");
+            a.precision = *precision;
         } else if (w[1] == "capacity") {
             a.capacity = static_cast<uint64_t>(integer(w[2]));
         } else if (w[1] == "shape") {

@@ -140,6 +140,7 @@ std::string print(const Object& o, PrintOptions options) {
     const Attributes& a = o.attributes;
     if (a.integrator) out += fmt::format("  attribute integrator {}\n", core::integratorName(*a.integrator));
     if (a.step > 0) out += fmt::format("  attribute step {}\n", number(a.step));
+    if (a.precision != Precision::Float) out += fmt::format("  attribute precision {}\n", precisionName(a.precision));
     if (a.tolerance > 0) out += fmt::format("  attribute tolerance {} {}\n", number(a.tolerance), number(a.toleranceOver));
     if (a.capacity) out += fmt::format("  attribute capacity {}\n", *a.capacity);
     if (a.shape) out += fmt::format("  attribute shape {}\n", core::shapeName(*a.shape));

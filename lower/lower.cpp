@@ -217,6 +217,8 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
         if (a.name == "integrator" && a.args[0]->kind == ExprKind::Name) {
             attributes.integrator = core::integratorFromName(static_cast<const NameExpr&>(*a.args[0]).name);
             attributes.integratorLoc = locate(a.args[0]->range);
+        } else if (a.name == "precision" && a.args[0]->kind == ExprKind::Name) {
+            attributes.precision = core::precisionFromName(static_cast<const NameExpr&>(*a.args[0]).name).value_or(core::Precision::Float);
         } else if ((a.name == "shape" || a.name == "blend") && a.args[0]->kind == ExprKind::Name) {
             const std::string& name = static_cast<const NameExpr&>(*a.args[0]).name;
             if (a.name == "shape") attributes.shape = core::shapeFromName(name);

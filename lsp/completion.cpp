@@ -122,6 +122,9 @@ nlohmann::json completion(const Analysis& a, const std::string& text, uint32_t o
             names.push_back({std::string(at.name), std::string(at.signature), std::string(at.doc), CompletionKind::Property});
     } else if (lead.size() >= 1 && lead.back() == '(' && before(text, lead.size() - 1).ends_with("@integrator")) {
         for (std::string_view m : integratorNames()) names.push_back({std::string(m), "integrator", "", CompletionKind::Constant});
+    } else if (lead.size() >= 1 && lead.back() == '(' && before(text, lead.size() - 1).ends_with("@precision")) {
+        names.push_back({"float", "precision", "state as floats (the default)", CompletionKind::Constant});
+        names.push_back({"double", "precision", "state as pairs of floats, 48 significant bits", CompletionKind::Constant});
     } else {
         bool pure = false;
         if (a.parsed)

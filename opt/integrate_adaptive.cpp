@@ -48,7 +48,7 @@ struct Bounds {
 
 }  // namespace
 
-std::vector<ValueId> bogackiShampine(StepBuilder& b, int stepSlot, float tolerancePerSecond) {
+std::vector<ValueId> bogackiShampine(StepBuilder& b, int stepSlot, float tolerancePerSecond, bool exactWeights) {
     Kernel& k = b.to();
     size_t n = b.size();
     const Type f32 = Type::f32(), boolean = Type::boolean();
@@ -90,8 +90,17 @@ std::vector<ValueId> bogackiShampine(StepBuilder& b, int stepSlot, float toleran
         for (size_t j = 0; j < n; ++j) y3.push_back(b.add(y[j], weighted(tried, {{0.75f, &k2}}, j)));
         StepBuilder::Point p3 = b.pointSince(instant(0.75f), y3);
         for (size_t j = 0; j < n; ++j) k3.push_back(b.at(p3, b.derivative(j)));
-        for (size_t j = 0; j < n; ++j)
-            y4.push_back(b.add(y[j], weighted(tried, {{2.0f / 9, &k1}, {1.0f / 3, &k2}, {4.0f / 9, &k3}}, j)));
+        for (size_t j = 0; j < n; ++j) {
+            if (!exactWeights) {
+                y4.push_back(b.add(y[j], weighted(tried, {{2.0f / 9, &k1}, {1.0f / 3, &k2}, {4.0f / 9, &k3}}, j)));
+                continue;
+            }
+            // Under @precision(double): (2·k1 + 3·k2 + 4·k3)/9, divided in pairs (the
+            // double-precision pass), where 2/9 as a float would be off by 1e-8.
+            ValueId step = weighted(tried, {{2, &k1}, {3, &k2}, {4, &k3}}, j);
+            Type t = k.at(step).type;
+            y4.push_back(b.add(y[j], k.op(Op::Div, t, {step, k.constant(t, {9, 9, 9, 9})})));
+        }
         StepBuilder::Point p4 = b.pointSince(instant(1), y4);
         for (size_t j = 0; j < n; ++j) k4.push_back(b.at(p4, b.derivative(j)));
 

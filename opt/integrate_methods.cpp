@@ -24,13 +24,16 @@ struct Tableau {
     std::vector<std::vector<float>> a;  // a[i][j]: stage j's weight in stage i's state
     std::vector<float> b;               // y' = y + (scale·dt)·Σ b_i·k_i
     float scale = 1;
+    // scale = 1/divisor. Under @precision(double) the sum is divided by it, so the
+    // double-precision pass divides in pairs: a float 1/6 would cost the weights 3e-8.
+    float divisor = 1;
 };
 
 const Tableau& tableau(core::Integrator method) {
     static const Tableau euler{{0}, {{}}, {1}, 1};
     static const Tableau midpoint{{0, 0.5f}, {{}, {0.5f}}, {0, 1}, 1};
     static const Tableau heun{{0, 1}, {{}, {1}}, {1, 1}, 0.5f};
-    static const Tableau rk4{{0, 0.5f, 0.5f, 1}, {{}, {0.5f}, {0, 0.5f}, {0, 0, 1}}, {1, 2, 2, 1}, 1.0f / 6};
+    static const Tableau rk4{{0, 0.5f, 0.5f, 1}, {{}, {0.5f}, {0, 0.5f}, {0, 0, 1}}, {1, 2, 2, 1}, 1.0f / 6, 6};
     switch (method) {
         case core::Integrator::Midpoint: return midpoint;
         case core::Integrator::Rk2: return heun;
@@ -46,7 +49,7 @@ ValueId timesDt(StepBuilder& b, float x) {
 
 }  // namespace
 
-std::vector<ValueId> rungeKutta(StepBuilder& b, core::Integrator method) {
+std::vector<ValueId> rungeKutta(StepBuilder& b, core::Integrator method, bool exactWeights) {
     const Tableau& t = tableau(method);
     size_t n = b.size();
     std::vector<std::vector<ValueId>> k;  // k[stage][integral]
@@ -81,7 +84,14 @@ std::vector<ValueId> rungeKutta(StepBuilder& b, core::Integrator method) {
             sum = any ? b.add(sum, term) : term;
             any = true;
         }
-        out.push_back(b.add(b.start(j), b.mul(timesDt(b, t.scale), sum)));
+        if (exactWeights && t.divisor != 1) {
+            ValueId step = b.mul(b.dt(), sum);
+            Type type = b.to().at(step).type;
+            ValueId divisor = b.to().constant(type, {t.divisor, t.divisor, t.divisor, t.divisor});
+            out.push_back(b.add(b.start(j), b.to().op(Op::Div, type, {step, divisor})));
+        } else {
+            out.push_back(b.add(b.start(j), b.mul(timesDt(b, t.scale), sum)));
+        }
     }
     return out;
 }

@@ -25,8 +25,10 @@
 
 namespace psys::opt {
 
-// euler, midpoint, rk2 (Heun's method) or rk4: the classical Butcher tableaux.
-std::vector<ir::ValueId> rungeKutta(StepBuilder& b, core::Integrator method);
+// euler, midpoint, rk2 (Heun's method) or rk4: the classical Butcher tableaux. With
+// `exactWeights` (@precision(double)), a weight that is no float (rk4's 1/6) is a division,
+// which the double-precision pass carries out in pairs; so is bs3's 2/9, 1/3, 4/9.
+std::vector<ir::ValueId> rungeKutta(StepBuilder& b, core::Integrator method, bool exactWeights = false);
 
 // Velocity Verlet (Störmer–Verlet, "kick-drift-kick"), second order, symplectic on a
 // separable system (positions from velocities, velocities from forces of the positions).
@@ -44,7 +46,8 @@ std::vector<ir::ValueId> leapfrog(StepBuilder& b);
 // The Bogacki–Shampine 3(2) pair with error control, up to four attempted steps an update
 // (the file's header says how): `stepSlot` is the object's f32 slot for the step to try
 // next; a step is kept while its error estimate is at most tolerancePerSecond × its length.
-std::vector<ir::ValueId> bogackiShampine(StepBuilder& b, int stepSlot, float tolerancePerSecond);
+std::vector<ir::ValueId> bogackiShampine(StepBuilder& b, int stepSlot, float tolerancePerSecond,
+                                        bool exactWeights = false);
 
 // Each integral y' = f with f = c·y + r (c its linear part, when it has one):
 // y + dt·φ1(−c·dt)·f, all at the start of the step; Euler's step where there is no c.

@@ -336,9 +336,10 @@ private:
                 float metres = a.tolerance > 0 ? a.tolerance : static_cast<float>(core::kBs3Tolerance);
                 float seconds = a.tolerance > 0 && a.toleranceOver > 0 ? a.toleranceOver
                                                                        : static_cast<float>(core::kToleranceSeconds);
-                return bogackiShampine(b, static_cast<int>(object_.state.size() - 1), metres / seconds);
+                return bogackiShampine(b, static_cast<int>(object_.state.size() - 1), metres / seconds,
+                                       a.precision == core::Precision::Double);
             }
-            default: return rungeKutta(b, method_);
+            default: return rungeKutta(b, method_, object_.attributes.precision == core::Precision::Double);
         }
     }
 

@@ -68,6 +68,7 @@ void scoping(ir::Module& module, PassErrors& errors);
 void lowerTemporal(ir::Module& module, const PassOptions& options, PassErrors& errors);
 void keyRandom(ir::Module& module, PassErrors& errors);
 void splitKernels(ir::Module& module, PassErrors& errors);
+void doublePrecision(ir::Module& module, PassErrors& errors);
 void simplify(ir::Module& module, const PassOptions& options, PassErrors& errors);
 void reassociate(ir::Module& module, PassErrors& errors);
 void hoistUniform(ir::Module& module, PassErrors& errors);

@@ -29,6 +29,8 @@ const std::vector<PassInfo>& passes() {
          PassRuns::Always, [](ir::Module& m, const PassOptions&, PassErrors& e) { keyRandom(m, e); }},
         {"split-kernels", "the behaviour becomes the kernels init, update, render, exports and spawn.N; what a post-update kernel needs from before the update is carried in state (thesis §3.3.1)",
          PassRuns::Always, [](ir::Module& m, const PassOptions&, PassErrors& e) { splitKernels(m, e); }},
+        {"double-precision", "an object under @precision(double) keeps its state as pairs of floats (48 bits) and computes what writes it in pair arithmetic, the same bits on every backend",
+         PassRuns::Always, [](ir::Module& m, const PassOptions&, PassErrors& e) { doublePrecision(m, e); }},
         {"reassociate", "sums and products in one canonical order, so (a+b+c)·(a+b+d) computes a+b once",
          PassRuns::Relaxed, [](ir::Module& m, const PassOptions&, PassErrors& e) { reassociate(m, e); }},
         {"simplify-kernels", "simplify again, on the split kernels",

@@ -56,8 +56,10 @@ void reassociateKernel(Kernel& kernel) {
 }  // namespace
 
 void reassociate(Module& module, PassErrors&) {
-    for (Object& o : module.objects)
+    for (Object& o : module.objects) {
+        if (o.attributes.precision == Precision::Double) continue;  // pair arithmetic is exact only in its order
         for (Kernel& k : o.kernels) reassociateKernel(k);
+    }
 }
 
 }  // namespace psys::opt

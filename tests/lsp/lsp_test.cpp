@@ -177,9 +177,11 @@ TEST_CASE("completion: names in scope inside an object, members after a dot, att
     auto members = labels(completion(a, dotted, cursor));
     CHECK(members == std::vector<std::string>{"alive", "age", "ivel", "pos", "vel"});
     std::string attr = "@\n" + text;
-    CHECK(labels(completion(a, attr, 1)) == std::vector<std::string>{"integrator", "step", "tolerance", "capacity", "shape", "texture", "blend"});
+    CHECK(labels(completion(a, attr, 1)) == std::vector<std::string>{"integrator", "step", "tolerance", "precision", "capacity", "shape", "texture", "blend"});
     std::string integrator = "@integrator(\n" + text;
     CHECK(has(labels(completion(a, integrator, 12)), "rk4"));
+    std::string precision = "@precision(\n" + text;
+    CHECK(labels(completion(a, precision, 11)) == std::vector<std::string>{"float", "double"});
 }
 
 TEST_CASE("diagnostics: ranges in UTF-16, notes as related information, warnings, syntax errors") {

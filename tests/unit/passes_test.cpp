@@ -371,7 +371,7 @@ TEST_CASE("the pipeline runs the registry's passes in its order, at every level,
     CHECK(passesPrinted(fire, true, false) == registered(true, false));
     CHECK(passesPrinted(fire, false, false) ==
           std::vector<std::string>{"lowering", "resolve-cycles", "scoping", "lower-temporal", "key-random", "split-kernels",
-                                   "lower-storage"});
+                                   "double-precision", "lower-storage"});
     std::set<std::string> names;
     for (const opt::PassInfo& pass : opt::passes()) {
         CHECK(names.insert(pass.name).second);  // one name, one pass
