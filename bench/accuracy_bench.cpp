@@ -8,14 +8,16 @@
 // same run: the same problem with 100 000 copies, on one thread, ns per object update.
 // A stiff decay is run at k·dt from 0.1 to 100 to see which methods stay bounded, and
 // the fountain with integrals gives the cost of each method on a real effect. Last, what
-// @tolerance chooses on each problem against the cheapest that meets it by brute force.
+// @tolerance chooses on each problem against the cheapest that meets it by brute force,
+// and float state against @precision(double) (measured on the state, not the drawn floats).
 //
-//   psys_accuracy [--csv FILE] [--copies N] [--quick] [--tolerance-only [--explain]]
+//   psys_accuracy [--csv FILE] [--copies N] [--quick] [--tolerance-only [--explain]] [--precision-only]
 //
 // The CSV is what bench/plot_accuracy.py draws (docs/images/accuracy.png).
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <algorithm>
@@ -39,27 +41,50 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
+// What a problem's error is measured on: the drawn point's position and colour, or the
+// same values read from the state (in double, hi + lo, under @precision(double)).
+struct Place {
+    std::array<double, 3> position{};
+    std::array<double, 4> color{};
+};
+
+Place placeOf(const rt::RenderPoint& p) {
+    return {{p.position[0], p.position[1], p.position[2]}, {p.color[0], p.color[1], p.color[2], p.color[3]}};
+}
+
 struct Problem {
     std::string file, type;
     double seconds;
     // The error of a drawn point at time t against the exact solution.
-    std::function<double(const rt::RenderPoint&, double)> error;
+    std::function<double(const Place&, double)> error;
     // The distance of the whole drawn point from its exact place, where the point draws
     // more than the position (the springs draw (x, v, 0)): what @tolerance bounds.
-    std::function<double(const rt::RenderPoint&, double)> drawn = nullptr;
+    std::function<double(const Place&, double)> drawn = nullptr;
+    // Where the state keeps the drawn values (stateAccuracy): the slots of the integrals
+    // the position and velocity are, each plus the constant it starts from in the source
+    // (`pos = vec3(1, 0, 0) + integrate(vel)`). The springs draw (x, v, 0).
+    std::string position = "integrate@pos", velocity = "integrate@vel";
+    std::array<double, 3> positionFrom{}, velocityFrom{};
+    bool springs = false;
 };
+
+// A number of a problem's source as the program has it: a float.
+double f32(double x) { return static_cast<float>(x); }
 
 double norm3(double x, double y, double z) { return std::sqrt(x * x + y * y + z * z); }
 
 // Position error of a point against an exact position.
-double positionError(const rt::RenderPoint& p, double x, double y, double z) {
+double positionError(const Place& p, double x, double y, double z) {
     return norm3(p.position[0] - x, p.position[1] - y, p.position[2] - z);
 }
 
 // bench/accuracy/eccentric.psys: a = 0.625, e = 0.6, from the far end at t = 0. The mean
 // anomaly M = π + n·t (n = a^−1.5), Kepler's equation E − e·sin E = M by Newton's method,
-// then x = −a·(cos E − e), y = −b·sin E with b = a·√(1 − e²).
-constexpr double kEccentricA = 0.625, kEccentricE = 0.6;
+// then x = −a·(cos E − e), y = −b·sin E with b = a·√(1 − e²). The speed it starts at is
+// √0.4 as a float, so a and e are those of that speed: a = 1/(2 − v²), e = 1/a − 1 (0.625
+// and 0.6 to 1e-8).
+const double kEccentricV = static_cast<float>(std::sqrt(0.4));
+const double kEccentricA = 1 / (2 - kEccentricV * kEccentricV), kEccentricE = 1 / kEccentricA - 1;
 const double kEccentricPeriod = 2 * kPi * std::pow(kEccentricA, 1.5);
 std::pair<double, double> keplerPosition(double t) {
     const double a = kEccentricA, e = kEccentricE, b = a * std::sqrt(1 - e * e);
@@ -72,47 +97,51 @@ std::pair<double, double> keplerPosition(double t) {
     return {-a * (std::cos(E) - e), -b * std::sin(E)};
 }
 
+// The exact solutions are those of the problems as their programs state them, in floats
+// (g = −9.8 is −9.80000019; the springs' w·w and 2·zeta·w are folded to floats): what a
+// state in double is then measured against.
 std::vector<Problem> problems() {
-    const double g = -9.8;
-    return {
-        {"projectile", "ball", 2,
-         [=](const rt::RenderPoint& p, double t) { return positionError(p, 2 * t, 10 * t + g * t * t / 2, 0); }},
-        {"drag", "ball", 4,
-         [=](const rt::RenderPoint& p, double t) {
-             // vel = v∞ + (v0 − v∞)e^(−kt), pos = v∞·t + (v0 − v∞)(1 − e^(−kt))/k per component.
-             const double k = 0.5, decay = (1 - std::exp(-k * t)) / k;
-             double x = 2 * decay, y = (g / k) * t + (10 - g / k) * decay;
-             return positionError(p, x, y, 0);
-         }},
-        {"spring", "mass", 10,
-         [](const rt::RenderPoint& p, double t) { return std::fabs(p.position[0] - std::cos(2 * kPi * t)); },
-         [](const rt::RenderPoint& p, double t) {
-             return positionError(p, std::cos(2 * kPi * t), -2 * kPi * std::sin(2 * kPi * t), 0);
-         }},
-        {"damped_spring", "mass", 10,
-         [](const rt::RenderPoint& p, double t) {
-             const double w = 2 * kPi, zeta = 0.1, wd = w * std::sqrt(1 - zeta * zeta);
-             double x = std::exp(-zeta * w * t) * (std::cos(wd * t) + zeta * w / wd * std::sin(wd * t));
-             return std::fabs(p.position[0] - x);
-         },
-         [](const rt::RenderPoint& p, double t) {
-             const double w = 2 * kPi, a = 0.1 * w, wd = w * std::sqrt(1 - 0.01);
-             double x = std::exp(-a * t) * (std::cos(wd * t) + a / wd * std::sin(wd * t));
-             double v = -std::exp(-a * t) * (a * a / wd + wd) * std::sin(wd * t);
-             return positionError(p, x, v, 0);
-         }},
-        {"orbit", "planet", 200 * kPi,  // 100 periods
-         [](const rt::RenderPoint& p, double t) { return positionError(p, std::cos(t), std::sin(t), 0); }},
-        {"eccentric", "planet", 2 * kEccentricPeriod,
-         [](const rt::RenderPoint& p, double t) {
-             auto [x, y] = keplerPosition(t);
-             return positionError(p, x, y, 0);
-         }},
+    const double g = f32(-9.8), w = f32(6.2831853);
+    // x'' = −k·x − c·x' from x = 1 at rest: x = e^(−a·t)·(cos(ωd·t) + a/ωd·sin(ωd·t)),
+    // x' = −e^(−a·t)·(k/ωd)·sin(ωd·t), with a = c/2 and ωd = √(k − a²).
+    auto spring = [](double k, double c) {
+        const double a = c / 2, wd = std::sqrt(k - a * a);
+        return [=](double t) {
+            return std::array<double, 2>{std::exp(-a * t) * (std::cos(wd * t) + a / wd * std::sin(wd * t)),
+                                         -std::exp(-a * t) * (k / wd) * std::sin(wd * t)};
+        };
     };
+    auto undamped = spring(f32(w * w), 0), damped = spring(f32(w * w), f32(f32(2 * f32(0.1)) * w));
+    auto springProblem = [](const char* file, auto exact) {
+        return Problem{file, "mass", 10, [=](const Place& p, double t) { return std::fabs(p.position[0] - exact(t)[0]); },
+                       [=](const Place& p, double t) { return positionError(p, exact(t)[0], exact(t)[1], 0); },
+                       "integrate@x", "integrate@v", {1, 0, 0}, {}, true};
+    };
+    Problem orbit{"orbit", "planet", 200 * kPi,  // 100 periods
+                  [](const Place& p, double t) { return positionError(p, std::cos(t), std::sin(t), 0); }};
+    orbit.positionFrom = {1, 0, 0};
+    orbit.velocityFrom = {0, 1, 0};
+    Problem eccentric{"eccentric", "planet", 2 * kEccentricPeriod, [](const Place& p, double t) {
+                          auto [x, y] = keplerPosition(t);
+                          return positionError(p, x, y, 0);
+                      }};
+    eccentric.positionFrom = {1, 0, 0};
+    eccentric.velocityFrom = {0, kEccentricV, 0};
+    Problem projectile{"projectile", "ball", 2,
+                       [=](const Place& p, double t) { return positionError(p, 2 * t, 10 * t + g * t * t / 2, 0); }};
+    projectile.velocityFrom = {2, 10, 0};
+    Problem drag{"drag", "ball", 4, [=](const Place& p, double t) {
+                     // vel = v∞ + (v0 − v∞)e^(−kt), pos = v∞·t + (v0 − v∞)(1 − e^(−kt))/k per component.
+                     const double k = 0.5, decay = (1 - std::exp(-k * t)) / k;
+                     double x = 2 * decay, y = (g / k) * t + (10 - g / k) * decay;
+                     return positionError(p, x, y, 0);
+                 }};
+    drag.velocityFrom = {2, 10, 0};
+    return {projectile, drag, springProblem("spring", undamped), springProblem("damped_spring", damped), orbit, eccentric};
 }
 
 // The orbit's energy v²/2 − 1/r (velocity in the colour), relative to its exact −1/2.
-double energyDrift(const rt::RenderPoint& p) {
+double energyDrift(const Place& p) {
     double v = norm3(p.color[0], p.color[1], p.color[2]);
     double r = norm3(p.position[0], p.position[1], p.position[2]);
     return std::fabs((v * v / 2 - 1 / r) + 0.5) / 0.5;
@@ -180,6 +209,60 @@ public:
                 std::exit(1);
             }
             last = points[0];
+            double e = problem.error(placeOf(last), f * step.frame);
+            m.maxError = std::isfinite(e) ? std::max(m.maxError, e) : INFINITY;
+            m.finalError = e;
+        }
+        if (problem.file == "orbit") m.drift = energyDrift(placeOf(last));
+        return m;
+    }
+
+    // As accuracy(), on the state itself rather than the drawn floats: the problem's
+    // position and velocity slots, hi + lo where the object keeps pairs (`pairs`: the
+    // program under @precision(double)).
+    Measured stateAccuracy(const Problem& problem, const std::string& text, Integrator method, const Step& step,
+                           bool pairs) {
+        Measured m;
+        std::string source = std::string(pairs ? "@precision(double);\n" : "") + (step.subSteps ? "@step(1/240);\n" : "") + text;
+        auto module = compile(source, method);
+        if (!module) {
+            m.closedForm = false;
+            return m;
+        }
+        rt::SystemOptions options;
+        options.threads = 1;
+        rt::System system(std::move(*module), jit_, options);
+        size_t type = static_cast<size_t>(system.typeIndex(problem.type));
+        const ir::Object& object = system.pool(type).object();
+        auto slot = [&](const std::string& name) {
+            for (size_t i = 0; i < object.state.size(); ++i)
+                if (object.state[i].name == name) return static_cast<int>(i);
+            return -1;
+        };
+        auto read = [&](const std::string& name, const std::array<double, 3>& from) {
+            std::array<double, 3> out = from;
+            int hi = slot(name), lo = slot(name + "@lo");
+            if (hi < 0) {
+                std::cerr << "psys_accuracy: " << problem.file << " keeps no slot " << name << "\n";
+                std::exit(1);
+            }
+            ir::Value h = system.pool(type).state.get(system.backend().memory(), hi, 0);
+            ir::Value l = lo >= 0 ? system.pool(type).state.get(system.backend().memory(), lo, 0) : ir::Value{};
+            for (size_t i = 0; i < 3; ++i) out[i] += static_cast<double>(h.f[i]) + l.f[i];
+            return out;
+        };
+        double seconds = quick_ ? std::min(problem.seconds, 1.0) : problem.seconds;
+        auto frames = static_cast<long>(std::lround(seconds / step.frame));
+        Place last;
+        for (long f = 1; f <= frames; ++f) {
+            if (system.step(step.frame)) std::exit(1);
+            auto x = read(problem.position, problem.positionFrom), v = read(problem.velocity, problem.velocityFrom);
+            if (problem.springs) {
+                last.position = {x[0], v[0], 0};
+            } else {
+                last.position = x;
+                last.color = {v[0], v[1], v[2], 1};
+            }
             double e = problem.error(last, f * step.frame);
             m.maxError = std::isfinite(e) ? std::max(m.maxError, e) : INFINITY;
             m.finalError = e;
@@ -369,10 +452,46 @@ void fountainTable(Bench& bench, const std::string& dir, bool quick) {
     std::cout << "\n(ns of the update loops per live drop per frame, median of 5 rounds of 20 frames)\n";
 }
 
+// Float state against @precision(double) (pairs of floats, opt/precision_double.cpp):
+// errors measured on the state itself, so the doubles are not rounded to the drawn floats.
+void precisionTable(Bench& bench, const std::string& dir, std::ofstream* csv) {
+    const std::vector<Step> steps = {kSteps[2], kSteps[4], kSteps[5]};
+    std::cout << "\n### float state against @precision(double)\n\n| problem | method | state | ns/update at 1/60 |";
+    for (const Step& s : steps) std::cout << " " << s.label << " |";
+    std::cout << " energy drift at 1/60 (orbit) |\n|---|---|---|---|";
+    for (size_t i = 0; i <= steps.size(); ++i) std::cout << "---|";
+    std::cout << "\n";
+    for (const Problem& p : problems()) {
+        std::string text = readFile(dir + "/" + p.file + ".psys");
+        for (Integrator m : {Integrator::Rk4, Integrator::Leapfrog}) {
+            for (bool pairs : {false, true}) {
+                std::string stated = (pairs ? "@precision(double);\n" : "") + text;
+                double cost = bench.cost(stated, p.type, m, steps[0]);
+                std::cout << fmt::format("| {} | {} | {} | {:.2f} |", p.file, core::integratorName(m),
+                                         pairs ? "double" : "float", cost);
+                double drift = 0;
+                for (const Step& s : steps) {
+                    Measured r = bench.stateAccuracy(p, text, m, s, pairs);
+                    if (&s == &steps[0]) drift = r.drift;
+                    std::cout << " " << sci(r.maxError) << " / " << sci(r.finalError) << " |";
+                    if (csv)
+                        *csv << fmt::format("{},{}{},{},{},{},{},{},{},{}\n", p.file, core::integratorName(m),
+                                            pairs ? " double" : "", s.label, s.frame, s.h(), r.maxError, r.finalError,
+                                            cost, r.drift);
+                }
+                std::cout << " " << (p.file == "orbit" ? sci(drift) : "—") << " |\n";
+            }
+        }
+    }
+    std::cout << "\n(max / final error of the state against the exact solution: position in metres, the springs' x; "
+                 "ns/update: one object's update at 1/60 s on the JIT, one thread)\n";
+}
+
 // What @tolerance chose for each problem at 1e-2, 1e-3 and 1e-4 m over its time, measured
 // here on the JIT against the exact solution, and the cheapest method and sub-step that
 // meets the tolerance found by brute force over every method at 1, 2, 4, 8 and 16
-// sub-steps a frame of 1/60 s (the same measurements: largest error, ns per update).
+// sub-steps a frame of 1/60 s, in float and in double (the same measurements: largest
+// error, ns per update).
 void toleranceTable(Bench& bench, const std::string& dir, bool quick, bool explain) {
     const double frame = 1.0 / 60;
     std::cout << "\n### what @tolerance chooses, against the cheapest by brute force\n\n| problem | tolerance | chosen "
@@ -385,20 +504,23 @@ void toleranceTable(Bench& bench, const std::string& dir, bool quick, bool expla
         struct Measure {
             Integrator method;
             int subSteps;
+            core::Precision precision;
             double error, cost;
         };
         std::vector<Measure> all;
-        auto withStep = [&](int s) {
-            return s > 1 ? fmt::format("@step({});\n", frame / s) + text : text;
+        auto withStep = [&](int s, core::Precision precision) {
+            return (precision == core::Precision::Double ? "@precision(double);\n" : "") +
+                   (s > 1 ? fmt::format("@step({});\n", frame / s) : "") + text;
         };
         const Step frames{"1/60", frame, false};
-        for (Integrator m : methods())
-            for (int s : {1, 2, 4, 8, 16}) {
-                if (m == Integrator::Exact && s > 1) break;
-                Measured r = bench.accuracy(p, withStep(s), m, frames);
-                if (!r.closedForm) break;
-                all.push_back({m, s, r.maxError, bench.cost(withStep(s), p.type, m, frames)});
-            }
+        for (core::Precision precision : {core::Precision::Float, core::Precision::Double})
+            for (Integrator m : methods())
+                for (int s : {1, 2, 4, 8, 16}) {
+                    if (m == Integrator::Exact && s > 1) break;
+                    Measured r = bench.accuracy(p, withStep(s, precision), m, frames);
+                    if (!r.closedForm) break;
+                    all.push_back({m, s, precision, r.maxError, bench.cost(withStep(s, precision), p.type, m, frames)});
+                }
         for (double tolerance : {1e-2, 1e-3, 1e-4}) {
             SourceManager sources;
             DiagnosticEngine diags(sources);
@@ -418,15 +540,15 @@ void toleranceTable(Bench& bench, const std::string& dir, bool quick, bool expla
             const Measure* chosen = nullptr;
             const Measure* cheapest = nullptr;
             for (const Measure& m : all) {
-                if (m.method == c.method && m.subSteps == c.subSteps) chosen = &m;
+                if (m.method == c.method && m.subSteps == c.subSteps && m.precision == c.precision) chosen = &m;
                 if (m.error <= tolerance && (!cheapest || m.cost < cheapest->cost)) cheapest = &m;
             }
             if (!chosen) std::exit(1);
             std::cout << fmt::format("| {} | {:.0e} | {}{} | {} | {:.2f} |", p.file, tolerance,
-                                     tune::describe(c.method, c.subSteps, frame), c.met ? "" : " (warned: cannot meet)",
+                                     tune::describe(c.method, c.subSteps, frame, c.precision), c.met ? "" : " (warned: cannot meet)",
                                      sci(chosen->error), chosen->cost);
             if (cheapest)
-                std::cout << fmt::format(" {} | {} | {:.2f} | {:.2f} |\n", tune::describe(cheapest->method, cheapest->subSteps, frame),
+                std::cout << fmt::format(" {} | {} | {:.2f} | {:.2f} |\n", tune::describe(cheapest->method, cheapest->subSteps, frame, cheapest->precision),
                                          sci(cheapest->error), cheapest->cost, chosen->cost / cheapest->cost);
             else
                 std::cout << " none meets it | — | — | — |\n";
@@ -442,12 +564,13 @@ int main(int argc, char** argv) {
     CLI::App app("psys_accuracy: error against cost for every integration method");
     std::string csvPath, dir = PSYS_ACCURACY_DIR;
     size_t copies = 100000;
-    bool quick = false, toleranceOnly = false, explain = false;
+    bool quick = false, toleranceOnly = false, precisionOnly = false, explain = false;
     app.add_option("--csv", csvPath, "Write every measurement to FILE (for bench/plot_accuracy.py)");
     app.add_option("--copies", copies, "Objects per cost measurement (100000)");
     app.add_option("--problems", dir, "The folder of problem files (bench/accuracy)");
     app.add_flag("--quick", quick, "A smoke test: a second of each problem, few timed frames (the figures mean nothing)");
     app.add_flag("--tolerance-only", toleranceOnly, "Only the table of what @tolerance chooses");
+    app.add_flag("--precision-only", precisionOnly, "Only the table of float state against @precision(double)");
     app.add_flag("--explain", explain, "Print on stderr why @tolerance chose what it did (psysc check --explain)");
     CLI11_PARSE(app, argc, argv);
     std::ofstream csvFile;
@@ -460,10 +583,15 @@ int main(int argc, char** argv) {
     Bench bench(copies, quick);
     std::cout << fmt::format("# psys_accuracy on {}\n", bench.jit().report().target.empty() ? "this CPU"
                                                                                           : bench.jit().report().target);
+    if (precisionOnly) {
+        precisionTable(bench, dir, csv);
+        return 0;
+    }
     if (!toleranceOnly) {
         accuracyTables(bench, dir, csv);
         stiffTable(bench, dir, csv);
         fountainTable(bench, dir, quick);
+        precisionTable(bench, dir, csv);
     }
     toleranceTable(bench, dir, quick, explain);
     return 0;

@@ -14,6 +14,7 @@
 namespace psys::tune {
 
 using core::Integrator;
+using core::Precision;
 
 namespace {
 
@@ -95,6 +96,7 @@ public:
         std::optional<Integrator> fixed = options_.pipeline.pass.everyObject;
         if (!fixed) fixed = object.attributes.integrator;
         c.methodFixed = fixed.has_value();
+        c.precisionFixed = object.attributes.precision == Precision::Double;
         index_ = index;
         frames_ = std::max<long>(1, std::lround(std::ceil(over / options_.frame - 1e-9)));
 
@@ -102,14 +104,17 @@ public:
         compared_ = 0;
         for (const Frame& f : reference) compared_ += f.size();
 
-        for (size_t m = 0; m < core::kIntegratorNames.size(); ++m) {
-            auto method = static_cast<Integrator>(m);
-            if (fixed && method != *fixed) continue;
-            const Compiled* compiled = compile(method);
-            if (!compiled) continue;  // `exact` without a closed form
-            for (int s : kSubSteps) {
-                if (method == Integrator::Exact && s > 1) break;  // the same at any step
-                c.trials.push_back({method, s, compiled->costPerUpdate * s, std::nullopt});
+        for (Precision precision : {Precision::Float, Precision::Double}) {
+            if (c.precisionFixed && precision == Precision::Float) continue;
+            for (size_t m = 0; m < core::kIntegratorNames.size(); ++m) {
+                auto method = static_cast<Integrator>(m);
+                if (fixed && method != *fixed) continue;
+                const Compiled* compiled = compile(method, precision);
+                if (!compiled) continue;  // `exact` without a closed form
+                for (int s : kSubSteps) {
+                    if (method == Integrator::Exact && s > 1) break;  // the same at any step
+                    c.trials.push_back({method, s, precision, compiled->costPerUpdate * s, std::nullopt});
+                }
             }
         }
         std::stable_sort(c.trials.begin(), c.trials.end(),
@@ -121,7 +126,7 @@ public:
         for (Trial& t : c.trials) {
             double budget = tolerance - c.floor;
             if (!(budget > 0)) break;
-            t.error = run(compile(t.method)->module, t.subSteps, &reference, budget).first + c.floor;
+            t.error = run(compile(t.method, t.precision)->module, t.subSteps, &reference, budget).first + c.floor;
             if (*t.error <= tolerance) {
                 chosen = &t;
                 break;
@@ -131,7 +136,7 @@ public:
         if (!chosen) {  // the best it can do: every candidate, each stopped once it is behind the best
             double best = INFINITY;
             for (Trial& t : c.trials) {
-                t.error = run(compile(t.method)->module, t.subSteps, &reference, best).first + c.floor;
+                t.error = run(compile(t.method, t.precision)->module, t.subSteps, &reference, best).first + c.floor;
                 if (*t.error < best || !chosen) {
                     best = std::min(best, *t.error);
                     chosen = &t;
@@ -140,6 +145,7 @@ public:
         }
         c.method = chosen->method;
         c.subSteps = chosen->subSteps;
+        c.precision = chosen->precision;
         c.error = *chosen->error;
         c.cost = chosen->cost;
         return c;
@@ -149,10 +155,10 @@ public:
 
 private:
     // The closed form where `exact` has one (its error float's rounding of a formula).
-    // Else rk4 at 1, 2, 4 and 8 sub-steps a frame: the finer of the two neighbours that
-    // agree best, their distance the reference's own error (`floor`) — finer steps cut
-    // rk4's truncation by 16 each halving, while float's rounding grows with the steps,
-    // so the best pair is where the two meet.
+    // Else rk4 in double at 1, 2, 4 and 8 sub-steps a frame: the finer of the two
+    // neighbours that agree best, their distance the reference's own error (`floor`) —
+    // finer steps cut rk4's truncation by 16 each halving, while rounding grows with the
+    // steps (in double far less than in float), so the best pair is where the two meet.
     Path referencePath(Choice& c) {
         if (const Compiled* exact = compile(Integrator::Exact)) {
             // A formula's few roundings: a handful of float's steps at the largest coordinate.
@@ -165,7 +171,7 @@ private:
             c.floor = 4 * FLT_EPSILON * largest;
             return path;
         }
-        const Compiled* rk4 = compile(Integrator::Rk4);
+        const Compiled* rk4 = compile(Integrator::Rk4, Precision::Double);
         Path coarser = run(rk4->module, 1, nullptr, INFINITY).second;
         Path best;
         c.floor = INFINITY;
@@ -174,7 +180,7 @@ private:
             double apart = pathDistance(finer, coarser);
             if (apart < c.floor) {
                 c.floor = apart;
-                c.reference = describe(Integrator::Rk4, s, options_.frame);
+                c.reference = describe(Integrator::Rk4, s, options_.frame, Precision::Double);
                 best = finer;
             }
             coarser = std::move(finer);
@@ -188,11 +194,11 @@ private:
         return worst;
     }
 
-    // The module with the object under `method` (compiled once), or null where the passes
-    // refuse it (`exact` without a closed form).
-    const Compiled* compile(Integrator method) {
-        if (auto it = modules_.find(method); it != modules_.end()) return it->second ? &*it->second : nullptr;
-        std::optional<Compiled>& slot = modules_[method];
+    // The module with the object under `method` in `precision` (compiled once), or null
+    // where the passes refuse it (`exact` without a closed form).
+    const Compiled* compile(Integrator method, Precision precision = Precision::Float) {
+        if (auto it = modules_.find({method, precision}); it != modules_.end()) return it->second ? &*it->second : nullptr;
+        std::optional<Compiled>& slot = modules_[{method, precision}];
         ir::Module module = lowered_;
         opt::PipelineOptions pipeline = options_.pipeline;
         // A method for every object (--integrator) stays every other object's; this one
@@ -204,6 +210,7 @@ private:
         }
         pipeline.pass.everyObject.reset();
         module.objects[index_].attributes.integrator = method;
+        module.objects[index_].attributes.precision = precision;
         stateTolerance(module.objects[index_], method, tolerance_, over_);
         pipeline.log = nullptr;
         pipeline.printAfter.clear();
@@ -269,13 +276,14 @@ private:
     double tolerance_ = 0, over_ = 0;
     long frames_ = 0;
     size_t compared_ = 0;
-    std::map<Integrator, std::optional<Compiled>> modules_;
+    std::map<std::pair<Integrator, Precision>, std::optional<Compiled>> modules_;
 };
 
 }  // namespace
 
-std::string describe(Integrator method, int subSteps, double frame) {
+std::string describe(Integrator method, int subSteps, double frame, Precision precision) {
     std::string name(core::integratorName(method));
+    if (precision == Precision::Double) name += " in double (@precision(double))";
     if (subSteps <= 1) return name;
     return fmt::format("{} with {} sub-steps a frame (@step({}))", name, subSteps, seconds(frame / subSteps));
 }
@@ -301,11 +309,12 @@ std::vector<Choice> chooseMethods(ir::Module& module, rt::Backend& backend, cons
         if (c.trials.empty()) continue;
         object.attributes.integrator = c.method;
         object.attributes.step = c.subSteps > 1 ? static_cast<float>(options.frame / c.subSteps) : 0;
+        object.attributes.precision = c.precision;
         stateTolerance(object, c.method, tolerance, over);
         if (!c.met) {
             std::string why = c.floor * 2 >= tolerance
-                                  ? fmt::format("the reference itself is only good to about {:.2g} m here: float state's "
-                                                "rounding", c.floor)
+                                  ? fmt::format("the reference itself, rk4 in double, is only good to about {:.2g} m here",
+                                                c.floor)
                               : c.methodFixed ? std::string("the integrator is the one written, by @integrator or "
                                                             "--integrator, and only the sub-step was chosen")
                                               : std::string("no finer sub-step than 1/16 of a frame is tried");
@@ -313,7 +322,7 @@ std::vector<Choice> chooseMethods(ir::Module& module, rt::Backend& backend, cons
                              fmt::format("no integrator and sub-step keeps `{}` within {:.3g} m over {:.4g} s at frames "
                                          "of {} s: the closest, {}, is within {:.2g} m ({})",
                                          object.name, tolerance, over, seconds(options.frame),
-                                         describe(c.method, c.subSteps, options.frame), c.error, why),
+                                         describe(c.method, c.subSteps, options.frame, c.precision), c.error, why),
                              object.name);
         }
         choices.push_back(std::move(c));
@@ -331,7 +340,7 @@ std::string explain(const std::vector<Choice>& choices) {
             continue;
         }
         out += fmt::format("{} {}, error {:.2g} m, cost {:.0f} a frame{}\n", c.met ? "chose" : "cannot meet it; closest",
-                           describe(c.method, c.subSteps, c.frame), c.error, c.cost,
+                           describe(c.method, c.subSteps, c.frame, c.precision), c.error, c.cost,
                            c.methodFixed ? " (the integrator as written; the sub-step chosen)" : "");
         out += fmt::format("  reference: {}, its own error about {:.2g} m\n", c.reference, c.floor);
         for (const Trial& t : c.trials) {
@@ -340,7 +349,7 @@ std::string explain(const std::vector<Choice>& choices) {
                                 : *t.error > c.tolerance ? fmt::format("over {:.2g} m (stopped)", *t.error)
                                                          : fmt::format("{:.2g} m", *t.error);
             out += fmt::format("  tried {:<50} cost {:>5.0f} a frame, error {}\n",
-                               describe(t.method, t.subSteps, c.frame), t.cost, error);
+                               describe(t.method, t.subSteps, c.frame, t.precision), t.cost, error);
         }
     }
     return out;

@@ -9,13 +9,16 @@
 // 2, 4, 8 and 16 sub-steps a frame — is compiled and run on a small population (the
 // system as written, at most `population` objects of each type alive), and its points
 // compared, object by object and frame by frame, with a reference: the closed form where
-// `exact` has one (its own error a few of float's steps at the largest coordinate), else rk4 at the sub-step where it agrees best with rk4 at twice that
-// step (their distance is the reference's own error, `floor`). A candidate meets the
-// tolerance when its distance from the reference plus that floor is within it — the floor
-// is also what float state can certify at all. Candidates are
-// tried cheapest first (a pass's arithmetic or, where more, its memory traffic, times the
-// sub-steps: tolerance.cpp's passCost) and the first that meets the tolerance wins; a run
-// stops as soon as it misses. Deterministic: the same source gives the same choice.
+// `exact` has one (its own error a few of float's steps at the largest coordinate), else
+// rk4 with its state in double (@precision(double)) at the sub-step where it agrees best
+// with itself at twice that step (their distance is the reference's own error, `floor`).
+// A candidate meets the tolerance when its distance from the reference plus that floor is
+// within it. Every method is also a candidate in double, for the tolerances float state's
+// rounding cannot hold (a long orbit to 1e-4 m); its pair arithmetic makes it dearer, so
+// float wins wherever it meets the tolerance. Candidates are tried cheapest first (a
+// pass's arithmetic or, where more, its memory traffic, times the sub-steps:
+// tolerance.cpp's passCost) and the first that meets the tolerance wins; a run stops as
+// soon as it misses. Deterministic: the same source gives the same choice.
 #pragma once
 
 #include <optional>
@@ -40,6 +43,7 @@ struct TuneOptions {
 struct Trial {
     core::Integrator method;
     int subSteps = 1;
+    core::Precision precision = core::Precision::Float;
     double cost = 0;               // of an object's updates a frame, in adds on a lane (passCost)
     std::optional<double> error;   // distance from the reference; none: not run
 };
@@ -54,6 +58,8 @@ struct Choice {
     bool met = false;
     core::Integrator method = core::Integrator::SemiImplicit;
     int subSteps = 1;
+    core::Precision precision = core::Precision::Float;
+    bool precisionFixed = false;     // @precision(double) written: only candidates in double
     double error = 0;  // the chosen candidate's distance from the reference plus the floor
     double cost = 0;
     double floor = 0;       // the reference's own error estimate
@@ -70,7 +76,8 @@ std::vector<Choice> chooseMethods(ir::Module& module, rt::Backend& backend, cons
 // What was chosen and why, a paragraph an object (psysc check --explain).
 std::string explain(const std::vector<Choice>& choices);
 
-// "rk4 with 4 sub-steps (@step(1/240))", "exact".
-std::string describe(core::Integrator method, int subSteps, double frame);
+// "rk4 with 4 sub-steps (@step(1/240))", "exact", "rk4 in double (@precision(double))".
+std::string describe(core::Integrator method, int subSteps, double frame,
+                     core::Precision precision = core::Precision::Float);
 
 }  // namespace psys::tune

@@ -124,15 +124,35 @@ TEST_CASE("every reference problem at 1e-2, 1e-3 and 1e-4 m meets its tolerance 
     }
 }
 
-TEST_CASE("a tolerance float state cannot reach is a located warning with the best found, never a silent miss") {
+TEST_CASE("a tolerance float state cannot reach is met in double: the orbit to 1e-4 m over 100 periods") {
     std::string text = test::readFile(std::string(PSYS_ACCURACY_DIR) + "/orbit.psys");
     Chosen c = compileUnderTolerance("@tolerance(1e-4, 628.3);\n" + text);
     REQUIRE(c.module);
     REQUIRE(c.choices.size() == 1);
+    const tune::Choice& choice = c.choices[0];
+    CAPTURE(tune::explain(c.choices));
+    CHECK(choice.met);
+    CHECK(c.diagnostics.empty());
+    CHECK(choice.precision == core::Precision::Double);
+    CHECK(c.module->objects[0].attributes.precision == core::Precision::Double);
+    CHECK(choice.floor < 1e-5);  // the reference, rk4 in double, is good to far better than the tolerance
+    // Every candidate in float was tried first and missed: their rounding alone is past it.
+    for (const tune::Trial& t : choice.trials) {
+        if (t.precision != core::Precision::Float || !t.error) continue;
+        CHECK(*t.error > 1e-4);
+    }
+    Problem orbit{"orbit", "planet", 628.3, [](double t) { return std::array<double, 3>{std::cos(t), std::sin(t), 0}; }};
+    CHECK(worstError(std::move(*c.module), orbit) <= 1e-4);
+}
+
+TEST_CASE("a tolerance no candidate can reach is a located warning with the best found, never a silent miss") {
+    std::string text = test::readFile(std::string(PSYS_ACCURACY_DIR) + "/orbit.psys");
+    Chosen c = compileUnderTolerance("@tolerance(1e-9, 20);\n" + text);  // below the drawn point's own rounding
+    REQUIRE(c.module);
+    REQUIRE(c.choices.size() == 1);
     CHECK_FALSE(c.choices[0].met);
-    CHECK(c.choices[0].floor > 1e-4);  // the reference's own rounding, over a hundred periods
-    CHECK(c.diagnostics.find("tolerance.psys:4:8: warning: no integrator and sub-step keeps `planet` within 0.0001 m "
-                             "over 628.3 s") != std::string::npos);
+    CHECK(c.diagnostics.find("tolerance.psys:4:8: warning: no integrator and sub-step keeps `planet` within 1e-09 m "
+                             "over 20 s") != std::string::npos);
     CHECK(c.diagnostics.find("the closest, ") != std::string::npos);
 }
 
@@ -178,7 +198,7 @@ TEST_CASE("the choice is deterministic and --explain says what was tried") {
     CHECK(a.choices[0].error == b.choices[0].error);
     std::string said = tune::explain(a.choices);
     CHECK(said.find("mass: @tolerance(0.001 m over 10 s): chose ") != std::string::npos);
-    CHECK(said.find("reference: rk4 with ") != std::string::npos);
+    CHECK(said.find("reference: rk4 in double (@precision(double)) with ") != std::string::npos);
     CHECK(said.find("tried euler") != std::string::npos);
 }
 
