@@ -48,6 +48,7 @@ void methodHints(const ir::Module& module, Analysis& a) {
                                            : ", adaptive within each update";
         else
             label += o.attributes.step > 0 ? ", step " + stepText(o.attributes.step) : ", a step per update";
+        if (o.attributes.precision == core::Precision::Double) label += ", state in double";
         if (o.attributes.tolerance > 0) label += fmt::format(" (chosen for @tolerance({:g}))", o.attributes.tolerance);
         a.hints.push_back({at, label, 2});
     }

@@ -80,6 +80,14 @@ TEST_CASE("bs3 on the GPU takes the interpreter's steps, each object its own") {
     CHECK(c.differences == 0);
 }
 
+TEST_CASE("@precision(double) on the GPU: the interpreter's bits") {
+    // Pair arithmetic in the shaders (their values are `precise`: nothing contracted or
+    // reordered), far from the origin, through sqrt, pow and division.
+    test::Comparison c = compareProgram(readFile(programsDir() + "/double_precision.psys"), 240, true, 0);
+    CHECK(c.points > 1000);
+    CHECK(c.differences == 0);
+}
+
 TEST_CASE("a launch split over dispatches computes what one dispatch computes") {
     // Where a pool outgrows a storage block, a launch runs as several dispatches; each
     // binds the columns it reads and writes in place from an aligned offset before its

@@ -79,6 +79,16 @@ TEST_CASE("every sample draws the same on the LLVM backend as on the interpreter
     }
 }
 
+TEST_CASE("@precision(double) on the JIT: the interpreter's bits, in exact maths") {
+    // Pair arithmetic (opt/precision_double.cpp) is exact only as written: the JIT must
+    // neither contract nor reorder it. Orbits far from the origin, through sqrt, pow and
+    // division, comparisons that kill, random starts.
+    std::string text = readFile(std::string(PSYS_PROGRAMS_DIR) + "/double_precision.psys");
+    test::Comparison c = compareBackends(text, test::kLongRun, true, MathMode::Exact);
+    CHECK(c.points > 1000);
+    CHECK(c.differences == 0);
+}
+
 // The extremes of docs/runtime.md, each past one chunk of rows (8,192) so that threads
 // split the work: a pool at capacity under a rate of 10^6 a second, everything killed in
 // one frame, a burst of 100k, frozen parents read by their children, a trigger (fired by

@@ -60,3 +60,16 @@ TEST_CASE("the inlay hint of an object under bs3 says its steps are its own") {
     CHECK(hintsOn(a, text, 0) == std::vector<std::string>{"bs3, adaptive within each update"});
     CHECK(hintsOn(a, text, 5) == std::vector<std::string>{"bs3, adaptive, sub-steps of 1/240 s"});
 }
+
+TEST_CASE("the inlay hint of an object under @precision(double) says its state is in double") {
+    std::string text = "@precision(double) @integrator(rk4) object ball {\n"
+                       "    pos = integrate(vel);\n"
+                       "    vel = integrate(vec3(0, -9.8, 0));\n"
+                       "    point(pos, white, 1);\n"
+                       "}\n"
+                       "spawn ball;\n";
+    Analysis a = analyze("/tmp/double.psys", text);
+    REQUIRE(a.parsed);
+    CHECK(a.diagnostics.empty());
+    CHECK(hintsOn(a, text, 0) == std::vector<std::string>{"rk4, a step per update, state in double"});
+}
