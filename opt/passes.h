@@ -69,6 +69,10 @@ void lowerTemporal(ir::Module& module, const PassOptions& options, PassErrors& e
 void keyRandom(ir::Module& module, PassErrors& errors);
 void splitKernels(ir::Module& module, PassErrors& errors);
 void doublePrecision(ir::Module& module, PassErrors& errors);
+// Whether double-precision computes `op` in pairs (where its operands are floats): simplify
+// does not fold it on constants in the behaviour of an object in double, so that the pass
+// pairs it with the optimizer as without it.
+bool pairedOp(ir::Op op);
 void simplify(ir::Module& module, const PassOptions& options, PassErrors& errors);
 void reassociate(ir::Module& module, PassErrors& errors);
 void hoistUniform(ir::Module& module, PassErrors& errors);

@@ -20,9 +20,10 @@
 // and inputs (their low part 0: a number in the source, a parameter, the age and dt are
 // floats), + − × ÷, negation, sqrt, whole powers 2 to 4, dot, the operations that move
 // lanes, selects and comparisons. Any other function (sin, min, floor, …) is computed in
-// float on the value rounded to float (the high part) and gives a float; so is arithmetic
-// on constants alone (`w * w`), as the optimizer folds it, so that a program means the
-// same with the optimizer and without.
+// float on the value rounded to float (the high part) and gives a float. Arithmetic on
+// constants alone (`w * w`) is paired too: simplify does not fold those ops in such an
+// object's behaviour (pairedOp), and folds the pair arithmetic after this pass, bit for
+// bit, so a program means the same with the optimizer and without.
 //
 // Which kernels: those that write the object's state (init, update). Each write of a slot
 // writes its low part too; every other kernel (render, exports, spawn) reads the high
@@ -55,11 +56,10 @@ public:
 
     Kernel run() {
         pairs_.resize(from_.size());
-        constant_.assign(from_.size(), false);
         for (ValueId v = 0; v < from_.size(); ++v) {
             const Inst& inst = from_.at(v);
             LocScope at(to_, inst.loc);
-            pairs_[v] = pair(v, inst);
+            pairs_[v] = pair(inst);
         }
         for (const Yield& y : from_.yields) {
             const Pair& p = pairs_[y.value];
@@ -184,16 +184,12 @@ private:
         return n == 2 || n == 3 || n == 4 ? static_cast<int>(n) : 0;
     }
 
-    Pair pair(ValueId v, const Inst& inst) {
+    Pair pair(const Inst& inst) {
         Type t = inst.type;
         auto x = [&](size_t n) -> const Pair& { return pairs_[inst.operands[n]]; };
-        bool allExact = true, allConstant = core::opInfo(inst.op).kind == core::OpKind::Pure;
-        for (ValueId o : inst.operands) {
-            allExact &= pairs_[o].exact;
-            allConstant &= constant_[o];
-        }
-        constant_[v] = inst.op == Op::Const || allConstant;
-        switch (constant_[v] ? Op::Const : inst.op) {
+        bool allExact = true;
+        for (ValueId o : inst.operands) allExact &= pairs_[o].exact;
+        switch (inst.op) {
             case Op::StateRead: {
                 int low = inst.attr >= 0 && static_cast<size_t>(inst.attr) < low_.size() ? low_[static_cast<size_t>(inst.attr)] : -1;
                 ValueId hi = to_.add(inst);
@@ -250,8 +246,19 @@ private:
     const std::vector<int>& low_;
     Kernel to_;
     std::vector<Pair> pairs_;
-    std::vector<bool> constant_;  // built from constants alone
 };
+
+}  // namespace
+
+bool pairedOp(Op op) {
+    switch (op) {
+        case Op::Add: case Op::Sub: case Op::Mul: case Op::Div: case Op::Neg: case Op::Sqrt: case Op::Pow: case Op::Dot:
+            return true;
+        default: return false;
+    }
+}
+
+namespace {
 
 bool writesState(const Kernel& k) {
     for (const Yield& y : k.yields)

@@ -95,6 +95,7 @@ bool finiteNonNegative(const Kernel& k, ValueId v) {
 // What the procedural patterns need to know about the instruction being rewritten.
 struct Context {
     bool relaxed = false;
+    bool pairs = false;      // the behaviour of an object in double: pairedOp ops are not folded
     std::vector<int> users;  // per old value: how many instructions, yields and equations use it
     ValueId oldOperand0 = 0; // the old value of the current instruction's first operand
 };
@@ -271,7 +272,11 @@ const Rules& simplifyRules(const Context& ctx) {
                                     if (creationInvariant(rw.to(), inst.operands[0])) return inst.operands[0];
                                     return std::nullopt;
                                 }});
-        r.add(ProceduralPattern{"constant folding", Op::Const, foldConstants});
+        r.add(ProceduralPattern{"constant folding", Op::Const, [](Rewriter& rw, const Inst& inst) -> std::optional<ValueId> {
+                                    // In pairs later (double-precision), not folded in float now.
+                                    if (current->pairs && inst.type.isFloat() && pairedOp(inst.op)) return std::nullopt;
+                                    return foldConstants(rw, inst);
+                                }});
         r.add(ProceduralPattern{"if-floating", Op::Const, floatIf});
         r.add(rewrite("x * 1 → x", x * lit(1.0f), x));
         r.add(rewrite("x * -1 → -x", x * lit(-1.0f), -x));
@@ -320,10 +325,11 @@ void dropFalseKill(Kernel& kernel) {
     kernel = std::move(clean);
 }
 
-void simplifyKernel(Kernel& kernel, bool relaxed) {
+void simplifyKernel(Kernel& kernel, bool relaxed, bool pairs = false) {
     for (int round = 0; round < 16; ++round) {
         Context ctx;
         ctx.relaxed = relaxed;
+        ctx.pairs = pairs;
         ctx.users.assign(kernel.size(), 0);
         for (const Inst& i : kernel.insts())
             for (ValueId o : i.operands) ++ctx.users[o];
@@ -352,7 +358,9 @@ void simplifyKernel(Kernel& kernel, bool relaxed) {
 
 void simplify(Module& module, const PassOptions& options, PassErrors&) {
     for (Object& o : module.objects)
-        for (Kernel& k : o.kernels) simplifyKernel(k, options.relaxed);
+        for (Kernel& k : o.kernels)
+            simplifyKernel(k, options.relaxed,
+                           o.attributes.precision == Precision::Double && k.kind == KernelKind::Behaviour);
     for (Trigger& t : module.triggers) simplifyKernel(t.kernel, options.relaxed);
     simplifyKernel(module.start.kernel, options.relaxed);
 }
