@@ -103,9 +103,9 @@ std::pair<double, double> keplerPosition(double t) {
     return {-a * (std::cos(E) - e), -b * std::sin(E)};
 }
 
-// The exact solutions are those of the problems as their programs state them, in floats
-// (g = −9.8 is −9.80000019; the springs' w·w and 2·zeta·w are folded to floats): what a
-// state in double is then measured against.
+// The exact solutions are those of the problems as their programs state them: their
+// numbers as floats (g = −9.8 is −9.80000019), the arithmetic on them exact (the springs'
+// w·w): what a state in double is measured against.
 std::vector<Problem> problems() {
     const double g = f32(-9.8), w = f32(6.2831853);
     // x'' = −k·x − c·x' from x = 1 at rest: x = e^(−a·t)·(cos(ωd·t) + a/ωd·sin(ωd·t)),
@@ -117,7 +117,7 @@ std::vector<Problem> problems() {
                                          -std::exp(-a * t) * (k / wd) * std::sin(wd * t)};
         };
     };
-    auto undamped = spring(f32(w * w), 0), damped = spring(f32(w * w), f32(f32(2 * f32(0.1)) * w));
+    auto undamped = spring(w * w, 0), damped = spring(w * w, 2 * f32(0.1) * w);
     auto springProblem = [](const char* file, auto exact) {
         return Problem{file, "mass", 10, [=](const Place& p, double t) { return std::fabs(p.position[0] - exact(t)[0]); },
                        [=](const Place& p, double t) { return positionError(p, exact(t)[0], exact(t)[1], 0); },
