@@ -191,36 +191,17 @@ class Bench {
 public:
     Bench(size_t copies, bool quick) : copies_(copies), quick_(quick) {}
 
-    // Steps one object through the problem, comparing after every step.
+    // Steps one object through the problem, comparing its drawn point after every step.
     Measured accuracy(const Problem& problem, const std::string& text, Integrator method, const Step& step) {
-        Measured m;
-        std::string source = step.subSteps ? "@step(1/240);\n" + text : text;
-        auto module = compile(source, method);
-        if (!module) {
-            m.closedForm = false;
-            return m;
-        }
-        rt::SystemOptions options;
-        options.threads = 1;
-        rt::System system(std::move(*module), jit_, options);
-        double seconds = quick_ ? std::min(problem.seconds, 1.0) : problem.seconds;
-        auto frames = static_cast<long>(std::lround(seconds / step.frame));
-        size_t type = static_cast<size_t>(system.typeIndex(problem.type));
-        rt::RenderPoint last{};
-        for (long f = 1; f <= frames; ++f) {
-            if (system.step(step.frame)) std::exit(1);
-            auto points = system.points(type);
-            if (points.size() != 1) {
-                std::cerr << "psys_accuracy: " << problem.file << " has " << points.size() << " objects\n";
-                std::exit(1);
-            }
-            last = points[0];
-            double e = problem.error(placeOf(last), timeAfter(f, step.frame));
-            m.maxError = std::isfinite(e) ? std::max(m.maxError, e) : INFINITY;
-            m.finalError = e;
-        }
-        if (problem.file == "orbit") m.drift = energyDrift(placeOf(last));
-        return m;
+        return measure(problem, step.subSteps ? "@step(1/240);\n" + text : text, method, step,
+                       [&](rt::System& system, size_t type) {
+                           auto points = system.points(type);
+                           if (points.size() != 1) {
+                               std::cerr << "psys_accuracy: " << problem.file << " has " << points.size() << " objects\n";
+                               std::exit(1);
+                           }
+                           return placeOf(points[0]);
+                       });
     }
 
     // As accuracy(), on the state itself rather than the drawn floats: the problem's
@@ -228,53 +209,36 @@ public:
     // program under @precision(double)).
     Measured stateAccuracy(const Problem& problem, const std::string& text, Integrator method, const Step& step,
                            bool pairs) {
-        Measured m;
         std::string source = std::string(pairs ? "@precision(double);\n" : "") + (step.subSteps ? "@step(1/240);\n" : "") + text;
-        auto module = compile(source, method);
-        if (!module) {
-            m.closedForm = false;
-            return m;
-        }
-        rt::SystemOptions options;
-        options.threads = 1;
-        rt::System system(std::move(*module), jit_, options);
-        size_t type = static_cast<size_t>(system.typeIndex(problem.type));
-        const ir::Object& object = system.pool(type).object();
-        auto slot = [&](const std::string& name) {
-            for (size_t i = 0; i < object.state.size(); ++i)
-                if (object.state[i].name == name) return static_cast<int>(i);
-            return -1;
-        };
-        auto read = [&](const std::string& name, const std::array<double, 3>& from) {
-            std::array<double, 3> out = from;
-            int hi = slot(name), lo = slot(name + "@lo");
-            if (hi < 0) {
-                std::cerr << "psys_accuracy: " << problem.file << " keeps no slot " << name << "\n";
-                std::exit(1);
-            }
-            ir::Value h = system.pool(type).state.get(system.backend().memory(), hi, 0);
-            ir::Value l = lo >= 0 ? system.pool(type).state.get(system.backend().memory(), lo, 0) : ir::Value{};
-            for (size_t i = 0; i < 3; ++i) out[i] += static_cast<double>(h.f[i]) + l.f[i];
-            return out;
-        };
-        double seconds = quick_ ? std::min(problem.seconds, 1.0) : problem.seconds;
-        auto frames = static_cast<long>(std::lround(seconds / step.frame));
-        Place last;
-        for (long f = 1; f <= frames; ++f) {
-            if (system.step(step.frame)) std::exit(1);
+        return measure(problem, source, method, step, [&](rt::System& system, size_t type) {
+            const ir::Object& object = system.pool(type).object();
+            auto slot = [&](const std::string& name) {
+                for (size_t i = 0; i < object.state.size(); ++i)
+                    if (object.state[i].name == name) return static_cast<int>(i);
+                return -1;
+            };
+            auto read = [&](const std::string& name, const std::array<double, 3>& from) {
+                std::array<double, 3> out = from;
+                int hi = slot(name), lo = slot(name + "@lo");
+                if (hi < 0) {
+                    std::cerr << "psys_accuracy: " << problem.file << " keeps no slot " << name << "\n";
+                    std::exit(1);
+                }
+                ir::Value h = system.pool(type).state.get(system.backend().memory(), hi, 0);
+                ir::Value l = lo >= 0 ? system.pool(type).state.get(system.backend().memory(), lo, 0) : ir::Value{};
+                for (size_t i = 0; i < 3; ++i) out[i] += static_cast<double>(h.f[i]) + l.f[i];
+                return out;
+            };
             auto x = read(problem.position, problem.positionFrom), v = read(problem.velocity, problem.velocityFrom);
+            Place p;
             if (problem.springs) {
-                last.position = {x[0], v[0], 0};
+                p.position = {x[0], v[0], 0};
             } else {
-                last.position = x;
-                last.color = {v[0], v[1], v[2], 1};
+                p.position = x;
+                p.color = {v[0], v[1], v[2], 1};
             }
-            double e = problem.error(last, timeAfter(f, step.frame));
-            m.maxError = std::isfinite(e) ? std::max(m.maxError, e) : INFINITY;
-            m.finalError = e;
-        }
-        if (problem.file == "orbit") m.drift = energyDrift(last);
-        return m;
+            return p;
+        });
     }
 
     // ns per object per frame: `copies` objects of the problem's type, on one thread.
@@ -307,6 +271,34 @@ public:
     codegen_llvm::LlvmBackend& jit() { return jit_; }
 
 private:
+    // One object of `source` stepped through the problem, where `where` says it is
+    // compared with the exact solution after every step.
+    Measured measure(const Problem& problem, const std::string& source, Integrator method, const Step& step,
+                     const std::function<Place(rt::System&, size_t)>& where) {
+        Measured m;
+        auto module = compile(source, method);
+        if (!module) {
+            m.closedForm = false;
+            return m;
+        }
+        rt::SystemOptions options;
+        options.threads = 1;
+        rt::System system(std::move(*module), jit_, options);
+        double seconds = quick_ ? std::min(problem.seconds, 1.0) : problem.seconds;
+        auto frames = static_cast<long>(std::lround(seconds / step.frame));
+        size_t type = static_cast<size_t>(system.typeIndex(problem.type));
+        Place last;
+        for (long f = 1; f <= frames; ++f) {
+            if (system.step(step.frame)) std::exit(1);
+            last = where(system, type);
+            double e = problem.error(last, timeAfter(f, step.frame));
+            m.maxError = std::isfinite(e) ? std::max(m.maxError, e) : INFINITY;
+            m.finalError = e;
+        }
+        if (problem.file == "orbit") m.drift = energyDrift(last);
+        return m;
+    }
+
     codegen_llvm::LlvmBackend jit_;
     size_t copies_;
     bool quick_;
