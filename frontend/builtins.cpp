@@ -84,7 +84,7 @@ constexpr BuiltinAttribute kAttributes[] = {
     {"step", "@step(seconds)", "a fixed sub-step: updates run in steps of at most this many seconds"},
     {"tolerance", "@tolerance(metres[, seconds])",
      "the largest position error accepted over the first `seconds` (10 when not given): the compiler chooses the "
-     "cheapest integrator and sub-step that meet it (psysc check --explain; docs/accuracy.md)"},
+     "cheapest integrator, sub-step and precision that meet it (psysc check --explain; docs/accuracy.md)"},
     {"precision", "@precision(float|double)",
      "how the state is kept: float (the default), or double: pairs of floats, 48 significant bits, on every "
      "backend (docs/accuracy.md); about 1e-13 m on a projectile where floats reach 1e-5 m"},
