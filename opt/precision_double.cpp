@@ -153,8 +153,7 @@ private:
     }
     // x < y and the others: on the high parts, then the low parts where those are equal.
     ValueId compare(Op o, const Pair& x, const Pair& y) {
-        ValueId onHigh = op(o, Type::boolean(), {x.hi, y.hi});
-        if (x.exact && y.exact) return onHigh;
+        if (x.exact && y.exact) return op(o, Type::boolean(), {x.hi, y.hi});
         Type t = Type::f32();
         Op strict = o == Op::Le ? Op::Lt : o == Op::Ge ? Op::Gt : o;
         ValueId tie = op(Op::And, Type::boolean(),
