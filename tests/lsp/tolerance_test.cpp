@@ -20,6 +20,14 @@ std::vector<std::string> hintsOn(const Analysis& a, const std::string& text, int
     return labels;
 }
 
+// A program's analysis, which must check clean.
+Analysis clean(const std::string& path, const std::string& text) {
+    Analysis a = analyze(path, text);
+    REQUIRE(a.parsed);
+    CHECK(a.diagnostics.empty());
+    return a;
+}
+
 }  // namespace
 
 TEST_CASE("inlay hints say what @tolerance chose, and a tolerance out of reach is a warning") {
@@ -30,9 +38,7 @@ TEST_CASE("inlay hints say what @tolerance chose, and a tolerance out of reach i
                          "    point(vec3(x, v, 0), white, 1);\n"
                          "}\n"
                          "spawn mass;\n";
-    Analysis a = analyze("/tmp/tolerance.psys", spring);
-    REQUIRE(a.parsed);
-    CHECK(a.diagnostics.empty());
+    Analysis a = clean("/tmp/tolerance.psys", spring);
     CHECK(hintsOn(a, spring, 1) == std::vector<std::string>{"rk4, a step per update (chosen for @tolerance(0.001))"});
 
     std::string tight = spring;
@@ -54,9 +60,7 @@ TEST_CASE("the inlay hint of an object under bs3 says its steps are its own") {
                        "    point(pos, white, 1);\n"
                        "}\n"
                        "spawn drop;\nspawn fine;\n";
-    Analysis a = analyze("/tmp/bs3.psys", text);
-    REQUIRE(a.parsed);
-    CHECK(a.diagnostics.empty());
+    Analysis a = clean("/tmp/bs3.psys", text);
     CHECK(hintsOn(a, text, 0) == std::vector<std::string>{"bs3, adaptive within each update"});
     CHECK(hintsOn(a, text, 5) == std::vector<std::string>{"bs3, adaptive, sub-steps of 1/240 s"});
 }
@@ -68,8 +72,6 @@ TEST_CASE("the inlay hint of an object under @precision(double) says its state i
                        "    point(pos, white, 1);\n"
                        "}\n"
                        "spawn ball;\n";
-    Analysis a = analyze("/tmp/double.psys", text);
-    REQUIRE(a.parsed);
-    CHECK(a.diagnostics.empty());
+    Analysis a = clean("/tmp/double.psys", text);
     CHECK(hintsOn(a, text, 0) == std::vector<std::string>{"rk4, a step per update, state in double"});
 }
