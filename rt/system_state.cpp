@@ -272,7 +272,6 @@ void State::settleAndRelease(Deaths& deaths, std::vector<LateKills>& lates) {
         release(one);
         next = at;
     };
-    std::vector<LateKills> single(1);
     for (LateKills& l : lates) {
         if (types[l.type].rowsInMemory) {  // freed in the memory at the step's end (endStep): counted
             countInMemory(l);
@@ -280,8 +279,11 @@ void State::settleAndRelease(Deaths& deaths, std::vector<LateKills>& lates) {
         }
         releaseUpTo(l.at);
         if (!simple(l)) {  // its kills frozen and released in its place, as settleLate and release would
+            // A list of its own each time: settleLate leaves the list it settles holding only
+            // what it keeps (nothing here: the type's rows are not in the memory).
             Deaths its;
-            single[0] = std::move(l);
+            std::vector<LateKills> single;
+            single.push_back(std::move(l));
             single[0].at = 0;
             settleLate(its, single);
             release(its);

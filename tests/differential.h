@@ -61,11 +61,8 @@ inline bool sameRows(const rt::System& a, const rt::System& b) {
     return true;
 }
 
-// Fires every trigger (each argument 1.5), then steps both systems `frames` times by
-// 1/60 s, comparing what is drawn after each step and the counts at the end.
-// Values are compared over the first `closeFrames` frames (test::closeFrames: a crowd's
-// first ones), what is alive over all of them.
-inline Comparison compareSystems(rt::System& a, rt::System& b, int frames, int closeFrames = INT_MAX) {
+// Fires every trigger of both systems (each argument 1.5).
+inline void fireEveryTrigger(rt::System& a, rt::System& b) {
     for (const ir::Trigger& t : a.module().triggers) {
         size_t width = 0;
         for (auto& p : t.params) width += static_cast<size_t>(p.type.width);
@@ -73,8 +70,17 @@ inline Comparison compareSystems(rt::System& a, rt::System& b, int frames, int c
         REQUIRE_FALSE(a.fire(t.name, args));
         REQUIRE_FALSE(b.fire(t.name, args));
     }
+}
+
+// Steps both systems `frames` times by 1/60 s, firing every trigger before step
+// `fireAt` (0: before the first; mid-run, the trigger's objects meet a step's deaths),
+// comparing what is drawn after each step and the counts at the end.
+// Values are compared over the first `closeFrames` frames (test::closeFrames: a crowd's
+// first ones), what is alive over all of them.
+inline Comparison compareSystems(rt::System& a, rt::System& b, int frames, int closeFrames = INT_MAX, int fireAt = 0) {
     Comparison result;
     for (int frame = 0; frame < frames; ++frame) {
+        if (frame == fireAt) fireEveryTrigger(a, b);
         REQUIRE_FALSE(a.step(1.0 / 60));
         REQUIRE_FALSE(b.step(1.0 / 60));
         for (size_t t = 0; t < a.typeCount(); ++t) {

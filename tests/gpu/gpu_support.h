@@ -125,11 +125,11 @@ struct Pair {
 };
 
 inline test::Comparison compareProgram(const std::string& text, int frames, bool optimize, double tolerance,
-                                bool hostSide = false) {
+                                       bool hostSide = false, int fireAt = 0) {
     interp::Interpreter interpreter;
     auto gpu = gpuBackend(hostSide);
     rt::System a(test::compileModule(text, optimize), interpreter), b(test::compileModule(text, optimize), *gpu);
-    test::Comparison result = test::compareSystems(a, b, frames, test::closeFrames(a.module()));
+    test::Comparison result = test::compareSystems(a, b, frames, test::closeFrames(a.module()), fireAt);
     CHECK(result.worst <= tolerance);
     return result;
 }

@@ -61,6 +61,21 @@ TEST_CASE("every sample draws the same on the GPU as on the interpreter, for 600
     MESSAGE("the samples' worst difference: " << worst);
 }
 
+TEST_CASE("the step's bookkeeping programs (tests/programs/step_*) on the GPU, with its host side and without") {
+    // Deaths settled beside bursts, triggers fired mid-run, late kills and nested types:
+    // each program once crashed the GLSL backend.
+    size_t programs = 0;
+    for (auto& entry : std::filesystem::directory_iterator(test::programsDir())) {
+        if (!entry.path().filename().string().starts_with("step_")) continue;
+        ++programs;
+        for (bool hostSide : {false, true}) {
+            INFO(entry.path().filename().string() << (hostSide ? " with the host side" : ""));
+            compareProgram(readFile(entry.path()), 120, true, kSamplesTolerance, hostSide, 10);
+        }
+    }
+    CHECK(programs >= 3);
+}
+
 TEST_CASE("bs3 on the GPU takes the interpreter's steps, each object its own") {
     // Drops under drags from none to stiff: each object's step shrinks as far as its drag
     // asks. Only + − × ÷ and comparisons decide a step (opt/integrate_adaptive.cpp), which

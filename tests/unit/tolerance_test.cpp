@@ -212,6 +212,18 @@ TEST_CASE("objects that integrate nothing, or state no tolerance, are left as wr
     CHECK_FALSE(c.module->objects[1].attributes.integrator.has_value());
 }
 
+TEST_CASE("the chooser's trial systems run beside a nested type's late kills") {
+    // The trials run the whole file: a step there once settled two late launches of the
+    // nested type into one emptied list (tests/programs/step_late_kills_beside_nested.psys).
+    Chosen c = compileUnderTolerance(R"(
+        @tolerance(1e-2) object thrown { pos = integrate(vec3(1, 2, 0)); point(pos, white, 1); }
+        object a { kill when age > 100; }
+        object b { emit c at 60 per second; object c { kill when age > 100; } }
+        spawn thrown; spawn a; spawn b;)");
+    REQUIRE(c.module);
+    CHECK(c.choices.size() == 1);
+}
+
 TEST_CASE("@tolerance is carried into the IR, printed and parsed back") {
     SourceManager sources;
     DiagnosticEngine diags(sources);
