@@ -10,7 +10,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
-bash scripts/setup.sh >/dev/null
+bash scripts/setup.sh test >/dev/null
 
 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_COMPILER=clang++-19 -DPSYS_FUZZ=ON -DPSYS_WERROR=OFF -DBUILD_TESTING=OFF >/dev/null

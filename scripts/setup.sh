@@ -1,26 +1,49 @@
 #!/usr/bin/env bash
-# Installs every Debian package psys needs to build, test and run, and the editor
-# extension's npm packages (editor-support/vscode, versions pinned in package-lock.json).
-# Non-interactive and idempotent: running it again changes nothing.
+# Installs the Debian packages (and, for the editor, the npm packages) one of psys's jobs
+# needs. Non-interactive and idempotent: running it again changes nothing.
+#   bash scripts/setup.sh run      # build and run psysc and psys-view (scripts/demo.sh)
+#   bash scripts/setup.sh editor   # the editor extension's npm packages (editor-support/vscode,
+#                                  # versions pinned in package-lock.json), and Node.js where missing
+#   bash scripts/setup.sh test     # everything the tests use: run + editor + the rest (scripts/test.sh)
+# With no profile: test.
 set -euo pipefail
 
-packages=(
-  cmake ninja-build pkg-config g++ git
+profile=${1:-test}
+case $profile in run | editor | test) ;; *) echo "usage: bash scripts/setup.sh [run|editor|test]" >&2; exit 2 ;; esac
+
+# Building and running psysc and psys-view, headless included (EGL on Mesa); ccache and mold
+# make rebuilds and links fast (CMakeLists.txt uses them where they are installed).
+run_packages=(
+  cmake ninja-build pkg-config g++ git ccache mold
   antlr4 libantlr4-runtime-dev
   llvm-19-dev libzstd-dev
   libglm-dev libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libimgui-dev
-  mesa-vulkan-drivers libvulkan1
-  doctest-dev libcli11-dev libfmt-dev nlohmann-json3-dev libstb-dev libtbb-dev
-  glslang-tools xvfb xauth patchelf xz-utils libbenchmark-dev python3-matplotlib vim
-  clang-19 libclang-rt-19-dev
-  ffmpeg fonts-dejavu-core
-  python3-dev python3-pybind11 python3-numpy python3-pytest
-  neovim
-  xterm x11-apps  # scripts/editor-screenshot.sh: Neovim in an xterm, captured with xwd
+  libcli11-dev libfmt-dev nlohmann-json3-dev libstb-dev libtbb-dev
+  fonts-dejavu-core  # the viewer's panel font
 )
-# Node.js 20 and npm (the editor extension's tests and package) come with the machine;
-# where they do not, Debian's are installed.
-command -v node >/dev/null && command -v npm >/dev/null || packages+=(nodejs npm)
+# The editor extension's tests and package: Node.js 20 and npm come with the machine; where
+# they do not, Debian's are installed.
+editor_packages=()
+command -v node >/dev/null && command -v npm >/dev/null || editor_packages+=(nodejs npm)
+# What only the tests, benchmarks and fuzzers use.
+test_packages=(
+  doctest-dev libbenchmark-dev
+  mesa-vulkan-drivers libvulkan1  # zink over lavapipe: the GPU tests' second GL
+  glslang-tools xvfb xauth
+  patchelf xz-utils               # the GPU bundle (scripts/gpu-bundle.sh)
+  python3-matplotlib
+  clang-19 libclang-rt-19-dev     # the fuzzers (scripts/fuzz.sh)
+  ffmpeg                          # the viewer's video recording
+  python3-dev python3-pybind11 python3-numpy python3-pytest
+  vim neovim                      # the editor tests' real clients
+  xterm x11-apps                  # scripts/editor-screenshot.sh: Neovim in an xterm, captured with xwd
+)
+
+packages=("${run_packages[@]}")
+case $profile in
+  editor) packages=("${editor_packages[@]}") ;;
+  test) packages+=("${editor_packages[@]}" "${test_packages[@]}") ;;
+esac
 
 missing=()
 for p in "${packages[@]}"; do
@@ -28,7 +51,7 @@ for p in "${packages[@]}"; do
 done
 
 if [ ${#missing[@]} -eq 0 ]; then
-  echo "setup: all ${#packages[@]} packages already installed"
+  echo "setup ($profile): all ${#packages[@]} packages already installed"
 else
   SUDO=""
   [ "$(id -u)" -eq 0 ] || SUDO="sudo"
@@ -36,6 +59,8 @@ else
   $SUDO apt-get update -q
   $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
+
+[ "$profile" = run ] && exit 0
 
 # npm ci installs exactly what package-lock.json pins; it runs again only when the lock changed.
 vscode="$(cd "$(dirname "$0")/.." && pwd)/editor-support/vscode"
