@@ -12,7 +12,8 @@ source scripts/stages.sh
 stage "set-up" bash scripts/setup.sh test
 jobs=$(nproc)
 
-stage "release: configure" cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPSYS_WERROR=ON
+stage "release: configure" cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPSYS_WERROR=ON \
+  -DBUILD_TESTING=ON -DPSYS_BENCH=ON
 stage "release: build" cmake --build build -j "$jobs"
 stage_tests "release" build
 stage "release: ctest" ctest --test-dir build -j "$jobs" --output-on-failure
@@ -33,7 +34,8 @@ sanitized_ctest() {
 }
 
 if [ "${PSYS_SKIP_SANITIZE:-0}" != 1 ]; then
-  stage "asan: configure" cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DPSYS_WERROR=ON -DPSYS_SANITIZE=ON
+  stage "asan: configure" cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DPSYS_WERROR=ON -DPSYS_SANITIZE=ON \
+    -DBUILD_TESTING=ON -DPSYS_BENCH=ON
   stage "asan: build" cmake --build build-asan -j "$jobs"
   stage_tests "asan" build-asan
   stage "asan: ctest" sanitized_ctest
