@@ -41,16 +41,19 @@ stages_report() {
         "$(stages_minutes "${stages_seconds[$i]}")" "${stages_results[$i]}"
     done
     printf '%-28s %9.1f %7.1f\n' total "$total" "$(stages_minutes "$total")"
-    # ctest keeps each test's time in Testing/Temporary/CTestCostData.txt ("NAME RUNS SECONDS",
-    # a run's own time where it ran once).
-    for entry in "${stages_test_dirs[@]}"; do
+    # ctest keeps each test's time in Testing/Temporary/CTestCostData.txt ("NAME RUNS SECONDS"
+    # a line, the name with spaces in it; a run's own time where it ran once), then "---".
+    for entry in "${stages_test_dirs[@]+"${stages_test_dirs[@]}"}"; do
       local name=${entry%%=*} dir=${entry#*=} data
       data=$dir/Testing/Temporary/CTestCostData.txt
       [ -f "$data" ] || continue
+      sed '/^---/q' "$data" | grep -v '^---' |
+        awk '{ cost = $NF; name = $1; for (i = 2; i <= NF - 2; ++i) name = name " " $i; printf "%9.1f  %s\n", cost, name }' |
+        sort -rn > "$dir/Testing/test-times.txt"
       echo
-      echo "== the 15 slowest tests of $name (seconds; $(sed '/^---/q' "$data" | grep -vc '^---') tests, $(
-        sed '/^---/q' "$data" | awk '$3 ~ /^[0-9.]+$/ { s += $3 } END { printf "%.0f", s }') s in all)"
-      sed '/^---/q' "$data" | awk '$3 ~ /^[0-9.]+$/ { printf "%9.1f  %s\n", $3, $1 }' | sort -rn | head -15
+      echo "== the 15 slowest tests of $name (seconds; $(wc -l < "$dir/Testing/test-times.txt") tests, $(
+        awk '{ s += $1 } END { printf "%.0f", s }' "$dir/Testing/test-times.txt") s in all)"
+      head -15 "$dir/Testing/test-times.txt"
     done
   } | tee build/stages.txt
 }
