@@ -130,9 +130,13 @@ struct CommandLowering {
                     emits.push_back({qualified(cmd->targetDecl), when});
                     ValueId on = lowering.guard(conditions);
                     // A burst in a `when` fires where the condition becomes true: it was
-                    // false at the previous update (`prev` is false at creation).
-                    if (when == EmitSite::When::Edge)
-                        on = k.op(Op::And, Type::boolean(), {on, k.op(Op::Not, Type::boolean(), {k.op(Op::Prev, Type::boolean(), {on})})});
+                    // false at the previous update (`prev` is false at creation). Each
+                    // burst's `prev` is a call site of its own, so its state slot has a
+                    // name of its own (`prev#SITE`): hot reload carries state by name.
+                    if (when == EmitSite::When::Edge) {
+                        ValueId before = lowering.temporal(Op::Prev, Type::boolean(), {on});
+                        on = k.op(Op::And, Type::boolean(), {on, k.op(Op::Not, Type::boolean(), {before})});
+                    }
                     ValueId zero = k.scalar(0);
                     ValueId count = cmd->count ? lowering.lowerOne(*cmd->count) : k.scalar(1);
                     if (cmd->rate) {

@@ -29,7 +29,7 @@ std::string run(rt::System& system, int frames) {
             for (const rt::RenderPoint& p : system.points(t)) test::appendPoint(out, p);
         for (const rt::TypeStats& t : system.stats().types)
             out += std::to_string(t.live) + "/" + std::to_string(t.created) + "/" + std::to_string(t.killed) + "/" +
-                   std::to_string(t.frozen) + ";";
+                   std::to_string(t.frozen) + "/" + std::to_string(t.dropped) + ";";
     }
     return out;
 }
@@ -72,6 +72,30 @@ TEST_CASE("reloading an unchanged source continues every sample bit for bit") {
         CHECK(after.time() == straight.time());
         CHECK(after.stats().types.size() == straight.stats().types.size());
     }
+}
+
+TEST_CASE("each burst on an edge keeps its own state through a reload: two `when`s in one object") {
+    // Each `when` burst's previous condition is a state slot of its own name: once both
+    // were `prev#0`, a reload gave the first the second's and bursts fired again.
+    std::string text = R"(
+        object a { emit b at 20 per second; }
+        object b {
+            when age > 0.3 { emit c count 2; }
+            when age > 0.6 { emit c count 5; }
+            kill when age > 1;
+            object c { point(vec3(age, 0, 0), white, 1); kill when age > 2; }
+        }
+        spawn a;)";
+    interp::Interpreter a, b;
+    rt::System straight(compile(text), a), before(compile(text), a);
+    run(straight, 40);
+    run(before, 40);
+    std::string second = run(straight, 40);
+    rt::System after(compile(text), b);
+    rt::ReloadReport report = after.carryOver(before);
+    CHECK(report.newSlots.empty());
+    CHECK(report.lostSlots.empty());
+    CHECK(run(after, 40) == second);
 }
 
 TEST_CASE("a reload that adds an equation starts its state as at each object's creation") {
