@@ -187,8 +187,11 @@ rt::RowsResult GlslBackend::run(const rt::RowsLaunch& launch) {
     if (late) {  // room for every dispatch's counts and kills, so that no region moves while it is issued
         size_t dispatches = (launch.end - launch.begin + rows - 1) / rows;
         reserveReadback(dispatches * 5 + (launch.end - launch.begin));
-        // Kills listed on the GPU for a pool that frees them there: one dispatch, one list.
-        late->listed = launch.killList.valid() && launch.end - launch.begin <= rows;
+        // Kills listed on the GPU for a pool that frees them there: one dispatch, one list
+        // (a kernel that kills nothing lists nothing: the run-time lists its none).
+        bool kills = launch.columns[ColumnLayout::kKill].valid() &&
+                     std::find(p.returned.begin(), p.returned.end(), ColumnLayout::kKill) != p.returned.end();
+        late->listed = kills && launch.killList.valid() && launch.end - launch.begin <= rows;
     }
     rt::RowsResult result;
     killedRows_.clear();
