@@ -4,6 +4,9 @@
 #   ./run.sh tests [doctest options]    the GPU test suite, then again in strict mode
 #   ./run.sh bench [bench options]      psys_gpu_bench (default: 1e5 1e6 1e7 particles)
 #   ./run.sh samples                    every sample on the GPU and on the interpreter: the same counts
+#   ./run.sh progen [options]           generated programs on every backend against the interpreter,
+#                                       on this GL and in strict mode (default: --minutes 5; the kept
+#                                       cases first); what differs is kept in ./progen-found
 set -uo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 bin=$here/bin
@@ -50,8 +53,24 @@ case "$what" in
       --screenshot "$here/fireworks.png" > /dev/null && echo "the viewer drew $here/fireworks.png"
     exit $failed
     ;;
+  progen)
+    [ $# -gt 0 ] || set -- --minutes 5
+    kept=()
+    for f in "$here"/programs/generated/*.psys; do
+      case $f in *.edit.psys) ;; *) [ -f "$f" ] && kept+=("$f") ;; esac
+    done
+    failed=0
+    for mode in "" strict; do
+      echo "== the program generator${mode:+ in strict mode}"
+      if [ ${#kept[@]} -gt 0 ]; then
+        PSYS_GPU_STRICT=${mode:+1} "$bin/psys-progen" --quiet --replay "${kept[@]}" || failed=1
+      fi
+      PSYS_GPU_STRICT=${mode:+1} "$bin/psys-progen" --quiet --out "$here/progen-found" "$@" || failed=1
+    done
+    exit $failed
+    ;;
   *)
-    echo "usage: run.sh tests|bench|samples [options]" >&2
+    echo "usage: run.sh tests|bench|samples|progen [options]" >&2
     exit 2
     ;;
 esac

@@ -7,6 +7,7 @@
 #
 # Builds Release in build-release (reusing it where it exists; PSYS_BUNDLE_BUILD names
 # another build directory) and carries psys_gpu_tests, psys_gpu_bench, psysc, psys-view,
+# psys-progen (the program generator: tools/progen),
 # the samples, the test programs and the standard library (share/psys/std, found beside
 # bin/ as an installed psys finds it), and every shared library they load but the C
 # library's own — libstdc++ and the vendor-neutral GL dispatch (libglvnd's libEGL,
@@ -21,13 +22,13 @@ build=${PSYS_BUNDLE_BUILD:-$root/build-release}
 if [ ! -f "$build/build.ninja" ]; then
   cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DPSYS_WERROR=ON
 fi
-cmake --build "$build" -j "$(nproc)" --target psys_gpu_tests psys_gpu_bench psysc psys-view
+cmake --build "$build" -j "$(nproc)" --target psys_gpu_tests psys_gpu_bench psysc psys-view psys-progen
 
 stage=$(mktemp -d)
 trap 'rm -rf "$stage"' EXIT
 top=$stage/psys-gpu
-mkdir -p "$top/bin/lib" "$top/samples" "$top/programs" "$top/share/psys/std"
-binaries=(tests/gpu/psys_gpu_tests bench/psys_gpu_bench tools/psysc/psysc tools/viewer/psys-view)
+mkdir -p "$top/bin/lib" "$top/samples" "$top/programs/generated" "$top/share/psys/std"
+binaries=(tests/gpu/psys_gpu_tests bench/psys_gpu_bench tools/psysc/psysc tools/viewer/psys-view tools/progen/psys-progen)
 for b in "${binaries[@]}"; do
   install -m 755 "$build/$b" "$top/bin/"
 done
@@ -69,9 +70,12 @@ done
 cp "$root"/samples/*.psys "$top/samples/"
 cp "$root"/library/std/*.psys "$top/share/psys/std/"
 cp "$root"/tests/programs/*.psys "$top/programs/"
+cp "$root"/tests/programs/generated/*.psys "$top/programs/generated/" 2>/dev/null || true
 install -m 755 "$root/scripts/gpu-bundle-run.sh" "$top/run.sh"
 git -C "$root" rev-parse HEAD > "$top/COMMIT" 2>/dev/null || echo unknown > "$top/COMMIT"
 
 mkdir -p "$(dirname "$out")"
-tar -C "$stage" -cf - psys-gpu | xz -T0 -6 > "$out"
+# PSYS_BUNDLE_XZ_LEVEL: xz's level (6 by default: 47 MB in 80 s here; the bundle test packs
+# at 1, 57 MB in 16 s — if that fits the 60 MiB a device takes, 6 does).
+tar -C "$stage" -cf - psys-gpu | xz -T0 -"${PSYS_BUNDLE_XZ_LEVEL:-6}" > "$out"
 echo "gpu-bundle: $out ($(du -h "$out" | cut -f1)): unpack anywhere, then psys-gpu/run.sh tests|bench|samples"
