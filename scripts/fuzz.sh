@@ -13,7 +13,8 @@ seconds=${1:-60}
 bash scripts/setup.sh test >/dev/null
 
 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_CXX_COMPILER=clang++-19 -DPSYS_FUZZ=ON -DPSYS_WERROR=OFF -DBUILD_TESTING=OFF >/dev/null
+  -DCMAKE_CXX_COMPILER=clang++-19 -DPSYS_FUZZ=ON -DPSYS_WERROR=OFF -DBUILD_TESTING=OFF -DPSYS_BENCH=OFF \
+  -DPSYS_DEBUG_INFO=lines >/dev/null
 cmake --build build-fuzz -j "$(nproc)" --target fuzz_frontend fuzz_ir fuzz_pipeline
 
 seeds=build-fuzz/seeds

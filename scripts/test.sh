@@ -13,7 +13,7 @@ stage "set-up" bash scripts/setup.sh test
 jobs=$(nproc)
 
 stage "release: configure" cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPSYS_WERROR=ON \
-  -DBUILD_TESTING=ON -DPSYS_BENCH=ON
+  -DBUILD_TESTING=ON -DPSYS_BENCH=ON -DPSYS_DEBUG_INFO=lines
 stage "release: build" cmake --build build -j "$jobs"
 stage_tests "release" build
 stage "release: ctest" ctest --test-dir build -j "$jobs" --output-on-failure
@@ -33,9 +33,11 @@ sanitized_ctest() {
   ctest --test-dir build-asan --rerun-failed --output-on-failure
 }
 
+# Under the sanitizers, the tests without the benchmarks: the release stage runs each once
+# (bench.*), and their loops are the library's, which the tests run here.
 if [ "${PSYS_SKIP_SANITIZE:-0}" != 1 ]; then
   stage "asan: configure" cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DPSYS_WERROR=ON -DPSYS_SANITIZE=ON \
-    -DBUILD_TESTING=ON -DPSYS_BENCH=ON
+    -DBUILD_TESTING=ON -DPSYS_BENCH=OFF -DPSYS_DEBUG_INFO=lines
   stage "asan: build" cmake --build build-asan -j "$jobs"
   stage_tests "asan" build-asan
   stage "asan: ctest" sanitized_ctest
