@@ -5,12 +5,16 @@
 #include <doctest/doctest.h>
 
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "driver/compile.h"
+#include "interp/interpreter.h"
 #include "rt/system.h"
+#include "tests/run_length.h"
 
 namespace psys::test {
 
@@ -109,6 +113,52 @@ inline std::string hostSees(const std::string& text, rt::Backend& backend, bool 
         out.append(reinterpret_cast<const char*>(&nonFinite), sizeof nonFinite);
     }
     return out;
+}
+
+// How many frames a sweep of `text` over many variants (every integration method, with
+// and without the optimizer) runs, at most `limit`: until every object type that comes
+// alive within `limit` frames (every trigger fired first, as the sweeps fire them) has been
+// alive for `settle` of them — its creation, its first updates, what it emits — under each
+// variant. Where a method could differ later, the variants differ in the update, which
+// every frame runs; the long runs are the default method's (600 frames: run_length.h).
+inline int coverFrames(const std::string& text, int limit, int settle = 30) {
+    // (asked again for each variant of a sweep: worked out once)
+    static std::map<std::tuple<std::string, int, int>, int> known;
+    auto key = std::make_tuple(text, limit, settle);
+    if (auto it = known.find(key); it != known.end()) return it->second;
+    interp::Interpreter backend;
+    rt::System system(compileModule(text), backend);
+    for (const ir::Trigger& t : system.module().triggers) {
+        size_t width = 0;
+        for (auto& p : t.params) width += static_cast<size_t>(p.type.width);
+        REQUIRE_FALSE(system.fire(t.name, std::vector<float>(width, 1.5f)));
+    }
+    std::vector<bool> seen(system.typeCount(), false), died(system.typeCount(), false);
+    int need = settle;
+    for (int f = 0; f < limit; ++f) {
+        REQUIRE_FALSE(system.step(1.0 / 60));
+        rt::Stats stats = system.stats();
+        for (size_t t = 0; t < seen.size(); ++t) {
+            if (!seen[t] && stats.types[t].live > 0) {
+                seen[t] = true;
+                need = std::max(need, f + 1 + settle);
+            }
+            if (!died[t] && stats.types[t].killed > 0) {  // and its first deaths
+                died[t] = true;
+                need = std::max(need, f + 1 + settle / 3);
+            }
+        }
+    }
+    return known[key] = std::min(limit, need);
+}
+
+// How many frames a sweep over every sample runs: the long run in the release build
+// (run_length.h); under the sanitizers, which look for memory errors and undefined
+// behaviour along the paths a run takes rather than for what a long run adds up, as many
+// as coverFrames says each type needs — its creation, its updates, its first deaths — at
+// most the sanitized long run (200).
+inline int sweepFrames(const std::string& text) {
+    return kSanitized ? std::min(longRun(), coverFrames(text, kLongRun)) : longRun();
 }
 
 }  // namespace psys::test

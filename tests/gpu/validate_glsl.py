@@ -34,14 +34,22 @@ def main():
         found = list(shaders(psysc, program))
         if not any(n.endswith(".comp") for n, _ in found):
             failures.append(f"{program}: no compute shader emitted")
+        paths = []
         for name, source in found:
             path = os.path.join(work, f"{stem}.{name}")
             with open(path, "w") as f:
                 f.write(source)
-            count += 1
-            check = subprocess.run([validator, path], capture_output=True, text=True)
-            if check.returncode != 0:
-                failures.append(f"{path}:\n{check.stdout}{check.stderr}")
+            paths.append(path)
+        count += len(paths)
+        # A program's shaders in one run (each its own compilation unit: no -l, nothing
+        # linked); where that fails, each again alone, for its own messages.
+        if paths and subprocess.run([validator, *paths], capture_output=True, text=True).returncode != 0:
+            for path in paths:
+                check = subprocess.run([validator, path], capture_output=True, text=True)
+                if check.returncode != 0:
+                    failures.append(f"{path}:\n{check.stdout}{check.stderr}")
+            if not failures:
+                failures.append(f"{program}: its shaders fail together and pass one by one")
     print(f"{count} shaders of {len(programs)} programs validated")
     if failures:
         sys.exit("\n".join(failures))

@@ -369,7 +369,7 @@ TEST_CASE("every sample runs under every method — exact reports those without 
                 continue;
             }
             Run run(text, {}, true, false, m);
-            run.steps(test::kLongRun / 2, kFrame);
+            run.steps(test::coverFrames(text, test::kLongRun / 2), kFrame);
             CHECK(run.system->stats().nonFiniteRender == 0);
         }
     }
@@ -378,7 +378,7 @@ TEST_CASE("every sample runs under every method — exact reports those without 
 TEST_CASE("the optimizer changes no bit under any method, on every sample") {
     for (Integrator m : allMethods()) {
         CAPTURE(core::integratorName(m));
-        CHECK(test::compareWithUnoptimized(false, m, test::kLongRun / 3, test::bitwise) > 10000);
+        CHECK(test::compareWithUnoptimized(false, m, test::kLongRun / 3, test::bitwise, true) > 10000);
     }
 }
 

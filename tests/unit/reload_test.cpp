@@ -11,6 +11,7 @@
 #include "driver/compile.h"
 #include "interp/interpreter.h"
 #include "rt/system.h"
+#include "tests/run_length.h"
 #include "test_support.h"
 #include "tests/system_support.h"
 
@@ -60,15 +61,17 @@ TEST_CASE("reloading an unchanged source continues every sample bit for bit") {
         rt::System straight(compile(text), a), before(compile(text), a);
         fireAll(straight);
         fireAll(before);
-        std::string first = run(straight, 150), second = run(straight, 150);
-        CHECK(run(before, 150) == first);
+        // (a quarter of the long run: 150 frames on either side of the reload, 50 sanitized)
+        const int frames = test::kLongRun / 4;
+        std::string first = run(straight, frames), second = run(straight, frames);
+        CHECK(run(before, frames) == first);
         // The reloaded system runs on another backend (another memory), as after a switch.
         rt::System after(compile(text), b);
         rt::ReloadReport report = after.carryOver(before);
         CHECK(report.dropped == 0);
         CHECK(report.newSlots.empty());
         CHECK(report.lostSlots.empty());
-        CHECK(run(after, 150) == second);
+        CHECK(run(after, frames) == second);
         CHECK(after.time() == straight.time());
         CHECK(after.stats().types.size() == straight.stats().types.size());
     }

@@ -125,9 +125,10 @@ inline bool compiles(const std::string& text, std::optional<core::Integrator> in
 }
 
 // Every sample (that compiles under `integrator`) for `frames` frames without the
-// optimizer against with it.
+// optimizer against with it; `cover`: only as many of them as test::coverFrames says
+// every type needs (a sweep over methods; any sweep under the sanitizers: sweepFrames).
 inline size_t compareWithUnoptimized(bool relaxed, std::optional<core::Integrator> integrator, int frames,
-                                     const std::function<bool(float, float)>& close) {
+                                     const std::function<bool(float, float)>& close, bool cover = false) {
     size_t points = 0;
     for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
         if (entry.path().extension() != ".psys") continue;
@@ -136,7 +137,7 @@ inline size_t compareWithUnoptimized(bool relaxed, std::optional<core::Integrato
         if (integrator && !compiles(text, integrator)) continue;
         Run plain(text, {}, false, false, integrator), optimized(text, {}, true, relaxed, integrator);
         // (relaxed maths rounds otherwise: a crowd is compared over its first frames)
-        points += compareRuns(plain, optimized, frames, close,
+        points += compareRuns(plain, optimized, cover ? coverFrames(text, frames) : frames, close,
                               relaxed ? test::closeFrames(plain.system->module()) : INT_MAX);
     }
     return points;
