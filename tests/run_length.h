@@ -1,6 +1,14 @@
 // How many frames the tests that run every sample side by side run: 600 (10 s at 60 Hz),
 // or 200 in the sanitizer build, where a frame costs ten times as much and what is looked
 // for (memory errors, undefined behaviour) shows in the first frames.
+//
+// A test that runs longer in the release build than under the sanitizers (a 600-frame
+// sweep), or only there (kSanitized below), is in the doctest suite `long`
+// (`TEST_CASE("…" * doctest::test_suite("long"))`), which scripts/test.sh's release stage
+// runs (it lists the suite from each test binary: `psys_unit_tests --test-suite=long
+// --list-test-cases`).
+// Every other test the sanitizer build registers runs there only, in CI: the same code on
+// the same inputs, with memory errors and undefined behaviour caught.
 #pragma once
 
 #include <climits>
@@ -20,6 +28,13 @@ constexpr bool kSanitized = true;
 constexpr int kLongRun = 600;
 constexpr bool kSanitized = false;
 #endif
+
+// How many frames a test over every sample and test program that looks at the step's
+// bookkeeping (kills, rows, draws) runs: `frames` in the release build, half of them under
+// the sanitizers — a frame there costs ten times as much, and the paths a run takes (each
+// kind of creation, death, trigger) show in the first half; such a test is in the suite
+// `long` (above), so the release stage runs it whole.
+inline int bookkeepingFrames(int frames) { return kSanitized ? frames / 2 : frames; }
 
 // The GPU suite runs three times: on llvmpipe, then in strict mode and on zink
 // (tests/gpu/CMakeLists.txt), which look for a missing barrier or work done out of order —

@@ -33,10 +33,9 @@ rt::Bounds boxOf(const std::vector<rt::RenderPoint>& points) {
 
 TEST_CASE("every sample's box on the GPU is its drawn points' box, the interpreter's within tolerance, 24 bytes back") {
     size_t boxes = 0, onGpu = 0;
-    for (auto& entry : std::filesystem::directory_iterator(test::samplesDir())) {
-        if (entry.path().extension() != ".psys") continue;
-        INFO(entry.path().filename().string());
-        Pair p(readFile(entry.path()));
+    for (const auto& path : test::sweptSamples()) {
+        INFO(path.filename().string());
+        Pair p(readFile(path));
         p.steps(std::min(120, test::closeFrames(p.gl->module())), 1.0 / 60);  // (a crowd: its first frames)
         for (size_t t = 0; t < p.gl->typeCount(); ++t) {
             INFO("type " << p.gl->module().objects[t].name);
@@ -60,6 +59,6 @@ TEST_CASE("every sample's box on the GPU is its drawn points' box, the interpret
         }
     }
     MESSAGE(boxes << " boxes, " << onGpu << " reduced on the GPU");
-    CHECK(boxes > 20);
-    CHECK(onGpu > 10);
+    CHECK(boxes > (test::onSecondGl() ? 4u : 20u));
+    CHECK(onGpu > (test::onSecondGl() ? 1u : 10u));
 }

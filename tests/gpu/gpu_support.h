@@ -5,12 +5,14 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 #include <sstream>
+#include <vector>
 
 #include "gpu/gl_debug.h"
 #include "gpu/glsl_backend.h"
@@ -32,6 +34,29 @@ inline std::string dataPath(const char* variable, const char* compiledIn) {
 inline std::string samplesDir() { return dataPath("PSYS_SAMPLES_DIR", PSYS_SAMPLES_DIR); }
 inline std::string programsDir() { return dataPath("PSYS_PROGRAMS_DIR", PSYS_PROGRAMS_DIR); }
 inline std::string sample(const std::string& name) { return samplesDir() + "/" + name + ".psys"; }
+
+// Whether the suite runs on a second GL (strict mode or zink: main.cpp sets PSYS_GL).
+inline bool onSecondGl() {
+    const char* gl = std::getenv("PSYS_GL");
+    return gl && *gl;
+}
+
+// The samples a sweep runs: every one on the machine's GL. On a second GL, which looks for
+// a missing barrier or work done out of order, "every sample draws the same" sweeps them
+// all (each sample's shaders compiled there, each step's order); the other sweeps (the
+// box, the host side) add their own code to it, which these four run there: bursts on
+// death and a trigger (fireworks), a crowd's folds (boids), trails (wand), a plain
+// emitter (fountain).
+inline std::vector<std::filesystem::path> sweptSamples() {
+    std::vector<std::filesystem::path> all;
+    for (auto& entry : std::filesystem::directory_iterator(samplesDir()))
+        if (entry.path().extension() == ".psys") all.push_back(entry.path());
+    std::sort(all.begin(), all.end());
+    if (!onSecondGl()) return all;
+    std::vector<std::filesystem::path> few;
+    for (const char* name : {"boids", "fireworks", "fountain", "wand"}) few.push_back(sample(name));
+    return few;
+}
 
 inline std::string readFile(const std::filesystem::path& p) {
     std::ifstream in(p);

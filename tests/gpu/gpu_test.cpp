@@ -44,7 +44,7 @@ using namespace psys;
 using namespace psys::test;
 
 
-TEST_CASE("every sample draws the same on the GPU as on the interpreter, for 600 frames (200 sanitized)") {
+TEST_CASE("every sample draws the same on the GPU as on the interpreter, for 600 frames (200 sanitized)" * doctest::test_suite("long")) {
     double worst = 0;
     for (auto& entry : std::filesystem::directory_iterator(test::samplesDir())) {
         if (entry.path().extension() != ".psys") continue;

@@ -7,7 +7,8 @@
 //            and compiles through SPIR-V: what llvmpipe lets pass and a GPU may not
 //            (docs/gpu.md, "A second GL")
 // Both look for what shows in a sample's first frames: they run 120 (PSYS_TEST_FRAMES;
-// tests/run_length.h), the long runs being llvmpipe's. ctest runs each case in each mode
+// tests/run_length.h), the long runs being llvmpipe's, and the sweeps other than "every
+// sample draws the same" over four samples (test::sweptSamples). ctest runs each case in each mode
 // as a test of its own (CMakeLists.txt).
 #define DOCTEST_CONFIG_IMPLEMENT
 #include <doctest/doctest.h>
@@ -41,7 +42,10 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "--gl is strict or zink, not `%s`\n", mode.c_str());
         return 2;
     }
-    if (!mode.empty()) setenv("PSYS_TEST_FRAMES", "120", 0);
+    if (!mode.empty()) {
+        setenv("PSYS_GL", mode.c_str(), 1);  // (test::onSecondGl)
+        setenv("PSYS_TEST_FRAMES", "120", 0);
+    }
     doctest::Context context(argc, argv);
     return context.run();
 }

@@ -8,14 +8,13 @@
 using namespace psys;
 using namespace psys::test;
 
-TEST_CASE("with small pools run on the host, every sample draws what the interpreter draws, for 600 frames") {
+TEST_CASE("with small pools run on the host, every sample draws what the interpreter draws, for 600 frames" * doctest::test_suite("long")) {
     // The emitters (a launcher, a comet, rockets: few rows, their columns on the host) run
     // on the host side; their particles on the GPU, reading them (spawns, parents' exports)
     // from the host's copies.
-    for (auto& entry : std::filesystem::directory_iterator(test::samplesDir())) {
-        if (entry.path().extension() != ".psys") continue;
-        INFO(entry.path().filename().string());
-        std::string text = readFile(entry.path());
+    for (const auto& path : test::sweptSamples()) {
+        INFO(path.filename().string());
+        std::string text = readFile(path);
         test::Comparison c = compareProgram(text, test::sweepFrames(text), true, kSamplesTolerance, true);
         CHECK(c.points > 0);
     }

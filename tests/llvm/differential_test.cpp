@@ -69,7 +69,7 @@ test::Comparison compareBackends(const std::string& text, int frames, bool optim
 
 }  // namespace
 
-TEST_CASE("every sample draws the same on the LLVM backend as on the interpreter, for 600 frames (200 sanitized)") {
+TEST_CASE("every sample draws the same on the LLVM backend as on the interpreter, for 600 frames (200 sanitized)" * doctest::test_suite("long")) {
     for (MathMode mode : {MathMode::Exact, MathMode::Fast}) {
         for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
             if (entry.path().extension() != ".psys") continue;
@@ -80,7 +80,7 @@ TEST_CASE("every sample draws the same on the LLVM backend as on the interpreter
     }
 }
 
-TEST_CASE("@precision(double) on the JIT: the interpreter's bits, in exact maths") {
+TEST_CASE("@precision(double) on the JIT: the interpreter's bits, in exact maths" * doctest::test_suite("long")) {
     // Pair arithmetic (opt/precision_double.cpp) is exact only as written: the JIT must
     // neither contract nor reorder it. Orbits far from the origin, through sqrt, pow and
     // division, comparisons that kill, random starts.

@@ -12,6 +12,7 @@
 #include "interp/interpreter.h"
 #include "rt/system.h"
 #include "run.h"
+#include "tests/run_length.h"
 
 using namespace psys;
 
@@ -71,7 +72,7 @@ void sameObjects(rt::System& a, rt::System& b, rt::System& c) {
 
 }  // namespace
 
-TEST_CASE("kills taken at the end of the step free the rows, in the order, that kills taken at once free") {
+TEST_CASE("kills taken at the end of the step free the rows, in the order, that kills taken at once free" * doctest::test_suite("long")) {
     // Drops, sparks, cells dying in their first update, objects created by triggers: a
     // backend answering late, the kills at the step's end, against the kills at once.
     std::vector<std::string> programs = test::samplesAndPrograms();
@@ -97,7 +98,7 @@ TEST_CASE("kills taken at the end of the step free the rows, in the order, that 
         interp::Interpreter listingBackend;
         rt::System a(test::compileModule(text), immediateBackend, atOnce), b(test::compileModule(text), lateBackend),
             c(test::compileModule(text), listingBackend);
-        for (int f = 0; f < 200; ++f) {
+        for (int f = 0; f < test::bookkeepingFrames(200); ++f) {
             if (f % 50 == 10)
                 for (const ir::Trigger& t : a.module().triggers) {
                     size_t width = 0;
@@ -121,7 +122,7 @@ TEST_CASE("kills taken at the end of the step free the rows, in the order, that 
     CHECK(late > 1000);
 }
 
-TEST_CASE("rows kept in the memory: the same objects in the same rows as rows kept on the host") {
+TEST_CASE("rows kept in the memory: the same objects in the same rows as rows kept on the host" * doctest::test_suite("long")) {
     // Pool::keepRowsInMemory through the memory's own operations (rt::Memory::allocateRows,
     // releaseRows, identify, markFresh, scatter by a row list), on a backend that answers
     // at once (kills listed by the run-time) and one that answers late (listed at the end
@@ -150,7 +151,7 @@ TEST_CASE("rows kept in the memory: the same objects in the same rows as rows ke
         rt::System a(test::compileModule(text), hostBackend, onHost), b(test::compileModule(text), keptBackend, kept),
             c(test::compileModule(text), lateBackend, kept);
         for (size_t t = 0; t < b.typeCount(); ++t) inMemory += b.pool(t).rowsInMemory();
-        for (int f = 0; f < 120; ++f) {
+        for (int f = 0; f < test::bookkeepingFrames(120); ++f) {
             if (f % 40 == 10)
                 for (const ir::Trigger& t : a.module().triggers) {
                     size_t width = 0;

@@ -166,7 +166,7 @@ TEST_CASE("the same seed gives the same run — another seed another") {
     CHECK(a != c);
 }
 
-TEST_CASE("every sample compiles, verifies and runs 600 frames at dt = 1/60 (200 sanitized)") {
+TEST_CASE("every sample compiles, verifies and runs 600 frames at dt = 1/60 (200 sanitized)" * doctest::test_suite("long")) {
     int count = 0;
     for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
         if (entry.path().extension() != ".psys") continue;
@@ -357,7 +357,7 @@ TEST_CASE("@step(h) advances an object in sub-steps no longer than h") {
     CHECK(after("@step(0.3)") == doctest::Approx(std::pow(0.75, 4)));  // 4 equal sub-steps of 0.25
 }
 
-TEST_CASE("the optimizer leaves every sample's output unchanged, bit for bit, over 600 frames (200 sanitized)") {
+TEST_CASE("the optimizer leaves every sample's output unchanged, bit for bit, over 600 frames (200 sanitized)" * doctest::test_suite("long")) {
     size_t points = test::compareWithUnoptimized(false, {}, test::kLongRun, bitwise, test::kSanitized);
     CHECK(points > 100000);
 }
@@ -391,7 +391,7 @@ TEST_CASE("creating objects in batches gives the run of creating them one by one
     CHECK(d.stats("cell").dropped > 0);
 }
 
-TEST_CASE("with relaxed maths every sample's output stays within 1e-4 of max(1, |value|) over 600 frames (200 sanitized)") {
+TEST_CASE("with relaxed maths every sample's output stays within 1e-4 of max(1, |value|) over 600 frames (200 sanitized)" * doctest::test_suite("long")) {
     // What differs: the last bits of reassociated sums and of x/c as x·(1/c), integrals of
     // constants taken as c·age instead of a float sum over 600 steps (the closed form is the
     // more accurate of the two), c + integrate(e) accumulated as one integral starting
@@ -437,19 +437,19 @@ struct CountingBackend : rt::Backend {
 
 }  // namespace
 
-TEST_CASE("drawing as the step goes draws what drawing after it draws, bit for bit, whenever the host draws") {
+TEST_CASE("drawing as the step goes draws what drawing after it draws, bit for bit, whenever the host draws" * doctest::test_suite("long")) {
     std::vector<std::function<bool(int)>> patterns = {
         [](int) { return true; }, [](int f) { return f % 3 == 2; }, [](int f) { return f % 7 < 4; }};
     size_t bytes = 0;
     for (const std::string& text : test::samplesAndPrograms())
         for (const auto& drawOn : patterns) {
             interp::Interpreter a, b;
-            std::string inStep = test::hostSees(text, a, true, 90, drawOn);
-            std::string after = test::hostSees(text, b, false, 90, drawOn);
+            std::string inStep = test::hostSees(text, a, true, test::bookkeepingFrames(90), drawOn);
+            std::string after = test::hostSees(text, b, false, test::bookkeepingFrames(90), drawOn);
             CHECK(inStep == after);
             bytes += inStep.size();
         }
-    CHECK(bytes > 1000000);
+    CHECK(bytes > (test::kSanitized ? 500000u : 1000000u));
 }
 
 TEST_CASE("a step after a drawn one draws as it goes: draw() then runs no render launch") {

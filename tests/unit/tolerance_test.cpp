@@ -126,7 +126,7 @@ TEST_CASE("every reference problem at 1e-2, 1e-3 and 1e-4 m meets its tolerance 
 }
 
 TEST_CASE("a tolerance float state cannot reach is met in double: the orbit to 1e-4 m over 100 periods" *
-          doctest::skip(test::kSanitized)) {
+          doctest::skip(test::kSanitized) * doctest::test_suite("long")) {
     std::string text = test::readFile(std::string(PSYS_ACCURACY_DIR) + "/orbit.psys");
     Chosen c = compileUnderTolerance("@tolerance(1e-4, 628.3);\n" + text);
     REQUIRE(c.module);
