@@ -163,41 +163,29 @@ Case shrink(const Case& c, const RunOptions& options, const Finding& found, unsi
             }
         }
         std::vector<std::string> source = lines(best.source);
-        // Whole blocks (a nested object, from its line to its closing brace), with the
-        // same block of the edit.
+        // Lines i to end of the source, with the same run of lines in the edit.
+        auto tryRemoving = [&](size_t i, size_t end) {
+            std::vector<std::string> s = source, e = lines(best.edit);
+            auto first = s.begin() + static_cast<std::ptrdiff_t>(i), last = s.begin() + static_cast<std::ptrdiff_t>(end) + 1;
+            auto inEdit = std::search(e.begin(), e.end(), first, last);
+            if (inEdit != e.end()) e.erase(inEdit, inEdit + (last - first));
+            s.erase(first, last);
+            Case fewer = best;
+            fewer.source = join(s);
+            if (!best.edit.empty()) fewer.edit = join(e);
+            if (!fails(fewer)) return;
+            best = fewer;
+            source = s;
+            changed = true;
+        };
+        // Whole blocks (a nested object, from its line to its closing brace), then lines.
         for (size_t i = source.size(); i-- > 0 && runs < budget;) {
             if (source[i].empty() || source[i].back() != '{') continue;
             size_t end = blockEnd(source, i);
-            if (end == i) continue;
-            Case fewer = best;
-            std::vector<std::string> s = source, e = lines(best.edit);
-            std::vector<std::string> block(s.begin() + static_cast<std::ptrdiff_t>(i), s.begin() + static_cast<std::ptrdiff_t>(end) + 1);
-            auto inEdit = std::search(e.begin(), e.end(), block.begin(), block.end());
-            if (inEdit != e.end()) e.erase(inEdit, inEdit + static_cast<std::ptrdiff_t>(block.size()));
-            s.erase(s.begin() + static_cast<std::ptrdiff_t>(i), s.begin() + static_cast<std::ptrdiff_t>(end) + 1);
-            fewer.source = join(s);
-            if (!best.edit.empty()) fewer.edit = join(e);
-            if (fails(fewer)) {
-                best = fewer;
-                source = s;
-                changed = true;
-            }
+            if (end != i) tryRemoving(i, end);
         }
-        for (size_t i = source.size(); i-- > 0 && runs < budget;) {
-            if (source[i].empty()) continue;
-            Case fewer = best;
-            std::vector<std::string> s = source, e = lines(best.edit);
-            auto inEdit = std::find(e.begin(), e.end(), s[i]);
-            if (inEdit != e.end()) e.erase(inEdit);
-            s.erase(s.begin() + static_cast<std::ptrdiff_t>(i));
-            fewer.source = join(s);
-            if (!best.edit.empty()) fewer.edit = join(e);
-            if (fails(fewer)) {
-                best = fewer;
-                source = s;
-                changed = true;
-            }
-        }
+        for (size_t i = source.size(); i-- > 0 && runs < budget;)
+            if (!source[i].empty()) tryRemoving(i, i);
         // Lines only the edit has.
         std::vector<std::string> edit = lines(best.edit);
         for (size_t i = edit.size(); i-- > 0 && runs < budget;) {
