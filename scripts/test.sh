@@ -45,8 +45,8 @@ long_tests() {
 # errors and undefined behaviour caught), unless the release build is where it proves
 # more — then in the release stage: the tests only the release build registers (the
 # benchmarks, the GPU suite in strict mode and on zink, the GPU bundle, the AOT archives,
-# the installed C API, Python), and those labelled `long`, which run longer there
-# (tests/run_length.h). Without the sanitizer stage, the release stage runs every test.
+# the installed C API, Python), and the doctest cases in the suite `long`, which run longer
+# there (tests/run_length.h). Without the sanitizer stage, the release stage runs every test.
 release_selection() {
   local file=$PWD/build/Testing/release-stage.txt  # (ctest reads a relative one from --test-dir)
   mkdir -p build/Testing
