@@ -56,6 +56,7 @@ void chooseUnderTolerance(CompileOptions& options, tune::TuneOptions tune, const
 SessionOptions Session::resolved(const SessionOptions& asked) {
     SessionOptions options = asked;
     options.compile.pipeline.pass.relaxed |= options.backend.relaxesMaths();
+    options.compile.pipeline.pass.reloadable |= options.reloadable;
     if (!options.compile.beforePasses) chooseUnderTolerance(options.compile, options.tune, options.backend);
     return options;
 }

@@ -26,6 +26,11 @@ struct SessionOptions {
     rt::SystemOptions system;
     // The chooser under @tolerance (tune/tolerance.h): its frame, a default tolerance.
     tune::TuneOptions tune;
+    // Whether the system may be hot-reloaded: then it is compiled so that its state is the
+    // program's own whatever the maths (opt::PassOptions::reloadable), and a reload under
+    // fast maths carries what one under exact maths does. A host that never reloads
+    // (psysc run) says so, and its fast maths gets the closed forms.
+    bool reloadable = true;
 };
 
 // Installs the chooser of integrators and steps under @tolerance in `options`, compiled

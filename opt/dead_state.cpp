@@ -10,7 +10,8 @@
 //   - stops storing a slot whose next value is the slot itself (it never changes after
 //     creation);
 //   - marks a parameter no kernel after `init` reads as not kept: it is used at creation
-//     and the pool does not store it.
+//     and the pool does not store it — but in a system that may be reloaded, which
+//     carries parameters by name (PassOptions::reloadable).
 #include <set>
 
 #include <fmt/format.h>
@@ -71,7 +72,7 @@ void renumber(Object& o, const std::vector<int>& map) {
     o.state = state;
 }
 
-void eliminate(Object& o) {
+void eliminate(Object& o, bool keepParams) {
     Kernel* update = o.kernel(KernelKind::Update);
     Kernel* init = o.kernel(KernelKind::Init);
     if (!update) return;
@@ -161,13 +162,13 @@ void eliminate(Object& o) {
         for (const Yield& y : k.yields) roots.push_back(y.value);
         reads(k, roots, slotsUnused, &params);
     }
-    for (size_t p = 0; p < o.params.size(); ++p) o.params[p].kept = params.count(static_cast<int>(p)) > 0;
+    for (size_t p = 0; p < o.params.size(); ++p) o.params[p].kept = keepParams || params.count(static_cast<int>(p)) > 0;
 }
 
 }  // namespace
 
-void deadState(Module& module, PassErrors&) {
-    for (Object& o : module.objects) eliminate(o);
+void deadState(Module& module, const PassOptions& options, PassErrors&) {
+    for (Object& o : module.objects) eliminate(o, options.reloadable);
 }
 
 }  // namespace psys::opt

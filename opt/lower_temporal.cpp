@@ -34,7 +34,9 @@
 // parameters, constants) is one integral that starts at c (slot `integrate@x.from-creation`,
 // value = first ? c : A + e·dt): equal in real arithmetic, rounded differently, and c is
 // no longer read every update (the fire's `pos = snapshot(ipos) + integrate(vel)`).
-// Neither for an object under @precision(double), whose integrals stay its state.
+// Neither for an object under @precision(double), whose integrals stay its state, nor in
+// a system that may be hot-reloaded (PassOptions::reloadable): a reload carries each
+// integral by name, and neither form has it.
 #include <algorithm>
 #include <map>
 #include <set>
@@ -154,7 +156,7 @@ private:
     // Every construct becomes state (the table above) but, for the methods other than
     // the default, the integrals: they stay `integrate` instructions, with their slots.
     Kernel lowerPerUpdate() {
-        if (relaxed() && !stageMethod(method_)) findFolds();
+        if (closedForms() && !stageMethod(method_)) findFolds();
         Kernel lowered = rewriter_.run([&](Rewriter& rw, ValueId old, const Inst& inst,
                                            const std::vector<ValueId>& ops) -> std::optional<ValueId> {
             if (auto folded = folds_.find(old); folded != folds_.end() && folded->second.applied)
@@ -187,7 +189,7 @@ private:
             case Op::Integrate: {
                 // Relaxed: the integral of something fixed at creation is c·age, exact in
                 // real arithmetic, whatever the method; no state needed (docs/optimizer.md).
-                if (relaxed() && creationInvariant(k, ops[0]))
+                if (closedForms() && creationInvariant(k, ops[0]))
                     return rw.emit(Inst::make(Op::Mul, t, {ops[0], broadcast(k, input(k, Op::Age, Type::f32()), t)}));
                 auto fold = std::find_if(folds_.begin(), folds_.end(), [old](auto& f) { return f.second.integral == old; });
                 int slot = fold == folds_.end() ? addSlot(t, StateInit::Zero)
@@ -347,6 +349,9 @@ private:
     // Relaxed maths' rewrites of integrals, but not for an object in double: c·age is
     // computed from the float age, which the object asked not to be held to.
     bool relaxed() const { return options_.relaxed && object_.attributes.precision != core::Precision::Double; }
+    // c·age and the integral that starts at c: not where a reload must find each
+    // integral as a slot of its own (PassOptions::reloadable).
+    bool closedForms() const { return relaxed() && !options_.reloadable; }
 
     Object& object_;
     const Kernel& from_;

@@ -26,6 +26,13 @@ struct PassOptions {
     // x/c → x·(1/c), sums and products put in one canonical order so they share parts,
     // and integrals of what is fixed at creation in closed form (c·age).
     bool relaxed = false;
+    // The system may be hot-reloaded (the viewer, the C API, Python): its state must be
+    // the program's own — every parameter kept, each integral a slot of its own from
+    // zero — whatever the maths, since a reload carries state by name
+    // (rt/reload.cpp). So, under relaxed maths too, no closed form c·age for an integral
+    // (nothing would carry it), no integral that starts at c (it would carry c with it),
+    // no slot recomputed instead of stored; and a parameter read only at creation is kept.
+    bool reloadable = false;
 };
 
 // The integration method of an object under these options.
@@ -77,7 +84,7 @@ void simplify(ir::Module& module, const PassOptions& options, PassErrors& errors
 void reassociate(ir::Module& module, PassErrors& errors);
 void hoistUniform(ir::Module& module, PassErrors& errors);
 void recomputeState(ir::Module& module, PassErrors& errors);
-void deadState(ir::Module& module, PassErrors& errors);
+void deadState(ir::Module& module, const PassOptions& options, PassErrors& errors);
 void lowerStorage(ir::Module& module, PassErrors& errors);
 // Not a pass: where a large argument meets sin, cos or tan, which fast maths may round
 // differently (opt/large_arguments.cpp); for `psysc check --remarks`.

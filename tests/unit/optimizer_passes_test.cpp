@@ -232,7 +232,7 @@ TEST_CASE("dead-state: unneeded slots go, equal slots merge, unchanged slots are
 end
 )");
     opt::PassErrors errors;
-    opt::deadState(m, errors);
+    opt::deadState(m, {}, errors);
     CHECK(errors.empty());
     CHECK(verify(m).empty());
     // v too is read only by init: the slots hold what is needed afterwards.
@@ -396,7 +396,7 @@ namespace {
 
 void recomputeThenDeadState(Module& m, opt::PassErrors& e) {
     opt::recomputeState(m, e);
-    opt::deadState(m, e);
+    opt::deadState(m, {}, e);
 }
 
 // The fire's shape: slot #0 holds last step's acc = -v·2 + exp(-age) (v: slot #1), which

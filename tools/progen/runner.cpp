@@ -42,11 +42,14 @@ struct Side {
     std::unique_ptr<rt::System> system;
 };
 
-std::optional<ir::Module> compile(const std::string& text, bool relaxed, std::string& errors) {
+// A case with an edit reloads: its systems are compiled as a host that reloads compiles
+// them (opt::PassOptions::reloadable).
+std::optional<ir::Module> compile(const std::string& text, bool relaxed, bool reloadable, std::string& errors) {
     SourceManager sources;
     DiagnosticEngine diags(sources);
     CompileOptions options;
     options.pipeline.pass.relaxed = relaxed;
+    options.pipeline.pass.reloadable = reloadable;
     auto module = compileText("case.psys", text, sources, diags, options);
     if (!module) errors = diags.render(false);
     return module;
@@ -101,7 +104,7 @@ public:
             std::string error;
             side.backend = makeBackend(config, error);
             if (!side.backend) return Finding{config.label, "error", -1, "the backend cannot start: " + error};
-            auto module = compile(c_.source, config.backend == "llvm" && !config.exact, error);
+            auto module = compile(c_.source, config.backend == "llvm" && !config.exact, !c_.edit.empty(), error);
             if (!module) return Finding{config.label, "compile", -1, error};
             side.system = std::make_unique<rt::System>(std::move(*module), *side.backend);
             if (config.threads) side.system->setThreads(config.threads);
@@ -150,7 +153,7 @@ private:
             case Event::Kind::Reload:
                 for (Side& side : sides_) {
                     std::string error;
-                    auto module = compile(c_.edit, side.config.backend == "llvm" && !side.config.exact, error);
+                    auto module = compile(c_.edit, side.config.backend == "llvm" && !side.config.exact, true, error);
                     if (!module) return Finding{side.config.label, "compile", f, "the edit: " + error};
                     auto next = std::make_unique<rt::System>(std::move(*module), *side.backend, side.system->options());
                     next->carryOver(*side.system);

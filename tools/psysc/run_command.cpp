@@ -165,6 +165,7 @@ int runSystem(const RunOptions& options) {
     session.system.seed = options.seed;
     session.system.capacity = options.capacity;
     session.system.threads = options.threads;
+    session.reloadable = false;  // a run never reloads
     host::CompileResult compiled;
     std::string error;
     auto s = host::Session::open(options.file, session, compiled, error);
