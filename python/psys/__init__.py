@@ -4,7 +4,7 @@
     fountain = psys.compile("samples/fountain.psys")          # or psys.compile(source=...)
     fountain.step(1 / 60, steps=120)
     drops = fountain.points("drop")                           # id, position (n×3), color, size
-    cols = fountain.columns("drop")                           # the system's own arrays, no copy
+    cols = fountain.columns("drop")                           # visible, id, x y z, r g b a, size (copies)
 
 Errors are exceptions: psys.CompileError carries the compiler's diagnostics (a list of
 dicts: severity, file, line, column, end_line, end_column, message); psys.Error the rest.

@@ -31,12 +31,13 @@ def test_a_sample_runs_and_its_points_come_back_as_arrays():
     assert st["steps"] == 60 and st["types"]["drop"]["live"] == len(p["id"])
 
 
-def test_columns_view_the_systems_memory_without_a_copy():
+def test_columns_are_arrays_of_their_own_read_only():
     s = psys.compile(source=DOTS, math="exact")
     s.step(1 / 60, steps=30)
     c = s.columns("bead")
     again = s.columns("bead")
-    assert np.shares_memory(c["x"], again["x"])  # the same memory both times
+    assert not np.shares_memory(c["x"], again["x"])  # a copy each call
+    assert not isinstance(c["x"].base, psys.System)
     assert not c["x"].flags.writeable
     seen = c["visible"] == 1
     p = s.points("bead")
@@ -45,6 +46,26 @@ def test_columns_view_the_systems_memory_without_a_copy():
     assert c["size"].strides == (0,) and (c["size"] == 2).all()  # a constant: one value, no column
     with pytest.raises(ValueError):
         c["x"][0] = 5
+
+
+def test_columns_outlive_a_reload_and_a_step_that_grows_the_pool():
+    # Once views of the system's memory: a reload freed it and a growing pool moved it,
+    # and an array read afterwards read freed memory (a segfault on a large pool).
+    grows = ("@capacity(2000000) object d(p: vec3) { pos = p; point(pos, vec4(1), 2); }\n"
+             "object src { emit d(nrand3()) count 300000; }\nspawn src;")
+    s = psys.compile(source=grows)
+    s.step(1 / 60, steps=2)
+    x = s.columns("d")["x"]
+    before = x.copy()
+    s.reload(source="object q { point(vec3(0), vec4(1), 1); }\nspawn q;")
+    s.step(1 / 60)
+    np.testing.assert_array_equal(x, before)
+    s = psys.compile(source=grows.replace("count 300000", "at 6000000 per second"))
+    s.step(1 / 60)
+    y = s.columns("d")["y"]
+    before = y.copy()
+    s.step(1 / 60, steps=3)  # 100k objects a step: the pool grows
+    np.testing.assert_array_equal(y, before)
 
 
 def test_the_jit_in_exact_maths_and_the_interpreter_give_the_same_bits():
