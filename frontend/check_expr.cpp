@@ -150,6 +150,10 @@ Type Checker::check(Expr& expr, const Context& ctx) {
                 diags_.error(expr.range, fmt::format("`->` (initial value, then next) cannot be used in {}: only object "
                                                      "equations have a history", placeWords(ctx.where)));
                 t = Type::error();
+            } else if (ctx.fold) {
+                diags_.error(expr.range, fmt::format("`->` (initial value, then next) cannot be used in the term of `{}`: "
+                                                     "a term is a function of the two objects as they are", ctx.fold->callee));
+                t = Type::error();
             } else if (init.isError() || next.isError()) t = Type::error();
             else if (auto both = unify(init, next)) t = *both;
             else {

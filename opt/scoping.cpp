@@ -101,11 +101,13 @@ void scopeNeighbours(Module& module, size_t self, PassErrors& errors) {
         Object& me = module.objects[self];
         g.selfPosition = exportOf(me, kPositionExport, Type::vec(3));
         g.otherPosition = exportOf(target, kPositionExport, Type::vec(3));
-        for (const Object* o : {&me, &target})
-            if ((o == &me ? g.selfPosition : g.otherPosition) < 0)
-                errors.error(at, fmt::format("object {}: a fold over `{}` measures between drawn positions, but `{}` "
-                                             "draws nothing (give it a `point`, `sprite`, `streak` or `trail`)",
-                                             me.name, target.name, o->name));
+        auto drawsNothing = [&](const Object& o) {
+            errors.error(at, fmt::format("object {}: a fold over `{}` measures between drawn positions, but `{}` "
+                                         "draws nothing (give it a `point`, `sprite`, `streak` or `trail`)",
+                                         me.name, target.name, o.name));
+        };
+        if (g.selfPosition < 0) drawsNothing(me);
+        if (g.otherPosition < 0 && &target != &me) drawsNothing(target);  // a fold over its own type: said once
         for (ValueId v = 0; v < pair.size(); ++v) {
             Inst& inst = pair.mutableAt(v);
             if (inst.op != Op::NeighbourRead) continue;

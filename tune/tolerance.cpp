@@ -152,6 +152,8 @@ public:
     }
 
     bool drewNothing() const { return compared_ == 0; }
+    // Whether the program compiled for the reference (else the real compile reports why).
+    bool compiles() const { return compiles_; }
 
 private:
     // The closed form where `exact` has one (its error float's rounding of a formula).
@@ -172,6 +174,8 @@ private:
             return path;
         }
         const Compiled* rk4 = compile(Integrator::Rk4, Precision::Double);
+        compiles_ = rk4 != nullptr;
+        if (!rk4) return {};  // the program does not compile (the real compile says why): nothing to compare
         Path coarser = run(rk4->module, 1, nullptr, INFINITY).second;
         Path best;
         c.floor = INFINITY;
@@ -277,6 +281,7 @@ private:
     long frames_ = 0;
     size_t compared_ = 0;
     std::map<std::pair<Integrator, Precision>, std::optional<Compiled>> modules_;
+    bool compiles_ = true;
 };
 
 }  // namespace
@@ -299,6 +304,7 @@ std::vector<Choice> chooseMethods(ir::Module& module, rt::Backend& backend, cons
         double over = own && object.attributes.toleranceOver > 0 ? object.attributes.toleranceOver : options.horizon;
         Chooser chooser(module, backend, options);
         Choice c = chooser.choose(i, tolerance, over, own);
+        if (!chooser.compiles()) continue;  // its errors are the compile's, not the chooser's
         if (chooser.drewNothing()) {
             messages.warning(object.loc, fmt::format("`{}` draws nothing in its first {} s: its tolerance cannot be "
                                                      "measured, and its integrator and step stay as written",
