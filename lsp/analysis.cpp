@@ -74,10 +74,15 @@ Analysis analyze(const std::string& path, std::string text, const std::atomic<bo
             // integrator's stability limit. They run on a clean program only.
             // Under @tolerance the chooser runs its trials on the interpreter (what the
             // hints and warnings say is what `psysc check` says, give or take fast maths).
+            // An editor never waits long on them: a tenth of `psysc check`'s budget of steps
+            // (a few seconds on the interpreter at most), and a newer text stops them.
             CompileOptions options;
             interp::Interpreter trials;
+            tune::TuneOptions tune;
+            tune.budget /= 10;
+            tune.cancelled = cancelled;
             options.beforePasses = [&](ir::Module& module, opt::PassErrors& messages) {
-                if (!stop()) tune::chooseMethods(module, trials, tune::TuneOptions{}, messages);
+                if (!stop()) tune::chooseMethods(module, trials, tune, messages);
             };
             if (diags.errorCount() == 0 && !stop())
                 if (auto module = compileProgram(program.get(), *a.sources, diags, options)) methodHints(*module, a);

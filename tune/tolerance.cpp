@@ -32,6 +32,9 @@ bool integrates(const ir::Object& object) {
     return false;
 }
 
+// A count as a person reads it: 60000, or 6e+21 past what anyone would count.
+std::string count(double n) { return n < 1e9 ? fmt::format("{:.0f}", n) : fmt::format("{:.2g}", n); }
+
 std::string seconds(double s) {
     double inverse = 1 / s;
     if (std::fabs(inverse - std::round(inverse)) < 1e-6 * inverse && inverse >= 2) return fmt::format("1/{:.0f}", inverse);
@@ -98,9 +101,12 @@ public:
         c.methodFixed = fixed.has_value();
         c.precisionFixed = object.attributes.precision == Precision::Double;
         index_ = index;
-        frames_ = std::max<long>(1, std::lround(std::ceil(over / options_.frame - 1e-9)));
+        // (in double, and no more than the budget: a horizon of 1e20 s is no overflow)
+        frames_ = static_cast<long>(std::clamp(std::ceil(over / options_.frame - 1e-9), 1.0,
+                                               static_cast<double>(options_.budget) + 1));
 
         Path reference = referencePath(c);
+        if (exhausted_) return finish(c);
         compared_ = 0;
         for (const Frame& f : reference) compared_ += f.size();
 
@@ -119,14 +125,15 @@ public:
         }
         std::stable_sort(c.trials.begin(), c.trials.end(),
                          [](const Trial& a, const Trial& b) { return a.cost < b.cost; });
-        if (compared_ == 0) c.trials.clear();  // nothing drawn to compare: no choice
-        if (c.trials.empty()) return c;
+        if (compared_ == 0 || !c.trusted) c.trials.clear();  // nothing to compare with: no choice
+        if (c.trials.empty()) return finish(c);
 
         const Trial* chosen = nullptr;
         for (Trial& t : c.trials) {
             double budget = tolerance - c.floor;
             if (!(budget > 0)) break;
             t.error = run(compile(t.method, t.precision)->module, t.subSteps, &reference, budget).first + c.floor;
+            if (exhausted_) return finish(c);
             if (*t.error <= tolerance) {
                 chosen = &t;
                 break;
@@ -137,6 +144,7 @@ public:
             double best = INFINITY;
             for (Trial& t : c.trials) {
                 t.error = run(compile(t.method, t.precision)->module, t.subSteps, &reference, best).first + c.floor;
+                if (exhausted_) return finish(c);
                 if (*t.error < best || !chosen) {
                     best = std::min(best, *t.error);
                     chosen = &t;
@@ -148,10 +156,10 @@ public:
         c.precision = chosen->precision;
         c.error = *chosen->error;
         c.cost = chosen->cost;
-        return c;
+        return finish(c);
     }
 
-    bool drewNothing() const { return compared_ == 0; }
+    bool drewNothing() const { return compared_ == 0 && !exhausted_; }
     // Whether the program compiled for the reference (else the real compile reports why).
     bool compiles() const { return compiles_; }
 
@@ -189,7 +197,20 @@ private:
             }
             coarser = std::move(finer);
         }
+        // A reference whose own error is a good part of what it draws has not settled at
+        // any step (a stiff or unstable equation): nothing can be measured against it.
+        for (const Frame& f : best)
+            for (const auto& point : f)
+                for (float x : point.second) c.largest = std::max(c.largest, std::fabs(static_cast<double>(x)));
+        c.trusted = exhausted_ || c.floor == 0 || (std::isfinite(c.floor) && c.floor <= 0.01 * c.largest);
         return best;
+    }
+
+    Choice& finish(Choice& c) const {
+        c.steps = steps_;
+        c.exhausted = exhausted_;
+        if (exhausted_) c.met = false;
+        return c;
     }
 
     static double pathDistance(const Path& a, const Path& r) {
@@ -240,6 +261,11 @@ private:
         const std::string& name = lowered_.objects[index_].name;
         size_t type = static_cast<size_t>(s.typeIndex(name));
         for (long f = 0; f < frames_; ++f) {
+            steps_ += subSteps;
+            if (steps_ > options_.budget || (options_.cancelled && options_.cancelled->load(std::memory_order_relaxed))) {
+                exhausted_ = true;
+                return {INFINITY, path};
+            }
             if (s.step(options_.frame)) return {INFINITY, path};
             Frame frame;
             for (const rt::RenderPoint& p : s.points(type)) frame.push_back({p.id, p.position});
@@ -279,6 +305,8 @@ private:
     size_t index_ = 0;
     double tolerance_ = 0, over_ = 0;
     long frames_ = 0;
+    long steps_ = 0;
+    bool exhausted_ = false;
     size_t compared_ = 0;
     std::map<std::pair<Integrator, Precision>, std::optional<Compiled>> modules_;
     bool compiles_ = true;
@@ -305,6 +333,28 @@ std::vector<Choice> chooseMethods(ir::Module& module, rt::Backend& backend, cons
         Chooser chooser(module, backend, options);
         Choice c = chooser.choose(i, tolerance, over, own);
         if (!chooser.compiles()) continue;  // its errors are the compile's, not the chooser's
+        if (c.exhausted) {
+            if (!(options.cancelled && options.cancelled->load()))
+                messages.warning(object.loc,
+                                 fmt::format("the trials for `{}`'s tolerance over {:.4g} s stopped at their budget of "
+                                             "{} steps before a choice (a trial runs {} frames of up to 16 sub-steps): "
+                                             "its integrator and step stay as written; a shorter horizon is measured in full",
+                                             object.name, over, options.budget, count(std::ceil(over / options.frame - 1e-9))),
+                                 object.name);
+            choices.push_back(std::move(c));
+            continue;
+        }
+        if (!c.trusted) {
+            messages.warning(object.loc,
+                             fmt::format("`{}`'s error cannot be measured: the reference, rk4 in double, does not settle "
+                                         "at any sub-step up to 8 a frame (its paths at two neighbouring sub-steps are at "
+                                         "best {:.2g} m apart, for coordinates of at most {:.2g} m): a stiff or unstable "
+                                         "equation? Its integrator and step stay as written",
+                                         object.name, c.floor, c.largest),
+                             object.name);
+            choices.push_back(std::move(c));
+            continue;
+        }
         if (chooser.drewNothing()) {
             messages.warning(object.loc, fmt::format("`{}` draws nothing in its first {} s: its tolerance cannot be "
                                                      "measured, and its integrator and step stay as written",
@@ -341,6 +391,15 @@ std::string explain(const std::vector<Choice>& choices) {
     for (const Choice& c : choices) {
         out += fmt::format("{}: @tolerance({:.3g} m over {:.4g} s){}: ", c.object, c.tolerance, c.over,
                            c.own ? "" : " (the default)");
+        if (c.exhausted) {
+            out += fmt::format("stopped at the budget of trial steps ({} run); integrator and step as written\n", c.steps);
+            continue;
+        }
+        if (!c.trusted) {
+            out += fmt::format("the reference does not settle ({}, its own error about {:.2g} m on coordinates up to "
+                               "{:.2g} m); integrator and step as written\n", c.reference, c.floor, c.largest);
+            continue;
+        }
         if (c.trials.empty()) {
             out += "nothing drawn to measure; integrator and step as written\n";
             continue;
@@ -348,7 +407,8 @@ std::string explain(const std::vector<Choice>& choices) {
         out += fmt::format("{} {}, error {:.2g} m, cost {:.0f} a frame{}\n", c.met ? "chose" : "cannot meet it; closest",
                            describe(c.method, c.subSteps, c.frame, c.precision), c.error, c.cost,
                            c.methodFixed ? " (the integrator as written; the sub-step chosen)" : "");
-        out += fmt::format("  reference: {}, its own error about {:.2g} m\n", c.reference, c.floor);
+        out += fmt::format("  reference: {}, its own error about {:.2g} m; {} trial steps\n", c.reference, c.floor,
+                           c.steps);
         for (const Trial& t : c.trials) {
             if (!t.error) continue;
             std::string error = !std::isfinite(*t.error)     ? "unbounded"

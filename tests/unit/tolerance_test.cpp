@@ -5,6 +5,7 @@
 // @integrator the author wrote is kept and only the step chosen.
 #include <doctest/doctest.h>
 
+#include <atomic>
 #include <cmath>
 #include <functional>
 #include <numbers>
@@ -32,13 +33,15 @@ struct Chosen {
     std::string diagnostics;
 };
 
-Chosen compileUnderTolerance(const std::string& text, double tolerance = 0) {
+Chosen compileUnderTolerance(const std::string& text, double tolerance = 0,
+                             std::function<void(tune::TuneOptions&)> adjust = {}) {
     Chosen c;
     SourceManager sources;
     DiagnosticEngine diags(sources);
     CompileOptions options;
     tune::TuneOptions tune;
     tune.tolerance = tolerance;
+    if (adjust) adjust(tune);
     interp::Interpreter trials;
     options.beforePasses = [&](ir::Module& module, opt::PassErrors& messages) {
         c.choices = tune::chooseMethods(module, trials, tune, messages);
@@ -260,4 +263,60 @@ TEST_CASE("an object that draws nothing under a tolerance is a warning and keeps
           std::string::npos);
     CHECK(tune::explain(c.choices) == "hidden: @tolerance(0.001 m over 2 s): nothing drawn to measure; integrator and "
                                       "step as written\n");
+}
+
+TEST_CASE("a choice costs at most its budget of steps whatever the horizon, and says when it ran out") {
+    // @tolerance(1e-3, 1000) ran 12 million steps (a minute; 1e6 s would have taken hours),
+    // and a horizon of 1e20 s overflowed the count of frames.
+    const std::string ball = "@tolerance(1e-3, HORIZON) object ball(v0: vec3) {\n"
+                             "    vel = v0 + integrate(vec3(0, -9.8, 0) - 0.1 * vel);\n"
+                             "    pos = integrate(vel); point(pos, white, 1); }\n"
+                             "object thrower { emit ball(vec3(rand(), 10, 0)) count 3; }\nspawn thrower;";
+    for (const char* horizon : {"1000", "1e20"}) {
+        INFO(horizon);
+        std::string text = ball;
+        text.replace(text.find("HORIZON"), 7, horizon);
+        Chosen c = compileUnderTolerance(text, 0, [](tune::TuneOptions& t) { t.budget = 20000; });
+        REQUIRE(c.module);
+        REQUIRE(c.choices.size() == 1);
+        CHECK(c.choices[0].exhausted);
+        CHECK_FALSE(c.choices[0].met);
+        CHECK(c.choices[0].steps <= 20000 + 16);
+        CHECK(c.diagnostics.find("stopped at their budget of 20000 steps before a choice") != std::string::npos);
+        CHECK_FALSE(c.module->objects[0].attributes.integrator.has_value());  // as written
+    }
+    // Within the budget the horizon is measured in full.
+    std::string text = ball;
+    text.replace(text.find("HORIZON"), 7, "2");
+    Chosen c = compileUnderTolerance(text, 0, [](tune::TuneOptions& t) { t.budget = 20000; });
+    REQUIRE(c.choices.size() == 1);
+    CHECK_FALSE(c.choices[0].exhausted);
+    CHECK(c.choices[0].met);
+}
+
+TEST_CASE("trials stop at once when cancelled (an editor's newer text), and nothing is chosen or said") {
+    std::atomic<bool> cancelled{true};
+    Chosen c = compileUnderTolerance(
+        "@tolerance(1e-4, 600) object ball { pos = integrate(vec3(1, 0, 0) + integrate(vec3(0, -1, 0))); "
+        "point(pos, white, 1); }\nspawn ball;",
+        0, [&](tune::TuneOptions& t) { t.cancelled = &cancelled; });
+    REQUIRE(c.choices.size() == 1);
+    CHECK(c.choices[0].exhausted);
+    CHECK(c.choices[0].steps <= 1);
+    CHECK(c.diagnostics.find("warning") == std::string::npos);
+}
+
+TEST_CASE("a reference that does not settle is said to be untrustworthy, and nothing is chosen by it") {
+    // A stiff spring: rk4 in double diverges at 4 sub-steps a frame; the chooser once took
+    // its distance from 8 as the reference's error and said "within 8.6e+27 m".
+    Chosen c = compileUnderTolerance("@tolerance(0.01) object spring(v0: vec3) {\n"
+                                     "    vel = v0 + integrate(-pos * 1e6); pos = integrate(vel); point(pos, white, 1); }\n"
+                                     "object maker { emit spring(vec3(rand(), 1, 0)) count 2; }\nspawn maker;");
+    REQUIRE(c.module);
+    REQUIRE(c.choices.size() == 1);
+    CHECK_FALSE(c.choices[0].trusted);
+    CHECK(c.diagnostics.find("`spring`'s error cannot be measured: the reference, rk4 in double, does not settle") !=
+          std::string::npos);
+    CHECK(c.diagnostics.find("within") == std::string::npos);
+    CHECK_FALSE(c.module->objects[0].attributes.integrator.has_value());
 }
