@@ -34,7 +34,10 @@ std::unique_ptr<llvm::TargetMachine> targetMachine(const AotTarget& target, std:
     std::string host = llvm::sys::getProcessTriple();  // as the JIT's (JITTargetMachineBuilder::detectHost)
     triple = target.triple.empty() ? host : target.triple;
     std::string features;
-    if (!target.cpu.empty()) {
+    bool native = target.cpu == "native";  // as compilers spell the host's CPU (-march=native)
+    if (native && triple != host)
+        throw std::runtime_error("`native` is this machine's CPU, and `" + triple + "` is not this machine (" + host + ")");
+    if (!target.cpu.empty() && !native) {
         cpu = target.cpu;
     } else if (triple == host) {  // the host's CPU and every feature it has
         cpu = llvm::sys::getHostCPUName().str();

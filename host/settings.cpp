@@ -6,7 +6,7 @@
 namespace psys::host {
 
 std::optional<double> parseNumber(const std::string& text) {
-    auto slash = text.find('/');
+    auto slash = text.rfind('/');  // the last: 1/60/2 is (1/60)/2
     if (slash != std::string::npos) {
         auto a = parseNumber(text.substr(0, slash)), b = parseNumber(text.substr(slash + 1));
         if (!a || !b) return std::nullopt;

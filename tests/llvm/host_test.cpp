@@ -27,6 +27,8 @@ struct TempFile {
 TEST_CASE("host settings: numbers, extern settings and trigger firings, and what is wrong with bad ones") {
     CHECK(*host::parseNumber("1/60") == doctest::Approx(1.0 / 60));
     CHECK(*host::parseNumber("1e-3") == 1e-3);
+    CHECK(*host::parseNumber("1/60/2") == doctest::Approx(1.0 / 120));  // left to right, as written (was 1/30)
+    CHECK_FALSE(host::parseStep("1/60/0"));                              // infinite, not 0 (1/(60/0))
     CHECK_FALSE(host::parseNumber("fast"));
     CHECK_FALSE(host::parseNumber(""));
     auto set = host::parseSet("wind=1,2,3");

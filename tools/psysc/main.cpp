@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <exception>
 #include <iostream>
@@ -86,6 +87,29 @@ std::unique_ptr<psys::ast::Program> checkOne(const std::string& path, psys::Sour
     return program;
 }
 
+// CLI11's own checks let NaN through (it compares false with both bounds) and print a
+// range of 300 digits for `abc`: these say what is wanted, in words.
+const CLI::Validator kPositiveMetres(
+    [](std::string& text) {
+        char* end = nullptr;
+        double v = std::strtod(text.c_str(), &end);
+        return !text.empty() && *end == '\0' && std::isfinite(v) && v > 0
+                   ? std::string()
+                   : "takes a positive number of metres (such as 0.01), not `" + text + "`";
+    },
+    "");
+// A whole count from 1 to 2^32 − 1, written as 1000000 or 1e6.
+const CLI::Validator kCount(
+    [](std::string& text) {
+        char* end = nullptr;
+        double v = std::strtod(text.c_str(), &end);
+        if (text.empty() || *end != '\0' || !(v >= 1 && v <= 4294967295.0) || v != std::floor(v))
+            return "takes a whole number from 1 to 4294967295 (such as 100000 or 1e6), not `" + text + "`";
+        text = fmt::format("{:.0f}", v);
+        return std::string();
+    },
+    "");
+
 // The options of `psysc run`.
 void addRunOptions(CLI::App& run, psys::tools::RunOptions& o) {
     run.add_option("file", o.file, "The system to run")->required()->type_name("FILE");
@@ -93,7 +117,7 @@ void addRunOptions(CLI::App& run, psys::tools::RunOptions& o) {
     run.add_option("--dt", o.dt, "Seconds per frame (1/60)");
     run.add_option("--seed", o.seed, "Random seed (1)");
     run.add_option("--capacity", o.capacity, "Most live objects per type, unless @capacity says (1048576)")
-        ->check(CLI::Range(1.0, 4294967295.0));
+        ->transform(kCount)->type_name("COUNT");
     run.add_option("--set", o.sets, "Set an extern: NAME=VALUE or NAME=X,Y,Z (repeatable)")
         ->allow_extra_args(false);
     run.add_option("--fire", o.fires, "Fire a trigger before a frame: TRIGGER[:X,Y,Z]@FRAME (repeatable)")->allow_extra_args(false);
@@ -202,7 +226,7 @@ int realMain(int argc, char** argv) {
     app.add_option("--tolerance", tolerance,
                    "For check and run: the largest position error in metres an object without @tolerance may have "
                    "over 10 s; the compiler chooses its integrator and sub-step (docs/accuracy.md)")
-        ->check(CLI::PositiveNumber)->type_name("METRES");
+        ->check(kPositiveMetres)->type_name("METRES");
     std::string statsFile;
     app.add_option("--stats", statsFile, "Per object type: operations per update before and after optimization, "
                    "state bytes per object")->type_name("FILE");
@@ -232,7 +256,7 @@ int realMain(int argc, char** argv) {
     build->add_option("--math", buildOptions.math, "fast (the default) or exact (the interpreter's results bit for bit)")
         ->check(CLI::IsMember({"fast", "exact"}));
     build->add_option("--target", buildOptions.target, "The target triple (the host's by default)")->type_name("TRIPLE");
-    build->add_option("--cpu", buildOptions.cpu, "The CPU to compile for (the host's by default; generic for another "
+    build->add_option("--cpu", buildOptions.cpu, "The CPU to compile for: a name LLVM knows, or native (this machine's, the default; generic for another "
                       "triple)")->type_name("CPU");
     build->fallthrough();
 
