@@ -11,6 +11,7 @@
 #include "codegen_glsl/glsl_shaders.h"
 #include "codegen_llvm/aot_object.h"
 #include "driver/compile.h"
+#include "host/session.h"
 #include "ir/parser.h"
 #include "ir/printer.h"
 #include "rt/system.h"
@@ -107,6 +108,11 @@ int buildSystem(const BuildOptions& o) {
     options.pipeline.optimize = o.optimize;
     options.pipeline.pass.relaxed = o.relaxed || o.math == "fast";  // as the JIT's fast maths compiles
     options.pipeline.pass.everyObject = o.integrator;
+    // @tolerance chooses as `psysc run` does, its trials on the JIT in the build's maths:
+    // the archive computes what the JIT would (it kept the default integrator before).
+    tune::TuneOptions tune;
+    tune.tolerance = o.tolerance;
+    host::chooseUnderTolerance(options, tune, host::BackendChoice{"llvm", o.math});
     SourceManager sources;
     DiagnosticEngine diags(sources);
     std::optional<ir::Module> compiled = compileFile(o.file, sources, diags, options);

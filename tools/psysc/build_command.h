@@ -19,6 +19,7 @@ struct BuildOptions {
     bool optimize = true;
     bool relaxed = false;
     std::optional<core::Integrator> integrator;
+    double tolerance = 0;        // --tolerance: every object's without @tolerance (0: none)
     bool colour = false;
 };
 

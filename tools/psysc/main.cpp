@@ -224,7 +224,7 @@ int realMain(int argc, char** argv) {
         ->check(CLI::IsMember(methods))->type_name("METHOD");
     double tolerance = 0;
     app.add_option("--tolerance", tolerance,
-                   "For check and run: the largest position error in metres an object without @tolerance may have "
+                   "For check, run and build: the largest position error in metres an object without @tolerance may have "
                    "over 10 s; the compiler chooses its integrator and sub-step (docs/accuracy.md)")
         ->check(kPositiveMetres)->type_name("METRES");
     std::string statsFile;
@@ -325,6 +325,7 @@ int realMain(int argc, char** argv) {
         buildOptions.relaxed = relaxedMath;
         buildOptions.optimize = !noOptimize;
         buildOptions.integrator = everyObject;
+        buildOptions.tolerance = tolerance;
         return psys::tools::buildSystem(buildOptions);
     }
     if (check->parsed()) {
