@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <set>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -28,10 +29,33 @@ std::string identifier(const std::string& name) {
 }
 
 
+// A name the language accepts as a C parameter in C99 and C++17: with `_` after it where
+// it is a keyword of either (`int`, `default`, `class`, `new`, …) or a name the generated
+// functions use themselves (`system`, `v`).
+std::string parameterName(const std::string& name) {
+    static const std::set<std::string> taken = {
+        // the generated functions' own
+        "system", "v",
+        // C99
+        "auto", "break", "case", "char", "const", "continue", "default", "do", "double", "else", "enum", "extern",
+        "float", "for", "goto", "if", "inline", "int", "long", "register", "restrict", "return", "short", "signed",
+        "sizeof", "static", "struct", "switch", "typedef", "union", "unsigned", "void", "volatile", "while", "_Bool",
+        "_Complex", "_Imaginary",
+        // C++17, its alternative tokens, and names the headers' macros take
+        "alignas", "alignof", "and", "and_eq", "asm", "bitand", "bitor", "bool", "catch", "char16_t", "char32_t", "class",
+        "compl", "constexpr", "const_cast", "decltype", "delete", "dynamic_cast", "explicit", "export", "false",
+        "friend", "mutable", "namespace", "new", "noexcept", "not", "not_eq", "nullptr", "operator", "or", "or_eq",
+        "private", "protected", "public", "reinterpret_cast", "static_assert", "static_cast", "template", "this",
+        "thread_local", "throw", "true", "try", "typeid", "typename", "using", "virtual", "wchar_t", "xor", "xor_eq",
+        "NULL", "assert", "errno"};
+    return taken.count(name) ? name + "_" : name;
+}
+
 // The C parameters of a value of type `t` called `name`, and the statement that packs them
 // into `float v[]`.
-void parameters(const ir::Type& t, const std::string& name, std::string& list, std::vector<std::string>& values) {
+void parameters(const ir::Type& t, const std::string& language, std::string& list, std::vector<std::string>& values) {
     static const char* xyzw[] = {"x", "y", "z", "w"};
+    const std::string name = parameterName(language);
     if (t.isBool()) {
         list += ", int " + name;
         values.push_back(name + " ? 1.0f : 0.0f");
@@ -104,6 +128,19 @@ bool write(const std::string& path, const std::string& bytes) {
 }  // namespace
 
 int buildSystem(const BuildOptions& o) {
+    // NAME names NAME.a, NAME.h and the C symbols NAME_aot, NAME_open, NAME_set_…: not
+    // empty (that wrote the hidden files `.a` and `.h`), and not the C API's own prefix.
+    std::string stem = std::filesystem::path(o.output).filename().string();
+    if (stem.empty() || stem == "." || stem == "..") {
+        std::cerr << "psysc: error: --output takes a path whose last part names the build (NAME.a, NAME.h), not `"
+                  << o.output << "`\n";
+        return 2;
+    }
+    if (std::string id = identifier(stem); id == "psys" || id.rfind("psys_", 0) == 0) {
+        std::cerr << "psysc: error: --output `" << o.output << "` would name the build's C symbols `" << id
+                  << "_…`, which are the C API's own (psys_aot, psys_open_aot, …): choose another name\n";
+        return 2;
+    }
     CompileOptions options;
     options.pipeline.optimize = o.optimize;
     options.pipeline.pass.relaxed = o.relaxed || o.math == "fast";  // as the JIT's fast maths compiles
