@@ -64,6 +64,7 @@ psys_error* compileModule(const std::string& path, const psys::CompileOptions& o
         result = host::compile(path, options, module, text);
         return 0;
     });
+    result.diagnostics->setProgram("psys");  // the library's (`psys: error: cannot read …`), not psysc's
     if (!module) return makeError(result.text(), diagnosticsOf(*result.diagnostics, true));
     warnings = diagnosticsOf(*result.diagnostics, false);
     return nullptr;

@@ -65,6 +65,9 @@ psys_error* readOptions(const char* function, const psys_options* given, Options
     out.backend = o.backend ? o.backend : "llvm";
     out.math = o.math ? o.math : "fast";
     if (o.capacity == 0) return makeError(fmt::format("{}: the capacity is at least 1 object a type", function));
+    if (o.threads > rt::SystemOptions::kMostThreads)
+        return makeError(fmt::format("{}: threads is 0 (every core) to {}, not {}", function,
+                                     rt::SystemOptions::kMostThreads, o.threads));
     out.system.seed = o.seed;
     out.system.capacity = o.capacity;
     out.system.threads = o.threads;

@@ -5,6 +5,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cstring>
 #include <memory>
 #include <optional>
@@ -56,10 +57,53 @@ void check(psys_error* e) {
     throw py::error_already_set();
 }
 
-std::vector<float> floats(const py::object& values) {
-    if (py::isinstance<py::float_>(values) || py::isinstance<py::int_>(values) || py::isinstance<py::bool_>(values))
-        return {values.cast<float>()};
-    return values.cast<std::vector<float>>();
+[[noreturn]] void raise(PyObject* type, const std::string& message) {
+    PyErr_SetString(type, message.c_str());
+    throw py::error_already_set();
+}
+
+// A value as floats: a number, a bool, a sequence of them, or a NumPy array of any shape
+// (a 0-d one included), flattened.
+std::vector<float> floats(const py::object& values, const char* what) {
+    if (py::isinstance<py::str>(values) || py::isinstance<py::bytes>(values) || values.is_none())
+        raise(PyExc_TypeError, std::string(what) + " takes a number or a sequence of numbers, not " +
+                                   py::str(py::type::of(values).attr("__name__")).cast<std::string>());
+    py::array_t<float, py::array::c_style | py::array::forcecast> a;
+    try {
+        a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(values);
+    } catch (const py::error_already_set&) {
+    }
+    if (!a)
+        raise(PyExc_TypeError, std::string(what) + " takes a number or a sequence of numbers, not " +
+                                   py::str(py::type::of(values).attr("__name__")).cast<std::string>());
+    return {a.data(), a.data() + a.size()};
+}
+
+// The C API reads a source up to its first NUL: one inside is the error psysc gives for
+// it (CompileError, at its line and column), not a program cut short.
+void refuseNul(const std::string& source, const std::string& name) {
+    size_t at = source.find('\0');
+    if (at == std::string::npos) return;
+    size_t lineStart = source.rfind('\n', at);
+    lineStart = lineStart == std::string::npos ? 0 : lineStart + 1;
+    auto line = static_cast<unsigned>(std::count(source.begin(), source.begin() + static_cast<long>(at), '\n') + 1);
+    auto column = static_cast<unsigned>(at - lineStart + 1);
+    const char* message = "unexpected character U+0000";
+    psys_diagnostic d{};
+    d.severity = PSYS_SEVERITY_ERROR;
+    d.file = name.c_str();
+    d.line = line;
+    d.column = column;
+    d.end_line = line;
+    d.end_column = column + 1;
+    d.message = message;
+    py::list diagnostics;
+    diagnostics.append(diagnostic(d));
+    py::object error = compileErrorType()(name + ":" + std::to_string(line) + ":" + std::to_string(column) +
+                                          ": error: " + message);
+    error.attr("diagnostics") = diagnostics;
+    PyErr_SetObject(compileErrorType().ptr(), error.ptr());
+    throw py::error_already_set();
 }
 
 class System {
@@ -80,6 +124,7 @@ public:
         if (capacity) o.capacity = capacity;
         o.threads = threads;
         o.optimize = optimize;
+        if (isSource) refuseNul(what, name);
         psys_system* s = nullptr;
         psys_error* e = nullptr;
         {
@@ -92,10 +137,11 @@ public:
     }
 
     void step(double dt, int steps) {
+        if (steps < 0) raise(PyExc_ValueError, "step: steps is 0 or more, not " + std::to_string(steps));
         for (int i = 0; i < steps; ++i) check(psys_step(s_, dt));
     }
     void set(const std::string& name, const py::object& values) {
-        std::vector<float> v = floats(values);
+        std::vector<float> v = floats(values, "set");
         check(psys_set_extern(s_, name.c_str(), v.data(), v.size()));
     }
     py::object get(const std::string& name) const {
@@ -111,12 +157,13 @@ public:
     void fire(const std::string& trigger, py::args args) {
         std::vector<float> all;
         for (py::handle a : args) {
-            std::vector<float> v = floats(py::reinterpret_borrow<py::object>(a));
+            std::vector<float> v = floats(py::reinterpret_borrow<py::object>(a), "fire");
             all.insert(all.end(), v.begin(), v.end());
         }
         check(psys_fire(s_, trigger.c_str(), all.data(), all.size()));
     }
     void reload(std::optional<std::string> source) {
+        if (source) refuseNul(*source, "<string>");
         check(psys_reload(s_, source ? source->c_str() : nullptr));
     }
 
@@ -153,7 +200,18 @@ public:
             }
             return static_cast<size_t>(t);
         }
-        return type.cast<size_t>();
+        size_t count = psys_type_count(s_);
+        long long index = 0;
+        try {
+            index = type.cast<long long>();
+        } catch (const py::cast_error&) {
+            raise(PyExc_TypeError, "a type is its name or its index, not " +
+                                       py::str(py::type::of(type).attr("__name__")).cast<std::string>());
+        }
+        if (index < 0 || static_cast<unsigned long long>(index) >= count)
+            raise(PyExc_IndexError, "there is no object type " + std::to_string(index) + ": the program's are " +
+                                        (count ? "0 to " + std::to_string(count - 1) : std::string("none")));
+        return static_cast<size_t>(index);
     }
 
     // The draw columns, each copied into an array of its own (read-only); a constant

@@ -42,6 +42,7 @@ struct SystemOptions {
     size_t capacity = 1 << 20;  // per object type, unless its @capacity says otherwise
     // Threads for launches over pools: 0 for every core. Results do not depend on it.
     unsigned threads = 0;
+    static constexpr unsigned kMostThreads = 256;  // TBB's own limit: the most `threads` asks for
     // Create the objects queued in a step in batches of any size; false: one at a time.
     // Results are the same (tests compare the two).
     bool createInBatches = true;

@@ -11,6 +11,8 @@ dicts: severity, file, line, column, end_line, end_column, message); psys.Error 
 docs/embedding.md has the whole story.
 """
 
+import os
+
 from . import _psys
 
 
@@ -37,9 +39,22 @@ def compile(path=None, *, source=None, name="<string>", backend="llvm", math="fa
     capacity: objects per type (0: the default, 2^20); threads: 0 for every core."""
     if (path is None) == (source is None):
         raise TypeError("psys.compile takes a path or source=, one of them")
+    for what, value, least, most in (("seed", seed, 0, 2**32 - 1), ("capacity", capacity, 0, 2**64 - 1),
+                                     ("threads", threads, 0, 256)):
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise TypeError(f"psys.compile: {what} is a whole number, not {type(value).__name__}")
+        if not least <= value <= most:
+            raise ValueError(f"psys.compile: {what} is {least} to {most}, not {value}")
     if source is not None:
+        if isinstance(source, bytes):
+            source = source.decode("utf-8")
+        if not isinstance(source, str):
+            raise TypeError(f"psys.compile: source is text, not {type(source).__name__}")
         return _psys._compile(source, True, name, backend, math, seed, capacity, threads, optimize)
-    return _psys._compile(str(path), False, "", backend, math, seed, capacity, threads, optimize)
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        raise TypeError(f"psys.compile: a path is text or os.PathLike, not {type(path).__name__}")
+    return _psys._compile(os.fsdecode(path), False, "", backend, math, seed, capacity, threads, optimize)
+
 
 
 __all__ = ["compile", "System", "Error", "CompileError", "version"]

@@ -154,3 +154,38 @@ def test_the_examples_run(tmp_path):
     subprocess.run([sys.executable, EXAMPLES / "python" / "snapshots.py", SAMPLES / "fountain.psys",
                     tmp_path / "s.png"], capture_output=True, text=True, check=True)
     assert (tmp_path / "s.png").stat().st_size > 0
+
+
+def test_bad_arguments_say_why_in_words():
+    s = psys.compile(source="extern f: float = 1;\nobject a { point(vec3(f), white, 1); }\nspawn a;")
+    with pytest.raises(ValueError, match="steps is 0 or more, not -1"):
+        s.step(1 / 60, steps=-1)  # once did nothing, silently
+    for threads in (257, -1):
+        with pytest.raises(ValueError, match=f"threads is 0 to 256, not {threads}"):
+            psys.compile(source="object a { }\nspawn a;", threads=threads)
+    with pytest.raises(IndexError, match="there is no object type -1: the program's are 0 to 0"):
+        s.points(-1)  # once "Unable to cast Python instance…"
+    with pytest.raises(TypeError, match="a type is its name or its index, not float"):
+        s.points(1.5)
+    s.set("f", np.array(2.0))  # a 0-d array (once "len() of unsized object")
+    assert s.get("f") == 2
+    s.set("f", np.float32(3))
+    assert s.get("f") == 3
+    with pytest.raises(TypeError, match="set takes a number or a sequence of numbers, not str"):
+        s.set("f", "x")
+    with pytest.raises(psys.Error, match="^psys: error: cannot read `no/such.psys`"):
+        psys.compile(b"no/such.psys")  # a bytes path is a path (once "`b'no/such.psys'`"), the library's own label
+    with pytest.raises(TypeError, match="a path is text or os.PathLike, not int"):
+        psys.compile(3)
+    assert psys.compile(SAMPLES / "fire.psys").types  # an os.PathLike
+
+
+def test_a_nul_in_a_source_is_the_error_psysc_gives_not_a_program_cut_short():
+    with pytest.raises(psys.CompileError) as e:
+        psys.compile(source="object a {\n point(vec3(0), white, 1);\0 }\nspawn a;", name="nul.psys")
+    assert str(e.value) == "nul.psys:2:27: error: unexpected character U+0000"
+    d = e.value.diagnostics[0]
+    assert (d["line"], d["column"], d["severity"]) == (2, 27, "error")
+    s = psys.compile(source="object a { point(vec3(0), white, 1); }\nspawn a;")
+    with pytest.raises(psys.CompileError, match="unexpected character U[+]0000"):
+        s.reload(source="object a {\0}")

@@ -134,7 +134,7 @@ void addRunOptions(CLI::App& run, psys::tools::RunOptions& o) {
                     "rewrites; the default) or exact (the interpreter's results bit for bit)")
         ->check(CLI::IsMember({"fast", "exact"}));
     run.add_option("--threads", o.threads, "Threads for pool updates: 0 for every core (0)")
-        ->check(CLI::Range(0, 256));  // TBB's own limit
+        ->check(CLI::Range(0u, psys::rt::SystemOptions::kMostThreads));
     run.add_flag("--timing", o.timing, "Print compile time and the time spent stepping and drawing");
     run.add_flag("--print-schedule", o.printSchedule, "Print the phases a step runs, in order, and run no frame");
     run.add_flag("--remarks", o.remarks, "llvm backend: print whether each update loop vectorized, and the library functions compiled code calls");

@@ -87,7 +87,7 @@ int realMain(int argc, char** argv) {
         ->check(CLI::IsMember(methods))->type_name("METHOD");
     app.add_option("--seed", o.session.system.seed, "Random seed (1)");
     app.add_option("--threads", o.session.system.threads, "Threads for the simulation: 0 for every core (0)")
-        ->check(CLI::Range(0, 256));  // TBB's own limit
+        ->check(CLI::Range(0u, rt::SystemOptions::kMostThreads));
     app.add_option("--dt", dt, "Seconds a step simulates (1/60)");
     auto* realFlag = app.add_flag("--real-time", realTime,
                                   "Headless: run steps of --dt as wall-clock time passes (a window's default)");
