@@ -25,21 +25,30 @@ size_t firstDifferentLine(const std::string& a, const std::string& b) {
     return line;
 }
 
-// Replaces `path` by `text` through a file beside it, so a failure leaves the old one whole.
+// Replaces the file at `path` by `text` as editors do: through a symbolic link, the file
+// it names (the link stays a link); a file with other hard links, in place (a new file
+// would leave them the old text); else through a file beside it, renamed over it, so a
+// failure leaves the old one whole.
 bool writeBack(const std::string& path, const std::string& text) {
-    fs::path temporary = path + ".psysfmt~";
+    std::error_code ec;
+    fs::path target = fs::canonical(path, ec);
+    if (ec) return false;
+    if (fs::hard_link_count(target, ec) > 1 && !ec) {
+        std::ofstream out(target, std::ios::binary | std::ios::trunc);
+        out << text;
+        return static_cast<bool>(out.flush());
+    }
+    fs::path temporary = target.string() + ".psysfmt~";
     {
         std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
         out << text;
         if (!out.flush()) {
-            std::error_code ec;
             fs::remove(temporary, ec);
             return false;
         }
     }
-    std::error_code ec;
-    fs::permissions(temporary, fs::status(path, ec).permissions(), ec);
-    fs::rename(temporary, path, ec);
+    fs::permissions(temporary, fs::status(target, ec).permissions(), ec);
+    fs::rename(temporary, target, ec);
     if (ec) fs::remove(temporary, ec);
     return !ec;
 }
