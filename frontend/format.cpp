@@ -254,7 +254,12 @@ bool sameAtoms(const std::vector<Atom>& a, const std::vector<Atom>& b) {
 
 std::optional<std::string> formatSource(int file, const SourceManager& sources, DiagnosticEngine& diags) {
     if (!parseModule(file, sources, diags)) return std::nullopt;
-    const std::string& text = sources.file(file).text();
+    // A UTF-8 byte order mark stays where the file had it, outside the layout (as a token
+    // it came out of the layout elsewhere, and formatting refused the file).
+    static const std::string kByteOrderMark = "\xEF\xBB\xBF";
+    const std::string& whole = sources.file(file).text();
+    bool marked = whole.rfind(kByteOrderMark, 0) == 0;
+    std::string text = marked ? whole.substr(kByteOrderMark.size()) : whole;
     auto atoms = atomsOf(text);
     if (!atoms) return std::nullopt;  // the parser has reported the character
     Layout layout;
@@ -266,7 +271,7 @@ std::optional<std::string> formatSource(int file, const SourceManager& sources, 
                                   "is (please report it)");
         return std::nullopt;
     }
-    return out;
+    return marked ? kByteOrderMark + out : out;
 }
 
 }  // namespace psys

@@ -176,5 +176,14 @@ TEST_CASE("format: every golden error file that parses keeps its AST and its dia
     CHECK(parsed > 80);
 }
 
+TEST_CASE("format: a UTF-8 byte order mark stays where the file had it") {
+    // It compiled, and formatting said "internal error … (please report it)".
+    const std::string bom = "\xEF\xBB\xBF";
+    auto out = format(bom + "object a {point(vec3(0),white,1);}\nspawn a;\n");
+    REQUIRE(out);
+    CHECK(*out == bom + "object a {\n    point(vec3(0), white, 1);\n}\nspawn a;\n");
+    CHECK(format(*out) == out);
+}
+
 }  // namespace
 }  // namespace psys
