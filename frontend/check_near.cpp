@@ -68,11 +68,19 @@ Type Checker::checkNear(CallExpr& call, const Context& ctx) {
     call.neighbours = target;
     // The radius: the grid's cell, fixed for the program.
     check(*call.args[1], ctx);
+    // From 1e-18 to 1e18: a distance within it squared is a normal float (the terms compare
+    // d² with r²); past them r² rounded to 0 or infinity, and a fold counted objects far
+    // outside its radius, differently for each of two objects.
+    constexpr double kLeast = 1e-18, kMost = 1e18;
     auto r = evaluateConstant(*call.args[1]);
-    if (!r || !(r->v[0] > 0) || !std::isfinite(r->v[0]) || !r->type.isFloat()) {
-        diags_.error(call.args[1]->range, fmt::format("the radius of `{}` must be a constant number above 0 (the "
-                                                      "objects within it are folded over); {}", call.callee,
-                                                      !r ? "it is not a constant" : "it is not"));
+    std::string why = !r                      ? "it is not a constant"
+                      : !r->type.isFloat()    ? "it is a " + r->type.str()
+                      : std::isnan(r->v[0])   ? "it is not a number (NaN)"
+                      : !(r->v[0] >= kLeast) || !(r->v[0] <= kMost) ? fmt::format("it is {:g}", r->v[0])
+                                              : "";
+    if (!why.empty()) {
+        diags_.error(call.args[1]->range, fmt::format("the radius of `{}` must be a constant number from 1e-18 to 1e18 "
+                                                      "(the objects within it are folded over); {}", call.callee, why));
         return Type::error();
     }
     call.radius = r->v[0];

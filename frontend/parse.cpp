@@ -334,9 +334,12 @@ private:
         if (auto* n = dynamic_cast<PsysParser::NumberLitContext*>(ctx)) {
             std::string text = n->NUMBER()->getText();
             double value = std::strtod(text.c_str(), nullptr);
-            // Numbers are floats: one past the largest float would silently be infinite.
-            if (value > std::numeric_limits<float>::max())
-                diags_.error(r, fmt::format("the number {} is too large for a float (the largest is 3.4028235e38)", text));
+            // Numbers are floats: one that rounds past the largest float would silently be
+            // infinite. 3.4028235e38 itself rounds to the largest; from halfway to the next
+            // power of two on, a number rounds to infinity.
+            if (value >= 3.4028235677973366e38)
+                diags_.error(r, fmt::format("the number {} is too large for a float: it rounds to infinity (the largest "
+                                            "float is 3.4028235e38)", text));
             return std::make_unique<NumberExpr>(r, value, text);
         }
         if (auto* b = dynamic_cast<PsysParser::BoolLitContext*>(ctx))
