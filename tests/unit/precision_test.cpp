@@ -85,6 +85,26 @@ TEST_CASE("double-precision: products, quotients and square roots to the pair's 
     CHECK(std::fabs(static_cast<double>(1.0f / 3) - 1.0 / 3) > 1e-9);
 }
 
+TEST_CASE("double-precision: large values stay finite where float does, and as exact") {
+    // Veltkamp's split computed 4097·x: from |x| ≈ 8.3e34 on it overflowed, and the pair
+    // became NaN (a state of 9e34 times 0.1 a step) where float keeps a finite value.
+    for (float x : {9e34f, 1e37f, 3e38f}) {
+        INFO(x);
+        auto product = evaluate("mul", x, 0, 0.5f);
+        CHECK(std::isfinite(product.first));
+        CHECK(std::isfinite(product.second));
+        CHECK(sum(product) == static_cast<double>(x) * 0.5);  // a power of two: exact either way
+        auto quotient = evaluate("div", x, 0, 3);
+        CHECK(std::isfinite(sum(quotient)));
+        // past ±2¹¹⁴ a product keeps float's accuracy: within half a float's step
+        CHECK(std::fabs(sum(quotient) - static_cast<double>(x) / 3) <= std::ldexp(static_cast<double>(x), -24));
+    }
+    // Small ones as exact as ever: 2⁻¹²⁰·(1 + 2⁻²⁰) · 2¹⁰⁰·(1 + 2⁻²¹), to the pair's bits.
+    const float tiny = std::ldexp(1.0f + std::ldexp(1.0f, -20), -120), big = std::ldexp(1.0f + std::ldexp(1.0f, -21), 100);
+    const double exact = static_cast<double>(tiny) * big;
+    CHECK(sum(evaluate("mul", tiny, 0, big)) == exact);
+}
+
 TEST_CASE("double-precision: objects without it are left as they are") {
     ir::Module m = updateOf("add");
     m.objects[0].attributes.precision = core::Precision::Float;
