@@ -64,7 +64,8 @@ psys_error* readOptions(const char* function, const psys_options* given, Options
     if (given) o = *given;
     out.backend = o.backend ? o.backend : "llvm";
     out.math = o.math ? o.math : "fast";
-    if (o.capacity == 0) return makeError(fmt::format("{}: the capacity is at least 1 object a type", function));
+    if (o.capacity == 0 || o.capacity > 4294967295u)  // the language's own limit (@capacity)
+        return makeError(fmt::format("{}: the capacity is 1 to 4294967295 objects a type, not {}", function, o.capacity));
     if (o.threads > rt::SystemOptions::kMostThreads)
         return makeError(fmt::format("{}: threads is 0 (every core) to {}, not {}", function,
                                      rt::SystemOptions::kMostThreads, o.threads));

@@ -300,10 +300,10 @@ std::optional<Value> System::externValue(std::string_view name) const {
 std::optional<std::string> System::checkCapacity(const ir::Module& module, const SystemOptions& options) {
     double memory = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
     for (const ir::Object& o : module.objects) {
-        double capacity = static_cast<double>(o.attributes.capacity ? *o.attributes.capacity : options.capacity);
-        double bytes = capacity * static_cast<double>(Pool::rowBytes(o));
+        uint64_t capacity = o.attributes.capacity ? *o.attributes.capacity : options.capacity;
+        double bytes = static_cast<double>(capacity) * static_cast<double>(Pool::rowBytes(o));
         if (memory > 0 && bytes > memory)
-            return fmt::format("object `{}`: a capacity of {:.0f} needs up to {:.1f} GB ({} bytes a row); this machine "
+            return fmt::format("object `{}`: a capacity of {} needs up to {:.1f} GB ({} bytes a row); this machine "
                                "has {:.1f} GB of memory", o.name, capacity, bytes / 1e9, Pool::rowBytes(o), memory / 1e9);
     }
     return std::nullopt;

@@ -369,8 +369,8 @@ std::vector<Choice> chooseMethods(ir::Module& module, rt::Backend& backend, cons
         stateTolerance(object, c.method, tolerance, over);
         if (!c.met) {
             std::string why = c.floor * 2 >= tolerance
-                                  ? fmt::format("the reference itself, rk4 in double, is only good to about {:.2g} m here",
-                                                c.floor)
+                                  ? fmt::format("the reference itself, {}, is only good to about {:.2g} m here",
+                                                c.reference, c.floor)
                               : c.methodFixed ? std::string("the integrator is the one written, by @integrator or "
                                                             "--integrator, and only the sub-step was chosen")
                                               : std::string("no finer sub-step than 1/16 of a frame is tried");

@@ -39,7 +39,7 @@ def compile(path=None, *, source=None, name="<string>", backend="llvm", math="fa
     capacity: objects per type (0: the default, 2^20); threads: 0 for every core."""
     if (path is None) == (source is None):
         raise TypeError("psys.compile takes a path or source=, one of them")
-    for what, value, least, most in (("seed", seed, 0, 2**32 - 1), ("capacity", capacity, 0, 2**64 - 1),
+    for what, value, least, most in (("seed", seed, 0, 2**32 - 1), ("capacity", capacity, 0, 4294967295),
                                      ("threads", threads, 0, 256)):
         if isinstance(value, bool) or not isinstance(value, int):
             raise TypeError(f"psys.compile: {what} is a whole number, not {type(value).__name__}")

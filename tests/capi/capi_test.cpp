@@ -268,6 +268,10 @@ TEST_CASE("NULL handles and arguments, an unknown type and bad options are error
     o.capacity = 0;
     CHECK(take(psys_compile_string(kDots, nullptr, &o, &out)).find("capacity") != std::string::npos);
     o = options("llvm");
+    o.capacity = SIZE_MAX;  // once "a capacity of 18446744073709551616 needs …"
+    CHECK(take(psys_compile_string(kDots, nullptr, &o, &out)) ==
+          "psys_compile_string: the capacity is 1 to 4294967295 objects a type, not 18446744073709551615");
+    o = options("llvm");
     o.threads = 257;  // TBB's limit: once taken
     CHECK(take(psys_compile_string(kDots, nullptr, &o, &out)) == "psys_compile_string: threads is 0 (every core) to 256, not 257");
     CHECK(take(psys_compile_file("no/such.psys", nullptr, &out)).rfind("psys: error: cannot read `no/such.psys`", 0) == 0);

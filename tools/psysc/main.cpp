@@ -340,11 +340,15 @@ int realMain(int argc, char** argv) {
         for (const std::string& file : checkFiles) {
             psys::SourceManager sources;
             choices->clear();
-            checkOne(file, sources, &options, colour, time, &failed, remarks);
+            bool thisFailed = false;
+            checkOne(file, sources, &options, colour, time, &thisFailed, remarks);
+            failed |= thisFailed;
+            // A file with errors chose nothing: its errors say why, not "no object states…".
             if (explain)
                 std::cout << (checkFiles.size() > 1 ? file + ":\n" : "")
-                          << (choices->empty() ? "no object states a tolerance (@tolerance, or --tolerance)\n"
-                                               : psys::tune::explain(*choices));
+                          << (thisFailed       ? "not compiled: nothing chosen\n"
+                              : choices->empty() ? "no object states a tolerance (@tolerance, or --tolerance)\n"
+                                                 : psys::tune::explain(*choices));
         }
         return failed ? 1 : 0;
     }
