@@ -11,6 +11,7 @@
 #include <llvm/IR/Verifier.h>
 #include <llvm/MC/MCSubtargetInfo.h>
 #include <llvm/MC/TargetRegistry.h>
+#include <llvm/TargetParser/Triple.h>
 #include <llvm/Object/ArchiveWriter.h>
 #include <llvm/Object/ObjectFile.h>
 #include <llvm/Support/TargetSelect.h>
@@ -35,7 +36,7 @@ std::unique_ptr<llvm::TargetMachine> targetMachine(const AotTarget& target, std:
     triple = target.triple.empty() ? host : target.triple;
     std::string features;
     bool native = target.cpu == "native";  // as compilers spell the host's CPU (-march=native)
-    if (native && triple != host)
+    if (native && llvm::Triple::normalize(triple) != llvm::Triple::normalize(host))
         throw std::runtime_error("`native` is this machine's CPU, and `" + triple + "` is not this machine (" + host + ")");
     if (!target.cpu.empty() && !native) {
         cpu = target.cpu;

@@ -74,12 +74,13 @@ Analysis analyze(const std::string& path, std::string text, const std::atomic<bo
             // integrator's stability limit. They run on a clean program only.
             // Under @tolerance the chooser runs its trials on the interpreter (what the
             // hints and warnings say is what `psysc check` says, give or take fast maths).
-            // An editor never waits long on them: a tenth of `psysc check`'s budget of steps
-            // (a few seconds on the interpreter at most), and a newer text stops them.
+            // An editor never waits long on them: a fortieth of `psysc check`'s budget of
+            // steps (about 2 s on the interpreter at most: didOpen and a request on an edited
+            // text analyse at once), and a newer text stops the ones in the background.
             CompileOptions options;
             interp::Interpreter trials;
             tune::TuneOptions tune;
-            tune.budget /= 10;
+            tune.budget /= 40;
             tune.cancelled = cancelled;
             options.beforePasses = [&](ir::Module& module, opt::PassErrors& messages) {
                 if (!stop()) tune::chooseMethods(module, trials, tune, messages);

@@ -6,7 +6,7 @@
 //     is never used, say);
 //   - merges slots that always hold the same value: the same type, the same start and the
 //     same next value (bouncing's velocity was stored twice: once to close the cycle,
-//     once for an explicit `prev`);
+//     once for an explicit `prev`) — not in a system that may be reloaded;
 //   - stops storing a slot whose next value is the slot itself (it never changes after
 //     creation);
 //   - marks a parameter no kernel after `init` reads as not kept: it is used at creation
@@ -72,7 +72,8 @@ void renumber(Object& o, const std::vector<int>& map) {
     o.state = state;
 }
 
-void eliminate(Object& o, bool keepParams) {
+void eliminate(Object& o, bool reloadable) {
+    const bool keepEach = reloadable, keepParams = reloadable;
     Kernel* update = o.kernel(KernelKind::Update);
     Kernel* init = o.kernel(KernelKind::Init);
     if (!update) return;
@@ -83,10 +84,12 @@ void eliminate(Object& o, bool keepParams) {
         return std::nullopt;
     };
 
-    // Merge slots with the same type, start and next value into the first of them.
+    // Merge slots with the same type, start and next value into the first of them — but
+    // in a system that may be reloaded, which carries each slot by its name (and relaxed
+    // maths' rewrites can make slots equal that exact maths keeps apart).
     std::vector<int> map(n);
     for (size_t s = 0; s < n; ++s) map[s] = static_cast<int>(s);
-    for (size_t b = 0; b < n; ++b)
+    for (size_t b = 0; b < n && !keepEach; ++b)
         for (size_t a = 0; a < b; ++a) {
             if (map[a] != static_cast<int>(a)) continue;
             bool same = o.state[a].type == o.state[b].type && o.state[a].init == o.state[b].init &&

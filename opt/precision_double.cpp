@@ -92,12 +92,14 @@ private:
         return {s, op(Op::Sub, t, {b, op(Op::Sub, t, {s, a})}), false};
     }
     // Veltkamp's split: a = h + l, each of 12 significant bits, so their products are exact.
-    // 4097·a overflows from |a| ≈ 8.3e34 and made the pair NaN where float stays finite:
-    // the multiplier reads a clamped to ±2¹¹⁴, so past it h is a itself, l ≈ 0, and the
-    // product keeps float's accuracy, finite (two operations; scaling a by 2⁻¹³ instead
-    // lost the low part of every product below 1e-34). The same bits within ±2¹¹⁴.
+    // 4097·a overflows past |a| ≈ 8.3e34 and made the pair NaN where float stays finite:
+    // the multiplier reads a clamped to the largest it can take (0x1.ffcp115), so past it h
+    // is close to a and l small, and the product keeps float's accuracy, finite (two
+    // operations; scaling a by 2⁻¹³ instead lost the low part of every product below
+    // 1e-34). The same bits as the plain split wherever that one is finite.
     std::pair<ValueId, ValueId> split(Type t, ValueId a) {
-        ValueId clamped = op(Op::Max, t, {op(Op::Min, t, {a, splat(t, 0x1p114f)}), splat(t, -0x1p114f)});
+        const float most = 0x1.ffcp115f;
+        ValueId clamped = op(Op::Max, t, {op(Op::Min, t, {a, splat(t, most)}), splat(t, -most)});
         ValueId c = op(Op::Mul, t, {splat(t, 4097.0f), clamped});
         ValueId h = op(Op::Sub, t, {c, op(Op::Sub, t, {c, a})});
         return {h, op(Op::Sub, t, {a, h})};

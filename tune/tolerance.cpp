@@ -82,8 +82,9 @@ struct Compiled {
 
 class Chooser {
 public:
-    Chooser(const ir::Module& lowered, rt::Backend& backend, const TuneOptions& options)
-        : lowered_(lowered), backend_(backend), options_(options) {}
+    // `spent`: the steps the program's trials ran so far — the budget is the program's.
+    Chooser(const ir::Module& lowered, rt::Backend& backend, const TuneOptions& options, long& spent)
+        : lowered_(lowered), backend_(backend), options_(options), steps_(spent), first_(spent) {}
 
     Choice choose(size_t index, double tolerance, double over, bool own) {
         const ir::Object& object = lowered_.objects[index];
@@ -207,7 +208,7 @@ private:
     }
 
     Choice& finish(Choice& c) const {
-        c.steps = steps_;
+        c.steps = steps_ - first_;
         c.exhausted = exhausted_;
         if (exhausted_) c.met = false;
         return c;
@@ -305,7 +306,8 @@ private:
     size_t index_ = 0;
     double tolerance_ = 0, over_ = 0;
     long frames_ = 0;
-    long steps_ = 0;
+    long& steps_;
+    const long first_;
     bool exhausted_ = false;
     size_t compared_ = 0;
     std::map<std::pair<Integrator, Precision>, std::optional<Compiled>> modules_;
@@ -324,13 +326,15 @@ std::string describe(Integrator method, int subSteps, double frame, Precision pr
 std::vector<Choice> chooseMethods(ir::Module& module, rt::Backend& backend, const TuneOptions& options,
                                   opt::PassErrors& messages) {
     std::vector<Choice> choices;
+    long spent = 0;  // one budget for the program, whatever the number of objects under a tolerance
     for (size_t i = 0; i < module.objects.size(); ++i) {
+        if (options.cancelled && options.cancelled->load(std::memory_order_relaxed)) break;
         ir::Object& object = module.objects[i];
         bool own = object.attributes.tolerance > 0;
         double tolerance = own ? object.attributes.tolerance : options.tolerance;
         if (!(tolerance > 0) || !integrates(object)) continue;
         double over = own && object.attributes.toleranceOver > 0 ? object.attributes.toleranceOver : options.horizon;
-        Chooser chooser(module, backend, options);
+        Chooser chooser(module, backend, options, spent);
         Choice c = chooser.choose(i, tolerance, over, own);
         if (!chooser.compiles()) continue;  // its errors are the compile's, not the chooser's
         if (c.exhausted) {

@@ -18,8 +18,8 @@
 // float wins wherever it meets the tolerance. Candidates are tried cheapest first (a
 // pass's arithmetic or, where more, its memory traffic, times the sub-steps:
 // tolerance.cpp's passCost) and the first that meets the tolerance wins; a run stops as
-// soon as it misses. Deterministic: the same source gives the same choice. Bounded: an
-// object's trials run at most `budget` steps, whatever its horizon.
+// soon as it misses. Deterministic: the same source gives the same choice. Bounded: a
+// program's trials run at most `budget` steps, whatever the horizons.
 #pragma once
 
 #include <atomic>
@@ -40,10 +40,11 @@ struct TuneOptions {
     double horizon = core::kToleranceSeconds;  // seconds compared under a @tolerance that states no time
     size_t population = 64;   // objects of each type alive at once in a trial
     opt::PipelineOptions pipeline;  // the passes the trials are compiled with
-    // The most steps (a frame's sub-steps of the trial population) an object's trials may
-    // run, the reference's included: the cost of a choice is bounded whatever the horizon
-    // (a @tolerance over 1000 s ran 12 million, a minute on the JIT). Past it the object
-    // keeps its integrator and step, with a warning saying so.
+    // The most steps (a frame's sub-steps of the trial population) the program's trials
+    // may run, the references' included: the cost of the choices is bounded whatever the
+    // horizon and however many objects state a tolerance (a @tolerance over 1000 s ran 12
+    // million, a minute on the JIT). Past it an object keeps its integrator and step, with
+    // a warning saying so.
     long budget = 2'000'000;
     // Set from another thread (an editor's newer text): the trials stop, nothing is chosen.
     const std::atomic<bool>* cancelled = nullptr;
@@ -75,7 +76,7 @@ struct Choice {
     std::string reference;  // what the reference was
     double largest = 0;     // the largest coordinate the reference (rk4 in double) draws
     bool trusted = true;    // false: its own error is over 1% of that — it has not settled
-    long steps = 0;         // run by the trials, the reference's included
+    long steps = 0;         // run by this object's trials, the reference's included
     bool exhausted = false; // the budget ran out (or the trials were cancelled) before a choice
     std::vector<Trial> trials;  // cheapest first
 };

@@ -53,7 +53,10 @@ def compile(path=None, *, source=None, name="<string>", backend="llvm", math="fa
         return _psys._compile(source, True, name, backend, math, seed, capacity, threads, optimize)
     if not isinstance(path, (str, bytes, os.PathLike)):
         raise TypeError(f"psys.compile: a path is text or os.PathLike, not {type(path).__name__}")
-    return _psys._compile(os.fsdecode(path), False, "", backend, math, seed, capacity, threads, optimize)
+    path = os.fsdecode(path)
+    if "\0" in path:  # the C API would read the path up to it: another file
+        raise ValueError("psys.compile: a path has no NUL character")
+    return _psys._compile(path, False, "", backend, math, seed, capacity, threads, optimize)
 
 
 

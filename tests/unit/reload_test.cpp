@@ -419,7 +419,8 @@ std::string carried(const ir::Module& m) {
     std::string out;
     for (const ir::Object& o : m.objects) {
         out += o.name + ":";
-        for (const ir::StateSlot& slot : o.state) out += " " + slot.name;
+        for (const ir::StateSlot& slot : o.state)  // (`carried%N`: written by each update before it is read)
+            if (slot.name.rfind("carried%", 0) != 0) out += " " + slot.name;
         out += " |";
         for (const ir::Param& p : o.params) out += p.kept ? " " + p.name : "";
         out += "\n";
@@ -433,10 +434,16 @@ TEST_CASE("what a reload carries is the program's own, whatever the maths: every
     // Under relaxed maths, integrals of what is fixed at creation become c·age and
     // `c + integrate(e)` one integral that starts at c; neither is a slot a reload can
     // carry, and it lost the velocity or the parameters (opt::PassOptions::reloadable).
-    for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
-        if (entry.path().extension() != ".psys") continue;
-        INFO(entry.path().filename().string());
-        std::string text = test::readFile(entry.path().string());
+    std::vector<std::pair<std::string, std::string>> programs;
+    for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR))
+        if (entry.path().extension() == ".psys")
+            programs.push_back({entry.path().filename().string(), test::readFile(entry.path().string())});
+    // Slots that relaxed maths' x/3 → x·(1/3) makes equal, and exact maths keeps apart: once
+    // merged under fast maths only.
+    programs.push_back({"two prevs", "object p(v: float) { a = prev(v / 3 + age); b = prev(v * 0.33333334 + age);\n"
+                                         "  point(vec3(a, b, 0), white, 1); }\nobject e { emit p(rand()) count 4; }\nspawn e;"});
+    for (const auto& [name, text] : programs) {
+        INFO(name);
         ir::Module relaxed = reloadable(text, true), exact = reloadable(text, false);
         CHECK(carried(relaxed) == carried(exact));
         for (const ir::Object& o : exact.objects)
@@ -449,7 +456,13 @@ TEST_CASE("what a reload carries is the program's own, whatever the maths: every
         rt::System after(std::move(exact), b);
         rt::ReloadReport report = after.carryOver(before);
         CHECK(report.dropped == 0);
-        CHECK(report.newSlots.empty());
-        CHECK(report.lostSlots.empty());
+        auto program = [](const std::vector<std::string>& slots) {
+            std::vector<std::string> out;
+            for (const std::string& s : slots)
+                if (s.find(".carried%") == std::string::npos) out.push_back(s);
+            return out;
+        };
+        CHECK(program(report.newSlots).empty());
+        CHECK(program(report.lostSlots).empty());
     }
 }

@@ -265,7 +265,7 @@ TEST_CASE("an object that draws nothing under a tolerance is a warning and keeps
                                       "step as written\n");
 }
 
-TEST_CASE("a choice costs at most its budget of steps whatever the horizon, and says when it ran out") {
+TEST_CASE("choices cost at most their budget of steps whatever the horizons, and say when it ran out") {
     // @tolerance(1e-3, 1000) ran 12 million steps (a minute; 1e6 s would have taken hours),
     // and a horizon of 1e20 s overflowed the count of frames.
     const std::string ball = "@tolerance(1e-3, HORIZON) object ball(v0: vec3) {\n"
@@ -285,6 +285,16 @@ TEST_CASE("a choice costs at most its budget of steps whatever the horizon, and 
         CHECK(c.diagnostics.find("stopped at their budget of 20000 steps before a choice") != std::string::npos);
         CHECK_FALSE(c.module->objects[0].attributes.integrator.has_value());  // as written
     }
+    // The budget is the program's: a second object under a tolerance gets what is left.
+    {
+        std::string two = ball;
+        two.replace(two.find("HORIZON"), 7, "1000");
+        two += "\n@tolerance(1e-3, 1000) object ball2 { pos = integrate(vec3(1, 0, 0)); point(pos, white, 1); }\nspawn ball2;";
+        Chosen c = compileUnderTolerance(two, 0, [](tune::TuneOptions& t) { t.budget = 20000; });
+        REQUIRE(c.choices.size() == 2);
+        CHECK(c.choices[0].steps + c.choices[1].steps <= 20000 + 32);
+        CHECK(c.choices[1].exhausted);
+    }
     // Within the budget the horizon is measured in full.
     std::string text = ball;
     text.replace(text.find("HORIZON"), 7, "2");
@@ -300,10 +310,9 @@ TEST_CASE("trials stop at once when cancelled (an editor's newer text), and noth
         "@tolerance(1e-4, 600) object ball { pos = integrate(vec3(1, 0, 0) + integrate(vec3(0, -1, 0))); "
         "point(pos, white, 1); }\nspawn ball;",
         0, [&](tune::TuneOptions& t) { t.cancelled = &cancelled; });
-    REQUIRE(c.choices.size() == 1);
-    CHECK(c.choices[0].exhausted);
-    CHECK(c.choices[0].steps <= 1);
+    CHECK(c.choices.empty());  // no object is tried once cancelled
     CHECK(c.diagnostics.find("warning") == std::string::npos);
+    CHECK_FALSE(c.module->objects[0].attributes.integrator.has_value());
 }
 
 TEST_CASE("a reference that does not settle is said to be untrustworthy, and nothing is chosen by it") {

@@ -1,5 +1,6 @@
 #include "build_command.h"
 
+#include <algorithm>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
@@ -30,42 +31,54 @@ std::string identifier(const std::string& name) {
 
 
 // A name the language accepts as a C parameter in C99 and C++17: with `_` after it where
-// it is a keyword of either (`int`, `default`, `class`, `new`, …) or a name the generated
-// functions use themselves (`system`, `v`).
+// it is a keyword of either (`int`, `default`, `class`, `new`, …), looks like a macro
+// (all capitals: `SIZE_MAX`), or would hide a function the body calls (`psys_fire`);
+// with `p` before it where it is reserved to the implementation (`_Atomic`, `__x`).
 std::string parameterName(const std::string& name) {
-    static const std::set<std::string> taken = {
-        // the generated functions' own
-        "system", "v",
-        // C99
+    static const std::set<std::string> keywords = {
+        // C99 and C11
         "auto", "break", "case", "char", "const", "continue", "default", "do", "double", "else", "enum", "extern",
         "float", "for", "goto", "if", "inline", "int", "long", "register", "restrict", "return", "short", "signed",
-        "sizeof", "static", "struct", "switch", "typedef", "union", "unsigned", "void", "volatile", "while", "_Bool",
-        "_Complex", "_Imaginary",
-        // C++17, its alternative tokens, and names the headers' macros take
+        "sizeof", "static", "struct", "switch", "typedef", "union", "unsigned", "void", "volatile", "while",
+        // C++17 and its alternative tokens; names the standard headers make macros of
         "alignas", "alignof", "and", "and_eq", "asm", "bitand", "bitor", "bool", "catch", "char16_t", "char32_t", "class",
         "compl", "constexpr", "const_cast", "decltype", "delete", "dynamic_cast", "explicit", "export", "false",
         "friend", "mutable", "namespace", "new", "noexcept", "not", "not_eq", "nullptr", "operator", "or", "or_eq",
         "private", "protected", "public", "reinterpret_cast", "static_assert", "static_cast", "template", "this",
         "thread_local", "throw", "true", "try", "typeid", "typename", "using", "virtual", "wchar_t", "xor", "xor_eq",
-        "NULL", "assert", "errno"};
-    return taken.count(name) ? name + "_" : name;
+        "assert", "errno", "offsetof"};
+    bool capitals = std::none_of(name.begin(), name.end(), [](char c) { return std::islower(static_cast<unsigned char>(c)); });
+    if (name.size() > 1 && name[0] == '_' && (name[1] == '_' || std::isupper(static_cast<unsigned char>(name[1]))))
+        return "p" + name;
+    if (keywords.count(name) || capitals || name.rfind("psys_", 0) == 0) return name + "_";
+    return name;
 }
 
-// The C parameters of a value of type `t` called `name`, and the statement that packs them
-// into `float v[]`.
-void parameters(const ir::Type& t, const std::string& language, std::string& list, std::vector<std::string>& values) {
+// The C parameters of a value of type `t` called `language`, and the statement that packs
+// them into `float v[]`; `used` holds the names taken already (the function's own
+// `system` and `v`, the parameters before), and a name taken gets `_` after it until it
+// is not (`int` beside `int_`).
+void parameters(const ir::Type& t, const std::string& language, std::string& list, std::vector<std::string>& values,
+                std::set<std::string>& used) {
     static const char* xyzw[] = {"x", "y", "z", "w"};
-    const std::string name = parameterName(language);
+    auto unique = [&](std::string name) {
+        while (used.count(name)) name += "_";
+        used.insert(name);
+        return name;
+    };
     if (t.isBool()) {
+        std::string name = unique(parameterName(language));
         list += ", int " + name;
         values.push_back(name + " ? 1.0f : 0.0f");
     } else if (t.width == 1) {
+        std::string name = unique(parameterName(language));
         list += ", float " + name;
         values.push_back(name);
     } else {
         for (int c = 0; c < t.width; ++c) {
-            list += fmt::format(", float {}_{}", name, xyzw[c]);
-            values.push_back(fmt::format("{}_{}", name, xyzw[c]));
+            std::string name = unique(parameterName(fmt::format("{}_{}", language, xyzw[c])));
+            list += ", float " + name;
+            values.push_back(name);
         }
     }
 }
@@ -92,7 +105,8 @@ std::string header(const ir::Module& m, const BuildOptions& o, const std::string
     for (const ir::Extern& e : m.externs) {
         std::string list;
         std::vector<std::string> values;
-        parameters(e.type, e.name, list, values);
+        std::set<std::string> used = {"system", "v"};
+        parameters(e.type, e.name, list, values, used);
         h += fmt::format("\n/* extern {}: {} */\nstatic inline psys_error* {}_set_{}(psys_system* system{}) {{\n"
                          "    const float v[] = {{{}}};\n    return psys_set_extern(system, \"{}\", v, {});\n}}\n",
                          e.name, rt::languageName(e), name, e.name, list, fmt::join(values, ", "), e.name, values.size());
@@ -100,8 +114,9 @@ std::string header(const ir::Module& m, const BuildOptions& o, const std::string
     for (const ir::Trigger& t : m.triggers) {
         std::string list, types;
         std::vector<std::string> values;
+        std::set<std::string> used = {"system", "v"};
         for (const ir::Param& p : t.params) {
-            parameters(p.type, p.name, list, values);
+            parameters(p.type, p.name, list, values, used);
             types += (types.empty() ? "" : ", ") + p.name + ": " + rt::languageName(p.type);
         }
         if (values.empty())

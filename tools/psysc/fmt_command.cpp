@@ -28,29 +28,34 @@ size_t firstDifferentLine(const std::string& a, const std::string& b) {
 // Replaces the file at `path` by `text` as editors do: through a symbolic link, the file
 // it names (the link stays a link); a file with other hard links, in place (a new file
 // would leave them the old text); else through a file beside it, renamed over it, so a
-// failure leaves the old one whole.
-bool writeBack(const std::string& path, const std::string& text) {
+// failure leaves the old one whole. Returns why it could not, or nothing.
+std::optional<std::string> writeBack(const std::string& path, const std::string& text) {
     std::error_code ec;
     fs::path target = fs::canonical(path, ec);
-    if (ec) return false;
+    if (ec) return ec.message();
     if (fs::hard_link_count(target, ec) > 1 && !ec) {
         std::ofstream out(target, std::ios::binary | std::ios::trunc);
         out << text;
-        return static_cast<bool>(out.flush());
+        if (!out.flush()) return std::string(std::strerror(errno));
+        return std::nullopt;
     }
     fs::path temporary = target.string() + ".psysfmt~";
     {
         std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+        if (!out) return "cannot create `" + temporary.string() + "`: " + std::strerror(errno);
         out << text;
         if (!out.flush()) {
+            std::string why = std::strerror(errno);
             fs::remove(temporary, ec);
-            return false;
+            return why;
         }
     }
     fs::permissions(temporary, fs::status(target, ec).permissions(), ec);
-    fs::rename(temporary, target, ec);
-    if (ec) fs::remove(temporary, ec);
-    return !ec;
+    std::error_code renamed;
+    fs::rename(temporary, target, renamed);
+    if (!renamed) return std::nullopt;
+    fs::remove(temporary, ec);  // (its own failure is not the one to report)
+    return renamed.message();
 }
 
 std::optional<std::string> readInput(const std::string& path, std::string& error) {
@@ -88,8 +93,8 @@ int formatFiles(const FormatOptions& options) {
                 failed = true;
             }
         } else if (options.write && path != "-") {
-            if (!same && !writeBack(path, *formatted)) {
-                std::cerr << "psysc: error: cannot write `" << path << "`: " << std::strerror(errno) << "\n";
+            if (auto why = same ? std::nullopt : writeBack(path, *formatted)) {
+                std::cerr << "psysc: error: cannot write `" << path << "`: " << *why << "\n";
                 failed = true;
             }
         } else {
