@@ -352,10 +352,14 @@ private:
     }
 
     // A bound on each type's objects: where emitters of emitters multiply past a few
-    // thousand (or a type emits itself), a capacity.
+    // thousand (or a type emits itself), a capacity. What triggers create counts as a
+    // start as spawns do (a type only a trigger created once emitted itself at 200 a
+    // second uncapped: a million objects, and the case timed out).
     void capPopulations() {
         std::vector<double> pop(m_.types.size(), 0);
         for (const auto& s : m_.spawns) pop[static_cast<size_t>(s.first)] += 1;
+        for (const Trigger& tr : m_.triggers)
+            for (const Emit& e : tr.emits) pop[static_cast<size_t>(e.target)] += 40;
         for (int round = 0; round < 6; ++round)
             for (size_t from = 0; from < m_.types.size(); ++from)
                 for (const Emit& e : m_.types[from].emits) {
