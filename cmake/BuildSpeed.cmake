@@ -5,6 +5,13 @@
 #     back from ~/.cache/ccache instead of compiled.
 #   - mold, where it is installed: the links (psysc, the viewer, the LLVM tests and the
 #     benchmarks link LLVM's static libraries) take a fraction of ld.bfd's time.
+#   - PSYS_UNITY (scripts/test.sh, scripts/demo.sh and scripts/fuzz.sh build with it): each
+#     target's sources compiled up to 16 at a time as one translation unit, so the headers
+#     they share (the standard library, fmt, LLVM, the ANTLR runtime, our own) are read and
+#     their templates instantiated once a batch, not once a file: a cold build in less than
+#     half the time. A change recompiles its whole batch, so a build by hand, which is
+#     rebuilt file by file, keeps it off. Files whose names would clash with a neighbour's
+#     (a file-wide `using namespace`) say SKIP_UNITY_BUILD_INCLUSION where they are listed.
 #   - PSYS_DEBUG_INFO: how much debug information RelWithDebInfo and Debug carry. `full`
 #     (-g, by default: a build by hand is debugged), `lines` (-g1: file and line in a
 #     backtrace, gdb and the sanitizers' reports, and a quarter less compile time: what
@@ -27,6 +34,12 @@ if(PSYS_MOLD)
   if(PSYS_HAVE_MOLD)
     add_link_options(-fuse-ld=mold)
   endif()
+endif()
+
+option(PSYS_UNITY "Compile each target's sources in batches (a unity build)" OFF)
+if(PSYS_UNITY)
+  set(CMAKE_UNITY_BUILD ON)
+  set(CMAKE_UNITY_BUILD_BATCH_SIZE 16)
 endif()
 
 set(PSYS_DEBUG_INFO full CACHE STRING "Debug information in RelWithDebInfo and Debug builds: full, lines or none")

@@ -39,7 +39,10 @@
 
 namespace psys::codegen_llvm {
 
-namespace {
+// Named, not anonymous: JitEngine::Impl holds an ObjectCache, and a member of an
+// internal type in a type with linkage is an error (-Wsubobject-linkage) wherever this
+// file is not the main file (the unity build includes it).
+namespace jit_detail {
 
 // Keeps what the loop vectorizer says about each loop; every other diagnostic goes to
 // LLVM's default printing (none is expected).
@@ -196,7 +199,9 @@ private:
     Remarks remarks_;
 };
 
-}  // namespace
+}  // namespace jit_detail
+
+using namespace jit_detail;
 
 // Records the external symbols each linked graph refers to: which library functions the
 // compiled code calls (the vector maths it was meant to use, say).

@@ -31,7 +31,7 @@ namespace {
 // Bucket counts to each bucket's first place: per group of 1024 buckets its sum (pass 0),
 // the groups' sums scanned in place by one group (pass 1), each group's buckets scanned
 // from its offset (pass 2), the total after the last bucket.
-const char* kScan = R"(
+const char* kGridScan = R"(
 layout(local_size_x = 256) in;
 layout(std430, binding = 4) readonly buffer Counts { uint counts[]; };
 layout(std430, binding = 5) buffer Start { uint start[]; };
@@ -84,7 +84,7 @@ void main() {
 )";
 
 // Each row to a place in its bucket (the order within one set by the sort after).
-const char* kScatter = R"(
+const char* kGridScatter = R"(
 layout(local_size_x = 256) in;
 layout(std430, binding = 3) readonly buffer BucketOf { uint bucketOf[]; };
 layout(std430, binding = 4) buffer Cursor { uint cursor[]; };
@@ -244,8 +244,8 @@ bool GlslBackend::fold(const rt::FoldLaunch& l) {
     if (!fold_) {
         fold_ = std::make_unique<FoldWork>();
         fold_->count = computeProgram(codegen_glsl::gridCountShader(), "the neighbour grid's count");
-        fold_->scan = computeProgram(utility(kScan), "the neighbour grid's scan");
-        fold_->scatter = computeProgram(utility(kScatter), "the neighbour grid's scatter");
+        fold_->scan = computeProgram(utility(kGridScan), "the neighbour grid's scan");
+        fold_->scatter = computeProgram(utility(kGridScatter), "the neighbour grid's scatter");
         fold_->sort = computeProgram(utility(kSort), "the neighbour grid's sort");
         fold_->place = computeProgram(utility(kPlace), "the neighbour grid's placing");
     }

@@ -12,7 +12,7 @@ source scripts/stages.sh
 stage "set-up" bash scripts/setup.sh run
 # Without the tests and benchmarks, which need packages only the test profile installs.
 stage "configure" cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DBUILD_TESTING=OFF -DPSYS_BENCH=OFF \
-  -DPSYS_DEBUG_INFO=lines
+  -DPSYS_DEBUG_INFO=lines -DPSYS_UNITY=ON
 stage "build psysc and psys-view" cmake --build build -j "$(nproc)" --target psysc psys-view
 
 stage "check" build/tools/psysc/psysc check --time "$sample"

@@ -14,7 +14,7 @@ bash scripts/setup.sh test >/dev/null
 
 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_COMPILER=clang++-19 -DPSYS_FUZZ=ON -DPSYS_WERROR=OFF -DBUILD_TESTING=OFF -DPSYS_BENCH=OFF \
-  -DPSYS_DEBUG_INFO=lines >/dev/null
+  -DPSYS_DEBUG_INFO=lines -DPSYS_UNITY=ON >/dev/null
 cmake --build build-fuzz -j "$(nproc)" --target fuzz_frontend fuzz_ir fuzz_pipeline
 
 seeds=build-fuzz/seeds

@@ -17,14 +17,14 @@ sanitize=1
 [ "${PSYS_SKIP_SANITIZE:-0}" = 1 ] && sanitize=0
 
 stage "release: configure" cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPSYS_WERROR=ON \
-  -DBUILD_TESTING=ON -DPSYS_BENCH=ON -DPSYS_DEBUG_INFO=lines
+  -DBUILD_TESTING=ON -DPSYS_BENCH=ON -DPSYS_DEBUG_INFO=lines -DPSYS_UNITY=ON
 stage "release: build" cmake --build build -j "$jobs"
 
 # Under the sanitizers, the tests without the benchmarks: the release stage runs each once
 # (bench.*), and their loops are the library's, which the tests run here.
 if [ $sanitize = 1 ]; then
   stage "asan: configure" cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DPSYS_WERROR=ON -DPSYS_SANITIZE=ON \
-    -DBUILD_TESTING=ON -DPSYS_BENCH=OFF -DPSYS_DEBUG_INFO=lines
+    -DBUILD_TESTING=ON -DPSYS_BENCH=OFF -DPSYS_DEBUG_INFO=lines -DPSYS_UNITY=ON
   stage "asan: build" cmake --build build-asan -j "$jobs"
 fi
 

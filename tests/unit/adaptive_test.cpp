@@ -12,11 +12,10 @@
 
 using namespace psys;
 using core::Integrator;
+using test::kFrame;
 using test::Run;
 
 namespace {
-
-constexpr double kFrame = 1.0 / 60;
 
 // From (1, 0) at the far end of an orbit of eccentricity 0.6 about a unit mass: nearest at
 // r = 0.25, four times closer, where it is four times faster; period 2π·0.625^1.5 ≈ 3.10 s.

@@ -18,11 +18,11 @@
 
 using namespace psys;
 using core::Integrator;
+using test::kFrame;
 using test::Run;
 
 namespace {
 
-constexpr double kFrame = 1.0 / 60;
 constexpr float kEps = std::numeric_limits<float>::epsilon();
 
 std::vector<Integrator> allMethods() {

@@ -23,6 +23,9 @@
 
 namespace psys::test {
 
+// One frame at 60 frames a second: the step the run tests take.
+inline constexpr double kFrame = 1.0 / 60;
+
 // A projectile thrown at (1, 10, 0) under gravity, drawn where it is: a program with
 // closed forms that several tests run.
 constexpr const char* kProjectile = R"(
