@@ -21,6 +21,7 @@
 
 #include <functional>
 
+#include "ir/carried.h"
 #include "opt/passes.h"
 #include "opt/rewrite.h"
 
@@ -117,7 +118,7 @@ private:
         for (auto& [slot, value] : carried_)
             if (value == v) return slot;
         const Inst& inst = b_.at(v);
-        object_.state.push_back({inst.name.empty() ? fmt::format("carried%{}", v) : "carried." + inst.name, inst.type,
+        object_.state.push_back({inst.name.empty() ? fmt::format("{}%{}", kCarriedSlot, v) : fmt::format("{}.{}", kCarriedSlot, inst.name), inst.type,
                                  StateInit::Next});
         int slot = static_cast<int>(object_.state.size() - 1);
         carried_.push_back({slot, v});

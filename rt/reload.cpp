@@ -6,7 +6,9 @@
 // an export is carried when the new type has one of the same name and type; a slot the
 // new type adds starts as it would have at the object's creation (its init value,
 // evaluated at the creation time with the carried parameters; parameters the old type did
-// not keep read 0); what the new type no longer has is dropped. Parents are kept when the
+// not keep read 0); what the new type no longer has is dropped. The report names the
+// slots added and dropped, but for those split-kernels carries (ir/carried.h), which an
+// edit renumbers and every update writes before they are read. Parents are kept when the
 // new child type's parent type is the old one's; readers are counted again, and a frozen
 // object nobody reads any more is freed. Time, the step count, ids and externs (by name
 // and type) continue. The start does not run again, but for a `spawn` of a type the old
@@ -15,6 +17,7 @@
 #include <map>
 #include <set>
 
+#include "ir/carried.h"
 #include "rt/rng.h"
 #include "rt/system_create.h"
 #include "rt/system_draw.h"
@@ -69,10 +72,10 @@ void carryType(const detail::State& old, size_t ot, detail::State& s, size_t t, 
     to.fresh = from.freshRows();
     for (auto [i, j] : matchByName(o.state, oo.state)) {
         if (j >= 0) copyValues(old.memory, from.state, static_cast<size_t>(j), s.memory, to.state, i, rows);
-        else report.newSlots.push_back(o.name + "." + o.state[i].name);
+        else if (!ir::isCarried(o.state[i])) report.newSlots.push_back(o.name + "." + o.state[i].name);
     }
     for (auto [j, i] : matchByName(oo.state, o.state))
-        if (i < 0) report.lostSlots.push_back(o.name + "." + oo.state[j].name);
+        if (i < 0 && !ir::isCarried(oo.state[j])) report.lostSlots.push_back(o.name + "." + oo.state[j].name);
     for (size_t p = 0; p < o.params.size(); ++p) {
         if (to.paramColumn[p] < 0) continue;
         for (size_t q = 0; q < oo.params.size(); ++q)
