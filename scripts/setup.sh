@@ -16,6 +16,7 @@ case $profile in run | editor | test) ;; *) echo "usage: bash scripts/setup.sh [
 run_packages=(
   cmake ninja-build pkg-config g++ git ccache mold
   antlr4 libantlr4-runtime-dev
+  uuid-dev  # the ANTLR runtime's CMake package links -luuid; Debian's -dev package does not pull it in
   llvm-19-dev libzstd-dev
   libglm-dev libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libimgui-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev libstb-dev libtbb-dev
