@@ -1,5 +1,6 @@
 #include "ir/evaluate.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "core/hash.h"
@@ -17,16 +18,20 @@ bool equal(const Value& a, const Value& b, const Type& t) {
     return true;
 }
 
-// A componentwise op over the lanes, with the op known at compile time so that
+// A componentwise op over the lanes of n rows, with the op known at compile time so that
 // core::lane's dispatch folds away (this is the interpreter's inner loop).
 template <Op op, int arity>
-Value lanes(const Value* operands, size_t width) {
-    Value out;
-    if constexpr (arity == 1)
-        for (size_t l = 0; l < width; ++l) out.f[l] = core::lane(op, operands[0].f[l]);
-    else if constexpr (arity == 2)
-        for (size_t l = 0; l < width; ++l) out.f[l] = core::lane(op, operands[0].f[l], operands[1].f[l]);
-    return out;
+void lanes(const Value* const* operands, size_t width, Value* out, size_t n) {
+    // Lane by lane into `out` itself: a Value built on the stack and copied whole stalls
+    // on store forwarding (its lanes stored one by one, then loaded as one).
+    for (size_t row = 0; row < n; ++row) {
+        Value& v = out[row];
+        v = Value{};
+        if constexpr (arity == 1)
+            for (size_t l = 0; l < width; ++l) v.f[l] = core::lane(op, operands[0][row].f[l]);
+        else if constexpr (arity == 2)
+            for (size_t l = 0; l < width; ++l) v.f[l] = core::lane(op, operands[0][row].f[l], operands[1][row].f[l]);
+    }
 }
 
 // Every unary and binary componentwise op of core/ops.h's table, through core/lanes.h.
@@ -35,23 +40,20 @@ bool laneWise(Op op) {
     return isPure(op) && isComponentwise(op) && (arity == 1 || arity == 2);
 }
 
-Value lanesOf(Op op, const Value* operands, size_t width) {
+void lanesOf(Op op, const Value* const* operands, size_t width, Value* out, size_t n) {
     switch (op) {
 #define PSYS_LANES(id, text, arity, kind, flags, delayed, spelling) \
-    case Op::id: return lanes<Op::id, arity>(operands, width);
+    case Op::id: lanes<Op::id, arity>(operands, width, out, n); return;
         PSYS_OPS(PSYS_LANES)
 #undef PSYS_LANES
     }
-    return {};
 }
 
-}  // namespace
-
-Value evaluate(const Inst& inst, const Value* operands, const Type* operandTypes) {
+// Every other pure op, on one row: `operands[i][row]` is operand i's value.
+Value other(const Inst& inst, const Value* const* operands, const Type* operandTypes, size_t row) {
     const auto w = static_cast<size_t>(inst.type.width);
-    auto a = [&](size_t i) -> const Value& { return operands[i]; };
+    auto a = [&](size_t i) -> const Value& { return operands[i][row]; };
     Value out;
-    if (laneWise(inst.op)) return lanesOf(inst.op, operands, w);
     switch (inst.op) {
         case Op::Lt: case Op::Le: case Op::Gt: case Op::Ge:
             return Value::boolean(core::compare(inst.op, a(0).f[0], a(1).f[0]));
@@ -87,53 +89,97 @@ Value evaluate(const Inst& inst, const Value* operands, const Type* operandTypes
     }
 }
 
+// One pure instruction on n rows: `operands[i]` points at operand i's n values.
+void evaluateRows(const Inst& inst, const Value* const* operands, const Type* operandTypes, Value* out, size_t n) {
+    if (laneWise(inst.op)) return lanesOf(inst.op, operands, static_cast<size_t>(inst.type.width), out, n);
+    for (size_t row = 0; row < n; ++row) out[row] = other(inst, operands, operandTypes, row);
+}
+
+}  // namespace
+
+Value evaluate(const Inst& inst, const Value* operands, const Type* operandTypes) {
+    std::vector<const Value*> each(inst.operands.size());
+    for (size_t i = 0; i < each.size(); ++i) each[i] = operands + i;  // one row each
+    Value out;
+    evaluateRows(inst, each.data(), operandTypes, &out, 1);
+    return out;
+}
+
 void Evaluator::run(const Kernel& kernel, const KernelInputs& in, std::vector<Value>& yields) {
-    registers_.resize(kernel.size());
-    std::vector<Value>& r = registers_;
+    run(kernel, std::span<const KernelInputs>(&in, 1), yields);
+}
+
+// Instruction by instruction, each over every row: the dispatch is paid once per
+// instruction and batch, not per row. Register v of row r is registers_[v * n + r].
+void Evaluator::run(const Kernel& kernel, std::span<const KernelInputs> rows, std::vector<Value>& yields) {
+    const size_t n = rows.size();
+    if (registers_.size() < kernel.size() * n) registers_.resize(kernel.size() * n);
+    Value* const r = registers_.data();
     size_t parent = 0;
     core::HostAlgebra host;
     for (ValueId v = 0; v < kernel.size(); ++v) {
         const Inst& inst = kernel.at(v);
-        Value out;
+        Value* out = r + v * n;
+        auto each = [&](auto&& value) {
+            for (size_t row = 0; row < n; ++row) out[row] = value(rows[row], row);
+        };
         switch (inst.op) {
-            case Op::Const: out.f = inst.constant; break;
-            case Op::Param: case Op::TriggerParam: out = in.params[inst.attr]; break;
-            case Op::StateRead: out = in.state[inst.attr]; break;
-            case Op::Extern: out = in.externs[inst.attr]; break;
-            case Op::Uniform: out = in.uniforms[inst.attr]; break;
-            case Op::Age: out = Value::scalar(in.age); break;
-            case Op::Dt: out = Value::scalar(in.dt); break;
-            case Op::Time: out = Value::scalar(in.time); break;
-            case Op::First: out = Value::boolean(in.first); break;
-            case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge: case Op::Fold: out = in.parents[parent++]; break;
-            case Op::NeighbourExport: out = (inst.attr2 ? in.other : in.self)[inst.attr]; break;
-            case Op::ObjectId: out.u = in.objectId; break;
-            case Op::DrawIndex: out.u = inst.attr == 1 ? in.childDraw : in.draw; break;
+            case Op::Const: {
+                Value c;
+                c.f = inst.constant;
+                std::fill(out, out + n, c);
+                break;
+            }
+            case Op::Param: case Op::TriggerParam: each([&](const KernelInputs& in, size_t) { return in.params[inst.attr]; }); break;
+            case Op::StateRead: each([&](const KernelInputs& in, size_t) { return in.state[inst.attr]; }); break;
+            case Op::Extern: each([&](const KernelInputs& in, size_t) { return in.externs[inst.attr]; }); break;
+            case Op::Uniform: each([&](const KernelInputs& in, size_t) { return in.uniforms[inst.attr]; }); break;
+            case Op::Age: each([](const KernelInputs& in, size_t) { return Value::scalar(in.age); }); break;
+            case Op::Dt: each([](const KernelInputs& in, size_t) { return Value::scalar(in.dt); }); break;
+            case Op::Time: each([](const KernelInputs& in, size_t) { return Value::scalar(in.time); }); break;
+            case Op::First: each([](const KernelInputs& in, size_t) { return Value::boolean(in.first); }); break;
+            case Op::ParentExport: case Op::ParentAlive: case Op::ParentAge: case Op::Fold:
+                each([&](const KernelInputs& in, size_t) { return in.parents[parent]; });
+                ++parent;
+                break;
+            case Op::NeighbourExport:
+                each([&](const KernelInputs& in, size_t) { return (inst.attr2 ? in.other : in.self)[inst.attr]; });
+                break;
+            case Op::ObjectId:
+                each([](const KernelInputs& in, size_t) { Value x; x.u = in.objectId; return x; });
+                break;
+            case Op::DrawIndex:
+                each([&](const KernelInputs& in, size_t) { Value x; x.u = inst.attr == 1 ? in.childDraw : in.draw; return x; });
+                break;
             case Op::Rand: case Op::NRand: {
-                uint32_t object = r[inst.operands[0]].u, draw = r[inst.operands[1]].u;
-                for (int i = 0; i < inst.type.width; ++i)
-                    out.f[static_cast<size_t>(i)] = core::drawLane(host, inst.op, in.seed, object,
-                                                                   static_cast<uint32_t>(inst.attr), draw,
-                                                                   static_cast<uint32_t>(i));
+                const Value* object = r + inst.operands[0] * n;
+                const Value* draw = r + inst.operands[1] * n;
+                each([&](const KernelInputs& in, size_t row) {
+                    Value x;
+                    for (int i = 0; i < inst.type.width; ++i)
+                        x.f[static_cast<size_t>(i)] = core::drawLane(host, inst.op, in.seed, object[row].u,
+                                                                     static_cast<uint32_t>(inst.attr), draw[row].u,
+                                                                     static_cast<uint32_t>(i));
+                    return x;
+                });
                 break;
             }
             default:
                 if (!isPure(inst.op)) throw std::runtime_error(unexpectedOp(inst, "the interpreter"));
-                operandValues_.clear();
+                operandRows_.clear();
                 operandTypes_.clear();
                 for (ValueId o : inst.operands) {
-                    operandValues_.push_back(r[o]);
+                    operandRows_.push_back(r + o * n);
                     operandTypes_.push_back(kernel.at(o).type);
                 }
-                out = evaluate(inst, operandValues_.data(), operandTypes_.data());
+                evaluateRows(inst, operandRows_.data(), operandTypes_.data(), out, n);
                 break;
         }
-        r[v] = out;
     }
-    yields.resize(kernel.yields.size());
-    for (size_t i = 0; i < kernel.yields.size(); ++i) yields[i] = r[kernel.yields[i].value];
+    yields.resize(kernel.yields.size() * n);
+    for (size_t i = 0; i < kernel.yields.size(); ++i)
+        std::copy_n(r + kernel.yields[i].value * n, n, yields.begin() + static_cast<std::ptrdiff_t>(i * n));
 }
-
 bool evaluates(Op op) {
     switch (op) {
         case Op::Const: case Op::Param: case Op::TriggerParam: case Op::StateRead: case Op::Extern:

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "ir/ir.h"
@@ -41,10 +42,14 @@ class Evaluator {
 public:
     // `yields[i]` receives the value of `kernel.yields[i]`.
     void run(const Kernel& kernel, const KernelInputs& in, std::vector<Value>& yields);
+    // The kernel once for each of `rows` (rows are independent: each gives what it would
+    // alone, bit for bit); `yields[i * rows.size() + r]` receives row r's kernel.yields[i].
+    // A batch of a few dozen rows pays the per-instruction dispatch once for them all.
+    void run(const Kernel& kernel, std::span<const KernelInputs> rows, std::vector<Value>& yields);
 
 private:
     std::vector<Value> registers_;
-    std::vector<Value> operandValues_;
+    std::vector<const Value*> operandRows_;
     std::vector<Type> operandTypes_;
 };
 

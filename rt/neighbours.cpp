@@ -127,24 +127,32 @@ public:
         size_t otherExports = 0;
         for (const Read& r : reads_)
             if (r.other) otherExports = std::max(otherExports, static_cast<size_t>(r.exportIndex) + 1);
-        other_.resize(otherExports);
+        otherWidth_ = otherExports;
     }
 
+    // The terms of `count` others, evaluated kBatch at a time (ir::Evaluator's batches:
+    // each as alone) and combined in the others' order.
     void operator()(const float* const* self, const float* const* other, uint32_t selfRow, const uint32_t* others,
                     uint32_t count, float* acc) {
-        load(self, selfRow, false, self_);
-        ir::KernelInputs in;
-        in.externs = externs_;
-        in.self = self_.data();
-        in.other = other_.data();
-        for (uint32_t k = 0; k < count; ++k) {
-            load(other, others[k], true, other_);
-            evaluator_.run(pair_, in, values_);
-            for (size_t y = 0; y < folds_.size(); ++y)
-                for (int c = 0; c < folds_[y].width; ++c) {
-                    float& a = acc[folds_[y].offset + static_cast<size_t>(c)];
-                    a = core::combine(folds_[y].reduce, a, values_[y].f[static_cast<size_t>(c)]);
-                }
+        load(self, selfRow, false, self_.data());
+        const size_t nOther = otherWidth_;
+        for (uint32_t first = 0; first < count; first += kBatch) {
+            const size_t n = std::min<size_t>(kBatch, count - first);
+            other_.resize(n * nOther);
+            inputs_.assign(n, ir::KernelInputs{});
+            for (size_t k = 0; k < n; ++k) {
+                load(other, others[first + k], true, other_.data() + k * nOther);
+                inputs_[k].externs = externs_;
+                inputs_[k].self = self_.data();
+                inputs_[k].other = other_.data() + k * nOther;
+            }
+            evaluator_.run(pair_, inputs_, values_);
+            for (size_t k = 0; k < n; ++k)
+                for (size_t y = 0; y < folds_.size(); ++y)
+                    for (int c = 0; c < folds_[y].width; ++c) {
+                        float& a = acc[folds_[y].offset + static_cast<size_t>(c)];
+                        a = core::combine(folds_[y].reduce, a, values_[y * n + k].f[static_cast<size_t>(c)]);
+                    }
         }
     }
 
@@ -153,7 +161,8 @@ private:
         bool other;
         int exportIndex, width;
     };
-    void load(const float* const* columns, uint32_t row, bool other, std::vector<Value>& out) const {
+    static constexpr size_t kBatch = 64;  // others a batch of evaluations
+    void load(const float* const* columns, uint32_t row, bool other, Value* out) const {
         for (const Read& r : reads_) {
             if (r.other != other) continue;
             for (int c = 0; c < r.width; ++c)
@@ -170,7 +179,9 @@ private:
     const Value* externs_;
     std::vector<Term> folds_;  // per yield
     std::vector<Read> reads_;
-    std::vector<Value> self_, other_, values_;
+    std::vector<Value> self_, other_, values_;  // other_: kBatch others' exports, otherWidth_ each
+    size_t otherWidth_ = 0;
+    std::vector<ir::KernelInputs> inputs_;
     ir::Evaluator evaluator_;
 };
 

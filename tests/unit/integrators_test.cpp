@@ -46,7 +46,7 @@ float phiInFloat(int n, float z) {
     k.yields.push_back({ir::YieldKind::Uniform, 0, 0, v});
     ir::Evaluator e;
     std::vector<ir::Value> out;
-    e.run(k, {}, out);
+    e.run(k, ir::KernelInputs{}, out);
     return out[0].f[0];
 }
 
