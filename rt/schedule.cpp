@@ -42,6 +42,12 @@ std::string names(const Schedule& s, const std::vector<int>& types) {
     return out;
 }
 
+// Whether `type`'s update runs in sub-steps (a group of the schedule's).
+bool subStepped(const Schedule& s, int type) {
+    return std::any_of(s.phases.begin(), s.phases.end(),
+                       [&](const Phase& p) { return p.kind == PhaseKind::SubSteps && p.type == type; });
+}
+
 std::string describe(const Schedule& s, const Phase& p) {
     std::string type = p.type >= 0 ? s.types[static_cast<size_t>(p.type)] : "";
     switch (p.kind) {
@@ -65,6 +71,9 @@ std::string describe(const Schedule& s, const Phase& p) {
         }
         case PhaseKind::Kills:
             if (p.inMemory) return fmt::format("{}: the kill lists kept for the step's end, where the memory frees them", type);
+            if (p.late && subStepped(s, p.type))
+                return fmt::format("{}: the last sub-step's listed kills kept for the step's end (nobody looks at them "
+                                   "before); an earlier sub-step's killed rows frozen at once, in row order", type);
             return p.late ? fmt::format("{}: the listed kills kept for the step's end (nobody looks at them before)", type)
                           : fmt::format("{}: the killed rows frozen, in row order", type);
         case PhaseKind::Emissions: {

@@ -37,7 +37,10 @@ struct Phase {
     int type = -1;              // the object type it works on, or -1
     size_t span = 0;            // SubSteps: how many of the phases after it repeat
     double stepLimit = 0;       // SubSteps: @step(h)
-    bool late = false;          // Kills: listed by the update's chunks, taken at the step's end (LateKills)
+    // Update, Kills: listed by the update's chunks, taken at the step's end (LateKills); in
+    // a sub-step group, in its last sub-step only (an earlier one's kills are taken at once:
+    // the next sub-step must not update the dead). The runner reads this, not the type.
+    bool late = false;
     bool listed = false;        // Kills: the update's chunks listed the killed rows (no scan of flags)
     bool exports = false;       // Update: the survivors' exports in the same chunk
     bool render = false;        // Update: the render in the same chunk, when the host draws every step

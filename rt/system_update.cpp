@@ -118,7 +118,7 @@ RowsLaunch poolUpdate(State& s, size_t type, double dt, double t1) {
 // allows), what each chunk killed listed by the chunk; the kills and emissions are the
 // phases after it (runKills, runEmissions), in row order, so that ids, the queue and the
 // free list come out the same with any number of threads.
-void runUpdate(State& s, size_t type, double dt, double t1, bool last) {
+void runUpdate(State& s, size_t type, double dt, double t1, bool last, bool late) {
     Pool& pool = s.pools[type];
     TypeInfo& info = s.types[type];
     TypeWork& work = s.work[type];
@@ -149,10 +149,10 @@ void runUpdate(State& s, size_t type, double dt, double t1, bool last) {
     const uint8_t* updatable = info.rowsInMemory ? nullptr : pool.mask();
     const auto* kill = s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]);
     // Objects that only die (no rate emits) are found while their chunk is in cache; where
-    // nobody looks at them before the end of the step (the last sub-step of a type whose
-    // dead nobody reads), they are taken then (LateKills), and a device need not wait.
+    // nobody looks at them before the end of the step (`late`: the schedule's phase says so,
+    // Phase::late, and this is the step's last sub-step), they are taken then (LateKills),
+    // and a device need not wait.
     bool listKills = info.kills && !info.updateEmits;
-    bool late = info.late && last;
     size_t chunks = s.chunkCount(rows);
     work.pass = {true, late, listKills && !late, chunks, {}};
     if (listKills || late) work.killed.resize(chunks);  // each chunk sets its own (State::latePart)

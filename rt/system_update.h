@@ -9,7 +9,7 @@ namespace psys::rt::detail {
 // The phases of a step over `type`'s pool for (t1 − dt, t1] (one sub-step of @step, the
 // `last` ending the step): the update pass (update, the survivors' exports, the render as
 // it goes), its kills, the survivors' rate emissions (queued for Creation).
-void runUpdate(State& state, size_t type, double dt, double t1, bool last);
+void runUpdate(State& state, size_t type, double dt, double t1, bool last, bool late);
 void runKills(State& state, size_t type, double dt, double t1);
 void runEmissions(State& state, Creation& creation, size_t type, double dt, double t1);
 

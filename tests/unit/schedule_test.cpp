@@ -140,3 +140,47 @@ TEST_CASE("a new object's first update has dt its age at the step's end, compute
         for (const rt::RenderPoint& p : points) CHECK(p.position[0] == doctest::Approx(p.position[1]).epsilon(1e-5));
     }
 }
+
+namespace {
+
+// Whether each update launch over the motes' pool (a uniform clock: not a creation's) was late.
+struct UpdateLateness : rt::Backend {
+    interp::Interpreter inner;
+    std::vector<bool> late;
+    std::string name() const override { return "lateness"; }
+    rt::Memory& memory() override { return inner.memory(); }
+    rt::RowsResult run(const rt::RowsLaunch& l) override {
+        if (l.object->name == "mote" && l.kernel->kind == ir::KernelKind::Update && l.clock.now == rt::Clock::Source::Uniform &&
+            l.clock.dt == rt::Clock::Source::Uniform && l.begin == 0)
+            late.push_back(l.late);
+        return inner.run(l);
+    }
+    void run(const rt::ChildrenLaunch& l) override { inner.run(l); }
+};
+
+}  // namespace
+
+TEST_CASE("under @step the printed schedule says what runs: only the last sub-step's kills are kept for the step's end") {
+    // The motes only die and nobody reads them: their kills are late — in the last of the
+    // step's 4 sub-steps; an earlier sub-step's dead are taken at once (the next sub-step
+    // must not update them).
+    std::string text = R"(
+        @step(0.005) object mote { x = integrate(1); point(vec3(x), white, 1); kill when age > 0.05 + 0.2 * rand(); }
+        object e { emit mote count 50; }
+        spawn e;)";
+    UpdateLateness backend;
+    rt::System system(test::compileModule(text), backend);
+    const rt::Schedule& s = system.schedule();
+    auto kills = std::find_if(s.phases.begin(), s.phases.end(), [&](const rt::Phase& p) {
+        return p.kind == rt::PhaseKind::Kills && s.types[static_cast<size_t>(p.type)] == "mote";
+    });
+    REQUIRE(kills != s.phases.end());
+    CHECK(kills->late);
+    CHECK(rt::printSchedule(s).find("mote: the last sub-step's listed kills kept for the step's end (nobody looks at "
+                                    "them before); an earlier sub-step's killed rows frozen at once") != std::string::npos);
+    for (int f = 0; f < 3; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
+    // The motes are created at the start; each step updates them in 4 sub-steps.
+    std::string seen;
+    for (bool l : backend.late) seen += l ? "L" : ".";
+    CHECK(seen == "...L...L...L");
+}
