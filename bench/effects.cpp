@@ -26,16 +26,17 @@ const Effect* findEffect(const std::string& name) {
     return e == kEffects.end() ? nullptr : &*e;
 }
 
+std::string samplesDir() {
+    const char* dir = std::getenv("PSYS_SAMPLES_DIR");
+    return dir && *dir ? dir : PSYS_SAMPLES_DIR;
+}
+
 ir::Module compileEffect(const std::string& name, bool relaxed) {
     SourceManager sources;
     DiagnosticEngine diags(sources);
     CompileOptions options;
     options.pipeline.pass.relaxed = relaxed;
-    // The samples of the source tree, or where the environment says (a GPU bundle carries
-    // them beside its binaries: scripts/gpu-bundle.sh).
-    const char* dir = std::getenv("PSYS_SAMPLES_DIR");
-    std::string samples = dir && *dir ? dir : PSYS_SAMPLES_DIR;
-    auto module = compileFile(samples + "/" + name + ".psys", sources, diags, options);
+    auto module = compileFile(samplesDir() + "/" + name + ".psys", sources, diags, options);
     if (!module) {
         diags.print(std::cerr, false);
         std::exit(1);

@@ -29,6 +29,10 @@ extern const std::vector<Effect> kEffects;
 // Null when there is no effect of that name.
 const Effect* findEffect(const std::string& name);
 
+// The samples' folder: the source tree's, or where the environment's PSYS_SAMPLES_DIR
+// says (a GPU bundle carries them beside its binaries: scripts/gpu-bundle.sh).
+std::string samplesDir();
+
 // The effect's sample, compiled (exits with the diagnostics if it does not compile);
 // `relaxed`: with the optimizer's relaxed rewrites, as fast maths on the JIT compiles
 // (host::BackendChoice::relaxesMaths).

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gpu_figures.h"
+#include "gpu_samples.h"
 #include "gpu_stress.h"
 #include "host_cache.h"
 #include "neighbours.h"
@@ -49,6 +50,12 @@ int main(int argc, char** argv) {
     app.add_flag("--neighbours", neighbours,
                  "Neighbour folds instead: a crowd of --particles (1e5 1e6 by default here), about 32 within reach of "
                  "each (bench/neighbours.h)");
+    bool samples = false;
+    app.add_flag("--samples", samples,
+                 "Every sample instead (or --only's), each scaled to --particles live objects (1e5 1e7 by default here) "
+                 "by starting its spawns many times: dispatches, waits and bytes between host and GPU a step");
+    std::vector<std::string> only;
+    app.add_option("--only", only, "With --samples: these samples only (their names, without .psys)");
     bool hostCache = false;
     app.add_flag("--host-cache", hostCache,
                  "What sharing the caches with a software GPU costs the host's thread: its fixed work between waits "
@@ -59,6 +66,15 @@ int main(int argc, char** argv) {
 
     auto gpu = bench::gpuBackend("psys_gpu_bench", hostRows);  // the emitters (few rows) on the host
     if (!gpu) return 1;
+    if (samples) {
+        bench::SampleScale scale;
+        if (app.count("--particles")) scale.sizes = sizes;
+        if (app.count("--frames")) scale.frames = frames;
+        scale.only = only;
+        std::cout << fmt::format("# psys_gpu_bench --samples on {}, host side: {}\n", gpu->report().target,
+                                 hostRows > 0 ? fmt::format("launches of at most {} rows", hostRows) : "off");
+        return bench::sampleFigures(std::cout, *gpu, scale, json);
+    }
     if (neighbours) {
         if (!app.count("--particles")) sizes = {1e5, 1e6};
         return bench::crowdFigures(std::cout, *gpu, sizes, frames);

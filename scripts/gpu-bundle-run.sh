@@ -2,7 +2,9 @@
 # run.sh of a GPU bundle (scripts/gpu-bundle.sh): psys's GPU tests, benchmark and samples
 # on this machine's GL, from wherever the bundle was unpacked.
 #   ./run.sh tests [doctest options]    the GPU test suite, then again in strict mode
-#   ./run.sh bench [bench options]      psys_gpu_bench (default: 1e5 1e6 1e7 particles)
+#   ./run.sh bench [bench options]      psys_gpu_bench (default: 1e5 1e6 1e7 particles); with
+#                                       --samples: every sample at 1e5 and 1e7 live objects, what
+#                                       a step costs the host (dispatches, waits, bytes)
 #   ./run.sh samples                    every sample on the GPU and on the interpreter: the same counts
 #   ./run.sh progen [options]           generated programs on every backend against the interpreter,
 #                                       on this GL and in strict mode (default: --minutes 5; the kept
