@@ -18,6 +18,8 @@
 #include <llvm/ExecutionEngine/Orc/JITTargetMachineBuilder.h>
 #include <unistd.h>
 
+#include "jit_build_id.h"  // PSYS_JIT_BUILD_ID (generated: codegen_llvm/CMakeLists.txt)
+
 #include <llvm/Config/llvm-config.h>
 #include <llvm/ExecutionEngine/JITLink/JITLink.h>
 #include <llvm/Object/ObjectFile.h>
@@ -114,13 +116,14 @@ public:
         std::string text;
         llvm::raw_string_ostream out(text);
         module.print(out, nullptr);
-        // This file's build stands for how modules are optimized and compiled: a new build
-        // of it never reads objects an older one made.
+        // This backend's sources stand for how modules are optimized and compiled (their
+        // hash, jit_build_id.h, made by the build): after an edit of them no object an
+        // older build made is read; a build of the same sources reads them all.
         return ir::Hasher()
             .add(text)
             .add(machine)
             .add(std::string_view(LLVM_VERSION_STRING))
-            .add(std::string_view(__DATE__ " " __TIME__))
+            .add(std::string_view(PSYS_JIT_BUILD_ID))
             .finish()
             .hex();
     }
