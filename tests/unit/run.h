@@ -55,6 +55,21 @@ struct Run {
     rt::TypeStats stats(const std::string& name) const { return system->stats().types[type(name)]; }
 };
 
+// The interpreter, shown each rows launch before it runs it: a test's look at what the
+// run-time asks of a backend.
+struct WatchedInterpreter : rt::Backend {
+    interp::Interpreter inner;
+    std::function<void(const rt::RowsLaunch&)> watch;
+    explicit WatchedInterpreter(std::function<void(const rt::RowsLaunch&)> w) : watch(std::move(w)) {}
+    std::string name() const override { return "watched"; }
+    rt::Memory& memory() override { return inner.memory(); }
+    rt::RowsResult run(const rt::RowsLaunch& l) override {
+        watch(l);
+        return inner.run(l);
+    }
+    void run(const rt::ChildrenLaunch& l) override { inner.run(l); }
+};
+
 // Every sample, the programs of tests/programs, and cells that emit their own type at
 // capacity (created after their type's update, some dying in their first update).
 inline std::vector<std::string> samplesAndPrograms() {

@@ -99,35 +99,22 @@ TEST_CASE("the schedule says which types keep their rows in the memory, and wher
     CHECK(rt::printSchedule(plain.schedule()).find("memory") == std::string::npos);  // the interpreter's own choice: the host
 }
 
-namespace {
-
-// The clocks of the update launches over creation batches (their clock is per row).
-struct FirstUpdateClocks : rt::Backend {
-    interp::Interpreter inner;
-    std::vector<std::pair<rt::Clock::Source, rt::Clock::Source>> clocks;
-    std::string name() const override { return "clocks"; }
-    rt::Memory& memory() override { return inner.memory(); }
-    rt::RowsResult run(const rt::RowsLaunch& l) override {
-        if (l.kernel->kind == ir::KernelKind::Update && l.clock.perRow()) clocks.push_back({l.clock.now, l.clock.dt});
-        return inner.run(l);
-    }
-    void run(const rt::ChildrenLaunch& l) override { inner.run(l); }
-};
-
-}  // namespace
-
 TEST_CASE("a new object's first update has dt its age at the step's end, computed by the backend — sub-steps under @step, per-row columns") {
     using S = rt::Clock::Source;
     for (bool step : {false, true}) {
         std::string text = std::string(step ? "@step(0.004) " : "") +
                            "object p { x = integrate(1); point(vec3(x, age, 0), white, 1); kill when age > 0.3; }\n"
                            "object e { emit p at 500 per second; }\nspawn e;";
-        FirstUpdateClocks backend;
+        // The clocks of the update launches over creation batches (their clock is per row).
+        std::vector<std::pair<S, S>> clocks;
+        test::WatchedInterpreter backend([&](const rt::RowsLaunch& l) {
+            if (l.kernel->kind == ir::KernelKind::Update && l.clock.perRow()) clocks.push_back({l.clock.now, l.clock.dt});
+        });
         rt::System system(test::compileModule(text), backend);
         for (int f = 0; f < 10; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
-        REQUIRE_FALSE(backend.clocks.empty());
+        REQUIRE_FALSE(clocks.empty());
         size_t subStepped = 0;  // batches where some object needs more than one sub-step
-        for (auto [now, dt] : backend.clocks) {
+        for (auto [now, dt] : clocks) {
             bool since = now == S::Uniform && dt == S::SinceCreated, columns = now == S::PerRow && dt == S::PerRow;
             CHECK((since || (step && columns)));
             subStepped += columns;
@@ -141,25 +128,6 @@ TEST_CASE("a new object's first update has dt its age at the step's end, compute
     }
 }
 
-namespace {
-
-// Whether each update launch over the motes' pool (a uniform clock: not a creation's) was late.
-struct UpdateLateness : rt::Backend {
-    interp::Interpreter inner;
-    std::vector<bool> late;
-    std::string name() const override { return "lateness"; }
-    rt::Memory& memory() override { return inner.memory(); }
-    rt::RowsResult run(const rt::RowsLaunch& l) override {
-        if (l.object->name == "mote" && l.kernel->kind == ir::KernelKind::Update && l.clock.now == rt::Clock::Source::Uniform &&
-            l.clock.dt == rt::Clock::Source::Uniform && l.begin == 0)
-            late.push_back(l.late);
-        return inner.run(l);
-    }
-    void run(const rt::ChildrenLaunch& l) override { inner.run(l); }
-};
-
-}  // namespace
-
 TEST_CASE("under @step the printed schedule says what runs: only the last sub-step's kills are kept for the step's end") {
     // The motes only die and nobody reads them: their kills are late — in the last of the
     // step's 4 sub-steps; an earlier sub-step's dead are taken at once (the next sub-step
@@ -168,7 +136,13 @@ TEST_CASE("under @step the printed schedule says what runs: only the last sub-st
         @step(0.005) object mote { x = integrate(1); point(vec3(x), white, 1); kill when age > 0.05 + 0.2 * rand(); }
         object e { emit mote count 50; }
         spawn e;)";
-    UpdateLateness backend;
+    // Whether each update launch over the motes' pool (a uniform clock: not a creation's) was late.
+    std::string seen;
+    test::WatchedInterpreter backend([&](const rt::RowsLaunch& l) {
+        if (l.object->name == "mote" && l.kernel->kind == ir::KernelKind::Update &&
+            l.clock.now == rt::Clock::Source::Uniform && l.clock.dt == rt::Clock::Source::Uniform && l.begin == 0)
+            seen += l.late ? "L" : ".";
+    });
     rt::System system(test::compileModule(text), backend);
     const rt::Schedule& s = system.schedule();
     auto kills = std::find_if(s.phases.begin(), s.phases.end(), [&](const rt::Phase& p) {
@@ -180,7 +154,5 @@ TEST_CASE("under @step the printed schedule says what runs: only the last sub-st
                                     "them before); an earlier sub-step's killed rows frozen at once") != std::string::npos);
     for (int f = 0; f < 3; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
     // The motes are created at the start; each step updates them in 4 sub-steps.
-    std::string seen;
-    for (bool l : backend.late) seen += l ? "L" : ".";
     CHECK(seen == "...L...L...L");
 }
