@@ -1,6 +1,7 @@
 #include "gpu_samples.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>

@@ -1,6 +1,7 @@
 #include "ir/evaluate.h"
 
 #include <algorithm>
+#include <array>
 #include <stdexcept>
 
 #include "core/hash.h"
@@ -98,10 +99,18 @@ void evaluateRows(const Inst& inst, const Value* const* operands, const Type* op
 }  // namespace
 
 Value evaluate(const Inst& inst, const Value* operands, const Type* operandTypes) {
-    std::vector<const Value*> each(inst.operands.size());
-    for (size_t i = 0; i < each.size(); ++i) each[i] = operands + i;  // one row each
+    // One row each: on the stack for the usual few operands (constant folding calls this
+    // for every instruction it folds), a vector past them.
+    std::array<const Value*, 8> few{};
+    std::vector<const Value*> many;
+    const Value** each = few.data();
+    if (inst.operands.size() > few.size()) {
+        many.resize(inst.operands.size());
+        each = many.data();
+    }
+    for (size_t i = 0; i < inst.operands.size(); ++i) each[i] = operands + i;
     Value out;
-    evaluateRows(inst, each.data(), operandTypes, &out, 1);
+    evaluateRows(inst, each, operandTypes, &out, 1);
     return out;
 }
 
