@@ -61,9 +61,24 @@ std::vector<uint32_t> GlslBackend::emitterBlock(GlMemory& memory, const Program&
 
 void GlslBackend::run(const rt::ChildrenLaunch& launch) { runChildren({&launch, 1}); }
 
-// In order, a run of launches of one spawn kernel on the GPU at a time; a launch small
-// enough for the host side (its columns there) runs there, after the launches before it.
-void GlslBackend::runChildren(std::span<const rt::ChildrenLaunch> launches) {
+// The launches of one spawn kernel together, one dispatch for those on the GPU; a launch
+// small enough for the host side (its columns there) runs there. A launch reads only its
+// emitter's row and writes only its own children's argument rows, so the order between
+// launches changes nothing: K emitters with two sites each, which queue their launches
+// site after site, make two dispatches, not 2·K.
+void GlslBackend::runChildren(std::span<const rt::ChildrenLaunch> all) {
+    std::vector<rt::ChildrenLaunch> grouped;
+    std::span<const rt::ChildrenLaunch> launches = all;
+    if (std::any_of(all.begin(), all.end(), [&](const rt::ChildrenLaunch& l) { return l.spawn != all.front().spawn; })) {
+        std::vector<const ir::Kernel*> kernels;  // in the order they first come
+        for (const rt::ChildrenLaunch& l : all)
+            if (std::find(kernels.begin(), kernels.end(), l.spawn) == kernels.end()) kernels.push_back(l.spawn);
+        grouped.reserve(all.size());
+        for (const ir::Kernel* k : kernels)
+            for (const rt::ChildrenLaunch& l : all)
+                if (l.spawn == k) grouped.push_back(l);
+        launches = grouped;
+    }
     size_t from = 0;
     auto flush = [&](size_t to) {
         if (to > from) dispatchChildren(launches.subspan(from, to - from));

@@ -1,8 +1,9 @@
 // Internal to rt/: creating objects. Emissions queue objects (with their exact creation
 // times and their arguments, computed by the emitter's spawn kernel); `drain` creates
-// what is queued, in queue order, a batch of one type at a time: init, exports at
-// creation, bursts, the first partial update to the end of the step (in sub-steps under
-// @step), exports, then kills and emissions object by object in queue order. Every
+// what is queued, in queue order (the runs of types that emit nothing grouped by type),
+// a batch of one type at a time: init, exports at creation, bursts, the first partial
+// update to the end of the step (in sub-steps under @step), exports, then kills and
+// emissions object by object in queue order. Every
 // object is created this way, one or many (docs/runtime.md, "Creation").
 #pragma once
 
@@ -80,6 +81,9 @@ private:
     // created in batches).
     void enqueue(const Run& run);
     void createBatch(size_t type, size_t from, size_t to, double t1);
+    // A type that emits nothing (its creation queues nothing) and reads no parent.
+    bool quiet(size_t type) const;
+    size_t groupQuiet(size_t from);  // see rt/system_queue.cpp
     // createBatch for a type whose rows are in the memory (rt/system_create_rows.cpp).
     void createInMemory(size_t type, Batch& b, size_t n, double t1);
     void launchInMemory(size_t type, Batch& b, size_t n, const ir::Kernel& kernel, const ColumnLayout& layout,

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "rt/rng.h"
 #include "rt/system_support.h"
@@ -153,13 +154,40 @@ void Creation::runSpawns() {
     spawns_.clear();
 }
 
+bool Creation::quiet(size_t type) const {
+    return s_.module.objects[type].emits.empty() && s_.types[type].parentType < 0;
+}
+
+// Where queue_[from] is of a quiet type: the quiet runs from there on, each type's runs
+// moved together (in their order, the types in the order they first come). Their
+// creation queues nothing, takes no id, frees no row of another type and orders no
+// parent's release, so only each type's own order matters — kept; their runs of one
+// type are adjacent in its staging columns, as one batch's must be. Without this, K
+// emitters of several types would create 4·K batches a step (the campfire's dispatches
+// grew with its fires). Returns the end of those runs.
+size_t Creation::groupQuiet(size_t from) {
+    size_t end = from;
+    while (end < queue_.size() && quiet(queue_[end].type)) ++end;
+    std::vector<size_t> rank(s_.pools.size(), SIZE_MAX);
+    size_t ranked = 0;
+    for (size_t i = from; i < end; ++i)
+        if (rank[queue_[i].type] == SIZE_MAX) rank[queue_[i].type] = ranked++;
+    if (ranked > 1)
+        std::stable_sort(queue_.begin() + static_cast<std::ptrdiff_t>(from), queue_.begin() + static_cast<std::ptrdiff_t>(end),
+                         [&](const Run& a, const Run& b) { return rank[a.type] < rank[b.type]; });
+    return end;
+}
+
 void Creation::drain(double t1) {
     runSpawns();
+    size_t grouped = 0;                       // queue_[.., grouped): quiet runs already grouped
     for (size_t i = 0; i < queue_.size();) {  // (creating queues more at its end)
         size_t type = queue_[i].type;
         size_t end = i + 1;
-        if (s_.options.createInBatches)
+        if (s_.options.createInBatches) {
+            if (i >= grouped && quiet(type)) grouped = groupQuiet(i);
             while (end < queue_.size() && queue_[end].type == type) ++end;
+        }
         createBatch(type, i, end, t1);
         i = end;
     }

@@ -133,6 +133,35 @@ TEST_CASE("a burst chain creates an object at a time on the host side, its write
     CHECK(p.stats("a").killed == 10000);
 }
 
+TEST_CASE("the dispatches a step do not grow with the emitters when their children emit nothing") {
+    // K sources, each emitting two types that emit nothing: the queue holds spark, puff,
+    // spark, puff, … Each type is created in one batch a step (rt/system_queue.cpp,
+    // Creation::groupQuiet) and each spawn kernel's launches go in one dispatch
+    // (GlslBackend::runChildren) — the campfire's dispatches grew tenfold with its fires.
+    // (40 and 432 dispatches a step before, 36 and 36 now.)
+    auto perStep = [](int sources) {
+        std::string text = R"(
+            object spark(p: vec3) { pos = snapshot(p) + integrate(vec3(0, -1, 0)); point(pos, white, 1); kill when age > 0.3; }
+            object puff(x: float) { point(vec3(x, age, rand()), white, 1); kill when age > 0.25; }
+            object source(x: float) {
+                emit spark(vec3(x, rand(), 0)) at 150 per second;
+                emit puff(x + rand()) at 70 per second;
+            }
+        )";
+        for (int k = 0; k < sources; ++k) text += "spawn source(" + std::to_string(k) + ");\n";
+        Pair p(text);  // (every launch on the GPU: no pool small enough for the host side)
+        p.steps(30, 1.0 / 60);  // (the pools grown)
+        uint64_t before = p.gpu->dispatches();
+        p.steps(10, 1.0 / 60);
+        double dispatches = static_cast<double>(p.gpu->dispatches() - before) / 10;
+        p.compare();
+        return dispatches;
+    };
+    double few = perStep(3), many = perStep(30);
+    MESSAGE("dispatches a step: " << few << " with 3 sources, " << many << " with 30");
+    CHECK(few == many);
+}
+
 TEST_CASE("many object types of a few objects each run on the host side: no dispatch a step") {
     // 100 types of one object: their updates (late or not) and draws run where their
     // columns are, on the host, as fast as the interpreter; a dispatch each would be 200

@@ -391,6 +391,50 @@ TEST_CASE("creating objects in batches gives the run of creating them one by one
     CHECK(d.stats("cell").dropped > 0);
 }
 
+TEST_CASE("a step creates each type that emits nothing in one batch, however many emitters ask, as one by one") {
+    // Three sources, each emitting two types: the queue holds spark, puff, spark, puff, …
+    // Neither emits nor reads a parent, so their runs are created a type at a time: one
+    // batch of each a step (six before), the same objects, ids, rows and values as
+    // creating them one by one — sparks dropped at their capacity included.
+    std::string text = R"(
+        @capacity(60) object spark(p: vec3) {
+            pos = snapshot(p) + integrate(vec3(0, -1, 0));
+            point(pos, white, 1);
+            kill when age > 0.3 + rand() * 0.2;
+        }
+        object puff(x: float) {
+            point(vec3(x, age, rand()), white, 1);
+            kill when age > 0.25;
+        }
+        object source(x: float) {
+            emit spark(vec3(x, rand(), 0)) at 150 per second;
+            emit puff(x + rand()) at 70 per second;
+        }
+        spawn source(0);
+        spawn source(1);
+        spawn source(2);)";
+    rt::SystemOptions oneByOne;
+    oneByOne.createInBatches = false;
+    Run a(text, oneByOne), b(text);
+    CHECK(compareRuns(a, b, 120, bitwise) > 5000);
+    CHECK(b.stats("spark").dropped > 0);
+    // The first updates of new objects (a creation's clock: per row) of each type, per step.
+    std::map<std::string, int> batches;
+    test::WatchedInterpreter backend([&](const rt::RowsLaunch& l) {
+        if (l.kernel->kind == ir::KernelKind::Update && l.clock.dt == rt::Clock::Source::SinceCreated)
+            ++batches[l.object->name];
+    });
+    rt::SystemOptions oneThread;  // (a batch is a launch: one chunk)
+    oneThread.threads = 1;
+    rt::System system(test::compileModule(text), backend, oneThread);
+    for (int f = 0; f < 6; ++f) {  // (45 sparks by then: none dropped yet)
+        batches.clear();
+        REQUIRE_FALSE(system.step(test::kFrame));
+        CHECK(batches["spark"] == 1);
+        CHECK(batches["puff"] == 1);
+    }
+}
+
 TEST_CASE("with relaxed maths every sample's output stays within 1e-4 of max(1, |value|) over 600 frames (200 sanitized)" * doctest::test_suite("long")) {
     // What differs: the last bits of reassociated sums and of x/c as x·(1/c), integrals of
     // constants taken as c·age instead of a float sum over 600 steps (the closed form is the
