@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 
 #include "rt/rng.h"
 #include "rt/system_support.h"
@@ -168,13 +167,16 @@ bool Creation::quiet(size_t type) const {
 size_t Creation::groupQuiet(size_t from) {
     size_t end = from;
     while (end < queue_.size() && quiet(queue_[end].type)) ++end;
-    std::vector<size_t> rank(s_.pools.size(), SIZE_MAX);
-    size_t ranked = 0;
+    std::vector<size_t> order;  // the types, in the order they first come
     for (size_t i = from; i < end; ++i)
-        if (rank[queue_[i].type] == SIZE_MAX) rank[queue_[i].type] = ranked++;
-    if (ranked > 1)
-        std::stable_sort(queue_.begin() + static_cast<std::ptrdiff_t>(from), queue_.begin() + static_cast<std::ptrdiff_t>(end),
-                         [&](const Run& a, const Run& b) { return rank[a.type] < rank[b.type]; });
+        if (std::find(order.begin(), order.end(), queue_[i].type) == order.end()) order.push_back(queue_[i].type);
+    if (order.size() < 2) return end;
+    std::vector<Run> grouped;
+    grouped.reserve(end - from);
+    for (size_t type : order)
+        for (size_t i = from; i < end; ++i)
+            if (queue_[i].type == type) grouped.push_back(queue_[i]);
+    std::copy(grouped.begin(), grouped.end(), queue_.begin() + static_cast<std::ptrdiff_t>(from));
     return end;
 }
 
