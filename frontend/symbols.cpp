@@ -244,9 +244,7 @@ Ref Checker::lookupName(const std::string& name, SourceRange range, const Contex
     if (ctx.where == Where::Object && ctx.object) {
         auto& scope = objectScopes_[ctx.object];
         if (auto it = scope.names.find(name); it != scope.names.end()) return it->second;
-        int level = 0;
         for (const ObjectDecl* p = ctx.object->parent; p; p = p->parent) {
-            ++level;
             auto& outer = objectScopes_[p];
             if (auto it = outer.names.find(name); it != outer.names.end()) {
                 diags_.error(range, fmt::format("`{}` belongs to the enclosing object `{}`; read it live as `{}.{}`",

@@ -33,7 +33,7 @@ test_packages=(
   glslang-tools xvfb xauth
   patchelf xz-utils               # the GPU bundle (scripts/gpu-bundle.sh)
   python3-matplotlib
-  clang-19 libclang-rt-19-dev     # the fuzzers (scripts/fuzz.sh)
+  clang-19 libclang-rt-19-dev     # the sanitizer build (scripts/test.sh) and the fuzzers (scripts/fuzz.sh)
   ffmpeg                          # the viewer's video recording
   python3-dev python3-pybind11 python3-numpy python3-pytest
   vim neovim                      # the editor tests' real clients

@@ -21,10 +21,14 @@ stage "release: configure" cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWi
 stage "release: build" cmake --build build -j "$jobs"
 
 # Under the sanitizers, the tests without the benchmarks: the release stage runs each once
-# (bench.*), and their loops are the library's, which the tests run here.
+# (bench.*), and their loops are the library's, which the tests run here. Built with
+# Clang: the release build has GCC's warnings, this one Clang's, and Clang compiles the
+# instrumented code in about two thirds of GCC's time (rt's batch: 44 s against 69).
 if [ $sanitize = 1 ]; then
-  stage "asan: configure" cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DPSYS_WERROR=ON -DPSYS_SANITIZE=ON \
-    -DBUILD_TESTING=ON -DPSYS_BENCH=OFF -DPSYS_DEBUG_INFO=lines -DPSYS_UNITY=ON
+  # (the C compiler from CC: C is enabled late, for the C API's test, and LLVM's CMake
+  # package checks a C source as soon as CMAKE_C_COMPILER is set)
+  stage "asan: configure" env CC=clang-19 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DPSYS_WERROR=ON \
+    -DPSYS_SANITIZE=ON -DCMAKE_CXX_COMPILER=clang++-19 -DBUILD_TESTING=ON -DPSYS_BENCH=OFF -DPSYS_DEBUG_INFO=lines -DPSYS_UNITY=ON
   stage "asan: build" cmake --build build-asan -j "$jobs"
 fi
 

@@ -236,7 +236,12 @@ TEST_CASE("a kernel of thousands of instructions (cut into blocks, fast code gen
     });
 }
 
-TEST_CASE("under every integration method every sample draws the same on both backends (exact maths)") {
+// A test of numbers (each method's kernels the same bits on both backends): under the
+// sanitizers each method's lowering and passes run on every sample in "the optimizer
+// changes no bit under any method" (tests/unit/integrators_test.cpp), and the JIT's host
+// side in the tests above; this sweep (121 s there) runs in the release build.
+TEST_CASE("under every integration method every sample draws the same on both backends (exact maths)" *
+          doctest::skip(test::kSanitized) * doctest::test_suite("long")) {
     for (size_t m = 0; m < core::kIntegratorNames.size(); ++m) {
         auto method = static_cast<core::Integrator>(m);
         for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
