@@ -1,0 +1,89 @@
+// Creating objects in batches: the same objects, ids, rows and values as creating them
+// one by one (rt/system_create.cpp, rt/system_queue.cpp).
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include "rt/system.h"
+#include "run.h"
+#include "test_support.h"
+
+using namespace psys;
+using test::bitwise;
+using test::compareRuns;
+using test::Run;
+
+TEST_CASE("creating objects in batches gives the run of creating them one by one, bit for bit") {
+    rt::SystemOptions oneByOne;
+    oneByOne.createInBatches = false;
+    size_t points = 0;
+    for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
+        if (entry.path().extension() != ".psys") continue;
+        INFO(entry.path().filename().string());
+        std::string text = test::readFile(entry.path().string());
+        Run a(text, oneByOne), b(text);
+        // Every kind of creation each type has (its rates, bursts, deaths) within the
+        // frames test::coverFrames gives: batches and one by one create alike after them.
+        points += compareRuns(a, b, test::coverFrames(text, test::kLongRun), bitwise);
+    }
+    CHECK(points > 30000);
+    // At capacity, objects that emit their own type while being created: an object's
+    // emissions see the rows allocated for the objects after it as free, as one by one.
+    std::string selfEmitting = R"(
+        @capacity(200) object cell {
+            point(vec3(rand(), rand(), 0) * age, white, age);
+            emit cell at 90 per second;
+            kill when age > 0.5 + rand();
+        }
+        spawn cell;)";
+    rt::SystemOptions small = oneByOne;
+    Run c(selfEmitting, small), d(selfEmitting);
+    CHECK(compareRuns(c, d, 300, bitwise) > 10000);
+    CHECK(d.stats("cell").dropped > 0);
+}
+
+TEST_CASE("a step creates each type that emits nothing in one batch, however many emitters ask, as one by one") {
+    // Three sources, each emitting two types: the queue holds spark, puff, spark, puff, …
+    // Neither emits nor reads a parent, so their runs are created a type at a time: one
+    // batch of each a step (six before), the same objects, ids, rows and values as
+    // creating them one by one — sparks dropped at their capacity included.
+    std::string text = R"(
+        @capacity(60) object spark(p: vec3) {
+            pos = snapshot(p) + integrate(vec3(0, -1, 0));
+            point(pos, white, 1);
+            kill when age > 0.3 + rand() * 0.2;
+        }
+        object puff(x: float) {
+            point(vec3(x, age, rand()), white, 1);
+            kill when age > 0.25;
+        }
+        object source(x: float) {
+            emit spark(vec3(x, rand(), 0)) at 150 per second;
+            emit puff(x + rand()) at 70 per second;
+        }
+        spawn source(0);
+        spawn source(1);
+        spawn source(2);)";
+    rt::SystemOptions oneByOne;
+    oneByOne.createInBatches = false;
+    Run a(text, oneByOne), b(text);
+    CHECK(compareRuns(a, b, 120, bitwise) > 5000);
+    CHECK(b.stats("spark").dropped > 0);
+    // The first updates of new objects (a creation's clock: per row) of each type, per step.
+    std::map<std::string, int> batches;
+    test::WatchedInterpreter backend([&](const rt::RowsLaunch& l) {
+        if (l.kernel->kind == ir::KernelKind::Update && l.clock.dt == rt::Clock::Source::SinceCreated)
+            ++batches[l.object->name];
+    });
+    rt::SystemOptions oneThread;  // (a batch is a launch: one chunk)
+    oneThread.threads = 1;
+    rt::System system(test::compileModule(text), backend, oneThread);
+    for (int f = 0; f < 6; ++f) {  // (45 sparks by then: none dropped yet)
+        batches.clear();
+        REQUIRE_FALSE(system.step(test::kFrame));
+        CHECK(batches["spark"] == 1);
+        CHECK(batches["puff"] == 1);
+    }
+}
