@@ -217,7 +217,7 @@ public:
     // Whether the kills of a late launch that answered with a ticket clear its aliveMask
     // on the device, which the backend's render launches read: what is drawn then leaves
     // them out before the run-time has taken them, and the run-time may take them at the
-    // next step instead of waiting at the end of this one (State::endStep).
+    // next step instead of waiting at the end of this one (Ledger::endStep).
     virtual bool clearsKilled() const { return false; }
     // Whether the pools of objects that only die should keep their rows in the memory
     // (Pool::keepRowsInMemory): where the memory is a device's, so that a step's

@@ -122,7 +122,7 @@ void reconnect(const detail::State& old, detail::State& s, const std::vector<int
             if (pool.status(r) == Status::Frozen && pool.readers[r] == 0) {
                 Handle parent = pool.parent[r];
                 pool.release(r);
-                s.releaseReader(t, parent);
+                s.ledger.releaseReader(t, parent);
             }
     }
 }
@@ -133,8 +133,7 @@ ReloadReport System::carryOver(const System& oldSystem) {
     detail::State& s = *state_;
     // What a device still owes the old system first, so that its pools are what they would
     // be on the host: its last step's rows freed, its kills counted.
-    oldSystem.state_->settleOwed();
-    oldSystem.state_->settleLate();
+    oldSystem.state_->ledger.settle(detail::Ledger::Wait::Yes);
     const detail::State& old = *oldSystem.state_;
     ReloadReport report;
     s.now = old.now;

@@ -134,7 +134,7 @@ Schedule stepSchedule(const State& s) {
         p.parallelism = parallelism;
         return p;
     };
-    add(PhaseKind::Settle, -1, Parallelism::Ordered);
+    add(PhaseKind::Settle, -1, Parallelism::Ordered);  // first: a step of no time runs it alone (System::step)
     add(PhaseKind::Ready, -1, Parallelism::Ordered);
     // Every type's folds before any update: each sees the others as the last step left them.
     for (size_t t = 0; t < s.types.size(); ++t) {

@@ -23,6 +23,7 @@ namespace psys::rt {
 using detail::finite;
 using detail::seconds;
 using detail::WallClock;
+using Wait = detail::Ledger::Wait;
 using ir::KernelKind;
 
 // Every launch shape a system asks for (rt/system_create.cpp, rt/system_update.cpp,
@@ -121,13 +122,11 @@ void System::start() {
         creation_->emitFromKernel(added, {}, kStartObject);
     }
     creation_->drain(s.now);
-    if (!s.backend.clearsKilled()) s.settleLate();  // else at the end of the next step
+    s.ledger.settle(Wait::No);
 }
 
 void System::finish() {
-    detail::State& s = *state_;
-    s.settleOwed();
-    s.settleLate();
+    state_->ledger.settle(Wait::Yes);
     drawing_->takeCounts();
 }
 
@@ -141,7 +140,7 @@ void System::runPhases(size_t first, size_t end, double dt, double t1, bool last
         auto type = static_cast<size_t>(p.type);
         auto start = WallClock::now();
         switch (p.kind) {
-            case PhaseKind::Settle: break;  // before a step's time is known (step)
+            case PhaseKind::Settle: s.ledger.settle(Wait::Yes); break;
             case PhaseKind::Ready:
                 for (Pool& pool : s.pools) pool.beginStep();
                 break;
@@ -173,7 +172,7 @@ void System::runPhases(size_t first, size_t end, double dt, double t1, bool last
                 continue;
             case PhaseKind::Release:
                 s.now = t1;  // the time moves on
-                s.endStep();
+                s.ledger.endStep();
                 break;
         }
         s.stats.emitSeconds += seconds(start, WallClock::now());
@@ -196,12 +195,11 @@ std::optional<std::string> System::step(double dt) {
                            dt, s.now, kLatestTime);
     }
     start();
-    // What a device still owes, before anything is updated (the schedule's settle): the last
-    // step's deaths (their rows freed), and those of triggers since (they are updated no more).
-    s.settleOwed();
-    s.settleLate();
-    // No time passes: no update runs, so nothing moves, nothing is emitted, and no `prev`
-    // or `->` chain advances (it would count updates, not time).
+    // The schedule's first phase settles what the last step and triggers since left (a step
+    // of no time too); then, unless no time passes, the rest. No time: no update runs, so
+    // nothing moves, nothing is emitted, and no `prev` or `->` chain advances (it would count
+    // updates, not time).
+    runPhases(0, 1, dt, s.now + dt, true);
     if (dt == 0) {
         ++s.stats.steps;
         return std::nullopt;
@@ -214,10 +212,9 @@ std::optional<std::string> System::step(double dt) {
     drawing_->stepping();
     for (size_t type = 0; type < s.pools.size(); ++type)
         s.work[type].inStep = {drawing && s.types[type].render && s.types[type].drawn[0], false, false, 0, 0};
-    // The schedule's phases (settle is done above: a step of no time settles too): ready,
-    // per type, parents before children, its update, kills and emissions (in sub-steps),
-    // what it queued created; release.
-    runPhases(0, s.schedule.phases.size(), dt, t1, true);
+    // The rest of the schedule's phases: ready, per type, parents before children, its
+    // update, kills and emissions (in sub-steps), what it queued created; release.
+    runPhases(1, s.schedule.phases.size(), dt, t1, true);
     s.now = t1;
     for (detail::TypeWork& w : s.work) {
         w.inStep.fresh = w.inStep.on;
@@ -236,7 +233,7 @@ std::optional<std::string> System::step(double dt) {
 bool System::finished() const {
     detail::State& s = *state_;
     if (!s.started) return false;
-    if (s.owedReady()) s.settleOwed();  // without waiting: else a step late
+    s.ledger.settle(Wait::No);  // what is ready: else a step late
     for (const Pool& p : s.pools)
         if (p.live() > 0) return false;
     return true;
@@ -348,10 +345,10 @@ std::optional<std::string> System::fire(std::string_view name, std::span<const f
         params.push_back(v);
     }
     start();
-    s.settleOwed();  // the rows the last step freed, before these objects take rows
+    s.ledger.settle(Wait::Yes);  // the rows the last step freed, before these objects take rows
     creation_->emitFromKernel(*trigger, params, kTriggerObject);
     creation_->drain(s.now);
-    if (!s.backend.clearsKilled()) s.settleLate();  // else at the end of the next step
+    s.ledger.settle(Wait::No);
     drawing_->invalidate();
     return std::nullopt;
 }
@@ -374,7 +371,7 @@ std::vector<RenderPoint> System::points(size_t type) {
 }
 
 Stats System::stats() const {
-    if (state_->owedReady()) state_->settleOwed();  // without waiting: else a step late
+    state_->ledger.settle(Wait::No);  // what is ready: else a step late
     drawing_->takeCounts();
     const detail::State& s = *state_;
     Stats out = s.stats;

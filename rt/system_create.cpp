@@ -283,7 +283,7 @@ void Creation::runBatch(const RowsLaunch& launch, size_t first, size_t end, size
         part.late = late != nullptr;
         RowsResult result = s_.backend.run(part);
         if (result.unstable) unstable += result.unstable;
-        if (late) s_.latePart(late->parts[c], result, launch.columns[ColumnLayout::kKill], begin, stop);
+        if (late) s_.ledger.record(late->parts[c], result, launch.columns[ColumnLayout::kKill], begin, stop);
     });
     s_.typeStats[type].unstable += unstable;
 }
@@ -348,17 +348,16 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
             if (!late && info.kills) {
                 const auto* kill = s_.view<uint8_t>(b.updateTable[ColumnLayout::kKill]);
                 for (size_t r = 0; r < n; ++r)
-                    if (b.poolRows[r] != kSkipRow && kill[first + r]) s_.kill(type, b.poolRows[r], t1 - b.spans[r]);
+                    if (b.poolRows[r] != kSkipRow && kill[first + r]) s_.ledger.kill(type, b.poolRows[r], t1 - b.spans[r]);
             }
         }
         if (late) {
             late->type = type;
-            late->at = s_.dying.size();
             late->t1 = t1;
             late->first = first;
             late->poolRows = b.poolRows;
             late->spans = b.spans;
-            s_.late.push_back(std::move(*late));
+            s_.ledger.defer(std::move(*late));
         }
         return;
     }
@@ -464,7 +463,7 @@ void Creation::killOrEmit(size_t type, Batch& b, size_t r, double dt, double t1)
     size_t i = b.first + r;
     uint32_t row = b.poolRows[r];
     bool dying = info.kills && s_.view<uint8_t>(b.updateTable[ColumnLayout::kKill])[i];
-    if (dying) s_.kill(type, row, t1 - dt);
+    if (dying) s_.ledger.kill(type, row, t1 - dt);
     if (!info.updateEmits || (dying && !info.emitsWhenKilled)) return;
     rate_.assign(o.emits.size(), 0);
     count_.assign(o.emits.size(), 1);

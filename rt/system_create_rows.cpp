@@ -5,7 +5,7 @@
 // allocateRows, identify, scatter by a row list), so that on a device the host's work is
 // the batch's, not its objects'. Such a type dies late, has no parent, no bursts, no
 // sub-steps and emits nothing: after its first update an object only waits to be freed
-// with the step's late kills (State::releaseInMemory).
+// with the step's late kills (rt/ledger.h).
 #include "rt/system_create.h"
 
 #include <algorithm>
@@ -71,10 +71,9 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
                                pool.state.column(s, static_cast<size_t>(c))});
     memory.scatter(columns, first, rows, 0, kept);
     late.type = type;
-    late.at = s_.dying.size();
     late.t1 = t1;
     late.first = first;
-    s_.late.push_back(std::move(late));
+    s_.ledger.defer(std::move(late));
 }
 
 // A launch over the batch's objects (those kept: its mask), in chunks; `late`: its kills
@@ -116,7 +115,7 @@ void Creation::launchInMemory(size_t type, Batch& b, size_t n, const ir::Kernel&
         }
         RowsResult result = s_.backend.run(part);
         if (result.unstable) unstable += result.unstable;
-        if (late) s_.latePart(late->parts[c], result, table[ColumnLayout::kKill], begin, stop);
+        if (late) s_.ledger.record(late->parts[c], result, table[ColumnLayout::kKill], begin, stop);
     });
     s_.typeStats[type].unstable += unstable;
 }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "ir/evaluate.h"
+#include "rt/ledger.h"
 #include "rt/parallel.h"
 #include "rt/schedule.h"
 #include "rt/system.h"
@@ -74,41 +75,6 @@ struct DrawnInStep {
     uint64_t nonFinite = 0;
 };
 
-// The kills (and unstable counts) of launches that answered late (RowsLaunch::late) or
-// whose kills are taken late: applied at the end of the step (State::settleLate), in
-// their place among the step's kills, so that rows are freed in the order they would have
-// been at once — or, where the backend clearsKilled and still owes some, at the next step
-// (State::owed), the rows freed then in that same order. Only for types whose dead nobody
-// looks at before then (TypeInfo::late): the room a creation sees counts a killed object
-// as taken until the end of the step anyway.
-struct LateKills {
-    size_t type = 0;
-    size_t at = 0;  // its place among State::dying
-    struct Part {
-        uint64_t ticket = 0;          // to collect (Backend::collect); 0: `rows` are here
-        std::vector<uint32_t> rows;   // launch rows, in order
-        // A type whose rows are in the memory: its launch's first row and kill list
-        // (RowsLaunch::killList), whether the backend listed the kills there, and whether
-        // they are counted (Pool::released).
-        size_t begin = 0;
-        Buffer killList;
-        bool listed = false, counted = false;
-        size_t count = 0;  // counted: how many
-    };
-    std::vector<Part> parts;
-    // A type whose rows are in the memory: its kills freed there (State::releaseInMemory)
-    // at the end of the step, in their place; a creation batch's rows (launch row first + r
-    // is pool row map[r]).
-    bool released = false;
-    Buffer map;
-    double t1 = 0, dt = 0;  // a pool's update: killed at t1 − dt
-    // A creation batch's first update: launch row first + r is pool row poolRows[r],
-    // killed at t1 − spans[r].
-    size_t first = 0;
-    std::vector<uint32_t> poolRows;
-    std::vector<double> spans;
-};
-
 // Per type: the scratch buffers and column tables of its launches over the pool.
 struct TypeWork {
     explicit TypeWork(Memory& memory) : update(memory), exports(memory), masks(memory), render(memory) {}
@@ -162,55 +128,13 @@ struct State {
     // The start's emit sites a reload added — spawns of types the old start did not spawn —
     // run at the next start() (rt/reload.cpp).
     std::vector<size_t> reloadSpawns;
-    using Deaths = std::vector<std::pair<size_t, uint32_t>>;
-    Deaths dying;
-    std::vector<LateKills> late;
-    // A step's deaths whose late kills the backend still owed at the step's end (it
-    // clearsKilled): taken, and the rows freed, at the next step's start, a trigger, a
-    // reload, finish, or by stats() once the backend has them ready.
-    struct Owed {
-        Deaths dying;
-        std::vector<LateKills> late;
-    };
-    std::optional<Owed> owed;
+    Ledger ledger{*this};  // the deaths of the step (rt/ledger.h)
     ir::Evaluator evaluator;  // the kernels the run-time evaluates itself (start, triggers, uniform kernels)
     std::unique_ptr<Parallel> parallel;
     Schedule schedule;  // the phases of a step (rt/schedule.h)
 
     // The ancestor `depth` levels up of (type, row), or (-1, 0) when there is none.
     std::pair<int, uint32_t> ancestor(size_t type, uint32_t row, int depth) const;
-    // An object is dead: frozen now, freed at the end of the step unless children read it.
-    // `at`: the time of its last values (those of the update before the one that killed it).
-    void kill(size_t type, uint32_t row, double at);
-    // The late kills (LateKills), each in its place: at the end of a step, a trigger, the start.
-    void settleLate() { settleLate(dying, late); }
-    void settleLate(Deaths& deaths, std::vector<LateKills>& lates);
-    // At the end of a step: its deaths freed (frozen parents with readers kept), or, where
-    // the backend clearsKilled and some late kill is not taken yet, handed to `owed`.
-    void endStep();
-    // What `owed` holds taken and freed (waiting for the backend where it must); `ready`:
-    // only if the backend has every ticket ready.
-    void settleOwed();
-    bool owedReady();
-    void release(Deaths& deaths);
-    // settleLate then release, at once: the late kills of a type that nobody reads and
-    // that reads no parent go straight onto its free stack in their place (nothing else
-    // can happen to them between), each part as one run of rows.
-    void settleAndRelease(Deaths& deaths, std::vector<LateKills>& lates);
-    // The late kills of a type whose rows are in the memory: freed there, at the end of
-    // the step (their rows listed on the host first where the backend did not list them);
-    // counted once the backend gives their counts (settleLate, settleAndRelease).
-    void releaseInMemory(LateKills& l);
-    void countInMemory(LateKills& l);
-    // Its kills the backend did not list, listed by the run-time from the rows it gives
-    // (and, where the backend does not clear kills, cleared in the pool's masks: a trigger's
-    // dead wait, not updated, not drawn, for the next step's end).
-    void listInMemory(LateKills& l);
-    // A launch's kills as a part of a LateKills: its ticket, or the rows it listed, else
-    // those of [begin, end) its kill flags (`flags`) mark.
-    void latePart(LateKills::Part& part, const RowsResult& result, Buffer flags, size_t begin, size_t end) const;
-    // A reader of `parent` is gone; a frozen parent without readers is freed, and so on up.
-    void releaseReader(size_t childType, Handle parent);
     // The values of `kernel`'s uniform kernel at (dt, time), evaluated on the host and
     // cached until dt, time or an extern changes; null when it has none.
     const Value* uniforms(size_t type, const ir::Kernel& kernel, float dt, float time);

@@ -58,7 +58,7 @@ void runEmissions(State& s, Creation& creation, size_t type, double dt, double t
 
 // The kills of the update pass just run: listed per chunk (objects that only die) and
 // taken now, or, for late launches, their kills (listed or ticketed) and unstable counts
-// kept for the end of the step (or the next step's start: State::owed), in their place
+// kept for the end of the step (or the next settle: rt/ledger.h), in their place
 // (LateKills); else read from the kill flags in row order.
 void runKills(State& s, size_t type, double dt, double t1) {
     TypeWork& work = s.work[type];
@@ -66,17 +66,17 @@ void runKills(State& s, size_t type, double dt, double t1) {
     if (!work.pass.ran) return;
     size_t chunks = work.pass.chunks;
     if (work.pass.late) {
-        LateKills& l = s.late.emplace_back();
+        LateKills l;
         l.type = type;
-        l.at = s.dying.size();
         l.t1 = t1;
         l.dt = dt;
         for (size_t c = 0; c < chunks; ++c) l.parts.push_back(std::move(work.killed[c]));
+        s.ledger.defer(std::move(l));
         return;
     }
     if (work.pass.listed) {
         for (size_t c = 0; c < chunks; ++c)
-            for (uint32_t row : work.killed[c].rows) s.kill(type, row, t1 - dt);
+            for (uint32_t row : work.killed[c].rows) s.ledger.kill(type, row, t1 - dt);
         return;
     }
     if (!info.kills) return;
@@ -86,7 +86,7 @@ void runKills(State& s, size_t type, double dt, double t1) {
     for (uint32_t row = 0; row < pool.rows(); ++row)
         if (updatable[row] && kill[row]) {
             if (info.emitsWhenKilled) work.pass.dying.push_back(row);
-            s.kill(type, row, t1 - dt);
+            s.ledger.kill(type, row, t1 - dt);
         }
 }
 
@@ -155,7 +155,7 @@ void runUpdate(State& s, size_t type, double dt, double t1, bool last, bool late
     bool listKills = info.kills && !info.updateEmits;
     size_t chunks = s.chunkCount(rows);
     work.pass = {true, late, listKills && !late, chunks, {}};
-    if (listKills || late) work.killed.resize(chunks);  // each chunk sets its own (State::latePart)
+    if (listKills || late) work.killed.resize(chunks);  // each chunk sets its own (Ledger::record)
     if (late && info.rowsInMemory)
         for (size_t c = 0; c < chunks; ++c)
             work.killed[c].killList = pool.scratchRows(std::min(s.backend.chunkRows(), rows - c * s.backend.chunkRows()) + 1);
@@ -171,7 +171,7 @@ void runUpdate(State& s, size_t type, double dt, double t1, bool last, bool late
         s.gatherParents(type, info.updateLayout, work.updateTable, updatable, part.begin, part.end, t1);
         RowsResult result = s.backend.run(part);
         if (result.unstable) unstable += result.unstable;
-        if (listKills || late) s.latePart(work.killed[c], result, work.updateTable[ColumnLayout::kKill], begin, end);
+        if (listKills || late) s.ledger.record(work.killed[c], result, work.updateTable[ColumnLayout::kKill], begin, end);
         if (info.exports) {
             auto* survivors = s.host<uint8_t>(exportMask);
             maskRows(survivors, updatable, info.kills ? kill : nullptr, nullptr, part.begin, part.end);

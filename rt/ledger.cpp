@@ -1,0 +1,251 @@
+// The deaths of a step, from the kill to the free stack (rt/ledger.h): one record of a
+// step's deaths and its late kills, settled by one call.
+#include "rt/ledger.h"
+
+#include <algorithm>
+
+#include "rt/system_state.h"
+#include "rt/system_support.h"
+
+namespace psys::rt::detail {
+
+void Ledger::kill(size_t type, uint32_t row, double at) {
+    ++s_.typeStats[type].killed;
+    s_.pools[type].freeze(row, at);  // no longer alive; freed at the end of the step if nobody reads it
+    dying_.push_back({type, row});
+}
+
+void Ledger::record(LateKills::Part& part, const RowsResult& result, Buffer flags, size_t begin, size_t end) const {
+    part.ticket = result.ticket;
+    part.begin = begin;
+    part.listed = result.killsListed;
+    part.counted = false;
+    part.rows.clear();
+    if (result.ticket || result.killed == 0) return;
+    if (result.killedRows.size() == result.killed)
+        part.rows.assign(result.killedRows.begin(), result.killedRows.end());
+    else
+        listKilled(s_.view<uint8_t>(flags), begin, end, part.rows);
+}
+
+void Ledger::defer(LateKills late) {
+    late.at = dying_.size();
+    late_.push_back(std::move(late));
+}
+
+void Ledger::settle(Wait wait) {
+    if (owed_ && (wait == Wait::Yes || owedReady())) {
+        Owed o = std::move(*owed_);
+        owed_.reset();
+        free(o.dying, o.late);
+    }
+    // A backend that clears kills itself shows the dead as dead already: nothing needs
+    // them taken before the next settle that waits.
+    if (wait == Wait::Yes || !s_.backend.clearsKilled()) take(dying_, late_);
+}
+
+void Ledger::endStep() {
+    for (LateKills& l : late_)
+        if (s_.types[l.type].rowsInMemory) releaseInMemory(l);
+    auto owes = [](const LateKills& l) {
+        return std::any_of(l.parts.begin(), l.parts.end(), [](const LateKills::Part& p) { return p.ticket != 0; });
+    };
+    if (s_.backend.clearsKilled() && std::any_of(late_.begin(), late_.end(), owes)) {
+        owed_ = Owed{std::move(dying_), std::move(late_)};
+        dying_.clear();
+        late_.clear();
+        return;
+    }
+    free(dying_, late_);
+}
+
+RowsResult Ledger::collect(size_t type, LateKills::Part& part) {
+    if (!part.ticket) {
+        RowsResult held;
+        held.killedRows = part.rows;
+        held.killed = part.rows.size();
+        return held;
+    }
+    RowsResult result = s_.backend.collect(part.ticket);
+    part.ticket = 0;
+    s_.typeStats[type].unstable += result.unstable;
+    return result;
+}
+
+void Ledger::listInMemory(LateKills& l) {
+    Pool& pool = s_.pools[l.type];
+    std::vector<uint32_t> list;
+    for (LateKills::Part& part : l.parts) {
+        if (!part.killList.valid() || part.listed) continue;
+        std::span<const uint32_t> rows = collect(l.type, part).killedRows;
+        list.assign(1, static_cast<uint32_t>(rows.size()));
+        for (uint32_t row : rows) list.push_back(static_cast<uint32_t>(row - part.begin));
+        s_.memory.write(part.killList, 0, list.size(), list.data());
+        s_.typeStats[l.type].killed += rows.size();
+        part.listed = part.counted = true;
+        part.count = rows.size();
+        if (!rows.empty() && !s_.backend.clearsKilled())
+            s_.memory.clearRows(pool.memoryRows(), part.killList, 0, static_cast<uint32_t>(part.begin), l.map,
+                                part.begin - l.first);
+    }
+}
+
+void Ledger::releaseInMemory(LateKills& l) {
+    if (l.released) return;
+    listInMemory(l);
+    l.released = true;
+    Pool& pool = s_.pools[l.type];
+    for (LateKills::Part& part : l.parts) {
+        if (!part.killList.valid()) continue;
+        bool none = part.counted && part.count == 0;  // listed here, nothing to free
+        if (!none) {
+            if (l.map.valid())
+                pool.release(part.killList, 0, 0, l.map, part.begin - l.first);
+            else
+                pool.release(part.killList, 0, static_cast<uint32_t>(part.begin), {}, 0);
+            if (part.counted) pool.released(part.count);
+        }
+        pool.recycle(part.killList);
+        part.killList = {};
+    }
+}
+
+void Ledger::countInMemory(LateKills& l) {
+    Pool& pool = s_.pools[l.type];
+    for (LateKills::Part& part : l.parts) {
+        if (part.counted) continue;
+        part.counted = true;
+        // (No ticket: listed by the backend with nothing killed; its release counted as 0.)
+        size_t killed = part.ticket ? collect(l.type, part).killed : 0;
+        s_.typeStats[l.type].killed += killed;
+        pool.released(killed);
+    }
+}
+
+void Ledger::take(Deaths& dying, std::vector<LateKills>& late) {
+    if (late.empty()) return;
+    Deaths merged;
+    merged.reserve(dying.size());
+    size_t next = 0;
+    std::vector<LateKills> kept;  // those of types whose rows are in the memory, not freed yet
+    for (LateKills& l : late) {
+        if (s_.types[l.type].rowsInMemory) {
+            if (l.released) {
+                countInMemory(l);
+            } else {  // (outside a step: a trigger's) freed at the next step's end
+                listInMemory(l);
+                kept.push_back(std::move(l));
+            }
+            continue;
+        }
+        for (; next < l.at; ++next) merged.push_back(dying[next]);
+        Pool& pool = s_.pools[l.type];
+        for (LateKills::Part& part : l.parts) {
+            for (uint32_t launchRow : collect(l.type, part).killedRows) {
+                uint32_t row = launchRow;
+                double at = l.t1 - l.dt;
+                if (!l.poolRows.empty()) {
+                    size_t r = launchRow - l.first;
+                    row = l.poolRows[r];
+                    at = l.t1 - l.spans[r];
+                }
+                ++s_.typeStats[l.type].killed;
+                pool.freeze(row, at);
+                merged.push_back({l.type, row});
+            }
+        }
+    }
+    for (; next < dying.size(); ++next) merged.push_back(dying[next]);
+    dying = std::move(merged);
+    late = std::move(kept);
+}
+
+void Ledger::free(Deaths& deaths, std::vector<LateKills>& lates) {
+    auto simple = [&](const LateKills& l) { return !s_.types[l.type].read && s_.types[l.type].parentType < 0; };
+    if (std::none_of(lates.begin(), lates.end(), simple)) {
+        take(deaths, lates);
+        release(deaths);
+        return;
+    }
+    // In the merged order of take: the deaths before each late launch's place, then its
+    // kills. A pool's free stack gets its rows in that order, and a simple type's rows
+    // touch no other pool, so each part goes as one run.
+    size_t next = 0;
+    Deaths one;
+    auto releaseUpTo = [&](size_t at) {
+        if (next >= at) return;
+        one.assign(deaths.begin() + static_cast<std::ptrdiff_t>(next), deaths.begin() + static_cast<std::ptrdiff_t>(at));
+        release(one);
+        next = at;
+    };
+    for (LateKills& l : lates) {
+        if (s_.types[l.type].rowsInMemory) {  // freed in the memory at the step's end (endStep): counted
+            countInMemory(l);
+            continue;
+        }
+        releaseUpTo(l.at);
+        if (!simple(l)) {  // its kills frozen and released in its place, as take and release would
+            // A list of its own each time: take leaves the list it settles holding only what
+            // it keeps (nothing here: the type's rows are not in the memory).
+            Deaths its;
+            std::vector<LateKills> single;
+            single.push_back(std::move(l));
+            single[0].at = 0;
+            take(its, single);
+            release(its);
+            continue;
+        }
+        Pool& pool = s_.pools[l.type];
+        std::vector<uint32_t> rows;
+        for (LateKills::Part& part : l.parts) {
+            std::span<const uint32_t> listed = collect(l.type, part).killedRows;
+            if (l.poolRows.empty()) {
+                s_.typeStats[l.type].killed += listed.size();
+                pool.releaseKilled(listed);
+                continue;
+            }
+            rows.clear();
+            for (uint32_t launchRow : listed) rows.push_back(l.poolRows[launchRow - l.first]);
+            s_.typeStats[l.type].killed += rows.size();
+            pool.releaseKilled(rows);
+        }
+    }
+    releaseUpTo(deaths.size());
+    deaths.clear();
+    lates.clear();
+}
+
+void Ledger::release(Deaths& deaths) {
+    for (auto [type, row] : deaths) {
+        Pool& pool = s_.pools[type];
+        if (pool.status(row) != Status::Frozen || pool.readers[row] > 0) continue;
+        Handle parent = pool.parent[row];
+        pool.release(row);
+        releaseReader(type, parent);
+    }
+    deaths.clear();
+}
+
+bool Ledger::owedReady() {
+    if (!owed_) return true;
+    for (const LateKills& l : owed_->late)
+        for (const LateKills::Part& p : l.parts)
+            if (p.ticket && !s_.backend.ready(p.ticket)) return false;
+    return true;
+}
+
+void Ledger::releaseReader(size_t childType, Handle parent) {
+    int t = s_.types[childType].parentType;
+    while (t >= 0 && parent.valid()) {
+        Pool& pool = s_.pools[static_cast<size_t>(t)];
+        if (!pool.matches(parent)) return;
+        if (--pool.readers[parent.row] > 0 || pool.status(parent.row) != Status::Frozen) return;
+        Handle up = pool.parent[parent.row];
+        pool.release(parent.row);
+        parent = up;
+        childType = static_cast<size_t>(t);
+        t = s_.types[childType].parentType;
+    }
+}
+
+}  // namespace psys::rt::detail

@@ -1,0 +1,116 @@
+// Internal to rt/: the deaths of a step, from the kill to the free stack, in one record.
+// A death is frozen when it is known — at once (a kill read from the flags or a chunk's
+// list) or late (a launch whose kills are taken at the step's end: LateKills) — and freed
+// by the step's Release phase in the order the deaths came, a frozen parent once its last
+// reader is gone. Where a backend still owes a late launch's kills at the step's end (it
+// clearsKilled: the GPU), the step's deaths wait, in their order, for the next settle.
+// Everything outside the step's Release phase goes through one call, `settle`: the
+// schedule's Settle phase, a trigger, the start, finish, a reload, stats.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "rt/backend.h"
+#include "rt/pool.h"
+
+namespace psys::rt::detail {
+
+struct State;
+
+// The kills (and unstable counts) of launches that answered late (RowsLaunch::late) or
+// whose kills are taken late: applied at the end of the step, in their place among the
+// step's kills, so that rows are freed in the order they would have been at once. Only
+// for types whose dead nobody looks at before then (TypeInfo::late): the room a creation
+// sees counts a killed object as taken until the end of the step anyway.
+struct LateKills {
+    size_t type = 0;
+    size_t at = 0;  // its place among the step's deaths (Ledger::defer sets it)
+    struct Part {
+        uint64_t ticket = 0;          // to collect (Backend::collect); 0: `rows` are here
+        std::vector<uint32_t> rows;   // launch rows, in order
+        // A type whose rows are in the memory: its launch's first row and kill list
+        // (RowsLaunch::killList), whether the backend listed the kills there, and whether
+        // they are counted (Pool::released).
+        size_t begin = 0;
+        Buffer killList;
+        bool listed = false, counted = false;
+        size_t count = 0;  // counted: how many
+    };
+    std::vector<Part> parts;
+    // A type whose rows are in the memory: its kills freed there at the end of the step,
+    // in their place; a creation batch's rows (launch row first + r is pool row map[r]).
+    bool released = false;
+    Buffer map;
+    double t1 = 0, dt = 0;  // a pool's update: killed at t1 − dt
+    // A creation batch's first update: launch row first + r is pool row poolRows[r],
+    // killed at t1 − spans[r].
+    size_t first = 0;
+    std::vector<uint32_t> poolRows;
+    std::vector<double> spans;
+};
+
+class Ledger {
+public:
+    explicit Ledger(State& state) : s_(state) {}
+
+    // An object is dead: frozen now, freed at the end of the step unless children read it.
+    // `at`: the time of its last values (those of the update before the one that killed it).
+    void kill(size_t type, uint32_t row, double at);
+    // A launch's kills as a part of a LateKills: its ticket, or the rows it listed, else
+    // those of [begin, end) its kill flags (`flags`) mark.
+    void record(LateKills::Part& part, const RowsResult& result, Buffer flags, size_t begin, size_t end) const;
+    // Kills to take late, placed after the deaths known so far.
+    void defer(LateKills late);
+
+    // Where the backend must be waited for: `Yes` takes everything (what the last step
+    // owes and every late kill; before anything takes rows or reads the pools whole: the
+    // Settle phase, a trigger, finish, a reload); `No` only what costs no wait (what is
+    // owed if the backend has it ready, and late kills on a backend that leaves kills to
+    // the host: after objects are created outside a step, stats, finished).
+    enum class Wait : bool { No, Yes };
+    void settle(Wait wait);
+    // The step's end (the Release phase): its deaths freed in their order (frozen parents
+    // with readers kept), or, where the backend clearsKilled and still owes some late
+    // kill, kept for the next settle.
+    void endStep();
+    // A reader of `parent` is gone; a frozen parent without readers is freed, and so on up.
+    void releaseReader(size_t childType, Handle parent);
+
+private:
+    using Deaths = std::vector<std::pair<size_t, uint32_t>>;
+    struct Owed {
+        Deaths dying;
+        std::vector<LateKills> late;
+    };
+
+    // A part's kills: collected from the backend once (its ticket cleared, its unstable
+    // count added), or the rows it holds.
+    RowsResult collect(size_t type, LateKills::Part& part);
+    // The late kills frozen in their place among `deaths` (those of types whose rows are in
+    // the memory listed, or counted where already freed, and kept).
+    void take(Deaths& deaths, std::vector<LateKills>& lates);
+    // take then release, at once: the late kills of a type that nobody reads and that
+    // reads no parent go straight onto its free stack in their place (nothing else can
+    // happen to them between), each part as one run of rows.
+    void free(Deaths& deaths, std::vector<LateKills>& lates);
+    void release(Deaths& deaths);
+    bool owedReady();
+    // A type whose rows are in the memory: its kills listed where the backend did not
+    // (and, where it does not clear kills, cleared in the pool's masks), freed there at the
+    // step's end, counted once the backend gives their counts.
+    void listInMemory(LateKills& l);
+    void releaseInMemory(LateKills& l);
+    void countInMemory(LateKills& l);
+
+    State& s_;
+    Deaths dying_;
+    std::vector<LateKills> late_;
+    std::optional<Owed> owed_;
+};
+
+}  // namespace psys::rt::detail
