@@ -111,6 +111,12 @@ std::vector<std::string> sampleNames(const SampleScale& scale) {
 }  // namespace
 
 int sampleFigures(std::ostream& out, gpu::GlslBackend& gpu, const SampleScale& scale, const std::string& json) {
+    for (const std::string& name : sampleNames(scale))
+        if (!std::filesystem::is_regular_file(samplesDir() + "/" + name + ".psys")) {
+            std::cerr << "psys_gpu_bench: there is no sample `" << name << "` (" << samplesDir() << "/" << name
+                      << ".psys); --only takes names separated by spaces\n";
+            return 2;
+        }
     out << "\n| sample | spawns × | live | dispatches/step | host↔GPU bytes/step | waits/step | late reads/step | rows on the host |\n"
            "|---|---:|---:|---:|---:|---:|---:|---|\n";
     nlohmann::json rows = nlohmann::json::array();

@@ -477,12 +477,29 @@ void GlMemory::clear(Buffer b, size_t first, size_t count) {
         std::memset(c.hostCopy.data() + first * rt::elemSize(c.elem), 0, count * rt::elemSize(c.elem));
         return;
     }
+    fillWords(c, first, count, 0);
+}
+
+void GlMemory::fill(Buffer b, size_t first, size_t count, uint32_t word) {
+    if (count == 0) return;
+    Column& c = at(b);
+    if (rt::elemSize(c.elem) != 4) throw std::logic_error("GlMemory::fill: a column of 4-byte elements");
+    if (!c.device) {
+        auto* words = reinterpret_cast<uint32_t*>(c.hostCopy.data()) + first;
+        std::fill(words, words + count, word);
+        return;
+    }
+    fillWords(c, first, count, word);
+}
+
+// Rows [first, first + count) of a column on the device, every 32-bit word set to `word`
+// (a u8 column's rows are a word each here: wordsPerRow).
+void GlMemory::fillWords(Column& c, size_t first, size_t count, uint32_t word) {
     flush(c);
     PassTimer::Scope timed(timer, "clear", count);
     size_t w = wordsPerRow(c.elem) * 4;
-    uint32_t zero = 0;
     glClearNamedBufferSubData(c.gl, GL_R32UI, static_cast<GLintptr>(first * w), static_cast<GLsizeiptr>(count * w),
-                              GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+                              GL_RED_INTEGER, GL_UNSIGNED_INT, &word);
     afterWrite(Write::Clear, kColumnReaders);
 }
 

@@ -35,6 +35,7 @@ public:
     void scatter(rt::Buffer from, size_t fromFirst, rt::Buffer to, std::span<const uint32_t> rows) override;
     void gather(rt::Buffer from, rt::Buffer to, size_t toFirst, std::span<const uint32_t> rows) override;
     void clear(rt::Buffer buffer, size_t first, size_t count) override;
+    void fill(rt::Buffer buffer, size_t first, size_t count, uint32_t word) override;
     void* host(rt::Buffer buffer) override;
     const void* view(rt::Buffer buffer) const override;
     unsigned glBuffer(rt::Buffer buffer) const override;
@@ -110,6 +111,7 @@ private:
     void runRows(unsigned program, unsigned from, unsigned to, size_t w, size_t first,
                  std::span<const uint32_t> rows, const char* pass) const;
     void flush(Column& c) const;  // its pending rows to the GPU
+    void fillWords(Column& c, size_t first, size_t count, uint32_t word);
     std::vector<uint32_t> pendingColumns_;  // columns that may have rows pending
     // Scatters from the host of at most this many rows into a column on the GPU wait, and
     // go with the next ones once this many rows are pending (or the column is used).

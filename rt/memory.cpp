@@ -17,6 +17,13 @@ void Memory::clear(Buffer buffer, size_t first, size_t count) {
     std::memset(static_cast<char*>(host(buffer)) + first * elemSize(elem(buffer)), 0, count * elemSize(elem(buffer)));
 }
 
+void Memory::fill(Buffer buffer, size_t first, size_t count, uint32_t word) {
+    if (count == 0) return;
+    if (elemSize(elem(buffer)) != 4) throw std::logic_error("Memory::fill: a column of 4-byte elements");
+    auto* words = static_cast<uint32_t*>(host(buffer)) + first;
+    std::fill(words, words + count, word);
+}
+
 Bounds Memory::bounds(Buffer visible, const std::array<Buffer, 3>& position, const std::array<float, 3>& constant,
                       size_t rows) const {
     Bounds out;

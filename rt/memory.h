@@ -85,6 +85,9 @@ public:
     // Zeroes `count` elements from row `first`, where the buffer lives (a device memory
     // does not bring the column to the host for it, as `host` would).
     virtual void clear(Buffer buffer, size_t first, size_t count);
+    // Sets `count` elements of a 4-byte column (f32, u32) from row `first` to the bits
+    // `word`, where the buffer lives (a constant column: an empty neighbour fold).
+    virtual void fill(Buffer buffer, size_t first, size_t count, uint32_t word);
 
     // The address of a buffer's first element where the host can address it, else null:
     // `host` for reading and writing, `view` for reading only (a memory that keeps

@@ -88,6 +88,9 @@ private:
     void createInMemory(size_t type, Batch& b, size_t n, double t1);
     void launchInMemory(size_t type, Batch& b, size_t n, const ir::Kernel& kernel, const ColumnLayout& layout,
                         std::vector<Buffer>& table, const Clock& clock, LateKills* late);
+    // The fold columns of a batch's table (its launches over rows [first, first + n)) set to
+    // a fold over nothing: what an object created in the step reads.
+    void emptyFolds(size_t type, const ColumnLayout& layout, const std::vector<Buffer>& table, size_t first, size_t n);
     void identify(size_t type, Batch& b, size_t n);
     std::vector<std::pair<Buffer, Buffer>> identityColumns(size_t type, const std::vector<Buffer>& table) const;
     void atCreation(size_t type, Batch& b, size_t n);

@@ -3,14 +3,19 @@
 // allocation rule, ids and creation times from the runs, init, the first update to the
 // step's end — with every per-object step an operation of the memory (rt::Memory::
 // allocateRows, identify, scatter by a row list), so that on a device the host's work is
-// the batch's, not its objects'. Such a type dies late, has no parent, no bursts, no
-// sub-steps and emits nothing: after its first update an object only waits to be freed
-// with the step's late kills (rt/ledger.h).
+// the batch's, not its objects'. Such a type dies late or never, has no parent, no
+// bursts, no sub-steps and emits nothing: after its first update (and its exports, where
+// it never dies) an object only waits to be freed with the step's late kills
+// (rt/ledger.h). What it folds over its neighbours is, for an object created in the step,
+// a fold over nothing: filled in, not gathered (rt/neighbours.cpp).
 #include "rt/system_create.h"
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cstdint>
+
+#include "core/fold.h"
 
 #include "rt/rng.h"
 #include "rt/system_support.h"
@@ -34,6 +39,10 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     pool.createdRows(rows, kept);  // updatable from the next step on
     if (info.init) bindBatch(type, b, b.initLayout, b.initParents, b.initTable, Table::Init);
     bindBatch(type, b, info.updateLayout, b.updateParents, b.updateTable, Table::Advanced);
+    if (info.exports) bindBatch(type, b, info.exportsLayout, b.exportsParents, b.exportsTable, Table::Advanced);
+    if (info.init) emptyFolds(type, b.initLayout, b.initTable, first, n);
+    emptyFolds(type, info.updateLayout, b.updateTable, first, n);
+    if (info.exports) emptyFolds(type, info.exportsLayout, b.exportsTable, first, n);
     std::vector<Buffer>& table = b.updateTable;
     ObjectRuns runs;
     for (size_t u = 0; u < b.runs.size(); ++u) {
@@ -62,18 +71,37 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     }
     LateKills late;
     late.map = rows;
-    launchInMemory(type, b, n, *info.update, info.updateLayout, table,
-                   {Clock::Source::Uniform, Clock::Source::SinceCreated, t1, 0, false}, &late);
+    const Clock toEnd{Clock::Source::Uniform, Clock::Source::SinceCreated, t1, 0, false};
+    launchInMemory(type, b, n, *info.update, info.updateLayout, table, toEnd, info.late ? &late : nullptr);
     columns.clear();
     for (size_t s = 0; s < o.state.size(); ++s)
         for (int c = 0; c < o.state[s].type.width; ++c)
             columns.push_back({table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)],
                                pool.state.column(s, static_cast<size_t>(c))});
+    if (info.exports) {  // (a type that never dies: every object of the batch survives)
+        launchInMemory(type, b, n, *info.exports, info.exportsLayout, b.exportsTable, toEnd, nullptr);
+        for (size_t e = 0; e < o.exports.size(); ++e)
+            for (int c = 0; c < o.exports[e].type.width; ++c)
+                columns.push_back({b.exportsTable[static_cast<size_t>(info.exportsLayout.exportOffset[e] + c)],
+                                   pool.exports.column(e, static_cast<size_t>(c))});
+    }
     memory.scatter(columns, first, rows, 0, kept);
+    if (!info.late) return;
     late.type = type;
     late.t1 = t1;
     late.first = first;
     s_.ledger.defer(std::move(late));
+}
+
+void Creation::emptyFolds(size_t type, const ColumnLayout& layout, const std::vector<Buffer>& table, size_t first,
+                          size_t n) {
+    const ir::Object& o = s_.module.objects[type];
+    for (const auto& p : layout.parentColumns) {
+        if (p.op != ir::Op::Fold) continue;
+        float empty = core::emptyFold(o.folds.at(static_cast<size_t>(p.exportIndex)).reduce);
+        for (int c = 0; c < p.width; ++c)
+            s_.memory.fill(table[static_cast<size_t>(p.offset + c)], first, n, std::bit_cast<uint32_t>(empty));
+    }
 }
 
 // A launch over the batch's objects (those kept: its mask), in chunks; `late`: its kills
@@ -94,7 +122,7 @@ void Creation::launchInMemory(size_t type, Batch& b, size_t n, const ir::Kernel&
     launch.externs = s_.externs.data();
     launch.uniformKernel = s_.uniformKernel(type, kernel);
     launch.seed = s_.options.seed;
-    launch.draw = late ? static_cast<uint32_t>(s_.step) : kCreationDraw;
+    launch.draw = clock.first ? kCreationDraw : static_cast<uint32_t>(s_.step);
     if (late) {
         size_t per = s_.backend.chunkRows(), chunks = s_.chunkCount(n);
         late->parts.resize(chunks);

@@ -3,8 +3,10 @@
 #include "rt/system_state.h"
 
 #include <algorithm>
+#include <bit>
 #include <stdexcept>
 
+#include "core/fold.h"
 #include "rt/system_support.h"
 
 namespace psys::rt::detail {
@@ -88,16 +90,21 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     }
     for (const TypeInfo& t : types)
         if (t.parentType >= 0) types[static_cast<size_t>(t.parentType)].read = true;
-    for (TypeInfo& t : types)
-        t.late = options.lateKills && (t.kills || t.unstable) && !t.updateEmits && !t.exports && !t.read;
-    // Rows in the memory: where nothing but the type's own late kills frees them, and its
-    // objects are created whole in a batch (no sub-steps, no bursts, not drawn as the step goes).
+    // Nobody looks at the type's dead during the step: it emits nothing in its updates, has
+    // no exports and no children.
+    auto unwatched = [](const TypeInfo& t) { return !t.updateEmits && !t.exports && !t.read; };
+    for (TypeInfo& t : types) t.late = options.lateKills && (t.kills || t.unstable) && unwatched(t);
+    // Rows in the memory: where nothing but the type's own late kills frees them — or
+    // nothing at all: it never dies, so its exports are every updated row's (folds read
+    // them) — and its objects are created whole in a batch (no sub-steps, no bursts, not
+    // drawn as the step goes).
     bool inMemory = options.rows == SystemOptions::Rows::InMemory ||
                     (options.rows == SystemOptions::Rows::AsBackend && backend.keepsRowsInMemory());
     for (size_t t = 0; t < types.size(); ++t) {
         TypeInfo& info = types[t];
-        info.rowsInMemory = inMemory && info.late && info.parentType < 0 && !info.bursts && info.stepLimit == 0 &&
-                            !(options.drawInStep && backend.rendersInStep() && info.render);
+        bool silent = !info.kills && !info.unstable && !info.updateEmits && !info.read;
+        info.rowsInMemory = inMemory && (info.late || silent) && info.parentType < 0 && !info.bursts &&
+                            info.stepLimit == 0 && !(options.drawInStep && backend.rendersInStep() && info.render);
         if (info.rowsInMemory) pools[t].keepRowsInMemory();
     }
     // Spawn kernels read the emitter's own columns, whose buffers never change: their
@@ -190,6 +197,21 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
     std::vector<float> values;
     int rowsDepth = -1;
     for (const auto& p : layout.parentColumns) {
+        // A pool's launch: its folds copied row for row (on a device, no list sent; no mask
+        // read: a pool whose rows are in the memory has none on the host); rows past the
+        // folds' hold objects created since, which fold over nothing.
+        if (p.op == ir::Op::Fold && !poolRows) {
+            const Pool& pool = pools[type];
+            size_t stop = std::clamp(pool.foldRows, begin, end);
+            float empty = core::emptyFold(pool.object().folds.at(static_cast<size_t>(p.exportIndex)).reduce);
+            for (int c = 0; c < p.width; ++c) {
+                Buffer to = table[static_cast<size_t>(p.offset + c)];
+                memory.copy(pool.folds.column(static_cast<size_t>(p.exportIndex), static_cast<size_t>(c)), begin, to,
+                            begin, stop - begin);
+                memory.fill(to, stop, end - stop, std::bit_cast<uint32_t>(empty));
+            }
+            continue;
+        }
         int parentType = static_cast<int>(type);
         for (int d = 0; d < p.depth && parentType >= 0; ++d) parentType = types[static_cast<size_t>(parentType)].parentType;
         if (p.depth != rowsDepth) {  // the parents' rows, kSkipRow where there is none
@@ -202,15 +224,10 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
         }
         if (p.op == ir::Op::Fold) {  // this object's own folds (rows: its own)
             const Pool& pool = pools[type];
-            // A pool's launch over rows that all have folds: a copy (on a device, no list sent).
-            bool copy = !poolRows && end <= pool.foldRows;
-            if (!copy) foldRowsOf(type, rows);
-            for (int c = 0; c < p.width; ++c) {
-                Buffer from = pool.folds.column(static_cast<size_t>(p.exportIndex), static_cast<size_t>(c));
-                Buffer to = table[static_cast<size_t>(p.offset + c)];
-                if (copy) memory.copy(from, begin, to, begin, end - begin);
-                else memory.gather(from, to, begin, rows);
-            }
+            foldRowsOf(type, rows);
+            for (int c = 0; c < p.width; ++c)
+                memory.gather(pool.folds.column(static_cast<size_t>(p.exportIndex), static_cast<size_t>(c)),
+                              table[static_cast<size_t>(p.offset + c)], begin, rows);
             rowsDepth = -1;
             continue;
         }

@@ -133,20 +133,21 @@ void runUpdate(State& s, size_t type, double dt, double t1, bool last, bool late
         return;
     }
     RowsLaunch update = poolUpdate(s, type, dt, t1);
+    // (Where the rows are in the memory, nothing here reads the mask: no parents, no
+    // drawing as the step goes, its folds copied, and it never dies.)
+    const uint8_t* updatable = info.rowsInMemory ? nullptr : pool.mask();
     RowsLaunch exports = update;
     Buffer exportMask;
     if (info.exports) {
         s.bindPool(type, info.exportsLayout, work.exports, work.exportsTable);
-        exportMask = work.masks.at(0, Elem::U8, rows);
+        // Exports of the survivors: of a type that never dies, every row updated.
+        exportMask = info.kills ? work.masks.at(0, Elem::U8, rows) : pool.updatable.column;
         exports.kernel = info.exports;
         exports.layout = &info.exportsLayout;
         exports.columns = work.exportsTable;
         exports.mask = exportMask;
         exports.uniforms = s.uniforms(type, *info.exports, static_cast<float>(dt), static_cast<float>(t1));
     }
-    // (Where the rows are in the memory, nothing here reads the mask: no parents, no
-    // exports, no drawing as the step goes.)
-    const uint8_t* updatable = info.rowsInMemory ? nullptr : pool.mask();
     const auto* kill = s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]);
     // Objects that only die (no rate emits) are found while their chunk is in cache; where
     // nobody looks at them before the end of the step (`late`: the schedule's phase says so,
@@ -173,8 +174,12 @@ void runUpdate(State& s, size_t type, double dt, double t1, bool last, bool late
         if (result.unstable) unstable += result.unstable;
         if (listKills || late) s.ledger.record(work.killed[c], result, work.updateTable[ColumnLayout::kKill], begin, end);
         if (info.exports) {
-            auto* survivors = s.host<uint8_t>(exportMask);
-            maskRows(survivors, updatable, info.kills ? kill : nullptr, nullptr, part.begin, part.end);
+            const uint8_t* survivors = updatable;
+            if (info.kills) {
+                auto* alive = s.host<uint8_t>(exportMask);
+                maskRows(alive, updatable, kill, nullptr, part.begin, part.end);
+                survivors = alive;
+            }
             RowsLaunch post = exports;
             post.begin = part.begin;
             post.end = part.end;

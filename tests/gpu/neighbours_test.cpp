@@ -51,3 +51,48 @@ TEST_CASE("a fold's grid on the GPU is the same every run: its buckets' rows sor
     };
     CHECK(run() == run());
 }
+
+TEST_CASE("a flock that never dies keeps its rows on the GPU: created there, folded there, what a step moves does not grow with it") {
+    // Birds that fold over each other and never die: their pool's rows, masks and exports
+    // stay on the GPU, and an object created in the step folds over nothing (the same
+    // empty folds the interpreter gives it) — birds joining at a rate, compared with the
+    // interpreter; then flocks of 2,000 and 20,000 made at once.
+    const char* flock = R"(
+        object bird(ipos: vec3) {
+            mates = near_count(bird, 0.6);
+            centre = near_sum(bird, 0.6, other.pos);
+            nearest = near_min(bird, 0.6, distance(pos, other.pos));
+            vel = vec3(0.2, 0, 0) -> prev(vel) * 0.9 + (mates > 0 ? centre / mates - pos : vec3(0)) * dt;
+            pos = ipos -> prev(pos) + vel * dt;
+            point(pos, vec4(mates / 10, min(nearest, 1), 0, 1), 1);
+        }
+        object sky { emit bird(rand3() * 3) at RATE per second; emit bird(rand3() * 3) count COUNT; }
+        spawn sky;)";
+    auto program = [&](int rate, int count) {
+        std::string text = flock;
+        text.replace(text.find("RATE"), 4, std::to_string(rate));
+        text.replace(text.find("COUNT"), 5, std::to_string(count));
+        return text;
+    };
+    Pair p(program(600, 0));
+    p.steps(30, 1.0 / 60);  // 300 birds by then, past the host side's few rows
+    CHECK(p.gl->pool(static_cast<size_t>(p.gl->typeIndex("bird"))).rowsInMemory());
+    CHECK(p.compare() <= kSamplesTolerance);
+    p.steps(30, 1.0 / 60);
+    CHECK(p.compare() <= kSamplesTolerance);
+
+    auto perStep = [&](int birds) {
+        auto gpu = gpuBackend();
+        rt::System system(test::compileModule(program(0, birds)), *gpu);
+        for (int f = 0; f < 5; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
+        CHECK(system.pool(static_cast<size_t>(system.typeIndex("bird"))).live() == static_cast<size_t>(birds));
+        uint64_t before = gpu->transferredBytes(), waits = gpu->waits();
+        for (int f = 0; f < 10; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
+        CHECK(gpu->waits() == waits);
+        return static_cast<double>(gpu->transferredBytes() - before) / 10;
+    };
+    double small = perStep(2000), large = perStep(20000);
+    MESSAGE("bytes between host and GPU a step: " << small << " with 2,000 birds, " << large << " with 20,000");
+    CHECK(large <= small + 8);
+    CHECK(large < 256);
+}
