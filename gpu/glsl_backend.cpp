@@ -82,7 +82,7 @@ GlslBackend::~GlslBackend() {
     for (auto& [key, p] : rows_) glDeleteProgram(p->program);
     for (auto& [key, p] : children_) glDeleteProgram(p->program);
     fold_.reset();  // (its GL objects, while the context is current)
-    for (auto& [ticket, late] : late_) settle(*late);  // its fence deleted
+    for (auto& [ticket, late] : late_) fetch(*late);  // its fence deleted
     glDeleteTextures(static_cast<GLsizei>(textures_.size()), textures_.data());
     GLuint buffers[] = {words_, counts_, block_, readback_, params_};
     glDeleteBuffers(5, buffers);

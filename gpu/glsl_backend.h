@@ -168,7 +168,7 @@ private:
     // valid until the next read.
     std::span<const uint32_t> readRegion(size_t at, size_t words);
     uint64_t finishLate(std::unique_ptr<Late> late);  // its fence; its ticket
-    void settle(Late& late);          // waits for it if it must, and reads its counts and kills
+    void fetch(Late& late);           // waits for it if it must, and reads its counts and kills
     void hostClearKilled(const rt::RowsLaunch& launch);
     void ensureWords(size_t words);
     bool onHost(std::span<const rt::Buffer> columns, rt::Buffer mask, size_t rows) const;

@@ -28,7 +28,7 @@ struct GlslBackend::Program {
 };
 
 // A late launch: where each of its dispatches left its counts (4 words) and kills (total,
-// then rows), the fence after the last, and once settled what they said.
+// then rows), the fence after the last, and once fetched what they said.
 struct GlslBackend::Late {
     struct Part {
         size_t begin;  // the dispatch's first row
@@ -37,7 +37,7 @@ struct GlslBackend::Late {
     };
     std::vector<Part> parts;
     GLsync fence = nullptr;
-    bool settled = false;
+    bool fetched = false;
     bool listed = false;  // its kills go to the launch's kill list (rt::RowsLaunch::killList), not here
     rt::RowsResult counts;
     std::vector<uint32_t> rows;

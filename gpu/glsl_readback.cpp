@@ -13,8 +13,8 @@
 // every earlier command on any driver; the fence only says when it will not wait.
 //
 // Regions: an immediate read-back uses the words after those late launches hold; late
-// launches keep theirs until collected (or settled: read into host memory). When the
-// words run out, the late launches are settled and the buffer grows to twice what was
+// launches keep theirs until collected (or fetched: read into host memory). When the
+// words run out, the late launches are fetched and the buffer grows to twice what was
 // asked, so that a step's regions soon fit without settling anything early.
 #include <algorithm>
 #include <cstring>
@@ -158,8 +158,8 @@ size_t GlslBackend::reserveReadback(size_t words) {
         // for twice what was asked, so that the steps to come fit without moving it again.
         size_t wanted = readbackUsed_ + words;
         for (auto& [ticket, late] : late_) {
-            lateEarly_ += !late->settled;
-            settle(*late);
+            lateEarly_ += !late->fetched;
+            fetch(*late);
         }
         readbackUsed_ = 0;
         ensureReadback(2 * wanted);
@@ -197,9 +197,9 @@ uint64_t GlslBackend::finishLate(std::unique_ptr<Late> late) {
     return ticket;
 }
 
-void GlslBackend::settle(Late& late) {
-    if (late.settled) return;
-    late.settled = true;
+void GlslBackend::fetch(Late& late) {
+    if (late.fetched) return;
+    late.fetched = true;
     ++lateReads_;
     if (glClientWaitSync(late.fence, 0, 0) == GL_TIMEOUT_EXPIRED) ++lateStalls_;
     waitFor(late.fence);
@@ -225,7 +225,7 @@ void GlslBackend::settle(Late& late) {
 
 bool GlslBackend::ready(uint64_t ticket) {
     auto it = late_.find(ticket);
-    if (it == late_.end() || it->second->settled) return true;
+    if (it == late_.end() || it->second->fetched) return true;
     if (context_) context_->makeCurrent();
     return glClientWaitSync(it->second->fence, 0, 0) != GL_TIMEOUT_EXPIRED;
 }
@@ -235,13 +235,13 @@ rt::RowsResult GlslBackend::collect(uint64_t ticket) {
     if (it == late_.end()) throw std::logic_error("collect: no late launch has this ticket");
     if (context_) context_->makeCurrent();
     Late& late = *it->second;
-    settle(late);
+    fetch(late);
     killedRows_ = std::move(late.rows);
     rt::RowsResult result = late.counts;
     result.killedRows = killedRows_;
     late_.erase(it);
-    // No region is kept once every late launch is settled (read, or waiting to be collected).
-    if (std::all_of(late_.begin(), late_.end(), [](const auto& entry) { return entry.second->settled; }))
+    // No region is kept once every late launch is fetched (read, or waiting to be collected).
+    if (std::all_of(late_.begin(), late_.end(), [](const auto& entry) { return entry.second->fetched; }))
         readbackUsed_ = 0;
     return result;
 }
