@@ -55,6 +55,32 @@ struct LateBackend : rt::Backend {
     }
 };
 
+// As a GPU: a late launch's kills clear its pool's alive mask at once (clearsKilled), so
+// the run-time may take them at the next settle; its tickets are ready only when `ready`
+// says so, and what it collects is counted.
+struct OwingBackend : LateBackend {
+    bool readyNow = false;
+    size_t collected = 0;
+    std::string name() const override { return "owing"; }
+    bool clearsKilled() const override { return true; }
+    bool ready(uint64_t) override { return readyNow; }
+    rt::RowsResult run(const rt::RowsLaunch& l) override {
+        rt::RowsResult r = LateBackend::run(l);
+        if (!r.ticket || !l.aliveMask.valid()) return r;
+        auto* alive = rt::hostData<uint8_t>(inner.memory(), l.aliveMask);
+        const uint32_t* listed =
+            l.aliveRowsBuffer.valid() ? rt::hostData<uint32_t>(inner.memory(), l.aliveRowsBuffer) : l.aliveRows.data();
+        for (uint32_t i : held.at(r.ticket).second)
+            alive[listed ? listed[i - l.aliveRowsFirst] : i] = 0;
+        return r;
+    }
+    rt::RowsResult collect(uint64_t ticket) override {
+        ++collected;
+        return LateBackend::collect(ticket);
+    }
+    using rt::Backend::run;
+};
+
 // Three systems hold the same objects in the same rows, drawn with the same ids in the same order.
 void sameObjects(rt::System& a, rt::System& b, rt::System& c) {
     REQUIRE(test::poolRows(a) == test::poolRows(b));
@@ -237,4 +263,59 @@ TEST_CASE("an emission rate or count every row shares is read from the host's va
         object e { emit p at rate / 3 + rand() per second count 2; }
         spawn e; spawn e; spawn e;)";
     CHECK(created(ownRate, poisoned).second > 0);
+}
+
+TEST_CASE("a step's deaths a device still owes are settled by the next settle that may wait, and by stats only when ready") {
+    // Drops that die at 0.4 s from a stream, on a backend that owes every late launch's
+    // kills until asked to wait (the GPU's way), against the interpreter: what is drawn is
+    // the same at once (its kills cleared the alive mask); the rows freed, the live counts
+    // and the ids after a settle that may wait — the next step's first phase (a step of no
+    // time runs it alone), a trigger before its objects take rows, finish — or once the
+    // backend says its tickets are ready (stats, finished); never a wait before.
+    const char* text = "object drop { point(vec3(age), white, 1); kill when age > 0.4; }\n"
+                       "object stream { emit drop at 600 per second; }\n"
+                       "trigger burst { emit drop count 50; }\nspawn stream;";
+    interp::Interpreter host;
+    OwingBackend owing;
+    rt::SystemOptions options;
+    options.rows = rt::SystemOptions::Rows::OnHost;  // (the rows compared are the host's)
+    rt::System a(test::compileModule(text), host, options), b(test::compileModule(text), owing, options);
+    auto drawnSame = [&] { REQUIRE(a.points(0).size() == b.points(0).size()); };
+    for (int f = 0; f < 40; ++f) {
+        REQUIRE_FALSE(a.step(1.0 / 60));
+        REQUIRE_FALSE(b.step(1.0 / 60));
+        drawnSame();
+    }
+    size_t collected = owing.collected;
+    CHECK(b.stats().types[0].killed < a.stats().types[0].killed);  // owed: not ready, not waited for
+    CHECK_FALSE(b.finished());
+    CHECK(owing.collected == collected);
+    REQUIRE_FALSE(b.step(0));  // the settle phase alone: everything owed taken and freed
+    REQUIRE_FALSE(a.step(0));
+    CHECK(owing.collected > collected);
+    CHECK(b.stats().types[0].killed == a.stats().types[0].killed);
+    CHECK(test::poolRows(a) == test::poolRows(b));
+    for (int f = 0; f < 10; ++f) {
+        REQUIRE_FALSE(a.step(1.0 / 60));
+        REQUIRE_FALSE(b.step(1.0 / 60));
+    }
+    REQUIRE_FALSE(a.fire("burst", {}));  // its objects take the rows the last step freed
+    REQUIRE_FALSE(b.fire("burst", {}));
+    CHECK(test::poolRows(a) == test::poolRows(b));
+    sameObjects(a, b, b);
+    REQUIRE_FALSE(a.step(1.0 / 60));
+    REQUIRE_FALSE(b.step(1.0 / 60));
+    owing.readyNow = true;  // stats takes what is ready
+    collected = owing.collected;
+    CHECK(b.stats().types[0].killed == a.stats().types[0].killed);
+    CHECK(owing.collected > collected);
+    CHECK(test::poolRows(a) == test::poolRows(b));
+    owing.readyNow = false;
+    REQUIRE_FALSE(a.step(1.0 / 60));
+    REQUIRE_FALSE(b.step(1.0 / 60));
+    a.finish();
+    b.finish();  // waits for everything
+    CHECK(b.stats().types[0].killed == a.stats().types[0].killed);
+    CHECK(b.stats().types[0].live == a.stats().types[0].live);
+    sameObjects(a, b, b);
 }
