@@ -160,7 +160,7 @@ void System::runPhases(size_t first, size_t end, double dt, double t1, bool last
                 continue;
             }
             case PhaseKind::Update:
-                detail::runUpdate(s, type, dt, t1, last, p.late && last);
+                detail::runUpdate(s, p, dt, t1, last);
                 if (last) s.work[type].inStep.updated = true;
                 s.stats.loopSeconds += seconds(start, WallClock::now());
                 continue;

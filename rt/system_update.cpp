@@ -118,7 +118,11 @@ RowsLaunch poolUpdate(State& s, size_t type, double dt, double t1) {
 // allows), what each chunk killed listed by the chunk; the kills and emissions are the
 // phases after it (runKills, runEmissions), in row order, so that ids, the queue and the
 // free list come out the same with any number of threads.
-void runUpdate(State& s, size_t type, double dt, double t1, bool last, bool late) {
+void runUpdate(State& s, const Phase& phase, double dt, double t1, bool last) {
+    auto type = static_cast<size_t>(phase.type);
+    // Where nobody looks at its dead before the step's end (and this sub-step ends it), its
+    // kills are taken then (LateKills).
+    const bool late = phase.late && last;
     Pool& pool = s.pools[type];
     TypeInfo& info = s.types[type];
     TypeWork& work = s.work[type];
@@ -135,7 +139,7 @@ void runUpdate(State& s, size_t type, double dt, double t1, bool last, bool late
     RowsLaunch update = poolUpdate(s, type, dt, t1);
     // (Where the rows are in the memory, nothing here reads the mask: no parents, no
     // drawing as the step goes, its folds copied, and it never dies.)
-    const uint8_t* updatable = info.rowsInMemory ? nullptr : pool.mask();
+    const uint8_t* updatable = phase.inMemory ? nullptr : pool.mask();
     RowsLaunch exports = update;
     Buffer exportMask;
     if (info.exports) {
@@ -149,15 +153,13 @@ void runUpdate(State& s, size_t type, double dt, double t1, bool last, bool late
         exports.uniforms = s.uniforms(type, *info.exports, static_cast<float>(dt), static_cast<float>(t1));
     }
     const auto* kill = s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]);
-    // Objects that only die (no rate emits) are found while their chunk is in cache; where
-    // nobody looks at them before the end of the step (`late`: the schedule's phase says so,
-    // Phase::late, and this is the step's last sub-step), they are taken then (LateKills),
-    // and a device need not wait.
-    bool listKills = info.kills && !info.updateEmits;
+    // Objects that only die (no rate emits) are found while their chunk is in cache
+    // (Phase::listed); late, a device need not wait for them.
+    const bool listKills = phase.listed;
     size_t chunks = s.chunkCount(rows);
     work.pass = {true, late, listKills && !late, chunks, {}};
     if (listKills || late) work.killed.resize(chunks);  // each chunk sets its own (Ledger::record)
-    if (late && info.rowsInMemory)
+    if (late && phase.inMemory)
         for (size_t c = 0; c < chunks; ++c)
             work.killed[c].killList = pool.scratchRows(std::min(s.backend.chunkRows(), rows - c * s.backend.chunkRows()) + 1);
     std::atomic<uint64_t> unstable = 0;
@@ -167,7 +169,7 @@ void runUpdate(State& s, size_t type, double dt, double t1, bool last, bool late
         part.end = end;
         part.late = late;
         if (late) part.aliveMask = pool.alive.column;  // its kills cleared there (Backend::clearsKilled)
-        if (late && info.rowsInMemory)  // and listed, for the pool to free them where its rows are
+        if (late && phase.inMemory)  // and listed, for the pool to free them where its rows are
             part.killList = work.killed[c].killList;
         s.gatherParents(type, info.updateLayout, work.updateTable, updatable, part.begin, part.end, t1);
         RowsResult result = s.backend.run(part);
