@@ -131,6 +131,10 @@ public:
         bool done = false;
         for (int tries = 0; tries < 8 && !done; ++tries) done = editOnce(r_.below(6));
         if (!done) changeTerm();
+        // The edit's populations bounded as the program's are: an edit may start a type the
+        // program never started (a removed type's spawn given to another: seed 940130's
+        // edit grew a million objects, and the case timed out).
+        capPopulations();
         m = m_;
     }
 
@@ -390,7 +394,6 @@ private:
         int added = addType(-1);
         for (size_t t = first; t < m_.types.size(); ++t) fillType(static_cast<int>(t));
         m_.spawns.push_back({added, args(-1, m_.types[static_cast<size_t>(added)].params)});
-        capPopulations();
         return true;
     }
     std::vector<int> live() const {
