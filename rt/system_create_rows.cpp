@@ -12,10 +12,7 @@
 
 #include <algorithm>
 #include <atomic>
-#include <bit>
 #include <cstdint>
-
-#include "core/fold.h"
 
 #include "rt/rng.h"
 #include "rt/system_support.h"
@@ -95,13 +92,8 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
 
 void Creation::emptyFolds(size_t type, const ColumnLayout& layout, const std::vector<Buffer>& table, size_t first,
                           size_t n) {
-    const ir::Object& o = s_.module.objects[type];
-    for (const auto& p : layout.parentColumns) {
-        if (p.op != ir::Op::Fold) continue;
-        float empty = core::emptyFold(o.folds.at(static_cast<size_t>(p.exportIndex)).reduce);
-        for (int c = 0; c < p.width; ++c)
-            s_.memory.fill(table[static_cast<size_t>(p.offset + c)], first, n, std::bit_cast<uint32_t>(empty));
-    }
+    for (const auto& p : layout.parentColumns)
+        if (p.op == ir::Op::Fold) s_.emptyFold(type, p, table, first, n);
 }
 
 // A launch over the batch's objects (those kept: its mask), in chunks; `late`: its kills

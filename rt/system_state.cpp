@@ -203,13 +203,10 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
         if (p.op == ir::Op::Fold && !poolRows) {
             const Pool& pool = pools[type];
             size_t stop = std::clamp(pool.foldRows, begin, end);
-            float empty = core::emptyFold(pool.object().folds.at(static_cast<size_t>(p.exportIndex)).reduce);
-            for (int c = 0; c < p.width; ++c) {
-                Buffer to = table[static_cast<size_t>(p.offset + c)];
-                memory.copy(pool.folds.column(static_cast<size_t>(p.exportIndex), static_cast<size_t>(c)), begin, to,
-                            begin, stop - begin);
-                memory.fill(to, stop, end - stop, std::bit_cast<uint32_t>(empty));
-            }
+            for (int c = 0; c < p.width; ++c)
+                memory.copy(pool.folds.column(static_cast<size_t>(p.exportIndex), static_cast<size_t>(c)), begin,
+                            table[static_cast<size_t>(p.offset + c)], begin, stop - begin);
+            emptyFold(type, p, table, stop, end - stop);
             continue;
         }
         int parentType = static_cast<int>(type);
@@ -255,6 +252,13 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
         }
         memory.write(table[static_cast<size_t>(p.offset)], begin, end - begin, values.data());
     }
+}
+
+void State::emptyFold(size_t type, const ColumnLayout::ParentColumn& p, std::span<const Buffer> table, size_t first,
+                      size_t count) {
+    float empty = core::emptyFold(module.objects[type].folds.at(static_cast<size_t>(p.exportIndex)).reduce);
+    for (int c = 0; c < p.width; ++c)
+        memory.fill(table[static_cast<size_t>(p.offset + c)], first, count, std::bit_cast<uint32_t>(empty));
 }
 
 void State::bindPool(size_t type, const ColumnLayout& layout, Scratch& scratch, std::vector<Buffer>& table) {

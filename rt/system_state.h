@@ -152,6 +152,10 @@ struct State {
     // The neighbour folds of a type's objects, for this step (rt/neighbours.cpp).
     void foldNeighbours(size_t type);
     void foldOnHost(const FoldLaunch& launch);
+    // Rows [first, first + count) of a fold's launch columns (`p`, in `table`) set to a fold
+    // over nothing: what an object created since the folds reads.
+    void emptyFold(size_t type, const ColumnLayout::ParentColumn& p, std::span<const Buffer> table, size_t first,
+                   size_t count);
     // Pool rows of `type` as the rows its fold columns are gathered from (in place).
     void foldRowsOf(size_t type, std::span<uint32_t> rows) const;
     // Points `table` at a pool's columns, kill flags and the scratch columns of the rest.

@@ -131,10 +131,7 @@ public:
         bool done = false;
         for (int tries = 0; tries < 8 && !done; ++tries) done = editOnce(r_.below(6));
         if (!done) changeTerm();
-        // The edit's populations bounded as the program's are: an edit may start a type the
-        // program never started (a removed type's spawn given to another: seed 940130's
-        // edit grew a million objects, and the case timed out).
-        capPopulations();
+        capPopulations();  // an edit may start a type the program never started (seed 940130)
         m = m_;
     }
 
