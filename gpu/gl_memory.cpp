@@ -123,13 +123,14 @@ GlMemory::~GlMemory() {
     for (auto& c : columns_)
         if (c && c->gl) glDeleteBuffers(1, &c->gl);
     for (unsigned program : {scatterProgram_, scatterColumnsProgram_, gatherProgram_, allocateProgram_, releaseProgram_, pushedProgram_, freshProgram_,
-                             identifyProgram_, boundsProgram_})
+                             identifyProgram_, boundsProgram_, emitRowsProgram_, emitScanProgram_})
         if (program) glDeleteProgram(program);
     if (runsBuffer_) glDeleteBuffers(1, &runsBuffer_);
     if (rowsBuffer_) glDeleteBuffers(1, &rowsBuffer_);
     if (paramsBuffer_) glDeleteBuffers(1, &paramsBuffer_);
     if (pendingBuffer_) glDeleteBuffers(1, &pendingBuffer_);
     if (boxBuffer_) glDeleteBuffers(1, &boxBuffer_);
+    if (metaBuffer_) glDeleteBuffers(1, &metaBuffer_);
 }
 
 GlMemory::Column& GlMemory::at(Buffer b) const { return *columns_.at(b.id); }

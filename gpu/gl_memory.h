@@ -51,6 +51,8 @@ public:
                  size_t rowsFirst, size_t count) override;
     void identify(const rt::ObjectRuns& runs, size_t n, size_t kept, rt::Buffer created, rt::Buffer ids,
                   rt::Buffer mask, size_t first) override;
+    // Rate emissions decided on the GPU: a dispatch a site, one scan (gpu/gl_emission.cpp).
+    void emitAtRate(const rt::RateSites& sites, rt::Buffer runs, rt::Buffer totals) override;
     // The box around the drawn rows, reduced on the GPU (gpu/gl_bounds.cpp).
     rt::Bounds bounds(rt::Buffer visible, const std::array<rt::Buffer, 3>& position, const std::array<float, 3>& constant,
                       size_t rows) const override;
@@ -125,6 +127,7 @@ private:
     void dispatchRows(unsigned program, size_t invocations);
     mutable std::vector<uint32_t> rowsSent_;  // what rowsBuffer_ holds
     mutable unsigned boundsProgram_ = 0, boxBuffer_ = 0;  // gpu/gl_bounds.cpp
+    unsigned emitRowsProgram_ = 0, emitScanProgram_ = 0, metaBuffer_ = 0;  // gpu/gl_emission.cpp
 };
 
 // Host rows to GPU words (u8 widened to a word) and back.

@@ -10,6 +10,8 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include "rt/emission.h"
+
 namespace psys::rt {
 
 void Memory::clear(Buffer buffer, size_t first, size_t count) {
@@ -128,6 +130,66 @@ void Memory::identify(const ObjectRuns& runs, size_t n, size_t kept, Buffer crea
             c[r] = runs.time(u, k);
             id[r] = runs.id[u] + k;
         }
+}
+
+// The rate emissions of emitter rows (Memory::emitAtRate): rt/emission.h's rule row by
+// row, each site's objects kept while its target's room lasts, the ids in row order.
+void Memory::emitAtRate(const RateSites& in, Buffer runs, Buffer totals) {
+    const size_t n = in.rows, sites = in.sites.size();
+    auto* total = static_cast<uint32_t*>(host(totals));
+    std::fill(total, total + kTotalsSites + kTotalsPerSite * sites, 0u);
+    if (n == 0) return;
+    auto* record = static_cast<uint32_t*>(host(runs));
+    const auto* mask = static_cast<const uint8_t*>(view(in.mask));
+    const auto* killed = in.killed.valid() ? static_cast<const uint8_t*>(view(in.killed)) : nullptr;
+    const auto* created = in.created.valid() ? static_cast<const double*>(view(in.created)) : nullptr;
+    struct Site {
+        const float *rate, *count;
+        double* accumulated;
+        uint64_t asked = 0;  // objects asked for so far (saturating)
+    };
+    std::vector<Site> site;
+    for (const RateSites::Site& s : in.sites)
+        site.push_back({s.rate.valid() ? static_cast<const float*>(view(s.rate)) : nullptr,
+                        s.count.valid() ? static_cast<const float*>(view(s.count)) : nullptr,
+                        static_cast<double*>(host(s.accumulated))});
+    uint64_t invalid = 0, clamped = 0;
+    uint32_t id = in.nextId;
+    for (size_t r = 0; r < n; ++r)
+        for (size_t k = 0; k < sites; ++k) {
+            const RateSites::Site& s = in.sites[k];
+            Site& d = site[k];
+            RateEmission e;
+            if (mask[r] && !(killed && killed[r])) {
+                double dt = created ? in.t1 - created[r] : in.dt;
+                e = rateEmission(d.accumulated[r], d.rate ? d.rate[r] : s.rateValue, d.count ? d.count[r] : s.countValue,
+                                 dt, in.t1);
+                d.accumulated[r] = e.accumulated;
+                invalid += e.invalid;
+                clamped += e.clamped;
+            }
+            uint64_t before = d.asked;
+            d.asked = e.children > UINT64_MAX - before ? UINT64_MAX : before + e.children;
+            auto place = static_cast<uint32_t>(std::min<uint64_t>(before, s.room));
+            auto kept = static_cast<uint32_t>(std::min<uint64_t>(d.asked, s.room)) - place;
+            uint32_t* w = record + (k * n + r) * kRunWords;
+            w[0] = place;
+            w[1] = kept;
+            w[2] = id;
+            w[3] = static_cast<uint32_t>(std::min<uint64_t>(e.perEvent, UINT32_MAX));
+            std::memcpy(w + 4, &e.firstTime, 8);
+            std::memcpy(w + 6, &e.spacing, 8);
+            id += kept;
+        }
+    total[kTotalsInvalid] = static_cast<uint32_t>(std::min<uint64_t>(invalid, UINT32_MAX));
+    total[kTotalsClamped] = static_cast<uint32_t>(std::min<uint64_t>(clamped, UINT32_MAX));
+    total[kTotalsIds] = id - in.nextId;
+    for (size_t k = 0; k < sites; ++k) {
+        uint32_t* t = total + kTotalsSites + kTotalsPerSite * k;
+        t[0] = static_cast<uint32_t>(std::min<uint64_t>(site[k].asked, in.sites[k].room));
+        t[1] = static_cast<uint32_t>(site[k].asked);
+        t[2] = static_cast<uint32_t>(site[k].asked >> 32);
+    }
 }
 
 // One column: a 64-byte aligned array that grows by doubling, so that appending rows one

@@ -61,6 +61,31 @@ struct ObjectRuns {
     double time(size_t u, uint32_t k) const { return eventTime(firstTime[u], k, perEvent[u], spacing[u]); }
 };
 
+// A type's rate emit sites over rows [0, rows) of its columns (Memory::emitAtRate).
+struct RateSites {
+    struct Site {
+        Buffer rate, count;  // f32 per row; invalid: rateValue, countValue every row's
+        float rateValue = 0, countValue = 1;
+        Buffer accumulated;  // f64 per row: events accumulated, in [0, 1)
+        uint32_t room = 0;   // objects its target may still take (its free rows less those queued)
+    };
+    std::vector<Site> sites;  // in the type's order of sites, each its own target type
+    size_t rows = 0;
+    Buffer mask;     // u8: the rows that emit
+    Buffer killed;   // u8: rows the update killed (they emit nothing); invalid: none
+    Buffer created;  // f64: where given, row r's update began at created[r] (a batch's first), else at t1 − dt
+    double dt = 0, t1 = 0;
+    uint32_t nextId = 0;  // the first id the emissions take
+};
+
+// Emitter rows' records in a runs buffer (Memory::emitAtRate), kRunWords words each, in
+// rt::ObjectRuns' form: first (the run's first object's place among the site's objects),
+// count, id, perEvent, firstTime (f64, low word first), spacing (f64).
+constexpr size_t kRunWords = 8;
+// A totals buffer (u32): the emissions' invalid rates and counts, the counts clamped, the
+// ids taken; then per site: objects kept, and objects asked for (u64, low word first).
+constexpr size_t kTotalsInvalid = 0, kTotalsClamped = 1, kTotalsIds = 2, kTotalsSites = 3, kTotalsPerSite = 3;
+
 class Memory {
 public:
     virtual ~Memory() = default;
@@ -134,6 +159,15 @@ public:
     // ids[first + r], and mask[first + r] = r < kept.
     virtual void identify(const ObjectRuns& runs, size_t n, size_t kept, Buffer created, Buffer ids, Buffer mask,
                           size_t first);
+    // The rate emissions of emitter rows (rt/emission.h's rule, in row order, a row's sites
+    // in order): each row of `sites.mask` not killed advances its accumulators and asks
+    // for its events' objects; a site's target keeps them while its room lasts (the rest
+    // dropped, counted in `totals`), and the kept take ids from nextId in row order, sites
+    // in order. Row r's run at site s is record s·rows + r of `runs` (kRunWords words: a
+    // row that emits nothing has count 0); the totals (kTotals…) in `totals`. Written here
+    // through `host`; a device does it where the rows are (GlMemory: a dispatch a site and
+    // one scan).
+    virtual void emitAtRate(const RateSites& sites, Buffer runs, Buffer totals);
     // The box around rows [0, rows) whose `visible` (f32) is 1: each position component's
     // least and greatest, from its column (f32), or `constant[c]` where it has none (an
     // invalid buffer). Min and max are exact, so the box is the same whatever the order

@@ -80,18 +80,11 @@ void Creation::emitInUpdate(const Emitter& e, std::span<const float> rate, std::
             continue;
         }
         if (!o.emits[site].rate() || dying) continue;
-        double r = validCount(rate[site], s_.stats.invalidEmissions);
-        double size = validCount(count[site], s_.stats.invalidEmissions);
-        double before = pool.emitted[site][e.row];
-        double total = before + r * dt;
-        // A whole number reached by adding up rounded rates (0.25 · 1/60, 240 times) counts as reached.
-        double events = std::floor(total + 1e-9);
-        pool.emitted[site][e.row] = std::max(0.0, total - events);
-        if (events < 1 || size < 1) continue;
-        uint64_t perEvent = wholeCount(size, s_.stats.clampedEmissions);  // counted when it is asked for
-        double firstTime = (t1 - dt) + (1.0 - before) / r;
-        uint64_t children = wholeCount(events * static_cast<double>(perEvent), s_.stats.clampedEmissions);
-        queueChildren(e, static_cast<int>(site), children, perEvent, firstTime, 1.0 / r);
+        RateEmission r = rateEmission(pool.emitted[site][e.row], rate[site], count[site], dt, t1);
+        pool.emitted[site][e.row] = r.accumulated;
+        s_.stats.invalidEmissions += r.invalid;
+        s_.stats.clampedEmissions += r.clamped;
+        if (r.children) queueChildren(e, static_cast<int>(site), r.children, r.perEvent, r.firstTime, r.spacing);
     }
 }
 

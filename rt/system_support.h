@@ -8,35 +8,12 @@
 #include <vector>
 
 #include "ir/value.h"
+#include "rt/emission.h"
 
 namespace psys::rt::detail {
 
 using WallClock = std::chrono::steady_clock;
 inline double seconds(WallClock::time_point a, WallClock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
-
-// An emission count or rate from a kernel: NaN, infinite and negative values count as
-// invalid and emit nothing.
-inline double validCount(float x, uint64_t& invalid) {
-    if (!std::isfinite(x) || x < 0) {
-        ++invalid;
-        return 0;
-    }
-    return x;
-}
-
-// The most objects one emission may ask for: counts and rates beyond it (1e30 from a
-// kernel, a trigger's argument) are taken as this many and counted, so no count overflows.
-constexpr double kMaxCount = 1e18;
-
-// A valid count as a whole number of objects, at most kMaxCount (a clamp is counted).
-inline uint64_t wholeCount(double x, uint64_t& clamped) {
-    x = std::floor(x);
-    if (x > kMaxCount) {
-        ++clamped;
-        return static_cast<uint64_t>(kMaxCount);
-    }
-    return static_cast<uint64_t>(x);
-}
 
 // a += b, stopping at the largest uint64 rather than wrapping around.
 inline void addSaturating(uint64_t& a, uint64_t b) { a = b > UINT64_MAX - a ? UINT64_MAX : a + b; }

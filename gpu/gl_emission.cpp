@@ -1,0 +1,248 @@
+// Rate emissions decided where an emitter's rows are (rt::Memory::emitAtRate): a dispatch
+// a site over the rows — rt/emission.h's rule in GLSL doubles, each row's accumulator
+// moved on, its objects asked for written into its record — then one work group that
+// scans the records in row order: each site's objects kept while its target's room lasts
+// (a prefix sum of what was asked, clamped), the ids of the kept in row order, sites in
+// order (a prefix sum of the kept). What comes back to the host is the totals: a few words
+// a site, however many emitters. Counts past 2³² are two words (GLSL 4.50 has no 64-bit
+// integers): what a row asks for is at most kMaxCount, a sum saturates. The differential
+// test (tests/gpu/rows_test.cpp) holds this to the host's rule.
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "gpu/gl_context.h"
+#include "gpu/gl_memory.h"
+#include "gpu/gl_programs.h"
+#include "gpu/hazards.h"
+
+namespace psys::gpu {
+
+using rt::Buffer;
+
+namespace {
+
+// One site over the rows: params rows, flags (1 rate per row, 2 count per row, 4 kill
+// flags, 8 creation times; the site from bit 8), the shared rate and count, dt, t1.
+// The rule's operations are `precise` and in the host's order: the same doubles.
+const char* kRows = R"(
+layout(std430, binding = 0) readonly buffer Mask { uint mask[]; };
+layout(std430, binding = 1) readonly buffer Killed { uint killed[]; };
+layout(std430, binding = 2) readonly buffer Created { uint created[]; };
+layout(std430, binding = 3) readonly buffer Rate { uint rates[]; };
+layout(std430, binding = 4) readonly buffer Count { uint counts[]; };
+layout(std430, binding = 5) buffer Accumulated { uint accumulated[]; };
+layout(std430, binding = 6) buffer Runs { uint runs[]; };
+layout(std430, binding = 7) buffer Totals { uint totals[]; };
+double ld(uint lo, uint hi) { return packDouble2x32(uvec2(lo, hi)); }
+// rt::validCount: NaN, infinite and negative are invalid (0, counted).
+double valid(float x, inout uint invalid) {
+    if ((floatBitsToUint(x) & 0x7f800000u) == 0x7f800000u || x < 0.0) {
+        invalid += 1u;
+        return 0.0LF;
+    }
+    return double(x);
+}
+// rt::wholeCount.
+double whole(double x, inout uint clamped) {
+    x = floor(x);
+    if (x > 1e18LF) {
+        clamped += 1u;
+        return 1e18LF;
+    }
+    return x;
+}
+void main() {
+    uint r = INVOCATION, rows = param(0u), flags = param(1u), site = flags >> 8u;
+    if (r >= rows) return;
+    uint w = (site * rows + r) * 8u;
+    uint invalid = 0u, clamped = 0u, perEvent = 1u;
+    uvec2 children = uvec2(0u);
+    double firstTime = 0.0LF, spacing = 0.0LF;
+    if (mask[r] != 0u && ((flags & 4u) == 0u || killed[r] == 0u)) {
+        double t1 = ld(param(6u), param(7u));
+        double dt = (flags & 8u) != 0u ? t1 - ld(created[2u * r], created[2u * r + 1u]) : ld(param(4u), param(5u));
+        double before = ld(accumulated[2u * r], accumulated[2u * r + 1u]);
+        double rate = valid(uintBitsToFloat((flags & 1u) != 0u ? rates[r] : param(2u)), invalid);
+        double size = valid(uintBitsToFloat((flags & 2u) != 0u ? counts[r] : param(3u)), invalid);
+        precise double total = before + rate * dt;
+        precise double reached = total + 1e-9LF;
+        double events = floor(reached);
+        precise double left = total - events;
+        uvec2 after = unpackDouble2x32(0.0LF < left ? left : 0.0LF);
+        accumulated[2u * r] = after.x;
+        accumulated[2u * r + 1u] = after.y;
+        if (events >= 1.0LF && size >= 1.0LF) {
+            double each = whole(size, clamped);
+            perEvent = each >= 4294967295.0LF ? 0xffffffffu : uint(each);
+            precise double start = t1 - dt;
+            precise double wait = (1.0LF - before) / rate;
+            precise double first = start + wait;
+            precise double gap = 1.0LF / rate;
+            firstTime = first;
+            spacing = gap;
+            precise double asked = events * each;
+            double c = whole(asked, clamped);
+            uint hi = uint(c / 4294967296.0LF);
+            precise double lo = c - double(hi) * 4294967296.0LF;
+            children = uvec2(uint(lo), hi);
+        }
+    }
+    runs[w] = children.x;
+    runs[w + 1u] = children.y;
+    runs[w + 3u] = perEvent;
+    uvec2 f = unpackDouble2x32(firstTime), s = unpackDouble2x32(spacing);
+    runs[w + 4u] = f.x;
+    runs[w + 5u] = f.y;
+    runs[w + 6u] = s.x;
+    runs[w + 7u] = s.y;
+    if (invalid != 0u) atomicAdd(totals[0], invalid);
+    if (clamped != 0u) atomicAdd(totals[1], clamped);
+}
+)";
+
+// One work group of 256: each invocation a chunk of rows in order. Per site: the chunk's
+// sum of what its rows asked for, an exclusive scan of the sums (by one invocation: 256
+// adds), then each row's place and kept; then the same over the chunks' kept for the ids.
+// `meta`: rows, sites, next id, then each site's room.
+const char* kScan = R"(
+layout(local_size_x = 256) in;
+layout(std430, binding = 0) readonly buffer Meta { uint meta[]; };
+layout(std430, binding = 6) buffer Runs { uint runs[]; };
+layout(std430, binding = 7) buffer Totals { uint totals[]; };
+shared uvec2 partial[256];
+shared uint keptBefore[256];
+// a + b, saturating at 2⁶⁴ − 1.
+uvec2 add64(uvec2 a, uvec2 b) {
+    uint c1, c2, c3;
+    uint lo = uaddCarry(a.x, b.x, c1);
+    uint hi = uaddCarry(a.y, b.y, c2);
+    hi = uaddCarry(hi, c1, c3);
+    return (c2 | c3) != 0u ? uvec2(0xffffffffu) : uvec2(lo, hi);
+}
+uint atMost(uvec2 a, uint room) { return a.y != 0u ? room : min(a.x, room); }
+void main() {
+    uint l = gl_LocalInvocationID.x, rows = meta[0], sites = meta[1];
+    uint chunk = (rows + 255u) / 256u, begin = min(l * chunk, rows), end = min(begin + chunk, rows);
+    uint kept = 0u;
+    for (uint s = 0u; s < sites; ++s) {
+        uint room = meta[3u + s], base = s * rows;
+        uvec2 sum = uvec2(0u);
+        for (uint r = begin; r < end; ++r) sum = add64(sum, uvec2(runs[(base + r) * 8u], runs[(base + r) * 8u + 1u]));
+        partial[l] = sum;
+        barrier();
+        if (l == 0u) {
+            uvec2 before = uvec2(0u);
+            for (uint k = 0u; k < 256u; ++k) {
+                uvec2 next = add64(before, partial[k]);
+                partial[k] = before;
+                before = next;
+            }
+            uint t = 3u + 3u * s;
+            totals[t] = atMost(before, room);
+            totals[t + 1u] = before.x;
+            totals[t + 2u] = before.y;
+        }
+        barrier();
+        uvec2 asked = partial[l];
+        for (uint r = begin; r < end; ++r) {
+            uint w = (base + r) * 8u;
+            uint place = atMost(asked, room);
+            asked = add64(asked, uvec2(runs[w], runs[w + 1u]));
+            runs[w] = place;
+            runs[w + 1u] = atMost(asked, room) - place;
+            kept += runs[w + 1u];
+        }
+        barrier();
+    }
+    keptBefore[l] = kept;
+    barrier();
+    if (l == 0u) {
+        uint before = 0u;
+        for (uint k = 0u; k < 256u; ++k) {
+            uint next = before + keptBefore[k];
+            keptBefore[k] = before;
+            before = next;
+        }
+        totals[2] = before;
+    }
+    barrier();
+    uint id = meta[2] + keptBefore[l];
+    for (uint r = begin; r < end; ++r)
+        for (uint s = 0u; s < sites; ++s) {
+            uint w = (s * rows + r) * 8u;
+            runs[w + 2u] = id;
+            id += runs[w + 1u];
+        }
+}
+)";
+
+std::string shader(const char* body, bool rows) {
+    std::string header = "#version 450\n";
+    if (rows) header += "layout(local_size_x = 64) in;\n";
+    return header + kParamsBlock + "#define INVOCATION " + kInvocationIndex + "\n" + body;
+}
+
+uint32_t bits(float x) {
+    uint32_t u;
+    std::memcpy(&u, &x, 4);
+    return u;
+}
+std::pair<uint32_t, uint32_t> words(double x) {
+    uint32_t w[2];
+    std::memcpy(w, &x, 8);
+    return {w[0], w[1]};
+}
+
+}  // namespace
+
+void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs, Buffer totals) {
+    std::vector<Buffer> used = {in.mask, in.killed, in.created, runs, totals};
+    for (const rt::RateSites::Site& s : in.sites) used.insert(used.end(), {s.rate, s.count, s.accumulated});
+    const size_t sites = in.sites.size(), n = in.rows;
+    if (n == 0 || std::all_of(used.begin(), used.end(), [&](Buffer b) { return allOnHost({b}); }))
+        return rt::Memory::emitAtRate(in, runs, totals);
+    flushPending();
+    fill(totals, 0, rt::kTotalsSites + rt::kTotalsPerSite * sites, 0);
+    if (!emitRowsProgram_) emitRowsProgram_ = computeProgram(shader(kRows, true), "rate emissions");
+    if (!emitScanProgram_) emitScanProgram_ = computeProgram(shader(kScan, false), "rate emissions' scan");
+    PassTimer::Scope timed(timer, "emissions", n * sites);
+    unsigned runsGl = bound(runs), totalsGl = bound(totals);
+    auto [dt0, dt1] = words(in.dt);
+    auto [t10, t11] = words(in.t1);
+    for (size_t k = 0; k < sites; ++k) {
+        const rt::RateSites::Site& s = in.sites[k];
+        auto or_ = [&](Buffer b) { return b.valid() ? deviceBuffer(b) : runsGl; };  // (a block must be bound)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceBuffer(in.mask));
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, or_(in.killed));
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, or_(in.created));
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, or_(s.rate));
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, or_(s.count));
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, bound(s.accumulated));
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, runsGl);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, totalsGl);
+        uint32_t flags = (s.rate.valid() ? 1u : 0u) | (s.count.valid() ? 2u : 0u) | (in.killed.valid() ? 4u : 0u) |
+                         (in.created.valid() ? 8u : 0u) | static_cast<uint32_t>(k) << 8;
+        bindParams(paramsBuffer_, {static_cast<uint32_t>(n), flags, bits(s.rateValue), bits(s.countValue), dt0, dt1,
+                                   t10, t11});
+        dispatchRows(emitRowsProgram_, n);
+    }
+    std::vector<uint32_t> meta = {static_cast<uint32_t>(n), static_cast<uint32_t>(sites), in.nextId};
+    for (const rt::RateSites::Site& s : in.sites) meta.push_back(s.room);
+    if (!metaBuffer_) glCreateBuffers(1, &metaBuffer_);
+    glNamedBufferData(metaBuffer_, static_cast<GLsizeiptr>(meta.size() * 4), meta.data(), GL_STREAM_DRAW);
+    afterWrite(Write::Upload, kStorageBlock);
+    transferred += meta.size() * 4;
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, metaBuffer_);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, runsGl);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, totalsGl);
+    glUseProgram(emitScanProgram_);
+    glDispatchCompute(1, 1, 1);
+    ++dispatches;
+    afterWrite(Write::Dispatch, kColumnReaders);
+}
+
+}  // namespace psys::gpu

@@ -1,0 +1,197 @@
+// Rate emissions decided where the emitters' rows are (rt::Memory::emitAtRate): the GPU's
+// dispatches (gpu/gl_emission.cpp) against the host's rule (rt/memory.cpp, rt/emission.h),
+// record by record and bit by bit — the accumulators, each row's run, the totals — over
+// rows that emit and rows that do not, rates and counts per row and shared, invalid and
+// enormous values, targets that run out of room part-way, and a batch's own clocks.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "gpu_support.h"
+#include "rt/emission.h"
+#include "rt/memory.h"
+
+using namespace psys;
+using psys::test::gpuBackend;
+
+namespace {
+
+struct Emitters {
+    rt::Memory& memory;
+    rt::RateSites sites;
+    rt::Buffer runs, totals;
+
+    Emitters(rt::Memory& m, size_t rows, size_t count) : memory(m) {
+        sites.rows = rows;
+        sites.mask = m.create(rt::Elem::U8, rows);
+        sites.killed = m.create(rt::Elem::U8, rows);
+        sites.created = m.create(rt::Elem::F64, rows);
+        for (size_t s = 0; s < count; ++s) {
+            rt::RateSites::Site site;
+            site.rate = m.create(rt::Elem::F32, rows);
+            site.count = m.create(rt::Elem::F32, rows);
+            site.accumulated = m.create(rt::Elem::F64, rows);
+            sites.sites.push_back(site);
+        }
+        runs = m.create(rt::Elem::U32, rows * count * rt::kRunWords);
+        totals = m.create(rt::Elem::U32, rt::kTotalsSites + rt::kTotalsPerSite * count);
+    }
+    template <typename T>
+    std::vector<T> read(rt::Buffer b, size_t n) const {
+        std::vector<T> v(n);
+        memory.read(b, 0, n, v.data());
+        return v;
+    }
+    template <typename T>
+    void write(rt::Buffer b, const std::vector<T>& v) {
+        memory.write(b, 0, v.size(), v.data());
+    }
+};
+
+float oneOf(std::mt19937& random, std::initializer_list<float> values) {
+    return *(values.begin() + random() % values.size());
+}
+
+}  // namespace
+
+TEST_CASE("rate emissions decided on the GPU: the host's runs, ids, drops and accumulators, bit for bit") {
+    auto gpu = gpuBackend();
+    rt::HostMemory hostMemory;
+    constexpr size_t kRows = 3000, kSites = 3;
+    Emitters host(hostMemory, kRows, kSites), device(gpu->memory(), kRows, kSites);
+    std::mt19937 random(11);
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    uint32_t nextId = 100;
+    bool cut = false, clamped = false;
+    for (int round = 0; round < 12; ++round) {
+        INFO("round " << round);
+        std::vector<uint8_t> mask(kRows), killed(kRows);
+        std::vector<double> created(kRows);
+        for (size_t r = 0; r < kRows; ++r) {
+            mask[r] = random() % 5 != 0;
+            killed[r] = random() % 9 == 0;
+            created[r] = 1.0 + (random() % 1000) / 997.0;  // before t1 = 2.5
+        }
+        for (Emitters* e : {&host, &device}) {
+            e->write(e->sites.mask, mask);
+            e->write(e->sites.killed, killed);
+            e->write(e->sites.created, created);
+            e->sites.dt = round % 2 ? 1.0 / 60 : 1.0 / 7;
+            e->sites.t1 = 2.5 + round;
+            e->sites.nextId = nextId;
+        }
+        // Odd rounds clock each row from its creation (a batch's first update).
+        bool ownClock = round % 3 == 2;
+        for (size_t s = 0; s < kSites; ++s) {
+            std::vector<float> rate(kRows), count(kRows);
+            for (size_t r = 0; r < kRows; ++r) {
+                rate[r] = random() % 50 == 0 ? oneOf(random, {nan, inf, -1, 0, 1e30f, 0.25f})
+                                             : static_cast<float>(random() % 4000) / 7.0f;
+                count[r] = random() % 60 == 0 ? oneOf(random, {nan, -2, 0, 0.5f, 1e25f, 3.7f}) : 1 + random() % 4;
+            }
+            bool perRowRate = (round + s) % 4 != 0, perRowCount = (round + s) % 3 != 0;
+            // Room: plenty, some, none — the last sites run out part-way.
+            auto room = static_cast<uint32_t>(s == 0 ? 10'000'000 : s == 1 ? 20'000 + random() % 30'000 : random() % 50);
+            for (Emitters* e : {&host, &device}) {
+                rt::RateSites::Site& site = e->sites.sites[s];
+                e->write(site.rate, rate);
+                e->write(site.count, count);
+                site.rateValue = perRowRate ? 0 : 240.5f;
+                site.countValue = perRowCount ? 1 : 2;
+                site.room = room;
+            }
+        }
+        auto run = [&](Emitters& e) {
+            rt::RateSites in = e.sites;
+            if (!ownClock) in.created = {};
+            for (size_t s = 0; s < kSites; ++s) {
+                if ((round + s) % 4 == 0) in.sites[s].rate = {};
+                if ((round + s) % 3 == 0) in.sites[s].count = {};
+            }
+            e.memory.emitAtRate(in, e.runs, e.totals);
+        };
+        run(host);
+        run(device);
+        const size_t words = kRows * kSites * rt::kRunWords, totalWords = rt::kTotalsSites + rt::kTotalsPerSite * kSites;
+        std::vector<uint32_t> totals = host.read<uint32_t>(host.totals, totalWords);
+        REQUIRE(totals == device.read<uint32_t>(device.totals, totalWords));
+        std::vector<uint32_t> runs = host.read<uint32_t>(host.runs, words);
+        std::vector<uint32_t> deviceRuns = device.read<uint32_t>(device.runs, words);
+        for (size_t i = 0; i < words; i += rt::kRunWords) {
+            INFO("site " << i / rt::kRunWords / kRows << ", row " << i / rt::kRunWords % kRows);
+            REQUIRE(std::vector<uint32_t>(runs.begin() + i, runs.begin() + i + 8) ==
+                    std::vector<uint32_t>(deviceRuns.begin() + i, deviceRuns.begin() + i + 8));
+        }
+        for (size_t s = 0; s < kSites; ++s)
+            REQUIRE(host.read<uint64_t>(host.sites.sites[s].accumulated, kRows) ==
+                    device.read<uint64_t>(device.sites.sites[s].accumulated, kRows));
+        for (size_t s = 0; s < kSites; ++s) {
+            const uint32_t* t = totals.data() + rt::kTotalsSites + rt::kTotalsPerSite * s;
+            uint64_t asked = t[1] | uint64_t{t[2]} << 32;
+            cut = cut || asked > t[0];
+        }
+        clamped = clamped || totals[rt::kTotalsClamped] > 0;
+        CHECK(totals[rt::kTotalsInvalid] > 0);
+        nextId += totals[rt::kTotalsIds];
+    }
+    CHECK(cut);
+    CHECK(clamped);
+    CHECK(nextId > 100'000);
+}
+
+TEST_CASE("a rate emission's records are the rule's: events, times, ids in row order and the cut at room") {
+    // Two rows, two sites, on the host: the records say what rt::rateEmission says, the
+    // ids run row by row, sites in order, and the second site's room of 5 cuts the
+    // second row's ask.
+    rt::HostMemory m;
+    Emitters e(m, 2, 2);
+    e.write(e.sites.mask, std::vector<uint8_t>{1, 1});
+    e.write(e.sites.killed, std::vector<uint8_t>{0, 0});
+    e.write(e.sites.sites[0].accumulated, std::vector<double>{0.5, 0});
+    e.write(e.sites.sites[1].accumulated, std::vector<double>{0, 0.9});
+    e.sites.created = {};
+    e.sites.dt = 0.1;
+    e.sites.t1 = 1;
+    e.sites.nextId = 7;
+    e.sites.sites[0].rate = {};
+    e.sites.sites[0].rateValue = 30;  // 0.5 + 3: 3 events
+    e.sites.sites[0].count = {};
+    e.sites.sites[0].countValue = 2;
+    e.sites.sites[0].room = 100;
+    e.write(e.sites.sites[1].rate, std::vector<float>{40, 21});  // 4 events; 0.9 + 2.1: 3 events
+    e.write(e.sites.sites[1].count, std::vector<float>{1, 1});
+    e.sites.sites[1].room = 5;
+    m.emitAtRate(e.sites, e.runs, e.totals);
+    auto runs = e.read<uint32_t>(e.runs, 4 * rt::kRunWords);
+    auto record = [&](size_t site, size_t row) { return runs.data() + (site * 2 + row) * rt::kRunWords; };
+    auto time = [](const uint32_t* w, size_t at) {
+        double t;
+        std::memcpy(&t, w + at, 8);
+        return t;
+    };
+    rt::RateEmission first = rt::rateEmission(0.5, 30, 2, 0.1, 1);
+    CHECK(first.children == 6);
+    // Row 0: site 0 (6 objects, ids 7…12), site 1 (4: 13…16); row 1: site 0 (6: 17…22), site 1 (1 of 3: 23).
+    CHECK(record(0, 0)[0] == 0);
+    CHECK(record(0, 0)[1] == 6);
+    CHECK(record(0, 0)[2] == 7);
+    CHECK(record(0, 0)[3] == 2);
+    CHECK(time(record(0, 0), 4) == first.firstTime);
+    CHECK(time(record(0, 0), 6) == first.spacing);
+    CHECK(record(1, 0)[1] == 4);
+    CHECK(record(1, 0)[2] == 13);
+    CHECK(record(0, 1)[0] == 6);
+    CHECK(record(0, 1)[2] == 17);
+    CHECK(record(1, 1)[0] == 4);
+    CHECK(record(1, 1)[1] == 1);
+    CHECK(record(1, 1)[2] == 23);
+    auto totals = e.read<uint32_t>(e.totals, rt::kTotalsSites + 2 * rt::kTotalsPerSite);
+    CHECK(totals[rt::kTotalsIds] == 17);
+    CHECK(totals[rt::kTotalsSites + rt::kTotalsPerSite] == 5);       // site 1 kept
+    CHECK(totals[rt::kTotalsSites + rt::kTotalsPerSite + 1] == 7);   // of 7 asked
+    CHECK(e.read<double>(e.sites.sites[0].accumulated, 2)[0] == doctest::Approx(0.5));
+}
