@@ -39,8 +39,9 @@ int main(int argc, char** argv) {
     std::string rowsIn = "gpu";
     app.add_option("--rows", rowsIn,
                    "Where the pools of objects that only die keep their rows: gpu (their bookkeeping dispatches), or "
-                   "host (to compare)")
-        ->check(CLI::IsMember({"gpu", "host"}));
+                   "host (to compare); memory: those of emitters whose emissions the GPU decides too "
+                   "(SystemOptions::Rows::InMemory)")
+        ->check(CLI::IsMember({"gpu", "host", "memory"}));
     std::string json;
     app.add_option("--json", json, "Also write the figures as JSON, a list of rows (bench/README.md names the fields)");
     bool stress = false;
@@ -64,6 +65,9 @@ int main(int argc, char** argv) {
     if (stress) return bench::stressFigures(std::cout, frames);
     if (hostCache) return bench::hostCacheFigures(std::cout, 10 * frames);
 
+    const rt::SystemOptions::Rows rowsOption = rowsIn == "host"     ? rt::SystemOptions::Rows::OnHost
+                                               : rowsIn == "memory" ? rt::SystemOptions::Rows::InMemory
+                                                                    : rt::SystemOptions::Rows::AsBackend;
     auto gpu = bench::gpuBackend("psys_gpu_bench", hostRows);  // the emitters (few rows) on the host
     if (!gpu) return 1;
     if (samples) {
@@ -71,6 +75,7 @@ int main(int argc, char** argv) {
         if (app.count("--particles")) scale.sizes = sizes;
         if (app.count("--frames")) scale.frames = frames;
         scale.only = only;
+        scale.rows = rowsOption;
         std::cout << fmt::format("# psys_gpu_bench --samples on {}, host side: {}\n", gpu->report().target,
                                  hostRows > 0 ? fmt::format("launches of at most {} rows", hostRows) : "off");
         return bench::sampleFigures(std::cout, *gpu, scale, json);
@@ -96,8 +101,7 @@ int main(int argc, char** argv) {
         }
         for (double particles : sizes) {
             bench::GpuFigures f = bench::measureGpu(*effect, particles, frames, *gpu,
-                                                    rowsIn == "host" ? rt::SystemOptions::Rows::OnHost
-                                                                     : rt::SystemOptions::Rows::AsBackend);
+                                                    rowsOption);
             std::string others;
             for (const auto& [pass, ms] : f.passMilliseconds)
                 if (pass != "update")

@@ -70,6 +70,7 @@ std::optional<SampleRun> runSample(gpu::GlslBackend& gpu, const std::string& pat
     }
     rt::SystemOptions options;
     options.capacity = std::max(options.capacity, static_cast<size_t>(size * 2));
+    options.rows = scale.rows;
     rt::System system(std::move(*module), gpu, options);
     auto live = [&] {
         double n = 0;

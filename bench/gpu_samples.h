@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "gpu/glsl_backend.h"
+#include "rt/system.h"
 
 namespace psys::bench {
 
@@ -21,6 +22,7 @@ struct SampleScale {
     int frames = 5;                          // measured steps of 1/60 s, after the warm-up
     double warmSeconds = 3;                  // the warm-up, in steps of 1/20 s
     std::vector<std::string> only;           // the samples' names; empty: every sample
+    rt::SystemOptions::Rows rows = rt::SystemOptions::Rows::AsBackend;  // where pools keep their rows
 };
 
 // Prints a table (and, with `json` non-empty, writes its rows there); 0, or 1 where a

@@ -6,7 +6,7 @@
 // order (a prefix sum of the kept). What comes back to the host is the totals: a few words
 // a site, however many emitters. Counts past 2³² are two words (GLSL 4.50 has no 64-bit
 // integers): what a row asks for is at most kMaxCount, a sum saturates. The differential
-// test (tests/gpu/rows_test.cpp) holds this to the host's rule.
+// test (tests/gpu/emission_test.cpp) holds this to the host's rule.
 #include <epoxy/gl.h>
 
 #include <algorithm>
@@ -26,7 +26,8 @@ using rt::Buffer;
 namespace {
 
 // One site over the rows: params rows, flags (1 rate per row, 2 count per row, 4 kill
-// flags, 8 creation times; the site from bit 8), the shared rate and count, dt, t1.
+// flags, 8 creation times, 16 fresh accumulators; the site from bit 8), the shared rate and count, dt, t1; the
+// rows from meta[3] on in the columns.
 // The rule's operations are `precise` and in the host's order: the same doubles.
 const char* kRows = R"(
 layout(std430, binding = 0) readonly buffer Mask { uint mask[]; };
@@ -36,7 +37,7 @@ layout(std430, binding = 3) readonly buffer Rate { uint rates[]; };
 layout(std430, binding = 4) readonly buffer Count { uint counts[]; };
 layout(std430, binding = 5) buffer Accumulated { uint accumulated[]; };
 layout(std430, binding = 6) buffer Runs { uint runs[]; };
-layout(std430, binding = 7) buffer Totals { uint totals[]; };
+layout(std430, binding = 8) readonly buffer Meta { uint meta[]; };
 double ld(uint lo, uint hi) { return packDouble2x32(uvec2(lo, hi)); }
 // rt::validCount: NaN, infinite and negative are invalid (0, counted).
 double valid(float x, inout uint invalid) {
@@ -58,23 +59,23 @@ double whole(double x, inout uint clamped) {
 void main() {
     uint r = INVOCATION, rows = param(0u), flags = param(1u), site = flags >> 8u;
     if (r >= rows) return;
-    uint w = (site * rows + r) * 8u;
+    uint w = (site * rows + r) * 8u, i = meta[3] + r;
     uint invalid = 0u, clamped = 0u, perEvent = 1u;
     uvec2 children = uvec2(0u);
     double firstTime = 0.0LF, spacing = 0.0LF;
-    if (mask[r] != 0u && ((flags & 4u) == 0u || killed[r] == 0u)) {
+    if (mask[i] != 0u && ((flags & 4u) == 0u || killed[i] == 0u)) {
         double t1 = ld(param(6u), param(7u));
-        double dt = (flags & 8u) != 0u ? t1 - ld(created[2u * r], created[2u * r + 1u]) : ld(param(4u), param(5u));
-        double before = ld(accumulated[2u * r], accumulated[2u * r + 1u]);
-        double rate = valid(uintBitsToFloat((flags & 1u) != 0u ? rates[r] : param(2u)), invalid);
-        double size = valid(uintBitsToFloat((flags & 2u) != 0u ? counts[r] : param(3u)), invalid);
+        double dt = (flags & 8u) != 0u ? t1 - ld(created[2u * i], created[2u * i + 1u]) : ld(param(4u), param(5u));
+        double before = (flags & 16u) != 0u ? 0.0LF : ld(accumulated[2u * i], accumulated[2u * i + 1u]);
+        double rate = valid(uintBitsToFloat((flags & 1u) != 0u ? rates[i] : param(2u)), invalid);
+        double size = valid(uintBitsToFloat((flags & 2u) != 0u ? counts[i] : param(3u)), invalid);
         precise double total = before + rate * dt;
         precise double reached = total + 1e-9LF;
         double events = floor(reached);
         precise double left = total - events;
         uvec2 after = unpackDouble2x32(0.0LF < left ? left : 0.0LF);
-        accumulated[2u * r] = after.x;
-        accumulated[2u * r + 1u] = after.y;
+        accumulated[2u * i] = after.x;
+        accumulated[2u * i + 1u] = after.y;
         if (events >= 1.0LF && size >= 1.0LF) {
             double each = whole(size, clamped);
             perEvent = each >= 4294967295.0LF ? 0xffffffffu : uint(each);
@@ -93,21 +94,20 @@ void main() {
     }
     runs[w] = children.x;
     runs[w + 1u] = children.y;
+    runs[w + 2u] = invalid | clamped << 16u;  // (the scan sums them, then writes the id here)
     runs[w + 3u] = perEvent;
     uvec2 f = unpackDouble2x32(firstTime), s = unpackDouble2x32(spacing);
     runs[w + 4u] = f.x;
     runs[w + 5u] = f.y;
     runs[w + 6u] = s.x;
     runs[w + 7u] = s.y;
-    if (invalid != 0u) atomicAdd(totals[0], invalid);
-    if (clamped != 0u) atomicAdd(totals[1], clamped);
 }
 )";
 
 // One work group of 256: each invocation a chunk of rows in order. Per site: the chunk's
 // sum of what its rows asked for, an exclusive scan of the sums (by one invocation: 256
 // adds), then each row's place and kept; then the same over the chunks' kept for the ids.
-// `meta`: rows, sites, next id, then each site's room.
+// `meta`: rows, sites, next id, the first row, then each site's room.
 const char* kScan = R"(
 layout(local_size_x = 256) in;
 layout(std430, binding = 0) readonly buffer Meta { uint meta[]; };
@@ -115,6 +115,7 @@ layout(std430, binding = 6) buffer Runs { uint runs[]; };
 layout(std430, binding = 7) buffer Totals { uint totals[]; };
 shared uvec2 partial[256];
 shared uint keptBefore[256];
+shared uvec2 counted[256];  // invalid, clamped
 // a + b, saturating at 2⁶⁴ − 1.
 uvec2 add64(uvec2 a, uvec2 b) {
     uint c1, c2, c3;
@@ -128,8 +129,9 @@ void main() {
     uint l = gl_LocalInvocationID.x, rows = meta[0], sites = meta[1];
     uint chunk = (rows + 255u) / 256u, begin = min(l * chunk, rows), end = min(begin + chunk, rows);
     uint kept = 0u;
+    uvec2 count = uvec2(0u);
     for (uint s = 0u; s < sites; ++s) {
-        uint room = meta[3u + s], base = s * rows;
+        uint room = meta[4u + s], base = s * rows;
         uvec2 sum = uvec2(0u);
         for (uint r = begin; r < end; ++r) sum = add64(sum, uvec2(runs[(base + r) * 8u], runs[(base + r) * 8u + 1u]));
         partial[l] = sum;
@@ -155,12 +157,18 @@ void main() {
             runs[w] = place;
             runs[w + 1u] = atMost(asked, room) - place;
             kept += runs[w + 1u];
+            count += uvec2(runs[w + 2u] & 0xffffu, runs[w + 2u] >> 16u);
         }
         barrier();
     }
     keptBefore[l] = kept;
+    counted[l] = count;
     barrier();
     if (l == 0u) {
+        uvec2 all = uvec2(0u);
+        for (uint k = 0u; k < 256u; ++k) all += counted[k];
+        totals[0] = all.x;
+        totals[1] = all.y;
         uint before = 0u;
         for (uint k = 0u; k < 256u; ++k) {
             uint next = before + keptBefore[k];
@@ -206,11 +214,17 @@ void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs, Buffer totals) {
     if (n == 0 || std::all_of(used.begin(), used.end(), [&](Buffer b) { return allOnHost({b}); }))
         return rt::Memory::emitAtRate(in, runs, totals);
     flushPending();
-    fill(totals, 0, rt::kTotalsSites + rt::kTotalsPerSite * sites, 0);
     if (!emitRowsProgram_) emitRowsProgram_ = computeProgram(shader(kRows, true), "rate emissions");
     if (!emitScanProgram_) emitScanProgram_ = computeProgram(shader(kScan, false), "rate emissions' scan");
     PassTimer::Scope timed(timer, "emissions", n * sites);
     unsigned runsGl = bound(runs), totalsGl = bound(totals);
+    std::vector<uint32_t> meta = {static_cast<uint32_t>(n), static_cast<uint32_t>(sites), in.nextId,
+                                  static_cast<uint32_t>(in.first)};
+    for (const rt::RateSites::Site& s : in.sites) meta.push_back(s.room);
+    if (!metaBuffer_) glCreateBuffers(1, &metaBuffer_);
+    glNamedBufferData(metaBuffer_, static_cast<GLsizeiptr>(meta.size() * 4), meta.data(), GL_STREAM_DRAW);
+    afterWrite(Write::Upload, kStorageBlock);
+    transferred += meta.size() * 4;
     auto [dt0, dt1] = words(in.dt);
     auto [t10, t11] = words(in.t1);
     for (size_t k = 0; k < sites; ++k) {
@@ -223,19 +237,13 @@ void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs, Buffer totals) {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, or_(s.count));
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, bound(s.accumulated));
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, runsGl);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, totalsGl);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, metaBuffer_);
         uint32_t flags = (s.rate.valid() ? 1u : 0u) | (s.count.valid() ? 2u : 0u) | (in.killed.valid() ? 4u : 0u) |
-                         (in.created.valid() ? 8u : 0u) | static_cast<uint32_t>(k) << 8;
+                         (in.created.valid() ? 8u : 0u) | (in.fresh ? 16u : 0u) | static_cast<uint32_t>(k) << 8;
         bindParams(paramsBuffer_, {static_cast<uint32_t>(n), flags, bits(s.rateValue), bits(s.countValue), dt0, dt1,
                                    t10, t11});
         dispatchRows(emitRowsProgram_, n);
     }
-    std::vector<uint32_t> meta = {static_cast<uint32_t>(n), static_cast<uint32_t>(sites), in.nextId};
-    for (const rt::RateSites::Site& s : in.sites) meta.push_back(s.room);
-    if (!metaBuffer_) glCreateBuffers(1, &metaBuffer_);
-    glNamedBufferData(metaBuffer_, static_cast<GLsizeiptr>(meta.size() * 4), meta.data(), GL_STREAM_DRAW);
-    afterWrite(Write::Upload, kStorageBlock);
-    transferred += meta.size() * 4;
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, metaBuffer_);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, runsGl);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, totalsGl);

@@ -71,6 +71,10 @@ rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program
         if (!launch.clock.perRow() && c >= p.layout.emits && c < p.layout.render &&
             p.layout.emitShared[static_cast<size_t>(c - p.layout.emits)].from != ColumnLayout::Shared::From::Column)
             continue;
+        if (launch.emissionsStay) {  // (the memory decides the emissions where the rows are)
+            memory_.adopt(b, begin, n, words_, block[LaunchBlock::kColumns + static_cast<size_t>(c)]);
+            continue;
+        }
         returned.push_back({b, block[LaunchBlock::kColumns + static_cast<size_t>(c)], 0});
     }
     if (!p.counts && !kills && returned.empty()) return {};

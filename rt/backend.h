@@ -59,6 +59,9 @@ struct RowsLaunch {
     // them says so (RowsResult::killsListed); else the run-time lists them from the rows
     // it is given.
     Buffer killList;
+    // The update of a type whose emissions the memory decides (Memory::emitAtRate): its
+    // emission columns stay in the memory (a device does not send them back).
+    bool emissionsStay = false;
 };
 
 struct RowsResult {

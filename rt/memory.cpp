@@ -140,9 +140,10 @@ void Memory::emitAtRate(const RateSites& in, Buffer runs, Buffer totals) {
     std::fill(total, total + kTotalsSites + kTotalsPerSite * sites, 0u);
     if (n == 0) return;
     auto* record = static_cast<uint32_t*>(host(runs));
-    const auto* mask = static_cast<const uint8_t*>(view(in.mask));
-    const auto* killed = in.killed.valid() ? static_cast<const uint8_t*>(view(in.killed)) : nullptr;
-    const auto* created = in.created.valid() ? static_cast<const double*>(view(in.created)) : nullptr;
+    const size_t f = in.first;
+    const auto* mask = static_cast<const uint8_t*>(view(in.mask)) + f;
+    const auto* killed = in.killed.valid() ? static_cast<const uint8_t*>(view(in.killed)) + f : nullptr;
+    const auto* created = in.created.valid() ? static_cast<const double*>(view(in.created)) + f : nullptr;
     struct Site {
         const float *rate, *count;
         double* accumulated;
@@ -150,9 +151,9 @@ void Memory::emitAtRate(const RateSites& in, Buffer runs, Buffer totals) {
     };
     std::vector<Site> site;
     for (const RateSites::Site& s : in.sites)
-        site.push_back({s.rate.valid() ? static_cast<const float*>(view(s.rate)) : nullptr,
-                        s.count.valid() ? static_cast<const float*>(view(s.count)) : nullptr,
-                        static_cast<double*>(host(s.accumulated))});
+        site.push_back({s.rate.valid() ? static_cast<const float*>(view(s.rate)) + f : nullptr,
+                        s.count.valid() ? static_cast<const float*>(view(s.count)) + f : nullptr,
+                        static_cast<double*>(host(s.accumulated)) + f});
     uint64_t invalid = 0, clamped = 0;
     uint32_t id = in.nextId;
     for (size_t r = 0; r < n; ++r)
@@ -162,7 +163,7 @@ void Memory::emitAtRate(const RateSites& in, Buffer runs, Buffer totals) {
             RateEmission e;
             if (mask[r] && !(killed && killed[r])) {
                 double dt = created ? in.t1 - created[r] : in.dt;
-                e = rateEmission(d.accumulated[r], d.rate ? d.rate[r] : s.rateValue, d.count ? d.count[r] : s.countValue,
+                e = rateEmission(in.fresh ? 0.0 : d.accumulated[r], d.rate ? d.rate[r] : s.rateValue, d.count ? d.count[r] : s.countValue,
                                  dt, in.t1);
                 d.accumulated[r] = e.accumulated;
                 invalid += e.invalid;

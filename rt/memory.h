@@ -71,9 +71,11 @@ struct RateSites {
     };
     std::vector<Site> sites;  // in the type's order of sites, each its own target type
     size_t rows = 0;
+    size_t first = 0;  // the rows are [first, first + rows) of every column (records from 0)
     Buffer mask;     // u8: the rows that emit
     Buffer killed;   // u8: rows the update killed (they emit nothing); invalid: none
     Buffer created;  // f64: where given, row r's update began at created[r] (a batch's first), else at t1 − dt
+    bool fresh = false;  // the rows' objects were just created: their accumulators start at 0 (not read)
     double dt = 0, t1 = 0;
     uint32_t nextId = 0;  // the first id the emissions take
 };

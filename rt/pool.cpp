@@ -106,7 +106,7 @@ Pool::Pool(const ir::Object& object, size_t capacity, Memory& memory)
         float empty = core::emptyFold(object.folds[f].reduce);
         for (int c = 0; c < object.folds[f].type.width; ++c) memory.write(folds.column(f, static_cast<size_t>(c)), 0, 1, &empty);
     }
-    emitted.assign(object.emits.size(), {});
+    for (size_t e = 0; e < object.emits.size(); ++e) emitted.push_back(memory.create(Elem::F64, 0));
 }
 
 size_t Pool::rowBytes(const ir::Object& object) {
@@ -140,6 +140,7 @@ Pool::~Pool() {
     if (!memory_) return;  // moved from
     memory_->release(created);
     memory_->release(ids);
+    for (Buffer b : emitted) memory_->release(b);
     updatable.release(*memory_);
     alive.release(*memory_);
     state.release(*memory_);
@@ -163,7 +164,7 @@ void Pool::grow(size_t n) {
     parent.resize(n);
     readers.resize(n, 0);
     diedAt.resize(n, 0);
-    for (auto& e : emitted) e.resize(n, 0);
+    for (Buffer b : emitted) memory_->resize(b, n);
     for (Buffer b : {created, ids}) memory_->resize(b, n);
     updatable.grow(*memory_, n);
     alive.grow(*memory_, n);
@@ -184,7 +185,10 @@ size_t Pool::allocate(size_t n, uint32_t* out) {
         status_[row] = Status::Alive;
         readers[row] = 0;
         parent[row] = {};
-        for (auto& e : emitted) e[row] = 0;
+    }
+    for (Buffer e : emitted) {
+        auto* accumulated = hostData<double>(*memory_, e);
+        for (uint32_t row : rows) accumulated[row] = 0;
     }
     updatable.set(rows, 0);
     alive.set(rows, 1);

@@ -175,7 +175,9 @@ public:
     std::vector<uint32_t> fresh;     // rows created during the current step (rows on the host)
     std::vector<uint32_t> freshRows() const;  // those rows, wherever the rows are kept
     void beginStep();                // the rows created before this step become updatable
-    std::vector<std::vector<double>> emitted;  // per rate site: events accumulated, in [0, 1)
+    // Per emit site (f64 per row): the events a rate site accumulated, in [0, 1) — where the
+    // rows are, so a memory that decides emissions (Memory::emitAtRate) moves them on there.
+    std::vector<Buffer> emitted;
 
     Memory& memory() const { return *memory_; }
     // Rebuilds the host bookkeeping of rows as given (hot reload, rt/reload.cpp).

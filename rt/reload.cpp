@@ -87,7 +87,7 @@ void carryType(const detail::State& old, size_t ot, detail::State& s, size_t t, 
         if (j >= 0) copyValues(old.memory, from.exports, static_cast<size_t>(j), s.memory, to.exports, i, rows);
     for (size_t site = 0; site < o.emits.size() && site < oo.emits.size(); ++site)
         if (o.emits[site].target == oo.emits[site].target && o.emits[site].when == oo.emits[site].when)
-            to.emitted[site] = from.emitted[site];
+            copyColumn(old.memory, from.emitted[site], s.memory, to.emitted[site], rows, 8);
     s.typeStats[t] = old.typeStats[ot];
 }
 

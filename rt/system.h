@@ -55,10 +55,12 @@ struct SystemOptions {
     // false: at once. Results are the same, rows included (tests compare the two).
     bool lateKills = true;
     // Where the pools of objects that only die (late kills, nothing reads them, no bursts
-    // or sub-steps) keep their rows — the free stack, generations, masks: in the memory
-    // (Pool::keepRowsInMemory, its operations doing the bookkeeping where the columns
-    // are) where the backend asks for it (Backend::keepsRowsInMemory: a device), always,
-    // or never. Results are the same, rows included (tests compare them).
+    // or sub-steps) or never die keep their rows — the free stack, generations, masks: in
+    // the memory (Pool::keepRowsInMemory, its operations doing the bookkeeping where the
+    // columns are) where the backend asks for it (Backend::keepsRowsInMemory: a device),
+    // always, or never. Always also keeps there the rows of emitters whose emissions the
+    // memory can decide (Memory::emitAtRate: rt/system_state.h, TypeInfo::rowsInMemory).
+    // Results are the same, rows included (tests compare them).
     enum class Rows : uint8_t { AsBackend, InMemory, OnHost } rows = Rows::AsBackend;
     // Called at the end of the step after which the system is finished (System::finished),
     // once each time it becomes so: a host may recycle the system there.

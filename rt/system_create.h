@@ -42,6 +42,15 @@ public:
     // count, at t1 — a dying object's too (its death is this update's event).
     void emitInUpdate(const Emitter& emitter, std::span<const float> rate, std::span<const float> count, double dt,
                       double t1, bool dying);
+    // The rate emissions of `type`'s rows that the memory decides (TypeInfo::rowsInMemory,
+    // Memory::emitAtRate): its pool's after an update (`table` its update table), or a
+    // batch's just created (its rows [first, first + n) of `table`, clocked from their
+    // creation, `poolRows` theirs in the pool). `uniforms`: where the update's clock is
+    // uniform, its uniform values (ColumnLayout::sharedEmit); null: the rates and counts
+    // are in the table's columns. What they create is queued as emitInUpdate queues it,
+    // row by row, sites in order: the same ids and rows.
+    void emitInMemory(size_t type, const std::vector<Buffer>& table, const Value* const* uniforms, RateSites sites,
+                      std::span<const uint32_t> poolRows, double t1);
     // A trigger's (or the start's) kernel, evaluated on the host: once for the counts,
     // then once per created object for its arguments, so each draws its own numbers.
     void emitFromKernel(const ir::Trigger& trigger, std::span<const Value> params, uint32_t objectId);
@@ -77,6 +86,9 @@ private:
     struct Batch;
 
     size_t stage(size_t type, size_t count);  // staging rows for `count` new objects of `type`
+    // The spawn launch for `count` children of `emitter` at `site`, their arguments at
+    // staging rows from `base`, the first child's draw `firstChild`.
+    void queueSpawn(const Emitter& emitter, int site, uint32_t firstChild, size_t count, size_t base);
     // Queues `count` objects of `type` (a run, or one run an object where objects are not
     // created in batches).
     void enqueue(const Run& run);
@@ -128,6 +140,7 @@ private:
     std::vector<Batch> batches_;
     std::vector<Value> yields_;
     std::vector<float> rate_, count_;
+    Scratch emissions_;  // emitInMemory's runs and totals
 };
 
 // Per type: the scratch columns a batch is created in, indexed like the staging rows (so

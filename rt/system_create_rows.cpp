@@ -4,15 +4,18 @@
 // step's end — with every per-object step an operation of the memory (rt::Memory::
 // allocateRows, identify, scatter by a row list), so that on a device the host's work is
 // the batch's, not its objects'. Such a type dies late or never, has no parent, no
-// bursts, no sub-steps and emits nothing: after its first update (and its exports, where
-// it never dies) an object only waits to be freed with the step's late kills
-// (rt/ledger.h). What it folds over its neighbours is, for an object created in the step,
-// a fold over nothing: filled in, not gathered (rt/neighbours.cpp).
+// bursts, no sub-steps, and emits nothing or only at a rate what the memory decides
+// (Creation::emitInMemory, here too: Memory::emitAtRate): after its first update (and its
+// exports, where it never dies) an object only waits to be freed with the step's late
+// kills (rt/ledger.h). What it folds over its neighbours is, for an object created in the
+// step, a fold over nothing: filled in, not gathered (rt/neighbours.cpp).
 #include "rt/system_create.h"
 
 #include <algorithm>
 #include <atomic>
 #include <cstdint>
+#include <cstring>
+#include <optional>
 
 #include "rt/rng.h"
 #include "rt/system_support.h"
@@ -24,7 +27,7 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     const TypeInfo& info = s_.types[type];
     const ir::Object& o = pool.object();
     const size_t first = b.first;
-    queued_[type] -= n;  // it queues nothing: no room to account for while it is created
+    queued_[type] -= n;  // what it queues is of other types: no room of its own to account for
     Buffer rows = pool.scratchRows(n);
     size_t kept = pool.allocate(n, rows, 0);  // the first `kept` objects: rows[0, kept)
     s_.typeStats[type].dropped += n - kept;
@@ -82,12 +85,88 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
                 columns.push_back({b.exportsTable[static_cast<size_t>(info.exportsLayout.exportOffset[e] + c)],
                                    pool.exports.column(e, static_cast<size_t>(c))});
     }
+    if (info.updateEmits) {  // the first update's emissions, and their accumulators to the pool
+        RateSites in;
+        in.rows = n;
+        in.first = first;
+        in.mask = mask;
+        in.created = table[ColumnLayout::kCreated];
+        in.fresh = true;
+        for (size_t site = 0; site < o.emits.size(); ++site) {
+            Buffer accumulated = emissions_.at(2 + site, Elem::F64, first + n);
+            in.sites.emplace_back().accumulated = accumulated;
+            columns.push_back({accumulated, pool.emitted[site]});
+        }
+        std::vector<uint32_t> poolRows(kept);
+        memory.read(rows, 0, kept, poolRows.data());
+        emitInMemory(type, table, nullptr, std::move(in), poolRows, t1);
+    }
     memory.scatter(columns, first, rows, 0, kept);
     if (!info.late) return;
     late.type = type;
     late.t1 = t1;
     late.first = first;
     s_.ledger.defer(std::move(late));
+}
+
+void Creation::emitInMemory(size_t type, const std::vector<Buffer>& table, const Value* const* uniforms,
+                            RateSites in, std::span<const uint32_t> poolRows, double t1) {
+    const TypeInfo& info = s_.types[type];
+    const ColumnLayout& layout = info.updateLayout;
+    const size_t n = in.rows, sites = in.sites.size();
+    if (n == 0) return;
+    for (size_t site = 0; site < sites; ++site) {
+        auto i = static_cast<int>(site);
+        RateSites::Site& out = in.sites[site];
+        out.rateValue = 0;
+        out.countValue = 1;
+        // (A batch's clocks are its rows': its columns hold every rate and count.)
+        auto source = [&](bool yielded, int column, float& shared, Buffer& perRow) {
+            if (!yielded) return;
+            if (auto v = uniforms ? layout.sharedEmit(column, s_.externs.data(), *uniforms) : std::nullopt)
+                shared = *v;
+            else
+                perRow = table[static_cast<size_t>(column)];
+        };
+        source(info.rated[site], layout.emitRate(i), out.rateValue, out.rate);
+        source(info.counted[site], layout.emitCount(i), out.countValue, out.count);
+        size_t target = info.emitTarget[site];
+        size_t free = s_.pools[target].free() + pending_[target];
+        out.room = static_cast<uint32_t>(std::min<size_t>(free > queued_[target] ? free - queued_[target] : 0, UINT32_MAX));
+    }
+    in.t1 = t1;
+    in.nextId = s_.nextId;
+    Buffer runs = emissions_.at(0, Elem::U32, n * sites * kRunWords);
+    Buffer totals = emissions_.at(1, Elem::U32, kTotalsSites + kTotalsPerSite * sites);
+    s_.memory.emitAtRate(in, runs, totals);
+    std::vector<uint32_t> total(kTotalsSites + kTotalsPerSite * sites);
+    s_.memory.read(totals, 0, total.size(), total.data());
+    s_.stats.invalidEmissions += total[kTotalsInvalid];
+    s_.stats.clampedEmissions += total[kTotalsClamped];
+    std::vector<size_t> base(sites, 0);
+    for (size_t site = 0; site < sites; ++site) {
+        const uint32_t* t = total.data() + kTotalsSites + kTotalsPerSite * site;
+        uint64_t asked = t[1] | uint64_t{t[2]} << 32;
+        size_t target = info.emitTarget[site];
+        addSaturating(s_.typeStats[target].dropped, asked - t[0]);
+        if (t[0]) base[site] = stage(target, t[0]);
+    }
+    if (total[kTotalsIds] == 0) return;
+    // The runs, row by row and sites in order, as emitInUpdate queues them.
+    std::vector<uint32_t> records(n * sites * kRunWords);
+    s_.memory.read(runs, 0, records.size(), records.data());
+    for (size_t r = 0; r < n; ++r)
+        for (size_t site = 0; site < sites; ++site) {
+            const uint32_t* w = records.data() + (site * n + r) * kRunWords;
+            if (w[1] == 0) continue;
+            uint32_t row = poolRows.empty() ? static_cast<uint32_t>(r) : poolRows[r];
+            queueSpawn({type, row, {}, row, t1, false}, static_cast<int>(site), w[2], w[1], base[site] + w[0]);
+            double firstTime, spacing;
+            std::memcpy(&firstTime, w + 4, 8);
+            std::memcpy(&spacing, w + 6, 8);
+            enqueue({info.emitTarget[site], base[site] + w[0], w[1], {}, firstTime, spacing, w[3], w[2]});
+        }
+    s_.nextId += total[kTotalsIds];
 }
 
 void Creation::emptyFolds(size_t type, const ColumnLayout& layout, const std::vector<Buffer>& table, size_t first,
@@ -115,6 +194,7 @@ void Creation::launchInMemory(size_t type, Batch& b, size_t n, const ir::Kernel&
     launch.uniformKernel = s_.uniformKernel(type, kernel);
     launch.seed = s_.options.seed;
     launch.draw = clock.first ? kCreationDraw : static_cast<uint32_t>(s_.step);
+    launch.emissionsStay = s_.types[type].updateEmits;
     if (late) {
         size_t per = s_.backend.chunkRows(), chunks = s_.chunkCount(n);
         late->parts.resize(chunks);

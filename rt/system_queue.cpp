@@ -33,30 +33,36 @@ void Creation::queueChildren(const Emitter& e, int site, uint64_t count, uint64_
     if (kept == 0) return;
     Handle parent = s_.types[target].parentType == static_cast<int>(e.type) ? s_.pools[e.type].handle(e.row) : Handle{};
     size_t base = stage(target, static_cast<size_t>(kept));
-    if (const ir::Kernel* spawn = info.spawn[static_cast<size_t>(site)]) {
-        const ColumnLayout& layout = info.spawnLayout[static_cast<size_t>(site)];
-        Spawn& queued = spawns_.emplace_back();
-        s_.parentValues(e.type, e.row, layout, e.at, queued.parents);
-        ChildrenLaunch& launch = queued.launch;
-        launch.object = &s_.pools[e.type].object();
-        launch.spawn = spawn;
-        launch.layout = &layout;
-        launch.columns = e.columns.empty() ? std::span<const Buffer>(s_.work[e.type].spawnTables[static_cast<size_t>(site)])
-                                           : e.columns;
-        launch.row = e.columns.empty() ? e.row : e.columnRow;
-        launch.clock.nowValue = e.at;
-        launch.clock.dtValue = static_cast<float>(s_.lastDt);
-        launch.clock.first = e.first;
-        launch.externs = s_.externs.data();
-        launch.seed = s_.options.seed;
-        launch.draw = e.first ? kCreationDraw : static_cast<uint32_t>(s_.step);
-        launch.firstChild = s_.nextId;
-        launch.count = static_cast<size_t>(kept);
-        launch.args = staging_[target].args;
-        launch.argsFirst = base;
-    }
+    queueSpawn(e, site, s_.nextId, static_cast<size_t>(kept), base);
     enqueue({target, base, static_cast<size_t>(kept), parent, firstTime, spacing, perEvent, s_.nextId});
     s_.nextId += static_cast<uint32_t>(kept);
+}
+
+void Creation::queueSpawn(const Emitter& e, int site, uint32_t firstChild, size_t count, size_t base) {
+    const TypeInfo& info = s_.types[e.type];
+    const ir::Kernel* spawn = info.spawn[static_cast<size_t>(site)];
+    if (!spawn) return;
+    size_t target = info.emitTarget[static_cast<size_t>(site)];
+    const ColumnLayout& layout = info.spawnLayout[static_cast<size_t>(site)];
+    Spawn& queued = spawns_.emplace_back();
+    s_.parentValues(e.type, e.row, layout, e.at, queued.parents);
+    ChildrenLaunch& launch = queued.launch;
+    launch.object = &s_.pools[e.type].object();
+    launch.spawn = spawn;
+    launch.layout = &layout;
+    launch.columns = e.columns.empty() ? std::span<const Buffer>(s_.work[e.type].spawnTables[static_cast<size_t>(site)])
+                                       : e.columns;
+    launch.row = e.columns.empty() ? e.row : e.columnRow;
+    launch.clock.nowValue = e.at;
+    launch.clock.dtValue = static_cast<float>(s_.lastDt);
+    launch.clock.first = e.first;
+    launch.externs = s_.externs.data();
+    launch.seed = s_.options.seed;
+    launch.draw = e.first ? kCreationDraw : static_cast<uint32_t>(s_.step);
+    launch.firstChild = firstChild;
+    launch.count = count;
+    launch.args = staging_[target].args;
+    launch.argsFirst = base;
 }
 
 void Creation::enqueue(const Run& run) {
@@ -80,8 +86,9 @@ void Creation::emitInUpdate(const Emitter& e, std::span<const float> rate, std::
             continue;
         }
         if (!o.emits[site].rate() || dying) continue;
-        RateEmission r = rateEmission(pool.emitted[site][e.row], rate[site], count[site], dt, t1);
-        pool.emitted[site][e.row] = r.accumulated;
+        double& accumulated = s_.host<double>(pool.emitted[site])[e.row];
+        RateEmission r = rateEmission(accumulated, rate[site], count[site], dt, t1);
+        accumulated = r.accumulated;
         s_.stats.invalidEmissions += r.invalid;
         s_.stats.clampedEmissions += r.clamped;
         if (r.children) queueChildren(e, static_cast<int>(site), r.children, r.perEvent, r.firstTime, r.spacing);

@@ -100,13 +100,36 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     // drawn as the step goes).
     bool inMemory = options.rows == SystemOptions::Rows::InMemory ||
                     (options.rows == SystemOptions::Rows::AsBackend && backend.keepsRowsInMemory());
+    auto keptWhole = [&](const TypeInfo& info) {
+        return info.parentType < 0 && !info.bursts && info.stepLimit == 0 &&
+               !(options.drawInStep && backend.rendersInStep() && info.render);
+    };
     for (size_t t = 0; t < types.size(); ++t) {
         TypeInfo& info = types[t];
         bool silent = !info.kills && !info.unstable && !info.updateEmits && !info.read;
-        info.rowsInMemory = inMemory && (info.late || silent) && info.parentType < 0 && !info.bursts &&
-                            info.stepLimit == 0 && !(options.drawInStep && backend.rendersInStep() && info.render);
-        if (info.rowsInMemory) pools[t].keepRowsInMemory();
+        info.rowsInMemory = inMemory && (info.late || silent) && keptWhole(info);
     }
+    // Emitters whose emissions the memory decides (Memory::emitAtRate): they never die,
+    // nobody reads them, every site emits at a rate into a type of its own that keeps its
+    // rows in the memory, emits nothing and reads no parent — so a step's emissions are
+    // one operation over the rows, and the objects they create batches of those types.
+    // Only where asked (Rows::InMemory) so far: on a device the host still reads the
+    // operation's totals and runs back in the step (docs/gpu.md, "Emitters in the memory").
+    for (size_t t = 0; t < types.size(); ++t) {
+        TypeInfo& info = types[t];
+        const ir::Object& o = module.objects[t];
+        bool emitter = options.rows == SystemOptions::Rows::InMemory && info.updateEmits && !info.kills && !info.unstable && !info.read &&
+                       !info.emitsWhenKilled && keptWhole(info);
+        for (size_t s = 0; emitter && s < o.emits.size(); ++s) {
+            size_t target = info.emitTarget[s];
+            const TypeInfo& to = types[target];
+            emitter = o.emits[s].rate() && to.rowsInMemory && module.objects[target].emits.empty() &&
+                      std::count(info.emitTarget.begin(), info.emitTarget.end(), target) == 1;
+        }
+        info.rowsInMemory = info.rowsInMemory || emitter;
+    }
+    for (size_t t = 0; t < types.size(); ++t)
+        if (types[t].rowsInMemory) pools[t].keepRowsInMemory();
     // Spawn kernels read the emitter's own columns, whose buffers never change: their
     // tables are bound once (the parent values come with each launch).
     for (size_t t = 0; t < pools.size(); ++t) {

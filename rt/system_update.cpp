@@ -26,6 +26,16 @@ void runEmissions(State& s, Creation& creation, size_t type, double dt, double t
     if (!work.pass.ran) return;
     const ir::Object& o = pool.object();
     const Value* uniforms = s.uniforms(type, *info.update, static_cast<float>(dt), static_cast<float>(t1));
+    if (info.rowsInMemory) {  // the memory decides them, where the rows are
+        RateSites in;
+        in.rows = pool.rows();
+        in.mask = pool.updatable.column;
+        in.dt = dt;
+        for (Buffer accumulated : pool.emitted) in.sites.emplace_back().accumulated = accumulated;
+        creation.emitInMemory(type, work.updateTable, &uniforms, std::move(in), {}, t1);
+        creation.runSpawns();
+        return;
+    }
     const uint8_t* updatable = pool.mask();
     std::vector<float> rate(o.emits.size(), 0), count(o.emits.size(), 1);
     std::vector<const float*> rates(o.emits.size()), counts(o.emits.size());
@@ -137,6 +147,7 @@ void runUpdate(State& s, const Phase& phase, double dt, double t1, bool last) {
         return;
     }
     RowsLaunch update = poolUpdate(s, type, dt, t1);
+    update.emissionsStay = phase.inMemory && info.updateEmits;
     // (Where the rows are in the memory, nothing here reads the mask: no parents, no
     // drawing as the step goes, its folds copied, and it never dies.)
     const uint8_t* updatable = phase.inMemory ? nullptr : pool.mask();

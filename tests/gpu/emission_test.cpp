@@ -25,30 +25,33 @@ struct Emitters {
     rt::RateSites sites;
     rt::Buffer runs, totals;
 
-    Emitters(rt::Memory& m, size_t rows, size_t count) : memory(m) {
+    // The emitters are rows [first, first + rows) of their columns.
+    Emitters(rt::Memory& m, size_t rows, size_t count, size_t first = 0) : memory(m) {
         sites.rows = rows;
-        sites.mask = m.create(rt::Elem::U8, rows);
-        sites.killed = m.create(rt::Elem::U8, rows);
-        sites.created = m.create(rt::Elem::F64, rows);
+        sites.first = first;
+        sites.mask = m.create(rt::Elem::U8, first + rows);
+        sites.killed = m.create(rt::Elem::U8, first + rows);
+        sites.created = m.create(rt::Elem::F64, first + rows);
         for (size_t s = 0; s < count; ++s) {
             rt::RateSites::Site site;
-            site.rate = m.create(rt::Elem::F32, rows);
-            site.count = m.create(rt::Elem::F32, rows);
-            site.accumulated = m.create(rt::Elem::F64, rows);
+            site.rate = m.create(rt::Elem::F32, first + rows);
+            site.count = m.create(rt::Elem::F32, first + rows);
+            site.accumulated = m.create(rt::Elem::F64, first + rows);
             sites.sites.push_back(site);
         }
         runs = m.create(rt::Elem::U32, rows * count * rt::kRunWords);
         totals = m.create(rt::Elem::U32, rt::kTotalsSites + rt::kTotalsPerSite * count);
     }
     template <typename T>
-    std::vector<T> read(rt::Buffer b, size_t n) const {
+    std::vector<T> read(rt::Buffer b, size_t n, size_t first = 0) const {
         std::vector<T> v(n);
-        memory.read(b, 0, n, v.data());
+        memory.read(b, first, n, v.data());
         return v;
     }
+    // An emitter column's rows.
     template <typename T>
     void write(rt::Buffer b, const std::vector<T>& v) {
-        memory.write(b, 0, v.size(), v.data());
+        memory.write(b, sites.first, v.size(), v.data());
     }
 };
 
@@ -62,7 +65,7 @@ TEST_CASE("rate emissions decided on the GPU: the host's runs, ids, drops and ac
     auto gpu = gpuBackend();
     rt::HostMemory hostMemory;
     constexpr size_t kRows = 3000, kSites = 3;
-    Emitters host(hostMemory, kRows, kSites), device(gpu->memory(), kRows, kSites);
+    Emitters host(hostMemory, kRows, kSites, 5), device(gpu->memory(), kRows, kSites, 5);
     std::mt19937 random(11);
     const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
     uint32_t nextId = 100;
@@ -108,6 +111,7 @@ TEST_CASE("rate emissions decided on the GPU: the host's runs, ids, drops and ac
         auto run = [&](Emitters& e) {
             rt::RateSites in = e.sites;
             if (!ownClock) in.created = {};
+            in.fresh = ownClock && round % 2 == 0;
             for (size_t s = 0; s < kSites; ++s) {
                 if ((round + s) % 4 == 0) in.sites[s].rate = {};
                 if ((round + s) % 3 == 0) in.sites[s].count = {};
@@ -127,8 +131,8 @@ TEST_CASE("rate emissions decided on the GPU: the host's runs, ids, drops and ac
                     std::vector<uint32_t>(deviceRuns.begin() + i, deviceRuns.begin() + i + 8));
         }
         for (size_t s = 0; s < kSites; ++s)
-            REQUIRE(host.read<uint64_t>(host.sites.sites[s].accumulated, kRows) ==
-                    device.read<uint64_t>(device.sites.sites[s].accumulated, kRows));
+            REQUIRE(host.read<uint64_t>(host.sites.sites[s].accumulated, kRows, 5) ==
+                    device.read<uint64_t>(device.sites.sites[s].accumulated, kRows, 5));
         for (size_t s = 0; s < kSites; ++s) {
             const uint32_t* t = totals.data() + rt::kTotalsSites + rt::kTotalsPerSite * s;
             uint64_t asked = t[1] | uint64_t{t[2]} << 32;
@@ -194,4 +198,46 @@ TEST_CASE("a rate emission's records are the rule's: events, times, ids in row o
     CHECK(totals[rt::kTotalsSites + rt::kTotalsPerSite] == 5);       // site 1 kept
     CHECK(totals[rt::kTotalsSites + rt::kTotalsPerSite + 1] == 7);   // of 7 asked
     CHECK(e.read<double>(e.sites.sites[0].accumulated, 2)[0] == doctest::Approx(0.5));
+}
+
+TEST_CASE("emitters whose emissions the GPU decides: the interpreter's objects, ids, rows and drops") {
+    // With rows kept in the memory (SystemOptions::Rows::InMemory), an emitter that never
+    // dies and emits at a rate into types that keep their rows there keeps its rows on the
+    // GPU too, and its emissions are Memory::emitAtRate's dispatches: rates shared and per
+    // row, counts per row, invalid rates (counted), a target at capacity (drops), emitters
+    // created in the step by a trigger (their first update's emissions), two sites.
+    std::vector<std::string> programs;
+    for (const char* sample : {"fountain", "emitter", "two_streams", "tornado"}) programs.push_back(test::readFile(test::sample(sample)));
+    programs.push_back(R"(
+        @capacity(300) object p(k: float) { point(vec3(k, age, 0), white, 1); kill when age > 0.4; }
+        object q { point(vec3(0, age, 1), red, 1); kill when age > 0.3; }
+        object e(r: float) {
+            emit p(rand() + r) at r per second count 1 + 2 * fract(age);
+            emit q at 20 + 10 * sin(age * 7) per second;
+        }
+        spawn e(900);
+        spawn e(-1);
+        spawn e(0.25);
+        spawn e(45);
+        trigger more { emit e(rand() * 200) count 3; })");
+    for (const std::string& text : programs) {
+        INFO(text.substr(0, 120));
+        rt::SystemOptions kept;
+        kept.rows = rt::SystemOptions::Rows::InMemory;
+        test::Pair p(text, true, false, kept);
+        size_t emitters = 0;
+        for (size_t t = 0; t < p.gl->typeCount(); ++t)
+            emitters += p.gl->pool(t).rowsInMemory() && !p.gl->module().objects[t].emits.empty();
+        CHECK(emitters == 1);
+        for (int f = 0; f < 90; ++f) {
+            if (f == 20 && !p.cpu->module().triggers.empty()) p.fire("more");
+            p.steps(1, 1.0 / 60);
+            if (f % 15 == 14) p.compare();
+        }
+        if (text.find("@capacity(300)") != std::string::npos) {
+            CHECK(p.stats("p").dropped > 0);
+            CHECK(p.gl->stats().invalidEmissions > 0);
+            CHECK(p.stats("e").live == 7);
+        }
+    }
 }

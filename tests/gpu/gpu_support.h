@@ -96,9 +96,10 @@ struct Pair {
     GpuBackend gpu;
     std::unique_ptr<rt::System> cpu, gl;
 
-    explicit Pair(const std::string& text, bool optimize = true, bool hostSide = false) : gpu(gpuBackend(hostSide)) {
+    explicit Pair(const std::string& text, bool optimize = true, bool hostSide = false, rt::SystemOptions options = {})
+        : gpu(gpuBackend(hostSide)) {
         cpu = std::make_unique<rt::System>(test::compileModule(text, optimize), interpreter);
-        gl = std::make_unique<rt::System>(test::compileModule(text, optimize), *gpu);
+        gl = std::make_unique<rt::System>(test::compileModule(text, optimize), *gpu, options);
     }
     void steps(int n, double dt) {
         for (int i = 0; i < n; ++i) {
