@@ -3,8 +3,7 @@
 // moved on, its objects asked for written into its record — then one work group that
 // scans the records in row order: each site's objects kept while its target's room lasts
 // (a prefix sum of what was asked, clamped), the ids of the kept in row order, sites in
-// order (a prefix sum of the kept). What comes back to the host is the totals: a few words
-// a site, however many emitters. Counts past 2³² are two words (GLSL 4.50 has no 64-bit
+// order (a prefix sum of the kept); the totals after the records. Counts past 2³² are two words (GLSL 4.50 has no 64-bit
 // integers): what a row asks for is at most kMaxCount, a sum saturates. The differential
 // test (tests/gpu/emission_test.cpp) holds this to the host's rule.
 #include <epoxy/gl.h>
@@ -107,12 +106,12 @@ void main() {
 // One work group of 256: each invocation a chunk of rows in order. Per site: the chunk's
 // sum of what its rows asked for, an exclusive scan of the sums (by one invocation: 256
 // adds), then each row's place and kept; then the same over the chunks' kept for the ids.
-// `meta`: rows, sites, next id, the first row, then each site's room.
+// `meta`: rows, sites, next id, the first row, then each site's room. The totals from
+// word rows · sites · 8 of the runs.
 const char* kScan = R"(
 layout(local_size_x = 256) in;
 layout(std430, binding = 0) readonly buffer Meta { uint meta[]; };
 layout(std430, binding = 6) buffer Runs { uint runs[]; };
-layout(std430, binding = 7) buffer Totals { uint totals[]; };
 shared uvec2 partial[256];
 shared uint keptBefore[256];
 shared uvec2 counted[256];  // invalid, clamped
@@ -126,7 +125,7 @@ uvec2 add64(uvec2 a, uvec2 b) {
 }
 uint atMost(uvec2 a, uint room) { return a.y != 0u ? room : min(a.x, room); }
 void main() {
-    uint l = gl_LocalInvocationID.x, rows = meta[0], sites = meta[1];
+    uint l = gl_LocalInvocationID.x, rows = meta[0], sites = meta[1], totals = rows * sites * 8u;
     uint chunk = (rows + 255u) / 256u, begin = min(l * chunk, rows), end = min(begin + chunk, rows);
     uint kept = 0u;
     uvec2 count = uvec2(0u);
@@ -143,10 +142,10 @@ void main() {
                 partial[k] = before;
                 before = next;
             }
-            uint t = 3u + 3u * s;
-            totals[t] = atMost(before, room);
-            totals[t + 1u] = before.x;
-            totals[t + 2u] = before.y;
+            uint t = totals + 3u + 3u * s;
+            runs[t] = atMost(before, room);
+            runs[t + 1u] = before.x;
+            runs[t + 2u] = before.y;
         }
         barrier();
         uvec2 asked = partial[l];
@@ -167,15 +166,15 @@ void main() {
     if (l == 0u) {
         uvec2 all = uvec2(0u);
         for (uint k = 0u; k < 256u; ++k) all += counted[k];
-        totals[0] = all.x;
-        totals[1] = all.y;
+        runs[totals] = all.x;
+        runs[totals + 1u] = all.y;
         uint before = 0u;
         for (uint k = 0u; k < 256u; ++k) {
             uint next = before + keptBefore[k];
             keptBefore[k] = before;
             before = next;
         }
-        totals[2] = before;
+        runs[totals + 2u] = before;
     }
     barrier();
     uint id = meta[2] + keptBefore[l];
@@ -207,17 +206,20 @@ std::pair<uint32_t, uint32_t> words(double x) {
 
 }  // namespace
 
-void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs, Buffer totals) {
-    std::vector<Buffer> used = {in.mask, in.killed, in.created, runs, totals};
+// On the host where the emitters' columns are small and there (a pool whose launches run
+// on the host side) and the runs are too (the runs buffer has rows · sites records: its
+// length is not the pool's).
+void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs) {
+    std::vector<Buffer> used = {in.mask, in.killed, in.created};
     for (const rt::RateSites::Site& s : in.sites) used.insert(used.end(), {s.rate, s.count, s.accumulated});
     const size_t sites = in.sites.size(), n = in.rows;
-    if (n == 0 || std::all_of(used.begin(), used.end(), [&](Buffer b) { return allOnHost({b}); }))
-        return rt::Memory::emitAtRate(in, runs, totals);
+    if (n == 0 || (!onDevice(runs) && std::all_of(used.begin(), used.end(), [&](Buffer b) { return allOnHost({b}); })))
+        return rt::Memory::emitAtRate(in, runs);
     flushPending();
     if (!emitRowsProgram_) emitRowsProgram_ = computeProgram(shader(kRows, true), "rate emissions");
     if (!emitScanProgram_) emitScanProgram_ = computeProgram(shader(kScan, false), "rate emissions' scan");
     PassTimer::Scope timed(timer, "emissions", n * sites);
-    unsigned runsGl = bound(runs), totalsGl = bound(totals);
+    unsigned runsGl = bound(runs);
     std::vector<uint32_t> meta = {static_cast<uint32_t>(n), static_cast<uint32_t>(sites), in.nextId,
                                   static_cast<uint32_t>(in.first)};
     for (const rt::RateSites::Site& s : in.sites) meta.push_back(s.room);
@@ -246,7 +248,6 @@ void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs, Buffer totals) {
     }
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, metaBuffer_);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, runsGl);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, totalsGl);
     glUseProgram(emitScanProgram_);
     glDispatchCompute(1, 1, 1);
     ++dispatches;

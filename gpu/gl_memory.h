@@ -52,7 +52,7 @@ public:
     void identify(const rt::ObjectRuns& runs, size_t n, size_t kept, rt::Buffer created, rt::Buffer ids,
                   rt::Buffer mask, size_t first) override;
     // Rate emissions decided on the GPU: a dispatch a site, one scan (gpu/gl_emission.cpp).
-    void emitAtRate(const rt::RateSites& sites, rt::Buffer runs, rt::Buffer totals) override;
+    void emitAtRate(const rt::RateSites& sites, rt::Buffer runs) override;
     // The box around the drawn rows, reduced on the GPU (gpu/gl_bounds.cpp).
     rt::Bounds bounds(rt::Buffer visible, const std::array<rt::Buffer, 3>& position, const std::array<float, 3>& constant,
                       size_t rows) const override;

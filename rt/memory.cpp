@@ -134,12 +134,12 @@ void Memory::identify(const ObjectRuns& runs, size_t n, size_t kept, Buffer crea
 
 // The rate emissions of emitter rows (Memory::emitAtRate): rt/emission.h's rule row by
 // row, each site's objects kept while its target's room lasts, the ids in row order.
-void Memory::emitAtRate(const RateSites& in, Buffer runs, Buffer totals) {
+void Memory::emitAtRate(const RateSites& in, Buffer runs) {
     const size_t n = in.rows, sites = in.sites.size();
-    auto* total = static_cast<uint32_t*>(host(totals));
+    auto* record = static_cast<uint32_t*>(host(runs));
+    uint32_t* total = record + runsTotalsAt(n, sites);
     std::fill(total, total + kTotalsSites + kTotalsPerSite * sites, 0u);
     if (n == 0) return;
-    auto* record = static_cast<uint32_t*>(host(runs));
     const size_t f = in.first;
     const auto* mask = static_cast<const uint8_t*>(view(in.mask)) + f;
     const auto* killed = in.killed.valid() ? static_cast<const uint8_t*>(view(in.killed)) + f : nullptr;

@@ -82,11 +82,17 @@ struct RateSites {
 
 // Emitter rows' records in a runs buffer (Memory::emitAtRate), kRunWords words each, in
 // rt::ObjectRuns' form: first (the run's first object's place among the site's objects),
-// count, id, perEvent, firstTime (f64, low word first), spacing (f64).
+// count, id, perEvent, firstTime (f64, low word first), spacing (f64); after the records
+// (rows · sites of them), the totals: the emissions' invalid rates and counts, the counts
+// clamped, the ids taken; then per site: objects kept, and objects asked for (u64, low
+// word first) — so that one read brings back all the host needs.
 constexpr size_t kRunWords = 8;
-// A totals buffer (u32): the emissions' invalid rates and counts, the counts clamped, the
-// ids taken; then per site: objects kept, and objects asked for (u64, low word first).
 constexpr size_t kTotalsInvalid = 0, kTotalsClamped = 1, kTotalsIds = 2, kTotalsSites = 3, kTotalsPerSite = 3;
+// The words of a runs buffer for `rows` emitters at `sites` sites, and where its totals start.
+constexpr size_t runsTotalsAt(size_t rows, size_t sites) { return rows * sites * kRunWords; }
+constexpr size_t runsWords(size_t rows, size_t sites) {
+    return runsTotalsAt(rows, sites) + kTotalsSites + kTotalsPerSite * sites;
+}
 
 class Memory {
 public:
@@ -164,12 +170,12 @@ public:
     // The rate emissions of emitter rows (rt/emission.h's rule, in row order, a row's sites
     // in order): each row of `sites.mask` not killed advances its accumulators and asks
     // for its events' objects; a site's target keeps them while its room lasts (the rest
-    // dropped, counted in `totals`), and the kept take ids from nextId in row order, sites
-    // in order. Row r's run at site s is record s·rows + r of `runs` (kRunWords words: a
-    // row that emits nothing has count 0); the totals (kTotals…) in `totals`. Written here
-    // through `host`; a device does it where the rows are (GlMemory: a dispatch a site and
-    // one scan).
-    virtual void emitAtRate(const RateSites& sites, Buffer runs, Buffer totals);
+    // dropped, counted in the totals), and the kept take ids from nextId in row order,
+    // sites in order. Row r's run at site s is record s·rows + r of `runs` (u32,
+    // runsWords(rows, sites) of them: kRunWords a record, a row that emits nothing has
+    // count 0), the totals after the records (kTotals…). Written here through `host`; a
+    // device does it where the rows are (GlMemory: a dispatch a site and one scan).
+    virtual void emitAtRate(const RateSites& sites, Buffer runs);
     // The box around rows [0, rows) whose `visible` (f32) is 1: each position component's
     // least and greatest, from its column (f32), or `constant[c]` where it has none (an
     // invalid buffer). Min and max are exact, so the box is the same whatever the order

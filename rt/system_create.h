@@ -140,7 +140,7 @@ private:
     std::vector<Batch> batches_;
     std::vector<Value> yields_;
     std::vector<float> rate_, count_;
-    Scratch emissions_;  // emitInMemory's runs and totals
+    Scratch emissions_;  // emitInMemory's: each type's runs, then a batch's accumulators by site
 };
 
 // Per type: the scratch columns a batch is created in, indexed like the staging rows (so

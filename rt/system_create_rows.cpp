@@ -93,7 +93,7 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
         in.created = table[ColumnLayout::kCreated];
         in.fresh = true;
         for (size_t site = 0; site < o.emits.size(); ++site) {
-            Buffer accumulated = emissions_.at(2 + site, Elem::F64, first + n);
+            Buffer accumulated = emissions_.at(s_.pools.size() + site, Elem::F64, first + n);
             in.sites.emplace_back().accumulated = accumulated;
             columns.push_back({accumulated, pool.emitted[site]});
         }
@@ -136,25 +136,23 @@ void Creation::emitInMemory(size_t type, const std::vector<Buffer>& table, const
     }
     in.t1 = t1;
     in.nextId = s_.nextId;
-    Buffer runs = emissions_.at(0, Elem::U32, n * sites * kRunWords);
-    Buffer totals = emissions_.at(1, Elem::U32, kTotalsSites + kTotalsPerSite * sites);
-    s_.memory.emitAtRate(in, runs, totals);
-    std::vector<uint32_t> total(kTotalsSites + kTotalsPerSite * sites);
-    s_.memory.read(totals, 0, total.size(), total.data());
+    // One read brings back the runs and, after them, the totals.
+    Buffer runs = emissions_.at(type, Elem::U32, runsWords(n, sites));  // (each type's where its rows are)
+    s_.memory.emitAtRate(in, runs);
+    std::vector<uint32_t> records(runsWords(n, sites));
+    s_.memory.read(runs, 0, records.size(), records.data());
+    const uint32_t* total = records.data() + runsTotalsAt(n, sites);
     s_.stats.invalidEmissions += total[kTotalsInvalid];
     s_.stats.clampedEmissions += total[kTotalsClamped];
     std::vector<size_t> base(sites, 0);
     for (size_t site = 0; site < sites; ++site) {
-        const uint32_t* t = total.data() + kTotalsSites + kTotalsPerSite * site;
+        const uint32_t* t = total + kTotalsSites + kTotalsPerSite * site;
         uint64_t asked = t[1] | uint64_t{t[2]} << 32;
         size_t target = info.emitTarget[site];
         addSaturating(s_.typeStats[target].dropped, asked - t[0]);
         if (t[0]) base[site] = stage(target, t[0]);
     }
-    if (total[kTotalsIds] == 0) return;
     // The runs, row by row and sites in order, as emitInUpdate queues them.
-    std::vector<uint32_t> records(n * sites * kRunWords);
-    s_.memory.read(runs, 0, records.size(), records.data());
     for (size_t r = 0; r < n; ++r)
         for (size_t site = 0; site < sites; ++site) {
             const uint32_t* w = records.data() + (site * n + r) * kRunWords;

@@ -23,7 +23,7 @@ namespace {
 struct Emitters {
     rt::Memory& memory;
     rt::RateSites sites;
-    rt::Buffer runs, totals;
+    rt::Buffer runs;  // the records, then the totals
 
     // The emitters are rows [first, first + rows) of their columns.
     Emitters(rt::Memory& m, size_t rows, size_t count, size_t first = 0) : memory(m) {
@@ -39,8 +39,7 @@ struct Emitters {
             site.accumulated = m.create(rt::Elem::F64, first + rows);
             sites.sites.push_back(site);
         }
-        runs = m.create(rt::Elem::U32, rows * count * rt::kRunWords);
-        totals = m.create(rt::Elem::U32, rt::kTotalsSites + rt::kTotalsPerSite * count);
+        runs = m.create(rt::Elem::U32, rt::runsWords(rows, count));
     }
     template <typename T>
     std::vector<T> read(rt::Buffer b, size_t n, size_t first = 0) const {
@@ -116,15 +115,15 @@ TEST_CASE("rate emissions decided on the GPU: the host's runs, ids, drops and ac
                 if ((round + s) % 4 == 0) in.sites[s].rate = {};
                 if ((round + s) % 3 == 0) in.sites[s].count = {};
             }
-            e.memory.emitAtRate(in, e.runs, e.totals);
+            e.memory.emitAtRate(in, e.runs);
         };
         run(host);
         run(device);
-        const size_t words = kRows * kSites * rt::kRunWords, totalWords = rt::kTotalsSites + rt::kTotalsPerSite * kSites;
-        std::vector<uint32_t> totals = host.read<uint32_t>(host.totals, totalWords);
-        REQUIRE(totals == device.read<uint32_t>(device.totals, totalWords));
-        std::vector<uint32_t> runs = host.read<uint32_t>(host.runs, words);
-        std::vector<uint32_t> deviceRuns = device.read<uint32_t>(device.runs, words);
+        const size_t words = rt::runsTotalsAt(kRows, kSites), all = rt::runsWords(kRows, kSites);
+        std::vector<uint32_t> runs = host.read<uint32_t>(host.runs, all);
+        std::vector<uint32_t> deviceRuns = device.read<uint32_t>(device.runs, all);
+        std::vector<uint32_t> totals(runs.begin() + static_cast<std::ptrdiff_t>(words), runs.end());
+        REQUIRE(totals == std::vector<uint32_t>(deviceRuns.begin() + static_cast<std::ptrdiff_t>(words), deviceRuns.end()));
         for (size_t i = 0; i < words; i += rt::kRunWords) {
             INFO("site " << i / rt::kRunWords / kRows << ", row " << i / rt::kRunWords % kRows);
             REQUIRE(std::vector<uint32_t>(runs.begin() + i, runs.begin() + i + 8) ==
@@ -169,8 +168,8 @@ TEST_CASE("a rate emission's records are the rule's: events, times, ids in row o
     e.write(e.sites.sites[1].rate, std::vector<float>{40, 21});  // 4 events; 0.9 + 2.1: 3 events
     e.write(e.sites.sites[1].count, std::vector<float>{1, 1});
     e.sites.sites[1].room = 5;
-    m.emitAtRate(e.sites, e.runs, e.totals);
-    auto runs = e.read<uint32_t>(e.runs, 4 * rt::kRunWords);
+    m.emitAtRate(e.sites, e.runs);
+    auto runs = e.read<uint32_t>(e.runs, rt::runsWords(2, 2));
     auto record = [&](size_t site, size_t row) { return runs.data() + (site * 2 + row) * rt::kRunWords; };
     auto time = [](const uint32_t* w, size_t at) {
         double t;
@@ -193,7 +192,7 @@ TEST_CASE("a rate emission's records are the rule's: events, times, ids in row o
     CHECK(record(1, 1)[0] == 4);
     CHECK(record(1, 1)[1] == 1);
     CHECK(record(1, 1)[2] == 23);
-    auto totals = e.read<uint32_t>(e.totals, rt::kTotalsSites + 2 * rt::kTotalsPerSite);
+    const uint32_t* totals = runs.data() + rt::runsTotalsAt(2, 2);
     CHECK(totals[rt::kTotalsIds] == 17);
     CHECK(totals[rt::kTotalsSites + rt::kTotalsPerSite] == 5);       // site 1 kept
     CHECK(totals[rt::kTotalsSites + rt::kTotalsPerSite + 1] == 7);   // of 7 asked

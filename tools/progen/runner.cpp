@@ -33,6 +33,8 @@ std::vector<Config> allConfigs() {
         {"llvm-fast-2t", "llvm", false, 2, true},
         {"glsl", "glsl", true, 1, true},
         {"glsl-device", "glsl", true, 1, false},
+        {"interp-memory", "interp", true, 1, true, true},
+        {"glsl-memory", "glsl", true, 1, false, true},
     };
 }
 
@@ -106,7 +108,9 @@ public:
             if (!side.backend) return Finding{config.label, "error", -1, "the backend cannot start: " + error};
             auto module = compile(c_.source, config.backend == "llvm" && !config.exact, !c_.edit.empty(), error);
             if (!module) return Finding{config.label, "compile", -1, error};
-            side.system = std::make_unique<rt::System>(std::move(*module), *side.backend);
+            rt::SystemOptions systemOptions;
+            if (config.rowsInMemory) systemOptions.rows = rt::SystemOptions::Rows::InMemory;
+            side.system = std::make_unique<rt::System>(std::move(*module), *side.backend, systemOptions);
             if (config.threads) side.system->setThreads(config.threads);
             sides_.push_back(std::move(side));
         }

@@ -20,11 +20,14 @@ struct Config {
     bool exact = true;    // llvm: exact maths; false: fast, with the relaxed rewrites
     unsigned threads = 1;
     bool hostSide = true;  // glsl: small pools on the host, as psysc and the viewer run it
+    bool rowsInMemory = false;  // SystemOptions::Rows::InMemory: emitters' rows too, their emissions by the memory
     bool bitwise() const { return backend != "glsl" && exact; }
 };
 
 // By name: interp, llvm-exact-1t, llvm-exact-2t, llvm-fast-2t, glsl (with its host side),
-// glsl-device (every pool on the GPU). nullopt for an unknown one.
+// glsl-device (every pool on the GPU), interp-memory and glsl-memory (rows kept in the
+// memory wherever they can be: SystemOptions::Rows::InMemory; the latter every pool on
+// the GPU). nullopt for an unknown one.
 std::optional<Config> configNamed(const std::string& name);
 std::vector<std::string> configNames();
 
