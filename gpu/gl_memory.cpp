@@ -123,7 +123,7 @@ GlMemory::~GlMemory() {
     for (auto& c : columns_)
         if (c && c->gl) glDeleteBuffers(1, &c->gl);
     for (unsigned program : {scatterProgram_, scatterColumnsProgram_, gatherProgram_, allocateProgram_, releaseProgram_, pushedProgram_, freshProgram_,
-                             identifyProgram_, boundsProgram_, emitRowsProgram_, emitScanProgram_})
+                             identifyProgram_, boundsProgram_, emitRowsProgram_, emitScanProgram_, identifyRecordsProgram_})
         if (program) glDeleteProgram(program);
     if (runsBuffer_) glDeleteBuffers(1, &runsBuffer_);
     if (rowsBuffer_) glDeleteBuffers(1, &rowsBuffer_);

@@ -51,6 +51,8 @@ public:
                  size_t rowsFirst, size_t count) override;
     void identify(const rt::ObjectRuns& runs, size_t n, size_t kept, rt::Buffer created, rt::Buffer ids,
                   rt::Buffer mask, size_t first) override;
+    void identifyRecords(rt::Buffer runs, size_t firstRecord, size_t records, size_t objects, rt::Buffer created,
+                         rt::Buffer ids, size_t first) override;
     // Rate emissions decided on the GPU: a dispatch a site, one scan (gpu/gl_emission.cpp).
     void emitAtRate(const rt::RateSites& sites, rt::Buffer runs) override;
     // The box around the drawn rows, reduced on the GPU (gpu/gl_bounds.cpp).
@@ -128,6 +130,7 @@ private:
     mutable std::vector<uint32_t> rowsSent_;  // what rowsBuffer_ holds
     mutable unsigned boundsProgram_ = 0, boxBuffer_ = 0;  // gpu/gl_bounds.cpp
     unsigned emitRowsProgram_ = 0, emitScanProgram_ = 0, metaBuffer_ = 0;  // gpu/gl_emission.cpp
+    unsigned identifyRecordsProgram_ = 0;                                   // gpu/gl_rows.cpp
 };
 
 // Host rows to GPU words (u8 widened to a word) and back.

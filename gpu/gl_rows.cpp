@@ -92,7 +92,7 @@ void main() {
 )";
 
 // Object r's run: the last whose first object is at or before r (rt::ObjectRuns; a run of
-// no objects shares its first with the next, which wins). Its time rounded as
+// no objects shares its first with the next, which wins); an object past it is not its. Its time rounded as
 // rt::eventTime's: `precise`, no fused multiply-add.
 const char* kIdentify = R"(
 layout(std430, binding = 0) readonly buffer Runs { uint runs[]; };
@@ -102,12 +102,15 @@ layout(std430, binding = 3) buffer Mask { uint mask[]; };
 void main() {
     uint r = INVOCATION, n = param(0u), kept = param(1u), runCount = param(2u), first = param(3u);
     if (r >= n) return;
+    mask[first + r] = r < kept ? 1u : 0u;
+    if (runCount == 0u) return;
     uint lo = 0u, hi = runCount - 1u;
     while (lo < hi) {
         uint mid = (lo + hi + 1u) >> 1u;
         if (runs[mid * 8u] <= r) lo = mid; else hi = mid - 1u;
     }
     uint u = lo * 8u, k = r - runs[u];
+    if (k >= runs[u + 1u]) return;  // (an object of a site's records: identifyRecords)
     double firstTime = packDouble2x32(uvec2(runs[u + 4u], runs[u + 5u]));
     double spacing = packDouble2x32(uvec2(runs[u + 6u], runs[u + 7u]));
     precise double offset = double(k / runs[u + 3u]) * spacing;
@@ -116,7 +119,32 @@ void main() {
     created[(first + r) * 2u] = words.x;
     created[(first + r) * 2u + 1u] = words.y;
     ids[first + r] = runs[u + 2u] + k;
-    mask[first + r] = r < kept ? 1u : 0u;
+}
+)";
+
+// The same from a site's records where emitAtRate left them: object r of the records
+// from `base` on, its times and id at `first` + r.
+const char* kIdentifyRecords = R"(
+layout(std430, binding = 0) readonly buffer Runs { uint runs[]; };
+layout(std430, binding = 1) buffer Created { uint created[]; };
+layout(std430, binding = 2) buffer Ids { uint ids[]; };
+void main() {
+    uint r = INVOCATION, n = param(0u), records = param(1u), first = param(2u), base = param(3u) * 8u;
+    if (r >= n) return;
+    uint lo = 0u, hi = records - 1u;
+    while (lo < hi) {
+        uint mid = (lo + hi + 1u) >> 1u;
+        if (runs[base + mid * 8u] <= r) lo = mid; else hi = mid - 1u;
+    }
+    uint u = base + lo * 8u, k = r - runs[u];
+    double firstTime = packDouble2x32(uvec2(runs[u + 4u], runs[u + 5u]));
+    double spacing = packDouble2x32(uvec2(runs[u + 6u], runs[u + 7u]));
+    precise double offset = double(k / runs[u + 3u]) * spacing;
+    precise double t = firstTime + offset;
+    uvec2 words = unpackDouble2x32(t);
+    created[(first + r) * 2u] = words.x;
+    created[(first + r) * 2u + 1u] = words.y;
+    ids[first + r] = runs[u + 2u] + k;
 }
 )";
 
@@ -210,7 +238,7 @@ void GlMemory::identify(const rt::ObjectRuns& runs, size_t n, size_t kept, Buffe
     if (allOnHost({created, ids, mask})) return rt::Memory::identify(runs, n, kept, created, ids, mask, first);
     flushPending();
     if (!identifyProgram_) identifyProgram_ = computeProgram(shader(kIdentify), "identify");
-    std::vector<uint32_t> words(runs.size() * 8);
+    std::vector<uint32_t> words(std::max<size_t>(runs.size(), 1) * 8);  // (a block is never empty)
     for (size_t u = 0; u < runs.size(); ++u) {
         uint32_t* w = words.data() + u * 8;
         w[0] = runs.first[u];
@@ -232,6 +260,22 @@ void GlMemory::identify(const rt::ObjectRuns& runs, size_t n, size_t kept, Buffe
     bindParams(paramsBuffer_, {static_cast<uint32_t>(n), static_cast<uint32_t>(kept),
                                static_cast<uint32_t>(runs.size()), static_cast<uint32_t>(first)});
     dispatchRows(identifyProgram_, n);
+}
+
+void GlMemory::identifyRecords(Buffer runs, size_t firstRecord, size_t records, size_t objects, Buffer created,
+                               Buffer ids, size_t first) {
+    if (objects == 0) return;
+    if (!onDevice(runs) && allOnHost({created, ids}))  // (the runs' length is not a pool's)
+        return rt::Memory::identifyRecords(runs, firstRecord, records, objects, created, ids, first);
+    flushPending();
+    if (!identifyRecordsProgram_) identifyRecordsProgram_ = computeProgram(shader(kIdentifyRecords), "identify from records");
+    PassTimer::Scope timed(timer, "identify", objects);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceBuffer(runs));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, bound(created));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, bound(ids));
+    bindParams(paramsBuffer_, {static_cast<uint32_t>(objects), static_cast<uint32_t>(records),
+                               static_cast<uint32_t>(first), static_cast<uint32_t>(firstRecord)});
+    dispatchRows(identifyRecordsProgram_, objects);
 }
 
 }  // namespace psys::gpu

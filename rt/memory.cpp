@@ -123,13 +123,31 @@ void Memory::identify(const ObjectRuns& runs, size_t n, size_t kept, Buffer crea
     auto* c = static_cast<double*>(host(created)) + first;
     auto* id = static_cast<uint32_t*>(host(ids)) + first;
     auto* m = static_cast<uint8_t*>(host(mask)) + first;
+    for (size_t r = 0; r < n; ++r) m[r] = r < kept;
     for (size_t u = 0; u < runs.size(); ++u)
         for (uint32_t k = 0; k < runs.count[u]; ++k) {
             size_t r = runs.first[u] + k;
-            m[r] = r < kept;
             c[r] = runs.time(u, k);
             id[r] = runs.id[u] + k;
         }
+}
+
+void Memory::identifyRecords(Buffer runs, size_t firstRecord, size_t records, size_t objects, Buffer created,
+                             Buffer ids, size_t first) {
+    if (objects == 0) return;
+    const auto* record = static_cast<const uint32_t*>(view(runs)) + firstRecord * kRunWords;
+    auto* c = static_cast<double*>(host(created)) + first;
+    auto* id = static_cast<uint32_t*>(host(ids)) + first;
+    for (size_t u = 0; u < records; ++u) {
+        const uint32_t* w = record + u * kRunWords;
+        double firstTime, spacing;
+        std::memcpy(&firstTime, w + 4, 8);
+        std::memcpy(&spacing, w + 6, 8);
+        for (uint32_t k = 0; k < w[1]; ++k) {
+            c[w[0] + k] = eventTime(firstTime, k, w[3], spacing);
+            id[w[0] + k] = w[2] + k;
+        }
+    }
 }
 
 // The rate emissions of emitter rows (Memory::emitAtRate): rt/emission.h's rule row by

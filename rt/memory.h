@@ -163,8 +163,9 @@ public:
     // i < count, with the rows in a buffer (a batch's columns into its pool rows at once).
     virtual void scatter(std::span<const std::pair<Buffer, Buffer>> columns, size_t fromFirst, Buffer rows,
                          size_t rowsFirst, size_t count);
-    // A creation batch's objects r < n from their runs (rt::ObjectRuns): created[first + r],
-    // ids[first + r], and mask[first + r] = r < kept.
+    // A creation batch's objects r < n from their runs (rt::ObjectRuns): mask[first + r] =
+    // r < kept, and created[first + r], ids[first + r] for the objects of the runs (those
+    // of a site's records are identifyRecords').
     virtual void identify(const ObjectRuns& runs, size_t n, size_t kept, Buffer created, Buffer ids, Buffer mask,
                           size_t first);
     // The rate emissions of emitter rows (rt/emission.h's rule, in row order, a row's sites
@@ -176,6 +177,11 @@ public:
     // count 0), the totals after the records (kTotals…). Written here through `host`; a
     // device does it where the rows are (GlMemory: a dispatch a site and one scan).
     virtual void emitAtRate(const RateSites& sites, Buffer runs);
+    // Objects r < objects of a batch from a site's records of `runs` (emitAtRate's,
+    // records [firstRecord, firstRecord + records): the objects the record's count says
+    // from its first on): created[first + r] and ids[first + r], where the records are.
+    virtual void identifyRecords(Buffer runs, size_t firstRecord, size_t records, size_t objects, Buffer created,
+                                 Buffer ids, size_t first);
     // The box around rows [0, rows) whose `visible` (f32) is 1: each position component's
     // least and greatest, from its column (f32), or `constant[c]` where it has none (an
     // invalid buffer). Min and max are exact, so the box is the same whatever the order

@@ -28,7 +28,7 @@ size_t components(const std::vector<ir::StateSlot>& slots) {
 
 }  // namespace
 
-Creation::Creation(State& state) : s_(state), emissions_(state.memory) {
+Creation::Creation(State& state) : s_(state), emissions_(state.memory), runs_(state.memory) {
     queued_.assign(s_.pools.size(), 0);
     pending_.assign(s_.pools.size(), 0);
     staging_.resize(s_.pools.size());

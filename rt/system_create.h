@@ -75,6 +75,11 @@ private:
         uint64_t perEvent;          // this many objects each
         uint32_t id;
         double time(size_t k) const { return eventTime(firstTime, k, perEvent, spacing); }
+        // Or the objects of one site as emitAtRate left them, where its memory keeps them
+        // (Memory::identifyRecords): `records` records of `runs` from `record` on (their
+        // ids are not a range: `id`, `firstTime` and `spacing` are not the run's).
+        Buffer runs = {};
+        size_t record = 0, records = 0;
     };
     // Per type: the arguments of queued objects, one f32 column per component of the
     // type's parameters (kept or not); an object's row is its place among the type's
@@ -140,7 +145,9 @@ private:
     std::vector<Batch> batches_;
     std::vector<Value> yields_;
     std::vector<float> rate_, count_;
-    Scratch emissions_;  // emitInMemory's: each type's runs, then a batch's accumulators by site
+    Scratch emissions_;  // emitInMemory's: a batch's accumulators by site,
+    Scratch runs_;       // and the runs of each call in a drain (runsUsed_ of them so far)
+    size_t runsUsed_ = 0;
 };
 
 // Per type: the scratch columns a batch is created in, indexed like the staging rows (so

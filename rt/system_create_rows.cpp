@@ -47,6 +47,7 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     ObjectRuns runs;
     for (size_t u = 0; u < b.runs.size(); ++u) {
         const Run& run = b.runs[u];
+        if (run.runs.valid()) continue;  // (identifyRecords, below)
         runs.first.push_back(static_cast<uint32_t>(b.runFirst[u]));
         runs.count.push_back(static_cast<uint32_t>(run.count));
         runs.id.push_back(run.id);
@@ -57,6 +58,10 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     Memory& memory = s_.memory;
     Buffer mask = b.columns.at(kMask, Elem::U8, first + n);
     memory.identify(runs, n, kept, table[ColumnLayout::kCreated], table[ColumnLayout::kIds], mask, first);
+    for (size_t u = 0; u < b.runs.size(); ++u)
+        if (const Run& run = b.runs[u]; run.runs.valid())
+            memory.identifyRecords(run.runs, run.record, run.records, run.count, table[ColumnLayout::kCreated],
+                                   table[ColumnLayout::kIds], first + b.runFirst[u]);
     std::vector<std::pair<Buffer, Buffer>> columns = identityColumns(type, table);
     memory.scatter(columns, first, rows, 0, kept);
     for (size_t s : info.zeroedState)  // (what init sets is not)
@@ -93,7 +98,7 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
         in.created = table[ColumnLayout::kCreated];
         in.fresh = true;
         for (size_t site = 0; site < o.emits.size(); ++site) {
-            Buffer accumulated = emissions_.at(s_.pools.size() + site, Elem::F64, first + n);
+            Buffer accumulated = emissions_.at(site, Elem::F64, first + n);
             in.sites.emplace_back().accumulated = accumulated;
             columns.push_back({accumulated, pool.emitted[site]});
         }
@@ -137,7 +142,8 @@ void Creation::emitInMemory(size_t type, const std::vector<Buffer>& table, const
     in.t1 = t1;
     in.nextId = s_.nextId;
     // One read brings back the runs and, after them, the totals.
-    Buffer runs = emissions_.at(type, Elem::U32, runsWords(n, sites));  // (each type's where its rows are)
+    // (The queue refers to them until it is drained: a buffer a call.)
+    Buffer runs = runs_.at(runsUsed_++, Elem::U32, runsWords(n, sites));
     s_.memory.emitAtRate(in, runs);
     std::vector<uint32_t> records(runsWords(n, sites));
     s_.memory.read(runs, 0, records.size(), records.data());
@@ -152,18 +158,19 @@ void Creation::emitInMemory(size_t type, const std::vector<Buffer>& table, const
         addSaturating(s_.typeStats[target].dropped, asked - t[0]);
         if (t[0]) base[site] = stage(target, t[0]);
     }
-    // The runs, row by row and sites in order, as emitInUpdate queues them.
+    // Each emitter's spawn launches, row by row and sites in order, as emitInUpdate queues
+    // them; each site's objects one run, its ids and times where the records are.
     for (size_t r = 0; r < n; ++r)
         for (size_t site = 0; site < sites; ++site) {
             const uint32_t* w = records.data() + (site * n + r) * kRunWords;
             if (w[1] == 0) continue;
             uint32_t row = poolRows.empty() ? static_cast<uint32_t>(r) : poolRows[r];
             queueSpawn({type, row, {}, row, t1, false}, static_cast<int>(site), w[2], w[1], base[site] + w[0]);
-            double firstTime, spacing;
-            std::memcpy(&firstTime, w + 4, 8);
-            std::memcpy(&spacing, w + 6, 8);
-            enqueue({info.emitTarget[site], base[site] + w[0], w[1], {}, firstTime, spacing, w[3], w[2]});
         }
+    for (size_t site = 0; site < sites; ++site) {
+        uint32_t kept = total[kTotalsSites + kTotalsPerSite * site];
+        if (kept) enqueue({info.emitTarget[site], base[site], kept, {}, 0, 0, 1, 0, runs, site * n, n});
+    }
     s_.nextId += total[kTotalsIds];
 }
 

@@ -194,6 +194,7 @@ void Creation::drain(double t1) {
         i = end;
     }
     queue_.clear();
+    runsUsed_ = 0;
     for (Staging& st : staging_) st.used = 0;
 }
 

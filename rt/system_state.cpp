@@ -118,7 +118,7 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     for (size_t t = 0; t < types.size(); ++t) {
         TypeInfo& info = types[t];
         const ir::Object& o = module.objects[t];
-        bool emitter = options.rows == SystemOptions::Rows::InMemory && info.updateEmits && !info.kills && !info.unstable && !info.read &&
+        bool emitter = options.rows == SystemOptions::Rows::InMemory && options.createInBatches && info.updateEmits && !info.kills && !info.unstable && !info.read &&
                        !info.emitsWhenKilled && keptWhole(info);
         for (size_t s = 0; emitter && s < o.emits.size(); ++s) {
             size_t target = info.emitTarget[s];

@@ -137,6 +137,43 @@ TEST_CASE("rate emissions decided on the GPU: the host's runs, ids, drops and ac
             uint64_t asked = t[1] | uint64_t{t[2]} << 32;
             cut = cut || asked > t[0];
         }
+        // Each site's objects' creation times and ids from its records where they are: the
+        // same bits on both memories, and those of identify from the same runs as a list.
+        for (size_t s = 0; s < kSites; ++s) {
+            uint32_t objects = totals[rt::kTotalsSites + rt::kTotalsPerSite * s];
+            rt::ObjectRuns list;
+            for (size_t r = 0; r < kRows; ++r) {
+                const uint32_t* w = runs.data() + (s * kRows + r) * rt::kRunWords;
+                double firstTime, spacing;
+                std::memcpy(&firstTime, w + 4, 8);
+                std::memcpy(&spacing, w + 6, 8);
+                list.first.push_back(w[0]);
+                list.count.push_back(w[1]);
+                list.id.push_back(w[2]);
+                list.perEvent.push_back(w[3]);
+                list.firstTime.push_back(firstTime);
+                list.spacing.push_back(spacing);
+            }
+            std::vector<uint64_t> created[3];
+            std::vector<uint32_t> ids[3];
+            int which = 0;
+            for (Emitters* e : {&host, &device, &host}) {
+                rt::Buffer c = e->memory.create(rt::Elem::F64, objects + 3), i = e->memory.create(rt::Elem::U32, objects + 3),
+                           m = e->memory.create(rt::Elem::U8, objects + 3);
+                if (which < 2)
+                    e->memory.identifyRecords(e->runs, s * kRows, kRows, objects, c, i, 3);
+                else
+                    e->memory.identify(list, objects, objects, c, i, m, 3);
+                created[which] = e->read<uint64_t>(c, objects, 3);
+                ids[which] = e->read<uint32_t>(i, objects, 3);
+                for (rt::Buffer b : {c, i, m}) e->memory.release(b);
+                ++which;
+            }
+            CHECK(created[0] == created[1]);
+            CHECK(created[0] == created[2]);
+            CHECK(ids[0] == ids[1]);
+            CHECK(ids[0] == ids[2]);
+        }
         clamped = clamped || totals[rt::kTotalsClamped] > 0;
         CHECK(totals[rt::kTotalsInvalid] > 0);
         nextId += totals[rt::kTotalsIds];
