@@ -91,60 +91,57 @@ void main() {
 }
 )";
 
-// Object r's run: the last whose first object is at or before r (rt::ObjectRuns; a run of
-// no objects shares its first with the next, which wins); an object past it is not its. Its time rounded as
-// rt::eventTime's: `precise`, no fused multiply-add.
-const char* kIdentify = R"(
+// What both identify shaders share: the runs (records of rt::kRunWords words, in
+// rt::ObjectRuns' form) from word `base` on, `count` of them; the run of object r — the
+// last whose first object is at or before r (a run of no objects shares its first with
+// the next, which wins); and object k of the run at word u written at row `at`, its time
+// rounded as rt::eventTime's: `precise`, no fused multiply-add.
+const char* kRunObjects = R"(
 layout(std430, binding = 0) readonly buffer Runs { uint runs[]; };
 layout(std430, binding = 1) buffer Created { uint created[]; };
 layout(std430, binding = 2) buffer Ids { uint ids[]; };
+uint runOf(uint r, uint base, uint count) {
+    uint lo = 0u, hi = count - 1u;
+    while (lo < hi) {
+        uint mid = (lo + hi + 1u) >> 1u;
+        if (runs[base + mid * 8u] <= r) lo = mid; else hi = mid - 1u;
+    }
+    return base + lo * 8u;
+}
+void identifyObject(uint u, uint k, uint at) {
+    double firstTime = packDouble2x32(uvec2(runs[u + 4u], runs[u + 5u]));
+    double spacing = packDouble2x32(uvec2(runs[u + 6u], runs[u + 7u]));
+    precise double offset = double(k / runs[u + 3u]) * spacing;
+    precise double t = firstTime + offset;
+    uvec2 words = unpackDouble2x32(t);
+    created[at * 2u] = words.x;
+    created[at * 2u + 1u] = words.y;
+    ids[at] = runs[u + 2u] + k;
+}
+)";
+
+// A batch's objects from runs the host sends: each object's mask, and the objects of the
+// runs (an object past its run's count is one of a site's records: identifyRecords).
+const char* kIdentify = R"(
 layout(std430, binding = 3) buffer Mask { uint mask[]; };
 void main() {
     uint r = INVOCATION, n = param(0u), kept = param(1u), runCount = param(2u), first = param(3u);
     if (r >= n) return;
     mask[first + r] = r < kept ? 1u : 0u;
     if (runCount == 0u) return;
-    uint lo = 0u, hi = runCount - 1u;
-    while (lo < hi) {
-        uint mid = (lo + hi + 1u) >> 1u;
-        if (runs[mid * 8u] <= r) lo = mid; else hi = mid - 1u;
-    }
-    uint u = lo * 8u, k = r - runs[u];
-    if (k >= runs[u + 1u]) return;  // (an object of a site's records: identifyRecords)
-    double firstTime = packDouble2x32(uvec2(runs[u + 4u], runs[u + 5u]));
-    double spacing = packDouble2x32(uvec2(runs[u + 6u], runs[u + 7u]));
-    precise double offset = double(k / runs[u + 3u]) * spacing;
-    precise double t = firstTime + offset;
-    uvec2 words = unpackDouble2x32(t);
-    created[(first + r) * 2u] = words.x;
-    created[(first + r) * 2u + 1u] = words.y;
-    ids[first + r] = runs[u + 2u] + k;
+    uint u = runOf(r, 0u, runCount), k = r - runs[u];
+    if (k < runs[u + 1u]) identifyObject(u, k, first + r);
 }
 )";
 
 // The same from a site's records where emitAtRate left them: object r of the records
-// from `base` on, its times and id at `first` + r.
+// from record `base` on, its times and id at `first` + r.
 const char* kIdentifyRecords = R"(
-layout(std430, binding = 0) readonly buffer Runs { uint runs[]; };
-layout(std430, binding = 1) buffer Created { uint created[]; };
-layout(std430, binding = 2) buffer Ids { uint ids[]; };
 void main() {
     uint r = INVOCATION, n = param(0u), records = param(1u), first = param(2u), base = param(3u) * 8u;
     if (r >= n) return;
-    uint lo = 0u, hi = records - 1u;
-    while (lo < hi) {
-        uint mid = (lo + hi + 1u) >> 1u;
-        if (runs[base + mid * 8u] <= r) lo = mid; else hi = mid - 1u;
-    }
-    uint u = base + lo * 8u, k = r - runs[u];
-    double firstTime = packDouble2x32(uvec2(runs[u + 4u], runs[u + 5u]));
-    double spacing = packDouble2x32(uvec2(runs[u + 6u], runs[u + 7u]));
-    precise double offset = double(k / runs[u + 3u]) * spacing;
-    precise double t = firstTime + offset;
-    uvec2 words = unpackDouble2x32(t);
-    created[(first + r) * 2u] = words.x;
-    created[(first + r) * 2u + 1u] = words.y;
-    ids[first + r] = runs[u + 2u] + k;
+    uint u = runOf(r, base, records);
+    identifyObject(u, r - runs[u], first + r);
 }
 )";
 
@@ -237,7 +234,7 @@ void GlMemory::identify(const rt::ObjectRuns& runs, size_t n, size_t kept, Buffe
     if (n == 0) return;
     if (allOnHost({created, ids, mask})) return rt::Memory::identify(runs, n, kept, created, ids, mask, first);
     flushPending();
-    if (!identifyProgram_) identifyProgram_ = computeProgram(shader(kIdentify), "identify");
+    if (!identifyProgram_) identifyProgram_ = computeProgram(shader((std::string(kRunObjects) + kIdentify).c_str()), "identify");
     std::vector<uint32_t> words(std::max<size_t>(runs.size(), 1) * 8);  // (a block is never empty)
     for (size_t u = 0; u < runs.size(); ++u) {
         uint32_t* w = words.data() + u * 8;
@@ -268,7 +265,7 @@ void GlMemory::identifyRecords(Buffer runs, size_t firstRecord, size_t records, 
     if (!onDevice(runs) && allOnHost({created, ids}))  // (the runs' length is not a pool's)
         return rt::Memory::identifyRecords(runs, firstRecord, records, objects, created, ids, first);
     flushPending();
-    if (!identifyRecordsProgram_) identifyRecordsProgram_ = computeProgram(shader(kIdentifyRecords), "identify from records");
+    if (!identifyRecordsProgram_) identifyRecordsProgram_ = computeProgram(shader((std::string(kRunObjects) + kIdentifyRecords).c_str()), "identify from records");
     PassTimer::Scope timed(timer, "identify", objects);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceBuffer(runs));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, bound(created));
