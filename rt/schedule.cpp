@@ -65,7 +65,7 @@ std::string describe(const Schedule& s, const Phase& p) {
             std::string also;
             if (p.exports) also += ", the survivors' exports";
             if (p.render) also += ", the render when the host draws every step";
-            std::string listed = p.inMemory ? ", its kills listed in the memory"
+            std::string listed = p.inMemory ? (p.late ? ", its kills listed in the memory" : ", its rows in the memory")
                                  : p.late || p.listed ? ", its kills listed" : "";
             return fmt::format("{}: the update kernel over the pool{}{}", type, also, listed);
         }
@@ -77,6 +77,10 @@ std::string describe(const Schedule& s, const Phase& p) {
             return p.late ? fmt::format("{}: the listed kills kept for the step's end (nobody looks at them before)", type)
                           : fmt::format("{}: the killed rows frozen, in row order", type);
         case PhaseKind::Emissions: {
+            if (p.inMemory)
+                return fmt::format("{}: rate emissions ({}) decided by the memory's operation over the rows — events, "
+                                   "times, the cut at room, ids — then the queue",
+                                   type, names(s, p.targets));
             return fmt::format("{}: {} ({}): events, times, ids, the queue", type,
                                p.events ? "rate emissions of the survivors, bursts on edges and deaths" : "rate emissions of the survivors",
                                names(s, p.targets));
@@ -92,9 +96,11 @@ std::string describe(const Schedule& s, const Phase& p) {
                                type, names(s, p.targets), memory);
         }
         case PhaseKind::Release: {
-            std::vector<int> kept;
-            for (size_t t = 0; t < s.inMemory.size(); ++t)
-                if (s.inMemory[t]) kept.push_back(static_cast<int>(t));
+            std::vector<int> kept;  // the types in the memory that die (a kills phase)
+            for (const Phase& q : s.phases)
+                if (q.kind == PhaseKind::Kills && q.inMemory &&
+                    std::find(kept.begin(), kept.end(), q.type) == kept.end())
+                    kept.push_back(q.type);
             std::string memory = kept.empty() ? "" : fmt::format("; {}: the kill lists freed in the memory, counted "
                                                                  "when the backend's counts come", names(s, kept));
             return "late kills taken in their place; the dead nobody reads freed onto the free stack" + memory;
@@ -175,6 +181,7 @@ Schedule stepSchedule(const State& s) {
             Phase& emissions = add(PhaseKind::Emissions, type, Parallelism::Ordered);
             emissions.targets = rated;
             emissions.events = info.emitsWhenKilled;
+            emissions.inMemory = info.rowsInMemory;  // Memory::emitAtRate
         }
         if (info.stepLimit > 0) out.phases[group].span = out.phases.size() - group - 1;
         if (info.updateEmits) add(PhaseKind::Create, type, Parallelism::Ordered).targets = targets;

@@ -44,7 +44,7 @@ struct Phase {
     bool listed = false;        // Kills: the update's chunks listed the killed rows (no scan of flags)
     bool exports = false;       // Update: the survivors' exports in the same chunk
     bool render = false;        // Update: the render in the same chunk, when the host draws every step
-    bool inMemory = false;      // Update, Kills: the type's rows are in the memory (Pool::keepRowsInMemory)
+    bool inMemory = false;      // Update, Kills, Emissions: the type's rows are in the memory (Pool::keepRowsInMemory)
     std::vector<int> targets;   // Emissions, Create: the types created
     bool events = false;        // Emissions: bursts on edges and deaths too (ir::EmitSite::whenKilled)
     Parallelism parallelism = Parallelism::Host;

@@ -113,13 +113,14 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     // nobody reads them, every site emits at a rate into a type of its own that keeps its
     // rows in the memory, emits nothing and reads no parent — so a step's emissions are
     // one operation over the rows, and the objects they create batches of those types.
-    // Only where asked (Rows::InMemory) so far: on a device the host still reads the
-    // operation's totals and runs back in the step (docs/gpu.md, "Emitters in the memory").
+    // Only where asked (Rows::InMemory, creating in batches) so far: on a device the host
+    // still reads the operation's records back in the step (docs/gpu.md, "Emitters in the
+    // memory").
     for (size_t t = 0; t < types.size(); ++t) {
         TypeInfo& info = types[t];
         const ir::Object& o = module.objects[t];
-        bool emitter = options.rows == SystemOptions::Rows::InMemory && options.createInBatches && info.updateEmits && !info.kills && !info.unstable && !info.read &&
-                       !info.emitsWhenKilled && keptWhole(info);
+        bool emitter = options.rows == SystemOptions::Rows::InMemory && options.createInBatches && info.updateEmits &&
+                       !info.kills && !info.unstable && !info.read && !info.emitsWhenKilled && keptWhole(info);
         for (size_t s = 0; emitter && s < o.emits.size(); ++s) {
             size_t target = info.emitTarget[s];
             const TypeInfo& to = types[target];

@@ -79,7 +79,9 @@ TEST_CASE("under @step a type's update, kills and emissions repeat per sub-step 
 
 TEST_CASE("the schedule says which types keep their rows in the memory, and where they are freed") {
     // The fountain's drops only die: with their rows in the memory, their kills are listed
-    // there and freed there at the step's end; the fountain itself keeps its rows on the host.
+    // there and freed there at the step's end. The fountain never dies and emits them at
+    // a rate: where rows are kept in the memory wherever they can be, its rows are there
+    // too and its emissions the memory's operation (Memory::emitAtRate).
     std::string text = test::readFile(std::string(PSYS_SAMPLES_DIR) + "/fountain.psys");
     rt::SystemOptions options;
     options.rows = rt::SystemOptions::Rows::InMemory;
@@ -89,13 +91,15 @@ TEST_CASE("the schedule says which types keep their rows in the memory, and wher
     const rt::Schedule& s = kept.schedule();
     REQUIRE(s.inMemory.size() == 2);
     CHECK(s.inMemory[static_cast<size_t>(kept.typeIndex("drop"))]);
-    CHECK_FALSE(s.inMemory[static_cast<size_t>(kept.typeIndex("fountain"))]);
+    CHECK(s.inMemory[static_cast<size_t>(kept.typeIndex("fountain"))]);
     CHECK(kept.pool(static_cast<size_t>(kept.typeIndex("drop"))).rowsInMemory());
     std::string printed = rt::printSchedule(s);
     CHECK(printed.find("its kills listed in the memory") != std::string::npos);
     CHECK(printed.find("drop: the kill lists kept for the step's end, where the memory frees them") != std::string::npos);
     CHECK(printed.find("(drop: rows, ids and creation times by the memory's operations)") != std::string::npos);
     CHECK(printed.find("drop: the kill lists freed in the memory") != std::string::npos);
+    CHECK(printed.find("fountain: the update kernel over the pool, its rows in the memory") != std::string::npos);
+    CHECK(printed.find("fountain: rate emissions (drop) decided by the memory's operation") != std::string::npos);
     CHECK(rt::printSchedule(plain.schedule()).find("memory") == std::string::npos);  // the interpreter's own choice: the host
 }
 
