@@ -28,7 +28,7 @@ namespace {
 // flags, 8 creation times, 16 fresh accumulators; the site from bit 8), the shared rate and count, dt, t1; the
 // rows from meta[3] on in the columns.
 // The rule's operations are `precise` and in the host's order: the same doubles.
-const char* kRows = R"(
+const char* kEmitRows = R"(
 layout(std430, binding = 0) readonly buffer Mask { uint mask[]; };
 layout(std430, binding = 1) readonly buffer Killed { uint killed[]; };
 layout(std430, binding = 2) readonly buffer Created { uint created[]; };
@@ -108,7 +108,7 @@ void main() {
 // adds), then each row's place and kept; then the same over the chunks' kept for the ids.
 // `meta`: rows, sites, next id, the first row, then each site's room. The totals from
 // word rows · sites · 8 of the runs.
-const char* kScan = R"(
+const char* kEmitScan = R"(
 layout(local_size_x = 256) in;
 layout(std430, binding = 0) readonly buffer Meta { uint meta[]; };
 layout(std430, binding = 6) buffer Runs { uint runs[]; };
@@ -187,18 +187,18 @@ void main() {
 }
 )";
 
-std::string shader(const char* body, bool rows) {
+std::string emissionShader(const char* body, bool rows) {
     std::string header = "#version 450\n";
     if (rows) header += "layout(local_size_x = 64) in;\n";
     return header + kParamsBlock + "#define INVOCATION " + kInvocationIndex + "\n" + body;
 }
 
-uint32_t bits(float x) {
+uint32_t floatBits(float x) {
     uint32_t u;
     std::memcpy(&u, &x, 4);
     return u;
 }
-std::pair<uint32_t, uint32_t> words(double x) {
+std::pair<uint32_t, uint32_t> doubleWords(double x) {
     uint32_t w[2];
     std::memcpy(w, &x, 8);
     return {w[0], w[1]};
@@ -216,8 +216,8 @@ void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs) {
     if (n == 0 || (!onDevice(runs) && std::all_of(used.begin(), used.end(), [&](Buffer b) { return allOnHost({b}); })))
         return rt::Memory::emitAtRate(in, runs);
     flushPending();
-    if (!emitRowsProgram_) emitRowsProgram_ = computeProgram(shader(kRows, true), "rate emissions");
-    if (!emitScanProgram_) emitScanProgram_ = computeProgram(shader(kScan, false), "rate emissions' scan");
+    if (!emitRowsProgram_) emitRowsProgram_ = computeProgram(emissionShader(kEmitRows, true), "rate emissions");
+    if (!emitScanProgram_) emitScanProgram_ = computeProgram(emissionShader(kEmitScan, false), "rate emissions' scan");
     PassTimer::Scope timed(timer, "emissions", n * sites);
     unsigned runsGl = bound(runs);
     std::vector<uint32_t> meta = {static_cast<uint32_t>(n), static_cast<uint32_t>(sites), in.nextId,
@@ -227,8 +227,8 @@ void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs) {
     glNamedBufferData(metaBuffer_, static_cast<GLsizeiptr>(meta.size() * 4), meta.data(), GL_STREAM_DRAW);
     afterWrite(Write::Upload, kStorageBlock);
     transferred += meta.size() * 4;
-    auto [dt0, dt1] = words(in.dt);
-    auto [t10, t11] = words(in.t1);
+    auto [dt0, dt1] = doubleWords(in.dt);
+    auto [t10, t11] = doubleWords(in.t1);
     for (size_t k = 0; k < sites; ++k) {
         const rt::RateSites::Site& s = in.sites[k];
         auto or_ = [&](Buffer b) { return b.valid() ? deviceBuffer(b) : runsGl; };  // (a block must be bound)
@@ -242,7 +242,7 @@ void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs) {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, metaBuffer_);
         uint32_t flags = (s.rate.valid() ? 1u : 0u) | (s.count.valid() ? 2u : 0u) | (in.killed.valid() ? 4u : 0u) |
                          (in.created.valid() ? 8u : 0u) | (in.fresh ? 16u : 0u) | static_cast<uint32_t>(k) << 8;
-        bindParams(paramsBuffer_, {static_cast<uint32_t>(n), flags, bits(s.rateValue), bits(s.countValue), dt0, dt1,
+        bindParams(paramsBuffer_, {static_cast<uint32_t>(n), flags, floatBits(s.rateValue), floatBits(s.countValue), dt0, dt1,
                                    t10, t11});
         dispatchRows(emitRowsProgram_, n);
     }
