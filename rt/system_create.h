@@ -145,7 +145,7 @@ private:
     std::vector<Batch> batches_;
     std::vector<Value> yields_;
     std::vector<float> rate_, count_;
-    Scratch emissions_;  // emitInMemory's: a batch's accumulators by site,
+    Scratch emissions_;  // emitInMemory's: a new batch's accumulators by site,
     Scratch runs_;       // and the runs of each call in a drain (runsUsed_ of them so far)
     size_t runsUsed_ = 0;
 };
