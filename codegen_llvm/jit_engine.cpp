@@ -34,6 +34,7 @@
 #include <llvm/Target/TargetMachine.h>
 #include <llvm/TargetParser/Host.h>
 
+#include "codegen_llvm/library_symbols.h"
 #include "codegen_llvm/link_observer.h"
 #include "codegen_llvm/optimize.h"
 #include "codegen_llvm/perf_map.h"
@@ -311,11 +312,11 @@ JitEngine::JitEngine(MathMode mode) : impl_(std::make_unique<Impl>()) {
     // libm's functions come from this process, as the interpreter's do; libmvec's vector
     // functions from glibc's libmvec.
     const char prefix = impl_->jit->getDataLayout().getGlobalPrefix();
-    auto process = llvm::orc::DynamicLibrarySearchGenerator::GetForCurrentProcess(prefix);
+    auto process = librarySymbols(nullptr, prefix);
     if (!process) throw std::runtime_error(llvm::toString(process.takeError()));
     impl_->jit->getMainJITDylib().addGenerator(std::move(*process));
     if (mode == MathMode::Fast) {
-        auto vectorMath = llvm::orc::DynamicLibrarySearchGenerator::Load("libmvec.so.1", prefix);
+        auto vectorMath = librarySymbols("libmvec.so.1", prefix);
         if (!vectorMath) throw std::runtime_error("glibc's vector math library: " + llvm::toString(vectorMath.takeError()));
         impl_->jit->getMainJITDylib().addGenerator(std::move(*vectorMath));
     }

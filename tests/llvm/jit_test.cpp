@@ -14,6 +14,13 @@
 #include <fstream>
 #include <sstream>
 
+#include <cmath>
+
+#include <llvm/ExecutionEngine/Orc/ExecutorProcessControl.h>
+#include <llvm/IR/IRBuilder.h>
+
+#include "codegen_llvm/jit_engine.h"
+#include "codegen_llvm/library_symbols.h"
 #include "codegen_llvm/llvm_backend.h"
 #include "driver/compile.h"
 #include "interp/interpreter.h"
@@ -304,4 +311,56 @@ TEST_CASE("the disk cache keeps at most 4096 objects, dropping the least recentl
 TEST_CASE("the JIT refuses an op it has no code for with the located internal error every backend gives") {
     codegen_llvm::LlvmBackend jit;
     CHECK(test::refusal(jit) == test::expectedRefusal("the LLVM backend"));
+}
+
+// ORC decides what a lookup's generator must define before it takes the generator: two
+// modules linked at once could both ask the process for `sinf`, and the second
+// definition failed the whole batch ("Duplicate definition of symbol 'sinf'").
+TEST_CASE("a library symbol another link defined in the meantime is skipped, the rest defined") {
+    llvm::orc::ExecutionSession session(std::make_unique<llvm::orc::UnsupportedExecutorProcessControl>());
+    llvm::orc::JITDylib& jd = session.createBareJITDylib("main");
+    auto symbol = [](void* address) {
+        return llvm::orc::ExecutorSymbolDef(llvm::orc::ExecutorAddr::fromPtr(address), llvm::JITSymbolFlags::Exported);
+    };
+    auto sinf = session.intern("sinf"), cosf = session.intern("cosf");
+    float (*sine)(float) = ::sinf, (*cosine)(float) = ::cosf;
+    REQUIRE_FALSE(llvm::errorToBool(codegen_llvm::defineMissing(jd, {{sinf, symbol((void*)sine)}})));
+    llvm::orc::SymbolMap both{{sinf, symbol((void*)sine)}, {cosf, symbol((void*)cosine)}};
+    CHECK(llvm::toString(jd.define(llvm::orc::absoluteSymbols(both))).find("Duplicate definition") != std::string::npos);
+    CHECK_FALSE(llvm::errorToBool(codegen_llvm::defineMissing(jd, both)));
+    auto found = session.lookup({&jd}, cosf);
+    REQUIRE(bool(found));
+    CHECK(found->getAddress().toPtr<void*>() == (void*)cosine);
+    CHECK_FALSE(llvm::errorToBool(session.endSession()));
+}
+
+TEST_CASE("kernels linked at once that call the same libm functions all link") {
+    const char* names[] = {"sinf", "cosf", "expf", "logf", "tanf", "sqrtf", "atan2f", "powf"};
+    for (codegen_llvm::MathMode mode : {codegen_llvm::MathMode::Exact, codegen_llvm::MathMode::Fast}) {
+        for (int round = 0; round < 8; ++round) {
+            codegen_llvm::JitEngine jit(mode);
+            std::vector<codegen_llvm::JitEngine::Unit> units;
+            for (int i = 0; i < 12; ++i) {
+                codegen_llvm::JitEngine::Unit unit{jit.newContext(), nullptr, "kernel" + std::to_string(i)};
+                unit.module = jit.newModule(*unit.context);
+                llvm::Type* f32 = llvm::Type::getFloatTy(*unit.context);
+                auto* one = llvm::FunctionType::get(f32, {f32}, false);
+                auto* two = llvm::FunctionType::get(f32, {f32, f32}, false);
+                auto* f = llvm::Function::Create(one, llvm::Function::ExternalLinkage, unit.name, *unit.module);
+                llvm::IRBuilder<> b(llvm::BasicBlock::Create(*unit.context, "entry", f));
+                llvm::Value* x = f->getArg(0);
+                for (int k = 0; k < 8; ++k) {  // each module asks in its own order
+                    std::string name = names[(i + k) % 8];
+                    bool binary = name == "atan2f" || name == "powf";
+                    auto callee = unit.module->getOrInsertFunction(name, binary ? two : one);
+                    x = binary ? b.CreateCall(callee, {x, x}) : b.CreateCall(callee, {x});
+                }
+                b.CreateRet(x);
+                units.push_back(std::move(unit));
+            }
+            std::vector<void*> kernels;
+            CHECK_NOTHROW(kernels = jit.add(std::move(units)));
+            CHECK(kernels.size() == 12);
+        }
+    }
 }
