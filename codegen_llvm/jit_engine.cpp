@@ -322,7 +322,9 @@ JitEngine::JitEngine(MathMode mode) : impl_(std::make_unique<Impl>()) {
     }
 }
 
-JitEngine::~JitEngine() = default;
+// The compile threads may still be optimizing and compiling modules of an `add` that
+// failed, with Impl's members: the JIT goes first (its session's end waits for them).
+JitEngine::~JitEngine() { impl_->jit.reset(); }
 
 std::string JitEngine::cpu() const { return impl_->cpu; }
 
