@@ -155,9 +155,21 @@ private:
     void dispatch(Program& program, const std::vector<uint32_t>& block, size_t count, const std::string& pass,
                   std::span<const BlockFill> fill = {});
     // gpu/glsl_children.cpp: an emitter's block of a children launch, its row's values
-    // filled on the GPU from word `base` of the words (`fill`) where they are there.
+    // filled on the GPU from word `base` of the words (`fill`) where they are there (no
+    // `base`: left out); the values of the block that come from its row, a column each.
+    struct RowField {
+        rt::Buffer column;
+        uint32_t word;  // the block's
+    };
+    static std::vector<RowField> rowFields(const Program& program, const rt::ChildrenLaunch& launch);
     static std::vector<uint32_t> emitterBlock(GlMemory& memory, const Program& program, const rt::ChildrenLaunch& launch,
-                                              uint32_t base, std::vector<BlockFill>& fill);
+                                              std::optional<uint32_t> base, std::vector<BlockFill>& fill);
+    bool blocksOnDevice(const rt::ChildrenLaunch& launch);
+    size_t sendBlocks(const Program& program, std::span<const rt::ChildrenLaunch> launches, size_t firstWord,
+                      size_t recordWords, size_t total, std::optional<size_t> direct);
+    void buildBlocks(const rt::ChildrenLaunch& launch, const std::vector<RowField>& fields, size_t templateAt,
+                     size_t firstWord, size_t recordWords);
+    unsigned blocksProgram_ = 0;
     // gpu/glsl_readback.cpp: what a launch sends back, into a region of one buffer, read
     // at once (one wait) or, for a late launch, when the run-time collects it.
     rt::RowsResult readBack(const rt::RowsLaunch& launch, const Program& program, size_t begin, size_t n,

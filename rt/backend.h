@@ -105,7 +105,19 @@ struct ChildrenLaunch {
     size_t count = 0;
     std::span<const Buffer> args;           // per component of the created type's parameters
     size_t argsFirst = 0;                   // child k's arguments at row argsFirst + k
+    // Or, where `records` is valid, the launches of one site's emitters as a rate emission
+    // left them (Memory::emitAtRate), so that they need not come back to the host:
+    // `recordCount` records from record `record` on, record k emitter row
+    // `rows`[rowsFirst + k] (row k where `rows` is not valid), its children at argsFirst
+    // plus its place (the record's word 0), drawn from its first id (word 2) on; `count`
+    // is then the children of all of them, and `row` and `firstChild` are not used.
+    Buffer records, rows;
+    size_t record = 0, recordCount = 0, rowsFirst = 0;
 };
+
+// A launch from records as one launch an emitter (those with children), read from the
+// memory: how a backend that does not build them where the records are runs them.
+std::vector<ChildrenLaunch> eachEmitter(const Memory& memory, const ChildrenLaunch& launch);
 
 // The folds of one neighbour group over every row of the folding type (rt/neighbours.cpp,
 // docs/language.md "Neighbours"): each fold of the group, for each object in self.mask,
@@ -203,9 +215,8 @@ public:
     // Children launches that may run together, in any order: each writes its own rows of
     // the arguments and reads what none of them writes (a step's emitters of a type, a
     // batch's bursts). A GPU runs a spawn kernel's launches as one dispatch.
-    virtual void runChildren(std::span<const ChildrenLaunch> launches) {
-        for (const ChildrenLaunch& l : launches) run(l);
-    }
+    // The default runs each launch, one an emitter (eachEmitter) where it has records.
+    virtual void runChildren(std::span<const ChildrenLaunch> launches);
     // The counts and kills of a late launch that answered with `ticket` (its killedRows
     // valid until the next launch or collect), once each ticket.
     virtual RowsResult collect(uint64_t ticket) {

@@ -45,12 +45,14 @@ public:
     // The rate emissions of `type`'s rows that the memory decides (TypeInfo::rowsInMemory,
     // Memory::emitAtRate): its pool's after an update (`table` its update table), or a
     // batch's just created (its rows [first, first + n) of `table`, clocked from their
-    // creation, `poolRows` theirs in the pool). `uniforms`: where the update's clock is
-    // uniform, its uniform values (ColumnLayout::sharedEmit); null: the rates and counts
-    // are in the table's columns. What they create is queued as emitInUpdate queues it,
-    // row by row, sites in order: the same ids and rows.
+    // creation, `rows` their rows in the pool, a u32 list in the memory). `uniforms`: where
+    // the update's clock is uniform, its uniform values (ColumnLayout::sharedEmit); null:
+    // the rates and counts are in the table's columns. What they create is queued as
+    // emitInUpdate queues it, row by row, sites in order: the same ids and rows. Only the
+    // totals come back to the host: a site's objects are one run, and its emitters' spawn
+    // launches one launch, both from the records where the memory keeps them.
     void emitInMemory(size_t type, const std::vector<Buffer>& table, const Value* const* uniforms, RateSites sites,
-                      std::span<const uint32_t> poolRows, double t1);
+                      Buffer rows, double t1);
     // A trigger's (or the start's) kernel, evaluated on the host: once for the counts,
     // then once per created object for its arguments, so each draws its own numbers.
     void emitFromKernel(const ir::Trigger& trigger, std::span<const Value> params, uint32_t objectId);
@@ -93,7 +95,8 @@ private:
     size_t stage(size_t type, size_t count);  // staging rows for `count` new objects of `type`
     // The spawn launch for `count` children of `emitter` at `site`, their arguments at
     // staging rows from `base`, the first child's draw `firstChild`.
-    void queueSpawn(const Emitter& emitter, int site, uint32_t firstChild, size_t count, size_t base);
+    // (Null where the site has no spawn kernel: its children take no arguments.)
+    ChildrenLaunch* queueSpawn(const Emitter& emitter, int site, uint32_t firstChild, size_t count, size_t base);
     // Queues `count` objects of `type` (a run, or one run an object where objects are not
     // created in batches).
     void enqueue(const Run& run);

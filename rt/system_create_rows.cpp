@@ -102,9 +102,7 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
             in.sites.emplace_back().accumulated = accumulated;
             columns.push_back({accumulated, pool.emitted[site]});
         }
-        std::vector<uint32_t> poolRows(kept);
-        memory.read(rows, 0, kept, poolRows.data());
-        emitInMemory(type, table, nullptr, std::move(in), poolRows, t1);
+        emitInMemory(type, table, nullptr, std::move(in), rows, t1);
     }
     memory.scatter(columns, first, rows, 0, kept);
     if (!info.late) return;
@@ -115,7 +113,7 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
 }
 
 void Creation::emitInMemory(size_t type, const std::vector<Buffer>& table, const Value* const* uniforms,
-                            RateSites in, std::span<const uint32_t> poolRows, double t1) {
+                            RateSites in, Buffer rows, double t1) {
     const TypeInfo& info = s_.types[type];
     const ColumnLayout& layout = info.updateLayout;
     const size_t n = in.rows, sites = in.sites.size();
@@ -141,35 +139,31 @@ void Creation::emitInMemory(size_t type, const std::vector<Buffer>& table, const
     }
     in.t1 = t1;
     in.nextId = s_.nextId;
-    // One read brings back the runs and, after them, the totals.
+    // The records stay where they are; only the totals come back.
     // (The queue refers to them until it is drained: a buffer a call.)
     Buffer runs = runs_.at(runsUsed_++, Elem::U32, runsWords(n, sites));
     s_.memory.emitAtRate(in, runs);
-    std::vector<uint32_t> records(runsWords(n, sites));
-    s_.memory.read(runs, 0, records.size(), records.data());
-    const uint32_t* total = records.data() + runsTotalsAt(n, sites);
+    std::vector<uint32_t> total(runsWords(n, sites) - runsTotalsAt(n, sites));
+    s_.memory.read(runs, runsTotalsAt(n, sites), total.size(), total.data());
     s_.stats.invalidEmissions += total[kTotalsInvalid];
     s_.stats.clampedEmissions += total[kTotalsClamped];
-    std::vector<size_t> base(sites, 0);
+    // Each site's objects one run, and its emitters' spawn launches one launch from the
+    // records (ChildrenLaunch::records): ids, times, places and emitter rows where the
+    // records are.
     for (size_t site = 0; site < sites; ++site) {
-        const uint32_t* t = total + kTotalsSites + kTotalsPerSite * site;
+        const uint32_t* t = total.data() + kTotalsSites + kTotalsPerSite * site;
         uint64_t asked = t[1] | uint64_t{t[2]} << 32;
         size_t target = info.emitTarget[site];
         addSaturating(s_.typeStats[target].dropped, asked - t[0]);
-        if (t[0]) base[site] = stage(target, t[0]);
-    }
-    // Each emitter's spawn launches, row by row and sites in order, as emitInUpdate queues
-    // them; each site's objects one run, its ids and times where the records are.
-    for (size_t r = 0; r < n; ++r)
-        for (size_t site = 0; site < sites; ++site) {
-            const uint32_t* w = records.data() + (site * n + r) * kRunWords;
-            if (w[1] == 0) continue;
-            uint32_t row = poolRows.empty() ? static_cast<uint32_t>(r) : poolRows[r];
-            queueSpawn({type, row, {}, row, t1, false}, static_cast<int>(site), w[2], w[1], base[site] + w[0]);
+        if (t[0] == 0) continue;
+        size_t base = stage(target, t[0]);
+        if (ChildrenLaunch* launch = queueSpawn({type, 0, {}, 0, t1, false}, static_cast<int>(site), 0, t[0], base)) {
+            launch->records = runs;
+            launch->record = site * n;
+            launch->recordCount = n;
+            launch->rows = rows;
         }
-    for (size_t site = 0; site < sites; ++site) {
-        uint32_t kept = total[kTotalsSites + kTotalsPerSite * site];
-        if (kept) enqueue({info.emitTarget[site], base[site], kept, {}, 0, 0, 1, 0, runs, site * n, n});
+        enqueue({target, base, t[0], {}, 0, 0, 1, 0, runs, site * n, n});
     }
     s_.nextId += total[kTotalsIds];
 }

@@ -38,10 +38,10 @@ void Creation::queueChildren(const Emitter& e, int site, uint64_t count, uint64_
     s_.nextId += static_cast<uint32_t>(kept);
 }
 
-void Creation::queueSpawn(const Emitter& e, int site, uint32_t firstChild, size_t count, size_t base) {
+ChildrenLaunch* Creation::queueSpawn(const Emitter& e, int site, uint32_t firstChild, size_t count, size_t base) {
     const TypeInfo& info = s_.types[e.type];
     const ir::Kernel* spawn = info.spawn[static_cast<size_t>(site)];
-    if (!spawn) return;
+    if (!spawn) return nullptr;
     size_t target = info.emitTarget[static_cast<size_t>(site)];
     const ColumnLayout& layout = info.spawnLayout[static_cast<size_t>(site)];
     Spawn& queued = spawns_.emplace_back();
@@ -63,6 +63,7 @@ void Creation::queueSpawn(const Emitter& e, int site, uint32_t firstChild, size_
     launch.count = count;
     launch.args = staging_[target].args;
     launch.argsFirst = base;
+    return &launch;
 }
 
 void Creation::enqueue(const Run& run) {

@@ -111,10 +111,11 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     }
     // Emitters whose emissions the memory decides (Memory::emitAtRate): they never die,
     // nobody reads them, every site emits at a rate into a type of its own that keeps its
-    // rows in the memory, emits nothing and reads no parent — so a step's emissions are
+    // rows in the memory, emits nothing and reads no parent, and whose arguments read no
+    // fold (a spawn launch from records has no parent values) — so a step's emissions are
     // one operation over the rows, and the objects they create batches of those types.
     // Only where asked (Rows::InMemory, creating in batches) so far: on a device the host
-    // still reads the operation's records back in the step (docs/gpu.md, "Emitters in the
+    // still reads the operation's totals back in the step (docs/gpu.md, "Emitters in the
     // memory").
     for (size_t t = 0; t < types.size(); ++t) {
         TypeInfo& info = types[t];
@@ -125,7 +126,8 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
             size_t target = info.emitTarget[s];
             const TypeInfo& to = types[target];
             emitter = o.emits[s].rate() && to.rowsInMemory && module.objects[target].emits.empty() &&
-                      std::count(info.emitTarget.begin(), info.emitTarget.end(), target) == 1;
+                      std::count(info.emitTarget.begin(), info.emitTarget.end(), target) == 1 &&
+                      info.spawnLayout[s].parentColumns.empty();
         }
         info.rowsInMemory = info.rowsInMemory || emitter;
     }

@@ -280,3 +280,38 @@ TEST_CASE("emitters whose emissions the GPU decides: the interpreter's objects, 
         }
     }
 }
+
+TEST_CASE("emitters the GPU decides: a step moves and waits as much for 2,000 of them as for 20") {
+    // Their spawn launches are one launch a site from the records (rt::ChildrenLaunch::
+    // records), the emitters' blocks built on the GPU: only the totals come back, and
+    // the host sends a template, not a block an emitter.
+    struct Step {
+        uint64_t bytes, waits, dispatches;
+    };
+    auto perStep = [](int emitters) {
+        std::string text = R"(
+            object p(k: float) { point(vec3(k, age, 0), white, 1); kill when age > 0.3; }
+            object e(r: float) { emit p(rand() + r) at 20 + r per second count 1 + fract(age); }
+            trigger many(n: float) { emit e(rand() * 10) count n; })";
+        rt::SystemOptions kept;
+        kept.rows = rt::SystemOptions::Rows::InMemory;
+        auto gpu = gpuBackend();
+        rt::System system(test::compileModule(text), *gpu, kept);
+        REQUIRE(system.pool(static_cast<size_t>(system.typeIndex("e"))).rowsInMemory());
+        float n = static_cast<float>(emitters);
+        REQUIRE_FALSE(system.fire("many", {&n, 1}));
+        for (int f = 0; f < 40; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
+        Step before{gpu->transferredBytes(), gpu->waits(), gpu->dispatches()};
+        for (int f = 0; f < 10; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
+        CHECK(system.stats().types.at(static_cast<size_t>(system.typeIndex("p"))).live > static_cast<size_t>(emitters));
+        return Step{(gpu->transferredBytes() - before.bytes) / 10, (gpu->waits() - before.waits) / 10,
+                    (gpu->dispatches() - before.dispatches) / 10};
+    };
+    Step few = perStep(20), many = perStep(2000);
+    INFO("bytes " << few.bytes << " → " << many.bytes << ", waits " << few.waits << " → " << many.waits
+                  << ", dispatches " << few.dispatches << " → " << many.dispatches);
+    MESSAGE("bytes " << few.bytes << " → " << many.bytes << ", waits " << few.waits << " → " << many.waits << ", dispatches " << few.dispatches << " → " << many.dispatches);
+    CHECK(many.waits == few.waits);
+    CHECK(many.dispatches == few.dispatches);
+    CHECK(many.bytes == few.bytes);
+}

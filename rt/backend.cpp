@@ -1,0 +1,39 @@
+// The parts of the backend contract (rt/backend.h) every backend shares.
+#include "rt/backend.h"
+
+namespace psys::rt {
+
+std::vector<ChildrenLaunch> eachEmitter(const Memory& memory, const ChildrenLaunch& launch) {
+    std::vector<uint32_t> records(launch.recordCount * kRunWords), rows;
+    if (records.empty()) return {};
+    memory.read(launch.records, launch.record * kRunWords, records.size(), records.data());
+    if (launch.rows.valid()) {
+        rows.resize(launch.recordCount);
+        memory.read(launch.rows, launch.rowsFirst, rows.size(), rows.data());
+    }
+    std::vector<ChildrenLaunch> each;
+    for (size_t k = 0; k < launch.recordCount; ++k) {
+        const uint32_t* w = records.data() + k * kRunWords;
+        if (w[1] == 0) continue;
+        ChildrenLaunch& one = each.emplace_back(launch);
+        one.records = one.rows = {};
+        one.record = one.recordCount = one.rowsFirst = 0;
+        one.row = rows.empty() ? static_cast<uint32_t>(k) : rows[k];
+        one.firstChild = w[2];
+        one.count = w[1];
+        one.argsFirst = launch.argsFirst + w[0];
+    }
+    return each;
+}
+
+void Backend::runChildren(std::span<const ChildrenLaunch> launches) {
+    for (const ChildrenLaunch& l : launches) {
+        if (!l.records.valid()) {
+            run(l);
+            continue;
+        }
+        for (const ChildrenLaunch& one : eachEmitter(memory(), l)) run(one);
+    }
+}
+
+}  // namespace psys::rt
