@@ -245,26 +245,35 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
     struct Slot {
         Buffer buffer;
         size_t word;
+        bool carried;  // its rows' values go in (else the shader only writes them)
     };
     std::vector<Slot> slots;
     std::vector<uint32_t> block = blockHeader(p.block, n, launch.clock, launch.seed, launch.draw);
     size_t words = n;  // the zeros first
     bool zeros = false;  // some column reads them (else they are not written: n words a launch)
-    auto place = [&](Buffer b) -> size_t {
+    auto place = [&](Buffer b, bool carried = true) -> size_t {
         if (!b.valid()) {
             zeros = true;
             return 0;
         }
-        for (const Slot& s : slots)
-            if (s.buffer == b) return s.word;
-        slots.push_back({b, words});
+        for (Slot& s : slots)
+            if (s.buffer == b) {
+                s.carried = s.carried || carried;
+                return s.word;
+            }
+        slots.push_back({b, words, carried});
         words += n * GlMemory::wordsPerRow(memory_.elem(b));
         return slots.back().word;
     };
+    // An emission column's rows are written for every row the launch updates, and no one
+    // reads the others (the host's emissions and Memory::emitAtRate take the mask's rows):
+    // its values need not go in.
+    auto writtenOnly = [&](int c) { return c >= p.layout.emits && c < p.layout.render; };
     const std::vector<bool>& direct = p.inPlace;
     for (int c = 0; c < p.layout.total; ++c)
         if (p.needed[static_cast<size_t>(c)] && !direct[static_cast<size_t>(c)])
-            block[LaunchBlock::kColumns + static_cast<size_t>(c)] = static_cast<uint32_t>(place(launch.columns[static_cast<size_t>(c)]));
+            block[LaunchBlock::kColumns + static_cast<size_t>(c)] =
+                static_cast<uint32_t>(place(launch.columns[static_cast<size_t>(c)], !writtenOnly(c)));
     // The kill flags: written for every row, carried only from the GPU.
     Buffer killBuffer = launch.columns[ColumnLayout::kKill];
     bool kills = std::find(p.returned.begin(), p.returned.end(), ColumnLayout::kKill) != p.returned.end();
@@ -285,6 +294,7 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
         afterWrite(Write::Clear, kStorageBlock);
     }
     for (const Slot& s : slots) {
+        if (!s.carried) continue;
         Elem e = memory_.elem(s.buffer);
         size_t w = GlMemory::wordsPerRow(e);
         if (memory_.onDevice(s.buffer)) {
