@@ -79,7 +79,8 @@ std::string describe(const Schedule& s, const Phase& p) {
         case PhaseKind::Emissions: {
             if (p.inMemory)
                 return fmt::format("{}: rate emissions ({}) decided by the memory's operation over the rows — events, "
-                                   "times, the cut at room, ids — then the queue",
+                                   "times, the cut at room, ids; only its totals to the host — then the queue: each "
+                                   "site's objects one run, its spawn launches one launch, from the records",
                                    type, names(s, p.targets));
             return fmt::format("{}: {} ({}): events, times, ids, the queue", type,
                                p.events ? "rate emissions of the survivors, bursts on edges and deaths" : "rate emissions of the survivors",

@@ -100,6 +100,7 @@ TEST_CASE("the schedule says which types keep their rows in the memory, and wher
     CHECK(printed.find("drop: the kill lists freed in the memory") != std::string::npos);
     CHECK(printed.find("fountain: the update kernel over the pool, its rows in the memory") != std::string::npos);
     CHECK(printed.find("fountain: rate emissions (drop) decided by the memory's operation") != std::string::npos);
+    CHECK(printed.find("its spawn launches one launch, from the records") != std::string::npos);
     CHECK(rt::printSchedule(plain.schedule()).find("memory") == std::string::npos);  // the interpreter's own choice: the host
 }
 
