@@ -334,30 +334,39 @@ TEST_CASE("a library symbol another link defined in the meantime is skipped, the
     CHECK_FALSE(llvm::errorToBool(session.endSession()));
 }
 
+namespace {
+
+// A unit whose function `name` (float → float) is what `body` builds from its argument.
+using Body = std::function<llvm::Value*(llvm::IRBuilder<>&, llvm::Module&, llvm::Value*)>;
+codegen_llvm::JitEngine::Unit floatKernel(const codegen_llvm::JitEngine& jit, const std::string& name, const Body& body) {
+    codegen_llvm::JitEngine::Unit unit{jit.newContext(), nullptr, name};
+    unit.module = jit.newModule(*unit.context);
+    llvm::Type* f32 = llvm::Type::getFloatTy(*unit.context);
+    auto* f = llvm::Function::Create(llvm::FunctionType::get(f32, {f32}, false), llvm::Function::ExternalLinkage, name,
+                                     *unit.module);
+    llvm::IRBuilder<> b(llvm::BasicBlock::Create(*unit.context, "entry", f));
+    b.CreateRet(body(b, *unit.module, f->getArg(0)));
+    return unit;
+}
+
+}  // namespace
+
 // Some kernels of an add are still compiling when another fails to link: the engine that
 // threw must wait for them when it goes (ASan saw them use it after it had gone).
 TEST_CASE("a kernel that cannot link fails its add with LLVM's error, and the engine goes cleanly") {
     for (int round = 0; round < 4; ++round) {
         codegen_llvm::JitEngine jit(codegen_llvm::MathMode::Exact);
         std::vector<codegen_llvm::JitEngine::Unit> units;
-        for (int i = 0; i < 8; ++i) {
-            codegen_llvm::JitEngine::Unit unit{jit.newContext(), nullptr, "kernel" + std::to_string(i)};
-            unit.module = jit.newModule(*unit.context);
-            llvm::Type* f32 = llvm::Type::getFloatTy(*unit.context);
-            auto* one = llvm::FunctionType::get(f32, {f32}, false);
-            auto* f = llvm::Function::Create(one, llvm::Function::ExternalLinkage, unit.name, *unit.module);
-            llvm::IRBuilder<> b(llvm::BasicBlock::Create(*unit.context, "entry", f));
-            llvm::Value* x = f->getArg(0);
-            if (i == 0) {  // quick to compile, and fails
-                x = b.CreateCall(unit.module->getOrInsertFunction("psys_no_such_function", one), {x});
-            } else {  // the others still compiling then
-                llvm::Value* a = x;
+        for (int i = 0; i < 8; ++i)
+            units.push_back(floatKernel(jit, "kernel" + std::to_string(i), [&](auto& b, llvm::Module& m, llvm::Value* x) {
+                llvm::Type* f32 = x->getType();
+                if (i == 0)  // quick to compile, and fails
+                    return static_cast<llvm::Value*>(b.CreateCall(
+                        m.getOrInsertFunction("psys_no_such_function", llvm::FunctionType::get(f32, {f32}, false)), {x}));
+                llvm::Value* a = x;  // the others still compiling then
                 for (int k = 0; k < 4000; ++k) a = b.CreateFAdd(b.CreateFMul(a, x), llvm::ConstantFP::get(f32, k));
-                x = a;
-            }
-            b.CreateRet(x);
-            units.push_back(std::move(unit));
-        }
+                return a;
+            }));
         std::string error;
         try {
             jit.add(std::move(units));
@@ -374,24 +383,19 @@ TEST_CASE("kernels linked at once that call the same libm functions all link") {
         for (int round = 0; round < 8; ++round) {
             codegen_llvm::JitEngine jit(mode);
             std::vector<codegen_llvm::JitEngine::Unit> units;
-            for (int i = 0; i < 12; ++i) {
-                codegen_llvm::JitEngine::Unit unit{jit.newContext(), nullptr, "kernel" + std::to_string(i)};
-                unit.module = jit.newModule(*unit.context);
-                llvm::Type* f32 = llvm::Type::getFloatTy(*unit.context);
-                auto* one = llvm::FunctionType::get(f32, {f32}, false);
-                auto* two = llvm::FunctionType::get(f32, {f32, f32}, false);
-                auto* f = llvm::Function::Create(one, llvm::Function::ExternalLinkage, unit.name, *unit.module);
-                llvm::IRBuilder<> b(llvm::BasicBlock::Create(*unit.context, "entry", f));
-                llvm::Value* x = f->getArg(0);
-                for (int k = 0; k < 8; ++k) {  // each module asks in its own order
-                    std::string name = names[(i + k) % 8];
-                    bool binary = name == "atan2f" || name == "powf";
-                    auto callee = unit.module->getOrInsertFunction(name, binary ? two : one);
-                    x = binary ? b.CreateCall(callee, {x, x}) : b.CreateCall(callee, {x});
-                }
-                b.CreateRet(x);
-                units.push_back(std::move(unit));
-            }
+            for (int i = 0; i < 12; ++i)
+                units.push_back(floatKernel(jit, "kernel" + std::to_string(i), [&](auto& b, llvm::Module& m, llvm::Value* x) {
+                    llvm::Type* f32 = x->getType();
+                    auto* one = llvm::FunctionType::get(f32, {f32}, false);
+                    auto* two = llvm::FunctionType::get(f32, {f32, f32}, false);
+                    for (int k = 0; k < 8; ++k) {  // each module asks in its own order
+                        std::string name = names[(i + k) % 8];
+                        bool binary = name == "atan2f" || name == "powf";
+                        auto callee = m.getOrInsertFunction(name, binary ? two : one);
+                        x = binary ? b.CreateCall(callee, {x, x}) : b.CreateCall(callee, {x});
+                    }
+                    return x;
+                }));
             std::vector<void*> kernels;
             CHECK_NOTHROW(kernels = jit.add(std::move(units)));
             CHECK(kernels.size() == 12);
