@@ -135,6 +135,10 @@ void addRunOptions(CLI::App& run, psys::tools::RunOptions& o) {
         ->check(CLI::IsMember({"fast", "exact"}));
     run.add_option("--threads", o.threads, "Threads for pool updates: 0 for every core (0)")
         ->check(CLI::Range(0u, psys::rt::SystemOptions::kMostThreads));
+    run.add_option("--rows", o.rows,
+                   "Where pools keep their rows: backend (as the backend keeps them, the default), memory (every "
+                   "type that can, emitters whose rate emissions the memory decides among them) or host")
+        ->check(CLI::IsMember({"backend", "memory", "host"}));
     run.add_flag("--timing", o.timing, "Print compile time and the time spent stepping and drawing");
     run.add_flag("--print-schedule", o.printSchedule, "Print the phases a step runs, in order, and run no frame");
     run.add_flag("--remarks", o.remarks, "llvm backend: print whether each update loop vectorized, and the library functions compiled code calls");

@@ -165,6 +165,8 @@ int runSystem(const RunOptions& options) {
     session.system.seed = options.seed;
     session.system.capacity = options.capacity;
     session.system.threads = options.threads;
+    using Rows = rt::SystemOptions::Rows;
+    session.system.rows = options.rows == "memory" ? Rows::InMemory : options.rows == "host" ? Rows::OnHost : Rows::AsBackend;
     session.reloadable = false;  // a run never reloads
     host::CompileResult compiled;
     std::string error;

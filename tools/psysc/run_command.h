@@ -29,6 +29,7 @@ struct RunOptions {
     std::string backend = "llvm";    // host/backends.h
     std::string math = "fast";       // or "exact" (llvm)
     unsigned threads = 0;            // 0: every core
+    std::string rows = "backend";    // rt::SystemOptions::Rows: backend, memory or host
     bool timing = false;
     bool remarks = false;
     bool printSchedule = false;
