@@ -1,0 +1,86 @@
+// The parts of the backend contract every backend shares (rt/backend.h, rt/memory.h):
+// the host memory's gather, and a children launch from records run as one launch an
+// emitter.
+#include <doctest/doctest.h>
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "rt/backend.h"
+#include "rt/memory.h"
+
+using namespace psys;
+
+TEST_CASE("a gather reads the rows it names, 0 for a skipped row — past the end is an error") {
+    rt::HostMemory memory;
+    rt::Buffer from = memory.create(rt::Elem::F32, 4), to = memory.create(rt::Elem::F32, 5);
+    std::vector<float> values = {10, 11, 12, 13}, filled(5, -1);
+    memory.write(from, 0, 4, values.data());
+    memory.write(to, 0, 5, filled.data());
+    std::vector<uint32_t> rows = {3, rt::kSkipRow, 1};
+    memory.gather(from, to, 1, rows);
+    const float* out = rt::viewData<float>(memory, to);
+    CHECK(std::vector<float>(out, out + 5) == std::vector<float>{-1, 13, 0, 11, -1});
+    std::vector<uint32_t> past = {4};
+    CHECK_THROWS_AS(memory.gather(from, to, 0, past), std::out_of_range);
+    CHECK_THROWS_AS(memory.gather(from, to, 3, rows), std::out_of_range);
+}
+
+namespace {
+
+// Records the children launches the default runChildren runs.
+struct ChildrenSeen : rt::Backend {
+    rt::HostMemory host;
+    std::vector<rt::ChildrenLaunch> seen;
+    std::string name() const override { return "children seen"; }
+    rt::Memory& memory() override { return host; }
+    rt::RowsResult run(const rt::RowsLaunch&) override { return {}; }
+    void run(const rt::ChildrenLaunch& l) override { seen.push_back(l); }
+};
+
+}  // namespace
+
+TEST_CASE("a launch from records runs as one launch an emitter with children: its row, place and first id") {
+    ChildrenSeen backend;
+    rt::Memory& memory = backend.memory();
+    // Records 1 to 3 of a runs buffer (the first is another site's): place, count, id, …
+    std::vector<uint32_t> words(4 * rt::kRunWords, 0);
+    auto record = [&](size_t r, uint32_t place, uint32_t count, uint32_t id) {
+        words[r * rt::kRunWords] = place;
+        words[r * rt::kRunWords + 1] = count;
+        words[r * rt::kRunWords + 2] = id;
+    };
+    record(0, 0, 50, 1);
+    record(1, 0, 2, 7);
+    record(2, 2, 0, 9);
+    record(3, 2, 3, 9);
+    rt::Buffer runs = memory.create(rt::Elem::U32, words.size()), rows = memory.create(rt::Elem::U32, 4);
+    memory.write(runs, 0, words.size(), words.data());
+    std::vector<uint32_t> rowList = {99, 5, 8, 11};
+    memory.write(rows, 0, 4, rowList.data());
+    rt::ChildrenLaunch launch;
+    launch.count = 5;
+    launch.argsFirst = 40;
+    launch.records = runs;
+    launch.record = 1;
+    launch.recordCount = 3;
+    launch.rows = rows;
+    launch.rowsFirst = 1;
+    std::vector<rt::ChildrenLaunch> all = {launch};
+    launch.records = {};  // an ordinary launch beside it runs as it is
+    launch.row = 3;
+    all.push_back(launch);
+    backend.runChildren(all);
+    REQUIRE(backend.seen.size() == 3);
+    auto& s = backend.seen;
+    CHECK((s[0].row == 5 && s[0].count == 2 && s[0].argsFirst == 40 && s[0].firstChild == 7));
+    CHECK((s[1].row == 11 && s[1].count == 3 && s[1].argsFirst == 42 && s[1].firstChild == 9));
+    CHECK_FALSE(s[0].records.valid());
+    CHECK((s[2].row == 3 && s[2].count == 5));
+    // Without a row list, record k is row k.
+    all[0].rows = {};
+    std::vector<rt::ChildrenLaunch> each = rt::eachEmitter(memory, all[0]);
+    REQUIRE(each.size() == 2);
+    CHECK((each[0].row == 0 && each[1].row == 2));
+}
