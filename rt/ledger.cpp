@@ -108,6 +108,8 @@ void Ledger::releaseInMemory(LateKills& l) {
         pool.recycle(part.killList);
         part.killList = {};
     }
+    if (l.map.valid()) pool.recycle(l.map);  // (its batch's rows: Pool::holdRows)
+    l.map = {};
 }
 
 void Ledger::countInMemory(LateKills& l) {

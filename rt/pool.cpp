@@ -269,6 +269,14 @@ void Pool::released(size_t count) {
 
 void Pool::createdRows(Buffer rows, size_t count) { freshRows_.push_back({rows, count}); }
 
+void Pool::recycle(Buffer b) {
+    if (auto it = std::find(held_.begin(), held_.end(), b); it != held_.end()) {
+        held_.erase(it);
+        return;
+    }
+    spare_.push_back(b);
+}
+
 // The smallest spare buffer that holds `n` rows, else the largest, grown: a step's kill
 // list of the whole pool and a batch's few rows do not trade buffers, so that none grows
 // step after step.

@@ -142,7 +142,12 @@ public:
     // A u32 buffer of at least `n` rows the pool keeps for a step's lists of rows (a batch's
     // rows, a launch's kills), and back to it once used.
     Buffer scratchRows(size_t n);
-    void recycle(Buffer b) { spare_.push_back(b); }
+    // One holder fewer of a scratch buffer: back to the spare ones once none holds it.
+    void recycle(Buffer b);
+    // A second holder of a batch's rows (createdRows): its late kills, freed through them
+    // at a step's end — for a trigger's batch, the next step's, after that step's start has
+    // marked the rows fresh and let them go.
+    void holdRows(Buffer rows) { held_.push_back(rows); }
 
     // Columns in the backend's memory.
     Buffer created, ids;             // f64, u32
@@ -216,6 +221,7 @@ private:
     };
     std::vector<FreshRows> freshRows_;
     std::vector<Buffer> spare_;
+    std::vector<Buffer> held_;  // (holdRows: one entry a second holder)
     uint64_t version_ = 0;
     mutable uint64_t fetched_ = 0;
     mutable std::vector<uint8_t> mask_;

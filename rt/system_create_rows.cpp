@@ -75,7 +75,10 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
                        {Clock::Source::PerRow, Clock::Source::Uniform, 0, 0, true}, nullptr);
     }
     LateKills late;
-    late.map = rows;
+    if (info.late) {
+        late.map = rows;  // (released through it at a step's end: Ledger::releaseInMemory)
+        pool.holdRows(rows);
+    }
     const Clock toEnd{Clock::Source::Uniform, Clock::Source::SinceCreated, t1, 0, false};
     launchInMemory(type, b, n, *info.update, info.updateLayout, table, toEnd, info.late ? &late : nullptr);
     columns.clear();
