@@ -180,9 +180,11 @@ rt::RowsResult GlslBackend::run(const rt::RowsLaunch& launch) {
     }
     size_t rows = std::min(maxWords_ / perRow, (maxWords_ - storageAlignment_ / 4) / 2);
     rows = std::clamp<size_t>(std::min(rows, dispatchRows_), 1, size_t{codegen_glsl::kMaxGroupsX} * kCompactGroup);
-    // Late: only the counts and kills come back, so they can wait for the run-time.
+    // Late: only the counts and kills come back (emission columns that stay in the memory
+    // do not: RowsLaunch::emissionsStay), so they can wait for the run-time.
+    auto comesBack = [&](int c) { return c != ColumnLayout::kKill && !launch.emissionsStay; };
     std::unique_ptr<Late> late;
-    if (launch.late && p.counts && std::all_of(p.returned.begin(), p.returned.end(), [](int c) { return c == ColumnLayout::kKill; }))
+    if (launch.late && p.counts && std::none_of(p.returned.begin(), p.returned.end(), comesBack))
         late = std::make_unique<Late>();
     if (late) {  // room for every dispatch's counts and kills, so that no region moves while it is issued
         size_t dispatches = (launch.end - launch.begin + rows - 1) / rows;

@@ -65,6 +65,8 @@ rt::RowsResult GlslBackend::readBack(const rt::RowsLaunch& launch, const Program
         if (!b.valid()) continue;
         if (c == ColumnLayout::kKill) {
             kills = true;
+            if (launch.emissionsStay)  // (the memory's emission reads them: a row killed emits nothing)
+                memory_.adopt(b, begin, n, words_, block[LaunchBlock::kColumns + static_cast<size_t>(c)]);
             continue;
         }
         // A rate or count every row shares: the run-time has it (ColumnLayout::sharedEmit).

@@ -60,7 +60,8 @@ struct RowsLaunch {
     // it is given.
     Buffer killList;
     // The update of a type whose emissions the memory decides (Memory::emitAtRate): its
-    // emission columns stay in the memory (a device does not send them back).
+    // emission columns and its kill flags (what the decision reads) stay in the memory —
+    // a device does not send them back, and keeps the flags there besides any kill list.
     bool emissionsStay = false;
 };
 

@@ -98,6 +98,7 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
         in.rows = n;
         in.first = first;
         in.mask = mask;
+        if (info.kills) in.killed = table[ColumnLayout::kKill];
         in.created = table[ColumnLayout::kCreated];
         in.fresh = true;
         for (size_t site = 0; site < o.emits.size(); ++site) {

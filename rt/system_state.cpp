@@ -109,19 +109,24 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         bool silent = !info.kills && !info.unstable && !info.updateEmits && !info.read;
         info.rowsInMemory = inMemory && (info.late || silent) && keptWhole(info);
     }
-    // Emitters whose emissions the memory decides (Memory::emitAtRate): they never die,
-    // nobody reads them, every site emits at a rate into a type of its own that keeps its
-    // rows in the memory, emits nothing and reads no parent, and whose arguments read no
-    // fold (a spawn launch from records has no parent values) — so a step's emissions are
-    // one operation over the rows, and the objects they create batches of those types.
+    // Emitters whose emissions the memory decides (Memory::emitAtRate): nobody reads them,
+    // every site emits at a rate into a type of its own that keeps its rows in the memory,
+    // emits nothing and reads no parent, and whose arguments read no fold (a spawn launch
+    // from records has no parent values) — so a step's emissions are one operation over
+    // the rows, and the objects they create batches of those types. One that dies bursts
+    // nothing on death and exports nothing: the operation reads its update's kill flags
+    // where they are (a row killed emits nothing), and its kills are late, as a type's
+    // that only dies — nobody else looks at them before the step's end.
     // Only where asked (Rows::InMemory, creating in batches) so far: on a device the host
     // still reads the operation's totals back in the step (docs/gpu.md, "Emitters in the
     // memory").
     for (size_t t = 0; t < types.size(); ++t) {
         TypeInfo& info = types[t];
         const ir::Object& o = module.objects[t];
+        bool dies = info.kills || info.unstable;
         bool emitter = options.rows == SystemOptions::Rows::InMemory && options.createInBatches && info.updateEmits &&
-                       !info.kills && !info.unstable && !info.read && !info.emitsWhenKilled && keptWhole(info);
+                       (!dies || (options.lateKills && !info.exports)) && !info.read && !info.emitsWhenKilled &&
+                       keptWhole(info);
         for (size_t s = 0; emitter && s < o.emits.size(); ++s) {
             size_t target = info.emitTarget[s];
             const TypeInfo& to = types[target];
@@ -130,6 +135,7 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
                       info.spawnLayout[s].parentColumns.empty();
         }
         info.rowsInMemory = info.rowsInMemory || emitter;
+        info.late = info.late || (emitter && dies);
     }
     for (size_t t = 0; t < types.size(); ++t)
         if (types[t].rowsInMemory) pools[t].keepRowsInMemory();

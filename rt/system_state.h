@@ -53,8 +53,9 @@ struct TypeInfo {
     bool read = false;                 // a type's objects read this type's live (its parent type)
     bool unstable = false;             // its update counts updates beyond the stability limit
     // What its updates give back — kills, the unstable count — may be taken at the end of
-    // the step (LateKills): it emits nothing at a rate, has no exports and nothing reads
-    // it, so no one looks at its dead before then.
+    // the step (LateKills): it emits nothing at a rate (or what it emits the memory
+    // decides, reading its kill flags there: rowsInMemory), has no exports and nothing
+    // reads it, so no one looks at its dead before then.
     bool late = false;
     // Its pool keeps its rows in the memory (Pool::keepRowsInMemory): a type with no
     // parent, no bursts and no sub-steps whose kills are late, or that never dies — and

@@ -30,6 +30,7 @@ void runEmissions(State& s, Creation& creation, size_t type, double dt, double t
         RateSites in;
         in.rows = pool.rows();
         in.mask = pool.updatable.column;
+        if (info.kills) in.killed = work.updateTable[ColumnLayout::kKill];  // (in the memory: RowsLaunch::emissionsStay)
         in.dt = dt;
         for (Buffer accumulated : pool.emitted) in.sites.emplace_back().accumulated = accumulated;
         creation.emitInMemory(type, work.updateTable, &uniforms, std::move(in), {}, t1);
@@ -163,7 +164,8 @@ void runUpdate(State& s, const Phase& phase, double dt, double t1, bool last) {
         exports.mask = exportMask;
         exports.uniforms = s.uniforms(type, *info.exports, static_cast<float>(dt), static_cast<float>(t1));
     }
-    const auto* kill = s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]);
+    // (Where the rows are in the memory the flags stay there: nothing here reads them.)
+    const uint8_t* kill = phase.inMemory ? nullptr : s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]);
     // Objects that only die (no rate emits) are found while their chunk is in cache
     // (Phase::listed); late, a device need not wait for them.
     const bool listKills = phase.listed;

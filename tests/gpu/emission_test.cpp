@@ -12,6 +12,8 @@
 #include <random>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "gpu_support.h"
 #include "rt/emission.h"
 #include "rt/memory.h"
@@ -244,7 +246,8 @@ TEST_CASE("emitters whose emissions the GPU decides: the interpreter's objects, 
     // dies and emits at a rate into types that keep their rows there keeps its rows on the
     // GPU too, and its emissions are Memory::emitAtRate's dispatches: rates shared and per
     // row, counts per row, invalid rates (counted), a target at capacity (drops), emitters
-    // created in the step by a trigger (their first update's emissions), two sites.
+    // created in the step by a trigger (their first update's emissions), two sites;
+    // emitters that die (some in their first update), their kills late, read where they are.
     std::vector<std::string> programs;
     for (const char* sample : {"fountain", "emitter", "two_streams", "tornado"}) programs.push_back(test::readFile(test::sample(sample)));
     programs.push_back(R"(
@@ -259,6 +262,15 @@ TEST_CASE("emitters whose emissions the GPU decides: the interpreter's objects, 
         spawn e(0.25);
         spawn e(45);
         trigger more { emit e(rand() * 200) count 3; })");
+    programs.push_back(R"(
+        @capacity(400) object p(k: float) { point(vec3(k, age, 0), white, 1); kill when age > 0.4; }
+        object e(r: float) {
+            emit p(rand() + r) at 30 + r per second count 1 + fract(age * 3);
+            kill when age > 0.2 + r * 0.01 || r > 35;
+        }
+        spawn e(1);
+        spawn e(20);
+        trigger more { emit e(rand() * 40) count 25; })");
     for (const std::string& text : programs) {
         INFO(text.substr(0, 120));
         rt::SystemOptions kept;
@@ -286,18 +298,19 @@ TEST_CASE("emitters the GPU decides: a step moves and waits as much for 2,000 of
     // records), the emitters' blocks built on the GPU: only the totals come back, and
     // the host sends a template, not a block an emitter. Their updates send no emission
     // column in (a rate every row shares, as q's, has no column the GPU keeps).
-    struct Step {
+    struct Steps {  // over the 10 steps measured
         uint64_t bytes, waits, dispatches;
     };
-    auto perStep = [](int emitters) {
-        std::string text = R"(
-            object p(k: float) { point(vec3(k, age, 0), white, 1); kill when age > 0.3; }
-            object q { point(vec3(0, age, 1), red, 1); kill when age > 0.2; }
-            object e(r: float) {
+    auto perStep = [](int emitters, const char* death) {
+        std::string text = fmt::format(R"(
+            object p(k: float) {{ point(vec3(k, age, 0), white, 1); kill when age > 0.3; }}
+            object q {{ point(vec3(0, age, 1), red, 1); kill when age > 0.2; }}
+            object e(r: float) {{
                 emit p(rand() + r) at 20 + r per second count 1 + fract(age);
                 emit q at 15 per second;
-            }
-            trigger many(n: float) { emit e(rand() * 10) count n; })";
+                {}
+            }}
+            trigger many(n: float) {{ emit e(rand() * 10) count n; }})", death);
         rt::SystemOptions kept;
         kept.rows = rt::SystemOptions::Rows::InMemory;
         auto gpu = gpuBackend();
@@ -306,15 +319,19 @@ TEST_CASE("emitters the GPU decides: a step moves and waits as much for 2,000 of
         float n = static_cast<float>(emitters);
         REQUIRE_FALSE(system.fire("many", {&n, 1}));
         for (int f = 0; f < 40; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
-        Step before{gpu->transferredBytes(), gpu->waits(), gpu->dispatches()};
+        Steps before{gpu->transferredBytes(), gpu->waits(), gpu->dispatches()};
         for (int f = 0; f < 10; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
         CHECK(system.stats().types.at(static_cast<size_t>(system.typeIndex("p"))).live > static_cast<size_t>(emitters));
-        return Step{(gpu->transferredBytes() - before.bytes) / 10, (gpu->waits() - before.waits) / 10,
-                    (gpu->dispatches() - before.dispatches) / 10};
+        return Steps{gpu->transferredBytes() - before.bytes, gpu->waits() - before.waits, gpu->dispatches() - before.dispatches};
     };
-    Step few = perStep(20), many = perStep(2000);
-    MESSAGE("bytes " << few.bytes << " → " << many.bytes << ", waits " << few.waits << " → " << many.waits << ", dispatches " << few.dispatches << " → " << many.dispatches);
-    CHECK(many.waits == few.waits);
-    CHECK(many.dispatches == few.dispatches);
-    CHECK(many.bytes == few.bytes);
+    // Emitters that never die, and emitters that all die in a step measured (their kills
+    // listed where their rows are, only their count coming back, late).
+    for (std::string death : {"", "kill when age > 0.75;"}) {
+        INFO(death);
+        Steps few = perStep(20, death.c_str()), many = perStep(2000, death.c_str());
+        MESSAGE(death << " over 10 steps: bytes " << few.bytes << " → " << many.bytes << ", waits " << few.waits << " → " << many.waits << ", dispatches " << few.dispatches << " → " << many.dispatches);
+        CHECK(many.waits == few.waits);
+        CHECK(many.dispatches == few.dispatches);
+        CHECK(many.bytes == few.bytes);
+    }
 }

@@ -19,7 +19,8 @@ using namespace psys;
 namespace {
 
 // Answers every late launch (RowsLaunch::late) with a ticket, as a device would, and wipes
-// its kill flags: the run-time must take those kills from collect(), at the end of the step.
+// its kill flags: the run-time must take those kills from collect(), at the end of the step
+// (an update whose emissions the memory decides keeps them there: RowsLaunch::emissionsStay).
 struct LateBackend : rt::Backend {
     interp::Interpreter inner;
     std::map<uint64_t, std::pair<rt::RowsResult, std::vector<uint32_t>>> held;
@@ -39,7 +40,7 @@ struct LateBackend : rt::Backend {
         for (size_t i = l.begin; i < l.end; ++i)
             if (flags[i]) {
                 killed.push_back(static_cast<uint32_t>(i));
-                flags[i] = 0;
+                if (!l.emissionsStay) flags[i] = 0;
             }
         held[next] = {r, std::move(killed)};
         ++late;
@@ -181,6 +182,17 @@ TEST_CASE("rows kept in the memory: the same objects in the same rows as rows ke
                        "object e { emit s(rand()) count 5000; kill; }\nspawn e;");
     programs.push_back("object s { point(vec3(age), white, 1); kill when age > 0.5 * rand(); }\n"
                        "trigger boom { emit s count 20000; }");
+    // Emitters that die, whose emissions the memory decides: some at once (a trigger's,
+    // in their first update), the rest at their own ages; a row killed emits nothing.
+    programs.push_back(R"(
+        @capacity(400) object p(k: float) { point(vec3(k, age, 0), white, 1); kill when age > 0.4; }
+        object e(r: float) {
+            emit p(rand() + r) at 30 + r per second count 1 + fract(age * 3);
+            kill when age > 0.2 + r * 0.01 || r > 35;
+        }
+        spawn e(1);
+        spawn e(20);
+        trigger more { emit e(rand() * 40) count 25; })");
     // A trigger's objects half of which die at once: they wait for the next step's end.
     programs.push_back("object s(k: float) { point(vec3(k, 0, 0), white, 1); kill when k < 0.5; }\n"
                        "trigger boom { emit s(rand()) count 5000; }");
