@@ -1,9 +1,10 @@
-// Rate emissions decided where an emitter's rows are (rt::Memory::emitAtRate): a dispatch
-// a site over the rows — rt/emission.h's rule in GLSL doubles, each row's accumulator
-// moved on, its objects asked for written into its record — then one work group that
-// scans the records in row order: each site's objects kept while its target's room lasts
-// (a prefix sum of what was asked, clamped), the ids of the kept in row order, sites in
-// order (a prefix sum of the kept); the totals after the records. Counts past 2³² are two
+// Rate emissions (and bursts on death) decided where an emitter's rows are
+// (rt::Memory::emitAtRate): a dispatch a site over the rows — rt/emission.h's rules in
+// GLSL doubles, each row's accumulator moved on, its objects asked for written into its
+// record — then one work group that scans the records in row order: each site's objects
+// kept while its target's room lasts (a prefix sum of what was asked, clamped), the ids
+// of the kept in row order, sites in order (a prefix sum of the kept); the totals after
+// the records. Counts past 2³² are two
 // words (GLSL 4.50 has no 64-bit integers): what a row asks for is at most kMaxCount, a
 // sum saturates. The differential test (tests/gpu/emission_test.cpp) holds this to the
 // host's rule.
@@ -26,8 +27,8 @@ using rt::Buffer;
 namespace {
 
 // One site over the rows: params rows, flags (1 rate per row, 2 count per row, 4 kill
-// flags, 8 creation times, 16 fresh accumulators; the site from bit 8), the shared rate and count, dt, t1; the
-// rows from meta[3] on in the columns.
+// flags, 8 creation times, 16 fresh accumulators, 32 a burst on death; the site from bit
+// 8), the shared rate and count, dt, t1; the rows from meta[3] on in the columns.
 // The rule's operations are `precise` and in the host's order: the same doubles.
 const char* kEmitRows = R"(
 layout(std430, binding = 0) readonly buffer Mask { uint mask[]; };
@@ -63,7 +64,18 @@ void main() {
     uint invalid = 0u, clamped = 0u, perEvent = 1u;
     uvec2 children = uvec2(0u);
     double firstTime = 0.0LF, spacing = 0.0LF;
-    if (mask[i] != 0u && ((flags & 4u) == 0u || killed[i] == 0u)) {
+    if ((flags & 32u) != 0u) {  // rt::deathBurst: every row of the mask, killed ones too
+        if (mask[i] != 0u) {
+            double size = valid(uintBitsToFloat((flags & 2u) != 0u ? counts[i] : param(3u)), invalid);
+            firstTime = ld(param(6u), param(7u));
+            if (size >= 1.0LF) {
+                double c = whole(size, clamped);
+                uint hi = uint(c / 4294967296.0LF);
+                precise double lo = c - double(hi) * 4294967296.0LF;
+                children = uvec2(uint(lo), hi);
+            }
+        }
+    } else if (mask[i] != 0u && ((flags & 4u) == 0u || killed[i] == 0u)) {
         double t1 = ld(param(6u), param(7u));
         double dt = (flags & 8u) != 0u ? t1 - ld(created[2u * i], created[2u * i + 1u]) : ld(param(4u), param(5u));
         double before = (flags & 16u) != 0u ? 0.0LF : ld(accumulated[2u * i], accumulated[2u * i + 1u]);
@@ -242,7 +254,8 @@ void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs) {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, runsGl);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, metaBuffer_);
         uint32_t flags = (s.rate.valid() ? 1u : 0u) | (s.count.valid() ? 2u : 0u) | (in.killed.valid() ? 4u : 0u) |
-                         (in.created.valid() ? 8u : 0u) | (in.fresh ? 16u : 0u) | static_cast<uint32_t>(k) << 8;
+                         (in.created.valid() ? 8u : 0u) | (in.fresh ? 16u : 0u) | (s.onDeath ? 32u : 0u) |
+                         static_cast<uint32_t>(k) << 8;
         bindParams(paramsBuffer_, {static_cast<uint32_t>(n), flags, floatBits(s.rateValue), floatBits(s.countValue), dt0, dt1,
                                    t10, t11});
         dispatchRows(emitRowsProgram_, n);

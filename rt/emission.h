@@ -1,5 +1,5 @@
-// The rate rule: what an emitter's update of `dt` ending at t1 asks of one rate emit site.
-// Written once, over the host's doubles, for every memory's bookkeeping
+// The rate rule: what an emitter's update of `dt` ending at t1 asks of one rate emit site
+// (and of one that bursts on death, below). Written once, over the host's doubles, for every memory's bookkeeping
 // (Creation::emitInUpdate and Memory::emitAtRate); a device spells the same in its own
 // language (gpu/gl_emission.cpp) and the differential tests hold the two together.
 //
@@ -62,6 +62,16 @@ inline RateEmission rateEmission(double before, float rate, float count, double 
     e.firstTime = (t1 - dt) + (1.0 - before) / r;
     e.spacing = 1.0 / r;
     e.children = wholeCount(events * static_cast<double>(e.perEvent), e.clamped);
+    return e;
+}
+
+// An `on death` burst (ir::EmitSite::When::Death): in the update that kills the emitter,
+// `count` objects at t1, each an event of its own (the update yields 0 where nothing died).
+inline RateEmission deathBurst(float count, double t1) {
+    RateEmission e;
+    double size = validCount(count, e.invalid);
+    e.firstTime = t1;
+    if (size >= 1) e.children = wholeCount(size, e.clamped);
     return e;
 }
 

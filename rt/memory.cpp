@@ -150,8 +150,9 @@ void Memory::identifyRecords(Buffer runs, size_t firstRecord, size_t records, si
     }
 }
 
-// The rate emissions of emitter rows (Memory::emitAtRate): rt/emission.h's rule row by
-// row, each site's objects kept while its target's room lasts, the ids in row order.
+// The rate emissions (and bursts on death) of emitter rows (Memory::emitAtRate):
+// rt/emission.h's rules row by row, each site's objects kept while its target's room
+// lasts, the ids in row order.
 void Memory::emitAtRate(const RateSites& in, Buffer runs) {
     const size_t n = in.rows, sites = in.sites.size();
     auto* record = static_cast<uint32_t*>(host(runs));
@@ -179,7 +180,11 @@ void Memory::emitAtRate(const RateSites& in, Buffer runs) {
             const RateSites::Site& s = in.sites[k];
             Site& d = site[k];
             RateEmission e;
-            if (mask[r] && !(killed && killed[r])) {
+            if (s.onDeath && mask[r]) {
+                e = deathBurst(d.count ? d.count[r] : s.countValue, in.t1);
+                invalid += e.invalid;
+                clamped += e.clamped;
+            } else if (!s.onDeath && mask[r] && !(killed && killed[r])) {
                 double dt = created ? in.t1 - created[r] : in.dt;
                 e = rateEmission(in.fresh ? 0.0 : d.accumulated[r], d.rate ? d.rate[r] : s.rateValue, d.count ? d.count[r] : s.countValue,
                                  dt, in.t1);

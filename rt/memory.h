@@ -61,19 +61,23 @@ struct ObjectRuns {
     double time(size_t u, uint32_t k) const { return eventTime(firstTime[u], k, perEvent[u], spacing[u]); }
 };
 
-// A type's rate emit sites over rows [0, rows) of its columns (Memory::emitAtRate).
+// A type's rate emit sites (and bursts on death) over rows [0, rows) of its columns
+// (Memory::emitAtRate).
 struct RateSites {
     struct Site {
         Buffer rate, count;  // f32 per row; invalid: rateValue, countValue every row's
         float rateValue = 0, countValue = 1;
         Buffer accumulated;  // f64 per row: events accumulated, in [0, 1)
         uint32_t room = 0;   // objects its target may still take (its free rows less those queued)
+        // A burst on death (rt::deathBurst): `count` objects at t1 from each row of the
+        // mask, killed ones too; no rate, its accumulator untouched.
+        bool onDeath = false;
     };
     std::vector<Site> sites;  // in the type's order of sites, each its own target type
     size_t rows = 0;
     size_t first = 0;  // the rows are [first, first + rows) of every column (records from 0)
     Buffer mask;     // u8: the rows that emit
-    Buffer killed;   // u8: rows the update killed (they emit nothing); invalid: none
+    Buffer killed;   // u8: rows the update killed (they emit at no rate); invalid: none
     Buffer created;  // f64: where given, row r's update began at created[r] (a batch's first), else at t1 − dt
     bool fresh = false;  // the rows' objects were just created: their accumulators start at 0 (not read)
     double dt = 0, t1 = 0;

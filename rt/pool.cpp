@@ -126,12 +126,13 @@ Pool::Pool(Pool&& other) noexcept
     : created(other.created), ids(other.ids), updatable(std::move(other.updatable)), alive(std::move(other.alive)), state(std::move(other.state)),
       params(std::move(other.params)), exports(std::move(other.exports)), folds(std::move(other.folds)),
       foldRows(other.foldRows), paramColumn(std::move(other.paramColumn)),
-      parent(std::move(other.parent)), readers(std::move(other.readers)), fresh(std::move(other.fresh)),
-      emitted(std::move(other.emitted)), object_(other.object_), capacity_(other.capacity_), memory_(other.memory_),
+      parent(std::move(other.parent)), readers(std::move(other.readers)), diedAt(std::move(other.diedAt)),
+      fresh(std::move(other.fresh)), emitted(std::move(other.emitted)), object_(other.object_), capacity_(other.capacity_), memory_(other.memory_),
       status_(std::move(other.status_)), generation_(std::move(other.generation_)),
       freeRows_(std::move(other.freeRows_)), live_(other.live_), frozen_(other.frozen_), inMemory_(other.inMemory_),
       rows_(other.rows_), top_(other.top_), highWater_(other.highWater_), uncounted_(other.uncounted_),
-      freshRows_(std::move(other.freshRows_)), spare_(std::move(other.spare_)), version_(other.version_),
+      freshRows_(std::move(other.freshRows_)), spare_(std::move(other.spare_)), held_(std::move(other.held_)),
+      version_(other.version_),
       fetched_(other.fetched_), mask_(std::move(other.mask_)) {
     other.memory_ = nullptr;
 }

@@ -78,10 +78,11 @@ std::string describe(const Schedule& s, const Phase& p) {
                           : fmt::format("{}: the killed rows frozen, in row order", type);
         case PhaseKind::Emissions: {
             if (p.inMemory)
-                return fmt::format("{}: rate emissions ({}) decided by the memory's operation over the rows — events, "
+                return fmt::format("{}: {} ({}) decided by the memory's operation over the rows — events, "
                                    "times, the cut at room, ids; only its totals to the host — then the queue: each "
                                    "site's objects one run, its spawn launches one launch, from the records",
-                                   type, names(s, p.targets));
+                                   type, p.events ? "rate emissions of the survivors, bursts on deaths" : "rate emissions",
+                                   names(s, p.targets));
             return fmt::format("{}: {} ({}): events, times, ids, the queue", type,
                                p.events ? "rate emissions of the survivors, bursts on edges and deaths" : "rate emissions of the survivors",
                                names(s, p.targets));

@@ -135,6 +135,7 @@ void Creation::emitInMemory(size_t type, const std::vector<Buffer>& table, const
             else
                 perRow = table[static_cast<size_t>(column)];
         };
+        out.onDeath = s_.pools[type].object().emits[site].when == ir::EmitSite::When::Death;
         source(info.rated[site], layout.emitRate(i), out.rateValue, out.rate);
         source(info.counted[site], layout.emitCount(i), out.countValue, out.count);
         size_t target = info.emitTarget[site];

@@ -81,9 +81,11 @@ void Creation::emitInUpdate(const Emitter& e, std::span<const float> rate, std::
     Pool& pool = s_.pools[e.type];
     const ir::Object& o = pool.object();
     for (size_t site = 0; site < o.emits.size(); ++site) {
-        if (o.emits[site].whenKilled()) {
-            double size = validCount(count[site], s_.stats.invalidEmissions);
-            if (size >= 1) queueChildren(e, static_cast<int>(site), wholeCount(size, s_.stats.clampedEmissions), 1, t1, 0);
+        if (o.emits[site].whenKilled()) {  // (an edge's burst too: the update yields its count where it fired)
+            RateEmission b = deathBurst(count[site], t1);
+            s_.stats.invalidEmissions += b.invalid;
+            s_.stats.clampedEmissions += b.clamped;
+            if (b.children) queueChildren(e, static_cast<int>(site), b.children, b.perEvent, b.firstTime, b.spacing);
             continue;
         }
         if (!o.emits[site].rate() || dying) continue;

@@ -110,12 +110,12 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         info.rowsInMemory = inMemory && (info.late || silent) && keptWhole(info);
     }
     // Emitters whose emissions the memory decides (Memory::emitAtRate): nobody reads them,
-    // every site emits at a rate into a type of its own that keeps its rows in the memory,
-    // emits nothing and reads no parent, and whose arguments read no fold (a spawn launch
-    // from records has no parent values) — so a step's emissions are one operation over
-    // the rows, and the objects they create batches of those types. One that dies bursts
-    // nothing on death and exports nothing: the operation reads its update's kill flags
-    // where they are (a row killed emits nothing), and its kills are late, as a type's
+    // every site emits at a rate or bursts on death into a type of its own that keeps its
+    // rows in the memory, emits nothing and reads no parent, and whose arguments read no
+    // fold (a spawn launch from records has no parent values) — so a step's emissions are
+    // one operation over the rows, and the objects they create batches of those types. One
+    // that dies exports nothing: the operation reads its update's kill flags where they
+    // are (a row killed emits at no rate, and bursts), and its kills are late, as a type's
     // that only dies — nobody else looks at them before the step's end.
     // Only where asked (Rows::InMemory, creating in batches) so far: on a device the host
     // still reads the operation's totals back in the step (docs/gpu.md, "Emitters in the
@@ -125,12 +125,12 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         const ir::Object& o = module.objects[t];
         bool dies = info.kills || info.unstable;
         bool emitter = options.rows == SystemOptions::Rows::InMemory && options.createInBatches && info.updateEmits &&
-                       (!dies || (options.lateKills && !info.exports)) && !info.read && !info.emitsWhenKilled &&
-                       keptWhole(info);
+                       (!dies || (options.lateKills && !info.exports)) && !info.read && keptWhole(info);
         for (size_t s = 0; emitter && s < o.emits.size(); ++s) {
             size_t target = info.emitTarget[s];
             const TypeInfo& to = types[target];
-            emitter = o.emits[s].rate() && to.rowsInMemory && module.objects[target].emits.empty() &&
+            emitter = (o.emits[s].rate() || o.emits[s].when == ir::EmitSite::When::Death) && to.rowsInMemory &&
+                      module.objects[target].emits.empty() &&
                       std::count(info.emitTarget.begin(), info.emitTarget.end(), target) == 1 &&
                       info.spawnLayout[s].parentColumns.empty();
         }

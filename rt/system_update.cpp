@@ -150,7 +150,8 @@ void runUpdate(State& s, const Phase& phase, double dt, double t1, bool last) {
     RowsLaunch update = poolUpdate(s, type, dt, t1);
     update.emissionsStay = phase.inMemory && info.updateEmits;
     // (Where the rows are in the memory, nothing here reads the mask: no parents, no
-    // drawing as the step goes, its folds copied, and it never dies.)
+    // drawing as the step goes, its folds copied, and its kills late — or none, with
+    // exports.)
     const uint8_t* updatable = phase.inMemory ? nullptr : pool.mask();
     RowsLaunch exports = update;
     Buffer exportMask;

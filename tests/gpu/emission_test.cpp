@@ -64,6 +64,7 @@ float oneOf(std::mt19937& random, std::initializer_list<float> values) {
 }  // namespace
 
 TEST_CASE("rate emissions decided on the GPU: the host's runs, ids, drops and accumulators, bit for bit") {
+    // Sites at a rate and bursts on death, every round some of each.
     auto gpu = gpuBackend();
     rt::HostMemory hostMemory;
     constexpr size_t kRows = 3000, kSites = 3;
@@ -117,6 +118,7 @@ TEST_CASE("rate emissions decided on the GPU: the host's runs, ids, drops and ac
             for (size_t s = 0; s < kSites; ++s) {
                 if ((round + s) % 4 == 0) in.sites[s].rate = {};
                 if ((round + s) % 3 == 0) in.sites[s].count = {};
+                in.sites[s].onDeath = (round + s) % 5 == 1;  // (rows killed too; no accumulator)
             }
             e.memory.emitAtRate(in, e.runs);
         };
@@ -239,6 +241,21 @@ TEST_CASE("a rate emission's records are the rule's: events, times, ids in row o
     CHECK(totals[rt::kTotalsSites + rt::kTotalsPerSite] == 5);       // site 1 kept
     CHECK(totals[rt::kTotalsSites + rt::kTotalsPerSite + 1] == 7);   // of 7 asked
     CHECK(e.read<double>(e.sites.sites[0].accumulated, 2)[0] == doctest::Approx(0.5));
+    // A burst on death: `count` objects at t1 from each row of the mask, killed or not
+    // (the update yields 0 where nothing died), its accumulator untouched.
+    e.write(e.sites.killed, std::vector<uint8_t>{1, 0});
+    e.sites.sites[1].onDeath = true;
+    e.write(e.sites.sites[1].count, std::vector<float>{3, 0});
+    e.sites.sites[1].room = 100;
+    m.emitAtRate(e.sites, e.runs);
+    runs = e.read<uint32_t>(e.runs, rt::runsWords(2, 2));
+    CHECK(record(1, 0)[1] == 3);
+    CHECK(record(1, 0)[3] == 1);
+    CHECK(time(record(1, 0), 4) == 1.0);
+    CHECK(time(record(1, 0), 6) == 0.0);
+    CHECK(record(1, 1)[1] == 0);
+    CHECK(record(0, 0)[1] == 0);  // (the killed row emits at no rate)
+    CHECK(e.read<double>(e.sites.sites[1].accumulated, 2)[1] == doctest::Approx(0.9 + 2.1 - 3));
 }
 
 TEST_CASE("emitters whose emissions the GPU decides: the interpreter's objects, ids, rows and drops") {
@@ -247,7 +264,8 @@ TEST_CASE("emitters whose emissions the GPU decides: the interpreter's objects, 
     // GPU too, and its emissions are Memory::emitAtRate's dispatches: rates shared and per
     // row, counts per row, invalid rates (counted), a target at capacity (drops), emitters
     // created in the step by a trigger (their first update's emissions), two sites;
-    // emitters that die (some in their first update), their kills late, read where they are.
+    // emitters that die (some in their first update), their kills late, read where they
+    // are, and emitters that burst on death.
     std::vector<std::string> programs;
     for (const char* sample : {"fountain", "emitter", "two_streams", "tornado"}) programs.push_back(test::readFile(test::sample(sample)));
     programs.push_back(R"(
@@ -271,6 +289,17 @@ TEST_CASE("emitters whose emissions the GPU decides: the interpreter's objects, 
         spawn e(1);
         spawn e(20);
         trigger more { emit e(rand() * 40) count 25; })");
+    programs.push_back(R"(
+        @capacity(250) object p(k: float) { point(vec3(k, age, 0), white, 1); kill when age > 0.4; }
+        object q(k: float) { point(vec3(k, 0, age), red, 1); kill when age > 0.2; }
+        object e(r: float) {
+            emit p(rand() + r) at 30 + r per second;
+            kill when age > 0.1 + r * 0.01 || r > 35;
+            on death { emit q(r + age) count 2 + r * 0.1; }
+        }
+        spawn e(1);
+        spawn e(20);
+        trigger more { emit e(rand() * 40) count 40; })");
     for (const std::string& text : programs) {
         INFO(text.substr(0, 120));
         rt::SystemOptions kept;
