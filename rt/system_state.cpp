@@ -111,31 +111,39 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     }
     // Emitters whose emissions the memory decides (Memory::emitAtRate): nobody reads them,
     // every site emits at a rate or bursts on death into a type of its own that keeps its
-    // rows in the memory, emits nothing and reads no parent, and whose arguments read no
-    // fold (a spawn launch from records has no parent values) — so a step's emissions are
-    // one operation over the rows, and the objects they create batches of those types. One
-    // that dies exports nothing: the operation reads its update's kill flags where they
-    // are (a row killed emits at no rate, and bursts), and its kills are late, as a type's
-    // that only dies — nobody else looks at them before the step's end.
+    // rows in the memory (one that emits nothing, or such an emitter itself) and reads no
+    // parent, and whose arguments read no fold (a spawn launch from records has no parent
+    // values) — so a step's emissions are one operation over the rows, and the objects
+    // they create batches of those types, whose first updates emit by the same operation.
+    // One that dies exports nothing: the operation reads its update's kill flags where
+    // they are (a row killed emits at no rate, and bursts), and its kills are late, as a
+    // type's that only dies — nobody else looks at them before the step's end. (Until no
+    // type changes: an emitter of emitters follows them in.)
     // Only where asked (Rows::InMemory, creating in batches) so far: on a device the host
     // still reads the operation's totals back in the step (docs/gpu.md, "Emitters in the
     // memory").
-    for (size_t t = 0; t < types.size(); ++t) {
-        TypeInfo& info = types[t];
+    auto decidedInMemory = [&](size_t t) {
+        const TypeInfo& info = types[t];
         const ir::Object& o = module.objects[t];
         bool dies = info.kills || info.unstable;
         bool emitter = options.rows == SystemOptions::Rows::InMemory && options.createInBatches && info.updateEmits &&
                        (!dies || (options.lateKills && !info.exports)) && !info.read && keptWhole(info);
         for (size_t s = 0; emitter && s < o.emits.size(); ++s) {
             size_t target = info.emitTarget[s];
-            const TypeInfo& to = types[target];
-            emitter = (o.emits[s].rate() || o.emits[s].when == ir::EmitSite::When::Death) && to.rowsInMemory &&
-                      module.objects[target].emits.empty() &&
+            emitter = (o.emits[s].rate() || o.emits[s].when == ir::EmitSite::When::Death) && types[target].rowsInMemory &&
                       std::count(info.emitTarget.begin(), info.emitTarget.end(), target) == 1 &&
                       info.spawnLayout[s].parentColumns.empty();
         }
-        info.rowsInMemory = info.rowsInMemory || emitter;
-        info.late = info.late || (emitter && dies);
+        return emitter;
+    };
+    for (bool more = true; more;) {
+        more = false;
+        for (size_t t = 0; t < types.size(); ++t) {
+            TypeInfo& info = types[t];
+            if (info.rowsInMemory || !decidedInMemory(t)) continue;
+            info.rowsInMemory = more = true;
+            info.late = info.late || info.kills || info.unstable;
+        }
     }
     for (size_t t = 0; t < types.size(); ++t)
         if (types[t].rowsInMemory) pools[t].keepRowsInMemory();
