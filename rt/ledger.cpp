@@ -112,6 +112,40 @@ void Ledger::releaseInMemory(LateKills& l) {
     l.map = {};
 }
 
+void Ledger::releaseForReload() {
+    for (LateKills& l : late_) {
+        if (!s_.types[l.type].rowsInMemory || l.released) continue;
+        l.released = true;
+        Pool& pool = s_.pools[l.type];
+        std::vector<uint32_t> map(l.map.valid() ? s_.memory.rows(l.map) : 0), rows, list;
+        if (!map.empty()) s_.memory.read(l.map, 0, map.size(), map.data());
+        for (LateKills::Part& part : l.parts) {
+            if (!part.killList.valid()) continue;
+            if (part.ticket) collect(l.type, part);  // (its unstable count: the kills are listed in the memory)
+            uint32_t n = 0;
+            s_.memory.read(part.killList, 0, 1, &n);
+            list.resize(n);
+            if (n) s_.memory.read(part.killList, 1, n, list.data());
+            for (uint32_t r : list) rows.push_back(map.empty() ? static_cast<uint32_t>(part.begin + r) : map[part.begin - l.first + r]);
+            if (!part.counted) s_.typeStats[l.type].killed += n;
+            part.counted = true;
+            pool.recycle(part.killList);
+            part.killList = {};
+        }
+        if (l.map.valid()) pool.recycle(l.map);
+        l.map = {};
+        if (rows.empty()) continue;
+        std::sort(rows.begin(), rows.end());
+        Buffer sorted = pool.scratchRows(rows.size() + 1);
+        list.assign(1, static_cast<uint32_t>(rows.size()));
+        list.insert(list.end(), rows.begin(), rows.end());
+        s_.memory.write(sorted, 0, list.size(), list.data());
+        pool.release(sorted, 0, 0, {}, 0);
+        pool.released(rows.size());
+        pool.recycle(sorted);
+    }
+}
+
 void Ledger::countInMemory(LateKills& l) {
     Pool& pool = s_.pools[l.type];
     for (LateKills::Part& part : l.parts) {

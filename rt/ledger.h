@@ -78,6 +78,11 @@ public:
     // with readers kept), or, where the backend clearsKilled and still owes some late
     // kill, kept for the next settle.
     void endStep();
+    // Before a hot reload (System::carryOver, after a settle that waits): the kills a
+    // trigger left listed in the memory for the next step's end freed now, in row order —
+    // as a reload frees the frozen rows of a pool kept on the host, after its free rows —
+    // and counted: the new system keeps no record of the old one's deaths.
+    void releaseForReload();
     // A reader of `parent` is gone; a frozen parent without readers is freed, and so on up.
     void releaseReader(size_t childType, Handle parent);
 

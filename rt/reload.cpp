@@ -134,6 +134,7 @@ ReloadReport System::carryOver(const System& oldSystem) {
     // What a device still owes the old system first, so that its pools are what they would
     // be on the host: its last step's rows freed, its kills counted.
     oldSystem.state_->ledger.settle(detail::Ledger::Wait::Yes);
+    oldSystem.state_->ledger.releaseForReload();
     const detail::State& old = *oldSystem.state_;
     ReloadReport report;
     s.now = old.now;

@@ -276,6 +276,40 @@ TEST_CASE("a trigger's kills freed at the next step's end free the rows its obje
     CHECK(a.stats().types[0].killed == 1);
 }
 
+TEST_CASE("a hot reload right after a trigger frees the trigger's dead as a pool kept on the host does") {
+    // Objects a trigger created that died in their first update wait, listed in the
+    // memory, for the next step's end; a reload before it frees them (after the free rows,
+    // in row order, as the frozen rows of a pool kept on the host), counts them, and the
+    // new system reuses their rows.
+    std::string text = test::readFile(PSYS_PROGRAMS_DIR "/generated/trigger_kills_after_a_step.psys");
+    rt::SystemOptions onHost, kept;
+    onHost.rows = rt::SystemOptions::Rows::OnHost;
+    kept.rows = rt::SystemOptions::Rows::InMemory;
+    interp::Interpreter hostBackend, hostAfter;
+    ListsInMemoryBackend listsBackend, listsAfter;
+    rt::System a(test::compileModule(text), hostBackend, onHost), d(test::compileModule(text), listsBackend, kept);
+    const float where[] = {1.247f, -2.725f, 0.24f}, none = 0;
+    for (rt::System* s : {&a, &d}) {
+        for (int f = 0; f < 3; ++f) REQUIRE_FALSE(s->fire("fire0", {&none, 1}));
+        REQUIRE_FALSE(s->step(1.0 / 60));
+        for (int f = 0; f < 4; ++f) REQUIRE_FALSE(s->fire("fire1", where));  // they die in their first update
+    }
+    rt::System a2(test::compileModule(text), hostAfter, onHost), d2(test::compileModule(text), listsAfter, kept);
+    a2.carryOver(a);
+    d2.carryOver(d);
+    CHECK(d2.stats().types[0].killed == a2.stats().types[0].killed);
+    CHECK(a2.stats().types[0].killed == 4);
+    for (int f = 0; f < 3; ++f) {
+        for (rt::System* s : {&a2, &d2}) {
+            REQUIRE_FALSE(s->fire("fire0", {&none, 1}));
+            REQUIRE_FALSE(s->step(1.0 / 60));
+        }
+        d2.stats();
+        sameObjects({&a2, &d2});
+    }
+    CHECK(a2.pool(0).rows() == 7);  // the four rows of the dead taken again
+}
+
 namespace {
 
 // Writes NaN over the emission columns of every update at a uniform clock, after it ran:
