@@ -281,26 +281,8 @@ TEST_CASE("emitters whose emissions the GPU decides: the interpreter's objects, 
         spawn e(0.25);
         spawn e(45);
         trigger more { emit e(rand() * 200) count 3; })");
-    programs.push_back(R"(
-        @capacity(400) object p(k: float) { point(vec3(k, age, 0), white, 1); kill when age > 0.4; }
-        object e(r: float) {
-            emit p(rand() + r) at 30 + r per second count 1 + fract(age * 3);
-            kill when age > 0.2 + r * 0.01 || r > 35;
-        }
-        spawn e(1);
-        spawn e(20);
-        trigger more { emit e(rand() * 40) count 25; })");
-    programs.push_back(R"(
-        @capacity(250) object p(k: float) { point(vec3(k, age, 0), white, 1); kill when age > 0.4; }
-        object q(k: float) { point(vec3(k, 0, age), red, 1); kill when age > 0.2; }
-        object e(r: float) {
-            emit p(rand() + r) at 30 + r per second;
-            kill when age > 0.1 + r * 0.01 || r > 35;
-            on death { emit q(r + age) count 2 + r * 0.1; }
-        }
-        spawn e(1);
-        spawn e(20);
-        trigger more { emit e(rand() * 40) count 40; })");
+    for (const char* name : {"emitters_that_die", "emitters_burst_on_death"})
+        programs.push_back(test::readFile(std::string(PSYS_PROGRAMS_DIR) + "/" + name + ".psys"));
     for (const std::string& text : programs) {
         INFO(text.substr(0, 120));
         rt::SystemOptions kept;

@@ -182,29 +182,7 @@ TEST_CASE("rows kept in the memory: the same objects in the same rows as rows ke
                        "object e { emit s(rand()) count 5000; kill; }\nspawn e;");
     programs.push_back("object s { point(vec3(age), white, 1); kill when age > 0.5 * rand(); }\n"
                        "trigger boom { emit s count 20000; }");
-    // Emitters that die, whose emissions the memory decides: some at once (a trigger's,
-    // in their first update), the rest at their own ages; a row killed emits nothing.
-    programs.push_back(R"(
-        @capacity(400) object p(k: float) { point(vec3(k, age, 0), white, 1); kill when age > 0.4; }
-        object e(r: float) {
-            emit p(rand() + r) at 30 + r per second count 1 + fract(age * 3);
-            kill when age > 0.2 + r * 0.01 || r > 35;
-        }
-        spawn e(1);
-        spawn e(20);
-        trigger more { emit e(rand() * 40) count 25; })");
-    // Emitters that burst on death, decided in the memory too.
-    programs.push_back(R"(
-        @capacity(250) object p(k: float) { point(vec3(k, age, 0), white, 1); kill when age > 0.4; }
-        object q(k: float) { point(vec3(k, 0, age), red, 1); kill when age > 0.2; }
-        object e(r: float) {
-            emit p(rand() + r) at 30 + r per second;
-            kill when age > 0.1 + r * 0.01 || r > 35;
-            on death { emit q(r + age) count 2 + r * 0.1; }
-        }
-        spawn e(1);
-        spawn e(20);
-        trigger more { emit e(rand() * 40) count 40; })");
+    // (Emitters that die and burst on death, decided in the memory: tests/programs.)
     // A trigger's objects half of which die at once: they wait for the next step's end.
     programs.push_back("object s(k: float) { point(vec3(k, 0, 0), white, 1); kill when k < 0.5; }\n"
                        "trigger boom { emit s(rand()) count 5000; }");
