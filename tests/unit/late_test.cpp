@@ -214,7 +214,7 @@ TEST_CASE("rows kept in the memory: the same objects in the same rows as rows ke
                 for (size_t i = 0; i < pa.size(); ++i) REQUIRE(pa[i].position == pb[i].position);
                 const rt::TypeStats sa = a.stats().types[t];
                 for (rt::System* s : {&b, &c, &d}) {
-                    const rt::TypeStats& sb = s->stats().types[t];
+                    const rt::TypeStats sb = s->stats().types[t];
                     CHECK(sa.live == sb.live);
                     CHECK(sa.killed == sb.killed);
                     CHECK(sa.dropped == sb.dropped);
