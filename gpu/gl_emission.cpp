@@ -4,9 +4,8 @@
 // record — then one work group that scans the records in row order: each site's objects
 // kept while its target's room lasts (a prefix sum of what was asked, clamped), the ids
 // of the kept in row order, sites in order (a prefix sum of the kept); the totals after
-// the records. Counts past 2³² are two
-// words (GLSL 4.50 has no 64-bit integers): what a row asks for is at most kMaxCount, a
-// sum saturates. The differential test (tests/gpu/emission_test.cpp) holds this to the
+// the records. Counts past 2³² are two words (GLSL 4.50 has no 64-bit integers): what a
+// row asks for is at most kMaxCount, a sum saturates. The differential test (tests/gpu/emission_test.cpp) holds this to the
 // host's rule.
 #include <epoxy/gl.h>
 

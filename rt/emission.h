@@ -1,7 +1,8 @@
 // The rate rule: what an emitter's update of `dt` ending at t1 asks of one rate emit site
-// (and of one that bursts on death, below). Written once, over the host's doubles, for every memory's bookkeeping
-// (Creation::emitInUpdate and Memory::emitAtRate); a device spells the same in its own
-// language (gpu/gl_emission.cpp) and the differential tests hold the two together.
+// (and of one that bursts on death, below). Written once, over the host's doubles, for
+// every memory's bookkeeping (Creation::emitInUpdate and Memory::emitAtRate); a device
+// spells the same in its own language (gpu/gl_emission.cpp) and the differential tests
+// hold the two together.
 //
 // Events fall where the accumulated rate crosses a whole number, so a stream is smooth
 // within a step and a rate of 0.25/s emits at 4 s, 8 s, …: the first at
