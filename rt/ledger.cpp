@@ -117,17 +117,14 @@ void Ledger::releaseForReload() {
         if (!s_.types[l.type].rowsInMemory || l.released) continue;
         l.released = true;
         Pool& pool = s_.pools[l.type];
-        std::vector<uint32_t> map(l.map.valid() ? s_.memory.rows(l.map) : 0), rows, list;
-        if (!map.empty()) s_.memory.read(l.map, 0, map.size(), map.data());
+        std::vector<uint32_t> rows, list;
         for (LateKills::Part& part : l.parts) {
             if (!part.killList.valid()) continue;
             if (part.ticket) collect(l.type, part);  // (its unstable count: the kills are listed in the memory)
-            uint32_t n = 0;
-            s_.memory.read(part.killList, 0, 1, &n);
-            list.resize(n);
-            if (n) s_.memory.read(part.killList, 1, n, list.data());
-            for (uint32_t r : list) rows.push_back(map.empty() ? static_cast<uint32_t>(part.begin + r) : map[part.begin - l.first + r]);
-            if (!part.counted) s_.typeStats[l.type].killed += n;
+            list = l.map.valid() ? s_.memory.killedRows(part.killList, 0, 0, l.map, part.begin - l.first)
+                                 : s_.memory.killedRows(part.killList, 0, static_cast<uint32_t>(part.begin), {}, 0);
+            rows.insert(rows.end(), list.begin(), list.end());
+            if (!part.counted) s_.typeStats[l.type].killed += list.size();
             part.counted = true;
             pool.recycle(part.killList);
             part.killList = {};

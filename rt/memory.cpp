@@ -77,6 +77,13 @@ void eachKilled(const Memory& memory, Buffer killed, size_t killedAt, uint32_t b
 
 }  // namespace
 
+std::vector<uint32_t> Memory::killedRows(Buffer killed, size_t killedAt, uint32_t base, Buffer map,
+                                         size_t mapFirst) const {
+    std::vector<uint32_t> rows;
+    eachKilled(*this, killed, killedAt, base, map, mapFirst, [&](uint32_t, uint32_t row) { rows.push_back(row); });
+    return rows;
+}
+
 void Memory::releaseRows(const PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
                          size_t mapFirst) {
     uint32_t& top = static_cast<uint32_t*>(host(pool.counters))[0];

@@ -156,6 +156,8 @@ public:
     // on, its masks cleared; the top moves on.
     virtual void releaseRows(const PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
                              size_t mapFirst);
+    // The pool rows of such a kill list, in its order, read where they are (a reload's).
+    std::vector<uint32_t> killedRows(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst) const;
     // The rows of a kill list (as releaseRows reads it) neither alive nor updatable, not
     // freed yet: killed objects that wait for the step's end.
     virtual void clearRows(const PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
