@@ -1,11 +1,12 @@
 // Rate emissions (and bursts on death) decided where an emitter's rows are
 // (rt::Memory::emitAtRate): a dispatch a site over the rows — rt/emission.h's rules in
 // GLSL doubles, each row's accumulator moved on, its objects asked for written into its
-// record — then one work group that scans the records in row order: each site's objects
-// kept while its target's room lasts (a prefix sum of what was asked, clamped), the ids
-// of the kept in row order, sites in order (a prefix sum of the kept); the totals after
-// the records. Counts past 2³² are two words (GLSL 4.50 has no 64-bit integers): what a
-// row asks for is at most kMaxCount, a sum saturates. The differential test (tests/gpu/emission_test.cpp) holds this to the
+// record — then one work group that scans the records in row order: each group's objects
+// (the sites into one target) kept while its room lasts (a prefix sum of what was asked,
+// clamped), each site's places among its own, the ids of the kept in row order, sites in
+// order (prefix sums of the kept); the totals after the records. Counts past 2³² are two
+// words (GLSL 4.50 has no 64-bit integers): what a row asks for is at most kMaxCount, a
+// sum saturates. The differential test (tests/gpu/emission_test.cpp) holds this to the
 // host's rule.
 #include <epoxy/gl.h>
 
@@ -27,7 +28,8 @@ namespace {
 
 // One site over the rows: params rows, flags (1 rate per row, 2 count per row, 4 kill
 // flags, 8 creation times, 16 fresh accumulators, 32 a burst on death; the site from bit
-// 8), the shared rate and count, dt, t1; the rows from meta[3] on in the columns.
+// 8: its record at meta's rt::RecordLayout), the shared rate and count, dt, t1; the rows
+// from meta[3] on in the columns.
 // The rule's operations are `precise` and in the host's order: the same doubles.
 const char* kEmitRows = R"(
 layout(std430, binding = 0) readonly buffer Mask { uint mask[]; };
@@ -59,7 +61,7 @@ double whole(double x, inout uint clamped) {
 void main() {
     uint r = INVOCATION, rows = param(0u), flags = param(1u), site = flags >> 8u;
     if (r >= rows) return;
-    uint w = (site * rows + r) * 8u, i = meta[3] + r;
+    uint w = (meta[6u + 4u * site] + r * meta[7u + 4u * site]) * RUN_WORDS, i = meta[3] + r;
     uint invalid = 0u, clamped = 0u, perEvent = 1u;
     uvec2 children = uvec2(0u);
     double firstTime = 0.0LF, spacing = 0.0LF;
@@ -115,11 +117,15 @@ void main() {
 }
 )";
 
-// One work group of 256: each invocation a chunk of rows in order. Per site: the chunk's
-// sum of what its rows asked for, an exclusive scan of the sums (by one invocation: 256
-// adds), then each row's place and kept; then the same over the chunks' kept for the ids.
-// `meta`: rows, sites, next id, the first row, then each site's room. The totals from
-// word rows · sites · 8 of the runs.
+// One work group of 256: each invocation a chunk of rows in order. Per site, what its
+// rows asked for (a sum of the chunks' sums) before places overwrite it; per group, the
+// chunk's sum of what its records asked for (a group's records are one range, rows in
+// order, a row's sites in order), an exclusive scan of the sums (by one invocation: 256
+// adds), then each record's place and kept; per site, the same over its records' kept
+// for their places among the site's; then over the chunks' kept for the ids (rows in
+// order, a row's sites in order). `meta`: rows, sites, next id, the first row, then per
+// site: its group's room, its group, its first record and stride (rt::RecordLayout). The
+// totals from word rows · sites · RUN_WORDS of the runs.
 const char* kEmitScan = R"(
 layout(local_size_x = 256) in;
 layout(std430, binding = 0) readonly buffer Meta { uint meta[]; };
@@ -136,39 +142,85 @@ uvec2 add64(uvec2 a, uvec2 b) {
     return (c2 | c3) != 0u ? uvec2(0xffffffffu) : uvec2(lo, hi);
 }
 uint atMost(uvec2 a, uint room) { return a.y != 0u ? room : min(a.x, room); }
+uint room(uint s) { return meta[4u + 4u * s]; }
+uint group(uint s) { return meta[5u + 4u * s]; }
+uint record(uint s, uint r) { return (meta[6u + 4u * s] + r * meta[7u + 4u * s]) * RUN_WORDS; }
+// An exclusive scan of partial[] in place, by invocation 0, which gets the sum back.
+uvec2 scanPartial(uint l) {
+    uvec2 before = uvec2(0u);
+    if (l == 0u)
+        for (uint k = 0u; k < 256u; ++k) {
+            uvec2 next = add64(before, partial[k]);
+            partial[k] = before;
+            before = next;
+        }
+    return before;
+}
 void main() {
-    uint l = gl_LocalInvocationID.x, rows = meta[0], sites = meta[1], totals = rows * sites * 8u;
+    uint l = gl_LocalInvocationID.x, rows = meta[0], sites = meta[1], totals = rows * sites * RUN_WORDS;
     uint chunk = (rows + 255u) / 256u, begin = min(l * chunk, rows), end = min(begin + chunk, rows);
-    uint kept = 0u;
     uvec2 count = uvec2(0u);
+    // What each site asked for, and the invalid and clamped counts (word 2, until the ids).
     for (uint s = 0u; s < sites; ++s) {
-        uint room = meta[4u + s], base = s * rows;
         uvec2 sum = uvec2(0u);
-        for (uint r = begin; r < end; ++r) sum = add64(sum, uvec2(runs[(base + r) * 8u], runs[(base + r) * 8u + 1u]));
+        for (uint r = begin; r < end; ++r) {
+            uint w = record(s, r);
+            sum = add64(sum, uvec2(runs[w], runs[w + 1u]));
+            count += uvec2(runs[w + 2u] & 0xffffu, runs[w + 2u] >> 16u);
+        }
         partial[l] = sum;
         barrier();
+        uvec2 all = scanPartial(l);
         if (l == 0u) {
-            uvec2 before = uvec2(0u);
-            for (uint k = 0u; k < 256u; ++k) {
-                uvec2 next = add64(before, partial[k]);
-                partial[k] = before;
-                before = next;
-            }
             uint t = totals + 3u + 3u * s;
-            runs[t] = atMost(before, room);
-            runs[t + 1u] = before.x;
-            runs[t + 2u] = before.y;
+            runs[t + 1u] = all.x;
+            runs[t + 2u] = all.y;
         }
         barrier();
+    }
+    // Each group's places, while its room lasts.
+    for (uint g = 0u; g < sites; ++g) {
+        if (group(g) != g) continue;  // (uniform: every invocation skips it)
+        uint stride = meta[7u + 4u * g], first = record(g, 0u) + begin * stride * RUN_WORDS;
+        uint last = record(g, 0u) + end * stride * RUN_WORDS, space = room(g);
+        uvec2 sum = uvec2(0u);
+        for (uint w = first; w < last; w += RUN_WORDS) sum = add64(sum, uvec2(runs[w], runs[w + 1u]));
+        partial[l] = sum;
+        barrier();
+        scanPartial(l);
+        barrier();
         uvec2 asked = partial[l];
-        for (uint r = begin; r < end; ++r) {
-            uint w = (base + r) * 8u;
-            uint place = atMost(asked, room);
+        for (uint w = first; w < last; w += RUN_WORDS) {
+            uint place = atMost(asked, space);
             asked = add64(asked, uvec2(runs[w], runs[w + 1u]));
             runs[w] = place;
-            runs[w + 1u] = atMost(asked, room) - place;
-            kept += runs[w + 1u];
-            count += uvec2(runs[w + 2u] & 0xffffu, runs[w + 2u] >> 16u);
+            runs[w + 1u] = atMost(asked, space) - place;
+        }
+        barrier();
+    }
+    // Each site's places among its own objects, and what it kept.
+    uint kept = 0u;
+    for (uint s = 0u; s < sites; ++s) {
+        uint sum = 0u;
+        for (uint r = begin; r < end; ++r) sum += runs[record(s, r) + 1u];
+        kept += sum;
+        keptBefore[l] = sum;
+        barrier();
+        if (l == 0u) {
+            uint before = 0u;
+            for (uint k = 0u; k < 256u; ++k) {
+                uint next = before + keptBefore[k];
+                keptBefore[k] = before;
+                before = next;
+            }
+            runs[totals + 3u + 3u * s] = before;
+        }
+        barrier();
+        uint place = keptBefore[l];
+        for (uint r = begin; r < end; ++r) {
+            uint w = record(s, r);
+            runs[w + SITE_PLACE] = place;
+            place += runs[w + 1u];
         }
         barrier();
     }
@@ -192,7 +244,7 @@ void main() {
     uint id = meta[2] + keptBefore[l];
     for (uint r = begin; r < end; ++r)
         for (uint s = 0u; s < sites; ++s) {
-            uint w = (s * rows + r) * 8u;
+            uint w = record(s, r);
             runs[w + 2u] = id;
             id += runs[w + 1u];
         }
@@ -200,7 +252,8 @@ void main() {
 )";
 
 std::string emissionShader(const char* body, bool rows) {
-    std::string header = "#version 450\n";
+    std::string header = "#version 450\n#define RUN_WORDS " + std::to_string(rt::kRunWords) + "u\n#define SITE_PLACE " +
+                         std::to_string(rt::kRunSitePlace) + "u\n";
     if (rows) header += "layout(local_size_x = 64) in;\n";
     return header + kParamsBlock + "#define INVOCATION " + kInvocationIndex + "\n" + body;
 }
@@ -234,7 +287,10 @@ void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs) {
     unsigned runsGl = bound(runs);
     std::vector<uint32_t> meta = {static_cast<uint32_t>(n), static_cast<uint32_t>(sites), in.nextId,
                                   static_cast<uint32_t>(in.first)};
-    for (const rt::RateSites::Site& s : in.sites) meta.push_back(s.room);
+    const rt::RecordLayout layout(in);
+    for (size_t k = 0; k < sites; ++k)
+        meta.insert(meta.end(), {in.sites[in.sites[k].group].room, in.sites[k].group, static_cast<uint32_t>(layout.first[k]),
+                                 static_cast<uint32_t>(layout.stride[k])});
     if (!metaBuffer_) glCreateBuffers(1, &metaBuffer_);
     glNamedBufferData(metaBuffer_, static_cast<GLsizeiptr>(meta.size() * 4), meta.data(), GL_STREAM_DRAW);
     afterWrite(Write::Upload, kStorageBlock);

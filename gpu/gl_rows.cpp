@@ -25,7 +25,7 @@ namespace {
 
 std::string shader(const char* body) {
     return std::string("#version 450\nlayout(local_size_x = 64) in;\n") + kParamsBlock + "#define INVOCATION " +
-           kInvocationIndex + "\n" + body;
+           kInvocationIndex + "\n#define RUN_WORDS " + std::to_string(rt::kRunWords) + "u\n" + body;
 }
 
 // FreeRows::row(k): stack[top − 1 − k] while the stack lasts, then past the high-water mark.
@@ -104,9 +104,9 @@ uint runOf(uint r, uint base, uint count) {
     uint lo = 0u, hi = count - 1u;
     while (lo < hi) {
         uint mid = (lo + hi + 1u) >> 1u;
-        if (runs[base + mid * 8u] <= r) lo = mid; else hi = mid - 1u;
+        if (runs[base + mid * RUN_WORDS] <= r) lo = mid; else hi = mid - 1u;
     }
-    return base + lo * 8u;
+    return base + lo * RUN_WORDS;
 }
 void identifyObject(uint u, uint k, uint at) {
     double firstTime = packDouble2x32(uvec2(runs[u + 4u], runs[u + 5u]));
@@ -138,7 +138,7 @@ void main() {
 // from record `base` on, its times and id at `first` + r.
 const char* kIdentifyRecords = R"(
 void main() {
-    uint r = INVOCATION, n = param(0u), records = param(1u), first = param(2u), base = param(3u) * 8u;
+    uint r = INVOCATION, n = param(0u), records = param(1u), first = param(2u), base = param(3u) * RUN_WORDS;
     if (r >= n) return;
     uint u = runOf(r, base, records);
     identifyObject(u, r - runs[u], first + r);
@@ -235,9 +235,9 @@ void GlMemory::identify(const rt::ObjectRuns& runs, size_t n, size_t kept, Buffe
     if (allOnHost({created, ids, mask})) return rt::Memory::identify(runs, n, kept, created, ids, mask, first);
     flushPending();
     if (!identifyProgram_) identifyProgram_ = computeProgram(shader((std::string(kRunObjects) + kIdentify).c_str()), "identify");
-    std::vector<uint32_t> words(std::max<size_t>(runs.size(), 1) * 8);  // (a block is never empty)
+    std::vector<uint32_t> words(std::max<size_t>(runs.size(), 1) * rt::kRunWords);  // (a block is never empty)
     for (size_t u = 0; u < runs.size(); ++u) {
-        uint32_t* w = words.data() + u * 8;
+        uint32_t* w = words.data() + u * rt::kRunWords;
         w[0] = runs.first[u];
         w[1] = runs.count[u];
         w[2] = runs.id[u];

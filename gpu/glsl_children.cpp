@@ -78,10 +78,13 @@ std::vector<uint32_t> GlslBackend::emitterBlock(GlMemory& memory, const Program&
 void GlslBackend::run(const rt::ChildrenLaunch& launch) { runChildren({&launch, 1}); }
 
 // Whether a launch from records can have its blocks built where the records are: the
-// records, the emitters' rows and their columns all on the GPU.
+// records, the emitters' rows and their columns all on the GPU — and, where its group
+// has other sites (its children's arguments among theirs), the arguments written in
+// place (a dispatch's words are copied to the columns a launch's range at a time).
 bool GlslBackend::blocksOnDevice(const rt::ChildrenLaunch& launch) {
     if (!memory_.onDevice(launch.records) || (launch.rows.valid() && !memory_.onDevice(launch.rows))) return false;
     const Program& p = childrenProgram(*launch.object, *launch.spawn);
+    if (launch.recordStride > 1 && p.direct.empty()) return false;
     for (const RowField& f : rowFields(p, launch))
         if (!memory_.onDevice(f.column)) return false;
     return true;
@@ -143,12 +146,13 @@ namespace {
 
 // Emitter blocks built where the records are (a launch from records): an invocation a
 // record, its block a copy of the launch's template with the record's children (count),
-// their place added to the first invocation and to the argument columns' words, its first
-// id as the first child's draw, and its emitter row's values copied from the columns —
-// up to kBlockSources columns a dispatch, listed in a table after the template: argument
-// columns, fields, then a word a field (block word | words a row << 24). Params: records,
-// the first record's word, the template's word, the first block's word, words a block,
-// flags (1: emitter rows from a list, 2: fields only), the list's first, the table's word.
+// their place among the site's added to the first invocation and their place among the
+// group's to the argument columns' words, its first id as the first child's draw, and its
+// emitter row's values copied from the columns — up to kBlockSources columns a dispatch,
+// listed in a table after the template: argument columns, fields, then a word a field
+// (block word | words a row << 24). Params: records, the first record's word, the
+// template's word, the first block's word, words a block, flags (1: emitter rows from a
+// list, 2: fields only; the records' stride from bit 8), the list's first, the table's word.
 constexpr size_t kBlockSources = 13;
 constexpr size_t kTableWords = 2 + kBlockSources;
 
@@ -167,12 +171,12 @@ layout(std430, binding = 2) readonly buffer Rows {{ uint rowOf[]; }};
 void main() {{
     uint k = {3};
     if (k >= param(0u)) return;
-    uint r = param(1u) + k * {4}u, at = param(3u) + k * param(4u), table = param(7u);
+    uint r = param(1u) + k * (param(5u) >> 8u) * {4}u, at = param(3u) + k * param(4u), table = param(7u);
     uint place = records[r], count = records[r + 1u];
     if ((param(5u) & 2u) == 0u) {{
         for (uint j = 0u; j < param(4u); ++j) w[at + j] = w[param(2u) + j];
         w[at + {5}u] = count;
-        w[at + {6}u] += place;
+        w[at + {6}u] += records[r + {9}u];
         w[at + {7}u] = records[r + 2u];
         for (uint c = 0u; c < w[table]; ++c) w[at + {8}u + c] += place;
     }}
@@ -185,7 +189,7 @@ void main() {{
 }}
 )",
                        kParamsBlock, sources, cases, kInvocationIndex, rt::kRunWords, LaunchBlock::kCount,
-                       LaunchBlock::kFirstInvocation, LaunchBlock::kFirstChild, LaunchBlock::kColumns);
+                       LaunchBlock::kFirstInvocation, LaunchBlock::kFirstChild, LaunchBlock::kColumns, rt::kRunSitePlace);
 }
 
 }  // namespace
@@ -205,7 +209,7 @@ void GlslBackend::dispatchChildren(std::span<const rt::ChildrenLaunch> launches)
     for (const rt::ChildrenLaunch& launch : launches) {
         total += launch.count;
         bound = std::min(bound, launch.argsFirst);
-        end = std::max(end, launch.argsFirst + launch.count);
+        end = std::max(end, launch.argsFirst + std::max(launch.count, launch.placed));
     }
     const bool direct = !p.direct.empty();
     bound = bound * 4 / storageAlignment_ * storageAlignment_ / 4;  // (f32 columns: a word a row)
@@ -334,7 +338,8 @@ void GlslBackend::buildBlocks(const rt::ChildrenLaunch& launch, const std::vecto
         for (size_t k = 0; k < kBlockSources; ++k)  // (every block bound to something)
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, static_cast<GLuint>(3 + k),
                              from + k < fields.size() ? memory_.deviceBuffer(fields[from + k].column) : records);
-        uint32_t flags = (launch.rows.valid() ? 1u : 0u) | (pass > 0 ? 2u : 0u);
+        uint32_t flags = (launch.rows.valid() ? 1u : 0u) | (pass > 0 ? 2u : 0u) |
+                         static_cast<uint32_t>(launch.recordStride) << 8;
         bindParams(params_, {static_cast<uint32_t>(launch.recordCount), static_cast<uint32_t>(launch.record * rt::kRunWords),
                              static_cast<uint32_t>(templateAt), static_cast<uint32_t>(firstWord),
                              static_cast<uint32_t>(recordWords), flags, static_cast<uint32_t>(launch.rowsFirst),

@@ -4,8 +4,8 @@
 namespace psys::rt {
 
 std::vector<ChildrenLaunch> eachEmitter(const Memory& memory, const ChildrenLaunch& launch) {
-    std::vector<uint32_t> records(launch.recordCount * kRunWords), rows;
-    if (records.empty()) return {};
+    if (launch.recordCount == 0) return {};
+    std::vector<uint32_t> records(((launch.recordCount - 1) * launch.recordStride + 1) * kRunWords), rows;
     memory.read(launch.records, launch.record * kRunWords, records.size(), records.data());
     if (launch.rows.valid()) {
         rows.resize(launch.recordCount);
@@ -13,11 +13,12 @@ std::vector<ChildrenLaunch> eachEmitter(const Memory& memory, const ChildrenLaun
     }
     std::vector<ChildrenLaunch> each;
     for (size_t k = 0; k < launch.recordCount; ++k) {
-        const uint32_t* w = records.data() + k * kRunWords;
+        const uint32_t* w = records.data() + k * launch.recordStride * kRunWords;
         if (w[1] == 0) continue;
         ChildrenLaunch& one = each.emplace_back(launch);
         one.records = one.rows = {};
-        one.record = one.recordCount = one.rowsFirst = 0;
+        one.record = one.recordCount = one.rowsFirst = one.placed = 0;
+        one.recordStride = 1;
         one.row = rows.empty() ? static_cast<uint32_t>(k) : rows[k];
         one.firstChild = w[2];
         one.count = w[1];

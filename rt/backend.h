@@ -108,12 +108,14 @@ struct ChildrenLaunch {
     size_t argsFirst = 0;                   // child k's arguments at row argsFirst + k
     // Or, where `records` is valid, the launches of one site's emitters as a rate emission
     // left them (Memory::emitAtRate), so that they need not come back to the host:
-    // `recordCount` records from record `record` on, record k emitter row
-    // `rows`[rowsFirst + k] (row k where `rows` is not valid), its children at argsFirst
-    // plus its place (the record's word 0), drawn from its first id (word 2) on; `count`
-    // is then the children of all of them, and `row` and `firstChild` are not used.
+    // `recordCount` records, record k at `record` + k · `recordStride` (rt::RecordLayout),
+    // of emitter row `rows`[rowsFirst + k] (row k where `rows` is not valid), its children
+    // at argsFirst plus its place among its group's (the record's word 0), drawn from its
+    // first id (word 2) on; `count` is then the children of all of them, `placed` those of
+    // their group (the argument rows [argsFirst, argsFirst + placed) they write among),
+    // and `row` and `firstChild` are not used.
     Buffer records, rows;
-    size_t record = 0, recordCount = 0, rowsFirst = 0;
+    size_t record = 0, recordCount = 0, recordStride = 1, rowsFirst = 0, placed = 0;
 };
 
 // A launch from records as one launch an emitter (those with children), read from the

@@ -157,9 +157,23 @@ void Memory::identifyRecords(Buffer runs, size_t firstRecord, size_t records, si
     }
 }
 
+RecordLayout::RecordLayout(const RateSites& in) : first(in.sites.size()), stride(in.sites.size()) {
+    const size_t n = in.rows, sites = in.sites.size();
+    size_t next = 0;  // the first record of the next group
+    for (size_t g = 0; g < sites; ++g) {
+        if (in.sites[g].group != g) continue;
+        size_t rank = 0;
+        for (size_t s = g; s < sites; ++s)
+            if (in.sites[s].group == g) first[s] = next + rank++;
+        for (size_t s = g; s < sites; ++s)
+            if (in.sites[s].group == g) stride[s] = rank;
+        next += rank * n;
+    }
+}
+
 // The rate emissions (and bursts on death) of emitter rows (Memory::emitAtRate):
-// rt/emission.h's rules row by row, each site's objects kept while its target's room
-// lasts, the ids in row order.
+// rt/emission.h's rules row by row, each group's objects kept while its room lasts, the
+// ids in row order.
 void Memory::emitAtRate(const RateSites& in, Buffer runs) {
     const size_t n = in.rows, sites = in.sites.size();
     auto* record = static_cast<uint32_t*>(host(runs));
@@ -170,16 +184,20 @@ void Memory::emitAtRate(const RateSites& in, Buffer runs) {
     const auto* mask = static_cast<const uint8_t*>(view(in.mask)) + f;
     const auto* killed = in.killed.valid() ? static_cast<const uint8_t*>(view(in.killed)) + f : nullptr;
     const auto* created = in.created.valid() ? static_cast<const double*>(view(in.created)) + f : nullptr;
+    const RecordLayout layout(in);
     struct Site {
         const float *rate, *count;
         double* accumulated;
-        uint64_t asked = 0;  // objects asked for so far (saturating)
+        uint64_t asked = 0;       // objects it asked for so far (saturating)
+        uint64_t groupAsked = 0;  // (its group's first site's:) objects the group asked for so far
+        uint32_t kept = 0;        // objects it kept so far
     };
     std::vector<Site> site;
     for (const RateSites::Site& s : in.sites)
         site.push_back({s.rate.valid() ? static_cast<const float*>(view(s.rate)) + f : nullptr,
                         s.count.valid() ? static_cast<const float*>(view(s.count)) + f : nullptr,
                         static_cast<double*>(host(s.accumulated)) + f});
+    auto add = [](uint64_t a, uint64_t b) { return b > UINT64_MAX - a ? UINT64_MAX : a + b; };
     uint64_t invalid = 0, clamped = 0;
     uint32_t id = in.nextId;
     for (size_t r = 0; r < n; ++r)
@@ -199,17 +217,22 @@ void Memory::emitAtRate(const RateSites& in, Buffer runs) {
                 invalid += e.invalid;
                 clamped += e.clamped;
             }
-            uint64_t before = d.asked;
-            d.asked = e.children > UINT64_MAX - before ? UINT64_MAX : before + e.children;
-            auto place = static_cast<uint32_t>(std::min<uint64_t>(before, s.room));
-            auto kept = static_cast<uint32_t>(std::min<uint64_t>(d.asked, s.room)) - place;
-            uint32_t* w = record + (k * n + r) * kRunWords;
+            uint64_t& asked = site[s.group].groupAsked;
+            const uint32_t room = in.sites[s.group].room;
+            uint64_t before = asked;
+            asked = add(before, e.children);
+            d.asked = add(d.asked, e.children);
+            auto place = static_cast<uint32_t>(std::min<uint64_t>(before, room));
+            auto kept = static_cast<uint32_t>(std::min<uint64_t>(asked, room)) - place;
+            uint32_t* w = record + layout.record(k, r) * kRunWords;
             w[0] = place;
             w[1] = kept;
             w[2] = id;
             w[3] = static_cast<uint32_t>(std::min<uint64_t>(e.perEvent, UINT32_MAX));
             std::memcpy(w + 4, &e.firstTime, 8);
             std::memcpy(w + 6, &e.spacing, 8);
+            w[kRunSitePlace] = d.kept;
+            d.kept += kept;
             id += kept;
         }
     total[kTotalsInvalid] = static_cast<uint32_t>(std::min<uint64_t>(invalid, UINT32_MAX));
@@ -217,7 +240,7 @@ void Memory::emitAtRate(const RateSites& in, Buffer runs) {
     total[kTotalsIds] = id - in.nextId;
     for (size_t k = 0; k < sites; ++k) {
         uint32_t* t = total + kTotalsSites + kTotalsPerSite * k;
-        t[0] = static_cast<uint32_t>(std::min<uint64_t>(site[k].asked, in.sites[k].room));
+        t[0] = site[k].kept;
         t[1] = static_cast<uint32_t>(site[k].asked);
         t[2] = static_cast<uint32_t>(site[k].asked >> 32);
     }

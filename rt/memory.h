@@ -68,12 +68,18 @@ struct RateSites {
         Buffer rate, count;  // f32 per row; invalid: rateValue, countValue every row's
         float rateValue = 0, countValue = 1;
         Buffer accumulated;  // f64 per row: events accumulated, in [0, 1)
-        uint32_t room = 0;   // objects its target may still take (its free rows less those queued)
+        // Objects its target may still take (its free rows less those queued): the room of
+        // every site of its group.
+        uint32_t room = 0;
+        // Its group: the first site into the same target (its own index where none before
+        // it is). A group's sites share its room, their objects one run: placed in row
+        // order, a row's sites in order, as the host queues them one emitter at a time.
+        uint32_t group = 0;
         // A burst on death (rt::deathBurst): `count` objects at t1 from each row of the
         // mask, killed ones too; no rate, its accumulator untouched.
         bool onDeath = false;
     };
-    std::vector<Site> sites;  // in the type's order of sites, each its own target type
+    std::vector<Site> sites;  // in the type's order of sites
     size_t rows = 0;
     size_t first = 0;  // the rows are [first, first + rows) of every column (records from 0)
     Buffer mask;     // u8: the rows that emit
@@ -84,13 +90,26 @@ struct RateSites {
     uint32_t nextId = 0;  // the first id the emissions take
 };
 
+// Where emitAtRate's records are: a group's records one range, in row order and a row's
+// sites in order (so their places rise with the record), the groups in the order of
+// their first sites. Site s's record for row r is first[s] + r · stride[s] (stride: the
+// sites of its group); group g's range starts at first[g] (its first site's rank is 0).
+struct RecordLayout {
+    std::vector<size_t> first, stride;
+    explicit RecordLayout(const RateSites& sites);
+    size_t record(size_t site, size_t row) const { return first[site] + row * stride[site]; }
+};
+
 // Emitter rows' records in a runs buffer (Memory::emitAtRate), kRunWords words each, in
-// rt::ObjectRuns' form: first (the run's first object's place among the site's objects),
-// count, id, perEvent, firstTime (f64, low word first), spacing (f64); after the records
-// (rows · sites of them), the totals: the emissions' invalid rates and counts, the counts
-// clamped, the ids taken; then per site: objects kept, and objects asked for (u64, low
-// word first) — so that one read brings back all the host needs.
-constexpr size_t kRunWords = 8;
+// rt::ObjectRuns' form: first (the run's first object's place among its group's objects),
+// count, id, perEvent, firstTime (f64, low word first), spacing (f64), then its first
+// object's place among its own site's objects (for the site's spawn launch); after the
+// records (rows · sites of them, where RecordLayout says), the totals: the emissions'
+// invalid rates and counts, the counts clamped, the ids taken; then per site: objects
+// kept, and objects asked for (u64, low word first) — so that one read brings back all
+// the host needs.
+constexpr size_t kRunWords = 9;
+constexpr size_t kRunSitePlace = 8;
 constexpr size_t kTotalsInvalid = 0, kTotalsClamped = 1, kTotalsIds = 2, kTotalsSites = 3, kTotalsPerSite = 3;
 // The words of a runs buffer for `rows` emitters at `sites` sites, and where its totals start.
 constexpr size_t runsTotalsAt(size_t rows, size_t sites) { return rows * sites * kRunWords; }
@@ -176,14 +195,14 @@ public:
                           size_t first);
     // The rate emissions of emitter rows (rt/emission.h's rule, in row order, a row's sites
     // in order): each row of `sites.mask` not killed advances its accumulators and asks
-    // for its events' objects; a site's target keeps them while its room lasts (the rest
-    // dropped, counted in the totals), and the kept take ids from nextId in row order,
-    // sites in order. Row r's run at site s is record s·rows + r of `runs` (u32,
-    // runsWords(rows, sites) of them: kRunWords a record, a row that emits nothing has
-    // count 0), the totals after the records (kTotals…). Written here through `host`; a
-    // device does it where the rows are (GlMemory: a dispatch a site and one scan).
+    // for its events' objects; a site's target keeps them while its group's room lasts
+    // (the rest dropped, counted in the totals), and the kept take ids from nextId in row
+    // order, sites in order. Row r's run at site s is record RecordLayout::record(s, r) of
+    // `runs` (u32, runsWords(rows, sites) of them: kRunWords a record, a row that emits
+    // nothing has count 0), the totals after the records (kTotals…). Written here through
+    // `host`; a device does it where the rows are (GlMemory: a dispatch a site and one scan).
     virtual void emitAtRate(const RateSites& sites, Buffer runs);
-    // Objects r < objects of a batch from a site's records of `runs` (emitAtRate's,
+    // Objects r < objects of a batch from a group's records of `runs` (emitAtRate's,
     // records [firstRecord, firstRecord + records): the objects the record's count says
     // from its first on): created[first + r] and ids[first + r], where the records are.
     virtual void identifyRecords(Buffer runs, size_t firstRecord, size_t records, size_t objects, Buffer created,

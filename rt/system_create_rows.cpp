@@ -139,6 +139,8 @@ void Creation::emitInMemory(size_t type, const std::vector<Buffer>& table, const
         source(info.rated[site], layout.emitRate(i), out.rateValue, out.rate);
         source(info.counted[site], layout.emitCount(i), out.countValue, out.count);
         size_t target = info.emitTarget[site];
+        out.group = static_cast<uint32_t>(std::find(info.emitTarget.begin(), info.emitTarget.end(), target) -
+                                          info.emitTarget.begin());
         size_t free = s_.pools[target].free() + pending_[target];
         out.room = static_cast<uint32_t>(std::min<size_t>(free > queued_[target] ? free - queued_[target] : 0, UINT32_MAX));
     }
@@ -152,23 +154,36 @@ void Creation::emitInMemory(size_t type, const std::vector<Buffer>& table, const
     s_.memory.read(runs, runsTotalsAt(n, sites), total.size(), total.data());
     s_.stats.invalidEmissions += total[kTotalsInvalid];
     s_.stats.clampedEmissions += total[kTotalsClamped];
-    // Each site's objects one run, and its emitters' spawn launches one launch from the
-    // records (ChildrenLaunch::records): ids, times, places and emitter rows where the
-    // records are.
-    for (size_t site = 0; site < sites; ++site) {
-        const uint32_t* t = total.data() + kTotalsSites + kTotalsPerSite * site;
-        uint64_t asked = t[1] | uint64_t{t[2]} << 32;
-        size_t target = info.emitTarget[site];
-        addSaturating(s_.typeStats[target].dropped, asked - t[0]);
-        if (t[0] == 0) continue;
-        size_t base = stage(target, t[0]);
-        if (ChildrenLaunch* launch = queueSpawn({type, 0, {}, 0, t1, false}, static_cast<int>(site), 0, t[0], base)) {
+    // Each group's objects one run, and each site's emitters' spawn launches one launch,
+    // from the records (ChildrenLaunch::records): ids, times, places and emitter rows
+    // where the records are.
+    const RecordLayout records(in);
+    for (size_t group = 0; group < sites; ++group) {
+        if (in.sites[group].group != group) continue;
+        uint64_t kept = 0, asked = 0;
+        for (size_t site = group; site < sites; ++site) {
+            const uint32_t* t = total.data() + kTotalsSites + kTotalsPerSite * site;
+            if (in.sites[site].group != group) continue;
+            kept += t[0];
+            addSaturating(asked, t[1] | uint64_t{t[2]} << 32);
+        }
+        size_t target = info.emitTarget[group];
+        addSaturating(s_.typeStats[target].dropped, asked - kept);
+        if (kept == 0) continue;
+        size_t base = stage(target, kept);
+        for (size_t site = group; site < sites; ++site) {
+            uint32_t siteKept = total[kTotalsSites + kTotalsPerSite * site];
+            if (in.sites[site].group != group || siteKept == 0) continue;
+            ChildrenLaunch* launch = queueSpawn({type, 0, {}, 0, t1, false}, static_cast<int>(site), 0, siteKept, base);
+            if (!launch) continue;
             launch->records = runs;
-            launch->record = site * n;
+            launch->record = records.first[site];
             launch->recordCount = n;
+            launch->recordStride = records.stride[site];
+            launch->placed = kept;
             launch->rows = rows;
         }
-        enqueue({target, base, t[0], {}, 0, 0, 1, 0, runs, site * n, n});
+        enqueue({target, base, kept, {}, 0, 0, 1, 0, runs, records.first[group], n * records.stride[group]});
     }
     s_.nextId += total[kTotalsIds];
 }

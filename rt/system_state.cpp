@@ -110,11 +110,15 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         info.rowsInMemory = inMemory && (info.late || silent) && keptWhole(info);
     }
     // Emitters whose emissions the memory decides (Memory::emitAtRate): nobody reads them,
-    // every site emits at a rate or bursts on death into a type of its own that keeps its
-    // rows in the memory (one that emits nothing, or such an emitter itself) and reads no
-    // parent, and whose arguments read no fold (a spawn launch from records has no parent
-    // values) — so a step's emissions are one operation over the rows, and the objects
-    // they create batches of those types, whose first updates emit by the same operation.
+    // every site emits at a rate or bursts on death into a type that keeps its rows in the
+    // memory (one that emits nothing, or such an emitter itself) and reads no parent, and
+    // whose arguments read no fold (a spawn launch from records has no parent values) —
+    // so a step's emissions are one operation over the rows, and the objects they create
+    // batches of those types, whose first updates emit by the same operation. Sites into
+    // one type share its room, their objects one batch in the host's order (rt::RateSites:
+    // a group). At most one of the types is an emitter: the host creates what each emitter
+    // asks for in its turn, and the children of two types of emitters would take their ids
+    // one emitter at a time, not one type at a time.
     // One that dies exports nothing: the operation reads its update's kill flags where
     // they are (a row killed emits at no rate, and bursts), and its kills are late, as a
     // type's that only dies — nobody else looks at them before the step's end. (Until no
@@ -128,11 +132,14 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         bool dies = info.kills || info.unstable;
         bool emitter = options.rows == SystemOptions::Rows::InMemory && options.createInBatches && info.updateEmits &&
                        (!dies || (options.lateKills && !info.exports)) && !info.read && keptWhole(info);
+        int emitting = -1;  // the one target that emits, if any
         for (size_t s = 0; emitter && s < o.emits.size(); ++s) {
-            size_t target = info.emitTarget[s];
-            emitter = (o.emits[s].rate() || o.emits[s].when == ir::EmitSite::When::Death) && types[target].rowsInMemory &&
-                      std::count(info.emitTarget.begin(), info.emitTarget.end(), target) == 1 &&
-                      info.spawnLayout[s].parentColumns.empty();
+            auto target = static_cast<int>(info.emitTarget[s]);
+            emitter = (o.emits[s].rate() || o.emits[s].when == ir::EmitSite::When::Death) &&
+                      types[static_cast<size_t>(target)].rowsInMemory && info.spawnLayout[s].parentColumns.empty();
+            if (module.objects[static_cast<size_t>(target)].emits.empty()) continue;
+            emitter = emitter && (emitting < 0 || emitting == target);
+            emitting = target;
         }
         return emitter;
     };

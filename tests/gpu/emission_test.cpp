@@ -2,7 +2,8 @@
 // dispatches (gpu/gl_emission.cpp) against the host's rule (rt/memory.cpp, rt/emission.h),
 // record by record and bit by bit — the accumulators, each row's run, the totals — over
 // rows that emit and rows that do not, rates and counts per row and shared, invalid and
-// enormous values, targets that run out of room part-way, and a batch's own clocks.
+// enormous values, targets that run out of room part-way, sites that share a target's
+// room, and a batch's own clocks.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -40,6 +41,7 @@ struct Emitters {
             site.rate = m.create(rt::Elem::F32, first + rows);
             site.count = m.create(rt::Elem::F32, first + rows);
             site.accumulated = m.create(rt::Elem::F64, first + rows);
+            site.group = static_cast<uint32_t>(s);  // (each into a target of its own)
             sites.sites.push_back(site);
         }
         runs = m.create(rt::Elem::U32, rt::runsWords(rows, count));
@@ -64,11 +66,14 @@ float oneOf(std::mt19937& random, std::initializer_list<float> values) {
 }  // namespace
 
 TEST_CASE("rate emissions decided on the GPU: the host's runs, ids, drops and accumulators, bit for bit") {
-    // Sites at a rate and bursts on death, every round some of each.
+    // Sites at a rate and bursts on death, every round some of each; sites 1 and 3 into
+    // one target (a group: its room shared, its objects placed in row order).
     auto gpu = gpuBackend();
     rt::HostMemory hostMemory;
-    constexpr size_t kRows = 3000, kSites = 3;
+    constexpr size_t kRows = 3000, kSites = 4;
     Emitters host(hostMemory, kRows, kSites, 5), device(gpu->memory(), kRows, kSites, 5);
+    host.sites.sites[3].group = device.sites.sites[3].group = 1;
+    const rt::RecordLayout layout(host.sites);
     std::mt19937 random(11);
     const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
     uint32_t nextId = 100;
@@ -92,6 +97,7 @@ TEST_CASE("rate emissions decided on the GPU: the host's runs, ids, drops and ac
         }
         // Odd rounds clock each row from its creation (a batch's first update).
         bool ownClock = round % 3 == 2;
+        uint32_t shared = 0;  // the group's room
         for (size_t s = 0; s < kSites; ++s) {
             std::vector<float> rate(kRows), count(kRows);
             for (size_t r = 0; r < kRows; ++r) {
@@ -100,8 +106,11 @@ TEST_CASE("rate emissions decided on the GPU: the host's runs, ids, drops and ac
                 count[r] = random() % 60 == 0 ? oneOf(random, {nan, -2, 0, 0.5f, 1e25f, 3.7f}) : 1 + random() % 4;
             }
             bool perRowRate = (round + s) % 4 != 0, perRowCount = (round + s) % 3 != 0;
-            // Room: plenty, some, none — the last sites run out part-way.
+            // Room: plenty, some, none — the last sites run out part-way (a group's is its
+            // first site's).
             auto room = static_cast<uint32_t>(s == 0 ? 10'000'000 : s == 1 ? 20'000 + random() % 30'000 : random() % 50);
+            if (s == 1) shared = room;
+            if (s == 3) room = shared;
             for (Emitters* e : {&host, &device}) {
                 rt::RateSites::Site& site = e->sites.sites[s];
                 e->write(site.rate, rate);
@@ -132,8 +141,7 @@ TEST_CASE("rate emissions decided on the GPU: the host's runs, ids, drops and ac
         auto differs = std::mismatch(runs.begin(), runs.end(), deviceRuns.begin());
         if (differs.first != runs.end()) {
             auto word = static_cast<size_t>(differs.first - runs.begin());
-            INFO("site " << word / rt::kRunWords / kRows << ", row " << word / rt::kRunWords % kRows << ", word "
-                         << word % rt::kRunWords);
+            INFO("record " << word / rt::kRunWords << ", word " << word % rt::kRunWords);
             REQUIRE(*differs.first == *differs.second);
         }
         for (size_t s = 0; s < kSites; ++s)
@@ -144,13 +152,28 @@ TEST_CASE("rate emissions decided on the GPU: the host's runs, ids, drops and ac
             uint64_t asked = t[1] | uint64_t{t[2]} << 32;
             cut = cut || asked > t[0];
         }
-        // Each site's objects' creation times and ids from its records where they are: the
-        // same bits on both memories, and those of identify from the same runs as a list.
+        // A group's sites take places among its objects in row order, a row's sites in
+        // order, and each its own places among its own.
+        uint32_t groupPlace = 0, sitePlace[kSites] = {};
+        for (size_t r = 0; r < kRows; ++r)
+            for (size_t s : {1, 3}) {
+                const uint32_t* w = runs.data() + layout.record(s, r) * rt::kRunWords;
+                REQUIRE(w[0] == groupPlace);
+                REQUIRE(w[rt::kRunSitePlace] == sitePlace[s]);
+                groupPlace += w[1];
+                sitePlace[s] += w[1];
+            }
+        // Each group's objects' creation times and ids from its records where they are:
+        // the same bits on both memories, and those of identify from the same runs as a list.
         for (size_t s = 0; s < kSites; ++s) {
-            uint32_t objects = totals[rt::kTotalsSites + rt::kTotalsPerSite * s];
+            if (host.sites.sites[s].group != s) continue;
+            uint32_t objects = 0;
+            for (size_t k = s; k < kSites; ++k)
+                if (host.sites.sites[k].group == s) objects += totals[rt::kTotalsSites + rt::kTotalsPerSite * k];
+            const size_t records = kRows * layout.stride[s];
             rt::ObjectRuns list;
-            for (size_t r = 0; r < kRows; ++r) {
-                const uint32_t* w = runs.data() + (s * kRows + r) * rt::kRunWords;
+            for (size_t r = 0; r < records; ++r) {
+                const uint32_t* w = runs.data() + (layout.first[s] + r) * rt::kRunWords;
                 double firstTime, spacing;
                 std::memcpy(&firstTime, w + 4, 8);
                 std::memcpy(&spacing, w + 6, 8);
@@ -168,7 +191,7 @@ TEST_CASE("rate emissions decided on the GPU: the host's runs, ids, drops and ac
                 rt::Buffer c = e->memory.create(rt::Elem::F64, objects + 3), i = e->memory.create(rt::Elem::U32, objects + 3),
                            m = e->memory.create(rt::Elem::U8, objects + 3);
                 if (which < 2)
-                    e->memory.identifyRecords(e->runs, s * kRows, kRows, objects, c, i, 3);
+                    e->memory.identifyRecords(e->runs, layout.first[s], records, objects, c, i, 3);
                 else
                     e->memory.identify(list, objects, objects, c, i, m, 3);
                 created[which] = e->read<uint64_t>(c, objects, 3);
@@ -258,6 +281,59 @@ TEST_CASE("a rate emission's records are the rule's: events, times, ids in row o
     CHECK(e.read<double>(e.sites.sites[1].accumulated, 2)[1] == doctest::Approx(0.9 + 2.1 - 3));
 }
 
+TEST_CASE("sites into one target share its room: places in row order, a row's sites in order, on both memories") {
+    // Two rows, three sites: 0 and 2 into one target with room for 8, 1 into another.
+    // Each row asks 4 at site 0 (2 events of 2), 1 at site 1, 3 at site 2.
+    auto gpu = gpuBackend();
+    rt::HostMemory hostMemory;
+    for (rt::Memory* m : {static_cast<rt::Memory*>(&hostMemory), &gpu->memory()}) {
+        Emitters e(*m, 2, 3);
+        e.write(e.sites.mask, std::vector<uint8_t>{1, 1});
+        e.write(e.sites.killed, std::vector<uint8_t>{0, 0});
+        e.sites.created = {};
+        e.sites.dt = 0.1;
+        e.sites.t1 = 1;
+        e.sites.nextId = 7;
+        const float rate[3] = {20, 10, 30}, count[3] = {2, 1, 1};
+        for (size_t s = 0; s < 3; ++s) {
+            rt::RateSites::Site& site = e.sites.sites[s];
+            e.write(site.accumulated, std::vector<double>{0, 0});
+            site.rate = site.count = {};
+            site.rateValue = rate[s];
+            site.countValue = count[s];
+            site.room = s == 1 ? 100 : 8;
+        }
+        e.sites.sites[2].group = 0;
+        m->emitAtRate(e.sites, e.runs);
+        auto runs = e.read<uint32_t>(e.runs, rt::runsWords(2, 3));
+        const rt::RecordLayout layout(e.sites);
+        CHECK(layout.first == std::vector<size_t>{0, 4, 1});  // (the group's records first, row by row)
+        CHECK(layout.stride == std::vector<size_t>{2, 1, 2});
+        auto record = [&](size_t site, size_t row) { return runs.data() + layout.record(site, row) * rt::kRunWords; };
+        // Row 0: site 0 places 0…3 (ids 7…10), site 1 (11), site 2 places 4…6 (12…14);
+        // row 1: site 0 place 7 (1 of 4: 15), site 1 (16), site 2 nothing left (of 3).
+        const uint32_t expected[3][2][4] = {{{0, 4, 7, 0}, {7, 1, 15, 4}},    // place, kept, id, place in the site
+                                            {{0, 1, 11, 0}, {1, 1, 16, 1}},
+                                            {{4, 3, 12, 0}, {8, 0, 17, 3}}};
+        for (size_t s = 0; s < 3; ++s)
+            for (size_t r = 0; r < 2; ++r) {
+                INFO("site " << s << ", row " << r);
+                const uint32_t* w = record(s, r);
+                CHECK(w[0] == expected[s][r][0]);
+                CHECK(w[1] == expected[s][r][1]);
+                CHECK(w[2] == expected[s][r][2]);
+                CHECK(w[rt::kRunSitePlace] == expected[s][r][3]);
+            }
+        const uint32_t* totals = runs.data() + rt::runsTotalsAt(2, 3);
+        CHECK(totals[rt::kTotalsIds] == 10);
+        const uint32_t keptAsked[3][2] = {{5, 8}, {2, 2}, {3, 6}};
+        for (size_t s = 0; s < 3; ++s) {
+            CHECK(totals[rt::kTotalsSites + rt::kTotalsPerSite * s] == keptAsked[s][0]);
+            CHECK(totals[rt::kTotalsSites + rt::kTotalsPerSite * s + 1] == keptAsked[s][1]);
+        }
+    }
+}
+
 TEST_CASE("emitters whose emissions the GPU decides: the interpreter's objects, ids, rows and drops") {
     // With rows kept in the memory (SystemOptions::Rows::InMemory), an emitter that never
     // dies and emits at a rate into types that keep their rows there keeps its rows on the
@@ -265,11 +341,15 @@ TEST_CASE("emitters whose emissions the GPU decides: the interpreter's objects, 
     // row, counts per row, invalid rates (counted), a target at capacity (drops), emitters
     // created in the step by a trigger (their first update's emissions), two sites;
     // emitters that die (some in their first update), their kills late, read where they
-    // are, emitters that burst on death, and an emitter of those (the rain).
-    std::vector<std::string> programs;
-    for (const char* sample : {"fountain", "emitter", "two_streams", "tornado", "rain"})
-        programs.push_back(test::readFile(test::sample(sample)));
-    programs.push_back(R"(
+    // are, emitters that burst on death, and an emitter of those (the rain); several
+    // sites into one target (the shapes; a small target shared by an emitter and the
+    // emitters it emits); an emitter of two types of emitters (which stays on the host).
+    // Each with the emitters whose rows it keeps in the memory.
+    std::vector<std::pair<std::string, size_t>> programs;
+    for (const char* sample : {"fountain", "emitter", "two_streams", "tornado", "shapes"})
+        programs.push_back({test::readFile(test::sample(sample)), 1});
+    programs.push_back({test::readFile(test::sample("rain")), 2});  // the cloud and its drops
+    programs.push_back({R"(
         @capacity(300) object p(k: float) { point(vec3(k, age, 0), white, 1); kill when age > 0.4; }
         object q { point(vec3(0, age, 1), red, 1); kill when age > 0.3; }
         object e(r: float) {
@@ -280,10 +360,25 @@ TEST_CASE("emitters whose emissions the GPU decides: the interpreter's objects, 
         spawn e(-1);
         spawn e(0.25);
         spawn e(45);
-        trigger more { emit e(rand() * 200) count 3; })");
-    for (const char* name : {"emitters_that_die", "emitters_burst_on_death"})
-        programs.push_back(test::readFile(std::string(PSYS_PROGRAMS_DIR) + "/" + name + ".psys"));
-    for (const std::string& text : programs) {
+        trigger more { emit e(rand() * 200) count 3; })", 1});
+    // Two sites into a type of 16 parameter components (its spawn launches write them into
+    // the dispatch's words, not in place: their emitters' blocks built on the host).
+    programs.push_back({R"(
+        @capacity(500) object w(a: vec4, b: vec4, c: vec4, d: vec4) {
+            point(a.xyz + b.xyz * age, c, d.x);
+            kill when age > 0.3 + d.y;
+        }
+        object e(r: float) {
+            emit w(vec4(r), vec4(rand()), vec4(1, 0, 0, 1), vec4(2, rand(), 0, 0)) at 50 + r per second;
+            emit w(vec4(-r), vec4(rand()), vec4(0, 1, 0, 1), vec4(3, 0.1, 0, 0)) at 700 per second count 2;
+        }
+        spawn e(1);
+        spawn e(20);
+        spawn e(300);)", 1});
+    for (auto [name, emitters] : {std::pair{"emitters_that_die", 1}, {"emitters_burst_on_death", 1},
+                                  {"sites_share_a_target", 2}, {"two_kinds_of_emitter_from_one", 2}})
+        programs.push_back({test::readFile(std::string(PSYS_PROGRAMS_DIR) + "/" + name + ".psys"), emitters});
+    for (const auto& [text, expected] : programs) {
         INFO(text.substr(0, 120));
         rt::SystemOptions kept;
         kept.rows = rt::SystemOptions::Rows::InMemory;
@@ -291,8 +386,7 @@ TEST_CASE("emitters whose emissions the GPU decides: the interpreter's objects, 
         size_t emitters = 0;
         for (size_t t = 0; t < p.gl->typeCount(); ++t)
             emitters += p.gl->pool(t).rowsInMemory() && !p.gl->module().objects[t].emits.empty();
-        // (The rain's cloud emits drops that burst on death: both decided there.)
-        CHECK(emitters == (text.find("object cloud") != std::string::npos ? 2 : 1));
+        CHECK(emitters == expected);
         for (int f = 0; f < 90; ++f) {
             if (f == 20 && !p.cpu->module().triggers.empty()) p.fire("more");
             p.steps(1, 1.0 / 60);

@@ -100,7 +100,8 @@ TEST_CASE("the schedule says which types keep their rows in the memory, and wher
     CHECK(printed.find("drop: the kill lists freed in the memory") != std::string::npos);
     CHECK(printed.find("fountain: the update kernel over the pool, its rows in the memory") != std::string::npos);
     CHECK(printed.find("fountain: rate emissions (drop) decided by the memory's operation") != std::string::npos);
-    CHECK(printed.find("its spawn launches one launch, from the records") != std::string::npos);
+    CHECK(printed.find("each target's objects one run, each site's spawn launches one launch, from the records") !=
+          std::string::npos);
     CHECK(rt::printSchedule(plain.schedule()).find("memory") == std::string::npos);  // the interpreter's own choice: the host
     // The rain's drops die and burst on death into types that only die: their rows, kills
     // and bursts in the memory too; and so the cloud, which emits them at a rate.
@@ -111,6 +112,20 @@ TEST_CASE("the schedule says which types keep their rows in the memory, and wher
     CHECK(printed.find("cloud: rate emissions (drop) decided by the memory's operation") != std::string::npos);
     CHECK(printed.find("drop: the kill lists kept for the step's end, where the memory frees them") != std::string::npos);
     CHECK(printed.find("drop: rate emissions of the survivors, bursts on deaths (droplet, ripple) decided by the memory's operation") !=
+          std::string::npos);
+    // The shapes' four sites into `mote` share its room: one operation still.
+    rt::System shapes(test::compileModule(test::readFile(std::string(PSYS_SAMPLES_DIR) + "/shapes.psys")), backend, options);
+    CHECK(shapes.pool(static_cast<size_t>(shapes.typeIndex("shapes"))).rowsInMemory());
+    CHECK(rt::printSchedule(shapes.schedule()).find("shapes: rate emissions (mote, spark, mote, mote, mote) decided by the "
+                                                    "memory's operation") != std::string::npos);
+    // An emitter of two types of emitters: the host decides its emissions (their children
+    // take ids one emitter at a time); the two emitters' rows are in the memory.
+    rt::System two(test::compileModule(test::readFile(std::string(PSYS_PROGRAMS_DIR) + "/two_kinds_of_emitter_from_one.psys")),
+                   backend, options);
+    CHECK_FALSE(two.pool(static_cast<size_t>(two.typeIndex("e"))).rowsInMemory());
+    CHECK(two.pool(static_cast<size_t>(two.typeIndex("a"))).rowsInMemory());
+    CHECK(two.pool(static_cast<size_t>(two.typeIndex("b"))).rowsInMemory());
+    CHECK(rt::printSchedule(two.schedule()).find("e: rate emissions of the survivors (a, b): events, times, ids, the queue") !=
           std::string::npos);
 }
 
