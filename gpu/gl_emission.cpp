@@ -1,4 +1,4 @@
-// Rate emissions (and bursts on death) decided where an emitter's rows are
+// Rate emissions (and bursts) decided where an emitter's rows are
 // (rt::Memory::emitAtRate): a dispatch a site over the rows — rt/emission.h's rules in
 // GLSL doubles, each row's accumulator moved on, its objects asked for written into its
 // record — then one work group that scans the records in row order: each group's objects
@@ -27,7 +27,8 @@ using rt::Buffer;
 namespace {
 
 // One site over the rows: params rows, flags (1 rate per row, 2 count per row, 4 kill
-// flags, 8 creation times, 16 fresh accumulators, 32 a burst on death; the site from bit
+// flags, 8 creation times, 16 fresh accumulators, 32 a burst at t1, 64 a burst at each
+// row's creation time; the site from bit
 // 8: its record at meta's rt::RecordLayout), the shared rate and count, dt, t1; the rows
 // from meta[3] on in the columns.
 // The rule's operations are `precise` and in the host's order: the same doubles.
@@ -65,10 +66,10 @@ void main() {
     uint invalid = 0u, clamped = 0u, perEvent = 1u;
     uvec2 children = uvec2(0u);
     double firstTime = 0.0LF, spacing = 0.0LF;
-    if ((flags & 32u) != 0u) {  // rt::deathBurst: every row of the mask, killed ones too
+    if ((flags & 96u) != 0u) {  // rt::burst: every row of the mask, killed ones too
         if (mask[i] != 0u) {
             double size = valid(uintBitsToFloat((flags & 2u) != 0u ? counts[i] : param(3u)), invalid);
-            firstTime = ld(param(6u), param(7u));
+            firstTime = (flags & 64u) != 0u ? ld(created[2u * i], created[2u * i + 1u]) : ld(param(6u), param(7u));
             if (size >= 1.0LF) {
                 double c = whole(size, clamped);
                 uint hi = uint(c / 4294967296.0LF);
@@ -305,12 +306,13 @@ void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs) {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, or_(in.created));
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, or_(s.rate));
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, or_(s.count));
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, bound(s.accumulated));
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, s.accumulated.valid() ? bound(s.accumulated) : runsGl);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, runsGl);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, metaBuffer_);
+        using Kind = rt::RateSites::Site::Kind;
         uint32_t flags = (s.rate.valid() ? 1u : 0u) | (s.count.valid() ? 2u : 0u) | (in.killed.valid() ? 4u : 0u) |
-                         (in.created.valid() ? 8u : 0u) | (in.fresh ? 16u : 0u) | (s.onDeath ? 32u : 0u) |
-                         static_cast<uint32_t>(k) << 8;
+                         (in.created.valid() ? 8u : 0u) | (in.fresh ? 16u : 0u) | (s.kind == Kind::Burst ? 32u : 0u) |
+                         (s.kind == Kind::AtCreation ? 64u : 0u) | static_cast<uint32_t>(k) << 8;
         bindParams(paramsBuffer_, {static_cast<uint32_t>(n), flags, floatBits(s.rateValue), floatBits(s.countValue), dt0, dt1,
                                    t10, t11});
         dispatchRows(emitRowsProgram_, n);

@@ -152,7 +152,8 @@ namespace {
 // listed in a table after the template: argument columns, fields, then a word a field
 // (block word | words a row << 24). Params: records, the first record's word, the
 // template's word, the first block's word, words a block, flags (1: emitter rows from a
-// list, 2: fields only; the records' stride from bit 8), the list's first, the table's word.
+// list, 2: fields only, 4: now the record's first time; the records' stride from bit 8),
+// the first row (of the list, or of the columns), the table's word.
 constexpr size_t kBlockSources = 13;
 constexpr size_t kTableWords = 2 + kBlockSources;
 
@@ -178,10 +179,14 @@ void main() {{
         w[at + {5}u] = count;
         w[at + {6}u] += records[r + {9}u];
         w[at + {7}u] = records[r + 2u];
+        if ((param(5u) & 4u) != 0u) {{
+            w[at + {10}u] = records[r + 4u];
+            w[at + {10}u + 1u] = records[r + 5u];
+        }}
         for (uint c = 0u; c < w[table]; ++c) w[at + {8}u + c] += place;
     }}
     if (count == 0u) return;
-    uint row = (param(5u) & 1u) != 0u ? rowOf[param(6u) + k] : k;
+    uint row = (param(5u) & 1u) != 0u ? rowOf[param(6u) + k] : param(6u) + k;
     for (uint f = 0u; f < w[table + 1u]; ++f) {{
         uint d = w[table + 2u + f], word = d & 0xffffffu, n = d >> 24u;
         for (uint j = 0u; j < n; ++j) w[at + word + j] = source(f, row * n + j);
@@ -189,7 +194,7 @@ void main() {{
 }}
 )",
                        kParamsBlock, sources, cases, kInvocationIndex, rt::kRunWords, LaunchBlock::kCount,
-                       LaunchBlock::kFirstInvocation, LaunchBlock::kFirstChild, LaunchBlock::kColumns, rt::kRunSitePlace);
+                       LaunchBlock::kFirstInvocation, LaunchBlock::kFirstChild, LaunchBlock::kColumns, rt::kRunSitePlace, LaunchBlock::kNow);
 }
 
 }  // namespace
@@ -338,7 +343,7 @@ void GlslBackend::buildBlocks(const rt::ChildrenLaunch& launch, const std::vecto
         for (size_t k = 0; k < kBlockSources; ++k)  // (every block bound to something)
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, static_cast<GLuint>(3 + k),
                              from + k < fields.size() ? memory_.deviceBuffer(fields[from + k].column) : records);
-        uint32_t flags = (launch.rows.valid() ? 1u : 0u) | (pass > 0 ? 2u : 0u) |
+        uint32_t flags = (launch.rows.valid() ? 1u : 0u) | (pass > 0 ? 2u : 0u) | (launch.nowFromRecords ? 4u : 0u) |
                          static_cast<uint32_t>(launch.recordStride) << 8;
         bindParams(params_, {static_cast<uint32_t>(launch.recordCount), static_cast<uint32_t>(launch.record * rt::kRunWords),
                              static_cast<uint32_t>(templateAt), static_cast<uint32_t>(firstWord),

@@ -1,6 +1,8 @@
 // The parts of the backend contract (rt/backend.h) every backend shares.
 #include "rt/backend.h"
 
+#include <cstring>
+
 namespace psys::rt {
 
 std::vector<ChildrenLaunch> eachEmitter(const Memory& memory, const ChildrenLaunch& launch) {
@@ -19,7 +21,9 @@ std::vector<ChildrenLaunch> eachEmitter(const Memory& memory, const ChildrenLaun
         one.records = one.rows = {};
         one.record = one.recordCount = one.rowsFirst = one.placed = 0;
         one.recordStride = 1;
-        one.row = rows.empty() ? static_cast<uint32_t>(k) : rows[k];
+        one.nowFromRecords = false;
+        one.row = rows.empty() ? static_cast<uint32_t>(launch.rowsFirst + k) : rows[k];
+        if (launch.nowFromRecords) std::memcpy(&one.clock.nowValue, w + 4, 8);
         one.firstChild = w[2];
         one.count = w[1];
         one.argsFirst = launch.argsFirst + w[0];

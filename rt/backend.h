@@ -109,13 +109,16 @@ struct ChildrenLaunch {
     // Or, where `records` is valid, the launches of one site's emitters as a rate emission
     // left them (Memory::emitAtRate), so that they need not come back to the host:
     // `recordCount` records, record k at `record` + k · `recordStride` (rt::RecordLayout),
-    // of emitter row `rows`[rowsFirst + k] (row k where `rows` is not valid), its children
-    // at argsFirst plus its place among its group's (the record's word 0), drawn from its
-    // first id (word 2) on; `count` is then the children of all of them, `placed` those of
-    // their group (the argument rows [argsFirst, argsFirst + placed) they write among),
-    // and `row` and `firstChild` are not used.
+    // of emitter row `rows`[rowsFirst + k] (row rowsFirst + k where `rows` is not valid),
+    // its children at argsFirst plus its place among its group's (the record's word 0),
+    // drawn from its first id (word 2) on, its clock's now the record's first time where
+    // `nowFromRecords` (a burst at creation: each emitter's creation time); `count` is then
+    // the children of all of them, `placed` those of their group (the argument rows
+    // [argsFirst, argsFirst + placed) they write among), and `row` and `firstChild` are
+    // not used.
     Buffer records, rows;
     size_t record = 0, recordCount = 0, recordStride = 1, rowsFirst = 0, placed = 0;
+    bool nowFromRecords = false;
 };
 
 // A launch from records as one launch an emitter (those with children), read from the

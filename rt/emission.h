@@ -1,5 +1,5 @@
 // The rate rule: what an emitter's update of `dt` ending at t1 asks of one rate emit site
-// (and of one that bursts on death, below). Written once, over the host's doubles, for
+// (and of a burst, below). Written once, over the host's doubles, for
 // every memory's bookkeeping (Creation::emitInUpdate and Memory::emitAtRate); a device
 // spells the same in its own language (gpu/gl_emission.cpp) and the differential tests
 // hold the two together.
@@ -66,12 +66,13 @@ inline RateEmission rateEmission(double before, float rate, float count, double 
     return e;
 }
 
-// An `on death` burst (ir::EmitSite::When::Death): in the update that kills the emitter,
-// `count` objects at t1, each an event of its own (the update yields 0 where nothing died).
-inline RateEmission deathBurst(float count, double t1) {
+// A burst: `count` objects at one time `at`, each an event of its own — an `on death` or
+// `when` burst in an update (at t1: the update yields 0 where nothing died or fired), a
+// burst at the emitter's creation (at its creation time).
+inline RateEmission burst(float count, double at) {
     RateEmission e;
     double size = validCount(count, e.invalid);
-    e.firstTime = t1;
+    e.firstTime = at;
     if (size >= 1) e.children = wholeCount(size, e.clamped);
     return e;
 }

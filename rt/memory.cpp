@@ -171,7 +171,7 @@ RecordLayout::RecordLayout(const RateSites& in) : first(in.sites.size()), stride
     }
 }
 
-// The rate emissions (and bursts on death) of emitter rows (Memory::emitAtRate):
+// The rate emissions (and bursts) of emitter rows (Memory::emitAtRate):
 // rt/emission.h's rules row by row, each group's objects kept while its room lasts, the
 // ids in row order.
 void Memory::emitAtRate(const RateSites& in, Buffer runs) {
@@ -196,7 +196,7 @@ void Memory::emitAtRate(const RateSites& in, Buffer runs) {
     for (const RateSites::Site& s : in.sites)
         site.push_back({s.rate.valid() ? static_cast<const float*>(view(s.rate)) + f : nullptr,
                         s.count.valid() ? static_cast<const float*>(view(s.count)) + f : nullptr,
-                        static_cast<double*>(host(s.accumulated)) + f});
+                        s.accumulated.valid() ? static_cast<double*>(host(s.accumulated)) + f : nullptr});
     auto add = [](uint64_t a, uint64_t b) { return b > UINT64_MAX - a ? UINT64_MAX : a + b; };
     uint64_t invalid = 0, clamped = 0;
     uint32_t id = in.nextId;
@@ -205,14 +205,14 @@ void Memory::emitAtRate(const RateSites& in, Buffer runs) {
             const RateSites::Site& s = in.sites[k];
             Site& d = site[k];
             RateEmission e;
-            if (s.onDeath && mask[r]) {
-                e = deathBurst(d.count ? d.count[r] : s.countValue, in.t1);
+            const float count = d.count ? d.count[r] : s.countValue;
+            if (s.kind != RateSites::Site::Kind::Rate && mask[r]) {
+                e = burst(count, s.kind == RateSites::Site::Kind::Burst ? in.t1 : created[r]);
                 invalid += e.invalid;
                 clamped += e.clamped;
-            } else if (!s.onDeath && mask[r] && !(killed && killed[r])) {
+            } else if (s.kind == RateSites::Site::Kind::Rate && mask[r] && !(killed && killed[r])) {
                 double dt = created ? in.t1 - created[r] : in.dt;
-                e = rateEmission(in.fresh ? 0.0 : d.accumulated[r], d.rate ? d.rate[r] : s.rateValue, d.count ? d.count[r] : s.countValue,
-                                 dt, in.t1);
+                e = rateEmission(in.fresh ? 0.0 : d.accumulated[r], d.rate ? d.rate[r] : s.rateValue, count, dt, in.t1);
                 d.accumulated[r] = e.accumulated;
                 invalid += e.invalid;
                 clamped += e.clamped;

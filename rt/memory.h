@@ -61,13 +61,13 @@ struct ObjectRuns {
     double time(size_t u, uint32_t k) const { return eventTime(firstTime[u], k, perEvent[u], spacing[u]); }
 };
 
-// A type's rate emit sites (and bursts on death) over rows [0, rows) of its columns
+// A type's rate emit sites (and bursts) over rows [0, rows) of its columns
 // (Memory::emitAtRate).
 struct RateSites {
     struct Site {
         Buffer rate, count;  // f32 per row; invalid: rateValue, countValue every row's
         float rateValue = 0, countValue = 1;
-        Buffer accumulated;  // f64 per row: events accumulated, in [0, 1)
+        Buffer accumulated;  // f64 per row: events accumulated, in [0, 1) (a rate's)
         // Objects its target may still take (its free rows less those queued): the room of
         // every site of its group.
         uint32_t room = 0;
@@ -75,9 +75,13 @@ struct RateSites {
         // it is). A group's sites share its room, their objects one run: placed in row
         // order, a row's sites in order, as the host queues them one emitter at a time.
         uint32_t group = 0;
-        // A burst on death (rt::deathBurst): `count` objects at t1 from each row of the
-        // mask, killed ones too; no rate, its accumulator untouched.
-        bool onDeath = false;
+        // What it emits (rt/emission.h): at a rate (rows the update killed emit nothing); a
+        // burst in the update (rt::burst: `count` objects at t1 from each row of the mask,
+        // killed ones too — a death's or an edge's: the update yields 0 where nothing
+        // fired); a burst at creation (`count` objects at each row's creation time, from
+        // `created`). Only a rate moves its accumulator.
+        enum class Kind : uint8_t { Rate, Burst, AtCreation };
+        Kind kind = Kind::Rate;
     };
     std::vector<Site> sites;  // in the type's order of sites
     size_t rows = 0;

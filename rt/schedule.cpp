@@ -81,7 +81,7 @@ std::string describe(const Schedule& s, const Phase& p) {
                 return fmt::format("{}: {} ({}) decided by the memory's operation over the rows — events, "
                                    "times, the cut at room, ids; only its totals to the host — then the queue: each "
                                    "target's objects one run, each site's spawn launches one launch, from the records",
-                                   type, p.events ? "rate emissions of the survivors, bursts on deaths" : "rate emissions",
+                                   type, p.events ? "rate emissions of the survivors, bursts on edges and deaths" : "rate emissions",
                                    names(s, p.targets));
             return fmt::format("{}: {} ({}): events, times, ids, the queue", type,
                                p.events ? "rate emissions of the survivors, bursts on edges and deaths" : "rate emissions of the survivors",

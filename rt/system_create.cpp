@@ -450,10 +450,12 @@ void Creation::queueBursts(size_t type, Batch& b, size_t r) {
         if (!o.emits[site].atCreation()) continue;
         auto column = static_cast<size_t>(b.initLayout.emitCount(static_cast<int>(site)));
         float size = b.initTable.empty() ? 0 : s_.view<float>(b.initTable[column])[i];
-        uint64_t count = wholeCount(validCount(size, s_.stats.invalidEmissions), s_.stats.clampedEmissions);
-        if (count < 1) continue;
+        RateEmission burst = rt::burst(size, created[i]);
+        s_.stats.invalidEmissions += burst.invalid;
+        s_.stats.clampedEmissions += burst.clamped;
+        if (burst.children == 0) continue;
         Emitter e{type, b.poolRows[r], b.burstTables[site], static_cast<uint32_t>(i), created[i], true};
-        queueChildren(e, static_cast<int>(site), count, 1, created[i], 0);
+        queueChildren(e, static_cast<int>(site), burst.children, burst.perEvent, burst.firstTime, burst.spacing);
     }
 }
 

@@ -26,6 +26,8 @@ struct Emitter {
 };
 
 class Creation {
+    struct Batch;  // (below: a batch of one type being created)
+
 public:
     explicit Creation(State& state);
     ~Creation();
@@ -42,17 +44,19 @@ public:
     // count, at t1 — a dying object's too (its death is this update's event).
     void emitInUpdate(const Emitter& emitter, std::span<const float> rate, std::span<const float> count, double dt,
                       double t1, bool dying);
-    // The rate emissions of `type`'s rows that the memory decides (TypeInfo::rowsInMemory,
+    // The emissions of `type`'s rows that the memory decides (TypeInfo::rowsInMemory,
     // Memory::emitAtRate): its pool's after an update (`table` its update table), or a
-    // batch's just created (its rows [first, first + n) of `table`, clocked from their
-    // creation, `rows` their rows in the pool, a u32 list in the memory). `uniforms`: where
-    // the update's clock is uniform, its uniform values (ColumnLayout::sharedEmit); null:
-    // the rates and counts are in the table's columns. What they create is queued as
-    // emitInUpdate queues it, row by row, sites in order: the same ids and rows. Only the
-    // totals come back to the host: a site's objects are one run, and its emitters' spawn
-    // launches one launch, both from the records where the memory keeps them.
+    // batch's just created (`batch`: its rows [first, first + n) of `table`, clocked from
+    // their creation, `rows` their rows in the pool, a u32 list in the memory; its bursts
+    // at creation among the sites, their counts init's). `sites`' site k is emit site
+    // emitSite[k], its kind set. `uniforms`: where the update's clock is uniform, its
+    // uniform values (ColumnLayout::sharedEmit); null: the rates and counts are in the
+    // table's columns. What they create is queued as queueBursts and emitInUpdate queue it,
+    // row by row, sites in order: the same ids and rows. Only the totals come back to the
+    // host: a target's objects are one run, and each site's emitters' spawn launches one
+    // launch, both from the records where the memory keeps them.
     void emitInMemory(size_t type, const std::vector<Buffer>& table, const Value* const* uniforms, RateSites sites,
-                      Buffer rows, double t1);
+                      std::span<const size_t> emitSite, const Batch* batch, Buffer rows, double t1);
     // A trigger's (or the start's) kernel, evaluated on the host: once for the counts,
     // then once per created object for its arguments, so each draws its own numbers.
     void emitFromKernel(const ir::Trigger& trigger, std::span<const Value> params, uint32_t objectId);
@@ -90,7 +94,6 @@ private:
         std::vector<Buffer> args;
         size_t used = 0;
     };
-    struct Batch;
 
     size_t stage(size_t type, size_t count);  // staging rows for `count` new objects of `type`
     // The spawn launch for `count` children of `emitter` at `site`, their arguments at

@@ -40,6 +40,11 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     if (info.init) bindBatch(type, b, b.initLayout, b.initParents, b.initTable, Table::Init);
     bindBatch(type, b, info.updateLayout, b.updateParents, b.updateTable, Table::Advanced);
     if (info.exports) bindBatch(type, b, info.exportsLayout, b.exportsParents, b.exportsTable, Table::Advanced);
+    const bool bursts = info.bursts && info.init;  // (a burst's count is init's)
+    b.burstTables.assign(o.emits.size(), {});
+    for (size_t site = 0; bursts && site < o.emits.size(); ++site)
+        if (o.emits[site].atCreation() && info.spawn[site])
+            bindBatch(type, b, info.spawnLayout[site], b.initParents, b.burstTables[site], Table::Bursts);
     if (info.init) emptyFolds(type, b.initLayout, b.initTable, first, n);
     emptyFolds(type, info.updateLayout, b.updateTable, first, n);
     if (info.exports) emptyFolds(type, info.exportsLayout, b.exportsTable, first, n);
@@ -74,6 +79,16 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
         launchInMemory(type, b, n, *info.init, b.initLayout, b.initTable,
                        {Clock::Source::PerRow, Clock::Source::Uniform, 0, 0, true}, nullptr);
     }
+    if (bursts)  // their spawn launches read the state at creation (one copy: every burst table's)
+        for (const std::vector<Buffer>& t : b.burstTables) {
+            if (t.empty()) continue;
+            for (size_t s = 0; s < o.state.size(); ++s)
+                for (int c = 0; c < o.state[s].type.width; ++c) {
+                    auto column = static_cast<size_t>(info.updateLayout.stateOffset[s] + c);
+                    memory.copy(table[column], first, t[column], first, n);
+                }
+            break;
+        }
     LateKills late;
     if (info.late) {
         late.map = rows;  // (released through it at a step's end: Ledger::releaseInMemory)
@@ -93,20 +108,30 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
                 columns.push_back({b.exportsTable[static_cast<size_t>(info.exportsLayout.exportOffset[e] + c)],
                                    pool.exports.column(e, static_cast<size_t>(c))});
     }
-    if (info.updateEmits) {  // the first update's emissions, and their accumulators to the pool
-        RateSites in;
+    if (info.updateEmits || bursts) {  // each object's bursts at creation, then its first update's
+        RateSites in;                   // emissions; their accumulators to the pool
         in.rows = n;
         in.first = first;
         in.mask = mask;
         if (info.kills) in.killed = table[ColumnLayout::kKill];
         in.created = table[ColumnLayout::kCreated];
         in.fresh = true;
+        std::vector<size_t> sites;
+        for (size_t site = 0; bursts && site < o.emits.size(); ++site)
+            if (o.emits[site].atCreation()) {
+                in.sites.emplace_back().kind = RateSites::Site::Kind::AtCreation;
+                sites.push_back(site);
+            }
         for (size_t site = 0; site < o.emits.size(); ++site) {
-            Buffer accumulated = emissions_.at(site, Elem::F64, first + n);
-            in.sites.emplace_back().accumulated = accumulated;
-            columns.push_back({accumulated, pool.emitted[site]});
+            if (!o.emits[site].inUpdate()) continue;
+            RateSites::Site& out = in.sites.emplace_back();
+            out.kind = o.emits[site].rate() ? RateSites::Site::Kind::Rate : RateSites::Site::Kind::Burst;
+            sites.push_back(site);
+            if (!o.emits[site].rate()) continue;
+            out.accumulated = emissions_.at(site, Elem::F64, first + n);
+            columns.push_back({out.accumulated, pool.emitted[site]});
         }
-        emitInMemory(type, table, nullptr, std::move(in), rows, t1);
+        emitInMemory(type, table, nullptr, std::move(in), sites, &b, rows, t1);
     }
     memory.scatter(columns, first, rows, 0, kept);
     if (!info.late) return;
@@ -117,14 +142,16 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
 }
 
 void Creation::emitInMemory(size_t type, const std::vector<Buffer>& table, const Value* const* uniforms,
-                            RateSites in, Buffer rows, double t1) {
+                            RateSites in, std::span<const size_t> emitSite, const Batch* batch, Buffer rows, double t1) {
+    using Kind = RateSites::Site::Kind;
     const TypeInfo& info = s_.types[type];
     const ColumnLayout& layout = info.updateLayout;
     const size_t n = in.rows, sites = in.sites.size();
-    if (n == 0) return;
-    for (size_t site = 0; site < sites; ++site) {
+    if (n == 0 || sites == 0) return;
+    for (size_t k = 0; k < sites; ++k) {
+        const size_t site = emitSite[k];
         auto i = static_cast<int>(site);
-        RateSites::Site& out = in.sites[site];
+        RateSites::Site& out = in.sites[k];
         out.rateValue = 0;
         out.countValue = 1;
         // (A batch's clocks are its rows': its columns hold every rate and count.)
@@ -135,12 +162,16 @@ void Creation::emitInMemory(size_t type, const std::vector<Buffer>& table, const
             else
                 perRow = table[static_cast<size_t>(column)];
         };
-        out.onDeath = s_.pools[type].object().emits[site].when == ir::EmitSite::When::Death;
-        source(info.rated[site], layout.emitRate(i), out.rateValue, out.rate);
-        source(info.counted[site], layout.emitCount(i), out.countValue, out.count);
+        if (out.kind == Kind::AtCreation) {  // init's count (Creation::queueBursts)
+            out.count = batch->initTable[static_cast<size_t>(batch->initLayout.emitCount(i))];
+        } else {
+            if (out.kind == Kind::Rate) source(info.rated[site], layout.emitRate(i), out.rateValue, out.rate);
+            source(info.counted[site], layout.emitCount(i), out.countValue, out.count);
+        }
         size_t target = info.emitTarget[site];
-        out.group = static_cast<uint32_t>(std::find(info.emitTarget.begin(), info.emitTarget.end(), target) -
-                                          info.emitTarget.begin());
+        size_t group = 0;  // the first site into the same target
+        while (info.emitTarget[emitSite[group]] != target) ++group;
+        out.group = static_cast<uint32_t>(group);
         size_t free = s_.pools[target].free() + pending_[target];
         out.room = static_cast<uint32_t>(std::min<size_t>(free > queued_[target] ? free - queued_[target] : 0, UINT32_MAX));
     }
@@ -156,32 +187,38 @@ void Creation::emitInMemory(size_t type, const std::vector<Buffer>& table, const
     s_.stats.clampedEmissions += total[kTotalsClamped];
     // Each group's objects one run, and each site's emitters' spawn launches one launch,
     // from the records (ChildrenLaunch::records): ids, times, places and emitter rows
-    // where the records are.
+    // where the records are — a burst at creation's from the batch's state at creation,
+    // at each emitter's creation time.
     const RecordLayout records(in);
     for (size_t group = 0; group < sites; ++group) {
         if (in.sites[group].group != group) continue;
         uint64_t kept = 0, asked = 0;
-        for (size_t site = group; site < sites; ++site) {
-            const uint32_t* t = total.data() + kTotalsSites + kTotalsPerSite * site;
-            if (in.sites[site].group != group) continue;
+        for (size_t k = group; k < sites; ++k) {
+            const uint32_t* t = total.data() + kTotalsSites + kTotalsPerSite * k;
+            if (in.sites[k].group != group) continue;
             kept += t[0];
             addSaturating(asked, t[1] | uint64_t{t[2]} << 32);
         }
-        size_t target = info.emitTarget[group];
+        size_t target = info.emitTarget[emitSite[group]];
         addSaturating(s_.typeStats[target].dropped, asked - kept);
         if (kept == 0) continue;
         size_t base = stage(target, kept);
-        for (size_t site = group; site < sites; ++site) {
-            uint32_t siteKept = total[kTotalsSites + kTotalsPerSite * site];
-            if (in.sites[site].group != group || siteKept == 0) continue;
-            ChildrenLaunch* launch = queueSpawn({type, 0, {}, 0, t1, false}, static_cast<int>(site), 0, siteKept, base);
+        for (size_t k = group; k < sites; ++k) {
+            uint32_t siteKept = total[kTotalsSites + kTotalsPerSite * k];
+            if (in.sites[k].group != group || siteKept == 0) continue;
+            const bool atCreation = in.sites[k].kind == Kind::AtCreation;
+            Emitter emitter{type, 0, {}, 0, t1, false};
+            if (atCreation) emitter = {type, 0, batch->burstTables[emitSite[k]], 0, t1, true};
+            ChildrenLaunch* launch = queueSpawn(emitter, static_cast<int>(emitSite[k]), 0, siteKept, base);
             if (!launch) continue;
             launch->records = runs;
-            launch->record = records.first[site];
+            launch->record = records.first[k];
             launch->recordCount = n;
-            launch->recordStride = records.stride[site];
+            launch->recordStride = records.stride[k];
             launch->placed = kept;
-            launch->rows = rows;
+            launch->rows = atCreation ? Buffer{} : rows;
+            launch->rowsFirst = atCreation ? batch->first : 0;
+            launch->nowFromRecords = atCreation;
         }
         enqueue({target, base, kept, {}, 0, 0, 1, 0, runs, records.first[group], n * records.stride[group]});
     }

@@ -82,7 +82,7 @@ void Creation::emitInUpdate(const Emitter& e, std::span<const float> rate, std::
     const ir::Object& o = pool.object();
     for (size_t site = 0; site < o.emits.size(); ++site) {
         if (o.emits[site].whenKilled()) {  // (an edge's burst too: the update yields its count where it fired)
-            RateEmission b = deathBurst(count[site], t1);
+            RateEmission b = burst(count[site], t1);
             s_.stats.invalidEmissions += b.invalid;
             s_.stats.clampedEmissions += b.clamped;
             if (b.children) queueChildren(e, static_cast<int>(site), b.children, b.perEvent, b.firstTime, b.spacing);

@@ -100,25 +100,26 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     // drawn as the step goes).
     bool inMemory = options.rows == SystemOptions::Rows::InMemory ||
                     (options.rows == SystemOptions::Rows::AsBackend && backend.keepsRowsInMemory());
+    // (An emitter's bursts at creation, below, are the memory's too.)
     auto keptWhole = [&](const TypeInfo& info) {
-        return info.parentType < 0 && !info.bursts && info.stepLimit == 0 &&
-               !(options.drawInStep && backend.rendersInStep() && info.render);
+        return info.parentType < 0 && info.stepLimit == 0 && !(options.drawInStep && backend.rendersInStep() && info.render);
     };
     for (size_t t = 0; t < types.size(); ++t) {
         TypeInfo& info = types[t];
         bool silent = !info.kills && !info.unstable && !info.updateEmits && !info.read;
-        info.rowsInMemory = inMemory && (info.late || silent) && keptWhole(info);
+        info.rowsInMemory = inMemory && (info.late || silent) && !info.bursts && keptWhole(info);
     }
     // Emitters whose emissions the memory decides (Memory::emitAtRate): nobody reads them,
-    // every site emits at a rate or bursts on death into a type that keeps its rows in the
-    // memory (one that emits nothing, or such an emitter itself) and reads no parent, and
-    // whose arguments read no fold (a spawn launch from records has no parent values) —
-    // so a step's emissions are one operation over the rows, and the objects they create
-    // batches of those types, whose first updates emit by the same operation. Sites into
-    // one type share its room, their objects one batch in the host's order (rt::RateSites:
-    // a group). At most one of the types is an emitter: the host creates what each emitter
-    // asks for in its turn, and the children of two types of emitters would take their ids
-    // one emitter at a time, not one type at a time.
+    // every site emits — at a rate, in a burst at creation, on an edge or on death — into
+    // a type that keeps its rows in the memory (one that emits nothing, or such an emitter
+    // itself) and reads no parent, and whose arguments read no fold (a spawn launch from
+    // records has no parent values) — so a step's emissions are one operation over the
+    // rows, and the objects they create batches of those types, whose bursts at creation
+    // and first updates emit by the same operation. Sites into one type share its room,
+    // their objects one batch in the host's order (rt::RateSites: a group). At most one of
+    // the types is an emitter: the host creates what each emitter asks for in its turn,
+    // and the children of two types of emitters would take their ids one emitter at a
+    // time, not one type at a time.
     // One that dies exports nothing: the operation reads its update's kill flags where
     // they are (a row killed emits at no rate, and bursts), and its kills are late, as a
     // type's that only dies — nobody else looks at them before the step's end. (Until no
@@ -130,13 +131,13 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         const TypeInfo& info = types[t];
         const ir::Object& o = module.objects[t];
         bool dies = info.kills || info.unstable;
-        bool emitter = options.rows == SystemOptions::Rows::InMemory && options.createInBatches && info.updateEmits &&
+        bool emitter = options.rows == SystemOptions::Rows::InMemory && options.createInBatches &&
+                       (info.updateEmits || info.bursts) &&
                        (!dies || (options.lateKills && !info.exports)) && !info.read && keptWhole(info);
         int emitting = -1;  // the one target that emits, if any
         for (size_t s = 0; emitter && s < o.emits.size(); ++s) {
             auto target = static_cast<int>(info.emitTarget[s]);
-            emitter = (o.emits[s].rate() || o.emits[s].when == ir::EmitSite::When::Death) &&
-                      types[static_cast<size_t>(target)].rowsInMemory && info.spawnLayout[s].parentColumns.empty();
+            emitter = types[static_cast<size_t>(target)].rowsInMemory && info.spawnLayout[s].parentColumns.empty();
             if (module.objects[static_cast<size_t>(target)].emits.empty()) continue;
             emitter = emitter && (emitting < 0 || emitting == target);
             emitting = target;

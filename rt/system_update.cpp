@@ -32,8 +32,15 @@ void runEmissions(State& s, Creation& creation, size_t type, double dt, double t
         in.mask = pool.updatable.column;
         if (info.kills) in.killed = work.updateTable[ColumnLayout::kKill];  // (in the memory: RowsLaunch::emissionsStay)
         in.dt = dt;
-        for (Buffer accumulated : pool.emitted) in.sites.emplace_back().accumulated = accumulated;
-        creation.emitInMemory(type, work.updateTable, &uniforms, std::move(in), {}, t1);
+        std::vector<size_t> sites;  // (a burst at creation emits nothing here)
+        for (size_t site = 0; site < o.emits.size(); ++site) {
+            if (!o.emits[site].inUpdate()) continue;
+            RateSites::Site& out = in.sites.emplace_back();
+            out.kind = o.emits[site].rate() ? RateSites::Site::Kind::Rate : RateSites::Site::Kind::Burst;
+            if (o.emits[site].rate()) out.accumulated = pool.emitted[site];
+            sites.push_back(site);
+        }
+        creation.emitInMemory(type, work.updateTable, &uniforms, std::move(in), sites, nullptr, {}, t1);
         creation.runSpawns();
         return;
     }

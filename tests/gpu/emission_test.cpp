@@ -127,7 +127,12 @@ TEST_CASE("rate emissions decided on the GPU: the host's runs, ids, drops and ac
             for (size_t s = 0; s < kSites; ++s) {
                 if ((round + s) % 4 == 0) in.sites[s].rate = {};
                 if ((round + s) % 3 == 0) in.sites[s].count = {};
-                in.sites[s].onDeath = (round + s) % 5 == 1;  // (rows killed too; no accumulator)
+                // Bursts in an update (rows killed too; no accumulator), and at creation
+                // (each row's creation time: where the round clocks rows from it).
+                using Kind = rt::RateSites::Site::Kind;
+                in.sites[s].kind = (round + s) % 5 == 1 ? Kind::Burst
+                                   : ownClock && (round + s) % 5 == 3 ? Kind::AtCreation
+                                                                     : Kind::Rate;
             }
             e.memory.emitAtRate(in, e.runs);
         };
@@ -267,7 +272,7 @@ TEST_CASE("a rate emission's records are the rule's: events, times, ids in row o
     // A burst on death: `count` objects at t1 from each row of the mask, killed or not
     // (the update yields 0 where nothing died), its accumulator untouched.
     e.write(e.sites.killed, std::vector<uint8_t>{1, 0});
-    e.sites.sites[1].onDeath = true;
+    e.sites.sites[1].kind = rt::RateSites::Site::Kind::Burst;
     e.write(e.sites.sites[1].count, std::vector<float>{3, 0});
     e.sites.sites[1].room = 100;
     m.emitAtRate(e.sites, e.runs);
@@ -279,6 +284,16 @@ TEST_CASE("a rate emission's records are the rule's: events, times, ids in row o
     CHECK(record(1, 1)[1] == 0);
     CHECK(record(0, 0)[1] == 0);  // (the killed row emits at no rate)
     CHECK(e.read<double>(e.sites.sites[1].accumulated, 2)[1] == doctest::Approx(0.9 + 2.1 - 3));
+    // A burst at creation: `count` objects at each row's creation time, killed or not.
+    e.sites.sites[1].kind = rt::RateSites::Site::Kind::AtCreation;
+    e.sites.created = m.create(rt::Elem::F64, 2);
+    e.write(e.sites.created, std::vector<double>{0.25, 0.5});
+    m.emitAtRate(e.sites, e.runs);
+    runs = e.read<uint32_t>(e.runs, rt::runsWords(2, 2));
+    CHECK(record(1, 0)[1] == 3);
+    CHECK(time(record(1, 0), 4) == 0.25);
+    CHECK(time(record(1, 0), 6) == 0.0);
+    CHECK(record(1, 1)[1] == 0);
 }
 
 TEST_CASE("sites into one target share its room: places in row order, a row's sites in order, on both memories") {
@@ -341,14 +356,17 @@ TEST_CASE("emitters whose emissions the GPU decides: the interpreter's objects, 
     // row, counts per row, invalid rates (counted), a target at capacity (drops), emitters
     // created in the step by a trigger (their first update's emissions), two sites;
     // emitters that die (some in their first update), their kills late, read where they
-    // are, emitters that burst on death, and an emitter of those (the rain); several
+    // are, emitters that burst on death, and an emitter of those (the rain); bursts at
+    // creation and on edges (the confetti, the fireworks' rockets and their launcher); several
     // sites into one target (the shapes; a small target shared by an emitter and the
     // emitters it emits); an emitter of two types of emitters (which stays on the host).
     // Each with the emitters whose rows it keeps in the memory.
     std::vector<std::pair<std::string, size_t>> programs;
     for (const char* sample : {"fountain", "emitter", "two_streams", "tornado", "shapes"})
         programs.push_back({test::readFile(test::sample(sample)), 1});
-    programs.push_back({test::readFile(test::sample("rain")), 2});  // the cloud and its drops
+    programs.push_back({test::readFile(test::sample("rain")), 2});       // the cloud and its drops
+    programs.push_back({test::readFile(test::sample("confetti")), 1});   // bursts on an edge, at creation too
+    programs.push_back({test::readFile(test::sample("fireworks")), 2});  // rockets that burst and die on an edge
     programs.push_back({R"(
         @capacity(300) object p(k: float) { point(vec3(k, age, 0), white, 1); kill when age > 0.4; }
         object q { point(vec3(0, age, 1), red, 1); kill when age > 0.3; }
@@ -376,7 +394,8 @@ TEST_CASE("emitters whose emissions the GPU decides: the interpreter's objects, 
         spawn e(20);
         spawn e(300);)", 1});
     for (auto [name, emitters] : {std::pair{"emitters_that_die", 1}, {"emitters_burst_on_death", 1},
-                                  {"sites_share_a_target", 2}, {"two_kinds_of_emitter_from_one", 2}})
+                                  {"sites_share_a_target", 2}, {"two_kinds_of_emitter_from_one", 2},
+                                  {"emitters_burst_at_creation_and_edges", 2}})
         programs.push_back({test::readFile(std::string(PSYS_PROGRAMS_DIR) + "/" + name + ".psys"), emitters});
     for (const auto& [text, expected] : programs) {
         INFO(text.substr(0, 120));

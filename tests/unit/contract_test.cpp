@@ -3,6 +3,8 @@
 // emitter.
 #include <doctest/doctest.h>
 
+#include <cstring>
+
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -55,6 +57,8 @@ TEST_CASE("a launch from records runs as one launch an emitter with children: it
     record(1, 0, 2, 7);
     record(2, 2, 0, 9);
     record(3, 2, 3, 9);
+    const double created = 2.25;  // (record 3's first time)
+    std::memcpy(&words[3 * rt::kRunWords + 4], &created, 8);
     rt::Buffer runs = memory.create(rt::Elem::U32, words.size()), rows = memory.create(rt::Elem::U32, 4);
     memory.write(runs, 0, words.size(), words.data());
     std::vector<uint32_t> rowList = {99, 5, 8, 11};
@@ -78,9 +82,20 @@ TEST_CASE("a launch from records runs as one launch an emitter with children: it
     CHECK((s[1].row == 11 && s[1].count == 3 && s[1].argsFirst == 42 && s[1].firstChild == 9));
     CHECK_FALSE(s[0].records.valid());
     CHECK((s[2].row == 3 && s[2].count == 5));
-    // Without a row list, record k is row k.
+    // Without a row list, record k is row rowsFirst + k.
     all[0].rows = {};
     std::vector<rt::ChildrenLaunch> each = rt::eachEmitter(memory, all[0]);
     REQUIRE(each.size() == 2);
-    CHECK((each[0].row == 0 && each[1].row == 2));
+    CHECK((each[0].row == 1 && each[1].row == 3));
+    CHECK(each[0].clock.nowValue == all[0].clock.nowValue);
+    // A group's site: every other record (rt::RecordLayout), each emitter's clock at its
+    // record's first time (a burst at creation).
+    all[0].recordCount = 2;
+    all[0].recordStride = 2;
+    all[0].nowFromRecords = true;
+    each = rt::eachEmitter(memory, all[0]);
+    REQUIRE(each.size() == 2);  // (records 1 and 3)
+    CHECK((each[0].row == 1 && each[0].count == 2 && each[0].argsFirst == 40 && each[0].firstChild == 7));
+    CHECK((each[1].row == 2 && each[1].count == 3 && each[1].argsFirst == 42 && each[1].firstChild == 9));
+    CHECK(each[1].clock.nowValue == created);
 }

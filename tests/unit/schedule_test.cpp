@@ -111,8 +111,16 @@ TEST_CASE("the schedule says which types keep their rows in the memory, and wher
     printed = rt::printSchedule(rain.schedule());
     CHECK(printed.find("cloud: rate emissions (drop) decided by the memory's operation") != std::string::npos);
     CHECK(printed.find("drop: the kill lists kept for the step's end, where the memory frees them") != std::string::npos);
-    CHECK(printed.find("drop: rate emissions of the survivors, bursts on deaths (droplet, ripple) decided by the memory's operation") !=
-          std::string::npos);
+    CHECK(printed.find("drop: rate emissions of the survivors, bursts on edges and deaths (droplet, ripple) decided by the "
+                       "memory's operation") != std::string::npos);
+    // The fireworks' rockets burst and die on an edge: their bursts (at creation too) and
+    // the launcher's rate emissions of them, the memory's.
+    rt::System fireworks(test::compileModule(test::readFile(std::string(PSYS_SAMPLES_DIR) + "/fireworks.psys")), backend,
+                         options);
+    CHECK(fireworks.pool(static_cast<size_t>(fireworks.typeIndex("rocket"))).rowsInMemory());
+    CHECK(fireworks.pool(static_cast<size_t>(fireworks.typeIndex("launcher"))).rowsInMemory());
+    CHECK(rt::printSchedule(fireworks.schedule()).find("rocket: rate emissions of the survivors, bursts on edges and deaths "
+                                                       "(spark, star) decided by the memory's operation") != std::string::npos);
     // The shapes' four sites into `mote` share its room: one operation still.
     rt::System shapes(test::compileModule(test::readFile(std::string(PSYS_SAMPLES_DIR) + "/shapes.psys")), backend, options);
     CHECK(shapes.pool(static_cast<size_t>(shapes.typeIndex("shapes"))).rowsInMemory());
