@@ -59,8 +59,8 @@ struct SystemOptions {
     // the memory (Pool::keepRowsInMemory, its operations doing the bookkeeping where the
     // columns are) where the backend asks for it (Backend::keepsRowsInMemory: a device),
     // always, or never. Always also keeps there the rows of emitters whose emissions the
-    // memory can decide — at a rate, on death (Memory::emitAtRate: rt/system_state.cpp,
-    // TypeInfo::rowsInMemory).
+    // memory can decide — at a rate, in bursts at creation, on edges, on deaths
+    // (Memory::emitAtRate: rt/system_state.cpp, TypeInfo::rowsInMemory).
     // Results are the same, rows included (tests compare them).
     enum class Rows : uint8_t { AsBackend, InMemory, OnHost } rows = Rows::AsBackend;
     // Called at the end of the step after which the system is finished (System::finished),

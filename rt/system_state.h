@@ -58,9 +58,10 @@ struct TypeInfo {
     // reads it, so no one looks at its dead before then.
     bool late = false;
     // Its pool keeps its rows in the memory (Pool::keepRowsInMemory): a type with no
-    // parent, no bursts and no sub-steps whose kills are late, or that never dies — and
-    // emits nothing, or emits at a rate or on death what the memory decides
-    // (Memory::emitAtRate; the State constructor, rt/system_state.cpp, says which).
+    // parent and no sub-steps whose kills are late, or that never dies — and emits
+    // nothing, or emits what the memory decides (Memory::emitAtRate: at a rate, in
+    // bursts at creation, on edges and on deaths; the State constructor,
+    // rt/system_state.cpp, says which).
     bool rowsInMemory = false;
     // The state slots a creation batch zeroes before init: those init does not set (every
     // one where there is no init, or where it reads the state).
