@@ -11,6 +11,8 @@
 
 #include <fmt/format.h>
 
+#include "tools/progen/model.h"
+
 namespace psys::progen {
 
 namespace {
@@ -42,66 +44,9 @@ private:
     uint64_t s_;
 };
 
-std::string num(double v) {
-    std::string s = fmt::format("{:.3f}", v);
-    while (s.back() == '0') s.pop_back();
-    if (s.back() == '.') s.pop_back();
-    return s == "-0" ? "0" : s;
-}
-
-enum class Ty { Float, Vec3 };
-
-struct Param {
-    std::string name;
-    Ty ty;
-};
-
-struct Emit {
-    enum Kind { Rate, RateCount, Burst, When, Death } kind = Burst;
-    int target = 0;
-    std::string rate, count, cond;
-    std::vector<std::string> args;
-};
-
-struct Type {
-    std::string name;
-    int parent = -1;
-    int depth = 0;
-    std::vector<Param> params;
-    std::vector<std::string> attrs;
-    std::vector<std::string> equations;  // whole statements
-    std::string draw;
-    std::vector<std::string> kills;  // conditions
-    std::string whenKill;           // a `when C { kill; }` condition, or empty
-    std::vector<Emit> emits;
-    std::vector<int> children;
-    bool hasVel = false, removed = false;
-    int foldOver = -1;  // the type its `crowd` fold reads
-};
-
-struct Trigger {
-    std::string name;
-    std::vector<Param> params;
-    std::vector<Emit> emits;
-};
-
-struct Extern {
-    std::string name;
-    Ty ty;
-    double lo, hi, def;
-};
-
-struct Model {
-    std::vector<Extern> externs;
-    std::vector<Type> types;
-    std::vector<Trigger> triggers;
-    std::vector<std::pair<int, std::vector<std::string>>> spawns;
-    std::string fileAttr;
-};
-
 class Builder {
 public:
-    Builder(uint64_t seed, bool ageControlled) : r_(seed), age_(ageControlled) {}
+    Builder(uint64_t seed, bool ageControlled) : r_(seed), more_(seed ^ 0x5eed5eed5eed5eedull), age_(ageControlled) {}
 
     Model build() {
         int externs = r_.between(0, 2);
@@ -136,7 +81,7 @@ public:
     }
 
 private:
-    Rng r_;
+    Rng r_, more_;
     bool age_;
     Model m_;
 
@@ -310,12 +255,24 @@ private:
         drawCommand(t);
         if (r_.chance(0.8)) t.kills.push_back(condition(t, 0.05, 2.5));
         if (r_.chance(0.1)) t.whenKill = condition(t, 0.2, 2);
-        // Emits: its own children always (only it can create them), other top-level types sometimes.
+        // Emits: its own children always (only it can create them), other top-level types
+        // sometimes.
         for (int child : t.children) {
             int n = r_.between(1, 2);
             for (int i = 0; i < n; ++i) t.emits.push_back(emitTo(index, child));
         }
-        if (r_.chance(0.4)) t.emits.push_back(emitTo(index, r_.pick(tops())));
+        if (r_.chance(0.4)) {
+            t.emits.push_back(emitTo(index, r_.pick(tops())));
+            // Half of the top-level types that have no children of their own (emitters
+            // whose emissions the memory may decide) one or two more, so that sites share
+            // a target's room and an emitter emits two types of emitters (what the
+            // memory's operation must order as the host does) — drawn from a stream of
+            // their own, so that every seed's program is otherwise what it was.
+            std::swap(r_, more_);
+            if (t.parent < 0 && t.children.empty() && r_.chance(0.5))
+                for (int i = r_.between(1, 2); i > 0; --i) t.emits.push_back(emitTo(index, r_.pick(tops())));
+            std::swap(r_, more_);
+        }
         for (const std::string& a : attributes(t)) t.attrs.push_back(a);
     }
 
@@ -486,83 +443,6 @@ private:
         return false;
     }
 };
-
-std::string emitText(const Emit& e, const std::vector<Type>& types) {
-    const Type& t = types[static_cast<size_t>(e.target)];
-    std::string call = t.name;
-    if (!e.args.empty()) {
-        call += "(";
-        for (size_t i = 0; i < e.args.size(); ++i) call += (i ? ", " : "") + e.args[i];
-        call += ")";
-    }
-    switch (e.kind) {
-        case Emit::Rate: return fmt::format("emit {} at {} per second;", call, e.rate);
-        case Emit::RateCount: return fmt::format("emit {} at {} per second count {};", call, e.rate, e.count);
-        case Emit::Burst: return fmt::format("emit {} count {};", call, e.count);
-        case Emit::When: return fmt::format("when {} {{ emit {} count {}; }}", e.cond, call, e.count);
-        case Emit::Death: return fmt::format("on death {{ emit {} count {}; }}", call, e.count);
-    }
-    return "";
-}
-
-std::string paramList(const std::vector<Param>& params) {
-    if (params.empty()) return "";
-    std::string out = "(";
-    for (size_t i = 0; i < params.size(); ++i)
-        out += fmt::format("{}{}: {}", i ? ", " : "", params[i].name, params[i].ty == Ty::Vec3 ? "vec3" : "float");
-    return out + ")";
-}
-
-void printType(const Model& m, int index, int indent, std::string& out) {
-    const Type& t = m.types[static_cast<size_t>(index)];
-    if (t.removed) return;
-    std::string pad(static_cast<size_t>(indent), ' '), in(static_cast<size_t>(indent + 4), ' ');
-    if (!t.attrs.empty()) {
-        out += pad;
-        for (size_t i = 0; i < t.attrs.size(); ++i) out += (i ? " " : "") + t.attrs[i];
-        out += "\n";
-    }
-    out += fmt::format("{}object {}{} {{\n", pad, t.name, paramList(t.params));
-    bool dies = !t.kills.empty() || !t.whenKill.empty();
-    for (const Emit& e : t.emits)  // `on death` at the top of the body
-        if (e.kind == Emit::Death && dies) out += in + emitText(e, m.types) + "\n";
-    for (const std::string& e : t.equations) out += in + e + "\n";
-    if (!t.draw.empty()) out += in + t.draw + "\n";
-    for (const std::string& k : t.kills) out += fmt::format("{}kill when {};\n", in, k);
-    if (!t.whenKill.empty()) out += fmt::format("{}when {} {{ kill; }}\n", in, t.whenKill);
-    for (const Emit& e : t.emits)
-        if (e.kind != Emit::Death) out += in + emitText(e, m.types) + "\n";
-    for (int c : t.children) printType(m, c, indent + 4, out);
-    out += pad + "}\n";
-}
-
-std::string print(const Model& m) {
-    std::string out;
-    if (!m.fileAttr.empty()) out += m.fileAttr + "\n";
-    for (const Extern& e : m.externs) {
-        if (e.ty == Ty::Float)
-            out += fmt::format("extern {}: float = {} range({}, {});\n", e.name, num(e.def), num(e.lo), num(e.hi));
-        else
-            out += fmt::format("extern {}: vec3 = vec3({}) range({}, {});\n", e.name, num(e.def), num(e.lo), num(e.hi));
-    }
-    for (size_t i = 0; i < m.types.size(); ++i)
-        if (m.types[i].parent < 0) printType(m, static_cast<int>(i), 0, out);
-    for (const Trigger& tr : m.triggers) {
-        out += fmt::format("trigger {}{} {{", tr.name, paramList(tr.params).empty() ? "" : paramList(tr.params));
-        for (const Emit& e : tr.emits) out += " " + emitText(e, m.types);
-        out += " }\n";
-    }
-    for (const auto& [type, args] : m.spawns) {
-        out += "spawn " + m.types[static_cast<size_t>(type)].name;
-        if (!args.empty()) {
-            out += "(";
-            for (size_t i = 0; i < args.size(); ++i) out += (i ? ", " : "") + args[i];
-            out += ")";
-        }
-        out += ";\n";
-    }
-    return out;
-}
 
 }  // namespace
 
