@@ -59,7 +59,11 @@ public:
             e.def = e.ty == Ty::Float ? 1 : 0;
             m_.externs.push_back(e);
         }
-        int tops = r_.between(1, 4);
+        // A flat program (3 in 10): top-level types only, most emitting others — where the
+        // memory decides emitters' emissions (SystemOptions::Rows::InMemory). Drawn from a
+        // stream of its own, as the extra sites are.
+        flat_ = more_.chance(0.3);
+        int tops = r_.between(flat_ ? 2 : 1, 4);
         for (int i = 0; i < tops; ++i) addType(-1);
         for (size_t t = 0; t < m_.types.size(); ++t) fillType(static_cast<int>(t));
         int triggers = r_.between(0, 2);
@@ -82,7 +86,7 @@ public:
 
 private:
     Rng r_, more_;
-    bool age_;
+    bool age_, flat_ = false;
     Model m_;
 
     std::vector<int> tops() const {
@@ -102,8 +106,8 @@ private:
         m_.types.push_back(t);
         int index = static_cast<int>(m_.types.size()) - 1;
         if (parent >= 0) m_.types[static_cast<size_t>(parent)].children.push_back(index);
-        // Nested children, up to three levels below a top-level type.
-        if (t.depth < 3 && r_.chance(t.depth == 0 ? 0.45 : 0.3)) {
+        // Nested children, up to three levels below a top-level type (none in a flat program).
+        if (!flat_ && t.depth < 3 && r_.chance(t.depth == 0 ? 0.45 : 0.3)) {
             int children = r_.between(1, 2);
             for (int i = 0; i < children; ++i) addType(index);
         }
@@ -244,7 +248,9 @@ private:
     void fillType(int index) {
         Type& t = m_.types[static_cast<size_t>(index)];
         equations(t);
-        if (t.parent < 0 && r_.chance(0.15)) {  // a fold over its own type or one declared before it
+        // A fold over its own type or one declared before it (fewer in a flat program: what
+        // is folded over exports, and an emitter that dies and exports is the host's).
+        if (t.parent < 0 && r_.chance(flat_ ? 0.05 : 0.15)) {
             std::vector<int> over;
             for (int o : tops())  // both must draw: near is measured between drawn positions
                 if (o == index || (o < index && !m_.types[static_cast<size_t>(o)].draw.empty())) over.push_back(o);
@@ -261,8 +267,12 @@ private:
             int n = r_.between(1, 2);
             for (int i = 0; i < n; ++i) t.emits.push_back(emitTo(index, child));
         }
-        if (r_.chance(0.4)) {
-            t.emits.push_back(emitTo(index, r_.pick(tops())));
+        // (A flat program's types emit only those after them: chains that end in types
+        // emitting nothing, as the memory's emitters need.)
+        std::vector<int> targets = tops();
+        if (flat_) std::erase_if(targets, [&](int o) { return o <= index; });
+        if (!targets.empty() && r_.chance(flat_ ? 0.8 : 0.4)) {
+            t.emits.push_back(emitTo(index, r_.pick(targets)));
             // Half of the top-level types that have no children of their own (emitters
             // whose emissions the memory may decide) one or two more, so that sites share
             // a target's room and an emitter emits two types of emitters (what the
@@ -270,7 +280,7 @@ private:
             // their own, so that every seed's program is otherwise what it was.
             std::swap(r_, more_);
             if (t.parent < 0 && t.children.empty() && r_.chance(0.5))
-                for (int i = r_.between(1, 2); i > 0; --i) t.emits.push_back(emitTo(index, r_.pick(tops())));
+                for (int i = r_.between(1, 2); i > 0; --i) t.emits.push_back(emitTo(index, r_.pick(targets)));
             std::swap(r_, more_);
         }
         for (const std::string& a : attributes(t)) t.attrs.push_back(a);
