@@ -104,6 +104,9 @@ private:
     // created in batches).
     void enqueue(const Run& run);
     void createBatch(size_t type, size_t from, size_t to, double t1);
+    // What emitInMemory's operation asked for, queued from its records (`total`: its totals).
+    void queueFromRecords(size_t type, const RateSites& sites, std::span<const size_t> emitSite, const Batch* batch,
+                          Buffer runs, const std::vector<uint32_t>& total, Buffer rows, double t1);
     // A type that emits nothing (its creation queues nothing) and reads no parent.
     bool quiet(size_t type) const;
     size_t groupQuiet(size_t from);  // see rt/system_queue.cpp

@@ -185,10 +185,19 @@ void Creation::emitInMemory(size_t type, const std::vector<Buffer>& table, const
     s_.memory.read(runs, runsTotalsAt(n, sites), total.size(), total.data());
     s_.stats.invalidEmissions += total[kTotalsInvalid];
     s_.stats.clampedEmissions += total[kTotalsClamped];
-    // Each group's objects one run, and each site's emitters' spawn launches one launch,
-    // from the records (ChildrenLaunch::records): ids, times, places and emitter rows
-    // where the records are — a burst at creation's from the batch's state at creation,
-    // at each emitter's creation time.
+    queueFromRecords(type, in, emitSite, batch, runs, total, rows, t1);
+    s_.nextId += total[kTotalsIds];
+}
+
+// Each group's objects one run, and each site's emitters' spawn launches one launch,
+// from the records (ChildrenLaunch::records): ids, times, places and emitter rows where
+// the records are — a burst at creation's from the batch's state at creation, at each
+// emitter's creation time. `total`: the operation's totals, read back.
+void Creation::queueFromRecords(size_t type, const RateSites& in, std::span<const size_t> emitSite, const Batch* batch,
+                                Buffer runs, const std::vector<uint32_t>& total, Buffer rows, double t1) {
+    using Kind = RateSites::Site::Kind;
+    const TypeInfo& info = s_.types[type];
+    const size_t n = in.rows, sites = in.sites.size();
     const RecordLayout records(in);
     for (size_t group = 0; group < sites; ++group) {
         if (in.sites[group].group != group) continue;
@@ -222,7 +231,6 @@ void Creation::emitInMemory(size_t type, const std::vector<Buffer>& table, const
         }
         enqueue({target, base, kept, {}, 0, 0, 1, 0, runs, records.first[group], n * records.stride[group]});
     }
-    s_.nextId += total[kTotalsIds];
 }
 
 void Creation::emptyFolds(size_t type, const ColumnLayout& layout, const std::vector<Buffer>& table, size_t first,
