@@ -41,6 +41,10 @@ inline uint64_t wholeCount(double x, uint64_t& clamped) {
     return static_cast<uint64_t>(x);
 }
 
+// a += b, stopping at the largest uint64 rather than wrapping around (what emissions ask
+// for, summed).
+inline void addSaturating(uint64_t& a, uint64_t b) { a = b > UINT64_MAX - a ? UINT64_MAX : a + b; }
+
 struct RateEmission {
     double accumulated = 0;  // events accumulated after the update, in [0, 1)
     uint64_t children = 0;   // objects asked for (0: none)

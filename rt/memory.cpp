@@ -197,7 +197,6 @@ void Memory::emitAtRate(const RateSites& in, Buffer runs) {
         site.push_back({s.rate.valid() ? static_cast<const float*>(view(s.rate)) + f : nullptr,
                         s.count.valid() ? static_cast<const float*>(view(s.count)) + f : nullptr,
                         s.accumulated.valid() ? static_cast<double*>(host(s.accumulated)) + f : nullptr});
-    auto add = [](uint64_t a, uint64_t b) { return b > UINT64_MAX - a ? UINT64_MAX : a + b; };
     uint64_t invalid = 0, clamped = 0;
     uint32_t id = in.nextId;
     for (size_t r = 0; r < n; ++r)
@@ -220,8 +219,8 @@ void Memory::emitAtRate(const RateSites& in, Buffer runs) {
             uint64_t& asked = site[s.group].groupAsked;
             const uint32_t room = in.sites[s.group].room;
             uint64_t before = asked;
-            asked = add(before, e.children);
-            d.asked = add(d.asked, e.children);
+            addSaturating(asked, e.children);
+            addSaturating(d.asked, e.children);
             auto place = static_cast<uint32_t>(std::min<uint64_t>(before, room));
             auto kept = static_cast<uint32_t>(std::min<uint64_t>(asked, room)) - place;
             uint32_t* w = record + layout.record(k, r) * kRunWords;

@@ -15,9 +15,6 @@ namespace psys::rt::detail {
 using WallClock = std::chrono::steady_clock;
 inline double seconds(WallClock::time_point a, WallClock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
-// a += b, stopping at the largest uint64 rather than wrapping around.
-inline void addSaturating(uint64_t& a, uint64_t b) { a = b > UINT64_MAX - a ? UINT64_MAX : a + b; }
-
 // The most sub-steps one update of an object takes under @step(h): a 10 s hitch at
 // @step(1/240) is 2,400; `@step(1e-30)` or a step of 1e30 s would never end. Past it the
 // update takes kMaxSubSteps longer sub-steps, and the type's stats count it.
