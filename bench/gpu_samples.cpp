@@ -1,7 +1,6 @@
 #include "gpu_samples.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -17,32 +16,10 @@
 
 namespace psys::bench {
 
-std::string withSpawnsRepeated(const std::string& source, size_t copies) {
-    std::string out;
-    int depth = 0;
-    for (size_t i = 0; i < source.size();) {
-        if (source.compare(i, 2, "//") == 0) {  // a comment, to its line's end
-            size_t end = source.find('\n', i);
-            end = end == std::string::npos ? source.size() : end;
-            out.append(source, i, end - i);
-            i = end;
-            continue;
-        }
-        char c = source[i];
-        bool word = i == 0 || !(std::isalnum(static_cast<unsigned char>(source[i - 1])) || source[i - 1] == '_');
-        if (depth == 0 && word && source.compare(i, 6, "spawn ") == 0) {
-            size_t end = source.find(';', i);
-            if (end == std::string::npos) break;
-            std::string decl = source.substr(i, end + 1 - i);
-            for (size_t k = 0; k < copies; ++k) out += (k ? "\n" : "") + decl;
-            i = end + 1;
-            continue;
-        }
-        depth += c == '{' ? 1 : c == '}' ? -1 : 0;
-        out += c;
-        ++i;
-    }
-    return out;
+void startTimes(ir::Module& module, size_t copies) {
+    ir::Kernel& start = module.start.kernel;
+    for (ir::Yield& y : start.yields)
+        if (y.kind == ir::YieldKind::EmitCount) y.value = start.scalar(static_cast<float>(copies));
 }
 
 namespace {
@@ -63,11 +40,12 @@ std::optional<SampleRun> runSample(gpu::GlslBackend& gpu, const std::string& pat
                                    size_t copies, double size, const SampleScale& scale) {
     SourceManager sources;
     DiagnosticEngine diags(sources);
-    auto module = compileText(path, withSpawnsRepeated(text, copies), sources, diags);
+    auto module = compileText(path, text, sources, diags);
     if (!module) {
         diags.print(std::cerr, false);
         return std::nullopt;
     }
+    startTimes(*module, copies);
     rt::SystemOptions options;
     options.capacity = std::max(options.capacity, static_cast<size_t>(size * 2));
     options.rows = scale.rows;

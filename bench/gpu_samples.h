@@ -5,7 +5,9 @@
 // whose rows the host keeps.
 //
 // A sample is scaled by starting its `spawn`s K times (each copy an object of its own,
-// with its own id and so its own random draws), K chosen from a run at K = 1.
+// with its own id and so its own random draws), K chosen from a run at K = 1: each
+// `spawn` a burst of K at the start, not K lines of source (a file may hold at most a
+// MiB, and a sample of one particle needs 10⁷ of them).
 #pragma once
 
 #include <iosfwd>
@@ -13,6 +15,7 @@
 #include <vector>
 
 #include "gpu/glsl_backend.h"
+#include "ir/ir.h"
 #include "rt/system.h"
 
 namespace psys::bench {
@@ -29,7 +32,8 @@ struct SampleScale {
 // sample could not be compiled or run.
 int sampleFigures(std::ostream& out, gpu::GlslBackend& gpu, const SampleScale& scale, const std::string& json);
 
-// `source` with each top-level `spawn …;` line written `copies` times.
-std::string withSpawnsRepeated(const std::string& source, size_t copies);
+// The module's `spawn`s each start `copies` objects (the start kernel's counts; its
+// arguments, evaluated once, are every copy's: no sample's draws a random value).
+void startTimes(ir::Module& module, size_t copies);
 
 }  // namespace psys::bench
