@@ -38,9 +38,9 @@ int main(int argc, char** argv) {
                    "Launches over at most this many rows run on the host when their columns are there (64; 0: none)");
     std::string rowsIn = "gpu";
     app.add_option("--rows", rowsIn,
-                   "Where the pools of objects that only die keep their rows: gpu (their bookkeeping dispatches), or "
-                   "host (to compare); memory: those of emitters whose emissions the GPU decides too "
-                   "(SystemOptions::Rows::InMemory)")
+                   "Where pools keep their rows: gpu (as the backend asks: on the GPU wherever a type can, emitters "
+                   "whose emissions the GPU decides among them; the default), memory (the same, asked of the "
+                   "run-time: SystemOptions::Rows::InMemory) or host (to compare)")
         ->check(CLI::IsMember({"gpu", "host", "memory"}));
     std::string json;
     app.add_option("--json", json, "Also write the figures as JSON, a list of rows (bench/README.md names the fields)");

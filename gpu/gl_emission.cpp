@@ -279,13 +279,17 @@ void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs) {
     std::vector<Buffer> used = {in.mask, in.killed, in.created};
     for (const rt::RateSites::Site& s : in.sites) used.insert(used.end(), {s.rate, s.count, s.accumulated});
     const size_t sites = in.sites.size(), n = in.rows;
-    if (n == 0 || (!onDevice(runs) && std::all_of(used.begin(), used.end(), [&](Buffer b) { return allOnHost({b}); })))
+    // Where the emitters' rows are on the host, so are their emissions (a launcher, a
+    // cloud: their records and totals read back without a wait); the runs are output only.
+    if (n == 0 || std::all_of(used.begin(), used.end(), [&](Buffer b) { return allOnHost({b}); })) {
+        overwriteOnHost(runs);
         return rt::Memory::emitAtRate(in, runs);
+    }
     flushPending();
     if (!emitRowsProgram_) emitRowsProgram_ = computeProgram(emissionShader(kEmitRows, true), "rate emissions");
     if (!emitScanProgram_) emitScanProgram_ = computeProgram(emissionShader(kEmitScan, false), "rate emissions' scan");
     PassTimer::Scope timed(timer, "emissions", n * sites);
-    unsigned runsGl = bound(runs);
+    unsigned runsGl = overwriteOnDevice(runs);
     std::vector<uint32_t> meta = {static_cast<uint32_t>(n), static_cast<uint32_t>(sites), in.nextId,
                                   static_cast<uint32_t>(in.first)};
     const rt::RecordLayout layout(in);

@@ -227,6 +227,24 @@ void GlMemory::toHost(Column& c) const {
     c.device = false;
 }
 
+void GlMemory::overwriteOnHost(Buffer b) {
+    Column& c = at(b);
+    if (!c.device) return;
+    c.pending.clear();
+    c.pendingRows = 0;
+    c.hostCopy.resize(c.rows * rt::elemSize(c.elem));
+    c.device = false;
+}
+
+unsigned GlMemory::overwriteOnDevice(Buffer b) {
+    Column& c = at(b);
+    c.pending.clear();
+    c.pendingRows = 0;
+    uploadRows(c, 0, 0);  // (a GL buffer of its rows, nothing sent)
+    written(b);
+    return c.gl;
+}
+
 void GlMemory::upload(Column& c) const { uploadRows(c, 0, c.rows); }
 
 void GlMemory::uploadRows(Column& c, size_t first, size_t count) const {
@@ -529,6 +547,13 @@ unsigned GlMemory::deviceBuffer(Buffer b) {
     Column& c = at(b);
     flush(c);
     upload(c);
+    return c.gl;
+}
+
+unsigned GlMemory::deviceRows(Buffer b, size_t first, size_t count) {
+    Column& c = at(b);
+    flush(c);
+    uploadRows(c, first, count);  // (nothing where it is on the GPU)
     return c.gl;
 }
 

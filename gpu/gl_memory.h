@@ -63,6 +63,9 @@ public:
     bool onDevice(rt::Buffer buffer) const;
     // Its GL buffer, holding the column's value (uploaded first when it is on the host).
     unsigned deviceBuffer(rt::Buffer buffer);
+    // Its GL buffer for a dispatch that only reads rows [first, first + count): a column on
+    // the host sends those rows alone, and stays the host's.
+    unsigned deviceRows(rt::Buffer buffer, size_t first, size_t count);
     // The GPU wrote `count` rows from `first` into `words` (a GL buffer) at word `word`:
     // they become the column's, and the column's value is on the GPU from now on.
     void adopt(rt::Buffer buffer, size_t first, size_t count, unsigned words, size_t word);
@@ -115,6 +118,11 @@ private:
     void runRows(unsigned program, unsigned from, unsigned to, size_t w, size_t first,
                  std::span<const uint32_t> rows, const char* pass) const;
     void flush(Column& c) const;  // its pending rows to the GPU
+    // A column an operation is about to write whole (its output, what it held not kept):
+    // on the host, its value becomes the host copy's without a read-back; on the GPU, the
+    // GL buffer's without an upload (its GL buffer, for the dispatch that writes it).
+    void overwriteOnHost(rt::Buffer b);
+    unsigned overwriteOnDevice(rt::Buffer b);
     void fillWords(Column& c, size_t first, size_t count, uint32_t word);
     std::vector<uint32_t> pendingColumns_;  // columns that may have rows pending
     // Scatters from the host of at most this many rows into a column on the GPU wait, and

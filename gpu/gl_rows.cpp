@@ -267,7 +267,8 @@ void GlMemory::identifyRecords(Buffer runs, size_t firstRecord, size_t records, 
     flushPending();
     if (!identifyRecordsProgram_) identifyRecordsProgram_ = computeProgram(shader((std::string(kRunObjects) + kIdentifyRecords).c_str()), "identify from records");
     PassTimer::Scope timed(timer, "identify", objects);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceBuffer(runs));
+    // (Records the host side's emitters wrote: only the group's go up.)
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceRows(runs, firstRecord * rt::kRunWords, records * rt::kRunWords));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, bound(created));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, bound(ids));
     bindParams(paramsBuffer_, {static_cast<uint32_t>(objects), static_cast<uint32_t>(records),

@@ -203,8 +203,10 @@ public:
     // (the rest dropped, counted in the totals), and the kept take ids from nextId in row
     // order, sites in order. Row r's run at site s is record RecordLayout::record(s, r) of
     // `runs` (u32, runsWords(rows, sites) of them: kRunWords a record, a row that emits
-    // nothing has count 0), the totals after the records (kTotals…). Written here through
-    // `host`; a device does it where the rows are (GlMemory: a dispatch a site and one scan).
+    // nothing has count 0), the totals after the records (kTotals…): `runs` is its output
+    // only — what it held before, and its words past runsWords, are not kept (a scratch
+    // buffer). Written here through `host`; a device does it where the rows are (GlMemory:
+    // a dispatch a site and one scan, unless the rows are a few on the host).
     virtual void emitAtRate(const RateSites& sites, Buffer runs);
     // Objects r < objects of a batch from a group's records of `runs` (emitAtRate's,
     // records [firstRecord, firstRecord + records): the objects the record's count says

@@ -124,14 +124,15 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     // they are (a row killed emits at no rate, and bursts), and its kills are late, as a
     // type's that only dies — nobody else looks at them before the step's end. (Until no
     // type changes: an emitter of emitters follows them in.)
-    // Only where asked (Rows::InMemory, creating in batches) so far: on a device the host
-    // still reads the operation's totals back in the step (docs/gpu.md, "Emitters in the
-    // memory").
+    // Wherever rows are kept in the memory (a device's backend asks for it, any backend
+    // with Rows::InMemory) and objects are created in batches. Where the emitters' rows are
+    // on a device, the host still reads the operation's totals back in the step
+    // (docs/gpu.md, "Emitters in the memory").
     auto decidedInMemory = [&](size_t t) {
         const TypeInfo& info = types[t];
         const ir::Object& o = module.objects[t];
         bool dies = info.kills || info.unstable;
-        bool emitter = options.rows == SystemOptions::Rows::InMemory && options.createInBatches &&
+        bool emitter = inMemory && options.createInBatches &&
                        (info.updateEmits || info.bursts) &&
                        (!dies || (options.lateKills && !info.exports)) && !info.read && keptWhole(info);
         int emitting = -1;  // the one target that emits, if any

@@ -69,7 +69,7 @@ bool check(const Case& c, RunOptions options, const std::string& name, const std
 
 int main(int argc, char** argv) {
     CLI::App app{"psys-progen: generated programs on every backend, against the interpreter"};
-    std::string seeds, configs = "interp,llvm-exact-1t,llvm-exact-2t,llvm-fast-2t,glsl,glsl-device,interp-memory,glsl-memory", out;
+    std::string seeds, configs = "interp,llvm-exact-1t,llvm-exact-2t,llvm-fast-2t,glsl,glsl-device,interp-memory", out;
     double minutes = 0;
     uint64_t first = 1, print = 0;
     unsigned timeout = 120;

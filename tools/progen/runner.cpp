@@ -34,7 +34,6 @@ std::vector<Config> allConfigs() {
         {"glsl", "glsl", true, 1, true},
         {"glsl-device", "glsl", true, 1, false},
         {"interp-memory", "interp", true, 1, true, true},
-        {"glsl-memory", "glsl", true, 1, false, true},
     };
 }
 

@@ -25,9 +25,9 @@ struct Config {
 };
 
 // By name: interp, llvm-exact-1t, llvm-exact-2t, llvm-fast-2t, glsl (with its host side),
-// glsl-device (every pool on the GPU), interp-memory and glsl-memory (rows kept in the
-// memory wherever they can be: SystemOptions::Rows::InMemory; the latter every pool on
-// the GPU). nullopt for an unknown one.
+// glsl-device (every pool on the GPU; both keep rows in the GPU's memory wherever they can
+// be, as the backend asks), interp-memory (the interpreter keeping them in its memory so:
+// SystemOptions::Rows::InMemory). nullopt for an unknown one.
 std::optional<Config> configNamed(const std::string& name);
 std::vector<std::string> configNames();
 
