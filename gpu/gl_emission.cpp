@@ -273,8 +273,8 @@ std::pair<uint32_t, uint32_t> doubleWords(double x) {
 }  // namespace
 
 // On the host where the emitters' columns are small and there (a pool whose launches run
-// on the host side) and the runs are too (the runs buffer has rows · sites records: its
-// length is not the pool's).
+// on the host side), wherever the runs buffer was (its length is not the pool's: rows ·
+// sites records); on the GPU otherwise.
 void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs) {
     std::vector<Buffer> used = {in.mask, in.killed, in.created};
     for (const rt::RateSites::Site& s : in.sites) used.insert(used.end(), {s.rate, s.count, s.accumulated});

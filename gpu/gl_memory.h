@@ -53,7 +53,8 @@ public:
                   rt::Buffer mask, size_t first) override;
     void identifyRecords(rt::Buffer runs, size_t firstRecord, size_t records, size_t objects, rt::Buffer created,
                          rt::Buffer ids, size_t first) override;
-    // Rate emissions decided on the GPU: a dispatch a site, one scan (gpu/gl_emission.cpp).
+    // Rate emissions decided on the GPU, a dispatch a site and one scan (gpu/gl_emission.cpp);
+    // on the host where the emitters' rows are a few there.
     void emitAtRate(const rt::RateSites& sites, rt::Buffer runs) override;
     // The box around the drawn rows, reduced on the GPU (gpu/gl_bounds.cpp).
     rt::Bounds bounds(rt::Buffer visible, const std::array<rt::Buffer, 3>& position, const std::array<float, 3>& constant,

@@ -58,9 +58,9 @@ struct SystemOptions {
     // or sub-steps) or never die keep their rows — the free stack, generations, masks: in
     // the memory (Pool::keepRowsInMemory, its operations doing the bookkeeping where the
     // columns are) where the backend asks for it (Backend::keepsRowsInMemory: a device),
-    // always, or never. Always also keeps there the rows of emitters whose emissions the
-    // memory can decide — at a rate, in bursts at creation, on edges, on deaths
-    // (Memory::emitAtRate: rt/system_state.cpp, TypeInfo::rowsInMemory).
+    // always, or never. Wherever they are kept there, so are the rows of emitters whose
+    // emissions the memory can decide — at a rate, in bursts at creation, on edges, on
+    // deaths (Memory::emitAtRate: rt/system_state.cpp, TypeInfo::rowsInMemory).
     // Results are the same, rows included (tests compare them).
     enum class Rows : uint8_t { AsBackend, InMemory, OnHost } rows = Rows::AsBackend;
     // Called at the end of the step after which the system is finished (System::finished),

@@ -210,21 +210,27 @@ TEST_CASE("emitters on the host side decide their emissions there: the rain's cl
     // records go up for the new drops' ids. What waits is the drops' own operation, twice a
     // step: over the pool's thousands of rows, and over the step's ~107 new drops (past the
     // host side's 64), which burst on death.
+    // The objects are the interpreter's throughout.
     std::string text = readFile(test::sample("rain"));
     for (int i = 1; i < 40; ++i) text += "\nspawn cloud;";
-    auto gpu = gpuBackend(true);
-    rt::System system(test::compileModule(text), *gpu);
-    for (int f = 0; f < 120; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
-    const rt::Pool& drops = system.pool(static_cast<size_t>(system.typeIndex("drop")));
+    Pair p(text, true, true);
+    p.steps(120, 1.0 / 60);
+    const rt::Pool& clouds = p.gl->pool(static_cast<size_t>(p.gl->typeIndex("cloud")));
+    const rt::Pool& drops = p.gl->pool(static_cast<size_t>(p.gl->typeIndex("drop")));
+    REQUIRE(clouds.rowsInMemory());
     REQUIRE(drops.rowsInMemory());
     REQUIRE(drops.live() > 3000);
-    uint64_t waits = gpu->waits(), bytes = gpu->transferredBytes();
-    for (int f = 0; f < 10; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
-    double perStep = static_cast<double>(gpu->transferredBytes() - bytes) / 10;
-    MESSAGE("the rain with 40 clouds: " << gpu->waits() - waits << " waits in 10 steps, " << perStep
+    CHECK(p.compare() <= kSamplesTolerance);
+    uint64_t waits = p.gpu->waits(), bytes = p.gpu->transferredBytes();
+    for (int f = 0; f < 10; ++f) REQUIRE_FALSE(p.gl->step(1.0 / 60));
+    double perStep = static_cast<double>(p.gpu->transferredBytes() - bytes) / 10;
+    MESSAGE("the rain with 40 clouds: " << p.gpu->waits() - waits << " waits in 10 steps, " << perStep
                                         << " bytes a step between host and GPU");
-    CHECK(gpu->waits() - waits == 20);
+    CHECK(p.gpu->waits() - waits == 20);
     CHECK(perStep < 16384);  // (the drops' records, were they sent: 72 bytes a drop)
+    for (int f = 0; f < 10; ++f) REQUIRE_FALSE(p.cpu->step(1.0 / 60));
+    p.steps(30, 1.0 / 60);
+    CHECK(p.compare() <= kSamplesTolerance);
 }
 
 TEST_CASE("a step's late kills are taken at the next step — what is drawn before leaves them out") {

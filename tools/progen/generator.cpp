@@ -60,8 +60,8 @@ public:
             m_.externs.push_back(e);
         }
         // A flat program (3 in 10): top-level types only, most emitting others — where the
-        // memory decides emitters' emissions (SystemOptions::Rows::InMemory). Drawn from a
-        // stream of its own, as the extra sites are.
+        // memory decides emitters' emissions (on the GPU; SystemOptions::Rows::InMemory on
+        // the interpreter). Drawn from a stream of its own, as the extra sites are.
         flat_ = more_.chance(0.3);
         int tops = r_.between(flat_ ? 2 : 1, 4);
         for (int i = 0; i < tops; ++i) addType(-1);
