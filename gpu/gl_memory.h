@@ -73,6 +73,10 @@ public:
     // The GPU wrote rows of the column in its own GL buffer (bound in place): its value is
     // on the GPU from now on.
     void written(rt::Buffer buffer);
+    // mask[map[mapFirst + r]] = 0 for each r of `rows` (u8 mask, u32 map), where they are:
+    // a launch the host side ran clears its kills in the alive mask through its batch's
+    // row list on the GPU, which it need not read back (gpu/gl_rows.cpp).
+    void clearMapped(rt::Buffer mask, std::span<const uint32_t> rows, rt::Buffer map, size_t mapFirst);
     // A GL buffer holding `rows` (sent once for every scatter, gather and launch that uses
     // the same list in a row: a creation batch's rows).
     unsigned rowList(std::span<const uint32_t> rows) const;
@@ -139,7 +143,7 @@ private:
     mutable std::vector<uint32_t> rowsSent_;  // what rowsBuffer_ holds
     mutable unsigned boundsProgram_ = 0, boxBuffer_ = 0;  // gpu/gl_bounds.cpp
     unsigned emitRowsProgram_ = 0, emitScanProgram_ = 0, metaBuffer_ = 0;  // gpu/gl_emission.cpp
-    unsigned identifyRecordsProgram_ = 0;                                   // gpu/gl_rows.cpp
+    unsigned identifyRecordsProgram_ = 0, clearMappedProgram_ = 0;          // gpu/gl_rows.cpp
 };
 
 // Host rows to GPU words (u8 widened to a word) and back.

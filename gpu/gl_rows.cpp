@@ -91,6 +91,18 @@ void main() {
 }
 )";
 
+// Rows of a mask cleared through a map: mask[map[mapFirst + rows[i]]] = 0.
+const char* kClearMapped = R"(
+layout(std430, binding = 0) readonly buffer Rows { uint rows[]; };
+layout(std430, binding = 1) readonly buffer Map { uint map[]; };
+layout(std430, binding = 4) buffer Mask { uint mask[]; };
+void main() {
+    uint i = INVOCATION, count = param(0u), mapFirst = param(1u);
+    if (i >= count) return;
+    mask[map[mapFirst + rows[i]]] = 0u;
+}
+)";
+
 // What both identify shaders share: the runs (records of rt::kRunWords words, in
 // rt::ObjectRuns' form) from word `base` on, `count` of them; the run of object r — the
 // last whose first object is at or before r (a run of no objects shares its first with
@@ -227,6 +239,24 @@ void GlMemory::markFresh(const rt::PoolRows& pool, Buffer rows, size_t first, si
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, deviceBuffer(pool.alive));
     bindParams(paramsBuffer_, {static_cast<uint32_t>(first), static_cast<uint32_t>(count)});
     dispatchRows(freshProgram_, count);
+}
+
+void GlMemory::clearMapped(Buffer mask, std::span<const uint32_t> rows, Buffer map, size_t mapFirst) {
+    if (rows.empty()) return;
+    if (allOnHost({mask, map})) {
+        auto* m = static_cast<uint8_t*>(host(mask));
+        const auto* through = static_cast<const uint32_t*>(view(map)) + mapFirst;
+        for (uint32_t r : rows) m[through[r]] = 0;
+        return;
+    }
+    flushPending();
+    if (!clearMappedProgram_) clearMappedProgram_ = computeProgram(shader(kClearMapped), "clear through a map");
+    PassTimer::Scope timed(timer, "clear", rows.size());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, rowList(rows));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, deviceBuffer(map));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, bound(mask));
+    bindParams(paramsBuffer_, {static_cast<uint32_t>(rows.size()), static_cast<uint32_t>(mapFirst)});
+    dispatchRows(clearMappedProgram_, rows.size());
 }
 
 void GlMemory::identify(const rt::ObjectRuns& runs, size_t n, size_t kept, Buffer created, Buffer ids, Buffer mask,

@@ -134,17 +134,17 @@ void GlslBackend::setHostSide(std::unique_ptr<rt::Backend> host, size_t rows) {
 // were drawn on the GPU).
 void GlslBackend::hostClearKilled(const rt::RowsLaunch& launch) {
     const auto* flags = static_cast<const uint8_t*>(memory_.view(launch.columns[ColumnLayout::kKill]));
-    std::vector<uint32_t> listed;  // a batch's rows kept in the memory: this launch's
-    if (launch.aliveRowsBuffer.valid()) {
-        listed.resize(launch.end - launch.begin);
-        memory_.read(launch.aliveRowsBuffer, launch.begin - launch.aliveRowsFirst, listed.size(), listed.data());
+    if (launch.aliveRowsBuffer.valid()) {  // a batch's rows kept in the memory: cleared where they are
+        std::vector<uint32_t> killed;
+        for (size_t i = launch.begin; i < launch.end; ++i)
+            if (flags[i]) killed.push_back(static_cast<uint32_t>(i - launch.aliveRowsFirst));
+        memory_.clearMapped(launch.aliveMask, killed, launch.aliveRowsBuffer, 0);
+        return;
     }
     uint8_t zero = 0;
     for (size_t i = launch.begin; i < launch.end; ++i) {
         if (!flags[i]) continue;
-        size_t row = !listed.empty()                ? listed[i - launch.begin]
-                     : launch.aliveRows.empty() ? i
-                                                : launch.aliveRows[i - launch.aliveRowsFirst];
+        size_t row = launch.aliveRows.empty() ? i : launch.aliveRows[i - launch.aliveRowsFirst];
         memory_.write(launch.aliveMask, row, 1, &zero);
     }
 }
