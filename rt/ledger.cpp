@@ -201,15 +201,21 @@ void Ledger::free(Deaths& deaths, std::vector<LateKills>& lates) {
         return;
     }
     // In the merged order of take: the deaths before each late launch's place, then its
-    // kills. A pool's free stack gets its rows in that order, and a simple type's rows
-    // touch no other pool, so each part goes as one run.
+    // kills. A simple type's rows touch no other pool, and its pool's free stack gets them
+    // in that order: each part goes as one run; the deaths of parents and children by the
+    // rule of `release`, after.
     size_t next = 0;
-    Deaths one;
+    Deaths kept;
     auto releaseUpTo = [&](size_t at) {
-        if (next >= at) return;
-        one.assign(deaths.begin() + static_cast<std::ptrdiff_t>(next), deaths.begin() + static_cast<std::ptrdiff_t>(at));
-        release(one);
-        next = at;
+        for (; next < at; ++next) {
+            auto [type, row] = deaths[next];
+            const TypeInfo& info = s_.types[type];
+            Pool& pool = s_.pools[type];
+            if (info.read || info.parentType >= 0)
+                kept.push_back(deaths[next]);
+            else if (pool.status(row) == Status::Frozen)
+                pool.release(row);
+        }
     };
     for (LateKills& l : lates) {
         if (s_.types[l.type].rowsInMemory) {  // freed in the memory at the step's end (endStep): counted
@@ -217,7 +223,7 @@ void Ledger::free(Deaths& deaths, std::vector<LateKills>& lates) {
             continue;
         }
         releaseUpTo(l.at);
-        if (!simple(l)) {  // its kills frozen and released in its place, as take and release would
+        if (!simple(l)) {  // its kills frozen in its place, as take would
             // A list of its own each time: take leaves the list it settles holding only what
             // it keeps (nothing here: the type's rows are not in the memory).
             Deaths its;
@@ -225,7 +231,7 @@ void Ledger::free(Deaths& deaths, std::vector<LateKills>& lates) {
             single.push_back(std::move(l));
             single[0].at = 0;
             take(its, single);
-            release(its);
+            kept.insert(kept.end(), its.begin(), its.end());
             continue;
         }
         Pool& pool = s_.pools[l.type];
@@ -244,19 +250,51 @@ void Ledger::free(Deaths& deaths, std::vector<LateKills>& lates) {
         }
     }
     releaseUpTo(deaths.size());
+    release(kept);
     deaths.clear();
     lates.clear();
 }
 
+// The rule that frees rows (docs/architecture.md, "The life of a step"): a type at a time,
+// the most deeply nested types first, so that a parent's readers are counted down before
+// its turn — first its deaths, in the order they came, where nobody reads them; then its
+// objects that died before and whose last reader went now, in row order. A freed object
+// is a reader gone for its parent. Nothing depends on how one type's deaths interleave
+// with its children's, so that a device freeing a kill list at a time, a type at a time,
+// gives the same stacks.
 void Ledger::release(Deaths& deaths) {
-    for (auto [type, row] : deaths) {
+    if (deaths.empty()) return;
+    const size_t types = s_.types.size();
+    std::vector<std::vector<uint32_t>> own(types), waited(types);
+    for (auto [type, row] : deaths) own[type].push_back(row);
+    auto free = [&](size_t type, uint32_t row) {
         Pool& pool = s_.pools[type];
-        if (pool.status(row) != Status::Frozen || pool.readers[row] > 0) continue;
+        if (pool.status(row) != Status::Frozen || pool.readers[row] > 0) return;
         Handle parent = pool.parent[row];
         pool.release(row);
-        releaseReader(type, parent);
+        int up = s_.types[type].parentType;
+        if (up < 0 || !parent.valid()) return;
+        Pool& parents = s_.pools[static_cast<size_t>(up)];
+        if (!parents.matches(parent)) return;
+        --parents.readers[parent.row];
+        waited[static_cast<size_t>(up)].push_back(parent.row);
+    };
+    for (size_t type : s_.deepestFirst) {
+        for (uint32_t row : own[type]) free(type, row);
+        std::vector<uint32_t>& rows = waited[type];
+        std::sort(rows.begin(), rows.end());
+        rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+        for (uint32_t row : rows) free(type, row);
     }
     deaths.clear();
+}
+
+void Ledger::freeUnread() {
+    Deaths frozen;
+    for (size_t t = 0; t < s_.pools.size(); ++t)
+        for (uint32_t r = 0; r < s_.pools[t].rows(); ++r)
+            if (s_.pools[t].status(r) == Status::Frozen) frozen.push_back({t, r});
+    release(frozen);
 }
 
 bool Ledger::owedReady() {
@@ -265,20 +303,6 @@ bool Ledger::owedReady() {
         for (const LateKills::Part& p : l.parts)
             if (p.ticket && !s_.backend.ready(p.ticket)) return false;
     return true;
-}
-
-void Ledger::releaseReader(size_t childType, Handle parent) {
-    int t = s_.types[childType].parentType;
-    while (t >= 0 && parent.valid()) {
-        Pool& pool = s_.pools[static_cast<size_t>(t)];
-        if (!pool.matches(parent)) return;
-        if (--pool.readers[parent.row] > 0 || pool.status(parent.row) != Status::Frozen) return;
-        Handle up = pool.parent[parent.row];
-        pool.release(parent.row);
-        parent = up;
-        childType = static_cast<size_t>(t);
-        t = s_.types[childType].parentType;
-    }
 }
 
 }  // namespace psys::rt::detail

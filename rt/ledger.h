@@ -1,8 +1,8 @@
 // Internal to rt/: the deaths of a step, from the kill to the free stack, in one record.
 // A death is frozen when it is known — at once (a kill read from the flags or a chunk's
 // list) or late (a launch whose kills are taken at the step's end: LateKills) — and freed
-// by the step's Release phase in the order the deaths came, a frozen parent once its last
-// reader is gone. Where a backend still owes a late launch's kills at the step's end (it
+// by the step's Release phase: a type's in the order its deaths came, a frozen parent once
+// its last reader is gone (Ledger::release says in which order). Where a backend still owes a late launch's kills at the step's end (it
 // clearsKilled: the GPU), the step's deaths wait, in their order, for the next settle.
 // Everything outside the step's Release phase goes through one call, `settle`: the
 // schedule's Settle phase, a trigger, the start, finish, a reload, stats.
@@ -83,8 +83,9 @@ public:
     // as a reload frees the frozen rows of a pool kept on the host, after its free rows —
     // and counted: the new system keeps no record of the old one's deaths.
     void releaseForReload();
-    // A reader of `parent` is gone; a frozen parent without readers is freed, and so on up.
-    void releaseReader(size_t childType, Handle parent);
+    // A reload's (rt/reload.cpp, readers counted again): every frozen object nobody reads
+    // freed, by the rule of the step's end (`release`), a pool's in row order.
+    void freeUnread();
 
 private:
     using Deaths = std::vector<std::pair<size_t, uint32_t>>;
@@ -103,6 +104,7 @@ private:
     // reads no parent go straight onto its free stack in their place (nothing else can
     // happen to them between), each part as one run of rows.
     void free(Deaths& deaths, std::vector<LateKills>& lates);
+    // The rule that frees the rows of deaths (and of the parents they were the last readers of).
     void release(Deaths& deaths);
     bool owedReady();
     // A type whose rows are in the memory: its kills listed where the backend did not

@@ -116,15 +116,7 @@ void reconnect(const detail::State& old, detail::State& s, const std::vector<int
         for (uint32_t r = 0; r < to.rows(); ++r)
             if (to.status(r) != Status::Free && parents.matches(to.parent[r])) ++parents.readers[to.parent[r].row];
     }
-    for (size_t t = 0; t < s.pools.size(); ++t) {
-        Pool& pool = s.pools[t];
-        for (uint32_t r = 0; r < pool.rows(); ++r)
-            if (pool.status(r) == Status::Frozen && pool.readers[r] == 0) {
-                Handle parent = pool.parent[r];
-                pool.release(r);
-                s.ledger.releaseReader(t, parent);
-            }
-    }
+    s.ledger.freeUnread();
 }
 
 }  // namespace

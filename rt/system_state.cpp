@@ -88,8 +88,13 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         types.push_back(typeInfo(module, obj));
         typeStats.push_back({obj.name, 0, 0, 0, 0, 0});
     }
-    for (const TypeInfo& t : types)
-        if (t.parentType >= 0) types[static_cast<size_t>(t.parentType)].read = true;
+    std::vector<int> depth(types.size(), 0);
+    for (size_t t = 0; t < types.size(); ++t) {
+        if (types[t].parentType >= 0) types[static_cast<size_t>(types[t].parentType)].read = true;
+        for (int up = types[t].parentType; up >= 0; up = types[static_cast<size_t>(up)].parentType) ++depth[t];
+        deepestFirst.push_back(t);
+    }
+    std::stable_sort(deepestFirst.begin(), deepestFirst.end(), [&](size_t a, size_t b) { return depth[a] > depth[b]; });
     // Nobody looks at the type's dead during the step: it emits nothing in its updates, has
     // no exports and no children.
     auto unwatched = [](const TypeInfo& t) { return !t.updateEmits && !t.exports && !t.read; };

@@ -117,6 +117,8 @@ struct State {
     SystemOptions options;
     std::vector<Pool> pools;
     std::vector<TypeInfo> types;
+    // The types, the most deeply nested first (a parent after its children: Ledger::release).
+    std::vector<size_t> deepestFirst;
     std::vector<TypeWork> work;
     std::vector<Value> externs;
     uint64_t externsVersion = 0;

@@ -134,6 +134,67 @@ TEST_CASE("a frozen parent is freed after its last reader dies") {
     CHECK(run.stats("parent").frozen == 0);
 }
 
+// The rule of the step's end (rt/ledger.h): a type's deaths freed in the order they came,
+// the children's before their parents' — whatever the order of their kills in the step.
+TEST_CASE("a parent dying beside its last reader is freed in its own place among its type's deaths") {
+    Run run(R"(
+        object p(life: float, childLife: float) {
+            emit c(childLife) count 1;
+            kill when age > life;
+            point(vec3(life, childLife, 0), white, 1);
+            object c(l: float) {
+                point(vec3(p.age, 0, 1), white, 1);
+                kill when age > l;
+            }
+        }
+        spawn p(1.1, 1.1);  // row 0: dies at 1.25 s, its child in the same step (after it)
+        spawn p(1.1, 0.1);  // row 1: its child gone at 0.25 s; dies at 1.25 s, read by nobody
+        trigger again(life: float) { emit p(life, 0.1) count 1; })");
+    run.steps(5, 0.25);
+    CHECK(run.stats("p").live == 0);
+    CHECK(run.stats("p").frozen == 0);
+    // Freed in the order they died (row 0, then row 1): the first object the trigger
+    // creates takes the row freed last. (Had row 0 waited for its child's kill, after row
+    // 1's own, the order would be the other.)
+    REQUIRE_FALSE(run.system->fire("again", std::vector<float>{9}).has_value());
+    REQUIRE_FALSE(run.system->fire("again", std::vector<float>{8}).has_value());
+    run.steps(1, 0.25);
+    const auto& p = run.points("p");
+    REQUIRE(p.size() == 2);
+    CHECK(p[0].position[0] == 8);
+    CHECK(p[1].position[0] == 9);
+}
+
+// …and a parent that died before, whose last reader goes now: after its type's deaths of
+// the step, in row order.
+TEST_CASE("parents whose last readers go in one step are freed after that step's deaths of their type, in row order") {
+    Run run(R"(
+        object p(life: float, childLife: float) {
+            emit c(childLife) count 1;
+            kill when age > life;
+            point(vec3(life, childLife, 0), white, 1);
+            object c(l: float) {
+                point(vec3(p.age, 0, 1), white, 1);
+                kill when age > l;
+            }
+        }
+        spawn p(0.1, 1.1);  // row 0: frozen at 0.25 s, its child dies at 1.25 s
+        spawn p(0.1, 1.1);  // row 1: the same
+        spawn p(1.1, 0.1);  // row 2: dies at 1.25 s, its child long gone
+        trigger again(life: float) { emit p(life, 0.1) count 1; })");
+    run.steps(5, 0.25);
+    CHECK(run.stats("p").frozen == 0);
+    // The stack: row 2 (its own death), then rows 0 and 1 (their readers gone): a trigger's
+    // objects take rows 1, 0, 2.
+    for (float life : {7.0f, 8.0f, 9.0f}) REQUIRE_FALSE(run.system->fire("again", std::vector<float>{life}).has_value());
+    run.steps(1, 0.25);
+    const auto& p = run.points("p");
+    REQUIRE(p.size() == 3);
+    CHECK(p[0].position[0] == 8);
+    CHECK(p[1].position[0] == 7);
+    CHECK(p[2].position[0] == 9);
+}
+
 TEST_CASE("the same seed gives the same run — another seed another") {
     std::string fireworks = test::readFile((std::filesystem::path(PSYS_SAMPLES_DIR) / "fireworks.psys").string());
     auto positions = [&](uint32_t seed) {
