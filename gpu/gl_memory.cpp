@@ -123,7 +123,9 @@ GlMemory::~GlMemory() {
     for (auto& c : columns_)
         if (c && c->gl) glDeleteBuffers(1, &c->gl);
     for (unsigned program : {scatterProgram_, scatterColumnsProgram_, gatherProgram_, allocateProgram_, releaseProgram_, pushedProgram_, freshProgram_,
-                             identifyProgram_, boundsProgram_, emitRowsProgram_, emitScanProgram_, identifyRecordsProgram_})
+                             identifyProgram_, boundsProgram_, emitRowsProgram_, emitScanProgram_, identifyRecordsProgram_,
+                             clearMappedProgram_, parentsProgram_, gatherAliveProgram_, survivorsProgram_,
+                             readersGoneProgram_, releaseUnreadProgram_, releaseWaitingProgram_})
         if (program) glDeleteProgram(program);
     if (runsBuffer_) glDeleteBuffers(1, &runsBuffer_);
     if (rowsBuffer_) glDeleteBuffers(1, &rowsBuffer_);
@@ -456,6 +458,30 @@ void GlMemory::gather(Buffer from, Buffer to, size_t toFirst, std::span<const ui
     upload(t);
     if (!gatherProgram_) gatherProgram_ = computeProgram(rowsShader(kGather), "gather");
     runRows(gatherProgram_, f.gl, t.gl, wordsPerRow(f.elem), toFirst, rows, "gather");
+    t.device = true;
+}
+
+// The same through a list in a column (a child pool's parents), where the values are.
+void GlMemory::gatherThrough(Buffer from, Buffer to, size_t toFirst, Buffer rows, size_t rowsFirst, size_t count) {
+    if (count == 0) return;
+    Column &f = at(from), &t = at(to);
+    if (!f.device && !t.device && !onDevice(rows)) return rt::Memory::gatherThrough(from, to, toFirst, rows, rowsFirst, count);
+    flush(f);
+    flush(t);
+    upload(f);
+    upload(t);
+    unsigned list = deviceBuffer(rows);
+    if (!gatherProgram_) gatherProgram_ = computeProgram(rowsShader(kGather), "gather");
+    PassTimer::Scope timed(timer, "gather", count);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.gl);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, t.gl);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, list);
+    glUseProgram(gatherProgram_);
+    bindParams(paramsBuffer_, {static_cast<uint32_t>(count), static_cast<uint32_t>(toFirst),
+                               static_cast<uint32_t>(wordsPerRow(f.elem)), static_cast<uint32_t>(rowsFirst)});
+    dispatchInvocations(count, 64);
+    ++dispatches;
+    afterWrite(Write::Dispatch, kColumnReaders);
     t.device = true;
 }
 

@@ -53,6 +53,21 @@ public:
                   rt::Buffer mask, size_t first) override;
     void identifyRecords(rt::Buffer runs, size_t firstRecord, size_t records, size_t objects, rt::Buffer created,
                          rt::Buffer ids, size_t first) override;
+    // Parents and their children on the GPU (gpu/gl_parents.cpp; parentsFromRecords and
+    // gatherThrough beside identifyRecords and gather).
+    void parentsFromRecords(rt::Buffer runs, size_t firstRecord, size_t records, size_t stride, rt::Buffer map,
+                            size_t mapFirst, size_t objects, size_t kept, rt::Buffer parents, size_t first,
+                            rt::Buffer readers) override;
+    void gatherThrough(rt::Buffer from, rt::Buffer to, size_t toFirst, rt::Buffer rows, size_t rowsFirst,
+                       size_t count) override;
+    void gatherAlive(rt::Buffer alive, rt::Buffer to, size_t toFirst, rt::Buffer rows, size_t rowsFirst,
+                     size_t count) override;
+    void survivors(rt::Buffer mask, rt::Buffer killed, rt::Buffer out, size_t first, size_t count) override;
+    void readersGone(rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map, size_t mapFirst,
+                     rt::Buffer parents, rt::Buffer readers) override;
+    void releaseUnread(const rt::PoolRows& pool, rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map,
+                       size_t mapFirst) override;
+    void releaseWaiting(const rt::PoolRows& pool, size_t rows) override;
     // Rate emissions decided on the GPU, a dispatch a site and one scan (gpu/gl_emission.cpp);
     // on the host where the emitters' rows are a few there.
     void emitAtRate(const rt::RateSites& sites, rt::Buffer runs) override;
@@ -143,8 +158,17 @@ private:
     mutable std::vector<uint32_t> rowsSent_;  // what rowsBuffer_ holds
     mutable unsigned boundsProgram_ = 0, boxBuffer_ = 0;  // gpu/gl_bounds.cpp
     unsigned emitRowsProgram_ = 0, emitScanProgram_ = 0, metaBuffer_ = 0;  // gpu/gl_emission.cpp
-    unsigned identifyRecordsProgram_ = 0, clearMappedProgram_ = 0;          // gpu/gl_rows.cpp
+    unsigned identifyRecordsProgram_ = 0, clearMappedProgram_ = 0, parentsProgram_ = 0;  // gpu/gl_rows.cpp
+    // gpu/gl_parents.cpp
+    unsigned gatherAliveProgram_ = 0, survivorsProgram_ = 0, readersGoneProgram_ = 0, releaseUnreadProgram_ = 0,
+             releaseWaitingProgram_ = 0;
+    void bindKillList(rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map, size_t mapFirst, uint32_t grid);
+    void bindScanBlocks(const rt::PoolRows& pool);
 };
+
+// A shader of the memory's operations (gpu/gl_rows.cpp, gl_parents.cpp): work groups of
+// 64, the Params block, INVOCATION and RUN_WORDS defined, then `body`.
+std::string operationShader(const std::string& body);
 
 // Host rows to GPU words (u8 widened to a word) and back.
 void toWords(const void* from, rt::Elem e, size_t rows, uint32_t* to);

@@ -21,12 +21,12 @@ namespace psys::gpu {
 
 using rt::Buffer;
 
-namespace {
-
-std::string shader(const char* body) {
+std::string operationShader(const std::string& body) {
     return std::string("#version 450\nlayout(local_size_x = 64) in;\n") + kParamsBlock + "#define INVOCATION " +
            kInvocationIndex + "\n#define RUN_WORDS " + std::to_string(rt::kRunWords) + "u\n" + body;
 }
+
+namespace {
 
 // FreeRows::row(k): stack[top − 1 − k] while the stack lasts, then past the high-water mark.
 const char* kAllocate = R"(
@@ -103,15 +103,12 @@ void main() {
 }
 )";
 
-// What both identify shaders share: the runs (records of rt::kRunWords words, in
-// rt::ObjectRuns' form) from word `base` on, `count` of them; the run of object r — the
-// last whose first object is at or before r (a run of no objects shares its first with
-// the next, which wins); and object k of the run at word u written at row `at`, its time
-// rounded as rt::eventTime's: `precise`, no fused multiply-add.
-const char* kRunObjects = R"(
+// What the identify and parents shaders share: the runs (records of rt::kRunWords words,
+// in rt::ObjectRuns' form) from word `base` on, `count` of them; the run of object r —
+// the last whose first object is at or before r (a run of no objects shares its first
+// with the next, which wins).
+const char* kRunOf = R"(
 layout(std430, binding = 0) readonly buffer Runs { uint runs[]; };
-layout(std430, binding = 1) buffer Created { uint created[]; };
-layout(std430, binding = 2) buffer Ids { uint ids[]; };
 uint runOf(uint r, uint base, uint count) {
     uint lo = 0u, hi = count - 1u;
     while (lo < hi) {
@@ -120,6 +117,13 @@ uint runOf(uint r, uint base, uint count) {
     }
     return base + lo * RUN_WORDS;
 }
+)";
+
+// Object k of the run at word u written at row `at`, its time rounded as rt::eventTime's:
+// `precise`, no fused multiply-add.
+const char* kRunObjects = R"(
+layout(std430, binding = 1) buffer Created { uint created[]; };
+layout(std430, binding = 2) buffer Ids { uint ids[]; };
 void identifyObject(uint u, uint k, uint at) {
     double firstTime = packDouble2x32(uvec2(runs[u + 4u], runs[u + 5u]));
     double spacing = packDouble2x32(uvec2(runs[u + 6u], runs[u + 7u]));
@@ -157,6 +161,24 @@ void main() {
 }
 )";
 
+// Object r of the records from record `base` on: its parent the row of its record's
+// emitter (`stride` records a row; through the emitter batch's rows where `mapped`), and
+// a reader more of it where it was kept.
+const char* kParentsFromRecords = R"(
+layout(std430, binding = 1) readonly buffer Map { uint map[]; };
+layout(std430, binding = 2) buffer Parents { uint parents[]; };
+layout(std430, binding = 3) buffer Readers { uint readers[]; };
+void main() {
+    uint r = INVOCATION, n = param(0u), records = param(1u), first = param(2u), base = param(3u) * RUN_WORDS;
+    uint stride = param(4u), mapped = param(5u), mapFirst = param(6u), kept = param(7u);
+    if (r >= n) return;
+    uint j = (runOf(r, base, records) - base) / RUN_WORDS / stride;
+    uint row = mapped != 0u ? map[mapFirst + j] : j;
+    parents[first + r] = row;
+    if (r < kept) atomicAdd(readers[row], 1u);
+}
+)";
+
 constexpr uint32_t kReleaseGrid = 64 * 1024;
 
 }  // namespace
@@ -191,7 +213,7 @@ void GlMemory::allocateRows(const rt::PoolRows& pool, size_t top, size_t highWat
     if (allOnHost({pool.stack, pool.generation, pool.updatable, pool.alive, pool.counters, out}))
         return rt::Memory::allocateRows(pool, top, highWater, n, out, outFirst);
     flushPending();
-    if (!allocateProgram_) allocateProgram_ = computeProgram(shader(kAllocate), "allocation");
+    if (!allocateProgram_) allocateProgram_ = computeProgram(operationShader(kAllocate), "allocation");
     PassTimer::Scope timed(timer, "allocation", n);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceBuffer(pool.stack));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, bound(out));
@@ -210,8 +232,8 @@ void GlMemory::releaseRows(const rt::PoolRows& pool, Buffer killed, size_t kille
     flushPending();
     size_t most = rows(killed) > killedAt ? rows(killed) - killedAt - 1 : 0;
     if (most == 0) return;
-    if (!releaseProgram_) releaseProgram_ = computeProgram(shader(kRelease), "release");
-    if (!pushedProgram_) pushedProgram_ = computeProgram(shader(kPushed), "release count");
+    if (!releaseProgram_) releaseProgram_ = computeProgram(operationShader(kRelease), "release");
+    if (!pushedProgram_) pushedProgram_ = computeProgram(operationShader(kPushed), "release count");
     auto grid = static_cast<uint32_t>(std::min<size_t>(most, kReleaseGrid));
     PassTimer::Scope timed(timer, "release", grid);
     unsigned list = deviceBuffer(killed);
@@ -232,7 +254,7 @@ void GlMemory::markFresh(const rt::PoolRows& pool, Buffer rows, size_t first, si
     if (count == 0) return;
     if (allOnHost({rows, pool.updatable, pool.alive})) return rt::Memory::markFresh(pool, rows, first, count);
     flushPending();
-    if (!freshProgram_) freshProgram_ = computeProgram(shader(kFresh), "fresh rows");
+    if (!freshProgram_) freshProgram_ = computeProgram(operationShader(kFresh), "fresh rows");
     PassTimer::Scope timed(timer, "fresh", count);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceBuffer(rows));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(pool.updatable));
@@ -250,7 +272,7 @@ void GlMemory::clearMapped(Buffer mask, std::span<const uint32_t> rows, Buffer m
         return;
     }
     flushPending();
-    if (!clearMappedProgram_) clearMappedProgram_ = computeProgram(shader(kClearMapped), "clear through a map");
+    if (!clearMappedProgram_) clearMappedProgram_ = computeProgram(operationShader(kClearMapped), "clear through a map");
     PassTimer::Scope timed(timer, "clear", rows.size());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, rowList(rows));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, deviceBuffer(map));
@@ -264,7 +286,7 @@ void GlMemory::identify(const rt::ObjectRuns& runs, size_t n, size_t kept, Buffe
     if (n == 0) return;
     if (allOnHost({created, ids, mask})) return rt::Memory::identify(runs, n, kept, created, ids, mask, first);
     flushPending();
-    if (!identifyProgram_) identifyProgram_ = computeProgram(shader((std::string(kRunObjects) + kIdentify).c_str()), "identify");
+    if (!identifyProgram_) identifyProgram_ = computeProgram(operationShader(std::string(kRunOf) + kRunObjects + kIdentify), "identify");
     std::vector<uint32_t> words(std::max<size_t>(runs.size(), 1) * rt::kRunWords);  // (a block is never empty)
     for (size_t u = 0; u < runs.size(); ++u) {
         uint32_t* w = words.data() + u * rt::kRunWords;
@@ -295,7 +317,7 @@ void GlMemory::identifyRecords(Buffer runs, size_t firstRecord, size_t records, 
     if (!onDevice(runs) && allOnHost({created, ids}))  // (the runs' length is not a pool's)
         return rt::Memory::identifyRecords(runs, firstRecord, records, objects, created, ids, first);
     flushPending();
-    if (!identifyRecordsProgram_) identifyRecordsProgram_ = computeProgram(shader((std::string(kRunObjects) + kIdentifyRecords).c_str()), "identify from records");
+    if (!identifyRecordsProgram_) identifyRecordsProgram_ = computeProgram(operationShader(std::string(kRunOf) + kRunObjects + kIdentifyRecords), "identify from records");
     PassTimer::Scope timed(timer, "identify", objects);
     // (Records the host side's emitters wrote: only the group's go up.)
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceRows(runs, firstRecord * rt::kRunWords, records * rt::kRunWords));
@@ -304,6 +326,29 @@ void GlMemory::identifyRecords(Buffer runs, size_t firstRecord, size_t records, 
     bindParams(paramsBuffer_, {static_cast<uint32_t>(objects), static_cast<uint32_t>(records),
                                static_cast<uint32_t>(first), static_cast<uint32_t>(firstRecord)});
     dispatchRows(identifyRecordsProgram_, objects);
+}
+
+void GlMemory::parentsFromRecords(Buffer runs, size_t firstRecord, size_t records, size_t stride, Buffer map,
+                                  size_t mapFirst, size_t objects, size_t kept, Buffer parents, size_t first,
+                                  Buffer readers) {
+    if (objects == 0) return;
+    if (!onDevice(runs) && allOnHost({map, parents, readers}))
+        return rt::Memory::parentsFromRecords(runs, firstRecord, records, stride, map, mapFirst, objects, kept, parents,
+                                              first, readers);
+    flushPending();
+    if (!parentsProgram_)
+        parentsProgram_ = computeProgram(operationShader(std::string(kRunOf) + kParentsFromRecords), "parents from records");
+    PassTimer::Scope timed(timer, "parents", objects);
+    unsigned list = deviceRows(runs, firstRecord * rt::kRunWords, records * rt::kRunWords);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, list);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, map.valid() ? deviceBuffer(map) : list);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, bound(parents));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(readers));
+    bindParams(paramsBuffer_, {static_cast<uint32_t>(objects), static_cast<uint32_t>(records),
+                               static_cast<uint32_t>(first), static_cast<uint32_t>(firstRecord),
+                               static_cast<uint32_t>(stride), map.valid() ? 1u : 0u, static_cast<uint32_t>(mapFirst),
+                               static_cast<uint32_t>(kept)});
+    dispatchRows(parentsProgram_, objects);
 }
 
 }  // namespace psys::gpu

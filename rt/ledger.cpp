@@ -45,8 +45,7 @@ void Ledger::settle(Wait wait) {
 }
 
 void Ledger::endStep() {
-    for (LateKills& l : late_)
-        if (s_.types[l.type].rowsInMemory) releaseInMemory(l);
+    releaseAllInMemory(late_);
     auto owes = [](const LateKills& l) {
         return std::any_of(l.parts.begin(), l.parts.end(), [](const LateKills::Part& p) { return p.ticket != 0; });
     };
@@ -72,8 +71,10 @@ RowsResult Ledger::collect(size_t type, LateKills::Part& part) {
     return result;
 }
 
-void Ledger::listInMemory(LateKills& l) {
+void Ledger::listInMemory(LateKills& l, bool aliveOnly) {
     Pool& pool = s_.pools[l.type];
+    PoolRows masks = pool.memoryRows();
+    if (aliveOnly) masks.updatable = {};
     std::vector<uint32_t> list;
     for (LateKills::Part& part : l.parts) {
         if (!part.killList.valid() || part.listed) continue;
@@ -85,25 +86,47 @@ void Ledger::listInMemory(LateKills& l) {
         part.listed = part.counted = true;
         part.count = rows.size();
         if (!rows.empty() && !s_.backend.clearsKilled())
-            s_.memory.clearRows(pool.memoryRows(), part.killList, 0, static_cast<uint32_t>(part.begin), l.map,
-                                part.begin - l.first);
+            s_.memory.clearRows(masks, part.killList, 0, static_cast<uint32_t>(part.begin), l.map, part.begin - l.first);
     }
 }
 
+// (Only the alive mask: the update's mask still holds them for the emissions of their
+// deaths, after; the release clears it.)
+void Ledger::listNow(LateKills& l) { listInMemory(l, true); }
+
+// By the rule of `release`: a type at a time, the most deeply nested first, each type's
+// kill lists in their order, then its frozen rows whose readers all went.
+void Ledger::releaseAllInMemory(std::vector<LateKills>& lates) {
+    for (size_t type : s_.deepestFirst) {
+        if (!s_.types[type].rowsInMemory) continue;
+        for (LateKills& l : lates)
+            if (l.type == type) releaseInMemory(l);
+        s_.pools[type].releaseWaiting();
+    }
+}
+
+// Its kills freed where they are: a child's each a reader less of its parent, a parent's
+// where nobody reads it (the others frozen: Pool::releaseUnread, counted from the memory).
 void Ledger::releaseInMemory(LateKills& l) {
     if (l.released) return;
     listInMemory(l);
     l.released = true;
     Pool& pool = s_.pools[l.type];
+    const bool read = pool.memoryRows().readers.valid();
     for (LateKills::Part& part : l.parts) {
         if (!part.killList.valid()) continue;
         bool none = part.counted && part.count == 0;  // listed here, nothing to free
         if (!none) {
-            if (l.map.valid())
-                pool.release(part.killList, 0, 0, l.map, part.begin - l.first);
+            uint32_t base = l.map.valid() ? 0 : static_cast<uint32_t>(part.begin);
+            size_t mapFirst = l.map.valid() ? part.begin - l.first : 0;
+            if (read)
+                pool.releaseUnread(part.killList, 0, base, l.map, mapFirst);
             else
-                pool.release(part.killList, 0, static_cast<uint32_t>(part.begin), {}, 0);
-            if (part.counted) pool.released(part.count);
+                pool.release(part.killList, 0, base, l.map, mapFirst);
+            if (pool.parentRows.valid())
+                s_.memory.readersGone(part.killList, 0, base, l.map, mapFirst, pool.parentRows,
+                                      s_.pools[static_cast<size_t>(s_.types[l.type].parentType)].memoryRows().readers);
+            if (part.counted && !read) pool.released(part.count);
         }
         pool.recycle(part.killList);
         part.killList = {};
@@ -113,7 +136,12 @@ void Ledger::releaseInMemory(LateKills& l) {
 }
 
 void Ledger::releaseForReload() {
-    for (LateKills& l : late_) {
+    std::vector<LateKills*> order;  // (children first: `release`'s order)
+    for (size_t type : s_.deepestFirst)
+        for (LateKills& l : late_)
+            if (l.type == type) order.push_back(&l);
+    for (LateKills* each : order) {
+        LateKills& l = *each;
         if (!s_.types[l.type].rowsInMemory || l.released) continue;
         l.released = true;
         Pool& pool = s_.pools[l.type];
@@ -137,10 +165,19 @@ void Ledger::releaseForReload() {
         list.assign(1, static_cast<uint32_t>(rows.size()));
         list.insert(list.end(), rows.begin(), rows.end());
         s_.memory.write(sorted, 0, list.size(), list.data());
-        pool.release(sorted, 0, 0, {}, 0);
-        pool.released(rows.size());
+        if (pool.memoryRows().readers.valid()) {
+            pool.releaseUnread(sorted, 0, 0, {}, 0);
+        } else {
+            pool.release(sorted, 0, 0, {}, 0);
+            pool.released(rows.size());
+        }
+        if (pool.parentRows.valid())
+            s_.memory.readersGone(sorted, 0, 0, {}, 0, pool.parentRows,
+                                  s_.pools[static_cast<size_t>(s_.types[l.type].parentType)].memoryRows().readers);
         pool.recycle(sorted);
     }
+    for (size_t type : s_.deepestFirst) s_.pools[type].releaseWaiting();
+    countParents();
 }
 
 void Ledger::countInMemory(LateKills& l) {
@@ -151,8 +188,15 @@ void Ledger::countInMemory(LateKills& l) {
         // (No ticket: listed by the backend with nothing killed; its release counted as 0.)
         size_t killed = part.ticket ? collect(l.type, part).killed : 0;
         s_.typeStats[l.type].killed += killed;
-        pool.released(killed);
+        if (!pool.memoryRows().readers.valid()) pool.released(killed);  // (else: countParents)
     }
+}
+
+// The pools children read: how many rows a step's releases froze and freed, as the memory
+// counted them (once they are all done: after the step's end).
+void Ledger::countParents() {
+    for (Pool& pool : s_.pools)
+        if (pool.memoryRows().readers.valid()) pool.countFromMemory();
 }
 
 void Ledger::take(Deaths& dying, std::vector<LateKills>& late) {
@@ -198,6 +242,7 @@ void Ledger::free(Deaths& deaths, std::vector<LateKills>& lates) {
     if (std::none_of(lates.begin(), lates.end(), simple)) {
         take(deaths, lates);
         release(deaths);
+        countParents();
         return;
     }
     // In the merged order of take: the deaths before each late launch's place, then its
@@ -253,6 +298,7 @@ void Ledger::free(Deaths& deaths, std::vector<LateKills>& lates) {
     release(kept);
     deaths.clear();
     lates.clear();
+    countParents();
 }
 
 // The rule that frees rows (docs/architecture.md, "The life of a step"): a type at a time,

@@ -83,6 +83,10 @@ public:
     // as a reload frees the frozen rows of a pool kept on the host, after its free rows —
     // and counted: the new system keeps no record of the old one's deaths.
     void releaseForReload();
+    // A late launch's kills of a type whose rows are in the memory and that children read,
+    // listed and cleared in its masks now (not at the step's end): the children's
+    // `parent.alive` in the same step sees them dead.
+    void listNow(LateKills& l);
     // A reload's (rt/reload.cpp, readers counted again): every frozen object nobody reads
     // freed, by the rule of the step's end (`release`), a pool's in row order.
     void freeUnread();
@@ -110,9 +114,11 @@ private:
     // A type whose rows are in the memory: its kills listed where the backend did not
     // (and, where it does not clear kills, cleared in the pool's masks), freed there at the
     // step's end, counted once the backend gives their counts.
-    void listInMemory(LateKills& l);
+    void listInMemory(LateKills& l, bool aliveOnly = false);
+    void releaseAllInMemory(std::vector<LateKills>& lates);
     void releaseInMemory(LateKills& l);
     void countInMemory(LateKills& l);
+    void countParents();
 
     State& s_;
     Deaths dying_;

@@ -103,10 +103,99 @@ void Memory::releaseRows(const PoolRows& pool, Buffer killed, size_t killedAt, u
 
 void Memory::clearRows(const PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
                        size_t mapFirst) {
+    auto* updatable = pool.updatable.valid() ? static_cast<uint8_t*>(host(pool.updatable)) : nullptr;
+    auto* alive = static_cast<uint8_t*>(host(pool.alive));
+    eachKilled(*this, killed, killedAt, base, map, mapFirst, [&](uint32_t, uint32_t row) {
+        if (updatable) updatable[row] = 0;
+        alive[row] = 0;
+    });
+}
+
+void Memory::parentsFromRecords(Buffer runs, size_t firstRecord, size_t records, size_t stride, Buffer map,
+                                size_t mapFirst, size_t objects, size_t kept, Buffer parents, size_t first,
+                                Buffer readers) {
+    if (objects == 0) return;
+    const auto* record = static_cast<const uint32_t*>(view(runs)) + firstRecord * kRunWords;
+    const auto* through = map.valid() ? static_cast<const uint32_t*>(view(map)) + mapFirst : nullptr;
+    auto* out = static_cast<uint32_t*>(host(parents)) + first;
+    auto* count = static_cast<uint32_t*>(host(readers));
+    for (size_t u = 0; u < records; ++u) {
+        const uint32_t* w = record + u * kRunWords;
+        auto j = static_cast<uint32_t>(u / stride);
+        uint32_t row = through ? through[j] : j;
+        for (uint32_t k = 0; k < w[1]; ++k) {
+            out[w[0] + k] = row;
+            if (w[0] + k < kept) ++count[row];
+        }
+    }
+}
+
+void Memory::gatherThrough(Buffer from, Buffer to, size_t toFirst, Buffer rows, size_t rowsFirst, size_t count) {
+    if (count == 0) return;
+    const auto* list = static_cast<const uint32_t*>(view(rows)) + rowsFirst;
+    gather(from, to, toFirst, std::span<const uint32_t>(list, count));
+}
+
+void Memory::gatherAlive(Buffer alive, Buffer to, size_t toFirst, Buffer rows, size_t rowsFirst, size_t count) {
+    if (count == 0) return;
+    const auto* list = static_cast<const uint32_t*>(view(rows)) + rowsFirst;
+    const auto* a = static_cast<const uint8_t*>(view(alive));
+    auto* out = static_cast<float*>(host(to)) + toFirst;
+    for (size_t i = 0; i < count; ++i) out[i] = list[i] != kSkipRow && a[list[i]] ? 1.0f : 0.0f;
+}
+
+void Memory::survivors(Buffer mask, Buffer killed, Buffer out, size_t first, size_t count) {
+    if (count == 0) return;
+    const auto* m = static_cast<const uint8_t*>(view(mask)) + first;
+    const auto* k = static_cast<const uint8_t*>(view(killed)) + first;
+    auto* o = static_cast<uint8_t*>(host(out)) + first;
+    for (size_t i = 0; i < count; ++i) o[i] = m[i] && !k[i];
+}
+
+void Memory::readersGone(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, Buffer parents,
+                         Buffer readers) {
+    const auto* parent = static_cast<const uint32_t*>(view(parents));
+    auto* count = static_cast<uint32_t*>(host(readers));
+    eachKilled(*this, killed, killedAt, base, map, mapFirst, [&](uint32_t, uint32_t row) {
+        if (parent[row] != kSkipRow) --count[parent[row]];
+    });
+}
+
+void Memory::releaseUnread(const PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
+                           size_t mapFirst) {
+    auto* counters = static_cast<uint32_t*>(host(pool.counters));
+    auto* stack = static_cast<uint32_t*>(host(pool.stack));
+    auto* generation = static_cast<uint32_t*>(host(pool.generation));
     auto* updatable = static_cast<uint8_t*>(host(pool.updatable));
     auto* alive = static_cast<uint8_t*>(host(pool.alive));
-    eachKilled(*this, killed, killedAt, base, map, mapFirst,
-               [&](uint32_t, uint32_t row) { updatable[row] = alive[row] = 0; });
+    const auto* readers = static_cast<const uint32_t*>(view(pool.readers));
+    auto* waiting = static_cast<uint8_t*>(host(pool.waiting));
+    eachKilled(*this, killed, killedAt, base, map, mapFirst, [&](uint32_t, uint32_t row) {
+        updatable[row] = alive[row] = 0;
+        if (readers[row] > 0) {
+            waiting[row] = 1;
+            ++counters[kCounterWaiting];
+            return;
+        }
+        stack[counters[kCounterTop]++] = row;
+        ++generation[row];
+    });
+}
+
+void Memory::releaseWaiting(const PoolRows& pool, size_t rows) {
+    auto* counters = static_cast<uint32_t*>(host(pool.counters));
+    if (rows == 0 || counters[kCounterWaiting] == 0) return;
+    auto* stack = static_cast<uint32_t*>(host(pool.stack));
+    auto* generation = static_cast<uint32_t*>(host(pool.generation));
+    const auto* readers = static_cast<const uint32_t*>(view(pool.readers));
+    auto* waiting = static_cast<uint8_t*>(host(pool.waiting));
+    for (uint32_t row = 0; row < rows; ++row) {
+        if (!waiting[row] || readers[row] > 0) continue;
+        waiting[row] = 0;
+        --counters[kCounterWaiting];
+        stack[counters[kCounterTop]++] = row;
+        ++generation[row];
+    }
 }
 
 void Memory::markFresh(const PoolRows& pool, Buffer rows, size_t first, size_t count) {

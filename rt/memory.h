@@ -47,8 +47,15 @@ struct Bounds {
 
 struct PoolRows {
     Buffer stack, generation, updatable, alive;
-    Buffer counters;  // u32: the stack's top, where a release pushes (the memory's own count of it)
+    // u32: the stack's top, where a release pushes (the memory's own count of it), then
+    // the rows frozen for their readers (`waiting`).
+    Buffer counters;
+    // A pool whose objects children read (rt/system_state.cpp: a parent type whose rows
+    // are in the memory beside its children's): per row, its children not freed yet
+    // (u32), and whether it is frozen for them (u8: killed, neither alive nor updatable).
+    Buffer readers, waiting;
 };
+constexpr size_t kCounterTop = 0, kCounterWaiting = 1, kCounters = 2;
 
 // A creation batch's objects as runs (rt/system_create.h, Creation::Run): object r of
 // run u (first[u] <= r < first[u] + count[u], k = r − first[u]) has the id id[u] + k and
@@ -181,13 +188,44 @@ public:
                              size_t mapFirst);
     // The pool rows of such a kill list, in its order, read where they are (a reload's).
     std::vector<uint32_t> killedRows(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst) const;
-    // The rows of a kill list (as releaseRows reads it) neither alive nor updatable, not
-    // freed yet: killed objects that wait for the step's end.
+    // The rows of a kill list (as releaseRows reads it) neither alive nor updatable (where
+    // `pool.updatable` is given), not freed yet: killed objects that wait for the step's end.
     virtual void clearRows(const PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
                            size_t mapFirst);
     // The rows rows[first, first + count) become updatable where they are alive (the rows a
     // step created, at the next step's start).
     virtual void markFresh(const PoolRows& pool, Buffer rows, size_t first, size_t count);
+    // Parents and children whose rows are both in the memory: a child pool holds its
+    // parent's row in `parents` (u32 a row, rt::kSkipRow for none); the parent pool counts
+    // its children not freed yet (PoolRows::readers) and keeps a killed object that has
+    // some frozen (PoolRows::waiting) until they are gone (rt/ledger.h's rule).
+    //
+    // Objects r < objects of a batch from a group's records (identifyRecords' arguments;
+    // `stride` records a row): parents[first + r] the pool row of its record's emitter —
+    // map[mapFirst + j] for the j-th row of the records where `map` is given (an emitter
+    // batch's rows), else j; and each of the first `kept` a reader more of it.
+    virtual void parentsFromRecords(Buffer runs, size_t firstRecord, size_t records, size_t stride, Buffer map,
+                                    size_t mapFirst, size_t objects, size_t kept, Buffer parents, size_t first,
+                                    Buffer readers);
+    // A parent's values through a child's `parents` rows, where they are: to[toFirst + i] =
+    // from[rows[rowsFirst + i]], 0 where that is kSkipRow; `alive` (u8) into an f32 column
+    // as 1 or 0 (a child's `parent.alive`).
+    virtual void gatherThrough(Buffer from, Buffer to, size_t toFirst, Buffer rows, size_t rowsFirst, size_t count);
+    virtual void gatherAlive(Buffer alive, Buffer to, size_t toFirst, Buffer rows, size_t rowsFirst, size_t count);
+    // out[first + i] = mask[first + i] && !killed[first + i] (u8): the rows an update left
+    // alive, whose exports it computes.
+    virtual void survivors(Buffer mask, Buffer killed, Buffer out, size_t first, size_t count);
+    // The rows of a child pool's kill list (as releaseRows reads it), freed: each a reader
+    // less of its parent (`parents`: the child pool's; `readers`: the parent pool's).
+    virtual void readersGone(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst,
+                             Buffer parents, Buffer readers);
+    // A parent pool's kill list freed as releaseRows frees it, but for rows some child
+    // still reads: those are frozen instead (waiting, neither alive nor updatable,
+    // counted in the counters), in the list's order the others pushed.
+    virtual void releaseUnread(const PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
+                               size_t mapFirst);
+    // The pool's waiting rows among [0, rows) whose readers are all gone, freed in row order.
+    virtual void releaseWaiting(const PoolRows& pool, size_t rows);
     // For each pair (from, to) of `columns`: to[rows[rowsFirst + i]] = from[fromFirst + i],
     // i < count, with the rows in a buffer (a batch's columns into its pool rows at once).
     virtual void scatter(std::span<const std::pair<Buffer, Buffer>> columns, size_t fromFirst, Buffer rows,

@@ -1,5 +1,7 @@
 #include "rt/pool.h"
 
+#include <array>
+
 #include <algorithm>
 #include <stdexcept>
 
@@ -123,7 +125,7 @@ size_t Pool::rowBytes(const ir::Object& object) {
 }
 
 Pool::Pool(Pool&& other) noexcept
-    : created(other.created), ids(other.ids), updatable(std::move(other.updatable)), alive(std::move(other.alive)), state(std::move(other.state)),
+    : created(other.created), ids(other.ids), parentRows(other.parentRows), updatable(std::move(other.updatable)), alive(std::move(other.alive)), state(std::move(other.state)),
       params(std::move(other.params)), exports(std::move(other.exports)), folds(std::move(other.folds)),
       foldRows(other.foldRows), paramColumn(std::move(other.paramColumn)),
       parent(std::move(other.parent)), readers(std::move(other.readers)), diedAt(std::move(other.diedAt)),
@@ -148,7 +150,7 @@ Pool::~Pool() {
     params.release(*memory_);
     exports.release(*memory_);
     folds.release(*memory_);
-    for (Buffer b : {rows_.stack, rows_.generation, rows_.counters})
+    for (Buffer b : {rows_.stack, rows_.generation, rows_.counters, rows_.readers, rows_.waiting, parentRows})
         if (b.valid()) memory_->release(b);
     for (const FreshRows& f : freshRows_) memory_->release(f.rows);
     for (Buffer b : spare_) memory_->release(b);
@@ -157,7 +159,8 @@ Pool::~Pool() {
 void Pool::grow(size_t n) {
     if (inMemory_) {
         highWater_ = n;
-        for (Buffer b : {rows_.stack, rows_.generation}) memory_->resize(b, n);
+        for (Buffer b : {rows_.stack, rows_.generation, rows_.readers, rows_.waiting, parentRows})
+            if (b.valid()) memory_->resize(b, n);
     } else {
         status_.resize(n, Status::Free);
         generation_.resize(n, 0);
@@ -233,15 +236,21 @@ void Pool::releaseKilled(std::span<const uint32_t> rows) {
     alive.set(rows, 0);
 }
 
-void Pool::keepRowsInMemory() {
+void Pool::keepRowsInMemory(bool child, bool read) {
     if (inMemory_) return;
     inMemory_ = true;
     rows_ = {memory_->create(Elem::U32, rows()), memory_->create(Elem::U32, rows()), updatable.column, alive.column,
-             memory_->create(Elem::U32, 1)};
+             memory_->create(Elem::U32, kCounters), {}, {}};
+    if (read) {
+        rows_.readers = memory_->create(Elem::U32, rows());
+        rows_.waiting = memory_->create(Elem::U8, rows());
+    }
+    if (child) parentRows = memory_->create(Elem::U32, rows());
     restoreInMemory();  // what the host has so far (nothing, before the first object)
 }
 
 size_t Pool::allocate(size_t n, Buffer out, size_t outFirst) {
+    counted();
     if (uncounted_) throw std::logic_error("a pool's rows allocated before its last releases were counted");
     size_t room = top_ + (capacity_ > highWater_ ? capacity_ - highWater_ : 0);
     size_t kept = std::min(n, room);
@@ -259,6 +268,36 @@ void Pool::release(Buffer killed, size_t killedAt, uint32_t base, Buffer map, si
     memory_->releaseRows(rows_, killed, killedAt, base, map, mapFirst);
     ++uncounted_;
     ++version_;
+}
+
+void Pool::releaseUnread(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst) {
+    memory_->releaseUnread(rows_, killed, killedAt, base, map, mapFirst);
+    ++uncounted_;
+    ++version_;
+}
+
+// (Only where some row may wait, as the host last counted: a row frozen in this step
+// waits for children that are freed in a later one — a step frees the children first.)
+void Pool::releaseWaiting() {
+    if (!rows_.waiting.valid() || (!countPending_ && frozen_ == 0)) return;
+    memory_->releaseWaiting(rows_, highWater_);
+    ++uncounted_;
+    ++version_;
+}
+
+void Pool::countFromMemory() {
+    if (uncounted_ > 0) countPending_ = true;
+}
+
+void Pool::counted() const {
+    if (!countPending_) return;
+    countPending_ = false;
+    std::array<uint32_t, kCounters> counters{};
+    memory_->read(rows_.counters, 0, kCounters, counters.data());
+    top_ = counters[kCounterTop];
+    frozen_ = counters[kCounterWaiting];
+    live_ = highWater_ - top_ - frozen_;
+    uncounted_ = 0;
 }
 
 void Pool::released(size_t count) {
@@ -299,7 +338,7 @@ void Pool::fetch() const {
     if (!inMemory_ || fetched_ == version_) return;
     size_t rows = highWater_;
     uint32_t top = 0;
-    memory_->read(rows_.counters, 0, 1, &top);  // the memory's: counted or not
+    memory_->read(rows_.counters, kCounterTop, 1, &top);  // the memory's: counted or not
     generation_.resize(rows);
     freeRows_.resize(top);
     mask_.resize(rows);
@@ -311,6 +350,12 @@ void Pool::fetch() const {
     memory_->read(rows_.alive, 0, rows, isAlive.data());
     for (size_t row = 0; row < rows; ++row)
         if (isAlive[row]) status_[row] = Status::Alive;
+    if (rows_.waiting.valid() && rows > 0) {  // frozen for their readers
+        std::vector<uint8_t> waiting(rows);
+        memory_->read(rows_.waiting, 0, rows, waiting.data());
+        for (size_t row = 0; row < rows; ++row)
+            if (waiting[row]) status_[row] = Status::Frozen;
+    }
     fetched_ = version_;
 }
 
@@ -373,9 +418,10 @@ void Pool::restore(std::vector<Status> status, std::vector<uint32_t> generation,
 
 // The rows restore() gave the host, into the memory. A frozen row is freed at once, after
 // the free rows given and in row order, as a reload frees the frozen rows nobody reads
-// (rt/reload.cpp): a pool whose rows are in the memory has no readers.
+// (rt/reload.cpp) — but in a pool that children read: its readers are counted again
+// first, and the reload frees the unread (uploadRows).
 void Pool::restoreInMemory() {
-    for (uint32_t row = 0; row < status_.size(); ++row)
+    for (uint32_t row = 0; row < status_.size() && !rows_.waiting.valid(); ++row)
         if (status_[row] == Status::Frozen) {
             status_[row] = Status::Free;
             ++generation_[row];
@@ -385,15 +431,40 @@ void Pool::restoreInMemory() {
     for (const FreshRows& f : freshRows_) recycle(f.rows);
     freshRows_.clear();
     uncounted_ = 0;
+    writeRows();
+}
+
+void Pool::uploadRows() {
+    if (!inMemory_) return;
+    fetch();
+    writeRows();
+}
+
+// The host's copies into the memory: the stack and its top, generations, alive rows (and
+// frozen ones, for a pool children read), readers and parents.
+void Pool::writeRows() {
     highWater_ = status_.size();
     top_ = freeRows_.size();
-    for (Buffer b : {rows_.stack, rows_.generation}) memory_->resize(b, highWater_);
+    for (Buffer b : {rows_.stack, rows_.generation, rows_.readers, rows_.waiting, parentRows})
+        if (b.valid()) memory_->resize(b, highWater_);
     if (top_) memory_->write(rows_.stack, 0, top_, freeRows_.data());
     if (highWater_) memory_->write(rows_.generation, 0, highWater_, generation_.data());
-    auto top = static_cast<uint32_t>(top_);
-    memory_->write(rows_.counters, 0, 1, &top);
-    std::vector<uint8_t> isAlive(highWater_);
-    for (size_t row = 0; row < highWater_; ++row) isAlive[row] = status_[row] == Status::Alive;
+    std::vector<uint8_t> isAlive(highWater_), waiting(highWater_);
+    std::vector<uint32_t> parents(highWater_, kSkipRow);
+    uint32_t frozen = 0;
+    for (size_t row = 0; row < highWater_; ++row) {
+        isAlive[row] = status_[row] == Status::Alive;
+        waiting[row] = status_[row] == Status::Frozen;
+        frozen += waiting[row];
+        if (status_[row] != Status::Free && parent[row].valid()) parents[row] = parent[row].row;
+    }
+    std::array<uint32_t, kCounters> counters{static_cast<uint32_t>(top_), frozen};
+    memory_->write(rows_.counters, 0, kCounters, counters.data());
+    if (highWater_ && rows_.waiting.valid()) {
+        memory_->write(rows_.waiting, 0, highWater_, waiting.data());
+        memory_->write(rows_.readers, 0, highWater_, readers.data());
+    }
+    if (highWater_ && parentRows.valid()) memory_->write(parentRows, 0, highWater_, parents.data());
     alive.restore(*memory_, std::move(isAlive));
     ++version_;
     fetched_ = 0;  // the masks: read back when asked

@@ -101,9 +101,18 @@ public:
     const ir::Object& object() const { return *object_; }
     size_t capacity() const { return capacity_; }
     size_t rows() const { return inMemory_ ? highWater_ : status_.size(); }  // the high-water mark
-    size_t live() const { return live_; }
-    size_t frozen() const { return frozen_; }
-    size_t free() const { return capacity_ - live_ - frozen_; }
+    size_t live() const {
+        counted();
+        return live_;
+    }
+    size_t frozen() const {
+        counted();
+        return frozen_;
+    }
+    size_t free() const { return capacity_ - live() - frozen(); }
+    // At least the live objects, as the host last counted them: without asking the memory
+    // for counts it owes (a step's kills not counted yet only make it more).
+    size_t liveAtMost() const { return live_; }
 
     // Rows for `n` new objects at once, by the allocation rule (rt/allocation.h): rows[k]
     // for the k-th, kSkipRow for those past capacity; returns how many got one.
@@ -124,7 +133,9 @@ public:
     }
 
     // The rows kept in the memory (see above): from now on, before any object is created.
-    void keepRowsInMemory();
+    // `child`: its objects' parents are in the memory too (parentRows); `read`: children
+    // whose rows are there read its objects (PoolRows::readers, waiting).
+    void keepRowsInMemory(bool child = false, bool read = false);
     bool rowsInMemory() const { return inMemory_; }
     // Rows for `n` objects of a batch by the allocation rule, in the memory: into
     // out[outFirst + k] for the first min(n, free()) of them; returns how many got one.
@@ -135,6 +146,18 @@ public:
     // the host counts them when it learns how many there were (released).
     void release(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst);
     void released(size_t count);
+    // A pool that children read (keepRowsInMemory's `read`): its kills freed where nobody
+    // reads them, the others frozen (Memory::releaseUnread); its frozen rows whose readers
+    // all went freed (Memory::releaseWaiting); the host's counts — the stack's top, the
+    // frozen, the live — read from the memory's own once such releases are done
+    // (countFromMemory), when the host next asks for them: a step that creates none of its
+    // objects and a host that asks for no stats wait for nothing.
+    void releaseUnread(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst);
+    void releaseWaiting();
+    void countFromMemory();
+    // The host's bookkeeping of rows into the memory, whole (hot reload: rt/reload.cpp,
+    // after parents and readers were counted again and the unread frozen freed).
+    void uploadRows();
     const PoolRows& memoryRows() const { return rows_; }
     // The rows of a batch just allocated (rows[0, count)), made updatable at the next step's
     // start; the buffer is the pool's from then on (a scratch one: scratchRows).
@@ -151,6 +174,7 @@ public:
 
     // Columns in the backend's memory.
     Buffer created, ids;             // f64, u32
+    Buffer parentRows;               // u32: a child's parent's row, where both keep their rows in the memory
     // u8 masks, kept by the host and synced (syncMasks) before a launch over the pool:
     // `updatable`, the rows a step updates (alive, not created during it); `alive`, the
     // rows alive (what is drawn is among them).
@@ -209,12 +233,14 @@ private:
     mutable std::vector<Status> status_;
     mutable std::vector<uint32_t> generation_;
     mutable std::vector<uint32_t> freeRows_;
-    size_t live_ = 0, frozen_ = 0;
+    mutable size_t live_ = 0, frozen_ = 0;
     // The rows in the memory: its buffers and the host's counts; what changed them since
     // the host copies were read back (a version each change, the one read back).
     bool inMemory_ = false;
     PoolRows rows_;
-    size_t top_ = 0, highWater_ = 0, uncounted_ = 0;
+    mutable size_t top_ = 0, highWater_ = 0, uncounted_ = 0;
+    mutable bool countPending_ = false;  // (countFromMemory: read when asked)
+    void counted() const;
     struct FreshRows {
         Buffer rows;
         size_t count;
@@ -227,6 +253,7 @@ private:
     mutable std::vector<uint8_t> mask_;
     void fetch() const;  // the host copies of the rows in the memory, where they are stale
     void restoreInMemory();
+    void writeRows();
 };
 
 }  // namespace psys::rt

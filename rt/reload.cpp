@@ -117,6 +117,7 @@ void reconnect(const detail::State& old, detail::State& s, const std::vector<int
             if (to.status(r) != Status::Free && parents.matches(to.parent[r])) ++parents.readers[to.parent[r].row];
     }
     s.ledger.freeUnread();
+    for (Pool& pool : s.pools) pool.uploadRows();  // (where the rows are in the memory)
 }
 
 }  // namespace
@@ -127,6 +128,7 @@ ReloadReport System::carryOver(const System& oldSystem) {
     // be on the host: its last step's rows freed, its kills counted.
     oldSystem.state_->ledger.settle(detail::Ledger::Wait::Yes);
     oldSystem.state_->ledger.releaseForReload();
+    oldSystem.state_->parentsToHost();
     const detail::State& old = *oldSystem.state_;
     ReloadReport report;
     s.now = old.now;

@@ -86,6 +86,11 @@ private:
         // ids are not a range: `id`, `firstTime` and `spacing` are not the run's).
         Buffer runs = {};
         size_t record = 0, records = 0;
+        // Their emitters (a child type's parents, Memory::parentsFromRecords): `stride`
+        // records a row of emitters; row j the pool row emitters[j] where given (a batch's
+        // rows), else j.
+        size_t stride = 1;
+        Buffer emitters = {};
     };
     // Per type: the arguments of queued objects, one f32 column per component of the
     // type's parameters (kept or not); an object's row is its place among the type's
@@ -113,7 +118,8 @@ private:
     // createBatch for a type whose rows are in the memory (rt/system_create_rows.cpp).
     void createInMemory(size_t type, Batch& b, size_t n, double t1);
     void launchInMemory(size_t type, Batch& b, size_t n, const ir::Kernel& kernel, const ColumnLayout& layout,
-                        std::vector<Buffer>& table, const Clock& clock, LateKills* late);
+                        std::vector<Buffer>& table, const Clock& clock, LateKills* late, Buffer mask = {});
+    Buffer parentsOf(size_t type, Batch& b, size_t n, size_t kept);
     // The fold columns of a batch's table (its launches over rows [first, first + n)) set to
     // a fold over nothing: what an object created in the step reads.
     void emptyFolds(size_t type, const ColumnLayout& layout, const std::vector<Buffer>& table, size_t first, size_t n);
@@ -177,6 +183,6 @@ struct Creation::Batch {
 
 // Scratch column indices of a batch.
 constexpr size_t kCreated = 0, kIds = 1, kKill = 2, kNow = 3, kDt = 4, kMask = 5, kStepMask = 6, kExportMask = 7,
-                 kZero = 8, kRenderMask = 9, kFirstValue = 10;
+                 kZero = 8, kRenderMask = 9, kParents = 10, kFirstValue = 11;
 
 }  // namespace psys::rt::detail

@@ -3,11 +3,12 @@
 // allocation rule, ids and creation times from the runs, init, the first update to the
 // step's end — with every per-object step an operation of the memory (rt::Memory::
 // allocateRows, identify, scatter by a row list), so that on a device the host's work is
-// the batch's, not its objects'. Such a type dies late or never, has no parent, no
-// bursts, no sub-steps, and emits nothing or only at a rate what the memory decides
-// (Creation::emitInMemory, here too: Memory::emitAtRate): after its first update (and its
-// exports, where it never dies) an object only waits to be freed with the step's late
-// kills (rt/ledger.h). What it folds over its neighbours is, for an object created in the
+// the batch's, not its objects'. Such a type dies late or never, has no parent but one
+// whose rows are there too (its objects' parent rows from the records of their parents'
+// emissions: Memory::parentsFromRecords), no bursts, no sub-steps, and emits nothing or
+// only what the memory decides (Creation::emitInMemory, here too: Memory::emitAtRate):
+// after its first update (and its exports, of the survivors) an object only waits to be
+// freed with the step's late kills (rt/ledger.h). What it folds over its neighbours is, for an object created in the
 // step, a fold over nothing: filled in, not gathered (rt/neighbours.cpp).
 #include "rt/system_create.h"
 
@@ -68,7 +69,14 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
             memory.identifyRecords(run.runs, run.record, run.records, run.count, table[ColumnLayout::kCreated],
                                    table[ColumnLayout::kIds], first + b.runFirst[u]);
     std::vector<std::pair<Buffer, Buffer>> columns = identityColumns(type, table);
+    if (pool.parentRows.valid()) columns.push_back({parentsOf(type, b, n, kept), pool.parentRows});
     memory.scatter(columns, first, rows, 0, kept);
+    if (pool.parentRows.valid()) {  // (their parents' values as the parents are now: the step's)
+        Buffer parents = b.columns.at(kParents, Elem::U32, first + n);
+        if (info.init) s_.gatherThrough(type, b.initLayout, b.initTable, parents, first, first, first + n);
+        s_.gatherThrough(type, info.updateLayout, table, parents, first, first, first + n);
+        if (info.exports) s_.gatherThrough(type, info.exportsLayout, b.exportsTable, parents, first, first, first + n);
+    }
     for (size_t s : info.zeroedState)  // (what init sets is not)
         for (int c = 0; c < o.state[s].type.width; ++c)
             memory.clear(table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)], first, n);
@@ -78,6 +86,15 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
         b.initTable[ColumnLayout::kNow] = b.initTable[ColumnLayout::kCreated];
         launchInMemory(type, b, n, *info.init, b.initLayout, b.initTable,
                        {Clock::Source::PerRow, Clock::Source::Uniform, 0, 0, true}, nullptr);
+    }
+    const bool dies = info.kills || info.unstable;
+    if (info.exports && dies) {  // what children read of an object its first update kills: its exports at creation
+        Buffer zero = b.columns.at(kZero, Elem::F32, first + n);
+        memory.clear(zero, first, n);
+        b.exportsTable[ColumnLayout::kNow] = b.exportsTable[ColumnLayout::kCreated];
+        b.exportsTable[ColumnLayout::kDt] = zero;
+        launchInMemory(type, b, n, *info.exports, info.exportsLayout, b.exportsTable,
+                       {Clock::Source::PerRow, Clock::Source::PerRow, 0, 0, true}, nullptr);
     }
     if (bursts)  // their spawn launches read the state at creation (one copy: every burst table's)
         for (const std::vector<Buffer>& t : b.burstTables) {
@@ -96,13 +113,19 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     }
     const Clock toEnd{Clock::Source::Uniform, Clock::Source::SinceCreated, t1, 0, false};
     launchInMemory(type, b, n, *info.update, info.updateLayout, table, toEnd, info.late ? &late : nullptr);
+    if (info.read) s_.ledger.listNow(late);  // its dead are dead to its children at once
     columns.clear();
     for (size_t s = 0; s < o.state.size(); ++s)
         for (int c = 0; c < o.state[s].type.width; ++c)
             columns.push_back({table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)],
                                pool.state.column(s, static_cast<size_t>(c))});
-    if (info.exports) {  // (a type that never dies: every object of the batch survives)
-        launchInMemory(type, b, n, *info.exports, info.exportsLayout, b.exportsTable, toEnd, nullptr);
+    if (info.exports) {  // of the survivors (a type that never dies: every object of the batch)
+        Buffer survivors = mask;
+        if (info.kills) {
+            survivors = b.columns.at(kExportMask, Elem::U8, first + n);
+            memory.survivors(mask, table[ColumnLayout::kKill], survivors, first, n);
+        }
+        launchInMemory(type, b, n, *info.exports, info.exportsLayout, b.exportsTable, toEnd, nullptr, survivors);
         for (size_t e = 0; e < o.exports.size(); ++e)
             for (int c = 0; c < o.exports[e].type.width; ++c)
                 columns.push_back({b.exportsTable[static_cast<size_t>(info.exportsLayout.exportOffset[e] + c)],
@@ -139,6 +162,31 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     late.t1 = t1;
     late.first = first;
     s_.ledger.defer(std::move(late));
+}
+
+// A child type's batch: each object's parent row, from the records of its parents'
+// emissions, and each kept object a reader more of its parent (objects r < kept).
+Buffer Creation::parentsOf(size_t type, Batch& b, size_t n, size_t kept) {
+    Memory& memory = s_.memory;
+    Buffer parents = b.columns.at(kParents, Elem::U32, b.first + n);
+    Buffer readers = s_.pools[static_cast<size_t>(s_.types[type].parentType)].memoryRows().readers;
+    for (size_t u = 0; u < b.runs.size(); ++u) {
+        const Run& run = b.runs[u];
+        size_t at = b.runFirst[u], its = kept > at ? std::min(kept - at, run.count) : 0;
+        if (run.runs.valid()) {
+            memory.parentsFromRecords(run.runs, run.record, run.records, run.stride, run.emitters, 0, run.count, its,
+                                      parents, b.first + at, readers);
+            continue;
+        }
+        // (A run the host queued: one parent, or none.)
+        memory.fill(parents, b.first + at, run.count, run.parent.valid() ? run.parent.row : kSkipRow);
+        if (!run.parent.valid() || its == 0) continue;
+        uint32_t count = 0;
+        memory.read(readers, run.parent.row, 1, &count);
+        count += static_cast<uint32_t>(its);
+        memory.write(readers, run.parent.row, 1, &count);
+    }
+    return parents;
 }
 
 void Creation::emitInMemory(size_t type, const std::vector<Buffer>& table, const Value* const* uniforms,
@@ -229,7 +277,8 @@ void Creation::queueFromRecords(size_t type, const RateSites& in, std::span<cons
             launch->rowsFirst = atCreation ? batch->first : 0;
             launch->nowFromRecords = atCreation;
         }
-        enqueue({target, base, kept, {}, 0, 0, 1, 0, runs, records.first[group], n * records.stride[group]});
+        enqueue({target, base, kept, {}, 0, 0, 1, 0, runs, records.first[group], n * records.stride[group],
+                 records.stride[group], rows});
     }
 }
 
@@ -239,20 +288,20 @@ void Creation::emptyFolds(size_t type, const ColumnLayout& layout, const std::ve
         if (p.op == ir::Op::Fold) s_.emptyFold(type, p, table, first, n);
 }
 
-// A launch over the batch's objects (those kept: its mask), in chunks; `late`: its kills
+// A launch over the batch's objects (those kept: its mask, or `mask`), in chunks; `late`: its kills
 // listed, each chunk into a kill list of its own, and cleared in the pool's alive mask
 // where the backend clearsKilled (through the batch's rows, late->map): until they are
 // freed, at the end of the step, nothing draws them and the next step does not update
 // them (a trigger's batch).
 void Creation::launchInMemory(size_t type, Batch& b, size_t n, const ir::Kernel& kernel, const ColumnLayout& layout,
-                              std::vector<Buffer>& table, const Clock& clock, LateKills* late) {
+                              std::vector<Buffer>& table, const Clock& clock, LateKills* late, Buffer mask) {
     const size_t first = b.first, end = first + n;
     RowsLaunch launch;
     launch.object = &s_.pools[type].object();
     launch.kernel = &kernel;
     launch.layout = &layout;
     launch.columns = table;
-    launch.mask = b.columns.at(kMask, Elem::U8, end);
+    launch.mask = mask.valid() ? mask : b.columns.at(kMask, Elem::U8, end);
     launch.clock = clock;
     launch.externs = s_.externs.data();
     launch.uniformKernel = s_.uniformKernel(type, kernel);

@@ -133,17 +133,54 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     // with Rows::InMemory) and objects are created in batches. Where the emitters' rows are
     // on a device, the host still reads the operation's totals back in the step
     // (docs/gpu.md, "Emitters in the memory").
+    // Children in the memory beside their parents: a nested type that nobody reads and
+    // that emits nothing, whose kills are late or who never dies (as a type that only dies),
+    // created whole in a batch, reading of its parent (one level up) only its exports and
+    // whether it is alive — its parent type's rows in the memory too (below), so that the
+    // parents' rows, readers and frozen objects are the memory's (Memory::releaseUnread).
+    // Its parent type is then such an emitter with no parent of its own, every type that
+    // reads it such a child, its exports read by nobody else (no fold).
+    std::vector<bool> folded(types.size(), false);
+    for (const ir::Object& o : module.objects)
+        for (const ir::NeighbourGroup& g : o.neighbours) folded[static_cast<size_t>(module.objectIndex(g.target))] = true;
+    auto readsLikeAChild = [&](const ColumnLayout& layout) {
+        return std::all_of(layout.parentColumns.begin(), layout.parentColumns.end(), [](const ColumnLayout::ParentColumn& p) {
+            return p.op == ir::Op::Fold || (p.depth == 1 && (p.op == ir::Op::ParentExport || p.op == ir::Op::ParentAlive));
+        });
+    };
+    std::vector<bool> child(types.size(), false);
+    for (size_t t = 0; t < types.size(); ++t) {
+        const TypeInfo& info = types[t];
+        const ir::Object& o = module.objects[t];
+        bool silent = !info.kills && !info.unstable && !info.updateEmits;
+        std::vector<const ColumnLayout*> layouts = {&info.updateLayout, &info.exportsLayout, &info.renderLayout};
+        ColumnLayout init;
+        if (info.init) layouts.push_back(&(init = columnLayout(o, *info.init)));
+        child[t] = inMemory && options.createInBatches && info.parentType >= 0 && (info.late || silent) && !info.read &&
+                   o.emits.empty() && info.stepLimit == 0 && !(options.drawInStep && backend.rendersInStep() && info.render) &&
+                   std::all_of(layouts.begin(), layouts.end(), [&](const ColumnLayout* l) { return readsLikeAChild(*l); });
+    }
+    // A type whose readers are all such children (and that nobody folds over).
+    auto readByChildren = [&](size_t t) {
+        if (folded[t]) return false;
+        for (size_t c = 0; c < types.size(); ++c)
+            if (types[c].parentType == static_cast<int>(t) && !child[c]) return false;
+        return true;
+    };
     auto decidedInMemory = [&](size_t t) {
         const TypeInfo& info = types[t];
         const ir::Object& o = module.objects[t];
         bool dies = info.kills || info.unstable;
+        bool parent = info.read && readByChildren(t);
         bool emitter = inMemory && options.createInBatches &&
                        (info.updateEmits || info.bursts) &&
-                       (!dies || (options.lateKills && !info.exports)) && !info.read && keptWhole(info);
+                       (!dies || (options.lateKills && (!info.exports || parent))) && (!info.read || parent) &&
+                       keptWhole(info);
         int emitting = -1;  // the one target that emits, if any
         for (size_t s = 0; emitter && s < o.emits.size(); ++s) {
             auto target = static_cast<int>(info.emitTarget[s]);
-            emitter = types[static_cast<size_t>(target)].rowsInMemory && info.spawnLayout[s].parentColumns.empty();
+            bool itsChild = child[static_cast<size_t>(target)] && types[static_cast<size_t>(target)].parentType == static_cast<int>(t);
+            emitter = (types[static_cast<size_t>(target)].rowsInMemory || itsChild) && info.spawnLayout[s].parentColumns.empty();
             if (module.objects[static_cast<size_t>(target)].emits.empty()) continue;
             emitter = emitter && (emitting < 0 || emitting == target);
             emitting = target;
@@ -157,10 +194,13 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
             if (info.rowsInMemory || !decidedInMemory(t)) continue;
             info.rowsInMemory = more = true;
             info.late = info.late || info.kills || info.unstable;
+            for (TypeInfo& c : types)  // (its children: `child` above)
+                if (c.parentType == static_cast<int>(t)) c.rowsInMemory = true;
         }
     }
     for (size_t t = 0; t < types.size(); ++t)
-        if (types[t].rowsInMemory) pools[t].keepRowsInMemory();
+        if (types[t].rowsInMemory)
+            pools[t].keepRowsInMemory(types[t].parentType >= 0, types[t].read);
     // Spawn kernels read the emitter's own columns, whose buffers never change: their
     // tables are bound once (the parent values come with each launch).
     for (size_t t = 0; t < pools.size(); ++t) {
@@ -247,6 +287,8 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
                           size_t begin, size_t end, double at, const double* atRows, const uint32_t* poolRows,
                           size_t poolRowsFirst) {
     if (layout.parentColumns.empty() || end <= begin) return;
+    if (pools[type].parentRows.valid() && !poolRows)  // a pool's launch: its parents' rows where they are
+        gatherThrough(type, layout, table, pools[type].parentRows, begin, begin, end);
     std::vector<uint32_t> rows(end - begin);
     std::vector<float> values;
     int rowsDepth = -1;
@@ -263,6 +305,7 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
             emptyFold(type, p, table, stop, end - stop);
             continue;
         }
+        if (pools[type].parentRows.valid()) continue;  // (gatherThrough's)
         int parentType = static_cast<int>(type);
         for (int d = 0; d < p.depth && parentType >= 0; ++d) parentType = types[static_cast<size_t>(parentType)].parentType;
         if (p.depth != rowsDepth) {  // the parents' rows, kSkipRow where there is none
@@ -305,6 +348,32 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
                 values[i - begin] = ageAt(parent.ageClock(r, atRows ? atRows[i] : at), view<double>(parent.created)[r]);
         }
         memory.write(table[static_cast<size_t>(p.offset)], begin, end - begin, values.data());
+    }
+}
+
+void State::parentsToHost() {
+    for (size_t t = 0; t < pools.size(); ++t) {
+        Pool& pool = pools[t];
+        if (!pool.parentRows.valid() || pool.rows() == 0) continue;
+        const std::vector<uint32_t>& generation = pools[static_cast<size_t>(types[t].parentType)].generations();
+        std::vector<uint32_t> rows(pool.rows());
+        memory.read(pool.parentRows, 0, rows.size(), rows.data());
+        for (size_t r = 0; r < rows.size(); ++r)
+            pool.parent[r] = rows[r] < generation.size() ? Handle{rows[r], generation[rows[r]]} : Handle{};
+    }
+}
+
+void State::gatherThrough(size_t type, const ColumnLayout& layout, std::span<const Buffer> table, Buffer parents,
+                          size_t parentsFirst, size_t begin, size_t end) {
+    const Pool& parent = pools[static_cast<size_t>(types[type].parentType)];
+    for (const auto& p : layout.parentColumns) {
+        if (p.op == ir::Op::ParentAlive)
+            memory.gatherAlive(parent.alive.column, table[static_cast<size_t>(p.offset)], begin, parents, parentsFirst,
+                               end - begin);
+        if (p.op != ir::Op::ParentExport) continue;  // (folds: gatherParents', emptyFolds')
+        for (int c = 0; c < p.width; ++c)
+            memory.gatherThrough(parent.exports.column(static_cast<size_t>(p.exportIndex), static_cast<size_t>(c)),
+                                 table[static_cast<size_t>(p.offset + c)], begin, parents, parentsFirst, end - begin);
     }
 }
 

@@ -155,6 +155,14 @@ struct State {
     void gatherParents(size_t type, const ColumnLayout& layout, std::span<const Buffer> table, const uint8_t* mask,
                        size_t begin, size_t end, double at, const double* atRows = nullptr,
                        const uint32_t* poolRows = nullptr, size_t poolRowsFirst = 0);
+    // The parents of child pools whose parents' rows are in the memory, read back into
+    // the host's handles (Pool::parent: hot reload).
+    void parentsToHost();
+    // A child type's whose rows are in the memory beside its parents': rows [begin, end)
+    // of its parent columns (but folds) through `parents` from row `parentsFirst` on, where
+    // they are (Memory::gatherThrough, gatherAlive).
+    void gatherThrough(size_t type, const ColumnLayout& layout, std::span<const Buffer> table, Buffer parents,
+                       size_t parentsFirst, size_t begin, size_t end);
     // The neighbour folds of a type's objects, for this step (rt/neighbours.cpp).
     void foldNeighbours(size_t type);
     void foldOnHost(const FoldLaunch& launch);

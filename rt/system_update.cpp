@@ -89,6 +89,7 @@ void runKills(State& s, size_t type, double dt, double t1) {
         l.t1 = t1;
         l.dt = dt;
         for (size_t c = 0; c < chunks; ++c) l.parts.push_back(std::move(work.killed[c]));
+        if (info.read && info.rowsInMemory) s.ledger.listNow(l);  // its dead are dead to its children at once
         s.ledger.defer(std::move(l));
         return;
     }
@@ -150,15 +151,15 @@ void runUpdate(State& s, const Phase& phase, double dt, double t1, bool last) {
     // Drawing as it goes (rt/system_draw.h): each chunk rendered after its update.
     std::optional<ChunkDrawing> drawing;
     if (last && work.inStep.on) drawing.emplace(s, type, t1);
-    if (pool.live() == 0) {  // nothing is drawn (what is created later is drawn at creation)
+    if (pool.liveAtMost() == 0) {  // nothing is drawn (what is created later is drawn at creation)
         if (drawing) drawing->none();
         return;
     }
     RowsLaunch update = poolUpdate(s, type, dt, t1);
     update.emissionsStay = phase.inMemory && info.updateEmits;
-    // (Where the rows are in the memory, nothing here reads the mask: no parents, no
-    // drawing as the step goes, its folds copied, and its kills late — or none, with
-    // exports.)
+    // (Where the rows are in the memory, nothing here reads the mask: its parents' rows
+    // are there too, no drawing as the step goes, its folds copied, and its kills late —
+    // its exports those of the survivors there.)
     const uint8_t* updatable = phase.inMemory ? nullptr : pool.mask();
     RowsLaunch exports = update;
     Buffer exportMask;
@@ -198,7 +199,10 @@ void runUpdate(State& s, const Phase& phase, double dt, double t1, bool last) {
         if (listKills || late) s.ledger.record(work.killed[c], result, work.updateTable[ColumnLayout::kKill], begin, end);
         if (info.exports) {
             const uint8_t* survivors = updatable;
-            if (info.kills) {
+            if (info.kills && phase.inMemory) {  // (where the flags are)
+                s.memory.survivors(pool.updatable.column, work.updateTable[ColumnLayout::kKill], exportMask, part.begin,
+                                   part.end - part.begin);
+            } else if (info.kills) {
                 auto* alive = s.host<uint8_t>(exportMask);
                 maskRows(alive, updatable, kill, nullptr, part.begin, part.end);
                 survivors = alive;

@@ -6,6 +6,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <numeric>
 #include <cstring>
 #include <random>
 #include <vector>
@@ -26,7 +27,8 @@ struct Rows {
     rt::Buffer out, killed, map;
     explicit Rows(rt::Memory& m, size_t n) : memory(m) {
         rows = {m.create(rt::Elem::U32, n), m.create(rt::Elem::U32, n), m.create(rt::Elem::U8, n),
-                m.create(rt::Elem::U8, n), m.create(rt::Elem::U32, 1)};
+                m.create(rt::Elem::U8, n), m.create(rt::Elem::U32, rt::kCounters), m.create(rt::Elem::U32, n),
+                m.create(rt::Elem::U8, n)};
         out = m.create(rt::Elem::U32, n);
         killed = m.create(rt::Elem::U32, n + 1);
         map = m.create(rt::Elem::U32, n);
@@ -108,6 +110,155 @@ TEST_CASE("the memory's row operations compute on the GPU what they compute on t
     }
     CHECK(highWater > 1000);
     CHECK(top > 100);
+}
+
+TEST_CASE("parents and their readers: the GPU frees and freezes the rows the host does, in its order") {
+    // Parents with random children; children die, their parents' readers counted down;
+    // parents die, the unread freed in the kill list's order and the read frozen; frozen
+    // parents whose children all went freed in row order. Both memories, after each.
+    auto gpu = gpuBackend();
+    rt::HostMemory hostMemory;
+    constexpr size_t kParents = 3000, kChildren = 9000;
+    Rows host(hostMemory, kParents), device(gpu->memory(), kParents);
+    std::mt19937 random(11);
+    std::vector<uint32_t> parentOf(kChildren), readers(kParents, 0);
+    for (uint32_t& p : parentOf) {
+        p = random() % 5 == 0 ? rt::kSkipRow : static_cast<uint32_t>(random() % kParents);
+        if (p != rt::kSkipRow) ++readers[p];
+    }
+    rt::Buffer parents[2];
+    int which = 0;
+    for (Rows* r : {&host, &device}) {
+        r->memory.allocateRows(r->rows, 0, 0, kParents, r->out, 0);
+        r->memory.write(r->rows.readers, 0, kParents, readers.data());
+        parents[which] = r->memory.create(rt::Elem::U32, kChildren);
+        r->memory.write(parents[which++], 0, kChildren, parentOf.data());
+    }
+    auto same = [&](const char* what) {
+        INFO(what);
+        REQUIRE(host.read<uint32_t>(host.rows.counters, rt::kCounters) ==
+                device.read<uint32_t>(device.rows.counters, rt::kCounters));
+        uint32_t top = host.read<uint32_t>(host.rows.counters, 1)[0];
+        REQUIRE(host.read<uint32_t>(host.rows.stack, top) == device.read<uint32_t>(device.rows.stack, top));
+        REQUIRE(host.read<uint32_t>(host.rows.generation, kParents) == device.read<uint32_t>(device.rows.generation, kParents));
+        REQUIRE(host.read<uint32_t>(host.rows.readers, kParents) == device.read<uint32_t>(device.rows.readers, kParents));
+        REQUIRE(host.read<uint8_t>(host.rows.waiting, kParents) == device.read<uint8_t>(device.rows.waiting, kParents));
+        REQUIRE(host.read<uint8_t>(host.rows.alive, kParents) == device.read<uint8_t>(device.rows.alive, kParents));
+        REQUIRE(host.read<uint8_t>(host.rows.updatable, kParents) ==
+                device.read<uint8_t>(device.rows.updatable, kParents));
+    };
+    std::vector<uint32_t> childrenAlive(kChildren), parentsAlive(kParents);
+    std::iota(childrenAlive.begin(), childrenAlive.end(), 0u);
+    std::iota(parentsAlive.begin(), parentsAlive.end(), 0u);
+    for (int round = 0; round < 12; ++round) {
+        INFO("round " << round);
+        // Children die (a list at a base of 0): their parents' readers counted down.
+        std::shuffle(childrenAlive.begin(), childrenAlive.end(), random);
+        size_t dying = childrenAlive.size() / 3;
+        std::vector<uint32_t> list{static_cast<uint32_t>(dying)};
+        list.insert(list.end(), childrenAlive.end() - static_cast<std::ptrdiff_t>(dying), childrenAlive.end());
+        childrenAlive.resize(childrenAlive.size() - dying);
+        which = 0;
+        for (Rows* r : {&host, &device}) {
+            r->memory.write(r->killed, 0, list.size(), list.data());
+            r->memory.readersGone(r->killed, 0, 0, {}, 0, parents[which++], r->rows.readers);
+        }
+        same("children gone");
+        // Parents die, in a shuffled order: the unread pushed in it, the read frozen.
+        std::shuffle(parentsAlive.begin(), parentsAlive.end(), random);
+        dying = std::min<size_t>(parentsAlive.size(), 150 + random() % 200);
+        list.assign(1, static_cast<uint32_t>(dying));
+        for (size_t i = parentsAlive.size() - dying; i < parentsAlive.size(); ++i) list.push_back(parentsAlive[i]);
+        parentsAlive.resize(parentsAlive.size() - dying);
+        for (Rows* r : {&host, &device}) {
+            r->memory.write(r->killed, 0, list.size(), list.data());
+            r->memory.releaseUnread(r->rows, r->killed, 0, 0, {}, 0);
+        }
+        same("parents released or frozen");
+        for (Rows* r : {&host, &device}) r->memory.releaseWaiting(r->rows, kParents);
+        same("frozen parents without readers freed");
+    }
+    auto counters = host.read<uint32_t>(host.rows.counters, rt::kCounters);
+    CHECK(counters[0] > 1000);  // freed,
+    CHECK(counters[1] > 50);    // and still frozen for their children
+}
+
+TEST_CASE("a child's parents: from the records, their values and whether they are alive, on the GPU as on the host") {
+    auto gpu = gpuBackend();
+    rt::HostMemory hostMemory;
+    // Records of 3 sites a row over 40 emitter rows (a batch's: through a map), each asking
+    // for 0–4 objects in order.
+    constexpr size_t kEmitters = 40, kStride = 3;
+    std::mt19937 random(5);
+    std::vector<uint32_t> runs, map(kEmitters);
+    uint32_t objects = 0;
+    for (size_t j = 0; j < kEmitters * kStride; ++j) {
+        uint32_t count = random() % 5;
+        std::vector<uint32_t> record(rt::kRunWords, 0);
+        record[0] = objects;
+        record[1] = count;
+        objects += count;
+        runs.insert(runs.end(), record.begin(), record.end());
+    }
+    for (uint32_t& m : map) m = 100 + random() % 50;
+    std::vector<float> exported(200);
+    for (float& v : exported) v = static_cast<float>(random() % 1000) / 7.0f;
+    std::vector<uint8_t> alive(200), mask(objects), killed(objects);
+    for (uint8_t& a : alive) a = random() % 2;
+    for (uint8_t& m : mask) m = random() % 4 != 0;
+    for (uint8_t& k : killed) k = random() % 3 == 0;
+    struct Out {
+        std::vector<uint32_t> parents, readers;
+        std::vector<float> values, isAlive;
+        std::vector<uint8_t> survivors;
+    } out[2];
+    int which = 0;
+    for (rt::Memory* m : {static_cast<rt::Memory*>(&hostMemory), &gpu->memory()}) {
+        rt::Buffer r = m->create(rt::Elem::U32, runs.size()), through = m->create(rt::Elem::U32, kEmitters);
+        rt::Buffer parents = m->create(rt::Elem::U32, objects + 7), readers = m->create(rt::Elem::U32, 200);
+        rt::Buffer from = m->create(rt::Elem::F32, 200), a = m->create(rt::Elem::U8, 200);
+        rt::Buffer values = m->create(rt::Elem::F32, objects + 7), isAlive = m->create(rt::Elem::F32, objects + 7);
+        rt::Buffer k = m->create(rt::Elem::U8, objects), ma = m->create(rt::Elem::U8, objects), s = m->create(rt::Elem::U8, objects);
+        m->write(r, 0, runs.size(), runs.data());
+        m->write(through, 0, kEmitters, map.data());
+        m->write(from, 0, 200, exported.data());
+        m->write(a, 0, 200, alive.data());
+        m->write(k, 0, objects, killed.data());
+        m->write(ma, 0, objects, mask.data());
+        // (the group's records from record 0; objects kept: all but the last 9)
+        m->parentsFromRecords(r, 0, kEmitters * kStride, kStride, through, 0, objects, objects - 9, parents, 7, readers);
+        m->gatherThrough(from, values, 7, parents, 7, objects);
+        m->gatherAlive(a, isAlive, 7, parents, 7, objects);
+        m->survivors(ma, k, s, 0, objects);
+        Out& o = out[which++];
+        o.parents.resize(objects);
+        o.readers.resize(200);
+        o.values.resize(objects);
+        o.isAlive.resize(objects);
+        o.survivors.resize(objects);
+        m->read(parents, 7, objects, o.parents.data());
+        m->read(readers, 0, 200, o.readers.data());
+        m->read(values, 7, objects, o.values.data());
+        m->read(isAlive, 7, objects, o.isAlive.data());
+        m->read(s, 0, objects, o.survivors.data());
+    }
+    // The host's, against the records by hand: object r of emitter row j's records.
+    uint32_t r = 0;
+    std::vector<uint32_t> readers(200, 0);
+    for (size_t j = 0; j < kEmitters * kStride; ++j)
+        for (uint32_t k = 0; k < runs[j * rt::kRunWords + 1]; ++k, ++r) {
+            REQUIRE(out[0].parents[r] == map[j / kStride]);
+            if (r < objects - 9) ++readers[map[j / kStride]];
+            CHECK(out[0].values[r] == exported[map[j / kStride]]);
+            CHECK(out[0].isAlive[r] == (alive[map[j / kStride]] ? 1.0f : 0.0f));
+        }
+    CHECK(out[0].readers == readers);
+    CHECK(out[0].parents == out[1].parents);
+    CHECK(out[0].readers == out[1].readers);
+    CHECK(out[0].values == out[1].values);
+    CHECK(out[0].isAlive == out[1].isAlive);
+    CHECK(out[0].survivors == out[1].survivors);
+    for (uint32_t i = 0; i < objects; ++i) CHECK(out[0].survivors[i] == (mask[i] && !killed[i]));
 }
 
 TEST_CASE("ids and creation times from a batch's runs: the same bits on the GPU as on the host") {
@@ -253,6 +404,61 @@ TEST_CASE("a pool of objects that only die keeps its rows on the GPU: what a ste
     };
     double small = perStep(2000), large = perStep(20000);
     MESSAGE("bytes between host and GPU a step: " << small << " with 2,000 drops, " << large << " with 20,000");
+    CHECK(large <= 1.1 * small + 8);
+    CHECK(large < 1024);
+}
+
+TEST_CASE("children and the parents they read keep their rows on the GPU: frozen parents freed there, nothing grows") {
+    // The comet's tail reads the comet live and after its death (frozen); comets die at
+    // random ages beside their tails, burst on death, and a launcher makes more. Both
+    // types keep their rows in the memory: against the interpreter object for object, row
+    // for row; the frozen comets freed on the GPU once their last tail is.
+    const char* comets = R"(
+        object comet {
+            pos = vec3(cos(age * (1 + rand())) * 5, 3 + sin(age * 2), sin(age) * 5);
+            sprite(pos, white, 0.5);
+            emit tail(nrand3() * 0.5) at 120 per second;
+            emit tail(vec3(0, 1, 0)) count 3;
+            on death { emit tail(vec3(1, 0, 0)) count 5; }
+            kill when age > 0.5 + rand() * 2;
+            @capacity(300)
+            object tail(offset: vec3) {
+                pos = comet.pos + offset * (1 + age);
+                sprite(pos, vec4(0.6, 0.8, comet.alive ? 1 : 0, clamp(1 - age / 2)), 0.15);
+                kill when age > 0.2 + rand() * 3 || (!comet.alive && age > 1);
+            }
+        }
+        object launcher { emit comet at 6 per second; kill when age > 4; }
+        spawn launcher;
+        spawn comet;)";
+    test::Pair p(comets);
+    size_t comet = static_cast<size_t>(p.gl->typeIndex("comet")), tail = static_cast<size_t>(p.gl->typeIndex("comet.tail"));
+    CHECK(p.gl->pool(comet).rowsInMemory());
+    CHECK(p.gl->pool(tail).rowsInMemory());
+    uint64_t frozen = 0;
+    for (int f = 0; f < 360; ++f) {
+        p.steps(1, 1.0 / 60);
+        p.compare();
+        REQUIRE(test::poolRows(*p.cpu) == test::poolRows(*p.gl));
+        frozen += p.stats("comet").frozen;
+    }
+    CHECK(frozen > 100);  // comets waited, frozen, for their tails
+    CHECK(p.stats("comet").created == 25);
+    CHECK(p.stats("comet.tail").dropped > 0);  // (at its capacity)
+    CHECK(p.stats("comet").live + p.stats("comet").frozen == 0);
+    // follow_parent at 30 and at 300 comets: the same bytes a step.
+    auto perStep = [](int comets) {
+        auto gpu = gpuBackend();
+        std::string text = readFile(test::sample("follow_parent"));
+        for (int k = 1; k < comets; ++k) text += "\nspawn comet;";
+        rt::System system(test::compileModule(text), *gpu);
+        for (int f = 0; f < 30; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
+        uint64_t before = gpu->transferredBytes();
+        for (int f = 0; f < 20; ++f) REQUIRE_FALSE(system.step(1.0 / 60));
+        return static_cast<double>(gpu->transferredBytes() - before) / 20;
+    };
+    double small = perStep(30), large = perStep(300);
+    MESSAGE("follow_parent, bytes between host and GPU a step: " << small << " with 30 comets, " << large << " with 300");
     CHECK(large <= 1.1 * small + 8);
     CHECK(large < 1024);
 }

@@ -211,18 +211,25 @@ TEST_CASE("a reload that removes an object type drops its objects and keeps the 
 
 TEST_CASE("a reload keeps parents and children, frozen parents included") {
     // The comet dies at 20 s; its tail reads it frozen until the last tail particle dies.
+    // Rows on the host, and in the memory (the parents' readers and frozen rows there).
     std::string text = test::readFile(std::string(PSYS_SAMPLES_DIR) + "/follow_parent.psys");
-    interp::Interpreter backend;
-    rt::System straight(compile(text), backend), before(compile(text), backend);
-    run(straight, 1205);
-    run(before, 1205);
-    REQUIRE(before.stats().types[0].frozen == 1);
-    std::string expected = run(straight, 120);
-    rt::System after(compile(text), backend);
-    after.carryOver(before);
-    CHECK(after.stats().types[0].frozen == 1);
-    CHECK(run(after, 120) == expected);
-    CHECK(after.stats().types[0].frozen == 0);  // freed with its last reader
+    for (auto rows : {rt::SystemOptions::Rows::OnHost, rt::SystemOptions::Rows::InMemory}) {
+        rt::SystemOptions options;
+        options.rows = rows;
+        options.drawInStep = false;  // (a type drawn as the step goes keeps its rows on the host)
+        interp::Interpreter backend;
+        rt::System straight(compile(text), backend, options), before(compile(text), backend, options);
+        CHECK(before.pool(0).rowsInMemory() == (rows == rt::SystemOptions::Rows::InMemory));
+        run(straight, 1205);
+        run(before, 1205);
+        REQUIRE(before.stats().types[0].frozen == 1);
+        std::string expected = run(straight, 120);
+        rt::System after(compile(text), backend, options);
+        after.carryOver(before);
+        CHECK(after.stats().types[0].frozen == 1);
+        CHECK(run(after, 120) == expected);
+        CHECK(after.stats().types[0].frozen == 0);  // freed with its last reader
+    }
 }
 
 TEST_CASE("a reload that removes a child type frees the frozen parents only it read") {

@@ -1,0 +1,248 @@
+// Parents and children whose rows are both on the GPU (rt::Memory's parent operations):
+// a child's parent values fetched through its `parents` rows, the survivors whose exports
+// an update computes, and the step's end by the rule of rt/ledger.h — a child pool's kill
+// list counting its parents' readers down, a parent pool's freeing the unread rows in the
+// list's order and freezing the rest, then its frozen rows without readers in row order.
+// The ordered pushes are one work group's scan (64 invocations, each a slice of the list
+// or the rows, in order), the stack's top moved on by the same dispatch. Each shader is
+// the GLSL spelling of what rt/memory.cpp writes for the host.
+#include <epoxy/gl.h>
+
+#include "gpu/gl_context.h"
+#include "gpu/gl_memory.h"
+#include "gpu/gl_programs.h"
+
+namespace psys::gpu {
+
+using rt::Buffer;
+
+namespace {
+
+// f32 1 or 0: whether the row's parent is alive (kSkipRow: none, 0).
+const char* kGatherAlive = R"(
+layout(std430, binding = 0) readonly buffer Alive { uint alive[]; };
+layout(std430, binding = 1) buffer To { uint to[]; };
+layout(std430, binding = 2) readonly buffer Rows { uint rows[]; };
+void main() {
+    uint i = INVOCATION, count = param(0u), first = param(1u), rowsAt = param(2u);
+    if (i >= count) return;
+    uint row = rows[rowsAt + i];
+    to[first + i] = row != 0xFFFFFFFFu && alive[row] != 0u ? floatBitsToUint(1.0) : 0u;
+}
+)";
+
+const char* kSurvivors = R"(
+layout(std430, binding = 0) readonly buffer Mask { uint mask[]; };
+layout(std430, binding = 1) readonly buffer Killed { uint killed[]; };
+layout(std430, binding = 2) buffer Out { uint survivors[]; };
+void main() {
+    uint i = INVOCATION, count = param(0u), first = param(1u);
+    if (i >= count) return;
+    survivors[first + i] = mask[first + i] != 0u && killed[first + i] == 0u ? 1u : 0u;
+}
+)";
+
+// A kill list's rows (its count, then launch rows: rt::Memory::releaseRows) and the pool
+// row of its i-th; shared by the shaders below.
+const char* kKillList = R"(
+layout(std430, binding = 0) readonly buffer Killed { uint killed[]; };
+layout(std430, binding = 1) readonly buffer Map { uint map[]; };
+uint killedRow(uint i) {
+    uint r = killed[param(1u) + 1u + i];
+    return param(4u) != 0u ? map[param(3u) + r] : param(2u) + r;
+}
+)";
+
+// The host does not know the list's length: a grid of at most kGrid strides over it.
+const char* kReadersGone = R"(
+layout(std430, binding = 2) readonly buffer Parents { uint parents[]; };
+layout(std430, binding = 3) buffer Readers { uint readers[]; };
+void main() {
+    uint count = killed[param(1u)], grid = param(5u);
+    for (uint i = INVOCATION; i < count; i += grid) {
+        uint p = parents[killedRow(i)];
+        if (p != 0xFFFFFFFFu) atomicAdd(readers[p], 0xFFFFFFFFu);
+    }
+}
+)";
+
+// One work group: each invocation takes a slice of [0, count) in order, counts what it
+// pushes, and pushes it at the top plus what the slices before it push.
+const char* kScanBlocks = R"(
+layout(std430, binding = 2) buffer Stack { uint stack[]; };
+layout(std430, binding = 3) buffer Generation { uint generation[]; };
+layout(std430, binding = 6) buffer Counters { uint counters[]; };
+layout(std430, binding = 7) readonly buffer Readers { uint readers[]; };
+layout(std430, binding = 8) buffer Waiting { uint waiting[]; };
+shared uint pushes[64];
+shared uint frozen[64];
+// Of this invocation's pushes and freezes, those of the invocations before it, and all.
+uvec4 scan(uint mine, uint mineFrozen) {
+    uint lane = gl_LocalInvocationIndex;
+    pushes[lane] = mine;
+    frozen[lane] = mineFrozen;
+    barrier();
+    uvec4 sums = uvec4(0u);
+    for (uint k = 0u; k < 64u; ++k) {
+        if (k < lane) sums.x += pushes[k];
+        sums.y += pushes[k];
+        sums.z += frozen[k];
+    }
+    return sums;
+}
+void push(uint at, uint row) {
+    stack[at] = row;
+    generation[row] += 1u;
+}
+)";
+
+// A parent pool's kill list: rows nobody reads pushed in the list's order, the others
+// frozen (waiting); none of them alive or updatable any more.
+const char* kReleaseUnread = R"(
+layout(std430, binding = 4) buffer Updatable { uint updatable[]; };
+layout(std430, binding = 5) buffer Alive { uint alive[]; };
+void main() {
+    uint lane = gl_LocalInvocationIndex, count = killed[param(1u)], top = counters[0];
+    uint per = (count + 63u) / 64u, begin = min(lane * per, count), end = min(begin + per, count);
+    uint unread = 0u;
+    for (uint i = begin; i < end; ++i) unread += readers[killedRow(i)] == 0u ? 1u : 0u;
+    uvec4 sums = scan(unread, end - begin - unread);
+    uint at = top + sums.x;
+    for (uint i = begin; i < end; ++i) {
+        uint row = killedRow(i);
+        updatable[row] = 0u;
+        alive[row] = 0u;
+        if (readers[row] == 0u) push(at++, row); else waiting[row] = 1u;
+    }
+    barrier();
+    if (lane == 0u) {
+        counters[0] = top + sums.y;
+        counters[1] += sums.z;
+    }
+}
+)";
+
+// The frozen rows among [0, rows) whose readers are all gone, pushed in row order.
+const char* kReleaseWaiting = R"(
+bool freed(uint row) { return waiting[row] != 0u && readers[row] == 0u; }
+void main() {
+    uint lane = gl_LocalInvocationIndex, rows = param(0u);
+    if (counters[1] == 0u) return;  // (every invocation alike)
+    uint top = counters[0];
+    uint per = (rows + 63u) / 64u, begin = min(lane * per, rows), end = min(begin + per, rows);
+    uint mine = 0u;
+    for (uint row = begin; row < end; ++row) mine += freed(row) ? 1u : 0u;
+    uvec4 sums = scan(mine, 0u);
+    uint at = top + sums.x;
+    for (uint row = begin; row < end; ++row) {
+        if (!freed(row)) continue;
+        waiting[row] = 0u;
+        push(at++, row);
+    }
+    barrier();
+    if (lane == 0u) {
+        counters[0] = top + sums.y;
+        counters[1] -= sums.y;
+    }
+}
+)";
+
+constexpr uint32_t kGrid = 64 * 1024;
+
+}  // namespace
+
+void GlMemory::gatherAlive(Buffer alive, Buffer to, size_t toFirst, Buffer rows, size_t rowsFirst, size_t count) {
+    if (count == 0) return;
+    if (!onDevice(rows) && allOnHost({alive, to}))
+        return rt::Memory::gatherAlive(alive, to, toFirst, rows, rowsFirst, count);
+    flushPending();
+    if (!gatherAliveProgram_) gatherAliveProgram_ = computeProgram(operationShader(kGatherAlive), "parents alive");
+    PassTimer::Scope timed(timer, "gather", count);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceBuffer(alive));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, bound(to));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, deviceBuffer(rows));
+    bindParams(paramsBuffer_, {static_cast<uint32_t>(count), static_cast<uint32_t>(toFirst),
+                               static_cast<uint32_t>(rowsFirst)});
+    dispatchRows(gatherAliveProgram_, count);
+}
+
+void GlMemory::survivors(Buffer mask, Buffer killed, Buffer out, size_t first, size_t count) {
+    if (count == 0) return;
+    if (allOnHost({mask, killed, out})) return rt::Memory::survivors(mask, killed, out, first, count);
+    flushPending();
+    if (!survivorsProgram_) survivorsProgram_ = computeProgram(operationShader(kSurvivors), "survivors");
+    PassTimer::Scope timed(timer, "survivors", count);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceBuffer(mask));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, deviceBuffer(killed));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, bound(out));
+    bindParams(paramsBuffer_, {static_cast<uint32_t>(count), static_cast<uint32_t>(first)});
+    dispatchRows(survivorsProgram_, count);
+}
+
+// The kill list's bindings and parameters (kKillList's).
+void GlMemory::bindKillList(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, uint32_t grid) {
+    unsigned list = deviceBuffer(killed);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, list);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, map.valid() ? deviceBuffer(map) : list);
+    bindParams(paramsBuffer_, {0u, static_cast<uint32_t>(killedAt), base, static_cast<uint32_t>(mapFirst),
+                               map.valid() ? 1u : 0u, grid});
+}
+
+void GlMemory::readersGone(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, Buffer parents,
+                           Buffer readers) {
+    if (allOnHost({killed, map, parents, readers}))
+        return rt::Memory::readersGone(killed, killedAt, base, map, mapFirst, parents, readers);
+    flushPending();
+    size_t most = rows(killed) > killedAt ? rows(killed) - killedAt - 1 : 0;
+    if (most == 0) return;
+    if (!readersGoneProgram_)
+        readersGoneProgram_ = computeProgram(operationShader(std::string(kKillList) + kReadersGone), "readers gone");
+    auto grid = static_cast<uint32_t>(std::min<size_t>(most, kGrid));
+    PassTimer::Scope timed(timer, "release", grid);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, deviceBuffer(parents));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(readers));
+    bindKillList(killed, killedAt, base, map, mapFirst, grid);
+    dispatchRows(readersGoneProgram_, grid);
+}
+
+void GlMemory::releaseUnread(const rt::PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
+                             size_t mapFirst) {
+    if (allOnHost({pool.stack, pool.generation, pool.updatable, pool.alive, pool.counters, pool.readers, pool.waiting,
+                   killed, map}))
+        return rt::Memory::releaseUnread(pool, killed, killedAt, base, map, mapFirst);
+    flushPending();
+    if (rows(killed) <= killedAt + 1) return;
+    if (!releaseUnreadProgram_)
+        releaseUnreadProgram_ = computeProgram(operationShader(std::string(kKillList) + kScanBlocks + kReleaseUnread),
+                                               "release of the unread");
+    PassTimer::Scope timed(timer, "release", 64);
+    bindScanBlocks(pool);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, bound(pool.updatable));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, bound(pool.alive));
+    bindKillList(killed, killedAt, base, map, mapFirst, 64);
+    dispatchRows(releaseUnreadProgram_, 64);
+}
+
+void GlMemory::releaseWaiting(const rt::PoolRows& pool, size_t rows) {
+    if (rows == 0) return;
+    if (allOnHost({pool.stack, pool.generation, pool.counters, pool.readers, pool.waiting}))
+        return rt::Memory::releaseWaiting(pool, rows);
+    flushPending();
+    if (!releaseWaitingProgram_)
+        releaseWaitingProgram_ =
+            computeProgram(operationShader(std::string(kScanBlocks) + kReleaseWaiting), "release of the waiting");
+    PassTimer::Scope timed(timer, "release", 64);
+    bindScanBlocks(pool);
+    bindParams(paramsBuffer_, {static_cast<uint32_t>(rows)});
+    dispatchRows(releaseWaitingProgram_, 64);
+}
+
+void GlMemory::bindScanBlocks(const rt::PoolRows& pool) {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, bound(pool.stack));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(pool.generation));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, bound(pool.counters));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, deviceBuffer(pool.readers));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, bound(pool.waiting));
+}
+
+}  // namespace psys::gpu
