@@ -62,6 +62,23 @@ vec4 lv(uint k) { return uintBitsToFloat(uvec4(lw(k), lw(k + 1u), lw(k + 2u), lw
 
 }  // namespace
 
+// A double to the nearest float, ties to even, as C converts it (rt/clock.h's ages): GLSL
+// does not say how float(double) rounds. The conversion is within an ulp either way, so
+// x − f is exact in doubles and the neighbour toward x is the only other candidate.
+std::string narrowHelper() {
+    return R"(float psys_narrow(double x) {
+    precise float f = float(x);
+    precise double e = x - double(f);
+    if (e == 0.0LF || isinf(f) || isnan(f)) return f;
+    uint b = floatBitsToUint(f);
+    precise float g = f == 0.0 ? uintBitsToFloat(e > 0.0LF ? 1u : 0x80000001u)
+                               : uintBitsToFloat((e > 0.0LF) == (f > 0.0) ? b + 1u : b - 1u);
+    precise double d = abs(x - double(g)), a = abs(e);
+    return d < a || (d == a && (floatBitsToUint(g) & 1u) == 0u) ? g : f;
+}
+)";
+}
+
 // What a shader's bodies (codegen_glsl/glsl_body.h) call: GLSL built-ins with
 // core/lanes.h's results where GLSL leaves them undefined, and the zero no compiler sees
 // through, read from word `zeroWord` of the shader's `lw` (which must hold 0).
@@ -85,20 +102,7 @@ float psys_div(float x, float y) {{
     if (psys_isnan(x) || x == 0.0) return psys_nan;
     return uintBitsToFloat(0x7f800000u | ((floatBitsToUint(x) ^ floatBitsToUint(y)) & 0x80000000u));
 }}
-// A double to the nearest float, ties to even, as C converts it (rt/clock.h's ages): GLSL
-// does not say how float(double) rounds. The conversion is within an ulp either way, so
-// x − f is exact in doubles and the neighbour toward x is the only other candidate.
-float psys_narrow(double x) {{
-    precise float f = float(x);
-    precise double e = x - double(f);
-    if (e == 0.0LF || isinf(f) || isnan(f)) return f;
-    uint b = floatBitsToUint(f);
-    precise float g = f == 0.0 ? uintBitsToFloat(e > 0.0LF ? 1u : 0x80000001u)
-                               : uintBitsToFloat((e > 0.0LF) == (f > 0.0) ? b + 1u : b - 1u);
-    precise double d = abs(x - double(g)), a = abs(e);
-    return d < a || (d == a && (floatBitsToUint(g) & 1u) == 0u) ? g : f;
-}}
-float psys_sqrt(float x) {{ return x < 0.0 ? psys_nan : sqrt(x); }}
+{1}float psys_sqrt(float x) {{ return x < 0.0 ? psys_nan : sqrt(x); }}
 float psys_log(float x) {{ return x < 0.0 ? psys_nan : x == 0.0 ? -psys_inf : log(x); }}
 float psys_asin(float x) {{ return abs(x) > 1.0 ? psys_nan : asin(x); }}
 float psys_acos(float x) {{ return abs(x) > 1.0 ? psys_nan : acos(x); }}
@@ -124,7 +128,7 @@ float psys_pow(float x, float y) {{  // C's pow: defined for every base
     if (isinf(x)) return y < 0.0 ? 0.0 : psys_inf;
     return pow(x, y);
 }}
-)", zeroWord);
+)", zeroWord, narrowHelper());
 }
 
 namespace {

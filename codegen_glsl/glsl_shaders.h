@@ -100,6 +100,8 @@ std::string childrenShader(const ir::Object& object, const ir::Kernel& spawn);
 // The helpers the statements of emitBody call (psys_div, psys_pow, psys_zero, …), for a
 // shader whose `lw(zeroWord)` holds 0.
 std::string mathHelpers(uint32_t zeroWord);
+// psys_narrow: a double to the nearest float, as C rounds it (mathHelpers holds it too).
+std::string narrowHelper();
 
 std::string drawVertexShader();
 std::string drawFragmentShader();

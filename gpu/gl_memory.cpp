@@ -125,7 +125,8 @@ GlMemory::~GlMemory() {
     for (unsigned program : {scatterProgram_, scatterColumnsProgram_, gatherProgram_, allocateProgram_, releaseProgram_, pushedProgram_, freshProgram_,
                              identifyProgram_, boundsProgram_, emitRowsProgram_, emitScanProgram_, identifyRecordsProgram_,
                              clearMappedProgram_, parentsProgram_, gatherAliveProgram_, survivorsProgram_,
-                             readersGoneProgram_, releaseUnreadProgram_, releaseWaitingProgram_})
+                             readersGoneProgram_, releaseUnreadProgram_, releaseWaitingProgram_, gatherAgeProgram_,
+                             stampDeathsProgram_})
         if (program) glDeleteProgram(program);
     if (runsBuffer_) glDeleteBuffers(1, &runsBuffer_);
     if (rowsBuffer_) glDeleteBuffers(1, &rowsBuffer_);

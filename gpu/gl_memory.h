@@ -62,6 +62,11 @@ public:
                        size_t count) override;
     void gatherAlive(rt::Buffer alive, rt::Buffer to, size_t toFirst, rt::Buffer rows, size_t rowsFirst,
                      size_t count) override;
+    void gatherAge(rt::Buffer created, rt::Buffer frozenAt, rt::Buffer alive, rt::Buffer to, size_t toFirst,
+                   rt::Buffer rows, size_t rowsFirst, size_t count, double now, rt::Buffer nowRows,
+                   size_t nowFirst) override;
+    void stampDeaths(rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map, size_t mapFirst,
+                     rt::Buffer frozenAt, double t1, double dt, rt::Buffer created) override;
     void survivors(rt::Buffer mask, rt::Buffer killed, rt::Buffer out, size_t first, size_t count) override;
     void readersGone(rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map, size_t mapFirst,
                      rt::Buffer parents, rt::Buffer readers) override;
@@ -160,9 +165,10 @@ private:
     unsigned emitRowsProgram_ = 0, emitScanProgram_ = 0, metaBuffer_ = 0;  // gpu/gl_emission.cpp
     unsigned identifyRecordsProgram_ = 0, clearMappedProgram_ = 0, parentsProgram_ = 0;  // gpu/gl_rows.cpp
     // gpu/gl_parents.cpp
-    unsigned gatherAliveProgram_ = 0, survivorsProgram_ = 0, readersGoneProgram_ = 0, releaseUnreadProgram_ = 0,
-             releaseWaitingProgram_ = 0;
-    void bindKillList(rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map, size_t mapFirst, uint32_t grid);
+    unsigned gatherAliveProgram_ = 0, gatherAgeProgram_ = 0, stampDeathsProgram_ = 0, survivorsProgram_ = 0,
+             readersGoneProgram_ = 0, releaseUnreadProgram_ = 0, releaseWaitingProgram_ = 0;
+    void bindKillList(rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map, size_t mapFirst, uint32_t grid,
+                      uint32_t mode = 0, std::array<uint32_t, 2> value = {});
     void bindScanBlocks(const rt::PoolRows& pool);
 };
 

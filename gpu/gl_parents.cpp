@@ -6,8 +6,12 @@
 // The ordered pushes are one work group's scan (64 invocations, each a slice of the list
 // or the rows, in order), the stack's top moved on by the same dispatch. Each shader is
 // the GLSL spelling of what rt/memory.cpp writes for the host.
+#include <array>
+#include <cstring>
+
 #include <epoxy/gl.h>
 
+#include "codegen_glsl/glsl_shaders.h"
 #include "gpu/gl_context.h"
 #include "gpu/gl_memory.h"
 #include "gpu/gl_programs.h"
@@ -31,6 +35,32 @@ void main() {
 }
 )";
 
+// A parent's age at the child's clock, or at its death where it is frozen: rt::ageAt over
+// doubles (two words a row, the low first), rounded as C rounds (psys_narrow).
+const char* kGatherAge = R"(
+layout(std430, binding = 0) readonly buffer Created { uint created[]; };
+layout(std430, binding = 1) readonly buffer FrozenAt { uint frozenAt[]; };
+layout(std430, binding = 2) readonly buffer Alive { uint alive[]; };
+layout(std430, binding = 3) buffer To { uint to[]; };
+layout(std430, binding = 4) readonly buffer Rows { uint rows[]; };
+layout(std430, binding = 5) readonly buffer Now { uint nowRows[]; };
+double word2(uint lo, uint hi) { return packDouble2x32(uvec2(lo, hi)); }
+void main() {
+    uint i = INVOCATION, count = param(0u), first = param(1u), rowsAt = param(2u), nowAt = param(3u);
+    if (i >= count) return;
+    uint p = rows[rowsAt + i];
+    if (p == 0xFFFFFFFFu) {
+        to[first + i] = 0u;
+        return;
+    }
+    uint k = 2u * (nowAt + i);
+    double clock = alive[p] == 0u ? word2(frozenAt[2u * p], frozenAt[2u * p + 1u])
+                 : param(4u) != 0u ? word2(nowRows[k], nowRows[k + 1u]) : word2(param(5u), param(6u));
+    precise double age = clock - word2(created[2u * p], created[2u * p + 1u]);
+    to[first + i] = floatBitsToUint(psys_narrow(age));
+}
+)";
+
 const char* kSurvivors = R"(
 layout(std430, binding = 0) readonly buffer Mask { uint mask[]; };
 layout(std430, binding = 1) readonly buffer Killed { uint killed[]; };
@@ -43,7 +73,7 @@ void main() {
 )";
 
 // A kill list's rows (its count, then launch rows: rt::Memory::releaseRows) and the pool
-// row of its i-th; shared by the shaders below.
+// row of its i-th; shared by the shaders below (params 1–5; 0, 6 and 7 are theirs).
 const char* kKillList = R"(
 layout(std430, binding = 0) readonly buffer Killed { uint killed[]; };
 layout(std430, binding = 1) readonly buffer Map { uint map[]; };
@@ -62,6 +92,28 @@ void main() {
     for (uint i = INVOCATION; i < count; i += grid) {
         uint p = parents[killedRow(i)];
         if (p != 0xFFFFFFFFu) atomicAdd(readers[p], 0xFFFFFFFFu);
+    }
+}
+)";
+
+// Each listed row's death: `value` (t1 − dt), or where param 0 says so value − (value −
+// created[row]) (a batch's first update: t1 − its age), as the host rounds it.
+const char* kStampDeaths = R"(
+layout(std430, binding = 2) buffer FrozenAt { uint frozenAt[]; };
+layout(std430, binding = 3) readonly buffer Created { uint created[]; };
+void main() {
+    uint count = killed[param(1u)], grid = param(5u);
+    double value = packDouble2x32(uvec2(param(6u), param(7u)));
+    for (uint i = INVOCATION; i < count; i += grid) {
+        uint row = killedRow(i);
+        precise double at = value;
+        if (param(0u) != 0u) {
+            precise double age = value - packDouble2x32(uvec2(created[2u * row], created[2u * row + 1u]));
+            at = value - age;
+        }
+        uvec2 w = unpackDouble2x32(at);
+        frozenAt[2u * row] = w.x;
+        frozenAt[2u * row + 1u] = w.y;
     }
 }
 )";
@@ -166,6 +218,50 @@ void GlMemory::gatherAlive(Buffer alive, Buffer to, size_t toFirst, Buffer rows,
     dispatchRows(gatherAliveProgram_, count);
 }
 
+void GlMemory::gatherAge(Buffer created, Buffer frozenAt, Buffer alive, Buffer to, size_t toFirst, Buffer rows,
+                         size_t rowsFirst, size_t count, double now, Buffer nowRows, size_t nowFirst) {
+    if (count == 0) return;
+    if (!onDevice(rows) && allOnHost({created, frozenAt, alive, to, nowRows}))
+        return rt::Memory::gatherAge(created, frozenAt, alive, to, toFirst, rows, rowsFirst, count, now, nowRows, nowFirst);
+    flushPending();
+    if (!gatherAgeProgram_)
+        gatherAgeProgram_ = computeProgram(operationShader(codegen_glsl::narrowHelper() + kGatherAge), "parents' ages");
+    PassTimer::Scope timed(timer, "gather", count);
+    std::array<uint32_t, 2> w{};
+    std::memcpy(w.data(), &now, 8);
+    unsigned list = deviceBuffer(rows);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceBuffer(created));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, deviceBuffer(frozenAt));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, deviceBuffer(alive));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(to));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, list);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, nowRows.valid() ? deviceBuffer(nowRows) : list);
+    bindParams(paramsBuffer_, {static_cast<uint32_t>(count), static_cast<uint32_t>(toFirst),
+                               static_cast<uint32_t>(rowsFirst), static_cast<uint32_t>(nowFirst),
+                               nowRows.valid() ? 1u : 0u, w[0], w[1]});
+    dispatchRows(gatherAgeProgram_, count);
+}
+
+void GlMemory::stampDeaths(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, Buffer frozenAt,
+                           double t1, double dt, Buffer created) {
+    if (allOnHost({killed, map, frozenAt, created}))
+        return rt::Memory::stampDeaths(killed, killedAt, base, map, mapFirst, frozenAt, t1, dt, created);
+    flushPending();
+    size_t most = rows(killed) > killedAt ? rows(killed) - killedAt - 1 : 0;
+    if (most == 0) return;
+    if (!stampDeathsProgram_)
+        stampDeathsProgram_ = computeProgram(operationShader(std::string(kKillList) + kStampDeaths), "deaths' times");
+    auto grid = static_cast<uint32_t>(std::min<size_t>(most, kGrid));
+    PassTimer::Scope timed(timer, "release", grid);
+    double value = created.valid() ? t1 : t1 - dt;  // (the host's rounding of t1 − dt)
+    std::array<uint32_t, 2> w{};
+    std::memcpy(w.data(), &value, 8);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, bound(frozenAt));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, created.valid() ? deviceBuffer(created) : deviceBuffer(frozenAt));
+    bindKillList(killed, killedAt, base, map, mapFirst, grid, created.valid() ? 1u : 0u, w);
+    dispatchRows(stampDeathsProgram_, grid);
+}
+
 void GlMemory::survivors(Buffer mask, Buffer killed, Buffer out, size_t first, size_t count) {
     if (count == 0) return;
     if (allOnHost({mask, killed, out})) return rt::Memory::survivors(mask, killed, out, first, count);
@@ -180,12 +276,13 @@ void GlMemory::survivors(Buffer mask, Buffer killed, Buffer out, size_t first, s
 }
 
 // The kill list's bindings and parameters (kKillList's).
-void GlMemory::bindKillList(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, uint32_t grid) {
+void GlMemory::bindKillList(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, uint32_t grid,
+                            uint32_t mode, std::array<uint32_t, 2> value) {
     unsigned list = deviceBuffer(killed);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, list);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, map.valid() ? deviceBuffer(map) : list);
-    bindParams(paramsBuffer_, {0u, static_cast<uint32_t>(killedAt), base, static_cast<uint32_t>(mapFirst),
-                               map.valid() ? 1u : 0u, grid});
+    bindParams(paramsBuffer_, {mode, static_cast<uint32_t>(killedAt), base, static_cast<uint32_t>(mapFirst),
+                               map.valid() ? 1u : 0u, grid, value[0], value[1]});
 }
 
 void GlMemory::readersGone(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, Buffer parents,

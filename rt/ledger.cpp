@@ -91,8 +91,20 @@ void Ledger::listInMemory(LateKills& l, bool aliveOnly) {
 }
 
 // (Only the alive mask: the update's mask still holds them for the emissions of their
-// deaths, after; the release clears it.)
-void Ledger::listNow(LateKills& l) { listInMemory(l, true); }
+// deaths, after; the release clears it. And their deaths' times, where children read
+// their ages.)
+void Ledger::listNow(LateKills& l) {
+    listInMemory(l, true);
+    Pool& pool = s_.pools[l.type];
+    if (!pool.frozenAt.valid()) return;
+    for (const LateKills::Part& part : l.parts) {  // (the time of their last values: children read their age)
+        if (!part.killList.valid() || (part.counted && part.count == 0)) continue;
+        uint32_t base = l.map.valid() ? 0 : static_cast<uint32_t>(part.begin);
+        size_t mapFirst = l.map.valid() ? part.begin - l.first : 0;
+        s_.memory.stampDeaths(part.killList, 0, base, l.map, mapFirst, pool.frozenAt, l.t1, l.dt,
+                              l.map.valid() ? pool.created : Buffer{});
+    }
+}
 
 // By the rule of `release`: a type at a time, the most deeply nested first, each type's
 // kill lists in their order, then its frozen rows whose readers all went.

@@ -10,6 +10,7 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include "rt/clock.h"
 #include "rt/emission.h"
 
 namespace psys::rt {
@@ -142,6 +143,29 @@ void Memory::gatherAlive(Buffer alive, Buffer to, size_t toFirst, Buffer rows, s
     const auto* a = static_cast<const uint8_t*>(view(alive));
     auto* out = static_cast<float*>(host(to)) + toFirst;
     for (size_t i = 0; i < count; ++i) out[i] = list[i] != kSkipRow && a[list[i]] ? 1.0f : 0.0f;
+}
+
+void Memory::gatherAge(Buffer created, Buffer frozenAt, Buffer alive, Buffer to, size_t toFirst, Buffer rows,
+                       size_t rowsFirst, size_t count, double now, Buffer nowRows, size_t nowFirst) {
+    if (count == 0) return;
+    const auto* list = static_cast<const uint32_t*>(view(rows)) + rowsFirst;
+    const auto* c = static_cast<const double*>(view(created));
+    const auto* d = static_cast<const double*>(view(frozenAt));
+    const auto* a = static_cast<const uint8_t*>(view(alive));
+    const auto* at = nowRows.valid() ? static_cast<const double*>(view(nowRows)) + nowFirst : nullptr;
+    auto* out = static_cast<float*>(host(to)) + toFirst;
+    for (size_t i = 0; i < count; ++i) {
+        uint32_t p = list[i];
+        out[i] = p == kSkipRow ? 0.0f : ageAt(a[p] ? (at ? at[i] : now) : d[p], c[p]);
+    }
+}
+
+void Memory::stampDeaths(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, Buffer frozenAt,
+                         double t1, double dt, Buffer created) {
+    auto* d = static_cast<double*>(host(frozenAt));
+    const auto* c = created.valid() ? static_cast<const double*>(view(created)) : nullptr;
+    eachKilled(*this, killed, killedAt, base, map, mapFirst,
+               [&](uint32_t, uint32_t row) { d[row] = c ? t1 - (t1 - c[row]) : t1 - dt; });
 }
 
 void Memory::survivors(Buffer mask, Buffer killed, Buffer out, size_t first, size_t count) {

@@ -212,6 +212,18 @@ public:
     // as 1 or 0 (a child's `parent.alive`).
     virtual void gatherThrough(Buffer from, Buffer to, size_t toFirst, Buffer rows, size_t rowsFirst, size_t count);
     virtual void gatherAlive(Buffer alive, Buffer to, size_t toFirst, Buffer rows, size_t rowsFirst, size_t count);
+    // A child's `parent.age` through its `parents` rows: to[toFirst + i] = ageAt(clock,
+    // created[p]) (rt/clock.h) for p = rows[rowsFirst + i], the clock `now` — or
+    // nowRows[nowFirst + i] where given (a batch's per-row clocks) — where the parent is
+    // alive, else its death's (frozenAt[p], f64: the time of its last values); 0 where p
+    // is kSkipRow.
+    virtual void gatherAge(Buffer created, Buffer frozenAt, Buffer alive, Buffer to, size_t toFirst, Buffer rows,
+                           size_t rowsFirst, size_t count, double now, Buffer nowRows, size_t nowFirst);
+    // A parent pool's kill list (as releaseRows reads it): each row's death, the time of its
+    // last values, into frozenAt — t1 − dt, or t1 − (t1 − created[row]) where `created` is
+    // given (a batch's first update, from each object's creation), as the host computes it.
+    virtual void stampDeaths(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst,
+                             Buffer frozenAt, double t1, double dt, Buffer created);
     // out[first + i] = mask[first + i] && !killed[first + i] (u8): the rows an update left
     // alive, whose exports it computes.
     virtual void survivors(Buffer mask, Buffer killed, Buffer out, size_t first, size_t count);

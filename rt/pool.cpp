@@ -125,7 +125,7 @@ size_t Pool::rowBytes(const ir::Object& object) {
 }
 
 Pool::Pool(Pool&& other) noexcept
-    : created(other.created), ids(other.ids), parentRows(other.parentRows), updatable(std::move(other.updatable)), alive(std::move(other.alive)), state(std::move(other.state)),
+    : created(other.created), ids(other.ids), parentRows(other.parentRows), frozenAt(other.frozenAt), updatable(std::move(other.updatable)), alive(std::move(other.alive)), state(std::move(other.state)),
       params(std::move(other.params)), exports(std::move(other.exports)), folds(std::move(other.folds)),
       foldRows(other.foldRows), paramColumn(std::move(other.paramColumn)),
       parent(std::move(other.parent)), readers(std::move(other.readers)), diedAt(std::move(other.diedAt)),
@@ -150,7 +150,7 @@ Pool::~Pool() {
     params.release(*memory_);
     exports.release(*memory_);
     folds.release(*memory_);
-    for (Buffer b : {rows_.stack, rows_.generation, rows_.counters, rows_.readers, rows_.waiting, parentRows})
+    for (Buffer b : {rows_.stack, rows_.generation, rows_.counters, rows_.readers, rows_.waiting, parentRows, frozenAt})
         if (b.valid()) memory_->release(b);
     for (const FreshRows& f : freshRows_) memory_->release(f.rows);
     for (Buffer b : spare_) memory_->release(b);
@@ -159,7 +159,7 @@ Pool::~Pool() {
 void Pool::grow(size_t n) {
     if (inMemory_) {
         highWater_ = n;
-        for (Buffer b : {rows_.stack, rows_.generation, rows_.readers, rows_.waiting, parentRows})
+        for (Buffer b : {rows_.stack, rows_.generation, rows_.readers, rows_.waiting, parentRows, frozenAt})
             if (b.valid()) memory_->resize(b, n);
     } else {
         status_.resize(n, Status::Free);
@@ -244,6 +244,7 @@ void Pool::keepRowsInMemory(bool child, bool read) {
     if (read) {
         rows_.readers = memory_->create(Elem::U32, rows());
         rows_.waiting = memory_->create(Elem::U8, rows());
+        frozenAt = memory_->create(Elem::F64, rows());
     }
     if (child) parentRows = memory_->create(Elem::U32, rows());
     restoreInMemory();  // what the host has so far (nothing, before the first object)
@@ -445,7 +446,7 @@ void Pool::uploadRows() {
 void Pool::writeRows() {
     highWater_ = status_.size();
     top_ = freeRows_.size();
-    for (Buffer b : {rows_.stack, rows_.generation, rows_.readers, rows_.waiting, parentRows})
+    for (Buffer b : {rows_.stack, rows_.generation, rows_.readers, rows_.waiting, parentRows, frozenAt})
         if (b.valid()) memory_->resize(b, highWater_);
     if (top_) memory_->write(rows_.stack, 0, top_, freeRows_.data());
     if (highWater_) memory_->write(rows_.generation, 0, highWater_, generation_.data());
@@ -463,6 +464,7 @@ void Pool::writeRows() {
     if (highWater_ && rows_.waiting.valid()) {
         memory_->write(rows_.waiting, 0, highWater_, waiting.data());
         memory_->write(rows_.readers, 0, highWater_, readers.data());
+        memory_->write(frozenAt, 0, highWater_, diedAt.data());
     }
     if (highWater_ && parentRows.valid()) memory_->write(parentRows, 0, highWater_, parents.data());
     alive.restore(*memory_, std::move(isAlive));

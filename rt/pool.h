@@ -9,11 +9,13 @@
 // drawn, its exports kept) until its last reader is gone.
 //
 // A pool may keep its rows in the memory of its columns instead (keepRowsInMemory: the
-// objects of a type that only die, on a device): the free stack, the generations and the
-// masks are buffers there, changed by the memory's operations (rt::Memory::allocateRows),
-// and the host keeps the counts — the stack's top, the high-water mark, the live count —
-// which are all a step needs. The rows' statuses, generations and free stack are read
-// back when asked (tests, hot reload), not kept on the host.
+// objects of a type that only die, emitters whose emissions the memory decides, children
+// and their parents, on a device): the free stack, the generations and the masks are
+// buffers there — and a child's parent rows, a parent's readers and frozen rows —
+// changed by the memory's operations (rt::Memory::allocateRows), and the host keeps the
+// counts — the stack's top, the high-water mark, the live count — which are all a step
+// needs. The rows' statuses, generations, free stack and parents are read back when
+// asked (tests, hot reload), not kept on the host.
 #pragma once
 
 #include <cstdint>
@@ -175,6 +177,7 @@ public:
     // Columns in the backend's memory.
     Buffer created, ids;             // f64, u32
     Buffer parentRows;               // u32: a child's parent's row, where both keep their rows in the memory
+    Buffer frozenAt;                 // f64: such a parent's death (diedAt), where its children read its age
     // u8 masks, kept by the host and synced (syncMasks) before a launch over the pool:
     // `updatable`, the rows a step updates (alive, not created during it); `alive`, the
     // rows alive (what is drawn is among them).
@@ -194,7 +197,8 @@ public:
     size_t foldRows = 0;
     std::vector<int> paramColumn;    // per parameter: its value in `params`, or -1
 
-    // Host bookkeeping.
+    // Host bookkeeping (where the rows are in the memory, parentRows and
+    // PoolRows::readers hold the parents and readers; these are a reload's copies).
     std::vector<Handle> parent;
     std::vector<uint32_t> readers;   // children that read this object live
     std::vector<double> diedAt;      // a frozen object's time of its last values

@@ -71,12 +71,7 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     std::vector<std::pair<Buffer, Buffer>> columns = identityColumns(type, table);
     if (pool.parentRows.valid()) columns.push_back({parentsOf(type, b, n, kept), pool.parentRows});
     memory.scatter(columns, first, rows, 0, kept);
-    if (pool.parentRows.valid()) {  // (their parents' values as the parents are now: the step's)
-        Buffer parents = b.columns.at(kParents, Elem::U32, first + n);
-        if (info.init) s_.gatherThrough(type, b.initLayout, b.initTable, parents, first, first, first + n);
-        s_.gatherThrough(type, info.updateLayout, table, parents, first, first, first + n);
-        if (info.exports) s_.gatherThrough(type, info.exportsLayout, b.exportsTable, parents, first, first, first + n);
-    }
+
     for (size_t s : info.zeroedState)  // (what init sets is not)
         for (int c = 0; c < o.state[s].type.width; ++c)
             memory.clear(table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)], first, n);
@@ -107,6 +102,9 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
             break;
         }
     LateKills late;
+    late.type = type;
+    late.t1 = t1;
+    late.first = first;
     if (info.late) {
         late.map = rows;  // (released through it at a step's end: Ledger::releaseInMemory)
         pool.holdRows(rows);
@@ -158,9 +156,6 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     }
     memory.scatter(columns, first, rows, 0, kept);
     if (!info.late) return;
-    late.type = type;
-    late.t1 = t1;
-    late.first = first;
     s_.ledger.defer(std::move(late));
 }
 
@@ -308,6 +303,9 @@ void Creation::launchInMemory(size_t type, Batch& b, size_t n, const ir::Kernel&
     launch.seed = s_.options.seed;
     launch.draw = clock.first ? kCreationDraw : static_cast<uint32_t>(s_.step);
     launch.emissionsStay = s_.types[type].updateEmits;
+    if (s_.pools[type].parentRows.valid())  // its parents' values as they are now, at the launch's clock
+        s_.gatherThrough(type, layout, table, b.columns.at(kParents, Elem::U32, end), first, first, end, clock.nowValue,
+                         clock.now == Clock::Source::PerRow ? table[ColumnLayout::kNow] : Buffer{});
     if (late) {
         size_t per = s_.backend.chunkRows(), chunks = s_.chunkCount(n);
         late->parts.resize(chunks);

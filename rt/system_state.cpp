@@ -135,9 +135,10 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     // (docs/gpu.md, "Emitters in the memory").
     // Children in the memory beside their parents: a nested type that nobody reads and
     // that emits nothing, whose kills are late or who never dies (as a type that only dies),
-    // created whole in a batch, reading of its parent (one level up) only its exports and
-    // whether it is alive — its parent type's rows in the memory too (below), so that the
-    // parents' rows, readers and frozen objects are the memory's (Memory::releaseUnread).
+    // created whole in a batch, reading of its parent (one level up) only its exports,
+    // whether it is alive and its age — its parent type's rows in the memory too (below), so
+    // that the parents' rows, readers and frozen objects are the memory's
+    // (Memory::releaseUnread).
     // Its parent type is then such an emitter with no parent of its own, every type that
     // reads it such a child, its exports read by nobody else (no fold).
     std::vector<bool> folded(types.size(), false);
@@ -145,7 +146,8 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         for (const ir::NeighbourGroup& g : o.neighbours) folded[static_cast<size_t>(module.objectIndex(g.target))] = true;
     auto readsLikeAChild = [&](const ColumnLayout& layout) {
         return std::all_of(layout.parentColumns.begin(), layout.parentColumns.end(), [](const ColumnLayout::ParentColumn& p) {
-            return p.op == ir::Op::Fold || (p.depth == 1 && (p.op == ir::Op::ParentExport || p.op == ir::Op::ParentAlive));
+            return p.op == ir::Op::Fold || (p.depth == 1 && (p.op == ir::Op::ParentExport || p.op == ir::Op::ParentAlive ||
+                                                             p.op == ir::Op::ParentAge));
         });
     };
     std::vector<bool> child(types.size(), false);
@@ -288,7 +290,7 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
                           size_t poolRowsFirst) {
     if (layout.parentColumns.empty() || end <= begin) return;
     if (pools[type].parentRows.valid() && !poolRows)  // a pool's launch: its parents' rows where they are
-        gatherThrough(type, layout, table, pools[type].parentRows, begin, begin, end);
+        gatherThrough(type, layout, table, pools[type].parentRows, begin, begin, end, at);
     std::vector<uint32_t> rows(end - begin);
     std::vector<float> values;
     int rowsDepth = -1;
@@ -354,6 +356,7 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
 void State::parentsToHost() {
     for (size_t t = 0; t < pools.size(); ++t) {
         Pool& pool = pools[t];
+        if (pool.frozenAt.valid() && pool.rows() > 0) memory.read(pool.frozenAt, 0, pool.rows(), pool.diedAt.data());
         if (!pool.parentRows.valid() || pool.rows() == 0) continue;
         const std::vector<uint32_t>& generation = pools[static_cast<size_t>(types[t].parentType)].generations();
         std::vector<uint32_t> rows(pool.rows());
@@ -364,12 +367,15 @@ void State::parentsToHost() {
 }
 
 void State::gatherThrough(size_t type, const ColumnLayout& layout, std::span<const Buffer> table, Buffer parents,
-                          size_t parentsFirst, size_t begin, size_t end) {
+                          size_t parentsFirst, size_t begin, size_t end, double at, Buffer atRows) {
     const Pool& parent = pools[static_cast<size_t>(types[type].parentType)];
     for (const auto& p : layout.parentColumns) {
         if (p.op == ir::Op::ParentAlive)
             memory.gatherAlive(parent.alive.column, table[static_cast<size_t>(p.offset)], begin, parents, parentsFirst,
                                end - begin);
+        if (p.op == ir::Op::ParentAge)
+            memory.gatherAge(parent.created, parent.frozenAt, parent.alive.column, table[static_cast<size_t>(p.offset)],
+                             begin, parents, parentsFirst, end - begin, at, atRows, begin);
         if (p.op != ir::Op::ParentExport) continue;  // (folds: gatherParents', emptyFolds')
         for (int c = 0; c < p.width; ++c)
             memory.gatherThrough(parent.exports.column(static_cast<size_t>(p.exportIndex), static_cast<size_t>(c)),

@@ -58,10 +58,10 @@ struct TypeInfo {
     // reads it, so no one looks at its dead before then.
     bool late = false;
     // Its pool keeps its rows in the memory (Pool::keepRowsInMemory): a type with no
-    // parent and no sub-steps whose kills are late, or that never dies — and emits
-    // nothing, or emits what the memory decides (Memory::emitAtRate: at a rate, in
-    // bursts at creation, on edges and on deaths; the State constructor,
-    // rt/system_state.cpp, says which).
+    // sub-steps whose kills are late, or that never dies — and emits nothing, or emits
+    // what the memory decides (Memory::emitAtRate: at a rate, in bursts at creation, on
+    // edges and on deaths) — with no parent, or a parent whose rows are there too (the
+    // State constructor, rt/system_state.cpp, says which).
     bool rowsInMemory = false;
     // The state slots a creation batch zeroes before init: those init does not set (every
     // one where there is no init, or where it reads the state).
@@ -160,9 +160,10 @@ struct State {
     void parentsToHost();
     // A child type's whose rows are in the memory beside its parents': rows [begin, end)
     // of its parent columns (but folds) through `parents` from row `parentsFirst` on, where
-    // they are (Memory::gatherThrough, gatherAlive).
+    // they are (Memory::gatherThrough, gatherAlive, gatherAge: at `at`, or atRows' row
+    // by row from `begin` — a batch's per-row clocks).
     void gatherThrough(size_t type, const ColumnLayout& layout, std::span<const Buffer> table, Buffer parents,
-                       size_t parentsFirst, size_t begin, size_t end);
+                       size_t parentsFirst, size_t begin, size_t end, double at, Buffer atRows = {});
     // The neighbour folds of a type's objects, for this step (rt/neighbours.cpp).
     void foldNeighbours(size_t type);
     void foldOnHost(const FoldLaunch& launch);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "gpu_support.h"
+#include "rt/clock.h"
 #include "rt/memory.h"
 
 using namespace psys;
@@ -183,7 +184,7 @@ TEST_CASE("parents and their readers: the GPU frees and freezes the rows the hos
     CHECK(counters[1] > 50);    // and still frozen for their children
 }
 
-TEST_CASE("a child's parents: from the records, their values and whether they are alive, on the GPU as on the host") {
+TEST_CASE("a child's parents: from the records, their values, whether they are alive and their ages, on the GPU as on the host") {
     auto gpu = gpuBackend();
     rt::HostMemory hostMemory;
     // Records of 3 sites a row over 40 emitter rows (a batch's: through a map), each asking
@@ -204,12 +205,19 @@ TEST_CASE("a child's parents: from the records, their values and whether they ar
     std::vector<float> exported(200);
     for (float& v : exported) v = static_cast<float>(random() % 1000) / 7.0f;
     std::vector<uint8_t> alive(200), mask(objects), killed(objects);
+    std::vector<double> createdAt(200), childClocks(objects);
+    for (double& c : createdAt) c = 7.25 - static_cast<double>(random() % 100000) / 3e4;
+    for (double& c : childClocks) c = 7.25 - static_cast<double>(random() % 1000) / 7e3;
+    std::vector<uint32_t> dying{0}, dyingFirst{0};  // the dead parents (alive 0), in two kill lists
+    for (uint32_t p = 0; p < 200; ++p) (p % 2 ? dying : dyingFirst).push_back(p);
+    dying[0] = static_cast<uint32_t>(dying.size() - 1);
+    dyingFirst[0] = static_cast<uint32_t>(dyingFirst.size() - 1);
     for (uint8_t& a : alive) a = random() % 2;
     for (uint8_t& m : mask) m = random() % 4 != 0;
     for (uint8_t& k : killed) k = random() % 3 == 0;
     struct Out {
         std::vector<uint32_t> parents, readers;
-        std::vector<float> values, isAlive;
+        std::vector<float> values, isAlive, ages, agesPerRow;
         std::vector<uint8_t> survivors;
     } out[2];
     int which = 0;
@@ -229,6 +237,19 @@ TEST_CASE("a child's parents: from the records, their values and whether they ar
         m->parentsFromRecords(r, 0, kEmitters * kStride, kStride, through, 0, objects, objects - 9, parents, 7, readers);
         m->gatherThrough(from, values, 7, parents, 7, objects);
         m->gatherAlive(a, isAlive, 7, parents, 7, objects);
+        // Ages: the parents' creation times, their deaths stamped from a kill list (half at a
+        // uniform time, half from their creation), at a uniform clock and at per-row ones.
+        rt::Buffer created = m->create(rt::Elem::F64, 200), frozenAt = m->create(rt::Elem::F64, 200),
+                   clocks = m->create(rt::Elem::F64, objects + 7), list = m->create(rt::Elem::U32, 201);
+        m->write(created, 0, 200, createdAt.data());
+        m->write(clocks, 7, objects, childClocks.data());
+        m->write(list, 0, dying.size(), dying.data());
+        m->stampDeaths(list, 0, 0, {}, 0, frozenAt, 7.25, 1.0 / 60, {});
+        m->write(list, 0, dyingFirst.size(), dyingFirst.data());
+        m->stampDeaths(list, 0, 0, {}, 0, frozenAt, 7.25, 0, created);
+        rt::Buffer ages = m->create(rt::Elem::F32, objects + 7), agesPerRow = m->create(rt::Elem::F32, objects + 7);
+        m->gatherAge(created, frozenAt, a, ages, 7, parents, 7, objects, 7.25, {}, 0);
+        m->gatherAge(created, frozenAt, a, agesPerRow, 7, parents, 7, objects, 0, clocks, 7);
         m->survivors(ma, k, s, 0, objects);
         Out& o = out[which++];
         o.parents.resize(objects);
@@ -241,6 +262,10 @@ TEST_CASE("a child's parents: from the records, their values and whether they ar
         m->read(values, 7, objects, o.values.data());
         m->read(isAlive, 7, objects, o.isAlive.data());
         m->read(s, 0, objects, o.survivors.data());
+        o.ages.resize(objects);
+        o.agesPerRow.resize(objects);
+        m->read(ages, 7, objects, o.ages.data());
+        m->read(agesPerRow, 7, objects, o.agesPerRow.data());
     }
     // The host's, against the records by hand: object r of emitter row j's records.
     uint32_t r = 0;
@@ -251,6 +276,10 @@ TEST_CASE("a child's parents: from the records, their values and whether they ar
             if (r < objects - 9) ++readers[map[j / kStride]];
             CHECK(out[0].values[r] == exported[map[j / kStride]]);
             CHECK(out[0].isAlive[r] == (alive[map[j / kStride]] ? 1.0f : 0.0f));
+            uint32_t p = map[j / kStride];
+            double died = p % 2 ? 7.25 - 1.0 / 60 : 7.25 - (7.25 - createdAt[p]);
+            CHECK(out[0].ages[r] == rt::ageAt(alive[p] ? 7.25 : died, createdAt[p]));
+            CHECK(out[0].agesPerRow[r] == rt::ageAt(alive[p] ? childClocks[r] : died, createdAt[p]));
         }
     CHECK(out[0].readers == readers);
     CHECK(out[0].parents == out[1].parents);
@@ -258,6 +287,8 @@ TEST_CASE("a child's parents: from the records, their values and whether they ar
     CHECK(out[0].values == out[1].values);
     CHECK(out[0].isAlive == out[1].isAlive);
     CHECK(out[0].survivors == out[1].survivors);
+    CHECK(out[0].ages == out[1].ages);
+    CHECK(out[0].agesPerRow == out[1].agesPerRow);
     for (uint32_t i = 0; i < objects; ++i) CHECK(out[0].survivors[i] == (mask[i] && !killed[i]));
 }
 
@@ -409,8 +440,9 @@ TEST_CASE("a pool of objects that only die keeps its rows on the GPU: what a ste
 }
 
 TEST_CASE("children and the parents they read keep their rows on the GPU: frozen parents freed there, nothing grows") {
-    // The comet's tail reads the comet live and after its death (frozen); comets die at
-    // random ages beside their tails, burst on death, and a launcher makes more. Both
+    // The comet's tail reads the comet — its position, whether it is alive, its age — live
+    // and after its death (frozen); comets die at random ages beside their tails, burst on
+    // death, and a launcher makes more. Both
     // types keep their rows in the memory: against the interpreter object for object, row
     // for row; the frozen comets freed on the GPU once their last tail is.
     const char* comets = R"(
@@ -424,7 +456,7 @@ TEST_CASE("children and the parents they read keep their rows on the GPU: frozen
             @capacity(300)
             object tail(offset: vec3) {
                 pos = comet.pos + offset * (1 + age);
-                sprite(pos, vec4(0.6, 0.8, comet.alive ? 1 : 0, clamp(1 - age / 2)), 0.15);
+                sprite(pos, vec4(0.6, 0.8, comet.alive ? 1 : 0, clamp(1 - age / 2)), 0.15 + comet.age * 0.01);
                 kill when age > 0.2 + rand() * 3 || (!comet.alive && age > 1);
             }
         }
