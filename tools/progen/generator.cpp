@@ -268,10 +268,13 @@ private:
             for (int i = 0; i < n; ++i) t.emits.push_back(emitTo(index, child));
         }
         // (A flat program's types emit only those after them: chains that end in types
-        // emitting nothing, as the memory's emitters need.)
+        // emitting nothing, as the memory's emitters need. A nested type with no children
+        // emits less often: children that emit nothing, their parents emitters, keep their
+        // rows in the memory too.)
         std::vector<int> targets = tops();
         if (flat_) std::erase_if(targets, [&](int o) { return o <= index; });
-        if (!targets.empty() && r_.chance(flat_ ? 0.8 : 0.4)) {
+        bool leaf = t.parent >= 0 && t.children.empty();
+        if (!targets.empty() && r_.chance(flat_ ? 0.8 : leaf ? 0.15 : 0.4)) {
             t.emits.push_back(emitTo(index, r_.pick(targets)));
             // Half of the top-level types that have no children of their own (emitters
             // whose emissions the memory may decide) one or two more, so that sites share
