@@ -136,8 +136,9 @@ TEST_CASE("a frozen parent is freed after its last reader dies") {
 
 // The rule of the step's end (rt/ledger.h): a type's deaths freed in the order they came,
 // the children's before their parents' — whatever the order of their kills in the step.
-TEST_CASE("a parent dying beside its last reader is freed in its own place among its type's deaths") {
-    Run run(R"(
+// Parents of given lives, each with one child of a given life that reads it, and a
+// trigger that makes more: which rows the trigger's take tells the free stack's order.
+constexpr const char* kParentsAndReaders = R"(
         object p(life: float, childLife: float) {
             emit c(childLife) count 1;
             kill when age > life;
@@ -147,9 +148,12 @@ TEST_CASE("a parent dying beside its last reader is freed in its own place among
                 kill when age > l;
             }
         }
+        trigger again(life: float) { emit p(life, 0.1) count 1; })";
+
+TEST_CASE("a parent dying beside its last reader is freed in its own place among its type's deaths") {
+    Run run(std::string(kParentsAndReaders) + R"(
         spawn p(1.1, 1.1);  // row 0: dies at 1.25 s, its child in the same step (after it)
-        spawn p(1.1, 0.1);  // row 1: its child gone at 0.25 s; dies at 1.25 s, read by nobody
-        trigger again(life: float) { emit p(life, 0.1) count 1; })");
+        spawn p(1.1, 0.1);  // row 1: its child gone at 0.25 s; dies at 1.25 s, read by nobody)");
     run.steps(5, 0.25);
     CHECK(run.stats("p").live == 0);
     CHECK(run.stats("p").frozen == 0);
@@ -168,20 +172,10 @@ TEST_CASE("a parent dying beside its last reader is freed in its own place among
 // …and a parent that died before, whose last reader goes now: after its type's deaths of
 // the step, in row order.
 TEST_CASE("parents whose last readers go in one step are freed after that step's deaths of their type, in row order") {
-    Run run(R"(
-        object p(life: float, childLife: float) {
-            emit c(childLife) count 1;
-            kill when age > life;
-            point(vec3(life, childLife, 0), white, 1);
-            object c(l: float) {
-                point(vec3(p.age, 0, 1), white, 1);
-                kill when age > l;
-            }
-        }
+    Run run(std::string(kParentsAndReaders) + R"(
         spawn p(0.1, 1.1);  // row 0: frozen at 0.25 s, its child dies at 1.25 s
         spawn p(0.1, 1.1);  // row 1: the same
-        spawn p(1.1, 0.1);  // row 2: dies at 1.25 s, its child long gone
-        trigger again(life: float) { emit p(life, 0.1) count 1; })");
+        spawn p(1.1, 0.1);  // row 2: dies at 1.25 s, its child long gone)");
     run.steps(5, 0.25);
     CHECK(run.stats("p").frozen == 0);
     // The stack: row 2 (its own death), then rows 0 and 1 (their readers gone): a trigger's

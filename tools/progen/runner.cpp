@@ -108,7 +108,10 @@ public:
             auto module = compile(c_.source, config.backend == "llvm" && !config.exact, !c_.edit.empty(), error);
             if (!module) return Finding{config.label, "compile", -1, error};
             rt::SystemOptions systemOptions;
-            if (config.rowsInMemory) systemOptions.rows = rt::SystemOptions::Rows::InMemory;
+            if (config.rowsInMemory) {  // (drawn after the step, as the GPU draws: a type drawn as the
+                systemOptions.rows = rt::SystemOptions::Rows::InMemory;  // step goes keeps its rows on the host)
+                systemOptions.drawInStep = false;
+            }
             side.system = std::make_unique<rt::System>(std::move(*module), *side.backend, systemOptions);
             if (config.threads) side.system->setThreads(config.threads);
             sides_.push_back(std::move(side));

@@ -137,8 +137,9 @@ void addRunOptions(CLI::App& run, psys::tools::RunOptions& o) {
         ->check(CLI::Range(0u, psys::rt::SystemOptions::kMostThreads));
     run.add_option("--rows", o.rows,
                    "Where pools keep their rows: backend (as the backend keeps them, the default: glsl in the "
-                   "GPU's memory wherever a type can, emitters whose emissions the memory decides among them), "
-                   "memory (so on any backend) or host")
+                   "GPU's memory wherever a type can, emitters whose emissions the memory decides and children "
+                   "with their parents among them), memory (so on any backend, drawing after each step as the "
+                   "GPU does) or host")
         ->check(CLI::IsMember({"backend", "memory", "host"}));
     run.add_flag("--timing", o.timing, "Print compile time and the time spent stepping and drawing");
     run.add_flag("--print-schedule", o.printSchedule, "Print the phases a step runs, in order, and run no frame");

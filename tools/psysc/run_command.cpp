@@ -167,6 +167,9 @@ int runSystem(const RunOptions& options) {
     session.system.threads = options.threads;
     using Rows = rt::SystemOptions::Rows;
     session.system.rows = options.rows == "memory" ? Rows::InMemory : options.rows == "host" ? Rows::OnHost : Rows::AsBackend;
+    // (A type drawn as the step goes keeps its rows on the host: where the rows are asked
+    // for in the memory, the CPU backends draw after the step, as the GPU does.)
+    if (options.rows == "memory") session.system.drawInStep = false;
     session.reloadable = false;  // a run never reloads
     host::CompileResult compiled;
     std::string error;
