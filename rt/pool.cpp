@@ -133,6 +133,7 @@ Pool::Pool(Pool&& other) noexcept
       status_(std::move(other.status_)), generation_(std::move(other.generation_)),
       freeRows_(std::move(other.freeRows_)), live_(other.live_), frozen_(other.frozen_), inMemory_(other.inMemory_),
       rows_(other.rows_), top_(other.top_), highWater_(other.highWater_), uncounted_(other.uncounted_),
+      countPending_(other.countPending_),
       freshRows_(std::move(other.freshRows_)), spare_(std::move(other.spare_)), held_(std::move(other.held_)),
       version_(other.version_),
       fetched_(other.fetched_), mask_(std::move(other.mask_)) {

@@ -302,7 +302,8 @@ void Creation::launchInMemory(size_t type, Batch& b, size_t n, const ir::Kernel&
     launch.uniformKernel = s_.uniformKernel(type, kernel);
     launch.seed = s_.options.seed;
     launch.draw = clock.first ? kCreationDraw : static_cast<uint32_t>(s_.step);
-    launch.emissionsStay = s_.types[type].updateEmits;
+    const TypeInfo& info = s_.types[type];
+    launch.emissionsStay = info.updateEmits || (info.kills && info.exports);  // (as runUpdate's)
     if (s_.pools[type].parentRows.valid())  // its parents' values as they are now, at the launch's clock
         s_.gatherThrough(type, layout, table, b.columns.at(kParents, Elem::U32, end), first, first, end, clock.nowValue,
                          clock.now == Clock::Source::PerRow ? table[ColumnLayout::kNow] : Buffer{});

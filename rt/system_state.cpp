@@ -289,8 +289,11 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
                           size_t begin, size_t end, double at, const double* atRows, const uint32_t* poolRows,
                           size_t poolRowsFirst) {
     if (layout.parentColumns.empty() || end <= begin) return;
-    if (pools[type].parentRows.valid() && !poolRows)  // a pool's launch: its parents' rows where they are
-        gatherThrough(type, layout, table, pools[type].parentRows, begin, begin, end, at);
+    // A pool's launch: its parents' rows where they are (per-row clocks: a reload's, at
+    // each object's creation, its pool's created column).
+    if (pools[type].parentRows.valid() && !poolRows)
+        gatherThrough(type, layout, table, pools[type].parentRows, begin, begin, end, at,
+                      atRows ? pools[type].created : Buffer{});
     std::vector<uint32_t> rows(end - begin);
     std::vector<float> values;
     int rowsDepth = -1;

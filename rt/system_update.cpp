@@ -156,7 +156,9 @@ void runUpdate(State& s, const Phase& phase, double dt, double t1, bool last) {
         return;
     }
     RowsLaunch update = poolUpdate(s, type, dt, t1);
-    update.emissionsStay = phase.inMemory && info.updateEmits;
+    // (What the memory reads of the update stays there: its emissions, and the kill flags
+    // of a type whose survivors' exports it computes.)
+    update.emissionsStay = phase.inMemory && (info.updateEmits || (info.kills && info.exports));
     // (Where the rows are in the memory, nothing here reads the mask: its parents' rows
     // are there too, no drawing as the step goes, its folds copied, and its kills late —
     // its exports those of the survivors there.)

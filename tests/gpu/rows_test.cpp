@@ -478,6 +478,24 @@ TEST_CASE("children and the parents they read keep their rows on the GPU: frozen
     CHECK(p.stats("comet").created == 25);
     CHECK(p.stats("comet.tail").dropped > 0);  // (at its capacity)
     CHECK(p.stats("comet").live + p.stats("comet").frozen == 0);
+    // Parents that emit only in a burst at creation, and die: their update emits nothing,
+    // yet its kill flags must stay on the GPU for the exports of its survivors — a killed
+    // comet keeps the position of its last update before, for its tail.
+    test::Pair bursts(R"(
+        object comet {
+            pos = vec3(age * 3, sin(age * 5), 0);
+            emit tail count 3;
+            kill when age > 0.3 + rand();
+            object tail { point(comet.pos + vec3(0, age, 0), white, 1); kill when age > 2; }
+        }
+        object launcher { emit comet at 10 per second; kill when age > 2; }
+        spawn launcher;)");
+    CHECK(bursts.gl->pool(static_cast<size_t>(bursts.gl->typeIndex("comet"))).rowsInMemory());
+    for (int f = 0; f < 150; ++f) {
+        bursts.steps(1, 1.0 / 60);
+        bursts.compare();
+    }
+    CHECK(bursts.stats("comet").frozen > 0);
     // follow_parent at 30 and at 300 comets: the same bytes a step.
     auto perStep = [](int comets) {
         auto gpu = gpuBackend();

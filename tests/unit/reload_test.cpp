@@ -232,6 +232,40 @@ TEST_CASE("a reload keeps parents and children, frozen parents included") {
     }
 }
 
+TEST_CASE("a reload that adds a child's equation of its parent's age starts it at the child's creation, rows in the memory too") {
+    // The new slot's init runs at each carried child's creation time: its parent's age
+    // then — whether the children and parents keep their rows on the host or in the memory
+    // (the parent rows gathered there, at per-row clocks).
+    std::string old = "object comet { pos = vec3(age, 0, 0); emit tail count 2; kill when age > 3;\n"
+                      "  object tail { point(comet.pos + vec3(0, age, 0), white, 1); kill when age > 5; } }\n"
+                      "object launcher { emit comet at 4 per second; kill when age > 2; }\nspawn launcher;";
+    std::string added = "object comet { pos = vec3(age, 0, 0); emit tail count 2; kill when age > 3;\n"
+                        "  object tail { h = snapshot(comet.age);\n"
+                        "    point(comet.pos + vec3(0, age, h), white, 1); kill when age > 5; } }\n"
+                        "object launcher { emit comet at 4 per second; kill when age > 2; }\nspawn launcher;";
+    std::vector<std::vector<rt::RenderPoint>> drawn;
+    for (auto rows : {rt::SystemOptions::Rows::OnHost, rt::SystemOptions::Rows::InMemory}) {
+        rt::SystemOptions options;
+        options.rows = rows;
+        options.drawInStep = false;
+        interp::Interpreter backend;
+        rt::System before(compile(old), backend, options);
+        CHECK(before.pool(1).rowsInMemory() == (rows == rt::SystemOptions::Rows::InMemory));
+        run(before, 200);  // comets dead (frozen) and alive, tails of both
+        rt::System after(compile(added), backend, options);
+        after.carryOver(before);
+        REQUIRE_FALSE(after.step(0));
+        drawn.push_back(after.points(1));
+    }
+    REQUIRE(drawn[0].size() > 10);
+    REQUIRE(drawn[0].size() == drawn[1].size());
+    for (size_t i = 0; i < drawn[0].size(); ++i) {
+        CHECK(drawn[0][i].id == drawn[1][i].id);
+        CHECK(drawn[0][i].position[2] == drawn[1][i].position[2]);  // h: the comet's age at the tail's creation
+        CHECK(drawn[0][i].position[2] >= 0);
+    }
+}
+
 TEST_CASE("a reload that removes a child type frees the frozen parents only it read") {
     std::string text = test::readFile(std::string(PSYS_SAMPLES_DIR) + "/follow_parent.psys");
     std::string childless = "object comet { pos = vec3(cos(age) * 5, 3 + sin(age * 2), sin(age) * 5);\n"
