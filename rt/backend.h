@@ -59,9 +59,10 @@ struct RowsLaunch {
     // them says so (RowsResult::killsListed); else the run-time lists them from the rows
     // it is given.
     Buffer killList;
-    // The update of a type whose emissions the memory decides (Memory::emitAtRate): its
-    // emission columns and its kill flags (what the decision reads) stay in the memory —
-    // a device does not send them back, and keeps the flags there besides any kill list.
+    // The update of a type whose emissions the memory decides (Memory::emitAtRate), or
+    // whose survivors' exports it computes (Memory::survivors): its emission columns and
+    // its kill flags (what they read) stay in the memory — a device does not send them
+    // back, and keeps the flags there besides any kill list.
     bool emissionsStay = false;
 };
 
