@@ -457,33 +457,13 @@ void GlMemory::gather(Buffer from, Buffer to, size_t toFirst, std::span<const ui
     flush(t);
     upload(f);
     upload(t);
-    if (!gatherProgram_) gatherProgram_ = computeProgram(rowsShader(kGather), "gather");
-    runRows(gatherProgram_, f.gl, t.gl, wordsPerRow(f.elem), toFirst, rows, "gather");
+    runRows(gatherProgram(), f.gl, t.gl, wordsPerRow(f.elem), toFirst, rows, "gather");
     t.device = true;
 }
 
-// The same through a list in a column (a child pool's parents), where the values are.
-void GlMemory::gatherThrough(Buffer from, Buffer to, size_t toFirst, Buffer rows, size_t rowsFirst, size_t count) {
-    if (count == 0) return;
-    Column &f = at(from), &t = at(to);
-    if (!f.device && !t.device && !onDevice(rows)) return rt::Memory::gatherThrough(from, to, toFirst, rows, rowsFirst, count);
-    flush(f);
-    flush(t);
-    upload(f);
-    upload(t);
-    unsigned list = deviceBuffer(rows);
+unsigned GlMemory::gatherProgram() {
     if (!gatherProgram_) gatherProgram_ = computeProgram(rowsShader(kGather), "gather");
-    PassTimer::Scope timed(timer, "gather", count);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.gl);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, t.gl);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, list);
-    glUseProgram(gatherProgram_);
-    bindParams(paramsBuffer_, {static_cast<uint32_t>(count), static_cast<uint32_t>(toFirst),
-                               static_cast<uint32_t>(wordsPerRow(f.elem)), static_cast<uint32_t>(rowsFirst)});
-    dispatchInvocations(count, 64);
-    ++dispatches;
-    afterWrite(Write::Dispatch, kColumnReaders);
-    t.device = true;
+    return gatherProgram_;
 }
 
 unsigned GlMemory::rowList(std::span<const uint32_t> rows) const {
@@ -503,15 +483,20 @@ unsigned GlMemory::rowList(std::span<const uint32_t> rows) const {
 // batch or a parent that uses it.
 void GlMemory::runRows(unsigned program, unsigned from, unsigned to, size_t w, size_t first,
                        std::span<const uint32_t> rows, const char* pass) const {
-    PassTimer::Scope timed(timer, pass, rows.size());
-    unsigned list = rowList(rows);
+    runRows(program, from, to, w, first, rowList(rows), 0, rows.size(), pass);
+}
+
+// The same over `count` rows of a list already in a GL buffer, from its word `rowsAt`.
+void GlMemory::runRows(unsigned program, unsigned from, unsigned to, size_t w, size_t first, unsigned list,
+                       size_t rowsAt, size_t count, const char* pass) const {
+    PassTimer::Scope timed(timer, pass, count);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, from);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, to);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, list);
     glUseProgram(program);
-    bindParams(paramsBuffer_, {static_cast<uint32_t>(rows.size()), static_cast<uint32_t>(first),
-                               static_cast<uint32_t>(w), 0u});
-    dispatchInvocations(rows.size(), 64);
+    bindParams(paramsBuffer_, {static_cast<uint32_t>(count), static_cast<uint32_t>(first), static_cast<uint32_t>(w),
+                               static_cast<uint32_t>(rowsAt)});
+    dispatchInvocations(count, 64);
     ++dispatches;
     afterWrite(Write::Dispatch, kColumnReaders);  // into a column: any reader may follow
 }

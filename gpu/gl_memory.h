@@ -53,8 +53,8 @@ public:
                   rt::Buffer mask, size_t first) override;
     void identifyRecords(rt::Buffer runs, size_t firstRecord, size_t records, size_t objects, rt::Buffer created,
                          rt::Buffer ids, size_t first) override;
-    // Parents and their children on the GPU (gpu/gl_parents.cpp; parentsFromRecords and
-    // gatherThrough beside identifyRecords and gather).
+    // Parents and their children on the GPU (gpu/gl_parents.cpp; parentsFromRecords
+    // beside identifyRecords in gpu/gl_rows.cpp).
     void parentsFromRecords(rt::Buffer runs, size_t firstRecord, size_t records, size_t stride, rt::Buffer map,
                             size_t mapFirst, size_t objects, size_t kept, rt::Buffer parents, size_t first,
                             rt::Buffer readers) override;
@@ -142,6 +142,9 @@ private:
     std::vector<uint32_t> free_;
     void runRows(unsigned program, unsigned from, unsigned to, size_t w, size_t first,
                  std::span<const uint32_t> rows, const char* pass) const;
+    void runRows(unsigned program, unsigned from, unsigned to, size_t w, size_t first, unsigned list, size_t rowsAt,
+                 size_t count, const char* pass) const;
+    unsigned gatherProgram();  // (gather's, gatherThrough's: made on first use)
     void flush(Column& c) const;  // its pending rows to the GPU
     // A column an operation is about to write whole (its output, what it held not kept):
     // on the host, its value becomes the host copy's without a read-back; on the GPU, the

@@ -203,6 +203,20 @@ constexpr uint32_t kGrid = 64 * 1024;
 
 }  // namespace
 
+// The same through a list in a column (a child pool's parents), where the values are.
+void GlMemory::gatherThrough(Buffer from, Buffer to, size_t toFirst, Buffer rows, size_t rowsFirst, size_t count) {
+    if (count == 0) return;
+    Column &f = at(from), &t = at(to);
+    if (!f.device && !t.device && !onDevice(rows)) return rt::Memory::gatherThrough(from, to, toFirst, rows, rowsFirst, count);
+    for (Column* c : {&f, &t}) {
+        flush(*c);
+        upload(*c);
+    }
+    unsigned list = deviceBuffer(rows);
+    runRows(gatherProgram(), f.gl, t.gl, wordsPerRow(f.elem), toFirst, list, rowsFirst, count, "gather");
+    t.device = true;
+}
+
 void GlMemory::gatherAlive(Buffer alive, Buffer to, size_t toFirst, Buffer rows, size_t rowsFirst, size_t count) {
     if (count == 0) return;
     if (!onDevice(rows) && allOnHost({alive, to}))
