@@ -1,8 +1,7 @@
 #include "rt/pool.h"
 
-#include <array>
-
 #include <algorithm>
+#include <array>
 #include <stdexcept>
 
 #include "core/fold.h"
