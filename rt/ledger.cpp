@@ -71,6 +71,13 @@ RowsResult Ledger::collect(size_t type, LateKills::Part& part) {
     return result;
 }
 
+// Where a part's kill list points (Memory::releaseRows' base and map): launch row r is
+// pool row part.begin + r, or a batch's map[part.begin − first + r].
+std::pair<uint32_t, size_t> Ledger::listRows(const LateKills& l, const LateKills::Part& part) {
+    if (l.map.valid()) return {0, part.begin - l.first};
+    return {static_cast<uint32_t>(part.begin), 0};
+}
+
 void Ledger::listInMemory(LateKills& l, bool aliveOnly) {
     Pool& pool = s_.pools[l.type];
     PoolRows masks = pool.memoryRows();
@@ -85,8 +92,10 @@ void Ledger::listInMemory(LateKills& l, bool aliveOnly) {
         s_.typeStats[l.type].killed += rows.size();
         part.listed = part.counted = true;
         part.count = rows.size();
-        if (!rows.empty() && !s_.backend.clearsKilled())
-            s_.memory.clearRows(masks, part.killList, 0, static_cast<uint32_t>(part.begin), l.map, part.begin - l.first);
+        if (!rows.empty() && !s_.backend.clearsKilled()) {
+            auto [base, mapFirst] = listRows(l, part);
+            s_.memory.clearRows(masks, part.killList, 0, base, l.map, mapFirst);
+        }
     }
 }
 
@@ -99,8 +108,7 @@ void Ledger::listNow(LateKills& l) {
     if (!pool.frozenAt.valid()) return;
     for (const LateKills::Part& part : l.parts) {  // (the time of their last values: children read their age)
         if (!part.killList.valid() || (part.counted && part.count == 0)) continue;
-        uint32_t base = l.map.valid() ? 0 : static_cast<uint32_t>(part.begin);
-        size_t mapFirst = l.map.valid() ? part.begin - l.first : 0;
+        auto [base, mapFirst] = listRows(l, part);
         s_.memory.stampDeaths(part.killList, 0, base, l.map, mapFirst, pool.frozenAt, l.t1, l.dt,
                               l.map.valid() ? pool.created : Buffer{});
     }
@@ -129,8 +137,7 @@ void Ledger::releaseInMemory(LateKills& l) {
         if (!part.killList.valid()) continue;
         bool none = part.counted && part.count == 0;  // listed here, nothing to free
         if (!none) {
-            uint32_t base = l.map.valid() ? 0 : static_cast<uint32_t>(part.begin);
-            size_t mapFirst = l.map.valid() ? part.begin - l.first : 0;
+            auto [base, mapFirst] = listRows(l, part);
             if (read)
                 pool.releaseUnread(part.killList, 0, base, l.map, mapFirst);
             else

@@ -115,6 +115,7 @@ private:
     // (and, where it does not clear kills, cleared in the pool's masks), freed there at the
     // step's end, counted once the backend gives their counts.
     void listInMemory(LateKills& l, bool aliveOnly = false);
+    static std::pair<uint32_t, size_t> listRows(const LateKills& l, const LateKills::Part& part);
     void releaseAllInMemory(std::vector<LateKills>& lates);
     void releaseInMemory(LateKills& l);
     void countInMemory(LateKills& l);
