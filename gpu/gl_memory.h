@@ -46,6 +46,8 @@ public:
     void releaseRows(const rt::PoolRows& pool, rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map,
                      size_t mapFirst) override;
     void markFresh(const rt::PoolRows& pool, rt::Buffer rows, size_t first, size_t count) override;
+    void subStepClocks(rt::Buffer created, rt::Buffer mask, rt::Buffer step, rt::Buffer now, rt::Buffer dt, size_t first,
+                       size_t n, uint32_t k, uint32_t most, double t1, double limit) override;
     using rt::Memory::scatter;
     void scatter(std::span<const std::pair<rt::Buffer, rt::Buffer>> columns, size_t fromFirst, rt::Buffer rows,
                  size_t rowsFirst, size_t count) override;
@@ -68,6 +70,8 @@ public:
     void stampDeaths(rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map, size_t mapFirst,
                      rt::Buffer frozenAt, double t1, double dt, rt::Buffer created) override;
     void survivors(rt::Buffer mask, rt::Buffer killed, rt::Buffer out, size_t first, size_t count) override;
+    void clearRows(const rt::PoolRows& pool, rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map,
+                   size_t mapFirst) override;
     void readersGone(rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map, size_t mapFirst,
                      rt::Buffer parents, rt::Buffer readers) override;
     void releaseUnread(const rt::PoolRows& pool, rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map,
@@ -166,10 +170,10 @@ private:
     mutable std::vector<uint32_t> rowsSent_;  // what rowsBuffer_ holds
     mutable unsigned boundsProgram_ = 0, boxBuffer_ = 0;  // gpu/gl_bounds.cpp
     unsigned emitRowsProgram_ = 0, emitScanProgram_ = 0, metaBuffer_ = 0;  // gpu/gl_emission.cpp
-    unsigned identifyRecordsProgram_ = 0, clearMappedProgram_ = 0, parentsProgram_ = 0;  // gpu/gl_rows.cpp
+    unsigned identifyRecordsProgram_ = 0, clearMappedProgram_ = 0, parentsProgram_ = 0, subStepProgram_ = 0;  // gpu/gl_rows.cpp
     // gpu/gl_parents.cpp
     unsigned gatherAliveProgram_ = 0, gatherAgeProgram_ = 0, stampDeathsProgram_ = 0, survivorsProgram_ = 0,
-             readersGoneProgram_ = 0, releaseUnreadProgram_ = 0, releaseWaitingProgram_ = 0;
+             readersGoneProgram_ = 0, releaseUnreadProgram_ = 0, releaseWaitingProgram_ = 0, clearRowsProgram_ = 0;
     void bindKillList(rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map, size_t mapFirst, uint32_t grid,
                       uint32_t mode = 0, std::array<uint32_t, 2> value = {});
     void bindScanBlocks(const rt::PoolRows& pool);

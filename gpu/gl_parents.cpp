@@ -1,6 +1,6 @@
 // Parents and children whose rows are both on the GPU (rt::Memory's parent operations):
 // a child's parent values fetched through its `parents` rows, the survivors whose exports
-// an update computes, and the step's end by the rule of rt/ledger.h — a child pool's kill
+// an update computes, a kill list's rows cleared in the masks, and the step's end by the rule of rt/ledger.h — a child pool's kill
 // list counting its parents' readers down, a parent pool's freeing the unread rows in the
 // list's order and freezing the rest, then its frozen rows without readers in row order.
 // The ordered pushes are one work group's scan (64 invocations, each a slice of the list
@@ -92,6 +92,21 @@ void main() {
     for (uint i = INVOCATION; i < count; i += grid) {
         uint p = parents[killedRow(i)];
         if (p != 0xFFFFFFFFu) atomicAdd(readers[p], 0xFFFFFFFFu);
+    }
+}
+)";
+
+// The listed rows out of the alive mask, and the updatable one where param 0 says so:
+// killed objects that wait for the step's end.
+const char* kClearRows = R"(
+layout(std430, binding = 2) buffer Updatable { uint updatable[]; };
+layout(std430, binding = 3) buffer Alive { uint alive[]; };
+void main() {
+    uint count = killed[param(1u)], grid = param(5u);
+    for (uint i = INVOCATION; i < count; i += grid) {
+        uint row = killedRow(i);
+        if (param(0u) != 0u) updatable[row] = 0u;
+        alive[row] = 0u;
     }
 }
 )";
@@ -297,6 +312,23 @@ void GlMemory::bindKillList(Buffer killed, size_t killedAt, uint32_t base, Buffe
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, map.valid() ? deviceBuffer(map) : list);
     bindParams(paramsBuffer_, {mode, static_cast<uint32_t>(killedAt), base, static_cast<uint32_t>(mapFirst),
                                map.valid() ? 1u : 0u, grid, value[0], value[1]});
+}
+
+void GlMemory::clearRows(const rt::PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
+                         size_t mapFirst) {
+    if (allOnHost({pool.updatable, pool.alive, killed, map}))
+        return rt::Memory::clearRows(pool, killed, killedAt, base, map, mapFirst);
+    flushPending();
+    size_t most = rows(killed) > killedAt ? rows(killed) - killedAt - 1 : 0;
+    if (most == 0) return;
+    if (!clearRowsProgram_)
+        clearRowsProgram_ = computeProgram(operationShader(std::string(kKillList) + kClearRows), "clear of the killed");
+    auto grid = static_cast<uint32_t>(std::min<size_t>(most, kGrid));
+    PassTimer::Scope timed(timer, "clear", grid);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, pool.updatable.valid() ? bound(pool.updatable) : deviceBuffer(pool.alive));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(pool.alive));
+    bindKillList(killed, killedAt, base, map, mapFirst, grid, pool.updatable.valid() ? 1u : 0u);
+    dispatchRows(clearRowsProgram_, grid);
 }
 
 void GlMemory::readersGone(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, Buffer parents,

@@ -1,17 +1,20 @@
 // A pool's rows kept on the GPU (rt::Memory::allocateRows): the allocation rule of
 // rt/allocation.h, the release of a late launch's kills, the rows a step created made
-// updatable, and a batch's ids and creation times from its runs — each one dispatch over
+// updatable, a batch's ids and creation times from its runs and its first update's
+// sub-step clocks — each one dispatch over
 // buffers that stay on the GPU, so that the host keeps only counts (the stack's top, the
 // high-water mark, the live count) and a step's bookkeeping does not grow with its objects.
 // Each shader is the GLSL spelling of the rule rt/memory.cpp writes for the host; the
 // differential tests hold the two to the same rows, ids and generations.
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <initializer_list>
 #include <string>
 
 #include <epoxy/gl.h>
 
+#include "codegen_glsl/glsl_shaders.h"
 #include "gpu/gl_context.h"
 #include "gpu/gl_memory.h"
 #include "gpu/gl_programs.h"
@@ -179,6 +182,42 @@ void main() {
 }
 )";
 
+// Sub-step k of a batch's first update: rt/clock.h's subStepCount and subStepEnd over
+// doubles, `precise` (no fused multiply-add), rounded to float as C rounds.
+const char* kSubStepClocks = R"(
+layout(std430, binding = 0) readonly buffer Created { uint created[]; };
+layout(std430, binding = 1) readonly buffer Mask { uint mask[]; };
+layout(std430, binding = 2) buffer Step { uint step[]; };
+layout(std430, binding = 3) buffer Now { uint now[]; };
+layout(std430, binding = 4) buffer Dt { uint dt[]; };
+double word2(uint lo, uint hi) { return packDouble2x32(uvec2(lo, hi)); }
+void main() {
+    uint i = INVOCATION, n = param(0u), first = param(1u), k = param(2u), most = param(3u);
+    if (i >= n) return;
+    uint at = first + i;
+    if ((k == 1u ? mask[at] : step[at]) == 0u) {
+        step[at] = 0u;
+        return;
+    }
+    double t1 = word2(param(4u), param(5u)), limit = word2(param(6u), param(7u));
+    precise double span = t1 - word2(created[2u * at], created[2u * at + 1u]);
+    uint steps = 1u;
+    if (limit > 0.0LF && span > limit) {
+        precise double q = span / limit;
+        steps = uint(min(ceil(q), double(most)));
+    }
+    step[at] = k <= steps ? 1u : 0u;
+    if (k > steps) return;
+    precise double fraction = double(k) / double(steps);
+    precise double t = (t1 - span) + span * fraction;
+    uvec2 w = unpackDouble2x32(k == steps ? t1 : t);
+    now[2u * at] = w.x;
+    now[2u * at + 1u] = w.y;
+    precise double length = span / double(steps);
+    dt[at] = floatBitsToUint(psys_narrow(length));
+}
+)";
+
 constexpr uint32_t kReleaseGrid = 64 * 1024;
 
 }  // namespace
@@ -279,6 +318,27 @@ void GlMemory::clearMapped(Buffer mask, std::span<const uint32_t> rows, Buffer m
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, bound(mask));
     bindParams(paramsBuffer_, {static_cast<uint32_t>(rows.size()), static_cast<uint32_t>(mapFirst)});
     dispatchRows(clearMappedProgram_, rows.size());
+}
+
+void GlMemory::subStepClocks(Buffer created, Buffer mask, Buffer step, Buffer now, Buffer dt, size_t first, size_t n,
+                             uint32_t k, uint32_t most, double t1, double limit) {
+    if (n == 0) return;
+    if (allOnHost({created, mask, step, now, dt}))
+        return rt::Memory::subStepClocks(created, mask, step, now, dt, first, n, k, most, t1, limit);
+    flushPending();
+    if (!subStepProgram_)
+        subStepProgram_ = computeProgram(operationShader(codegen_glsl::narrowHelper() + kSubStepClocks), "sub-step clocks");
+    PassTimer::Scope timed(timer, "sub-steps", n);
+    std::array<uint32_t, 2> end{}, h{};
+    std::memcpy(end.data(), &t1, 8);
+    std::memcpy(h.data(), &limit, 8);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceBuffer(created));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, deviceBuffer(mask));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, bound(step));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(now));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, bound(dt));
+    bindParams(paramsBuffer_, {static_cast<uint32_t>(n), static_cast<uint32_t>(first), k, most, end[0], end[1], h[0], h[1]});
+    dispatchRows(subStepProgram_, n);
 }
 
 void GlMemory::identify(const rt::ObjectRuns& runs, size_t n, size_t kept, Buffer created, Buffer ids, Buffer mask,

@@ -15,6 +15,7 @@
 // and age is always `ageAt(now, created)`. `time` in equations is float(now).
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 
 namespace psys::rt {
@@ -56,6 +57,30 @@ struct HostTimeAlgebra {
 inline float ageAt(double now, double created) {
     HostTimeAlgebra a;
     return ageAt(a, now, created);
+}
+
+// Sub-steps (@step(h)): an update over (t1 − span, t1] in equal sub-steps of at most h
+// seconds, the same rule for a pool's step (System::runPhases) and for each new object's
+// first update (Creation, and Memory::subStepClocks where the rows are).
+// The most sub-steps one update of an object takes under @step(h): a 10 s hitch at
+// @step(1/240) is 2,400; `@step(1e-30)` or a step of 1e30 s would never end. Past it the
+// update takes kMaxSubSteps longer sub-steps, and the type's stats count it.
+constexpr uint32_t kMaxSubSteps = 10000;
+
+// Sub-steps of at most `h` seconds covering `span` (h <= 0: one), capped and counted.
+inline uint32_t subStepCount(double span, double h, uint64_t& capped) {
+    if (!(h > 0) || !(span > h)) return 1;
+    double n = std::ceil(span / h);
+    if (n > kMaxSubSteps) {
+        ++capped;
+        return kMaxSubSteps;
+    }
+    return static_cast<uint32_t>(n);
+}
+
+// The end of sub-step k (from 1) of `steps`: t1 itself for the last.
+inline double subStepEnd(double t1, double span, uint32_t k, uint32_t steps) {
+    return k == steps ? t1 : (t1 - span) + span * (static_cast<double>(k) / steps);
 }
 
 }  // namespace psys::rt

@@ -114,6 +114,22 @@ void Ledger::listNow(LateKills& l) {
     }
 }
 
+// (Where the backend clears kills, the update cleared them in the alive mask; the
+// updatable mask here, but a batch's, whose new rows are not updatable yet.)
+void Ledger::takeOut(LateKills& l, Buffer batchMask) {
+    listInMemory(l);
+    Pool& pool = s_.pools[l.type];
+    PoolRows updatable, step;
+    updatable.alive = pool.updatable.column;
+    step.alive = batchMask;
+    for (const LateKills::Part& part : l.parts) {
+        if (!part.killList.valid() || (part.counted && part.count == 0)) continue;
+        if (s_.backend.clearsKilled() && !l.map.valid())
+            s_.memory.clearRows(updatable, part.killList, 0, listRows(l, part).first, {}, 0);
+        if (batchMask.valid()) s_.memory.clearRows(step, part.killList, 0, static_cast<uint32_t>(part.begin), {}, 0);
+    }
+}
+
 // By the rule of `release`: a type at a time, the most deeply nested first, each type's
 // kill lists in their order, then its frozen rows whose readers all went.
 void Ledger::releaseAllInMemory(std::vector<LateKills>& lates) {

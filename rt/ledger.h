@@ -87,6 +87,11 @@ public:
     // listed and cleared in its masks now (not at the step's end): the children's
     // `parent.alive` in the same step sees them dead.
     void listNow(LateKills& l);
+    // A late launch's kills of a type whose rows are in the memory, listed and cleared in
+    // both its masks now, freed at the step's end: an update before its last sub-step's
+    // (the next sub-step must not update them), or a batch's (`batchMask`: its step mask,
+    // by launch row, cleared too).
+    void takeOut(LateKills& l, Buffer batchMask = {});
     // A reload's (rt/reload.cpp, readers counted again): every frozen object nobody reads
     // freed, by the rule of the step's end (`release`), a pool's in row order.
     void freeUnread();

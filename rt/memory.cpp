@@ -168,6 +168,29 @@ void Memory::stampDeaths(Buffer killed, size_t killedAt, uint32_t base, Buffer m
                [&](uint32_t, uint32_t row) { d[row] = c ? t1 - (t1 - c[row]) : t1 - dt; });
 }
 
+void Memory::subStepClocks(Buffer created, Buffer mask, Buffer step, Buffer now, Buffer dt, size_t first, size_t n,
+                           uint32_t k, uint32_t most, double t1, double limit) {
+    const auto* from = static_cast<const double*>(view(created)) + first;
+    const auto* kept = static_cast<const uint8_t*>(view(mask)) + first;
+    auto* on = static_cast<uint8_t*>(host(step)) + first;
+    auto* at = static_cast<double*>(host(now)) + first;
+    auto* length = static_cast<float*>(host(dt)) + first;
+    for (size_t r = 0; r < n; ++r) {
+        if (!(k == 1 ? kept[r] : on[r])) {
+            on[r] = 0;
+            continue;
+        }
+        double span = t1 - from[r];
+        uint64_t capped = 0;
+        uint32_t steps = subStepCount(span, limit, capped);
+        if (steps > most) throw std::logic_error("a new object's first update takes more sub-steps than its batch's bound");
+        on[r] = k <= steps;
+        if (!on[r]) continue;
+        at[r] = subStepEnd(t1, span, k, steps);
+        length[r] = static_cast<float>(span / steps);
+    }
+}
+
 void Memory::survivors(Buffer mask, Buffer killed, Buffer out, size_t first, size_t count) {
     if (count == 0) return;
     const auto* m = static_cast<const uint8_t*>(view(mask)) + first;

@@ -224,6 +224,14 @@ public:
     // given (a batch's first update, from each object's creation), as the host computes it.
     virtual void stampDeaths(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst,
                              Buffer frozenAt, double t1, double dt, Buffer created);
+    // Sub-step k (from 1) of a batch's first update, by rt/clock.h's rule, for rows
+    // [first, first + n): each object's subStepCount(t1 − created, limit) sub-steps over
+    // its span; step[r] (u8) = k ≤ its sub-steps and, for k = 1, mask[r], after that
+    // step[r] itself (what the last sub-step killed cleared there: clearRows); where
+    // set, now[r] (f64) = subStepEnd and dt[r] (f32) = span / sub-steps. No object may
+    // take more than `most` (the host's bound: it does not know the creation times).
+    virtual void subStepClocks(Buffer created, Buffer mask, Buffer step, Buffer now, Buffer dt, size_t first, size_t n,
+                               uint32_t k, uint32_t most, double t1, double limit);
     // out[first + i] = mask[first + i] && !killed[first + i] (u8): the rows an update left
     // alive, whose exports it computes.
     virtual void survivors(Buffer mask, Buffer killed, Buffer out, size_t first, size_t count);

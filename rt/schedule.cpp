@@ -70,6 +70,9 @@ std::string describe(const Schedule& s, const Phase& p) {
             return fmt::format("{}: the update kernel over the pool{}{}", type, also, listed);
         }
         case PhaseKind::Kills:
+            if (p.inMemory && subStepped(s, p.type))
+                return fmt::format("{}: the kill lists kept for the step's end, where the memory frees them; an earlier "
+                                   "sub-step's taken out of the masks there at once", type);
             if (p.inMemory) return fmt::format("{}: the kill lists kept for the step's end, where the memory frees them", type);
             if (p.late && subStepped(s, p.type))
                 return fmt::format("{}: the last sub-step's listed kills kept for the step's end (nobody looks at them "

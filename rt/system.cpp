@@ -151,11 +151,9 @@ void System::runPhases(size_t first, size_t end, double dt, double t1, bool last
             case PhaseKind::SubSteps: {
                 // Sub-steps of equal length, each a pass over the pool: an object killed in one
                 // takes no more, and what it emits in each is queued in (sub-step, row) order.
-                uint32_t n = detail::subStepCount(dt, p.stepLimit, s.typeStats[type].cappedSubSteps);
-                double t0 = t1 - dt;
+                uint32_t n = subStepCount(dt, p.stepLimit, s.typeStats[type].cappedSubSteps);
                 for (uint32_t k = 1; k <= n; ++k)
-                    runPhases(i + 1, i + 1 + p.span, dt / n, k == n ? t1 : t0 + dt * (static_cast<double>(k) / n),
-                              last && k == n);
+                    runPhases(i + 1, i + 1 + p.span, dt / n, subStepEnd(t1, dt, k, n), last && k == n);
                 i += p.span;
                 continue;
             }

@@ -373,9 +373,8 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
             uint32_t steps = b.subSteps[r];
             stepMask[i] = mask[i] && k <= steps && pool.status(b.poolRows[r]) == Status::Alive;
             if (!stepMask[i]) continue;
-            double span = b.spans[r], t0 = t1 - span;
-            now[i] = k == steps ? t1 : t0 + span * (static_cast<double>(k) / steps);
-            dt[i] = static_cast<float>(span / steps);
+            now[i] = subStepEnd(t1, b.spans[r], k, steps);
+            dt[i] = static_cast<float>(b.spans[r] / steps);
         }
         advance(type, b, n, kStepMask, {Clock::Source::PerRow, Clock::Source::PerRow, 0, 0, false});
         inOrder(false, [&](size_t r) {

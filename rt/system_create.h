@@ -117,6 +117,7 @@ private:
     size_t groupQuiet(size_t from);  // see rt/system_queue.cpp
     // createBatch for a type whose rows are in the memory (rt/system_create_rows.cpp).
     void createInMemory(size_t type, Batch& b, size_t n, double t1);
+    Clock firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows, double t1, LateKills& late);
     void launchInMemory(size_t type, Batch& b, size_t n, const ir::Kernel& kernel, const ColumnLayout& layout,
                         std::vector<Buffer>& table, const Clock& clock, LateKills* late, Buffer mask = {});
     Buffer parentsOf(size_t type, Batch& b, size_t n, size_t kept);

@@ -5,10 +5,10 @@
 // allocateRows, identify, scatter by a row list), so that on a device the host's work is
 // the batch's, not its objects'. Such a type dies late or never, has no parent but one
 // whose rows are there too (its objects' parent rows from the records of their parents'
-// emissions: Memory::parentsFromRecords), no bursts, no sub-steps, and emits nothing or
-// only what the memory decides (Creation::emitInMemory, here too: Memory::emitAtRate):
-// after its first update (and its exports, of the survivors) an object only waits to be
-// freed with the step's late kills (rt/ledger.h). What it folds over its neighbours is, for an object created in the
+// emissions: Memory::parentsFromRecords), and emits nothing (then it may take sub-steps:
+// firstUpdateInMemory) or only what the memory decides (Creation::emitInMemory, here
+// too: Memory::emitAtRate): after its first update (and its exports, of the survivors)
+// an object only waits to be freed with the step's late kills (rt/ledger.h). What it folds over its neighbours is, for an object created in the
 // step, a fold over nothing: filled in, not gathered (rt/neighbours.cpp).
 #include "rt/system_create.h"
 
@@ -102,15 +102,7 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
             break;
         }
     LateKills late;
-    late.type = type;
-    late.t1 = t1;
-    late.first = first;
-    if (info.late) {
-        late.map = rows;  // (released through it at a step's end: Ledger::releaseInMemory)
-        pool.holdRows(rows);
-    }
-    const Clock toEnd{Clock::Source::Uniform, Clock::Source::SinceCreated, t1, 0, false};
-    launchInMemory(type, b, n, *info.update, info.updateLayout, table, toEnd, info.late ? &late : nullptr);
+    const Clock toEnd = firstUpdateInMemory(type, b, n, rows, t1, late);
     if (info.read) s_.ledger.listNow(late);  // its dead are dead to its children at once
     columns.clear();
     for (size_t s = 0; s < o.state.size(); ++s)
@@ -123,6 +115,8 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
             survivors = b.columns.at(kExportMask, Elem::U8, first + n);
             memory.survivors(mask, table[ColumnLayout::kKill], survivors, first, n);
         }
+        b.exportsTable[ColumnLayout::kNow] = table[ColumnLayout::kNow];  // (sub-steps: each row's last clock)
+        b.exportsTable[ColumnLayout::kDt] = table[ColumnLayout::kDt];
         launchInMemory(type, b, n, *info.exports, info.exportsLayout, b.exportsTable, toEnd, nullptr, survivors);
         for (size_t e = 0; e < o.exports.size(); ++e)
             for (int c = 0; c < o.exports[e].type.width; ++c)
@@ -157,6 +151,69 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     memory.scatter(columns, first, rows, 0, kept);
     if (!info.late) return;
     s_.ledger.defer(std::move(late));
+}
+
+// The batch's first update to t1, its kills late (the last sub-step's into `late`); in
+// sub-steps no longer than @step where an object's span may take more than one, each
+// object through its own (Memory::subStepClocks), the k-th of each at once, what one
+// kills taken out of the masks before the next (Ledger::takeOut) and freed at the step's
+// end. Returns the clock its exports are computed at: each row's last.
+Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows, double t1, LateKills& late) {
+    const TypeInfo& info = s_.types[type];
+    Pool& pool = s_.pools[type];
+    std::vector<Buffer>& table = b.updateTable;
+    auto lateKills = [&]() {
+        LateKills l;
+        l.type = type;
+        l.t1 = t1;
+        l.first = b.first;
+        if (info.late) {
+            l.map = rows;  // (released through it at a step's end: Ledger::releaseInMemory)
+            pool.holdRows(rows);
+        }
+        return l;
+    };
+    late = lateKills();
+    // The host does not know the creation times, but no object of a batch was created
+    // before the step began (s_.now until its end): the most sub-steps any of them takes.
+    uint64_t capped = 0;
+    const uint32_t most = subStepCount(t1 - s_.now, info.stepLimit, capped);
+    if (most == 1) {
+        const Clock toEnd{Clock::Source::Uniform, Clock::Source::SinceCreated, t1, 0, false};
+        launchInMemory(type, b, n, *info.update, info.updateLayout, table, toEnd, info.late ? &late : nullptr);
+        return toEnd;
+    }
+    Memory& memory = s_.memory;
+    const size_t end = b.first + n;
+    Buffer mask = b.columns.at(kMask, Elem::U8, end), step = b.columns.at(kStepMask, Elem::U8, end);
+    if (capped) {  // a hitch past kMaxSubSteps: the objects whose own sub-steps are capped, counted (a read)
+        std::vector<double> created(n);
+        std::vector<uint8_t> kept(n);
+        memory.read(table[ColumnLayout::kCreated], b.first, n, created.data());
+        memory.read(mask, b.first, n, kept.data());
+        uint64_t count = 0;
+        for (size_t r = 0; r < n; ++r)
+            if (kept[r]) subStepCount(t1 - created[r], info.stepLimit, count);
+        s_.typeStats[type].cappedSubSteps += count;
+    }
+    const Clock perRow{Clock::Source::PerRow, Clock::Source::PerRow, 0, 0, false};
+    for (uint32_t k = 1; k <= most; ++k) {
+        memory.subStepClocks(table[ColumnLayout::kCreated], mask, step, table[ColumnLayout::kNow],
+                             table[ColumnLayout::kDt], b.first, n, k, most, t1, info.stepLimit);
+        if (!info.late) {
+            launchInMemory(type, b, n, *info.update, info.updateLayout, table, perRow, nullptr, step);
+            continue;
+        }
+        if (k == most) {
+            launchInMemory(type, b, n, *info.update, info.updateLayout, table, perRow, &late, step);
+            break;
+        }
+        LateKills each = lateKills();
+        launchInMemory(type, b, n, *info.update, info.updateLayout, table, perRow, &each, step);
+        s_.ledger.takeOut(each, step);
+        s_.ledger.defer(std::move(each));
+    }
+    return perRow;
 }
 
 // A child type's batch: each object's parent row, from the records of its parents'

@@ -101,13 +101,16 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     for (TypeInfo& t : types) t.late = options.lateKills && (t.kills || t.unstable) && unwatched(t);
     // Rows in the memory: where nothing but the type's own late kills frees them — or
     // nothing at all: it never dies, so its exports are every updated row's (folds read
-    // them) — and its objects are created whole in a batch (no sub-steps, no bursts, not
-    // drawn as the step goes).
+    // them) — and its objects are created in a batch (no bursts, not drawn as the step
+    // goes). Such a type may take sub-steps: each sub-step's kills are listed there and
+    // taken out of its masks at once, freed at the step's end (Ledger::takeOut), and a
+    // batch's first update steps each object through its own sub-steps
+    // (Memory::subStepClocks).
     bool inMemory = options.rows == SystemOptions::Rows::InMemory ||
                     (options.rows == SystemOptions::Rows::AsBackend && backend.keepsRowsInMemory());
     // (An emitter's bursts at creation, below, are the memory's too.)
     auto keptWhole = [&](const TypeInfo& info) {
-        return info.parentType < 0 && info.stepLimit == 0 && !(options.drawInStep && backend.rendersInStep() && info.render);
+        return info.parentType < 0 && !(options.drawInStep && backend.rendersInStep() && info.render);
     };
     for (size_t t = 0; t < types.size(); ++t) {
         TypeInfo& info = types[t];
@@ -115,7 +118,8 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         info.rowsInMemory = inMemory && (info.late || silent) && !info.bursts && keptWhole(info);
     }
     // Emitters whose emissions the memory decides (Memory::emitAtRate): nobody reads them,
-    // every site emits — at a rate, in a burst at creation, on an edge or on death — into
+    // no sub-steps, every site emits — at a rate, in a burst at creation, on an edge or on
+    // death — into
     // a type that keeps its rows in the memory (one that emits nothing, or such an emitter
     // itself) and reads no parent, and whose arguments read no fold (a spawn launch from
     // records has no parent values) — so a step's emissions are one operation over the
@@ -177,7 +181,7 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         bool emitter = inMemory && options.createInBatches &&
                        (info.updateEmits || info.bursts) &&
                        (!dies || (options.lateKills && (!info.exports || parent))) && (!info.read || parent) &&
-                       keptWhole(info);
+                       keptWhole(info) && info.stepLimit == 0;
         int emitting = -1;  // the one target that emits, if any
         for (size_t s = 0; emitter && s < o.emits.size(); ++s) {
             auto target = static_cast<int>(info.emitTarget[s]);

@@ -90,6 +90,7 @@ struct TypeWork {
     // listed per chunk, its chunks.
     struct Pass {
         bool ran = false, late = false, listed = false;
+        bool takeOut = false;  // its late kills taken out of the masks at once (an earlier sub-step's, in the memory)
         size_t chunks = 0;
         // Where the type creates as its objects die (TypeInfo::emitsWhenKilled): the rows
         // this pass killed, in row order (no longer updatable when its emissions run).

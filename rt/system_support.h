@@ -8,28 +8,13 @@
 #include <vector>
 
 #include "ir/value.h"
+#include "rt/clock.h"
 #include "rt/emission.h"
 
 namespace psys::rt::detail {
 
 using WallClock = std::chrono::steady_clock;
 inline double seconds(WallClock::time_point a, WallClock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
-
-// The most sub-steps one update of an object takes under @step(h): a 10 s hitch at
-// @step(1/240) is 2,400; `@step(1e-30)` or a step of 1e30 s would never end. Past it the
-// update takes kMaxSubSteps longer sub-steps, and the type's stats count it.
-constexpr uint32_t kMaxSubSteps = 10000;
-
-// Sub-steps of at most `h` seconds covering `span` (h <= 0: one), capped and counted.
-inline uint32_t subStepCount(double span, double h, uint64_t& capped) {
-    if (!(h > 0) || !(span > h)) return 1;
-    double n = std::ceil(span / h);
-    if (n > kMaxSubSteps) {
-        ++capped;
-        return kMaxSubSteps;
-    }
-    return static_cast<uint32_t>(n);
-}
 
 inline bool finite(const ir::Value& v, int width) {
     for (int i = 0; i < width; ++i)

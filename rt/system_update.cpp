@@ -90,6 +90,7 @@ void runKills(State& s, size_t type, double dt, double t1) {
         l.dt = dt;
         for (size_t c = 0; c < chunks; ++c) l.parts.push_back(std::move(work.killed[c]));
         if (info.read && info.rowsInMemory) s.ledger.listNow(l);  // its dead are dead to its children at once
+        if (work.pass.takeOut) s.ledger.takeOut(l);                // the next sub-step must not update them
         s.ledger.defer(std::move(l));
         return;
     }
@@ -140,8 +141,10 @@ RowsLaunch poolUpdate(State& s, size_t type, double dt, double t1) {
 void runUpdate(State& s, const Phase& phase, double dt, double t1, bool last) {
     auto type = static_cast<size_t>(phase.type);
     // Where nobody looks at its dead before the step's end (and this sub-step ends it), its
-    // kills are taken then (LateKills).
-    const bool late = phase.late && last;
+    // kills are taken then (LateKills); where its rows are in the memory, every sub-step's
+    // kills are listed there, and an earlier sub-step's taken out of its masks at once
+    // (runKills), freed at the step's end with the last's.
+    const bool late = phase.late && (last || phase.inMemory);
     Pool& pool = s.pools[type];
     TypeInfo& info = s.types[type];
     TypeWork& work = s.work[type];
@@ -181,7 +184,7 @@ void runUpdate(State& s, const Phase& phase, double dt, double t1, bool last) {
     // (Phase::listed); late, a device need not wait for them.
     const bool listKills = phase.listed;
     size_t chunks = s.chunkCount(rows);
-    work.pass = {true, late, listKills && !late, chunks, {}};
+    work.pass = {true, late, listKills && !late, late && !last, chunks, {}};
     if (listKills || late) work.killed.resize(chunks);  // each chunk sets its own (Ledger::record)
     if (late && phase.inMemory)
         for (size_t c = 0; c < chunks; ++c)

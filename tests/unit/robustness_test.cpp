@@ -62,6 +62,26 @@ TEST_CASE("@step sub-steps are capped at 10,000 an update, and counted") {
         CHECK(run.stats("a").cappedSubSteps == 1);
         CHECK(run.stats("a").live == 1);
     }
+    SUBCASE("rows in the memory: a batch's objects counted as the host counts them") {
+        // (The memory steps each new object through its own sub-steps: Memory::subStepClocks;
+        // past the cap the host reads their creation times back to count them.)
+        rt::SystemOptions kept;
+        kept.rows = rt::SystemOptions::Rows::InMemory;
+        kept.drawInStep = false;
+        const char* text = "@step(1e-7) object a { pos = integrate(vec3(1)); point(pos, white, 1); kill when age > 3e-3; }\n"
+                           "object e { emit a at 2000 per second; }\nspawn e;";
+        Run host(text), memory(text, kept);
+        REQUIRE(memory.system->pool(memory.type("a")).rowsInMemory());
+        for (int f = 0; f < 3; ++f) {
+            host.steps(1, 1.0 / 400);
+            memory.steps(1, 1.0 / 400);
+            CHECK(memory.stats("a").cappedSubSteps == host.stats("a").cappedSubSteps);
+            CHECK(memory.stats("a").killed == host.stats("a").killed);
+            CHECK(test::poolRows(*memory.system) == test::poolRows(*host.system));
+        }
+        CHECK(host.stats("a").cappedSubSteps > 3);
+        CHECK(host.stats("a").killed > 0);
+    }
     SUBCASE("a 10 s hitch at @step(1/240) is 2,400 sub-steps: not capped") {
         Run run("@step(1/240) object a { pos = integrate(vec3(1)); point(pos, white, 1); }\nspawn a;");
         run.steps(1, 10.0);
