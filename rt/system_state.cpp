@@ -138,8 +138,9 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     // on a device, the host still reads the operation's totals back in the step
     // (docs/gpu.md, "Emitters in the memory").
     // Children in the memory beside their parents: a nested type that nobody reads and
-    // that emits nothing, whose kills are late or who never dies (as a type that only dies),
-    // created whole in a batch, reading of its parent (one level up) only its exports,
+    // that emits nothing, whose kills are late or who never dies (as a type that only dies,
+    // in sub-steps too: its parents' values gathered at each sub-step's clock), created in
+    // a batch, reading of its parent (one level up) only its exports,
     // whether it is alive and its age — its parent type's rows in the memory too (below), so
     // that the parents' rows, readers and frozen objects are the memory's
     // (Memory::releaseUnread).
@@ -163,7 +164,7 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         ColumnLayout init;
         if (info.init) layouts.push_back(&(init = columnLayout(o, *info.init)));
         child[t] = inMemory && options.createInBatches && info.parentType >= 0 && (info.late || silent) && !info.read &&
-                   o.emits.empty() && info.stepLimit == 0 && !(options.drawInStep && backend.rendersInStep() && info.render) &&
+                   o.emits.empty() && !(options.drawInStep && backend.rendersInStep() && info.render) &&
                    std::all_of(layouts.begin(), layouts.end(), [&](const ColumnLayout* l) { return readsLikeAChild(*l); });
     }
     // A type whose readers are all such children (and that nobody folds over).

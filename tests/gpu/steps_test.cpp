@@ -104,11 +104,13 @@ TEST_CASE("a batch's sub-step clocks and a kill list's cleared rows: the same bi
 TEST_CASE("objects in sub-steps keep their rows on the GPU: the interpreter's objects, rows and counts") {
     // tests/programs/step_sub_steps_in_the_memory.psys: drops that die between sub-steps
     // at a capacity that drops, from an emitter whose emissions the GPU decides; sparks
-    // from a trigger fired mid-run; orbits that never die.
+    // from a trigger fired mid-run; orbits that never die; comets' tails that read their
+    // comet live and frozen, at each sub-step's clock.
     test::Pair p(readFile(test::programsDir() + "/step_sub_steps_in_the_memory.psys"));
-    for (const char* type : {"drop", "spark", "orbit", "spout"})
+    for (const char* type : {"drop", "spark", "orbit", "spout", "comet", "comet.tail"})
         CHECK(p.gl->pool(static_cast<size_t>(p.gl->typeIndex(type))).rowsInMemory());
     const float centre[] = {0, 1, 0};
+    uint64_t frozen = 0;
     for (int f = 0; f < 150; ++f) {
         if (f == 10 || f == 70) {
             REQUIRE_FALSE(p.cpu->fire("flash", centre));
@@ -116,11 +118,15 @@ TEST_CASE("objects in sub-steps keep their rows on the GPU: the interpreter's ob
         }
         p.steps(1, 1.0 / 60);
         p.compare();
+        frozen += p.stats("comet").frozen;
     }
     CHECK(p.stats("drop").dropped > 0);
     CHECK(p.stats("drop").killed > 300);
     CHECK(p.stats("spark").killed == 600);
     CHECK(p.stats("orbit").live == 50);
+    CHECK(p.stats("comet").created == 6);  // (the launcher's 2 s at 3 a second)
+    CHECK(frozen > 0);  // comets waited, frozen, for their tails
+    CHECK(p.stats("comet.tail").killed > 200);
 }
 
 TEST_CASE("a fountain in sub-steps on the GPU: what a step moves and waits for does not grow with its drops") {
