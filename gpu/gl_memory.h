@@ -174,6 +174,7 @@ private:
     // gpu/gl_parents.cpp
     unsigned gatherAliveProgram_ = 0, gatherAgeProgram_ = 0, stampDeathsProgram_ = 0, survivorsProgram_ = 0,
              readersGoneProgram_ = 0, releaseUnreadProgram_ = 0, releaseWaitingProgram_ = 0, clearRowsProgram_ = 0;
+    uint32_t killListGrid(rt::Buffer killed, size_t killedAt) const;
     void bindKillList(rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map, size_t mapFirst, uint32_t grid,
                       uint32_t mode = 0, std::array<uint32_t, 2> value = {});
     void bindScanBlocks(const rt::PoolRows& pool);

@@ -276,11 +276,10 @@ void GlMemory::stampDeaths(Buffer killed, size_t killedAt, uint32_t base, Buffer
     if (allOnHost({killed, map, frozenAt, created}))
         return rt::Memory::stampDeaths(killed, killedAt, base, map, mapFirst, frozenAt, t1, dt, created);
     flushPending();
-    size_t most = rows(killed) > killedAt ? rows(killed) - killedAt - 1 : 0;
-    if (most == 0) return;
+    uint32_t grid = killListGrid(killed, killedAt);
+    if (grid == 0) return;
     if (!stampDeathsProgram_)
         stampDeathsProgram_ = computeProgram(operationShader(std::string(kKillList) + kStampDeaths), "deaths' times");
-    auto grid = static_cast<uint32_t>(std::min<size_t>(most, kGrid));
     PassTimer::Scope timed(timer, "release", grid);
     double value = created.valid() ? t1 : t1 - dt;  // (the host's rounding of t1 − dt)
     std::array<uint32_t, 2> w{};
@@ -304,6 +303,13 @@ void GlMemory::survivors(Buffer mask, Buffer killed, Buffer out, size_t first, s
     dispatchRows(survivorsProgram_, count);
 }
 
+// The invocations over a kill list in `killed` from word `killedAt`, whose length the host
+// does not know: one a row it may hold, at most kGrid (0: it holds none).
+uint32_t GlMemory::killListGrid(Buffer killed, size_t killedAt) const {
+    size_t most = rows(killed) > killedAt ? rows(killed) - killedAt - 1 : 0;
+    return static_cast<uint32_t>(std::min<size_t>(most, kGrid));
+}
+
 // The kill list's bindings and parameters (kKillList's).
 void GlMemory::bindKillList(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, uint32_t grid,
                             uint32_t mode, std::array<uint32_t, 2> value) {
@@ -319,11 +325,10 @@ void GlMemory::clearRows(const rt::PoolRows& pool, Buffer killed, size_t killedA
     if (allOnHost({pool.updatable, pool.alive, killed, map}))
         return rt::Memory::clearRows(pool, killed, killedAt, base, map, mapFirst);
     flushPending();
-    size_t most = rows(killed) > killedAt ? rows(killed) - killedAt - 1 : 0;
-    if (most == 0) return;
+    uint32_t grid = killListGrid(killed, killedAt);
+    if (grid == 0) return;
     if (!clearRowsProgram_)
         clearRowsProgram_ = computeProgram(operationShader(std::string(kKillList) + kClearRows), "clear of the killed");
-    auto grid = static_cast<uint32_t>(std::min<size_t>(most, kGrid));
     PassTimer::Scope timed(timer, "clear", grid);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, pool.updatable.valid() ? bound(pool.updatable) : deviceBuffer(pool.alive));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(pool.alive));
@@ -336,11 +341,10 @@ void GlMemory::readersGone(Buffer killed, size_t killedAt, uint32_t base, Buffer
     if (allOnHost({killed, map, parents, readers}))
         return rt::Memory::readersGone(killed, killedAt, base, map, mapFirst, parents, readers);
     flushPending();
-    size_t most = rows(killed) > killedAt ? rows(killed) - killedAt - 1 : 0;
-    if (most == 0) return;
+    uint32_t grid = killListGrid(killed, killedAt);
+    if (grid == 0) return;
     if (!readersGoneProgram_)
         readersGoneProgram_ = computeProgram(operationShader(std::string(kKillList) + kReadersGone), "readers gone");
-    auto grid = static_cast<uint32_t>(std::min<size_t>(most, kGrid));
     PassTimer::Scope timed(timer, "release", grid);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, deviceBuffer(parents));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(readers));
