@@ -229,7 +229,8 @@ public:
     // its span; step[r] (u8) = k ≤ its sub-steps and, for k = 1, mask[r], after that
     // step[r] itself (what the last sub-step killed cleared there: clearRows); where
     // set, now[r] (f64) = subStepEnd and dt[r] (f32) = span / sub-steps. No object may
-    // take more than `most` (the host's bound: it does not know the creation times).
+    // take more than `most` (the host's bound: it does not know the creation times; a
+    // device clamps there, the host throws).
     virtual void subStepClocks(Buffer created, Buffer mask, Buffer step, Buffer now, Buffer dt, size_t first, size_t n,
                                uint32_t k, uint32_t most, double t1, double limit);
     // out[first + i] = mask[first + i] && !killed[first + i] (u8): the rows an update left

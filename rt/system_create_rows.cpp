@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <optional>
@@ -175,9 +176,12 @@ Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows
     };
     late = lateKills();
     // The host does not know the creation times, but no object of a batch was created
-    // before the step began (s_.now until its end): the most sub-steps any of them takes.
+    // before the step began (s_.now until its end) by more than the rounding of its time
+    // (an event's time is a sum from the start of its emitter's update, a few units in the
+    // last place off): the most sub-steps any of them takes.
+    const double ulp = std::nextafter(std::fabs(t1), INFINITY) - std::fabs(t1);
     uint64_t capped = 0;
-    const uint32_t most = subStepCount(t1 - s_.now, info.stepLimit, capped);
+    const uint32_t most = subStepCount(t1 - s_.now + 16 * ulp, info.stepLimit, capped);
     if (most == 1) {
         const Clock toEnd{Clock::Source::Uniform, Clock::Source::SinceCreated, t1, 0, false};
         launchInMemory(type, b, n, *info.update, info.updateLayout, table, toEnd, info.late ? &late : nullptr);
