@@ -72,6 +72,8 @@ public:
     void survivors(rt::Buffer mask, rt::Buffer killed, rt::Buffer out, size_t first, size_t count) override;
     void clearRows(const rt::PoolRows& pool, rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map,
                    size_t mapFirst) override;
+    void appendKills(rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map, size_t mapFirst,
+                     rt::Buffer into) override;
     void readersGone(rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map, size_t mapFirst,
                      rt::Buffer parents, rt::Buffer readers) override;
     void releaseUnread(const rt::PoolRows& pool, rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map,
@@ -173,7 +175,8 @@ private:
     unsigned identifyRecordsProgram_ = 0, clearMappedProgram_ = 0, parentsProgram_ = 0, subStepProgram_ = 0;  // gpu/gl_rows.cpp
     // gpu/gl_parents.cpp
     unsigned gatherAliveProgram_ = 0, gatherAgeProgram_ = 0, stampDeathsProgram_ = 0, survivorsProgram_ = 0,
-             readersGoneProgram_ = 0, releaseUnreadProgram_ = 0, releaseWaitingProgram_ = 0, clearRowsProgram_ = 0;
+             readersGoneProgram_ = 0, releaseUnreadProgram_ = 0, releaseWaitingProgram_ = 0, clearRowsProgram_ = 0,
+             appendProgram_ = 0, appendedProgram_ = 0;
     uint32_t killListGrid(rt::Buffer killed, size_t killedAt) const;
     void bindKillList(rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map, size_t mapFirst, uint32_t grid,
                       uint32_t mode = 0, std::array<uint32_t, 2> value = {});

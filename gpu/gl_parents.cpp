@@ -111,6 +111,21 @@ void main() {
 }
 )";
 
+// The listed rows' pool rows after those `into` holds; then (kAppended) its count moved on.
+const char* kAppend = R"(
+layout(std430, binding = 2) buffer Into { uint into[]; };
+void main() {
+    uint count = killed[param(1u)], grid = param(5u), at = into[0];
+    for (uint i = INVOCATION; i < count; i += grid) into[1u + at + i] = killedRow(i);
+}
+)";
+const char* kAppended = R"(
+layout(std430, binding = 2) buffer Into { uint into[]; };
+void main() {
+    if (INVOCATION == 0u) into[0] += killed[param(1u)];
+}
+)";
+
 // Each listed row's death: `value` (t1 − dt), or where param 0 says so value − (value −
 // created[row]) (a batch's first update: t1 − its age), as the host rounds it.
 const char* kStampDeaths = R"(
@@ -334,6 +349,21 @@ void GlMemory::clearRows(const rt::PoolRows& pool, Buffer killed, size_t killedA
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(pool.alive));
     bindKillList(killed, killedAt, base, map, mapFirst, grid, pool.updatable.valid() ? 1u : 0u);
     dispatchRows(clearRowsProgram_, grid);
+}
+
+void GlMemory::appendKills(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, Buffer into) {
+    if (allOnHost({killed, map, into})) return rt::Memory::appendKills(killed, killedAt, base, map, mapFirst, into);
+    flushPending();
+    uint32_t grid = killListGrid(killed, killedAt);
+    if (grid == 0) return;
+    if (!appendProgram_) appendProgram_ = computeProgram(operationShader(std::string(kKillList) + kAppend), "kills gathered");
+    if (!appendedProgram_)
+        appendedProgram_ = computeProgram(operationShader(std::string(kKillList) + kAppended), "kills gathered: count");
+    PassTimer::Scope timed(timer, "release", grid);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, bound(into));
+    bindKillList(killed, killedAt, base, map, mapFirst, grid);
+    dispatchRows(appendProgram_, grid);
+    dispatchRows(appendedProgram_, 1);  // the same bindings and parameters
 }
 
 void GlMemory::readersGone(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, Buffer parents,

@@ -3,6 +3,7 @@
 #include "rt/ledger.h"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include "rt/system_state.h"
 #include "rt/system_support.h"
@@ -116,18 +117,42 @@ void Ledger::listNow(LateKills& l) {
 
 // (Where the backend clears kills, the update cleared them in the alive mask; the
 // updatable mask here, but a batch's, whose new rows are not updatable yet.)
-void Ledger::takeOut(LateKills& l, Buffer batchMask) {
+void Ledger::takeOut(LateKills& l, Buffer into, Buffer batchMask) {
     listInMemory(l);
+    LateKills::Part* gathered = nullptr;  // (deferGathered's)
+    for (auto it = late_.rbegin(); !gathered && it != late_.rend(); ++it)
+        if (it->type == l.type && it->parts.size() == 1 && it->parts[0].gathered && it->parts[0].killList == into)
+            gathered = &it->parts[0];
+    if (!gathered) throw std::logic_error("kills taken out with no list to gather them into");
     Pool& pool = s_.pools[l.type];
     PoolRows updatable, step;
     updatable.alive = pool.updatable.column;
     step.alive = batchMask;
-    for (const LateKills::Part& part : l.parts) {
-        if (!part.killList.valid() || (part.counted && part.count == 0)) continue;
-        if (s_.backend.clearsKilled() && !l.map.valid())
-            s_.memory.clearRows(updatable, part.killList, 0, listRows(l, part).first, {}, 0);
-        if (batchMask.valid()) s_.memory.clearRows(step, part.killList, 0, static_cast<uint32_t>(part.begin), {}, 0);
+    for (LateKills::Part& part : l.parts) {
+        if (!part.killList.valid()) continue;
+        if (!(part.counted && part.count == 0)) {
+            auto [base, mapFirst] = listRows(l, part);
+            if (s_.backend.clearsKilled() && !l.map.valid()) s_.memory.clearRows(updatable, part.killList, 0, base, {}, 0);
+            if (batchMask.valid()) s_.memory.clearRows(step, part.killList, 0, static_cast<uint32_t>(part.begin), {}, 0);
+            s_.memory.appendKills(part.killList, 0, base, l.map, mapFirst, into);
+        }
+        ++gathered->lists;
+        pool.recycle(part.killList);  // (the next sub-step's, then)
+        part.killList = {};
+        part.taken = true;
     }
+    if (l.map.valid()) pool.recycle(l.map);
+    l.map = {};
+}
+
+void Ledger::deferGathered(size_t type, Buffer into) {
+    s_.memory.fill(into, 0, 1, 0);
+    LateKills l;
+    l.type = type;
+    LateKills::Part& part = l.parts.emplace_back();
+    part.killList = into;
+    part.listed = part.counted = part.gathered = true;
+    defer(std::move(l));
 }
 
 // By the rule of `release`: a type at a time, the most deeply nested first, each type's
@@ -150,18 +175,22 @@ void Ledger::releaseInMemory(LateKills& l) {
     Pool& pool = s_.pools[l.type];
     const bool read = pool.memoryRows().readers.valid();
     for (LateKills::Part& part : l.parts) {
+        if (part.taken) {  // (freed with the step's gathered list: counted here where the host listed it)
+            if (part.counted && !read) pool.released(part.count);
+            continue;
+        }
         if (!part.killList.valid()) continue;
-        bool none = part.counted && part.count == 0;  // listed here, nothing to free
+        bool none = part.counted && part.count == 0 && !part.gathered;  // listed here, nothing to free
         if (!none) {
             auto [base, mapFirst] = listRows(l, part);
             if (read)
                 pool.releaseUnread(part.killList, 0, base, l.map, mapFirst);
             else
-                pool.release(part.killList, 0, base, l.map, mapFirst);
+                pool.release(part.killList, 0, base, l.map, mapFirst, part.gathered ? part.lists : 1);
             if (pool.parentRows.valid())
                 s_.memory.readersGone(part.killList, 0, base, l.map, mapFirst, pool.parentRows,
                                       s_.pools[static_cast<size_t>(s_.types[l.type].parentType)].memoryRows().readers);
-            if (part.counted && !read) pool.released(part.count);
+            if (part.counted && !read && !part.gathered) pool.released(part.count);
         }
         pool.recycle(part.killList);
         part.killList = {};

@@ -40,6 +40,11 @@ struct LateKills {
         Buffer killList;
         bool listed = false, counted = false;
         size_t count = 0;  // counted: how many
+        // Its kills gathered into its type's list of the step's earlier sub-steps, its own
+        // list gone (`taken`: Ledger::takeOut), or that list itself (`gathered`: its rows
+        // are counted as the others' parts, where they were taken).
+        bool taken = false, gathered = false;
+        size_t lists = 0;  // gathered: the parts taken into it (each counts its own)
     };
     std::vector<Part> parts;
     // A type whose rows are in the memory: its kills freed there at the end of the step,
@@ -90,8 +95,13 @@ public:
     // A late launch's kills of a type whose rows are in the memory, listed and cleared in
     // both its masks now, freed at the step's end: an update before its last sub-step's
     // (the next sub-step must not update them), or a batch's (`batchMask`: its step mask,
-    // by launch row, cleared too).
-    void takeOut(LateKills& l, Buffer batchMask = {});
+    // by launch row, cleared too). Its lists are gathered into `into` (Memory::appendKills:
+    // one list a type a step, or a batch, whatever the sub-steps), which deferGathered
+    // placed among the step's deaths before them.
+    void takeOut(LateKills& l, Buffer into, Buffer batchMask = {});
+    // `into` (a u32 buffer of a row more than the pool's, or the batch's, rows) emptied and
+    // placed among the step's deaths now, for takeOut to gather into.
+    void deferGathered(size_t type, Buffer into);
     // A reload's (rt/reload.cpp, readers counted again): every frozen object nobody reads
     // freed, by the rule of the step's end (`release`), a pool's in row order.
     void freeUnread();

@@ -112,6 +112,11 @@ void Memory::clearRows(const PoolRows& pool, Buffer killed, size_t killedAt, uin
     });
 }
 
+void Memory::appendKills(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, Buffer into) {
+    auto* list = static_cast<uint32_t*>(host(into));
+    eachKilled(*this, killed, killedAt, base, map, mapFirst, [&](uint32_t, uint32_t row) { list[1 + list[0]++] = row; });
+}
+
 void Memory::parentsFromRecords(Buffer runs, size_t firstRecord, size_t records, size_t stride, Buffer map,
                                 size_t mapFirst, size_t objects, size_t kept, Buffer parents, size_t first,
                                 Buffer readers) {

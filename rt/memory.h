@@ -188,6 +188,10 @@ public:
                              size_t mapFirst);
     // The pool rows of such a kill list, in its order, read where they are (a reload's).
     std::vector<uint32_t> killedRows(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst) const;
+    // A kill list's pool rows (as releaseRows reads it) appended to the list `into` (its
+    // count, then pool rows: base 0, no map), in order: a step's sub-steps' kills gathered
+    // into one list, at most a row each (a row dies once a step).
+    virtual void appendKills(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, Buffer into);
     // The rows of a kill list (as releaseRows reads it) neither alive nor updatable (where
     // `pool.updatable` is given), not freed yet: killed objects that wait for the step's end.
     virtual void clearRows(const PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,

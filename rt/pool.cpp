@@ -265,9 +265,9 @@ size_t Pool::allocate(size_t n, Buffer out, size_t outFirst) {
     return kept;
 }
 
-void Pool::release(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst) {
+void Pool::release(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, size_t lists) {
     memory_->releaseRows(rows_, killed, killedAt, base, map, mapFirst);
-    ++uncounted_;
+    uncounted_ += lists;
     ++version_;
 }
 

@@ -145,8 +145,9 @@ public:
     size_t allocate(size_t n, Buffer out, size_t outFirst);
     // A late launch's kills (their count, then launch rows, in `killed` from word
     // `killedAt`: rt::Memory::releaseRows) freed in the memory, onto the stack in order;
-    // the host counts them when it learns how many there were (released).
-    void release(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst);
+    // the host counts them when it learns how many there were (released: once, or once a
+    // list `lists` gathered: Ledger::takeOut).
+    void release(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, size_t lists = 1);
     void released(size_t count);
     // A pool that children read (keepRowsInMemory's `read`): its kills freed where nobody
     // reads them, the others frozen (Memory::releaseUnread); its frozen rows whose readers

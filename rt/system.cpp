@@ -143,6 +143,7 @@ void System::runPhases(size_t first, size_t end, double dt, double t1, bool last
             case PhaseKind::Settle: s.ledger.settle(Wait::Yes); break;
             case PhaseKind::Ready:
                 for (Pool& pool : s.pools) pool.beginStep();
+                for (detail::TypeWork& work : s.work) work.taken = {};  // (the last step's: its Release freed them)
                 break;
             case PhaseKind::Neighbours:
                 s.foldNeighbours(type);

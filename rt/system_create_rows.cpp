@@ -201,6 +201,7 @@ Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows
         s_.typeStats[type].cappedSubSteps += count;
     }
     const Clock perRow{Clock::Source::PerRow, Clock::Source::PerRow, 0, 0, false};
+    Buffer taken;  // (the earlier sub-steps' kills, gathered: Ledger::takeOut)
     for (uint32_t k = 1; k <= most; ++k) {
         memory.subStepClocks(table[ColumnLayout::kCreated], mask, step, table[ColumnLayout::kNow],
                              table[ColumnLayout::kDt], b.first, n, k, most, t1, info.stepLimit);
@@ -214,7 +215,11 @@ Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows
         }
         LateKills each = lateKills();
         launchInMemory(type, b, n, *info.update, info.updateLayout, table, perRow, &each, step);
-        s_.ledger.takeOut(each, step);
+        if (!taken.valid()) {
+            taken = pool.scratchRows(n + 1);
+            s_.ledger.deferGathered(type, taken);
+        }
+        s_.ledger.takeOut(each, taken, step);
         s_.ledger.defer(std::move(each));
     }
     return perRow;

@@ -86,6 +86,7 @@ struct TypeWork {
     std::vector<Buffer> updateTable, exportsTable, renderTable;
     DrawnInStep inStep;
     std::vector<LateKills::Part> killed;  // per chunk: the rows that died, in order (or a late launch's ticket)
+    Buffer taken;  // this step's earlier sub-steps' kills, gathered (Ledger::takeOut), once there are some
     // The update pass just run: whether it ran (a pool with live rows), its kills are late or
     // listed per chunk, its chunks.
     struct Pass {

@@ -90,7 +90,13 @@ void runKills(State& s, size_t type, double dt, double t1) {
         l.dt = dt;
         for (size_t c = 0; c < chunks; ++c) l.parts.push_back(std::move(work.killed[c]));
         if (info.read && info.rowsInMemory) s.ledger.listNow(l);  // its dead are dead to its children at once
-        if (work.pass.takeOut) s.ledger.takeOut(l);                // the next sub-step must not update them
+        if (work.pass.takeOut) {  // the next sub-step must not update them
+            if (!work.taken.valid()) {
+                work.taken = s.pools[type].scratchRows(s.pools[type].rows() + 1);
+                s.ledger.deferGathered(type, work.taken);
+            }
+            s.ledger.takeOut(l, work.taken);
+        }
         s.ledger.defer(std::move(l));
         return;
     }

@@ -18,10 +18,11 @@ using namespace psys;
 using psys::test::gpuBackend;
 using psys::test::readFile;
 
-TEST_CASE("a batch's sub-step clocks and a kill list's cleared rows: the same bits on the GPU as on the host") {
+TEST_CASE("a batch's sub-step clocks, a kill list's cleared and gathered rows: the same bits on the GPU as on the host") {
     // Spans of no time, of exact multiples of @step, just past one, and at random, far
     // from the origin (where t1 − span rounds): each object's count of sub-steps, the end
-    // of each and its length, with rows killed between sub-steps taken out.
+    // of each and its length, with rows killed between sub-steps taken out and gathered
+    // into one list (through a batch's rows, or from a base).
     auto gpu = gpuBackend();
     rt::HostMemory hostMemory;
     const double t1 = 12345.678 + 1.0 / 60, limit = 1.0 / 240;
@@ -39,12 +40,17 @@ TEST_CASE("a batch's sub-step clocks and a kill list's cleared rows: the same bi
     const uint32_t most = rt::subStepCount(1.0 / 60, limit, capped);
     REQUIRE(most == 4);
     struct Columns {
-        rt::Buffer created, mask, step, now, dt, killed, updatable, alive;
+        rt::Buffer created, mask, step, now, dt, killed, updatable, alive, map, gathered;
     };
     auto columnsOn = [&](rt::Memory& m) {
         Columns c{m.create(rt::Elem::F64, first + n), m.create(rt::Elem::U8, first + n), m.create(rt::Elem::U8, first + n),
                   m.create(rt::Elem::F64, first + n), m.create(rt::Elem::F32, first + n), m.create(rt::Elem::U32, n + 1),
-                  m.create(rt::Elem::U8, first + n), m.create(rt::Elem::U8, first + n)};
+                  m.create(rt::Elem::U8, first + n), m.create(rt::Elem::U8, first + n),
+                  m.create(rt::Elem::U32, n), m.create(rt::Elem::U32, n + 1)};
+        std::vector<uint32_t> through(n);
+        for (uint32_t r = 0; r < n; ++r) through[r] = (r * 7919 + 5) % static_cast<uint32_t>(n);  // (a permutation)
+        m.write(c.map, 0, n, through.data());
+        m.fill(c.gathered, 0, 1, 0);
         m.write(c.created, 0, first + n, created.data());
         m.write(c.mask, 0, first + n, mask.data());
         std::vector<uint8_t> ones(first + n, 1);
@@ -53,6 +59,7 @@ TEST_CASE("a batch's sub-step clocks and a kill list's cleared rows: the same bi
         return c;
     };
     Columns host = columnsOn(hostMemory), device = columnsOn(gpu->memory());
+    size_t killedSoFar = 0;
     for (uint32_t k = 1; k <= most; ++k) {
         hostMemory.subStepClocks(host.created, host.mask, host.step, host.now, host.dt, first, n, k, most, t1, limit);
         gpu->memory().subStepClocks(device.created, device.mask, device.step, device.now, device.dt, first, n, k, most,
@@ -87,7 +94,12 @@ TEST_CASE("a batch's sub-step clocks and a kill list's cleared rows: the same bi
             both.alive = c->alive;
             m->clearRows(step, c->killed, 0, static_cast<uint32_t>(first), {}, 0);
             m->clearRows(both, c->killed, 0, static_cast<uint32_t>(first), {}, 0);
+            if (k % 2)
+                m->appendKills(c->killed, 0, static_cast<uint32_t>(first), {}, 0, c->gathered);
+            else
+                m->appendKills(c->killed, 0, 0, c->map, 0, c->gathered);
         }
+        killedSoFar += list[0];
     }
     for (rt::Buffer Columns::*b : {&Columns::step, &Columns::updatable, &Columns::alive}) {
         std::vector<uint8_t> a(first + n), d(first + n);
@@ -95,6 +107,12 @@ TEST_CASE("a batch's sub-step clocks and a kill list's cleared rows: the same bi
         gpu->memory().read(device.*b, 0, first + n, d.data());
         CHECK(a == d);
     }
+    std::vector<uint32_t> gatheredHost(n + 1), gatheredDevice(n + 1);
+    hostMemory.read(host.gathered, 0, n + 1, gatheredHost.data());
+    gpu->memory().read(device.gathered, 0, n + 1, gatheredDevice.data());
+    CHECK(gatheredHost[0] == killedSoFar);
+    CHECK(killedSoFar > 100);
+    CHECK(gatheredHost == gatheredDevice);
     // (An object of no age takes one sub-step, ending at t1.)
     std::vector<double> now(n);
     hostMemory.read(host.now, first, n, now.data());
