@@ -145,10 +145,8 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     // that the parents' rows, readers and frozen objects are the memory's
     // (Memory::releaseUnread).
     // Its parent type is then such an emitter with no parent of its own, every type that
-    // reads it such a child, its exports read by nobody else (no fold).
-    std::vector<bool> folded(types.size(), false);
-    for (const ir::Object& o : module.objects)
-        for (const ir::NeighbourGroup& g : o.neighbours) folded[static_cast<size_t>(module.objectIndex(g.target))] = true;
+    // reads it such a child. (A fold over it reads the rows updatable at the step's start,
+    // as on the host: a frozen parent is not among them.)
     auto readsLikeAChild = [&](const ColumnLayout& layout) {
         return std::all_of(layout.parentColumns.begin(), layout.parentColumns.end(), [](const ColumnLayout::ParentColumn& p) {
             return p.op == ir::Op::Fold || (p.depth == 1 && (p.op == ir::Op::ParentExport || p.op == ir::Op::ParentAlive ||
@@ -167,9 +165,8 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
                    o.emits.empty() && !(options.drawInStep && backend.rendersInStep() && info.render) &&
                    std::all_of(layouts.begin(), layouts.end(), [&](const ColumnLayout* l) { return readsLikeAChild(*l); });
     }
-    // A type whose readers are all such children (and that nobody folds over).
+    // A type whose readers are all such children.
     auto readByChildren = [&](size_t t) {
-        if (folded[t]) return false;
         for (size_t c = 0; c < types.size(); ++c)
             if (types[c].parentType == static_cast<int>(t) && !child[c]) return false;
         return true;

@@ -513,6 +513,23 @@ TEST_CASE("children and the parents they read keep their rows on the GPU: frozen
     CHECK(large < 1024);
 }
 
+TEST_CASE("parents that another type folds over keep their rows on the GPU beside their children") {
+    // tests/programs/step_parents_folded_over.psys: moths fold over the comets alive at
+    // each step's start (a frozen comet, waiting for its tails, is not updatable: not
+    // among them), as on the interpreter, object for object and row for row.
+    test::Pair p(readFile(test::programsDir() + "/step_parents_folded_over.psys"));
+    CHECK(p.gl->pool(static_cast<size_t>(p.gl->typeIndex("comet"))).rowsInMemory());
+    CHECK(p.gl->pool(static_cast<size_t>(p.gl->typeIndex("comet.tail"))).rowsInMemory());
+    uint64_t frozen = 0;
+    for (int f = 0; f < 300; ++f) {
+        p.steps(1, 1.0 / 60);
+        p.compare();
+        frozen += p.stats("comet").frozen;
+    }
+    CHECK(frozen > 20);
+    CHECK(p.stats("comet").created == 12);
+}
+
 TEST_CASE("objects a trigger creates that die in their first update are not drawn before the next step") {
     // Their kill lists are freed at the next step's end; until then the GPU has cleared
     // them in the alive mask the draws read, as the interpreter has frozen them.
