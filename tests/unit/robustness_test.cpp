@@ -65,12 +65,9 @@ TEST_CASE("@step sub-steps are capped at 10,000 an update, and counted") {
     SUBCASE("rows in the memory: a batch's objects counted as the host counts them") {
         // (The memory steps each new object through its own sub-steps: Memory::subStepClocks;
         // past the cap the host reads their creation times back to count them.)
-        rt::SystemOptions kept;
-        kept.rows = rt::SystemOptions::Rows::InMemory;
-        kept.drawInStep = false;
         const char* text = "@step(1e-7) object a { pos = integrate(vec3(1)); point(pos, white, 1); kill when age > 3e-3; }\n"
                            "object e { emit a at 2000 per second; }\nspawn e;";
-        Run host(text), memory(text, kept);
+        Run host(text), memory(text, test::rowsInMemory());
         REQUIRE(memory.system->pool(memory.type("a")).rowsInMemory());
         for (int f = 0; f < 3; ++f) {
             host.steps(1, 1.0 / 400);
@@ -93,12 +90,9 @@ TEST_CASE("a hitch of hundreds of sub-steps, rows in the memory: the kills gathe
     // 20,000 objects through 720 sub-steps of one 3 s step, most dying between them: each
     // sub-step's kill list is gathered into the step's (Ledger::takeOut) and goes back to
     // the pool for the next — without, 720 lists of 20,000 rows (58 MB).
-    rt::SystemOptions kept;
-    kept.rows = rt::SystemOptions::Rows::InMemory;
-    kept.drawInStep = false;
     const char* text = "@step(1/240) object a { pos = integrate(vec3(1)); point(pos, white, 1); kill when age > rand() * 4; }\n"
                        "object e { emit a count 20000; }\nspawn e;";
-    Run host(text), memory(text, kept);
+    Run host(text), memory(text, test::rowsInMemory());
     REQUIRE(memory.system->pool(memory.type("a")).rowsInMemory());
     auto& bytes = dynamic_cast<rt::HostMemory&>(memory.backend.memory());
     for (double dt : {1.0 / 60, 1.0 / 60, 3.0}) {

@@ -36,6 +36,15 @@ constexpr const char* kProjectile = R"(
     }
     spawn p;)";
 
+// Rows kept in the memory wherever they can be (SystemOptions::Rows::InMemory), as on a
+// GPU: no drawing as the step goes (a type drawn so keeps its rows on the host).
+inline rt::SystemOptions rowsInMemory() {
+    rt::SystemOptions options;
+    options.rows = rt::SystemOptions::Rows::InMemory;
+    options.drawInStep = false;
+    return options;
+}
+
 struct Run {
     interp::Interpreter backend;
     std::unique_ptr<rt::System> system;

@@ -83,9 +83,7 @@ TEST_CASE("the schedule says which types keep their rows in the memory, and wher
     // a rate: where rows are kept in the memory wherever they can be, its rows are there
     // too and its emissions the memory's operation (Memory::emitAtRate).
     std::string text = test::readFile(std::string(PSYS_SAMPLES_DIR) + "/fountain.psys");
-    rt::SystemOptions options;
-    options.rows = rt::SystemOptions::Rows::InMemory;
-    options.drawInStep = false;
+    const rt::SystemOptions options = test::rowsInMemory();
     interp::Interpreter backend, other;
     rt::System kept(test::compileModule(text), backend, options), plain(test::compileModule(text), other);
     const rt::Schedule& s = kept.schedule();
