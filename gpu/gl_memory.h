@@ -178,6 +178,7 @@ private:
              readersGoneProgram_ = 0, releaseUnreadProgram_ = 0, releaseWaitingProgram_ = 0, clearRowsProgram_ = 0,
              appendProgram_ = 0, appendedProgram_ = 0;
     uint32_t killListGrid(rt::Buffer killed, size_t killedAt) const;
+    void killListProgram(unsigned& program, const char* body, const char* name);
     void bindKillList(rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map, size_t mapFirst, uint32_t grid,
                       uint32_t mode = 0, std::array<uint32_t, 2> value = {});
     void bindScanBlocks(const rt::PoolRows& pool);

@@ -293,8 +293,7 @@ void GlMemory::stampDeaths(Buffer killed, size_t killedAt, uint32_t base, Buffer
     flushPending();
     uint32_t grid = killListGrid(killed, killedAt);
     if (grid == 0) return;
-    if (!stampDeathsProgram_)
-        stampDeathsProgram_ = computeProgram(operationShader(std::string(kKillList) + kStampDeaths), "deaths' times");
+    killListProgram(stampDeathsProgram_, kStampDeaths, "deaths' times");
     PassTimer::Scope timed(timer, "release", grid);
     double value = created.valid() ? t1 : t1 - dt;  // (the host's rounding of t1 − dt)
     std::array<uint32_t, 2> w{};
@@ -325,6 +324,11 @@ uint32_t GlMemory::killListGrid(Buffer killed, size_t killedAt) const {
     return static_cast<uint32_t>(std::min<size_t>(most, kGrid));
 }
 
+// A program over a kill list (kKillList's helpers, then `body`), made on first use.
+void GlMemory::killListProgram(unsigned& program, const char* body, const char* name) {
+    if (!program) program = computeProgram(operationShader(std::string(kKillList) + body), name);
+}
+
 // The kill list's bindings and parameters (kKillList's).
 void GlMemory::bindKillList(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, uint32_t grid,
                             uint32_t mode, std::array<uint32_t, 2> value) {
@@ -342,8 +346,7 @@ void GlMemory::clearRows(const rt::PoolRows& pool, Buffer killed, size_t killedA
     flushPending();
     uint32_t grid = killListGrid(killed, killedAt);
     if (grid == 0) return;
-    if (!clearRowsProgram_)
-        clearRowsProgram_ = computeProgram(operationShader(std::string(kKillList) + kClearRows), "clear of the killed");
+    killListProgram(clearRowsProgram_, kClearRows, "clear of the killed");
     PassTimer::Scope timed(timer, "clear", grid);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, pool.updatable.valid() ? bound(pool.updatable) : deviceBuffer(pool.alive));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(pool.alive));
@@ -356,9 +359,8 @@ void GlMemory::appendKills(Buffer killed, size_t killedAt, uint32_t base, Buffer
     flushPending();
     uint32_t grid = killListGrid(killed, killedAt);
     if (grid == 0) return;
-    if (!appendProgram_) appendProgram_ = computeProgram(operationShader(std::string(kKillList) + kAppend), "kills gathered");
-    if (!appendedProgram_)
-        appendedProgram_ = computeProgram(operationShader(std::string(kKillList) + kAppended), "kills gathered: count");
+    killListProgram(appendProgram_, kAppend, "kills gathered");
+    killListProgram(appendedProgram_, kAppended, "kills gathered: count");
     PassTimer::Scope timed(timer, "release", grid);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, bound(into));
     bindKillList(killed, killedAt, base, map, mapFirst, grid);
@@ -373,8 +375,7 @@ void GlMemory::readersGone(Buffer killed, size_t killedAt, uint32_t base, Buffer
     flushPending();
     uint32_t grid = killListGrid(killed, killedAt);
     if (grid == 0) return;
-    if (!readersGoneProgram_)
-        readersGoneProgram_ = computeProgram(operationShader(std::string(kKillList) + kReadersGone), "readers gone");
+    killListProgram(readersGoneProgram_, kReadersGone, "readers gone");
     PassTimer::Scope timed(timer, "release", grid);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, deviceBuffer(parents));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(readers));
