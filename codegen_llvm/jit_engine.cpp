@@ -322,9 +322,18 @@ JitEngine::JitEngine(MathMode mode) : impl_(std::make_unique<Impl>()) {
     }
 }
 
-// The compile threads may still be optimizing and compiling modules of an `add` that
-// failed, with Impl's members: the JIT goes first (its session's end waits for them).
-JitEngine::~JitEngine() { impl_->jit.reset(); }
+// The compile threads may still be running tasks when the engine goes: a module of an
+// `add` that failed, or the tail of one whose lookup has returned (LLVM 19 completes a
+// query in a task of its own, so `add` can return while the thread that emitted the last
+// module still tears its link down). LLJIT's end of session removes the dylibs first and
+// waits for the threads after: the thread then finds its tracker defunct and frees into a
+// dylib being cleared (psys_bench's compile loop on a loaded machine: a session error in 3
+// runs of 120, once heap corruption in CI; 0 of 160 since). So the dispatcher is shut
+// down first, which waits for every task, then the JIT goes, before Impl's members.
+JitEngine::~JitEngine() {
+    impl_->jit->getExecutionSession().getExecutorProcessControl().getDispatcher().shutdown();
+    impl_->jit.reset();
+}
 
 std::string JitEngine::cpu() const { return impl_->cpu; }
 
