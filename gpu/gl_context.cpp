@@ -97,8 +97,8 @@ void dispatchInvocations(size_t invocations, unsigned groupSize) {
 }
 
 void bindParams(unsigned& buffer, std::initializer_list<uint32_t> values) {
-    uint32_t words[8] = {};
-    if (values.size() > 8) throw std::logic_error("a utility shader takes at most 8 parameters");
+    uint32_t words[12] = {};
+    if (values.size() > 12) throw std::logic_error("a utility shader takes at most 12 parameters");
     std::copy(values.begin(), values.end(), words);
     if (!buffer) glCreateBuffers(1, &buffer);
     glNamedBufferData(buffer, sizeof words, words, GL_STREAM_DRAW);  // a new store: no dispatch in flight sees it

@@ -63,9 +63,9 @@ inline constexpr const char* kInvocationIndex =
 // dispatch (a clearing of killed rows then cleared one row of a thousand), and a block the
 // host writes is what the kernels already use everywhere.
 inline constexpr const char* kParamsBlock =
-    "layout(std140, binding = 1) uniform Params { uvec4 P[2]; };\n"
+    "layout(std140, binding = 1) uniform Params { uvec4 P[3]; };\n"
     "uint param(uint k) { return P[k >> 2u][k & 3u]; }\n";
-// Writes up to 8 values into `buffer` (created on first use: the caller owns it) and
+// Writes up to 12 values into `buffer` (created on first use: the caller owns it) and
 // binds it as the Params block.
 void bindParams(unsigned& buffer, std::initializer_list<uint32_t> values);
 

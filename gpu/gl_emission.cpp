@@ -28,7 +28,7 @@ namespace {
 
 // One site over the rows: params rows, flags (1 rate per row, 2 count per row, 4 kill
 // flags, 8 creation times, 16 fresh accumulators, 32 a burst at t1, 64 a burst at each
-// row's creation time; the site from bit
+// row's creation time, 128 each row's end and length of its update; the site from bit
 // 8: its record at meta's rt::RecordLayout), the shared rate and count, dt, t1; the rows
 // from meta[3] on in the columns.
 // The rule's operations are `precise` and in the host's order: the same doubles.
@@ -40,7 +40,9 @@ layout(std430, binding = 3) readonly buffer Rate { uint rates[]; };
 layout(std430, binding = 4) readonly buffer Count { uint counts[]; };
 layout(std430, binding = 5) buffer Accumulated { uint accumulated[]; };
 layout(std430, binding = 6) buffer Runs { uint runs[]; };
+layout(std430, binding = 7) readonly buffer Now { uint nows[]; };
 layout(std430, binding = 8) readonly buffer Meta { uint meta[]; };
+layout(std430, binding = 9) readonly buffer Length { uint lengths[]; };
 double ld(uint lo, uint hi) { return packDouble2x32(uvec2(lo, hi)); }
 // rt::validCount: NaN, infinite and negative are invalid (0, counted).
 double valid(float x, inout uint invalid) {
@@ -66,10 +68,12 @@ void main() {
     uint invalid = 0u, clamped = 0u, perEvent = 1u;
     uvec2 children = uvec2(0u);
     double firstTime = 0.0LF, spacing = 0.0LF;
+    bool clocked = (flags & 128u) != 0u;  // (rt::RateSites::now, length)
+    double end = clocked ? ld(nows[2u * i], nows[2u * i + 1u]) : ld(param(6u), param(7u));
     if ((flags & 96u) != 0u) {  // rt::burst: every row of the mask, killed ones too
         if (mask[i] != 0u) {
             double size = valid(uintBitsToFloat((flags & 2u) != 0u ? counts[i] : param(3u)), invalid);
-            firstTime = (flags & 64u) != 0u ? ld(created[2u * i], created[2u * i + 1u]) : ld(param(6u), param(7u));
+            firstTime = (flags & 64u) != 0u ? ld(created[2u * i], created[2u * i + 1u]) : end;
             if (size >= 1.0LF) {
                 double c = whole(size, clamped);
                 uint hi = uint(c / 4294967296.0LF);
@@ -78,8 +82,9 @@ void main() {
             }
         }
     } else if (mask[i] != 0u && ((flags & 4u) == 0u || killed[i] == 0u)) {
-        double t1 = ld(param(6u), param(7u));
-        double dt = (flags & 8u) != 0u ? t1 - ld(created[2u * i], created[2u * i + 1u]) : ld(param(4u), param(5u));
+        double t1 = end;
+        double dt = clocked ? ld(lengths[2u * i], lengths[2u * i + 1u])
+                    : (flags & 8u) != 0u ? t1 - ld(created[2u * i], created[2u * i + 1u]) : ld(param(4u), param(5u));
         double before = (flags & 16u) != 0u ? 0.0LF : ld(accumulated[2u * i], accumulated[2u * i + 1u]);
         double rate = valid(uintBitsToFloat((flags & 1u) != 0u ? rates[i] : param(2u)), invalid);
         double size = valid(uintBitsToFloat((flags & 2u) != 0u ? counts[i] : param(3u)), invalid);
@@ -276,7 +281,7 @@ std::pair<uint32_t, uint32_t> doubleWords(double x) {
 // on the host side), wherever the runs buffer was (its length is not the pool's: rows ·
 // sites records); on the GPU otherwise.
 void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs) {
-    std::vector<Buffer> used = {in.mask, in.killed, in.created};
+    std::vector<Buffer> used = {in.mask, in.killed, in.created, in.now, in.length};
     for (const rt::RateSites::Site& s : in.sites) used.insert(used.end(), {s.rate, s.count, s.accumulated});
     const size_t sites = in.sites.size(), n = in.rows;
     // Where the emitters' rows are on the host, so are their emissions (a launcher, a
@@ -312,11 +317,14 @@ void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs) {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, or_(s.count));
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, s.accumulated.valid() ? bound(s.accumulated) : runsGl);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, runsGl);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, or_(in.now));
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, metaBuffer_);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, or_(in.length));
         using Kind = rt::RateSites::Site::Kind;
         uint32_t flags = (s.rate.valid() ? 1u : 0u) | (s.count.valid() ? 2u : 0u) | (in.killed.valid() ? 4u : 0u) |
                          (in.created.valid() ? 8u : 0u) | (in.fresh ? 16u : 0u) | (s.kind == Kind::Burst ? 32u : 0u) |
-                         (s.kind == Kind::AtCreation ? 64u : 0u) | static_cast<uint32_t>(k) << 8;
+                         (s.kind == Kind::AtCreation ? 64u : 0u) | (in.now.valid() ? 128u : 0u) |
+                         static_cast<uint32_t>(k) << 8;
         bindParams(paramsBuffer_, {static_cast<uint32_t>(n), flags, floatBits(s.rateValue), floatBits(s.countValue), dt0, dt1,
                                    t10, t11});
         dispatchRows(emitRowsProgram_, n);

@@ -46,7 +46,7 @@ public:
     void releaseRows(const rt::PoolRows& pool, rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map,
                      size_t mapFirst) override;
     void markFresh(const rt::PoolRows& pool, rt::Buffer rows, size_t first, size_t count) override;
-    void subStepClocks(rt::Buffer created, rt::Buffer mask, rt::Buffer step, rt::Buffer now, rt::Buffer dt, size_t first,
+    void subStepClocks(rt::Buffer created, rt::Buffer mask, rt::Buffer step, rt::Buffer now, rt::Buffer dt, rt::Buffer length, size_t first,
                        size_t n, uint32_t k, uint32_t most, double t1, double limit) override;
     using rt::Memory::scatter;
     void scatter(std::span<const std::pair<rt::Buffer, rt::Buffer>> columns, size_t fromFirst, rt::Buffer rows,

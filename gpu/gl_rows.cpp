@@ -190,6 +190,7 @@ layout(std430, binding = 1) readonly buffer Mask { uint mask[]; };
 layout(std430, binding = 2) buffer Step { uint step[]; };
 layout(std430, binding = 3) buffer Now { uint now[]; };
 layout(std430, binding = 4) buffer Dt { uint dt[]; };
+layout(std430, binding = 5) buffer Length { uint lengths[]; };  // (param 8: whether given)
 double word2(uint lo, uint hi) { return packDouble2x32(uvec2(lo, hi)); }
 void main() {
     uint i = INVOCATION, n = param(0u), first = param(1u), k = param(2u), most = param(3u);
@@ -215,6 +216,10 @@ void main() {
     now[2u * at + 1u] = w.y;
     precise double length = span / double(steps);
     dt[at] = floatBitsToUint(psys_narrow(length));
+    if (param(8u) == 0u) return;
+    uvec2 l = unpackDouble2x32(length);
+    lengths[2u * at] = l.x;
+    lengths[2u * at + 1u] = l.y;
 }
 )";
 
@@ -320,11 +325,11 @@ void GlMemory::clearMapped(Buffer mask, std::span<const uint32_t> rows, Buffer m
     dispatchRows(clearMappedProgram_, rows.size());
 }
 
-void GlMemory::subStepClocks(Buffer created, Buffer mask, Buffer step, Buffer now, Buffer dt, size_t first, size_t n,
-                             uint32_t k, uint32_t most, double t1, double limit) {
+void GlMemory::subStepClocks(Buffer created, Buffer mask, Buffer step, Buffer now, Buffer dt, Buffer length,
+                             size_t first, size_t n, uint32_t k, uint32_t most, double t1, double limit) {
     if (n == 0) return;
-    if (allOnHost({created, mask, step, now, dt}))
-        return rt::Memory::subStepClocks(created, mask, step, now, dt, first, n, k, most, t1, limit);
+    if (allOnHost({created, mask, step, now, dt, length}))
+        return rt::Memory::subStepClocks(created, mask, step, now, dt, length, first, n, k, most, t1, limit);
     flushPending();
     if (!subStepProgram_)
         subStepProgram_ = computeProgram(operationShader(codegen_glsl::narrowHelper() + kSubStepClocks), "sub-step clocks");
@@ -337,7 +342,9 @@ void GlMemory::subStepClocks(Buffer created, Buffer mask, Buffer step, Buffer no
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, bound(step));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, bound(now));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, bound(dt));
-    bindParams(paramsBuffer_, {static_cast<uint32_t>(n), static_cast<uint32_t>(first), k, most, end[0], end[1], h[0], h[1]});
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, length.valid() ? bound(length) : bound(dt));  // (a block must be bound)
+    bindParams(paramsBuffer_, {static_cast<uint32_t>(n), static_cast<uint32_t>(first), k, most, end[0], end[1], h[0], h[1],
+                               length.valid() ? 1u : 0u});
     dispatchRows(subStepProgram_, n);
 }
 

@@ -173,13 +173,14 @@ void Memory::stampDeaths(Buffer killed, size_t killedAt, uint32_t base, Buffer m
                [&](uint32_t, uint32_t row) { d[row] = c ? t1 - (t1 - c[row]) : t1 - dt; });
 }
 
-void Memory::subStepClocks(Buffer created, Buffer mask, Buffer step, Buffer now, Buffer dt, size_t first, size_t n,
-                           uint32_t k, uint32_t most, double t1, double limit) {
+void Memory::subStepClocks(Buffer created, Buffer mask, Buffer step, Buffer now, Buffer dt, Buffer length,
+                           size_t first, size_t n, uint32_t k, uint32_t most, double t1, double limit) {
     const auto* from = static_cast<const double*>(view(created)) + first;
     const auto* kept = static_cast<const uint8_t*>(view(mask)) + first;
     auto* on = static_cast<uint8_t*>(host(step)) + first;
     auto* at = static_cast<double*>(host(now)) + first;
-    auto* length = static_cast<float*>(host(dt)) + first;
+    auto* narrow = static_cast<float*>(host(dt)) + first;
+    auto* wide = length.valid() ? static_cast<double*>(host(length)) + first : nullptr;
     for (size_t r = 0; r < n; ++r) {
         if (!(k == 1 ? kept[r] : on[r])) {
             on[r] = 0;
@@ -192,7 +193,8 @@ void Memory::subStepClocks(Buffer created, Buffer mask, Buffer step, Buffer now,
         on[r] = k <= steps;
         if (!on[r]) continue;
         at[r] = subStepEnd(t1, span, k, steps);
-        length[r] = static_cast<float>(span / steps);
+        narrow[r] = static_cast<float>(span / steps);
+        if (wide) wide[r] = span / steps;
     }
 }
 
@@ -325,6 +327,8 @@ void Memory::emitAtRate(const RateSites& in, Buffer runs) {
     const auto* mask = static_cast<const uint8_t*>(view(in.mask)) + f;
     const auto* killed = in.killed.valid() ? static_cast<const uint8_t*>(view(in.killed)) + f : nullptr;
     const auto* created = in.created.valid() ? static_cast<const double*>(view(in.created)) + f : nullptr;
+    const auto* now = in.now.valid() ? static_cast<const double*>(view(in.now)) + f : nullptr;
+    const auto* length = in.length.valid() ? static_cast<const double*>(view(in.length)) + f : nullptr;
     const RecordLayout layout(in);
     struct Site {
         const float *rate, *count;
@@ -347,12 +351,13 @@ void Memory::emitAtRate(const RateSites& in, Buffer runs) {
             RateEmission e;
             const float count = d.count ? d.count[r] : s.countValue;
             if (s.kind != RateSites::Site::Kind::Rate && mask[r]) {
-                e = burst(count, s.kind == RateSites::Site::Kind::Burst ? in.t1 : created[r]);
+                e = burst(count, s.kind == RateSites::Site::Kind::Burst ? (now ? now[r] : in.t1) : created[r]);
                 invalid += e.invalid;
                 clamped += e.clamped;
             } else if (s.kind == RateSites::Site::Kind::Rate && mask[r] && !(killed && killed[r])) {
-                double dt = created ? in.t1 - created[r] : in.dt;
-                e = rateEmission(in.fresh ? 0.0 : d.accumulated[r], d.rate ? d.rate[r] : s.rateValue, count, dt, in.t1);
+                const double end = now ? now[r] : in.t1;
+                const double dt = length ? length[r] : created ? in.t1 - created[r] : in.dt;
+                e = rateEmission(in.fresh ? 0.0 : d.accumulated[r], d.rate ? d.rate[r] : s.rateValue, count, dt, end);
                 d.accumulated[r] = e.accumulated;
                 invalid += e.invalid;
                 clamped += e.clamped;

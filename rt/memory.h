@@ -96,6 +96,11 @@ struct RateSites {
     Buffer mask;     // u8: the rows that emit
     Buffer killed;   // u8: rows the update killed (they emit at no rate); invalid: none
     Buffer created;  // f64: where given, row r's update began at created[r] (a batch's first), else at t1 − dt
+    // f64, both or neither: where given, row r's update is the sub-step that ends at now[r]
+    // and lasts length[r] (a batch's first update in sub-steps: Memory::subStepClocks) —
+    // its rate over that, its bursts in the update at now[r]; `created` then only places
+    // the bursts at creation.
+    Buffer now, length;
     bool fresh = false;  // the rows' objects were just created: their accumulators start at 0 (not read)
     double dt = 0, t1 = 0;
     uint32_t nextId = 0;  // the first id the emissions take
@@ -232,11 +237,12 @@ public:
     // [first, first + n): each object's subStepCount(t1 − created, limit) sub-steps over
     // its span; step[r] (u8) = k ≤ its sub-steps and, for k = 1, mask[r], after that
     // step[r] itself (what the last sub-step killed cleared there: clearRows); where
-    // set, now[r] (f64) = subStepEnd and dt[r] (f32) = span / sub-steps. No object may
-    // take more than `most` (the host's bound: it does not know the creation times; a
-    // device clamps there, the host throws).
-    virtual void subStepClocks(Buffer created, Buffer mask, Buffer step, Buffer now, Buffer dt, size_t first, size_t n,
-                               uint32_t k, uint32_t most, double t1, double limit);
+    // set, now[r] (f64) = subStepEnd and dt[r] (f32) = span / sub-steps, and where
+    // `length` is given length[r] (f64) = span / sub-steps unrounded (an emitter's rate
+    // rule reads it: RateSites::length). No object may take more than `most` (the host's
+    // bound: it does not know the creation times; a device clamps there, the host throws).
+    virtual void subStepClocks(Buffer created, Buffer mask, Buffer step, Buffer now, Buffer dt, Buffer length,
+                               size_t first, size_t n, uint32_t k, uint32_t most, double t1, double limit);
     // out[first + i] = mask[first + i] && !killed[first + i] (u8): the rows an update left
     // alive, whose exports it computes.
     virtual void survivors(Buffer mask, Buffer killed, Buffer out, size_t first, size_t count);

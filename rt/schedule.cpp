@@ -188,8 +188,20 @@ Schedule stepSchedule(const State& s) {
             emissions.events = info.emitsWhenKilled;
             emissions.inMemory = info.rowsInMemory;  // Memory::emitAtRate
         }
+        // An emitter in the memory, in sub-steps, of objects that emit nothing and read no
+        // parent: what each sub-step queued is created after it, to the step's end — the
+        // rows, ids and order it would take after the last (nothing between frees or takes
+        // their rows, and they create nothing), but each sub-step's records of its emissions
+        // (Memory::emitAtRate: its rows × sites) go with it, not held through every
+        // sub-step of a hitch.
+        bool eachSubStep = info.stepLimit > 0 && info.rowsInMemory && info.updateEmits &&
+                           std::all_of(targets.begin(), targets.end(), [&](int target) {
+                               return s.module.objects[static_cast<size_t>(target)].emits.empty() &&
+                                      s.types[static_cast<size_t>(target)].parentType < 0;
+                           });
+        if (eachSubStep) add(PhaseKind::Create, type, Parallelism::Ordered).targets = targets;
         if (info.stepLimit > 0) out.phases[group].span = out.phases.size() - group - 1;
-        if (info.updateEmits) add(PhaseKind::Create, type, Parallelism::Ordered).targets = targets;
+        if (info.updateEmits && !eachSubStep) add(PhaseKind::Create, type, Parallelism::Ordered).targets = targets;
     }
     add(PhaseKind::Release, -1, Parallelism::Ordered);
     return out;

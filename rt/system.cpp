@@ -131,8 +131,9 @@ void System::finish() {
 }
 
 // The executor of the schedule (rt/schedule.h) on any backend: phases [first, end) of a
-// step, or of one of its sub-steps, over (t1 − dt, t1]; `last`: the sub-step ending the step.
-void System::runPhases(size_t first, size_t end, double dt, double t1, bool last) {
+// step, or of one of its sub-steps, over (t1 − dt, t1]; `last`: the sub-step ending the step,
+// which ends at `stepEnd`.
+void System::runPhases(size_t first, size_t end, double dt, double t1, bool last, double stepEnd) {
     detail::State& s = *state_;
     const std::vector<Phase>& phases = s.schedule.phases;
     for (size_t i = first; i < end; ++i) {
@@ -154,7 +155,7 @@ void System::runPhases(size_t first, size_t end, double dt, double t1, bool last
                 // takes no more, and what it emits in each is queued in (sub-step, row) order.
                 uint32_t n = subStepCount(dt, p.stepLimit, s.typeStats[type].cappedSubSteps);
                 for (uint32_t k = 1; k <= n; ++k)
-                    runPhases(i + 1, i + 1 + p.span, dt / n, subStepEnd(t1, dt, k, n), last && k == n);
+                    runPhases(i + 1, i + 1 + p.span, dt / n, subStepEnd(t1, dt, k, n), last && k == n, stepEnd);
                 i += p.span;
                 continue;
             }
@@ -165,8 +166,8 @@ void System::runPhases(size_t first, size_t end, double dt, double t1, bool last
                 continue;
             case PhaseKind::Kills: detail::runKills(s, type, dt, t1); break;
             case PhaseKind::Emissions: detail::runEmissions(s, *creation_, type, dt, t1); break;
-            case PhaseKind::Create:
-                creation_->drain(t1);
+            case PhaseKind::Create:  // (after a sub-step too: its objects to the step's end)
+                creation_->drain(stepEnd);
                 s.stats.createSeconds += seconds(start, WallClock::now());
                 continue;
             case PhaseKind::Release:
@@ -198,7 +199,7 @@ std::optional<std::string> System::step(double dt) {
     // of no time too); then, unless no time passes, the rest. No time: no update runs, so
     // nothing moves, nothing is emitted, and no `prev` or `->` chain advances (it would count
     // updates, not time).
-    runPhases(0, 1, dt, s.now + dt, true);
+    runPhases(0, 1, dt, s.now + dt, true, s.now + dt);
     if (dt == 0) {
         ++s.stats.steps;
         return std::nullopt;
@@ -213,7 +214,7 @@ std::optional<std::string> System::step(double dt) {
         s.work[type].inStep = {drawing && s.types[type].render && s.types[type].drawn[0], false, false, 0, 0};
     // The rest of the schedule's phases: ready, per type, parents before children, its
     // update, kills and emissions (in sub-steps), what it queued created; release.
-    runPhases(1, s.schedule.phases.size(), dt, t1, true);
+    runPhases(1, s.schedule.phases.size(), dt, t1, true, t1);
     s.now = t1;
     for (detail::TypeWork& w : s.work) {
         w.inStep.fresh = w.inStep.on;

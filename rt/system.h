@@ -243,7 +243,7 @@ public:
 
 private:
     void start();
-    void runPhases(size_t first, size_t end, double dt, double t1, bool last);
+    void runPhases(size_t first, size_t end, double dt, double t1, bool last, double stepEnd);
     void initNewSlots(const ReloadReport& report);
 
     std::unique_ptr<detail::State> state_;

@@ -117,7 +117,19 @@ private:
     size_t groupQuiet(size_t from);  // see rt/system_queue.cpp
     // createBatch for a type whose rows are in the memory (rt/system_create_rows.cpp).
     void createInMemory(size_t type, Batch& b, size_t n, double t1);
-    Clock firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows, double t1, LateKills& late);
+    // `columns`: what goes to the pool rows after it (an emitter's accumulators join them).
+    Clock firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows, double t1, LateKills& late,
+                              std::vector<std::pair<Buffer, Buffer>>& columns);
+    // A batch's emissions the memory decides (emitInMemory): its bursts at creation, its
+    // first update's (`inUpdate`) of the rows `mask` selects — to t1 from each one's
+    // creation, or over each one's sub-step (`now`, `length`: RateSites) — the rates'
+    // accumulators starting at 0 where `fresh` (and joining `columns`, for the pool).
+    struct BatchSites {
+        bool atCreation = false, inUpdate = false, fresh = false;
+        Buffer mask, now, length;
+    };
+    void emitFromBatch(size_t type, Batch& b, size_t n, Buffer rows, double t1, const BatchSites& which,
+                       std::vector<std::pair<Buffer, Buffer>>& columns);
     void launchInMemory(size_t type, Batch& b, size_t n, const ir::Kernel& kernel, const ColumnLayout& layout,
                         std::vector<Buffer>& table, const Clock& clock, LateKills* late, Buffer mask = {});
     Buffer parentsOf(size_t type, Batch& b, size_t n, size_t kept);
@@ -184,6 +196,6 @@ struct Creation::Batch {
 
 // Scratch column indices of a batch.
 constexpr size_t kCreated = 0, kIds = 1, kKill = 2, kNow = 3, kDt = 4, kMask = 5, kStepMask = 6, kExportMask = 7,
-                 kZero = 8, kRenderMask = 9, kParents = 10, kFirstValue = 11;
+                 kZero = 8, kRenderMask = 9, kParents = 10, kLength = 11, kFirstValue = 12;
 
 }  // namespace psys::rt::detail

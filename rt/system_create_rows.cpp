@@ -103,9 +103,9 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
             break;
         }
     LateKills late;
-    const Clock toEnd = firstUpdateInMemory(type, b, n, rows, t1, late);
-    if (info.read) s_.ledger.listNow(late);  // its dead are dead to its children at once
     columns.clear();
+    const Clock toEnd = firstUpdateInMemory(type, b, n, rows, t1, late, columns);
+    if (info.read) s_.ledger.listNow(late);  // its dead are dead to its children at once
     for (size_t s = 0; s < o.state.size(); ++s)
         for (int c = 0; c < o.state[s].type.width; ++c)
             columns.push_back({table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)],
@@ -124,34 +124,44 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
                 columns.push_back({b.exportsTable[static_cast<size_t>(info.exportsLayout.exportOffset[e] + c)],
                                    pool.exports.column(e, static_cast<size_t>(c))});
     }
-    if (info.updateEmits || bursts) {  // each object's bursts at creation, then its first update's
-        RateSites in;                   // emissions; their accumulators to the pool
-        in.rows = n;
-        in.first = first;
-        in.mask = mask;
-        if (info.kills) in.killed = table[ColumnLayout::kKill];
-        in.created = table[ColumnLayout::kCreated];
-        in.fresh = true;
-        std::vector<size_t> sites;
-        for (size_t site = 0; bursts && site < o.emits.size(); ++site)
-            if (o.emits[site].atCreation()) {
-                in.sites.emplace_back().kind = RateSites::Site::Kind::AtCreation;
-                sites.push_back(site);
-            }
-        for (size_t site = 0; site < o.emits.size(); ++site) {
-            if (!o.emits[site].inUpdate()) continue;
-            RateSites::Site& out = in.sites.emplace_back();
-            out.kind = o.emits[site].rate() ? RateSites::Site::Kind::Rate : RateSites::Site::Kind::Burst;
-            sites.push_back(site);
-            if (!o.emits[site].rate()) continue;
-            out.accumulated = emissions_.at(site, Elem::F64, first + n);
-            columns.push_back({out.accumulated, pool.emitted[site]});
-        }
-        emitInMemory(type, table, nullptr, std::move(in), sites, &b, rows, t1);
-    }
+    // Each object's bursts at creation, then its first update's emissions (in sub-steps:
+    // firstUpdateInMemory's, each after its sub-step).
+    if ((info.updateEmits || bursts) && toEnd.now == Clock::Source::Uniform)
+        emitFromBatch(type, b, n, rows, t1, {bursts, info.updateEmits, true, mask, {}, {}}, columns);
     memory.scatter(columns, first, rows, 0, kept);
     if (!info.late) return;
     s_.ledger.defer(std::move(late));
+}
+
+void Creation::emitFromBatch(size_t type, Batch& b, size_t n, Buffer rows, double t1, const BatchSites& which,
+                             std::vector<std::pair<Buffer, Buffer>>& columns) {
+    const TypeInfo& info = s_.types[type];
+    const ir::Object& o = s_.pools[type].object();
+    RateSites in;
+    in.rows = n;
+    in.first = b.first;
+    in.mask = which.mask;
+    if (info.kills) in.killed = b.updateTable[ColumnLayout::kKill];
+    in.created = b.updateTable[ColumnLayout::kCreated];
+    in.now = which.now;
+    in.length = which.length;
+    in.fresh = which.fresh;
+    std::vector<size_t> sites;
+    for (size_t site = 0; which.atCreation && site < o.emits.size(); ++site)
+        if (o.emits[site].atCreation()) {
+            in.sites.emplace_back().kind = RateSites::Site::Kind::AtCreation;
+            sites.push_back(site);
+        }
+    for (size_t site = 0; which.inUpdate && site < o.emits.size(); ++site) {
+        if (!o.emits[site].inUpdate()) continue;
+        RateSites::Site& out = in.sites.emplace_back();
+        out.kind = o.emits[site].rate() ? RateSites::Site::Kind::Rate : RateSites::Site::Kind::Burst;
+        sites.push_back(site);
+        if (!o.emits[site].rate()) continue;
+        out.accumulated = emissions_.at(site, Elem::F64, b.first + n);
+        if (which.fresh) columns.push_back({out.accumulated, s_.pools[type].emitted[site]});
+    }
+    emitInMemory(type, b.updateTable, nullptr, std::move(in), sites, &b, rows, t1);
 }
 
 // The batch's first update to t1, its kills late (the last sub-step's into `late`); in
@@ -159,7 +169,8 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
 // object through its own (Memory::subStepClocks), the k-th of each at once, what one
 // kills taken out of the masks before the next (Ledger::takeOut) and freed at the step's
 // end. Returns the clock its exports are computed at: each row's last.
-Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows, double t1, LateKills& late) {
+Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows, double t1, LateKills& late,
+                                    std::vector<std::pair<Buffer, Buffer>>& columns) {
     const TypeInfo& info = s_.types[type];
     Pool& pool = s_.pools[type];
     std::vector<Buffer>& table = b.updateTable;
@@ -201,26 +212,29 @@ Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows
         s_.typeStats[type].cappedSubSteps += count;
     }
     const Clock perRow{Clock::Source::PerRow, Clock::Source::PerRow, 0, 0, false};
+    // An emitter's: its bursts at creation first (as the host queues every object's before
+    // its sub-steps), then each sub-step's emissions after its update, over the sub-step's
+    // own clock, before what it killed is taken out (its bursts on death are from them).
+    const bool emits = info.updateEmits, bursts = info.bursts && info.init;
+    Buffer length = emits ? b.columns.at(kLength, Elem::F64, end) : Buffer{};
+    if (bursts) emitFromBatch(type, b, n, rows, t1, {true, false, false, mask, {}, {}}, columns);
     Buffer taken;  // (the earlier sub-steps' kills, gathered: Ledger::takeOut)
     for (uint32_t k = 1; k <= most; ++k) {
         memory.subStepClocks(table[ColumnLayout::kCreated], mask, step, table[ColumnLayout::kNow],
-                             table[ColumnLayout::kDt], b.first, n, k, most, t1, info.stepLimit);
-        if (!info.late) {
-            launchInMemory(type, b, n, *info.update, info.updateLayout, table, perRow, nullptr, step);
-            continue;
-        }
-        if (k == most) {
-            launchInMemory(type, b, n, *info.update, info.updateLayout, table, perRow, &late, step);
-            break;
-        }
-        LateKills each = lateKills();
-        launchInMemory(type, b, n, *info.update, info.updateLayout, table, perRow, &each, step);
+                             table[ColumnLayout::kDt], length, b.first, n, k, most, t1, info.stepLimit);
+        std::optional<LateKills> each;
+        if (info.late && k < most) each = lateKills();
+        LateKills* kills = !info.late ? nullptr : k < most ? &*each : &late;
+        launchInMemory(type, b, n, *info.update, info.updateLayout, table, perRow, kills, step);
+        if (emits)
+            emitFromBatch(type, b, n, rows, t1, {false, true, k == 1, step, table[ColumnLayout::kNow], length}, columns);
+        if (!each) continue;
         if (!taken.valid()) {
             taken = pool.scratchRows(n + 1);
             s_.ledger.deferGathered(type, taken);
         }
-        s_.ledger.takeOut(each, taken, step);
-        s_.ledger.defer(std::move(each));
+        s_.ledger.takeOut(*each, taken, step);
+        s_.ledger.defer(std::move(*each));
     }
     return perRow;
 }

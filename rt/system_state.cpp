@@ -117,10 +117,8 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         bool silent = !info.kills && !info.unstable && !info.updateEmits && !info.read;
         info.rowsInMemory = inMemory && (info.late || silent) && !info.bursts && keptWhole(info);
     }
-    // Emitters whose emissions the memory decides (Memory::emitAtRate): nobody reads them,
-    // no sub-steps, every site emits — at a rate, in a burst at creation, on an edge or on
-    // death — into
-    // a type that keeps its rows in the memory (one that emits nothing, or such an emitter
+    // Emitters whose emissions the memory decides (Memory::emitAtRate): every site emits —
+    // at a rate, in a burst at creation, on an edge or on death — into a type that keeps its rows in the memory (one that emits nothing, or such an emitter
     // itself) and reads no parent, and whose arguments read no fold (a spawn launch from
     // records has no parent values) — so a step's emissions are one operation over the
     // rows, and the objects they create batches of those types, whose bursts at creation
@@ -132,7 +130,10 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     // One that dies exports nothing: the operation reads its update's kill flags where
     // they are (a row killed emits at no rate, and bursts), and its kills are late, as a
     // type's that only dies — nobody else looks at them before the step's end. (Until no
-    // type changes: an emitter of emitters follows them in.)
+    // type changes: an emitter of emitters follows them in.) One in sub-steps (@step) is
+    // read by nobody and exports nothing: each sub-step's emissions follow its update, over
+    // its clock, before what it killed is taken out of the masks (runEmissions; a new
+    // object's first update: Creation::firstUpdateInMemory).
     // Wherever rows are kept in the memory (a device's backend asks for it, any backend
     // with Rows::InMemory) and objects are created in batches. Where the emitters' rows are
     // on a device, the host still reads the operation's totals back in the step
@@ -179,7 +180,7 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         bool emitter = inMemory && options.createInBatches &&
                        (info.updateEmits || info.bursts) &&
                        (!dies || (options.lateKills && (!info.exports || parent))) && (!info.read || parent) &&
-                       keptWhole(info) && info.stepLimit == 0;
+                       keptWhole(info) && (info.stepLimit == 0 || (!info.read && !info.exports));
         int emitting = -1;  // the one target that emits, if any
         for (size_t s = 0; emitter && s < o.emits.size(); ++s) {
             auto target = static_cast<int>(info.emitTarget[s]);

@@ -96,6 +96,9 @@ struct TypeWork {
         // Where the type creates as its objects die (TypeInfo::emitsWhenKilled): the rows
         // this pass killed, in row order (no longer updatable when its emissions run).
         std::vector<uint32_t> dying;
+        // An emitter's sub-step kills, taken out after its emissions (its bursts on death
+        // are from the rows they kill): runKills leaves them to runEmissions.
+        std::optional<LateKills> untaken;
     } pass;
     std::vector<std::vector<Buffer>> spawnTables;  // per emit site: the pool's columns for its spawn kernel
 };

@@ -14,6 +14,21 @@
 
 namespace psys::rt::detail {
 
+namespace {
+
+// An earlier sub-step's late kills `l` of `type`, in the memory, taken out of its masks at
+// once (the next sub-step must not update them), gathered into the step's list.
+void takeOutKills(State& s, size_t type, LateKills& l) {
+    TypeWork& work = s.work[type];
+    if (!work.taken.valid()) {
+        work.taken = s.pools[type].scratchRows(s.pools[type].rows() + 1);
+        s.ledger.deferGathered(type, work.taken);
+    }
+    s.ledger.takeOut(l, work.taken);
+}
+
+}  // namespace
+
 // After an update of `type`: the survivors emit, and the objects it killed their bursts
 // on events (ir::EmitSite::whenKilled), in row order (their spawn launches run together at
 // the end; a killed object's row keeps its last values until the step's end). A rate or count every
@@ -42,6 +57,12 @@ void runEmissions(State& s, Creation& creation, size_t type, double dt, double t
         }
         creation.emitInMemory(type, work.updateTable, &uniforms, std::move(in), sites, nullptr, {}, t1);
         creation.runSpawns();
+        if (s.work[type].pass.untaken) {
+            LateKills& l = *s.work[type].pass.untaken;
+            takeOutKills(s, type, l);
+            s.ledger.defer(std::move(l));
+            s.work[type].pass.untaken.reset();
+        }
         return;
     }
     const uint8_t* updatable = pool.mask();
@@ -90,13 +111,11 @@ void runKills(State& s, size_t type, double dt, double t1) {
         l.dt = dt;
         for (size_t c = 0; c < chunks; ++c) l.parts.push_back(std::move(work.killed[c]));
         if (info.read && info.rowsInMemory) s.ledger.listNow(l);  // its dead are dead to its children at once
-        if (work.pass.takeOut) {  // the next sub-step must not update them
-            if (!work.taken.valid()) {
-                work.taken = s.pools[type].scratchRows(s.pools[type].rows() + 1);
-                s.ledger.deferGathered(type, work.taken);
-            }
-            s.ledger.takeOut(l, work.taken);
+        if (work.pass.takeOut && info.updateEmits) {  // (after its emissions: takeOutKills)
+            work.pass.untaken = std::move(l);
+            return;
         }
+        if (work.pass.takeOut) takeOutKills(s, type, l);
         s.ledger.defer(std::move(l));
         return;
     }
@@ -190,7 +209,7 @@ void runUpdate(State& s, const Phase& phase, double dt, double t1, bool last) {
     // (Phase::listed); late, a device need not wait for them.
     const bool listKills = phase.listed;
     size_t chunks = s.chunkCount(rows);
-    work.pass = {true, late, listKills && !late, late && !last, chunks, {}};
+    work.pass = {true, late, listKills && !late, late && !last, chunks, {}, {}};
     if (listKills || late) work.killed.resize(chunks);  // each chunk sets its own (Ledger::record)
     if (late && phase.inMemory)
         for (size_t c = 0; c < chunks; ++c)

@@ -73,6 +73,10 @@ TEST_CASE("rate emissions decided on the GPU: the host's runs, ids, drops and ac
     constexpr size_t kRows = 3000, kSites = 4;
     Emitters host(hostMemory, kRows, kSites, 5), device(gpu->memory(), kRows, kSites, 5);
     host.sites.sites[3].group = device.sites.sites[3].group = 1;
+    for (Emitters* e : {&host, &device}) {  // (each row's sub-step: some rounds)
+        e->sites.now = e->memory.create(rt::Elem::F64, 5 + kRows);
+        e->sites.length = e->memory.create(rt::Elem::F64, 5 + kRows);
+    }
     const rt::RecordLayout layout(host.sites);
     std::mt19937 random(11);
     const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
@@ -81,22 +85,29 @@ TEST_CASE("rate emissions decided on the GPU: the host's runs, ids, drops and ac
     for (int round = 0; round < 6; ++round) {
         INFO("round " << round);
         std::vector<uint8_t> mask(kRows), killed(kRows);
-        std::vector<double> created(kRows);
+        std::vector<double> created(kRows), now(kRows), length(kRows);
         for (size_t r = 0; r < kRows; ++r) {
             mask[r] = random() % 5 != 0;
             killed[r] = random() % 9 == 0;
-            created[r] = 1.0 + (random() % 1000) / 997.0;  // before t1 = 2.5
+            created[r] = 1.0 + (random() % 1000) / 997.0 + round;  // before t1 = 2.5 + round
+            // A sub-step of its first update: the k-th of 3, over a third of its span.
+            double span = 2.5 + round - created[r];
+            length[r] = span / 3;
+            now[r] = created[r] + span * static_cast<double>(r % 3 + 1) / 3;
         }
         for (Emitters* e : {&host, &device}) {
             e->write(e->sites.mask, mask);
             e->write(e->sites.killed, killed);
             e->write(e->sites.created, created);
+            e->write(e->sites.now, now);
+            e->write(e->sites.length, length);
             e->sites.dt = round % 2 ? 1.0 / 60 : 1.0 / 7;
             e->sites.t1 = 2.5 + round;
             e->sites.nextId = nextId;
         }
-        // Odd rounds clock each row from its creation (a batch's first update).
-        bool ownClock = round % 3 == 2;
+        // Some rounds clock each row from its creation (a batch's first update), some over
+        // each row's own sub-step (its end and length: RateSites::now, length).
+        bool ownClock = round % 3 == 2, subStep = round % 3 == 1;
         uint32_t shared = 0;  // the group's room
         for (size_t s = 0; s < kSites; ++s) {
             std::vector<float> rate(kRows), count(kRows);
@@ -122,8 +133,9 @@ TEST_CASE("rate emissions decided on the GPU: the host's runs, ids, drops and ac
         }
         auto run = [&](Emitters& e) {
             rt::RateSites in = e.sites;
-            if (!ownClock) in.created = {};
-            in.fresh = ownClock && round % 2 == 0;
+            if (!ownClock && !subStep) in.created = {};
+            if (!subStep) in.now = in.length = {};
+            in.fresh = (ownClock || subStep) && round % 2 == 0;
             for (size_t s = 0; s < kSites; ++s) {
                 if ((round + s) % 4 == 0) in.sites[s].rate = {};
                 if ((round + s) % 3 == 0) in.sites[s].count = {};
@@ -131,7 +143,7 @@ TEST_CASE("rate emissions decided on the GPU: the host's runs, ids, drops and ac
                 // (each row's creation time: where the round clocks rows from it).
                 using Kind = rt::RateSites::Site::Kind;
                 in.sites[s].kind = (round + s) % 5 == 1 ? Kind::Burst
-                                   : ownClock && (round + s) % 5 == 3 ? Kind::AtCreation
+                                   : (ownClock || subStep) && (round + s) % 5 == 3 ? Kind::AtCreation
                                                                      : Kind::Rate;
             }
             e.memory.emitAtRate(in, e.runs);

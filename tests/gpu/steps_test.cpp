@@ -40,13 +40,13 @@ TEST_CASE("a batch's sub-step clocks, a kill list's cleared and gathered rows: t
     const uint32_t most = rt::subStepCount(1.0 / 60, limit, capped);
     REQUIRE(most == 4);
     struct Columns {
-        rt::Buffer created, mask, step, now, dt, killed, updatable, alive, map, gathered;
+        rt::Buffer created, mask, step, now, dt, killed, updatable, alive, map, gathered, length;
     };
     auto columnsOn = [&](rt::Memory& m) {
         Columns c{m.create(rt::Elem::F64, first + n), m.create(rt::Elem::U8, first + n), m.create(rt::Elem::U8, first + n),
                   m.create(rt::Elem::F64, first + n), m.create(rt::Elem::F32, first + n), m.create(rt::Elem::U32, n + 1),
                   m.create(rt::Elem::U8, first + n), m.create(rt::Elem::U8, first + n),
-                  m.create(rt::Elem::U32, n), m.create(rt::Elem::U32, n + 1)};
+                  m.create(rt::Elem::U32, n), m.create(rt::Elem::U32, n + 1), m.create(rt::Elem::F64, first + n)};
         std::vector<uint32_t> through(n);
         for (uint32_t r = 0; r < n; ++r) through[r] = (r * 7919 + 5) % static_cast<uint32_t>(n);  // (a permutation)
         m.write(c.map, 0, n, through.data());
@@ -61,9 +61,11 @@ TEST_CASE("a batch's sub-step clocks, a kill list's cleared and gathered rows: t
     Columns host = columnsOn(hostMemory), device = columnsOn(gpu->memory());
     size_t killedSoFar = 0;
     for (uint32_t k = 1; k <= most; ++k) {
-        hostMemory.subStepClocks(host.created, host.mask, host.step, host.now, host.dt, first, n, k, most, t1, limit);
-        gpu->memory().subStepClocks(device.created, device.mask, device.step, device.now, device.dt, first, n, k, most,
-                                    t1, limit);
+        const bool wide = k % 2 == 1;  // (the unrounded lengths asked for, or not)
+        hostMemory.subStepClocks(host.created, host.mask, host.step, host.now, host.dt, wide ? host.length : rt::Buffer{},
+                                 first, n, k, most, t1, limit);
+        gpu->memory().subStepClocks(device.created, device.mask, device.step, device.now, device.dt,
+                                    wide ? device.length : rt::Buffer{}, first, n, k, most, t1, limit);
         std::vector<uint8_t> stepHost(n), stepDevice(n);
         std::vector<double> nowHost(n), nowDevice(n);
         std::vector<float> dtHost(n), dtDevice(n);
@@ -77,6 +79,14 @@ TEST_CASE("a batch's sub-step clocks, a kill list's cleared and gathered rows: t
         REQUIRE(stepHost == stepDevice);
         CHECK(std::memcmp(nowHost.data(), nowDevice.data(), n * sizeof(double)) == 0);
         CHECK(std::memcmp(dtHost.data(), dtDevice.data(), n * sizeof(float)) == 0);
+        if (wide) {
+            std::vector<double> lengthHost(n), lengthDevice(n);
+            hostMemory.read(host.length, first, n, lengthHost.data());
+            gpu->memory().read(device.length, first, n, lengthDevice.data());
+            CHECK(std::memcmp(lengthHost.data(), lengthDevice.data(), n * sizeof(double)) == 0);
+            for (size_t r = 0; r < n; ++r)
+                if (stepHost[r]) CHECK(static_cast<float>(lengthHost[r]) == dtHost[r]);
+        }
         size_t stepped = 0;
         for (size_t r = 0; r < n; ++r) stepped += stepHost[r];
         CHECK(stepped > (k == 1 ? n / 2 : 10));
@@ -145,6 +155,29 @@ TEST_CASE("objects in sub-steps keep their rows on the GPU: the interpreter's ob
     CHECK(p.stats("comet").created == 6);  // (the launcher's 2 s at 3 a second)
     CHECK(frozen > 0);  // comets waited, frozen, for their tails
     CHECK(p.stats("comet.tail").killed > 200);
+}
+
+TEST_CASE("emitters in sub-steps decide their emissions on the GPU: the interpreter's objects, ids and rows") {
+    // tests/programs/step_emitters_in_sub_steps.psys: fuses in sub-steps, each new one
+    // through its own in its first update, emit drops at a rate that grows with their age,
+    // in a burst at creation and on death, and die between sub-steps; a sprinkler that
+    // never dies emits in sub-steps of its own; the drops' pool drops at capacity.
+    test::Pair p(readFile(test::programsDir() + "/step_emitters_in_sub_steps.psys"));
+    for (const char* type : {"drop", "fuse", "sprinkler", "launcher"})
+        CHECK(p.gl->pool(static_cast<size_t>(p.gl->typeIndex(type))).rowsInMemory());
+    auto& gpu = *p.gpu;
+    uint64_t waits = 0, hitch = 0;
+    for (int f = 0; f < 150; ++f) {
+        uint64_t before = gpu.waits();
+        p.steps(1, f == 60 ? 0.25 : 1.0 / 60);  // (a hitch: 50 sub-steps of a fuse)
+        (f == 60 ? hitch : waits) = std::max(f == 60 ? hitch : waits, gpu.waits() - before);
+        p.compare();
+    }
+    CHECK(p.stats("drop").dropped > 0);
+    CHECK(p.stats("fuse").created > 20);
+    CHECK(p.stats("fuse").killed > 20);
+    // A wait a sub-step of each emitter type, for its emissions' totals (docs/gpu.md).
+    MESSAGE("emitters in sub-steps: at most " << waits << " waits a step at 1/60 s, " << hitch << " at a step of 0.25 s");
 }
 
 TEST_CASE("a fountain in sub-steps on the GPU: what a step moves and waits for does not grow with its drops") {

@@ -125,19 +125,26 @@ TEST_CASE("the schedule says which types keep their rows in the memory, and wher
     CHECK(rt::printSchedule(shapes.schedule()).find("shapes: rate emissions (mote, spark, mote, mote, mote) decided by the "
                                                     "memory's operation") != std::string::npos);
     // Drops in sub-steps keep their rows in the memory: each sub-step's kills listed there
-    // (an earlier one's taken out of the masks at once); an emitter in sub-steps keeps
-    // its rows on the host (its emissions are the host's, sub-step by sub-step).
+    // (an earlier one's taken out of the masks at once); so does their emitter in
+    // sub-steps, its emissions the memory's each sub-step — one whose children read it
+    // keeps its rows on the host.
     rt::System stepped(test::compileModule("@step(1/240) object d { point(vec3(age), white, 1); kill when age > rand(); }\n"
                                            "@step(1/240) object e { emit d at 100 per second; }\nspawn e;"),
                        backend, options);
     CHECK(stepped.pool(static_cast<size_t>(stepped.typeIndex("d"))).rowsInMemory());
-    CHECK_FALSE(stepped.pool(static_cast<size_t>(stepped.typeIndex("e"))).rowsInMemory());
+    CHECK(stepped.pool(static_cast<size_t>(stepped.typeIndex("e"))).rowsInMemory());
+    rt::System read(test::compileModule("@step(1/240) object c { pos = vec3(age); emit t at 50 per second;\n"
+                                        "object t { point(c.pos, white, 1); kill when age > 0.2; } }\nspawn c;"),
+                    backend, options);
+    CHECK_FALSE(read.pool(static_cast<size_t>(read.typeIndex("c"))).rowsInMemory());
     printed = rt::printSchedule(stepped.schedule());
     CHECK(printed.find("d: the next 2 phases once per sub-step") != std::string::npos);
     CHECK(printed.find("  update     chunks on every thread   d: the update kernel over the pool, its kills listed in "
                        "the memory") != std::string::npos);
     CHECK(printed.find("d: the kill lists kept for the step's end, where the memory frees them; an earlier sub-step's "
                        "taken out of the masks there at once") != std::string::npos);
+    CHECK(printed.find("  emissions  in order                 e: rate emissions (d) decided by the memory's operation") !=
+          std::string::npos);
     // An emitter of two types of emitters: the host decides its emissions (their children
     // take ids one emitter at a time); the two emitters' rows are in the memory.
     rt::System two(test::compileModule(test::readFile(std::string(PSYS_PROGRAMS_DIR) + "/two_kinds_of_emitter_from_one.psys")),
