@@ -128,7 +128,7 @@ float ov(uint s, uint j) {{ return uintBitsToFloat(ow[s * lw(1u) + j]); }}  // (
 std::string gridCountShader() {
     return fmt::format(R"(#version 450
 layout(local_size_x = 256) in;
-layout(std140, binding = 1) uniform Params {{ uvec4 P[2]; }};
+layout(std140, binding = 1) uniform Params {{ uvec4 P[3]; }};
 uint param(uint k) {{ return P[k >> 2u][k & 3u]; }}
 layout(std430, binding = 2) readonly buffer Other {{ uint ow[]; }};
 layout(std430, binding = 3) writeonly buffer BucketOf {{ uint bucketOf[]; }};

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -281,6 +282,7 @@ std::pair<uint32_t, uint32_t> doubleWords(double x) {
 // on the host side), wherever the runs buffer was (its length is not the pool's: rows ·
 // sites records); on the GPU otherwise.
 void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs) {
+    if (in.now.valid() != in.length.valid()) throw std::logic_error("rate sites with a row's end but not its length");
     std::vector<Buffer> used = {in.mask, in.killed, in.created, in.now, in.length};
     for (const rt::RateSites::Site& s : in.sites) used.insert(used.end(), {s.rate, s.count, s.accumulated});
     const size_t sites = in.sites.size(), n = in.rows;

@@ -78,11 +78,13 @@ std::vector<uint32_t> GlslBackend::emitterBlock(GlMemory& memory, const Program&
 void GlslBackend::run(const rt::ChildrenLaunch& launch) { runChildren({&launch, 1}); }
 
 // Whether a launch from records can have its blocks built where the records are: the
-// records, the emitters' rows and their columns all on the GPU — and, where its group
+// records, the emitters' rows, their sub-step ends and their columns all on the GPU — and, where its group
 // has other sites (its children's arguments among theirs), the arguments written in
 // place (a dispatch's words are copied to the columns a launch's range at a time).
 bool GlslBackend::blocksOnDevice(const rt::ChildrenLaunch& launch) {
-    if (!memory_.onDevice(launch.records) || (launch.rows.valid() && !memory_.onDevice(launch.rows))) return false;
+    if (!memory_.onDevice(launch.records) || (launch.rows.valid() && !memory_.onDevice(launch.rows)) ||
+        (launch.nows.valid() && !memory_.onDevice(launch.nows)))
+        return false;
     const Program& p = childrenProgram(*launch.object, *launch.spawn);
     if (launch.recordStride > 1 && p.direct.empty()) return false;
     for (const RowField& f : rowFields(p, launch))
@@ -152,9 +154,10 @@ namespace {
 // listed in a table after the template: argument columns, fields, then a word a field
 // (block word | words a row << 24). Params: records, the first record's word, the
 // template's word, the first block's word, words a block, flags (1: emitter rows from a
-// list, 2: fields only, 4: now the record's first time; the records' stride from bit 8),
-// the first row (of the list, or of the columns), the table's word.
-constexpr size_t kBlockSources = 13;
+// list, 2: fields only, 4: now the record's first time, 8: now the emitter's own, from a
+// column of f64 at param 8 on; the records' stride from bit 8), the first row (of the
+// list, or of the columns), the table's word.
+constexpr size_t kBlockSources = 12;
 constexpr size_t kTableWords = 2 + kBlockSources;
 
 std::string blocksShader() {
@@ -168,6 +171,7 @@ layout(local_size_x = 64) in;
 {0}layout(std430, binding = 0) buffer Words {{ uint w[]; }};
 layout(std430, binding = 1) readonly buffer Records {{ uint records[]; }};
 layout(std430, binding = 2) readonly buffer Rows {{ uint rowOf[]; }};
+layout(std430, binding = 15) readonly buffer Nows {{ uint nows[]; }};
 {1}uint source(uint f, uint o) {{ switch (f) {{ {2}}} return 0u; }}
 void main() {{
     uint k = {3};
@@ -182,6 +186,10 @@ void main() {{
         if ((param(5u) & 4u) != 0u) {{
             w[at + {10}u] = records[r + 4u];
             w[at + {10}u + 1u] = records[r + 5u];
+        }}
+        if ((param(5u) & 8u) != 0u) {{
+            w[at + {10}u] = nows[2u * (param(8u) + k)];
+            w[at + {10}u + 1u] = nows[2u * (param(8u) + k) + 1u];
         }}
         for (uint c = 0u; c < w[table]; ++c) w[at + {8}u + c] += place;
     }}
@@ -343,12 +351,14 @@ void GlslBackend::buildBlocks(const rt::ChildrenLaunch& launch, const std::vecto
         for (size_t k = 0; k < kBlockSources; ++k)  // (every block bound to something)
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, static_cast<GLuint>(3 + k),
                              from + k < fields.size() ? memory_.deviceBuffer(fields[from + k].column) : records);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 15, launch.nows.valid() ? memory_.deviceBuffer(launch.nows) : records);
         uint32_t flags = (launch.rows.valid() ? 1u : 0u) | (pass > 0 ? 2u : 0u) | (launch.nowFromRecords ? 4u : 0u) |
-                         static_cast<uint32_t>(launch.recordStride) << 8;
+                         (launch.nows.valid() ? 8u : 0u) | static_cast<uint32_t>(launch.recordStride) << 8;
         bindParams(params_, {static_cast<uint32_t>(launch.recordCount), static_cast<uint32_t>(launch.record * rt::kRunWords),
                              static_cast<uint32_t>(templateAt), static_cast<uint32_t>(firstWord),
                              static_cast<uint32_t>(recordWords), flags, static_cast<uint32_t>(launch.rowsFirst),
-                             static_cast<uint32_t>(templateAt + recordWords + pass * kTableWords)});
+                             static_cast<uint32_t>(templateAt + recordWords + pass * kTableWords),
+                             static_cast<uint32_t>(launch.nowsFirst)});
         glUseProgram(blocksProgram_);
         dispatchInvocations(launch.recordCount, 64);
         ++memory_.dispatches;

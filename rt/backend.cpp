@@ -8,6 +8,11 @@ namespace psys::rt {
 std::vector<ChildrenLaunch> eachEmitter(const Memory& memory, const ChildrenLaunch& launch) {
     if (launch.recordCount == 0) return {};
     std::vector<uint32_t> records(((launch.recordCount - 1) * launch.recordStride + 1) * kRunWords), rows;
+    std::vector<double> nows;
+    if (launch.nows.valid()) {
+        nows.resize(launch.recordCount);
+        memory.read(launch.nows, launch.nowsFirst, nows.size(), nows.data());
+    }
     memory.read(launch.records, launch.record * kRunWords, records.size(), records.data());
     if (launch.rows.valid()) {
         rows.resize(launch.recordCount);
@@ -18,12 +23,13 @@ std::vector<ChildrenLaunch> eachEmitter(const Memory& memory, const ChildrenLaun
         const uint32_t* w = records.data() + k * launch.recordStride * kRunWords;
         if (w[1] == 0) continue;
         ChildrenLaunch& one = each.emplace_back(launch);
-        one.records = one.rows = {};
-        one.record = one.recordCount = one.rowsFirst = one.placed = 0;
+        one.records = one.rows = one.nows = {};
+        one.record = one.recordCount = one.rowsFirst = one.placed = one.nowsFirst = 0;
         one.recordStride = 1;
         one.nowFromRecords = false;
         one.row = rows.empty() ? static_cast<uint32_t>(launch.rowsFirst + k) : rows[k];
         if (launch.nowFromRecords) std::memcpy(&one.clock.nowValue, w + 4, 8);
+        if (!nows.empty()) one.clock.nowValue = nows[k];
         one.firstChild = w[2];
         one.count = w[1];
         one.argsFirst = launch.argsFirst + w[0];

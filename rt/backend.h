@@ -113,13 +113,17 @@ struct ChildrenLaunch {
     // of emitter row `rows`[rowsFirst + k] (row rowsFirst + k where `rows` is not valid),
     // its children at argsFirst plus its place among its group's (the record's word 0),
     // drawn from its first id (word 2) on, its clock's now the record's first time where
-    // `nowFromRecords` (a burst at creation: each emitter's creation time); `count` is then
+    // `nowFromRecords` (a burst at creation: each emitter's creation time), or emitter k's
+    // nows[nowsFirst + k] (f64) where `nows` is valid (a new emitter's sub-step: its end, as
+    // the host clocks it: Creation::killOrEmit); `count` is then
     // the children of all of them, `placed` those of their group (the argument rows
     // [argsFirst, argsFirst + placed) they write among), and `row` and `firstChild` are
     // not used.
     Buffer records, rows;
     size_t record = 0, recordCount = 0, recordStride = 1, rowsFirst = 0, placed = 0;
     bool nowFromRecords = false;
+    Buffer nows;
+    size_t nowsFirst = 0;
 };
 
 // A launch from records as one launch an emitter (those with children), read from the

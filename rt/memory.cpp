@@ -318,6 +318,7 @@ RecordLayout::RecordLayout(const RateSites& in) : first(in.sites.size()), stride
 // rt/emission.h's rules row by row, each group's objects kept while its room lasts, the
 // ids in row order.
 void Memory::emitAtRate(const RateSites& in, Buffer runs) {
+    if (in.now.valid() != in.length.valid()) throw std::logic_error("rate sites with a row's end but not its length");
     const size_t n = in.rows, sites = in.sites.size();
     auto* record = static_cast<uint32_t*>(host(runs));
     uint32_t* total = record + runsTotalsAt(n, sites);

@@ -188,16 +188,19 @@ Schedule stepSchedule(const State& s) {
             emissions.events = info.emitsWhenKilled;
             emissions.inMemory = info.rowsInMemory;  // Memory::emitAtRate
         }
-        // An emitter in the memory, in sub-steps, of objects that emit nothing and read no
-        // parent: what each sub-step queued is created after it, to the step's end — the
-        // rows, ids and order it would take after the last (nothing between frees or takes
-        // their rows, and they create nothing), but each sub-step's records of its emissions
-        // (Memory::emitAtRate: its rows × sites) go with it, not held through every
-        // sub-step of a hitch.
+        // An emitter in the memory, in sub-steps, of objects that emit nothing, read no
+        // parent and take no sub-steps: what each sub-step queued is created after it, to
+        // the step's end — the rows, ids and order it would take after the last (nothing
+        // between frees or takes their rows, they create nothing, and what their first
+        // update kills is freed in their queue order either way: a target in sub-steps
+        // would free them in (batch, sub-step, row) order, not (sub-step, row)) — but each
+        // sub-step's records of its emissions (Memory::emitAtRate: its rows × sites) go
+        // with it, not held through every sub-step of a hitch.
         bool eachSubStep = info.stepLimit > 0 && info.rowsInMemory && info.updateEmits &&
                            std::all_of(targets.begin(), targets.end(), [&](int target) {
+                               const TypeInfo& to = s.types[static_cast<size_t>(target)];
                                return s.module.objects[static_cast<size_t>(target)].emits.empty() &&
-                                      s.types[static_cast<size_t>(target)].parentType < 0;
+                                      to.parentType < 0 && to.stepLimit == 0;
                            });
         if (eachSubStep) add(PhaseKind::Create, type, Parallelism::Ordered).targets = targets;
         if (info.stepLimit > 0) out.phases[group].span = out.phases.size() - group - 1;

@@ -28,7 +28,7 @@ size_t components(const std::vector<ir::StateSlot>& slots) {
 
 }  // namespace
 
-Creation::Creation(State& state) : s_(state), emissions_(state.memory), runs_(state.memory) {
+Creation::Creation(State& state) : s_(state), emissions_(state.memory), runs_(state.memory), subStepNows_(state.memory) {
     queued_.assign(s_.pools.size(), 0);
     pending_.assign(s_.pools.size(), 0);
     staging_.resize(s_.pools.size());
@@ -361,8 +361,8 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
         }
         return;
     }
-    // Sub-steps: every object through its own, the k-th of each at once.
-    inOrder(true, [&](size_t r) { queueBursts(type, b, r); });
+    // Sub-steps: every object through its own, the k-th of each at once; each object's
+    // bursts at creation just before its first sub-step's emissions, as in one update.
     auto* stepMask = s_.host<uint8_t>(b.columns.at(kStepMask, Elem::U8, end));
     auto* now = s_.host<double>(table[ColumnLayout::kNow]);
     auto* dt = s_.host<float>(table[ColumnLayout::kDt]);
@@ -377,7 +377,8 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
             dt[i] = static_cast<float>(b.spans[r] / steps);
         }
         advance(type, b, n, kStepMask, {Clock::Source::PerRow, Clock::Source::PerRow, 0, 0, false});
-        inOrder(false, [&](size_t r) {
+        inOrder(k == 1, [&](size_t r) {
+            if (k == 1) queueBursts(type, b, r);
             if (stepMask[first + r]) killOrEmit(type, b, r, b.spans[r] / b.subSteps[r], now[first + r]);
         });
     }

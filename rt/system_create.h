@@ -175,6 +175,7 @@ private:
     std::vector<float> rate_, count_;
     Scratch emissions_;  // emitInMemory's: a new batch's accumulators by site,
     Scratch runs_;       // and the runs of each call in a drain (runsUsed_ of them so far)
+    Scratch subStepNows_;  // a new emitter batch's sub-step ends, by sub-step (its spawn launches')
     size_t runsUsed_ = 0;
 };
 

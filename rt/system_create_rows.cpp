@@ -212,22 +212,27 @@ Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows
         s_.typeStats[type].cappedSubSteps += count;
     }
     const Clock perRow{Clock::Source::PerRow, Clock::Source::PerRow, 0, 0, false};
-    // An emitter's: its bursts at creation first (as the host queues every object's before
-    // its sub-steps), then each sub-step's emissions after its update, over the sub-step's
-    // own clock, before what it killed is taken out (its bursts on death are from them).
+    // An emitter's: each sub-step's emissions after its update, over the sub-step's own
+    // clock, before what it killed is taken out (its bursts on death are from them); its
+    // bursts at creation with the first's, each object's just before its own emissions,
+    // as the host queues them (Creation::firstUpdate).
     const bool emits = info.updateEmits, bursts = info.bursts && info.init;
     Buffer length = emits ? b.columns.at(kLength, Elem::F64, end) : Buffer{};
-    if (bursts) emitFromBatch(type, b, n, rows, t1, {true, false, false, mask, {}, {}}, columns);
     Buffer taken;  // (the earlier sub-steps' kills, gathered: Ledger::takeOut)
     for (uint32_t k = 1; k <= most; ++k) {
+        // (An emitter's spawn launches, run after the batch, read each sub-step's ends: a
+        // column of each sub-step's own.)
+        if (emits) table[ColumnLayout::kNow] = subStepNows_.at(k - 1, Elem::F64, end);
         memory.subStepClocks(table[ColumnLayout::kCreated], mask, step, table[ColumnLayout::kNow],
                              table[ColumnLayout::kDt], length, b.first, n, k, most, t1, info.stepLimit);
         std::optional<LateKills> each;
         if (info.late && k < most) each = lateKills();
         LateKills* kills = !info.late ? nullptr : k < most ? &*each : &late;
         launchInMemory(type, b, n, *info.update, info.updateLayout, table, perRow, kills, step);
-        if (emits)
-            emitFromBatch(type, b, n, rows, t1, {false, true, k == 1, step, table[ColumnLayout::kNow], length}, columns);
+        if (emits || (bursts && k == 1))  // (in the first sub-step every object kept takes: step is mask)
+            emitFromBatch(type, b, n, rows, t1,
+                          {bursts && k == 1, emits, k == 1, step, emits ? table[ColumnLayout::kNow] : Buffer{}, length},
+                          columns);
         if (!each) continue;
         if (!taken.valid()) {
             taken = pool.scratchRows(n + 1);
@@ -351,6 +356,10 @@ void Creation::queueFromRecords(size_t type, const RateSites& in, std::span<cons
             launch->rows = atCreation ? Buffer{} : rows;
             launch->rowsFirst = atCreation ? batch->first : 0;
             launch->nowFromRecords = atCreation;
+            if (!atCreation && in.now.valid()) {  // (each emitter's sub-step end: a buffer of this sub-step's)
+                launch->nows = in.now;
+                launch->nowsFirst = in.first;
+            }
         }
         enqueue({target, base, kept, {}, 0, 0, 1, 0, runs, records.first[group], n * records.stride[group],
                  records.stride[group], rows});

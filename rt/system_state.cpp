@@ -190,6 +190,13 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
             emitter = emitter && (emitting < 0 || emitting == target);
             emitting = target;
         }
+        // (An emitting target in sub-steps, with targets of other types beside it: the host
+        // queues each emitter's objects of every type in turn, so it creates the emitting
+        // ones in batches of one, each through all its sub-steps before the next; one run of
+        // them would take their k-th sub-steps together, its emissions' ids in another order.)
+        if (emitter && emitting >= 0 && types[static_cast<size_t>(emitting)].stepLimit > 0)
+            for (size_t s = 0; s < o.emits.size(); ++s)
+                if (static_cast<int>(info.emitTarget[s]) != emitting) emitter = false;
         return emitter;
     };
     for (bool more = true; more;) {

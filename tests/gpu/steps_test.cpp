@@ -160,10 +160,11 @@ TEST_CASE("objects in sub-steps keep their rows on the GPU: the interpreter's ob
 TEST_CASE("emitters in sub-steps decide their emissions on the GPU: the interpreter's objects, ids and rows") {
     // tests/programs/step_emitters_in_sub_steps.psys: fuses in sub-steps, each new one
     // through its own in its first update, emit drops at a rate that grows with their age,
-    // in a burst at creation and on death, and die between sub-steps; a sprinkler that
-    // never dies emits in sub-steps of its own; the drops' pool drops at capacity.
+    // in a burst at creation and on death, and die between sub-steps; crackers burst at
+    // creation and die at once; a sprinkler and a flare that never die emit in sub-steps of
+    // their own (the flare's sparks created after each); the drops' pool drops at capacity.
     test::Pair p(readFile(test::programsDir() + "/step_emitters_in_sub_steps.psys"));
-    for (const char* type : {"drop", "fuse", "sprinkler", "launcher"})
+    for (const char* type : {"drop", "fuse", "sprinkler", "launcher", "popper", "cracker", "flare", "spark", "pops"})
         CHECK(p.gl->pool(static_cast<size_t>(p.gl->typeIndex(type))).rowsInMemory());
     auto& gpu = *p.gpu;
     uint64_t waits = 0, hitch = 0;
