@@ -317,13 +317,16 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
     });
     s_.typeStats[type].cappedSubSteps += capped;
     // In queue order: `each(r, ordinal)` for the objects created, with the accounting of
-    // rows allocated for the objects after them.
+    // rows allocated for the objects after them — as they leave the queue (an update, a
+    // first sub-step); at a later sub-step every object of the batch is there, and what
+    // they emit into their own type sees the pool's free rows alone (as where the memory
+    // decides: Creation::createInMemory).
     auto inOrder = [&](bool leaveQueue, auto each) {
         size_t ordinal = 0;
         for (size_t r = 0; r < n; ++r) {
             if (leaveQueue) --queued_[type];
             if (b.poolRows[r] == kSkipRow) continue;
-            pending_[type] = allocated - 1 - ordinal++;
+            pending_[type] = leaveQueue ? allocated - 1 - ordinal++ : 0;
             each(r);
         }
         pending_[type] = 0;

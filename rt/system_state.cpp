@@ -138,15 +138,15 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     // with Rows::InMemory) and objects are created in batches. Where the emitters' rows are
     // on a device, the host still reads the operation's totals back in the step
     // (docs/gpu.md, "Emitters in the memory").
-    // Children in the memory beside their parents: a nested type that nobody reads and
-    // that emits nothing, whose kills are late or who never dies (as a type that only dies,
-    // in sub-steps too: its parents' values gathered at each sub-step's clock), created in
-    // a batch, reading of its parent (one level up) only its exports,
-    // whether it is alive and its age — its parent type's rows in the memory too (below), so
-    // that the parents' rows, readers and frozen objects are the memory's
-    // (Memory::releaseUnread).
-    // Its parent type is then such an emitter with no parent of its own, every type that
-    // reads it such a child. (A fold over it reads the rows updatable at the step's start,
+    // Children in the memory beside their parents: a nested type that nobody reads, created
+    // in a batch, reading of its parent (one level up) only its exports, whether it is alive
+    // and its age, that emits nothing and whose kills are late or who never dies (as a type
+    // that only dies, in sub-steps too: its parents' values gathered at each sub-step's
+    // clock) — or that is an emitter in the memory itself — its parent type's rows in the
+    // memory too (below), so that the parents' rows, readers and frozen objects are the
+    // memory's (Memory::releaseUnread).
+    // Its parent type is then such an emitter with no parent of its own (a child is read by
+    // nobody), every type that reads it such a child. (A fold over it reads the rows updatable at the step's start,
     // as on the host: a frozen parent is not among them.)
     auto readsLikeAChild = [&](const ColumnLayout& layout) {
         return std::all_of(layout.parentColumns.begin(), layout.parentColumns.end(), [](const ColumnLayout::ParentColumn& p) {
@@ -154,7 +154,8 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
                                                              p.op == ir::Op::ParentAge));
         });
     };
-    std::vector<bool> child(types.size(), false);
+    // (A child that emits is such an emitter itself, below: `candidate`.)
+    std::vector<bool> childShape(types.size(), false), quietChild(types.size(), false);
     for (size_t t = 0; t < types.size(); ++t) {
         const TypeInfo& info = types[t];
         const ir::Object& o = module.objects[t];
@@ -162,15 +163,28 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         std::vector<const ColumnLayout*> layouts = {&info.updateLayout, &info.exportsLayout, &info.renderLayout};
         ColumnLayout init;
         if (info.init) layouts.push_back(&(init = columnLayout(o, *info.init)));
-        child[t] = inMemory && options.createInBatches && info.parentType >= 0 && (info.late || silent) && !info.read &&
-                   o.emits.empty() && !(options.drawInStep && backend.rendersInStep() && info.render) &&
-                   std::all_of(layouts.begin(), layouts.end(), [&](const ColumnLayout* l) { return readsLikeAChild(*l); });
+        childShape[t] = inMemory && options.createInBatches && info.parentType >= 0 && !info.read &&
+                        !(options.drawInStep && backend.rendersInStep() && info.render) &&
+                        std::all_of(layouts.begin(), layouts.end(), [&](const ColumnLayout* l) { return readsLikeAChild(*l); });
+        quietChild[t] = childShape[t] && (info.late || silent) && o.emits.empty();
     }
+    // Emitters are decided together, as the greatest set that holds: every type starts a
+    // candidate and one that fails its rules — a target outside the memory among them —
+    // leaves, until none does; so an emitter of its own type (a rocket of rockets), two
+    // emitters of each other, and a child that emits beside its parent keep their rows in
+    // the memory, as a chain of emitters does.
+    std::vector<bool> candidate(types.size(), true);
+    auto child = [&](size_t t) { return quietChild[t] || (childShape[t] && candidate[t]); };
     // A type whose readers are all such children.
     auto readByChildren = [&](size_t t) {
         for (size_t c = 0; c < types.size(); ++c)
-            if (types[c].parentType == static_cast<int>(t) && !child[c]) return false;
+            if (types[c].parentType == static_cast<int>(t) && !child(c)) return false;
         return true;
+    };
+    auto inMemoryOr = [&](size_t target) {
+        int parent = types[target].parentType;
+        return types[target].rowsInMemory || candidate[target] ||
+               (child(target) && parent >= 0 && candidate[static_cast<size_t>(parent)]);
     };
     auto decidedInMemory = [&](size_t t) {
         const TypeInfo& info = types[t];
@@ -180,12 +194,13 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         bool emitter = inMemory && options.createInBatches &&
                        (info.updateEmits || info.bursts) &&
                        (!dies || (options.lateKills && (!info.exports || parent))) && (!info.read || parent) &&
-                       keptWhole(info) && (info.stepLimit == 0 || (!info.read && !info.exports));
+                       (keptWhole(info) || (childShape[t] && candidate[static_cast<size_t>(info.parentType)])) &&
+                       (info.stepLimit == 0 || (!info.read && !info.exports));
         int emitting = -1;  // the one target that emits, if any
         for (size_t s = 0; emitter && s < o.emits.size(); ++s) {
             auto target = static_cast<int>(info.emitTarget[s]);
-            bool itsChild = child[static_cast<size_t>(target)] && types[static_cast<size_t>(target)].parentType == static_cast<int>(t);
-            emitter = (types[static_cast<size_t>(target)].rowsInMemory || itsChild) && info.spawnLayout[s].parentColumns.empty();
+            bool itsChild = child(static_cast<size_t>(target)) && types[static_cast<size_t>(target)].parentType == static_cast<int>(t);
+            emitter = (inMemoryOr(static_cast<size_t>(target)) || itsChild) && info.spawnLayout[s].parentColumns.empty();
             if (module.objects[static_cast<size_t>(target)].emits.empty()) continue;
             emitter = emitter && (emitting < 0 || emitting == target);
             emitting = target;
@@ -199,16 +214,39 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
                 if (static_cast<int>(info.emitTarget[s]) != emitting) emitter = false;
         return emitter;
     };
-    for (bool more = true; more;) {
-        more = false;
-        for (size_t t = 0; t < types.size(); ++t) {
-            TypeInfo& info = types[t];
-            if (info.rowsInMemory || !decidedInMemory(t)) continue;
-            info.rowsInMemory = more = true;
-            info.late = info.late || info.kills || info.unstable;
-            for (TypeInfo& c : types)  // (its children: `child` above)
-                if (c.parentType == static_cast<int>(t)) c.rowsInMemory = true;
+    // Except a chain of bursts at creation (`object a { emit a; … }`, or a and b bursting
+    // each other): every object makes the next wave in its first update, so where the memory
+    // decides, a wave of one object is a batch of a dozen dispatches and a wait on a GPU —
+    // 10,000 waves took 9.2 s a step where the host takes 0.26 s for 600 (docs/gpu.md).
+    std::vector<bool> chained(types.size(), false);
+    for (size_t from = 0; from < types.size(); ++from) {
+        std::vector<bool> seen(types.size(), false);
+        std::vector<size_t> next = {from};
+        while (!next.empty() && !chained[from]) {
+            size_t t = next.back();
+            next.pop_back();
+            for (size_t e = 0; e < module.objects[t].emits.size(); ++e) {
+                size_t target = types[t].emitTarget[e];
+                if (!module.objects[t].emits[e].atCreation() || seen[target]) continue;
+                chained[from] = chained[from] || target == from;
+                seen[target] = true;
+                next.push_back(target);
+            }
         }
+    }
+    for (size_t t = 0; t < types.size(); ++t) candidate[t] = !types[t].rowsInMemory && !chained[t] && decidedInMemory(t);
+    for (bool fewer = true; fewer;) {
+        fewer = false;
+        for (size_t t = 0; t < types.size(); ++t)
+            if (candidate[t] && !decidedInMemory(t)) candidate[t] = false, fewer = true;
+    }
+    for (size_t t = 0; t < types.size(); ++t) {
+        if (!candidate[t]) continue;
+        TypeInfo& info = types[t];
+        info.rowsInMemory = true;
+        info.late = info.late || info.kills || info.unstable;
+        for (TypeInfo& c : types)  // (its children: `child` above, some of them candidates too)
+            if (c.parentType == static_cast<int>(t)) c.rowsInMemory = true;
     }
     for (size_t t = 0; t < types.size(); ++t)
         if (types[t].rowsInMemory)

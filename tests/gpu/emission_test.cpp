@@ -371,8 +371,9 @@ TEST_CASE("emitters whose emissions the GPU decides: the interpreter's objects, 
     // are, emitters that burst on death, and an emitter of those (the rain); bursts at
     // creation and on edges (the confetti, the fireworks' rockets and their launcher); several
     // sites into one target (the shapes; a small target shared by an emitter and the
-    // emitters it emits); an emitter of two types of emitters (which stays on the host).
-    // Each with the emitters whose rows it keeps in the memory.
+    // emitters it emits); an emitter of two types of emitters (which stays on the host);
+    // emitters of their own kind, and two of each other (a chain of bursts at creation
+    // stays on the host, and so does its maker); children that emit, in sub-steps too. Each with the emitters whose rows it keeps in the memory.
     std::vector<std::pair<std::string, size_t>> programs;
     for (const char* sample : {"fountain", "emitter", "two_streams", "tornado", "shapes"})
         programs.push_back({test::readFile(test::sample(sample)), 1});
@@ -407,7 +408,8 @@ TEST_CASE("emitters whose emissions the GPU decides: the interpreter's objects, 
         spawn e(300);)", 1});
     for (auto [name, emitters] : {std::pair{"emitters_that_die", 1}, {"emitters_burst_on_death", 1},
                                   {"sites_share_a_target", 2}, {"two_kinds_of_emitter_from_one", 2},
-                                  {"emitters_burst_at_creation_and_edges", 2}})
+                                  {"emitters_burst_at_creation_and_edges", 2}, {"step_emitters_of_their_own_kind", 3},
+                                  {"step_children_that_emit", 5}})
         programs.push_back({test::readFile(std::string(PSYS_PROGRAMS_DIR) + "/" + name + ".psys"), emitters});
     for (const auto& [text, expected] : programs) {
         INFO(text.substr(0, 120));
