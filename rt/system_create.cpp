@@ -94,8 +94,9 @@ void Creation::bindBatch(size_t type, Batch& b, const ColumnLayout& layout, Scra
 // (one run an object where objects are not created in batches). Rows are allocated
 // in queue order (what does not fit is dropped and counted); init, exports at creation
 // and the first update run over the whole batch; then object by object, in queue order,
-// its bursts, its death or its emissions. While an object emits, the rows allocated for
-// the objects after it count as free, as they would if each object were created alone.
+// its bursts, its death or its emissions. While an object emits in its update (its first
+// sub-step), the rows allocated for the objects after it count as free, as they would if
+// each object were created alone; at a later sub-step they are all there.
 void Creation::createBatch(size_t type, size_t from, size_t to, double t1) {
     runSpawns();  // the arguments of what the last batch queued (it reads its batch's columns)
     Pool& pool = s_.pools[type];

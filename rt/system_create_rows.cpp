@@ -29,7 +29,10 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     const TypeInfo& info = s_.types[type];
     const ir::Object& o = pool.object();
     const size_t first = b.first;
-    queued_[type] -= n;  // what it queues is of other types: no room of its own to account for
+    // (What it queues into its own type sees the pool's free rows, the batch's taken: as
+    // the host's rule gives — the batch's later rows counted free less its later objects
+    // still queued — unless the batch dropped some, when no row is free either way.)
+    queued_[type] -= n;
     Buffer rows = pool.scratchRows(n);
     size_t kept = pool.allocate(n, rows, 0);  // the first `kept` objects: rows[0, kept)
     s_.typeStats[type].dropped += n - kept;

@@ -112,10 +112,17 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     auto keptWhole = [&](const TypeInfo& info) {
         return info.parentType < 0 && !(options.drawInStep && backend.rendersInStep() && info.render);
     };
+    // A type that only dies whose exports folds read (no children) is one too: its kills
+    // late all the same — a fold reads the rows updatable at the step's start — and its
+    // exports those of its survivors, from the kill flags where they are (Memory::survivors;
+    // not yet under @step).
     for (size_t t = 0; t < types.size(); ++t) {
         TypeInfo& info = types[t];
         bool silent = !info.kills && !info.unstable && !info.updateEmits && !info.read;
-        info.rowsInMemory = inMemory && (info.late || silent) && !info.bursts && keptWhole(info);
+        bool folded = options.lateKills && (info.kills || info.unstable) && !info.updateEmits && !info.read &&
+                      info.exports && info.stepLimit == 0;
+        info.rowsInMemory = inMemory && (info.late || silent || folded) && !info.bursts && keptWhole(info);
+        info.late = info.late || (info.rowsInMemory && folded);
     }
     // Emitters whose emissions the memory decides (Memory::emitAtRate): every site emits —
     // at a rate, in a burst at creation, on an edge or on death — into a type that keeps its rows in the memory (one that emits nothing, or such an emitter
@@ -215,9 +222,11 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         return emitter;
     };
     // Except a chain of bursts at creation (`object a { emit a; … }`, or a and b bursting
-    // each other): every object makes the next wave in its first update, so where the memory
+    // each other): every object makes the next wave as it is created, so where the memory
     // decides, a wave of one object is a batch of a dozen dispatches and a wait on a GPU —
-    // 10,000 waves took 9.2 s a step where the host takes 0.26 s for 600 (docs/gpu.md).
+    // 10,000 waves took 9.2 s for 600 frames where the host's 0.26 s (docs/gpu.md). (A chain
+    // through bursts on edges or deaths makes such waves only where objects fire them in
+    // their first update.)
     std::vector<bool> chained(types.size(), false);
     for (size_t from = 0; from < types.size(); ++from) {
         std::vector<bool> seen(types.size(), false);
@@ -227,7 +236,7 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
             next.pop_back();
             for (size_t e = 0; e < module.objects[t].emits.size(); ++e) {
                 size_t target = types[t].emitTarget[e];
-                if (!module.objects[t].emits[e].atCreation() || seen[target]) continue;
+                if (module.objects[t].emits[e].when != ir::EmitSite::When::Creation || seen[target]) continue;
                 chained[from] = chained[from] || target == from;
                 seen[target] = true;
                 next.push_back(target);

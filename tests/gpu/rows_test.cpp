@@ -530,6 +530,27 @@ TEST_CASE("parents that another type folds over keep their rows on the GPU besid
     CHECK(p.stats("comet").created == 12);
 }
 
+TEST_CASE("types that only die and that folds read keep their rows on the GPU: late kills, the survivors' exports") {
+    // tests/programs/step_folded_types_that_die.psys: gnats fold over each other and die,
+    // a swallow folds over the gnats alive at each step's start, mayflies die in their
+    // first update and are folded over: the interpreter's objects and rows, and no wait a
+    // step for their kills (they come a frame late).
+    test::Pair p(readFile(test::programsDir() + "/step_folded_types_that_die.psys"));
+    for (const char* type : {"gnat", "mayfly", "swallow", "swarm"})
+        CHECK(p.gl->pool(static_cast<size_t>(p.gl->typeIndex(type))).rowsInMemory());
+    uint64_t waits = 0;
+    for (int f = 0; f < 240; ++f) {
+        uint64_t before = p.gpu->waits();
+        p.steps(1, 1.0 / 60);
+        if (f >= 10) waits = std::max(waits, p.gpu->waits() - before);
+        p.compare();
+    }
+    CHECK(p.stats("gnat").killed > 200);
+    CHECK(p.stats("gnat").dropped > 0);
+    CHECK(p.stats("mayfly").killed > 400);
+    CHECK(waits <= 1);  // (the swarm's emissions' totals)
+}
+
 TEST_CASE("objects a trigger creates that die in their first update are not drawn before the next step") {
     // Their kill lists are freed at the next step's end; until then the GPU has cleared
     // them in the alive mask the draws read, as the interpreter has frozen them.
