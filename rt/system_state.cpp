@@ -134,9 +134,10 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     // the types is an emitter: the host creates what each emitter asks for in its turn,
     // and the children of two types of emitters would take their ids one emitter at a
     // time, not one type at a time.
-    // One that dies exports nothing: the operation reads its update's kill flags where
-    // they are (a row killed emits at no rate, and bursts), and its kills are late, as a
-    // type's that only dies — nobody else looks at them before the step's end. (Until no
+    // One that dies has its kills late, as a type's that only dies — nobody but its
+    // children looks at them before the step's end — and the operation reads its update's
+    // kill flags where they are (a row killed emits at no rate, and bursts); its exports,
+    // where children or folds read them, are its survivors' (Memory::survivors). (Until no
     // type changes: an emitter of emitters follows them in.) One in sub-steps (@step) is
     // read by nobody and exports nothing: each sub-step's emissions follow its update, over
     // its clock, before what it killed is taken out of the masks (runEmissions; a new
@@ -200,7 +201,7 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         bool parent = info.read && readByChildren(t);
         bool emitter = inMemory && options.createInBatches &&
                        (info.updateEmits || info.bursts) &&
-                       (!dies || (options.lateKills && (!info.exports || parent))) && (!info.read || parent) &&
+                       (!dies || options.lateKills) && (!info.read || parent) &&
                        (keptWhole(info) || (childShape[t] && candidate[static_cast<size_t>(info.parentType)])) &&
                        (info.stepLimit == 0 || (!info.read && !info.exports));
         int emitting = -1;  // the one target that emits, if any
