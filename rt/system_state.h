@@ -54,14 +54,16 @@ struct TypeInfo {
     bool unstable = false;             // its update counts updates beyond the stability limit
     // What its updates give back — kills, the unstable count — may be taken at the end of
     // the step (LateKills): it emits nothing at a rate (or what it emits the memory
-    // decides, reading its kill flags there: rowsInMemory), has no exports and nothing
-    // reads it, so no one looks at its dead before then.
+    // decides, reading its kill flags there: rowsInMemory), has no exports (or, with its
+    // rows in the memory, its survivors' exports, computed from its kill flags there) and
+    // nothing but children in the memory reads it, so no one else looks at its dead before
+    // then.
     bool late = false;
-    // Its pool keeps its rows in the memory (Pool::keepRowsInMemory): a type with no
-    // sub-steps whose kills are late, or that never dies — and emits nothing, or emits
-    // what the memory decides (Memory::emitAtRate: at a rate, in bursts at creation, on
-    // edges and on deaths) — with no parent, or a parent whose rows are there too (the
-    // State constructor, rt/system_state.cpp, says which).
+    // Its pool keeps its rows in the memory (Pool::keepRowsInMemory): a type whose kills
+    // are late, or that never dies — and emits nothing, or emits what the memory decides
+    // (Memory::emitAtRate: at a rate, in bursts at creation, on edges and on deaths) — with
+    // no parent, or a parent whose rows are there too, in sub-steps or not (the State
+    // constructor, rt/system_state.cpp, says which).
     bool rowsInMemory = false;
     // The state slots a creation batch zeroes before init: those init does not set (every
     // one where there is no init, or where it reads the state).

@@ -533,7 +533,8 @@ TEST_CASE("parents that another type folds over keep their rows on the GPU besid
 TEST_CASE("types that only die and that folds read keep their rows on the GPU: late kills, the survivors' exports") {
     // tests/programs/step_folded_types_that_die.psys: gnats fold over each other and die,
     // a swallow folds over the gnats alive at each step's start, mayflies die in their
-    // first update and are folded over, and so are hornets, emitters of gnats that die:
+    // first update (a trigger's too) and are folded over, and so are hornets, emitters of
+    // gnats that die:
     // the interpreter's objects and rows, and no wait a step for their kills (they come a
     // frame late).
     test::Pair p(readFile(test::programsDir() + "/step_folded_types_that_die.psys"));
@@ -541,6 +542,7 @@ TEST_CASE("types that only die and that folds read keep their rows on the GPU: l
         CHECK(p.gl->pool(static_cast<size_t>(p.gl->typeIndex(type))).rowsInMemory());
     uint64_t waits = 0;
     for (int f = 0; f < 240; ++f) {
+        if (f == 20 || f == 21) p.fire("swat");  // (mayflies that die at once, a step late)
         uint64_t before = p.gpu->waits();
         p.steps(1, 1.0 / 60);
         if (f >= 10) waits = std::max(waits, p.gpu->waits() - before);
