@@ -78,23 +78,37 @@ TypeInfo typeInfo(const ir::Module& module, const ir::Object& o) {
     return t;
 }
 
-}  // namespace
+// The types in a chain of bursts at creation (`object a { emit a; … }`, or a and b
+// bursting each other), which are no emitters the memory decides: every object makes the
+// next wave as it is created, so where the memory decides, a wave of one object is a batch
+// of a dozen dispatches and a wait on a GPU — 10,000 waves took 9.2 s for 600 frames,
+// 0.26 s where the host decides (docs/gpu.md). (A chain through bursts on edges or deaths
+// makes such waves only where objects fire them as they are created or in their first
+// update.)
+std::vector<bool> burstChains(const std::vector<TypeInfo>& types, const ir::Module& module) {
+    std::vector<bool> chained(types.size(), false);
+    for (size_t from = 0; from < types.size(); ++from) {
+        std::vector<bool> seen(types.size(), false);
+        std::vector<size_t> next = {from};
+        while (!next.empty() && !chained[from]) {
+            size_t t = next.back();
+            next.pop_back();
+            for (size_t e = 0; e < module.objects[t].emits.size(); ++e) {
+                size_t target = types[t].emitTarget[e];
+                if (module.objects[t].emits[e].when != ir::EmitSite::When::Creation || seen[target]) continue;
+                chained[from] = chained[from] || target == from;
+                seen[target] = true;
+                next.push_back(target);
+            }
+        }
+    }
+    return chained;
+}
 
-State::State(ir::Module m, Backend& b, SystemOptions o)
-    : module(std::move(m)), backend(b), memory(b.memory()), options(o), parallel(std::make_unique<Parallel>(o.threads)) {
-    for (const ir::Object& obj : module.objects) {
-        size_t capacity = obj.attributes.capacity ? static_cast<size_t>(*obj.attributes.capacity) : options.capacity;
-        pools.emplace_back(obj, capacity, memory);
-        types.push_back(typeInfo(module, obj));
-        typeStats.push_back({obj.name, 0, 0, 0, 0, 0});
-    }
-    std::vector<int> depth(types.size(), 0);
-    for (size_t t = 0; t < types.size(); ++t) {
-        if (types[t].parentType >= 0) types[static_cast<size_t>(types[t].parentType)].read = true;
-        for (int up = types[t].parentType; up >= 0; up = types[static_cast<size_t>(up)].parentType) ++depth[t];
-        deepestFirst.push_back(t);
-    }
-    std::stable_sort(deepestFirst.begin(), deepestFirst.end(), [&](size_t a, size_t b) { return depth[a] > depth[b]; });
+// Which types' kills are late and which keep their rows in the memory (TypeInfo::late,
+// rowsInMemory), decided once for the program.
+void decideRows(std::vector<TypeInfo>& types, const ir::Module& module, const SystemOptions& options,
+                const Backend& backend) {
     // Nobody looks at the type's dead during the step: it emits nothing in its updates, has
     // no exports and no children.
     auto unwatched = [](const TypeInfo& t) { return !t.updateEmits && !t.exports && !t.read; };
@@ -222,28 +236,7 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
                 if (static_cast<int>(info.emitTarget[s]) != emitting) emitter = false;
         return emitter;
     };
-    // Except a chain of bursts at creation (`object a { emit a; … }`, or a and b bursting
-    // each other): every object makes the next wave as it is created, so where the memory
-    // decides, a wave of one object is a batch of a dozen dispatches and a wait on a GPU —
-    // 10,000 waves took 9.2 s for 600 frames where the host's 0.26 s (docs/gpu.md). (A chain
-    // through bursts on edges or deaths makes such waves only where objects fire them in
-    // their first update.)
-    std::vector<bool> chained(types.size(), false);
-    for (size_t from = 0; from < types.size(); ++from) {
-        std::vector<bool> seen(types.size(), false);
-        std::vector<size_t> next = {from};
-        while (!next.empty() && !chained[from]) {
-            size_t t = next.back();
-            next.pop_back();
-            for (size_t e = 0; e < module.objects[t].emits.size(); ++e) {
-                size_t target = types[t].emitTarget[e];
-                if (module.objects[t].emits[e].when != ir::EmitSite::When::Creation || seen[target]) continue;
-                chained[from] = chained[from] || target == from;
-                seen[target] = true;
-                next.push_back(target);
-            }
-        }
-    }
+    std::vector<bool> chained = burstChains(types, module);
     for (size_t t = 0; t < types.size(); ++t) candidate[t] = !types[t].rowsInMemory && !chained[t] && decidedInMemory(t);
     for (bool fewer = true; fewer;) {
         fewer = false;
@@ -258,6 +251,26 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         for (TypeInfo& c : types)  // (its children: `child` above, some of them candidates too)
             if (c.parentType == static_cast<int>(t)) c.rowsInMemory = true;
     }
+}
+
+}  // namespace
+
+State::State(ir::Module m, Backend& b, SystemOptions o)
+    : module(std::move(m)), backend(b), memory(b.memory()), options(o), parallel(std::make_unique<Parallel>(o.threads)) {
+    for (const ir::Object& obj : module.objects) {
+        size_t capacity = obj.attributes.capacity ? static_cast<size_t>(*obj.attributes.capacity) : options.capacity;
+        pools.emplace_back(obj, capacity, memory);
+        types.push_back(typeInfo(module, obj));
+        typeStats.push_back({obj.name, 0, 0, 0, 0, 0});
+    }
+    std::vector<int> depth(types.size(), 0);
+    for (size_t t = 0; t < types.size(); ++t) {
+        if (types[t].parentType >= 0) types[static_cast<size_t>(types[t].parentType)].read = true;
+        for (int up = types[t].parentType; up >= 0; up = types[static_cast<size_t>(up)].parentType) ++depth[t];
+        deepestFirst.push_back(t);
+    }
+    std::stable_sort(deepestFirst.begin(), deepestFirst.end(), [&](size_t a, size_t b) { return depth[a] > depth[b]; });
+    decideRows(types, module, options, backend);
     for (size_t t = 0; t < types.size(); ++t)
         if (types[t].rowsInMemory)
             pools[t].keepRowsInMemory(types[t].parentType >= 0, types[t].read);
