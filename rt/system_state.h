@@ -62,8 +62,8 @@ struct TypeInfo {
     // Its pool keeps its rows in the memory (Pool::keepRowsInMemory): a type whose kills
     // are late, or that never dies — and emits nothing, or emits what the memory decides
     // (Memory::emitAtRate: at a rate, in bursts at creation, on edges and on deaths) — with
-    // no parent, or a parent whose rows are there too, in sub-steps or not (the State
-    // constructor, rt/system_state.cpp, says which).
+    // no parent, or a parent whose rows are there too, in sub-steps or not (decideRows,
+    // rt/system_state.cpp, says which).
     bool rowsInMemory = false;
     // The state slots a creation batch zeroes before init: those init does not set (every
     // one where there is no init, or where it reads the state).
