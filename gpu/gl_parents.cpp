@@ -172,9 +172,13 @@ uvec4 scan(uint mine, uint mineFrozen) {
     }
     return sums;
 }
-void push(uint at, uint row) {
+layout(std430, binding = 9) readonly buffer Parents { uint parents[]; };
+layout(std430, binding = 10) buffer ParentReaders { uint parentReaders[]; };
+// (`parented`: the pool has parents, each row freed a reader less of its own.)
+void push(uint at, uint row, bool parented) {
     stack[at] = row;
     generation[row] += 1u;
+    if (parented && parents[row] != 0xFFFFFFFFu) atomicAdd(parentReaders[parents[row]], 0xFFFFFFFFu);
 }
 )";
 
@@ -194,7 +198,7 @@ void main() {
         uint row = killedRow(i);
         updatable[row] = 0u;
         alive[row] = 0u;
-        if (readers[row] == 0u) push(at++, row); else waiting[row] = 1u;
+        if (readers[row] == 0u) push(at++, row, param(6u) != 0u); else waiting[row] = 1u;
     }
     barrier();
     if (lane == 0u) {
@@ -219,7 +223,7 @@ void main() {
     for (uint row = begin; row < end; ++row) {
         if (!freed(row)) continue;
         waiting[row] = 0u;
-        push(at++, row);
+        push(at++, row, param(1u) != 0u);
     }
     barrier();
     if (lane == 0u) {
@@ -386,7 +390,7 @@ void GlMemory::readersGone(Buffer killed, size_t killedAt, uint32_t base, Buffer
 void GlMemory::releaseUnread(const rt::PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
                              size_t mapFirst) {
     if (allOnHost({pool.stack, pool.generation, pool.updatable, pool.alive, pool.counters, pool.readers, pool.waiting,
-                   killed, map}))
+                   pool.parents, pool.parentReaders, killed, map}))
         return rt::Memory::releaseUnread(pool, killed, killedAt, base, map, mapFirst);
     flushPending();
     if (rows(killed) <= killedAt + 1) return;
@@ -397,13 +401,14 @@ void GlMemory::releaseUnread(const rt::PoolRows& pool, Buffer killed, size_t kil
     bindScanBlocks(pool);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, bound(pool.updatable));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, bound(pool.alive));
-    bindKillList(killed, killedAt, base, map, mapFirst, 64);
+    bindKillList(killed, killedAt, base, map, mapFirst, 64, 0, {pool.parents.valid() ? 1u : 0u, 0});
     dispatchRows(releaseUnreadProgram_, 64);
 }
 
 void GlMemory::releaseWaiting(const rt::PoolRows& pool, size_t rows) {
     if (rows == 0) return;
-    if (allOnHost({pool.stack, pool.generation, pool.counters, pool.readers, pool.waiting}))
+    if (allOnHost({pool.stack, pool.generation, pool.counters, pool.readers, pool.waiting, pool.parents,
+                   pool.parentReaders}))
         return rt::Memory::releaseWaiting(pool, rows);
     flushPending();
     if (!releaseWaitingProgram_)
@@ -411,7 +416,7 @@ void GlMemory::releaseWaiting(const rt::PoolRows& pool, size_t rows) {
             computeProgram(operationShader(std::string(kScanBlocks) + kReleaseWaiting), "release of the waiting");
     PassTimer::Scope timed(timer, "release", 64);
     bindScanBlocks(pool);
-    bindParams(paramsBuffer_, {static_cast<uint32_t>(rows)});
+    bindParams(paramsBuffer_, {static_cast<uint32_t>(rows), pool.parents.valid() ? 1u : 0u});
     dispatchRows(releaseWaitingProgram_, 64);
 }
 
@@ -421,6 +426,10 @@ void GlMemory::bindScanBlocks(const rt::PoolRows& pool) {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, bound(pool.counters));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, deviceBuffer(pool.readers));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, bound(pool.waiting));
+    // (Where it has none, the pool's own readers stand in: the shaders read neither.)
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, deviceBuffer(pool.parents.valid() ? pool.parents : pool.readers));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10,
+                     pool.parents.valid() ? bound(pool.parentReaders) : deviceBuffer(pool.readers));
 }
 
 }  // namespace psys::gpu

@@ -167,7 +167,8 @@ void Ledger::releaseAllInMemory(std::vector<LateKills>& lates) {
 }
 
 // Its kills freed where they are: a child's each a reader less of its parent, a parent's
-// where nobody reads it (the others frozen: Pool::releaseUnread, counted from the memory).
+// where nobody reads it (the others frozen: Pool::releaseUnread, counted from the memory;
+// a row it frees a reader less of its own parent, where it has one).
 void Ledger::releaseInMemory(LateKills& l) {
     if (l.released) return;
     listInMemory(l);
@@ -187,7 +188,7 @@ void Ledger::releaseInMemory(LateKills& l) {
                 pool.releaseUnread(part.killList, 0, base, l.map, mapFirst);
             else
                 pool.release(part.killList, 0, base, l.map, mapFirst, part.gathered ? part.lists : 1);
-            if (pool.parentRows.valid())
+            if (pool.parentRows.valid() && !read)  // (a read one's: as it frees them, PoolRows::parents)
                 s_.memory.readersGone(part.killList, 0, base, l.map, mapFirst, pool.parentRows,
                                       s_.pools[static_cast<size_t>(s_.types[l.type].parentType)].memoryRows().readers);
             if (part.counted && !read && !part.gathered) pool.released(part.count);
@@ -235,7 +236,7 @@ void Ledger::releaseForReload() {
             pool.release(sorted, 0, 0, {}, 0);
             pool.released(rows.size());
         }
-        if (pool.parentRows.valid())
+        if (pool.parentRows.valid() && !pool.memoryRows().readers.valid())
             s_.memory.readersGone(sorted, 0, 0, {}, 0, pool.parentRows,
                                   s_.pools[static_cast<size_t>(s_.types[l.type].parentType)].memoryRows().readers);
         pool.recycle(sorted);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <new>
 #include <stdexcept>
@@ -74,6 +75,16 @@ void eachKilled(const Memory& memory, Buffer killed, size_t killedAt, uint32_t b
     if (list[0] == 0) return;
     const auto* rows = map.valid() ? static_cast<const uint32_t*>(memory.view(map)) + mapFirst : nullptr;
     for (uint32_t i = 0; i < list[0]; ++i) each(i, rows ? rows[list[1 + i]] : base + list[1 + i]);
+}
+
+// A freed row of a pool with parents (PoolRows::parents): a reader less of its parent.
+std::function<void(uint32_t)> readerGone(Memory& memory, const PoolRows& pool) {
+    if (!pool.parents.valid()) return [](uint32_t) {};
+    const auto* parent = static_cast<const uint32_t*>(memory.view(pool.parents));
+    auto* readers = static_cast<uint32_t*>(memory.host(pool.parentReaders));
+    return [parent, readers](uint32_t row) {
+        if (parent[row] != kSkipRow) --readers[parent[row]];
+    };
 }
 
 }  // namespace
@@ -224,6 +235,7 @@ void Memory::releaseUnread(const PoolRows& pool, Buffer killed, size_t killedAt,
     auto* alive = static_cast<uint8_t*>(host(pool.alive));
     const auto* readers = static_cast<const uint32_t*>(view(pool.readers));
     auto* waiting = static_cast<uint8_t*>(host(pool.waiting));
+    auto parentReaderGone = readerGone(*this, pool);
     eachKilled(*this, killed, killedAt, base, map, mapFirst, [&](uint32_t, uint32_t row) {
         updatable[row] = alive[row] = 0;
         if (readers[row] > 0) {
@@ -233,6 +245,7 @@ void Memory::releaseUnread(const PoolRows& pool, Buffer killed, size_t killedAt,
         }
         stack[counters[kCounterTop]++] = row;
         ++generation[row];
+        parentReaderGone(row);
     });
 }
 
@@ -243,12 +256,14 @@ void Memory::releaseWaiting(const PoolRows& pool, size_t rows) {
     auto* generation = static_cast<uint32_t*>(host(pool.generation));
     const auto* readers = static_cast<const uint32_t*>(view(pool.readers));
     auto* waiting = static_cast<uint8_t*>(host(pool.waiting));
+    auto parentReaderGone = readerGone(*this, pool);
     for (uint32_t row = 0; row < rows; ++row) {
         if (!waiting[row] || readers[row] > 0) continue;
         waiting[row] = 0;
         --counters[kCounterWaiting];
         stack[counters[kCounterTop]++] = row;
         ++generation[row];
+        parentReaderGone(row);
     }
 }
 

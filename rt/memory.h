@@ -54,6 +54,10 @@ struct PoolRows {
     // are in the memory beside its children's): per row, its children not freed yet
     // (u32), and whether it is frozen for them (u8: killed, neither alive nor updatable).
     Buffer readers, waiting;
+    // Such a pool that is a child itself (a grandparent's child, read by its own children):
+    // its rows' parents (u32, rt::kSkipRow for none) and its parent pool's readers, a row
+    // freed by releaseUnread or releaseWaiting a reader less there (rt/ledger.h's rule).
+    Buffer parents, parentReaders;
 };
 constexpr size_t kCounterTop = 0, kCounterWaiting = 1, kCounters = 2;
 
@@ -252,10 +256,12 @@ public:
                              Buffer parents, Buffer readers);
     // A parent pool's kill list freed as releaseRows frees it, but for rows some child
     // still reads: those are frozen instead (waiting, neither alive nor updatable,
-    // counted in the counters), in the list's order the others pushed.
+    // counted in the counters), in the list's order the others pushed. Where the pool has
+    // parents (PoolRows::parents), each row pushed is a reader less of its parent.
     virtual void releaseUnread(const PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,
                                size_t mapFirst);
-    // The pool's waiting rows among [0, rows) whose readers are all gone, freed in row order.
+    // The pool's waiting rows among [0, rows) whose readers are all gone, freed in row order
+    // (each a reader less of its parent, likewise).
     virtual void releaseWaiting(const PoolRows& pool, size_t rows);
     // For each pair (from, to) of `columns`: to[rows[rowsFirst + i]] = from[fromFirst + i],
     // i < count, with the rows in a buffer (a batch's columns into its pool rows at once).

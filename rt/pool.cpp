@@ -177,6 +177,10 @@ void Pool::grow(size_t n) {
     exports.resize(*memory_, n);
 }
 
+void Pool::countsDownParent(Buffer parentReaders) {
+    if (rows_.parents.valid()) rows_.parentReaders = parentReaders;
+}
+
 size_t Pool::allocate(size_t n, uint32_t* out) {
     FreeRows free{freeRows_.data(), freeRows_.size(), rows(), capacity_};
     size_t kept = std::min(n, free.room());
@@ -240,13 +244,14 @@ void Pool::keepRowsInMemory(bool child, bool read) {
     if (inMemory_) return;
     inMemory_ = true;
     rows_ = {memory_->create(Elem::U32, rows()), memory_->create(Elem::U32, rows()), updatable.column, alive.column,
-             memory_->create(Elem::U32, kCounters), {}, {}};
+             memory_->create(Elem::U32, kCounters), {}, {}, {}, {}};
     if (read) {
         rows_.readers = memory_->create(Elem::U32, rows());
         rows_.waiting = memory_->create(Elem::U8, rows());
         frozenAt = memory_->create(Elem::F64, rows());
     }
     if (child) parentRows = memory_->create(Elem::U32, rows());
+    if (child && read) rows_.parents = parentRows;  // (and its parent's readers: countsDownParent)
     restoreInMemory();  // what the host has so far (nothing, before the first object)
 }
 

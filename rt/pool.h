@@ -138,6 +138,9 @@ public:
     // `child`: its objects' parents are in the memory too (parentRows); `read`: children
     // whose rows are there read its objects (PoolRows::readers, waiting).
     void keepRowsInMemory(bool child = false, bool read = false);
+    // A child that is read (both): its frees count its parents' readers down, in the
+    // parent pool's `parentReaders` (PoolRows::parents).
+    void countsDownParent(Buffer parentReaders);
     bool rowsInMemory() const { return inMemory_; }
     // Rows for `n` objects of a batch by the allocation rule, in the memory: into
     // out[outFirst + k] for the first min(n, free()) of them; returns how many got one.

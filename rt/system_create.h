@@ -113,8 +113,7 @@ private:
     void queueFromRecords(size_t type, const RateSites& sites, std::span<const size_t> emitSite, const Batch* batch,
                           Buffer runs, const std::vector<uint32_t>& total, Buffer rows, double t1);
     // A type that emits nothing (its creation queues nothing) and reads no parent.
-    bool quiet(size_t type) const;
-    size_t groupQuiet(size_t from);  // see rt/system_queue.cpp
+    void groupByType(size_t from, size_t to);  // see rt/system_queue.cpp
     // createBatch for a type whose rows are in the memory (rt/system_create_rows.cpp).
     void createInMemory(size_t type, Batch& b, size_t n, double t1);
     // `columns`: what goes to the pool rows after it (an emitter's accumulators join them).

@@ -156,43 +156,35 @@ void Creation::runSpawns() {
     spawns_.clear();
 }
 
-bool Creation::quiet(size_t type) const {
-    return s_.module.objects[type].emits.empty() && s_.types[type].parentType < 0;
-}
-
-// Where queue_[from] is of a quiet type: the quiet runs from there on, each type's runs
-// moved together (in their order, the types in the order they first come). Their
-// creation queues nothing, takes no id, frees no row of another type and orders no
-// parent's release, so only each type's own order matters — kept; their runs of one
-// type are adjacent in its staging columns, as one batch's must be. Without this, K
-// emitters of several types would create 4·K batches a step (the campfire's dispatches
-// grew with its fires). Returns the end of those runs.
-size_t Creation::groupQuiet(size_t from) {
-    size_t end = from;
-    while (end < queue_.size() && quiet(queue_[end].type)) ++end;
-    std::vector<size_t> order;  // the types, in the order they first come
-    for (size_t i = from; i < end; ++i)
-        if (std::find(order.begin(), order.end(), queue_[i].type) == order.end()) order.push_back(queue_[i].type);
-    if (order.size() < 2) return end;
-    std::vector<Run> grouped;
-    grouped.reserve(end - from);
-    for (size_t type : order)
-        for (size_t i = from; i < end; ++i)
-            if (queue_[i].type == type) grouped.push_back(queue_[i]);
-    std::copy(grouped.begin(), grouped.end(), queue_.begin() + static_cast<std::ptrdiff_t>(from));
-    return end;
+// The queue is created a generation at a time — the runs queued before the drain, then
+// those their creation queued, and so on — and a generation type by type, in the
+// module's order of types, each type's runs in the order they came (a type's runs of one
+// generation are adjacent in its staging columns, as one batch's must be). A run's
+// objects took their ids as they were queued; what a generation's order decides is the
+// order in which their creation emits — its objects' ids, rows and what their targets'
+// room drops. So K emitters of several types create a batch of each type a step, not
+// one a type and emitter (the campfire's dispatches grew with its fires), and where the
+// memory decides an emitter's emissions (each target's objects one run, in the order of
+// its sites: rt/system_create_rows.cpp) the generation is the same as where the host
+// queues them an emitter row at a time — so an emitter of two types of emitters, or of
+// an emitter in sub-steps beside another type, may be the memory's (decideRows).
+void Creation::groupByType(size_t from, size_t to) {
+    std::stable_sort(queue_.begin() + static_cast<std::ptrdiff_t>(from), queue_.begin() + static_cast<std::ptrdiff_t>(to),
+                     [](const Run& a, const Run& b) { return a.type < b.type; });
 }
 
 void Creation::drain(double t1) {
     runSpawns();
-    size_t grouped = 0;                       // queue_[.., grouped): quiet runs already grouped
+    size_t generation = 0;                    // queue_[.., generation): this generation's runs
     for (size_t i = 0; i < queue_.size();) {  // (creating queues more at its end)
+        if (i == generation) {
+            generation = queue_.size();
+            groupByType(i, generation);
+        }
         size_t type = queue_[i].type;
         size_t end = i + 1;
-        if (s_.options.createInBatches) {
-            if (i >= grouped && quiet(type)) grouped = groupQuiet(i);
-            while (end < queue_.size() && queue_[end].type == type) ++end;
-        }
+        if (s_.options.createInBatches)
+            while (end < generation && queue_[end].type == type) ++end;
         createBatch(type, i, end, t1);
         i = end;
     }

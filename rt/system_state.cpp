@@ -144,10 +144,9 @@ void decideRows(std::vector<TypeInfo>& types, const ir::Module& module, const Sy
     // records has no parent values) — so a step's emissions are one operation over the
     // rows, and the objects they create batches of those types, whose bursts at creation
     // and first updates emit by the same operation. Sites into one type share its room,
-    // their objects one batch in the host's order (rt::RateSites: a group). At most one of
-    // the types is an emitter: the host creates what each emitter asks for in its turn,
-    // and the children of two types of emitters would take their ids one emitter at a
-    // time, not one type at a time.
+    // their objects one batch in the host's order (rt::RateSites: a group); the batches of
+    // a step's generation go type by type, wherever its emissions were decided
+    // (Creation::groupByType).
     // One that dies has its kills late, as a type's that only dies — nobody but its
     // children looks at them before the step's end — and the operation reads its update's
     // kill flags where they are (a row killed emits at no rate, and bursts); its exports,
@@ -185,10 +184,10 @@ void decideRows(std::vector<TypeInfo>& types, const ir::Module& module, const Sy
         std::vector<const ColumnLayout*> layouts = {&info.updateLayout, &info.exportsLayout, &info.renderLayout};
         ColumnLayout init;
         if (info.init) layouts.push_back(&(init = columnLayout(o, *info.init)));
-        childShape[t] = inMemory && options.createInBatches && info.parentType >= 0 && !info.read &&
+        childShape[t] = inMemory && options.createInBatches && info.parentType >= 0 &&
                         !(options.drawInStep && backend.rendersInStep() && info.render) &&
                         std::all_of(layouts.begin(), layouts.end(), [&](const ColumnLayout* l) { return readsLikeAChild(*l); });
-        quietChild[t] = childShape[t] && (info.late || silent) && o.emits.empty();
+        quietChild[t] = childShape[t] && !info.read && (info.late || silent) && o.emits.empty();
     }
     // Emitters are decided together, as the greatest set that holds: every type starts a
     // candidate and one that fails its rules — a target outside the memory among them —
@@ -218,22 +217,11 @@ void decideRows(std::vector<TypeInfo>& types, const ir::Module& module, const Sy
                        (!dies || options.lateKills) && (!info.read || parent) &&
                        (keptWhole(info) || (childShape[t] && candidate[static_cast<size_t>(info.parentType)])) &&
                        (info.stepLimit == 0 || (!info.read && !info.exports));
-        int emitting = -1;  // the one target that emits, if any
         for (size_t s = 0; emitter && s < o.emits.size(); ++s) {
-            auto target = static_cast<int>(info.emitTarget[s]);
-            bool itsChild = child(static_cast<size_t>(target)) && types[static_cast<size_t>(target)].parentType == static_cast<int>(t);
-            emitter = (inMemoryOr(static_cast<size_t>(target)) || itsChild) && info.spawnLayout[s].parentColumns.empty();
-            if (module.objects[static_cast<size_t>(target)].emits.empty()) continue;
-            emitter = emitter && (emitting < 0 || emitting == target);
-            emitting = target;
+            size_t target = info.emitTarget[s];
+            bool itsChild = child(target) && types[target].parentType == static_cast<int>(t);
+            emitter = (inMemoryOr(target) || itsChild) && info.spawnLayout[s].parentColumns.empty();
         }
-        // (An emitting target in sub-steps, with targets of other types beside it: the host
-        // queues each emitter's objects of every type in turn, so it creates the emitting
-        // ones in batches of one, each through all its sub-steps before the next; one run of
-        // them would take their k-th sub-steps together, its emissions' ids in another order.)
-        if (emitter && emitting >= 0 && types[static_cast<size_t>(emitting)].stepLimit > 0)
-            for (size_t s = 0; s < o.emits.size(); ++s)
-                if (static_cast<int>(info.emitTarget[s]) != emitting) emitter = false;
         return emitter;
     };
     std::vector<bool> chained = burstChains(types, module);
@@ -274,6 +262,9 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     for (size_t t = 0; t < types.size(); ++t)
         if (types[t].rowsInMemory)
             pools[t].keepRowsInMemory(types[t].parentType >= 0, types[t].read);
+    for (size_t t = 0; t < types.size(); ++t)  // (after every pool is: a parent's readers)
+        if (types[t].rowsInMemory && types[t].parentType >= 0)
+            pools[t].countsDownParent(pools[static_cast<size_t>(types[t].parentType)].memoryRows().readers);
     // Spawn kernels read the emitter's own columns, whose buffers never change: their
     // tables are bound once (the parent values come with each launch).
     for (size_t t = 0; t < pools.size(); ++t) {

@@ -407,7 +407,7 @@ TEST_CASE("emitters whose emissions the GPU decides: the interpreter's objects, 
         spawn e(20);
         spawn e(300);)", 1});
     for (auto [name, emitters] : {std::pair{"emitters_that_die", 1}, {"emitters_burst_on_death", 1},
-                                  {"sites_share_a_target", 2}, {"two_kinds_of_emitter_from_one", 2},
+                                  {"sites_share_a_target", 2}, {"two_kinds_of_emitter_from_one", 3},
                                   {"emitters_burst_at_creation_and_edges", 2}, {"step_emitters_of_their_own_kind", 4},
                                   {"step_children_that_emit", 5}})
         programs.push_back({test::readFile(std::string(PSYS_PROGRAMS_DIR) + "/" + name + ".psys"), emitters});

@@ -29,7 +29,7 @@ struct Rows {
     explicit Rows(rt::Memory& m, size_t n) : memory(m) {
         rows = {m.create(rt::Elem::U32, n), m.create(rt::Elem::U32, n), m.create(rt::Elem::U8, n),
                 m.create(rt::Elem::U8, n), m.create(rt::Elem::U32, rt::kCounters), m.create(rt::Elem::U32, n),
-                m.create(rt::Elem::U8, n)};
+                m.create(rt::Elem::U8, n), {}, {}};
         out = m.create(rt::Elem::U32, n);
         killed = m.create(rt::Elem::U32, n + 1);
         map = m.create(rt::Elem::U32, n);
@@ -116,16 +116,22 @@ TEST_CASE("the memory's row operations compute on the GPU what they compute on t
 TEST_CASE("parents and their readers: the GPU frees and freezes the rows the host does, in its order") {
     // Parents with random children; children die, their parents' readers counted down;
     // parents die, the unread freed in the kill list's order and the read frozen; frozen
-    // parents whose children all went freed in row order. Both memories, after each.
+    // parents whose children all went freed in row order. The parents are children too
+    // (PoolRows::parents): each freed a reader less of its own parent. Both memories,
+    // after each.
     auto gpu = gpuBackend();
     rt::HostMemory hostMemory;
-    constexpr size_t kParents = 3000, kChildren = 9000;
+    constexpr size_t kParents = 3000, kChildren = 9000, kGrandparents = 400;
     Rows host(hostMemory, kParents), device(gpu->memory(), kParents);
     std::mt19937 random(11);
-    std::vector<uint32_t> parentOf(kChildren), readers(kParents, 0);
+    std::vector<uint32_t> parentOf(kChildren), readers(kParents, 0), grandparentOf(kParents), grandReaders(kGrandparents, 0);
     for (uint32_t& p : parentOf) {
         p = random() % 5 == 0 ? rt::kSkipRow : static_cast<uint32_t>(random() % kParents);
         if (p != rt::kSkipRow) ++readers[p];
+    }
+    for (uint32_t& g : grandparentOf) {
+        g = random() % 7 == 0 ? rt::kSkipRow : static_cast<uint32_t>(random() % kGrandparents);
+        if (g != rt::kSkipRow) ++grandReaders[g];
     }
     rt::Buffer parents[2];
     int which = 0;
@@ -134,6 +140,10 @@ TEST_CASE("parents and their readers: the GPU frees and freezes the rows the hos
         r->memory.write(r->rows.readers, 0, kParents, readers.data());
         parents[which] = r->memory.create(rt::Elem::U32, kChildren);
         r->memory.write(parents[which++], 0, kChildren, parentOf.data());
+        r->rows.parents = r->memory.create(rt::Elem::U32, kParents);
+        r->memory.write(r->rows.parents, 0, kParents, grandparentOf.data());
+        r->rows.parentReaders = r->memory.create(rt::Elem::U32, kGrandparents);
+        r->memory.write(r->rows.parentReaders, 0, kGrandparents, grandReaders.data());
     }
     auto same = [&](const char* what) {
         INFO(what);
@@ -147,6 +157,8 @@ TEST_CASE("parents and their readers: the GPU frees and freezes the rows the hos
         REQUIRE(host.read<uint8_t>(host.rows.alive, kParents) == device.read<uint8_t>(device.rows.alive, kParents));
         REQUIRE(host.read<uint8_t>(host.rows.updatable, kParents) ==
                 device.read<uint8_t>(device.rows.updatable, kParents));
+        REQUIRE(host.read<uint32_t>(host.rows.parentReaders, kGrandparents) ==
+                device.read<uint32_t>(device.rows.parentReaders, kGrandparents));
     };
     std::vector<uint32_t> childrenAlive(kChildren), parentsAlive(kParents);
     std::iota(childrenAlive.begin(), childrenAlive.end(), 0u);
@@ -182,6 +194,11 @@ TEST_CASE("parents and their readers: the GPU frees and freezes the rows the hos
     auto counters = host.read<uint32_t>(host.rows.counters, rt::kCounters);
     CHECK(counters[0] > 1000);  // freed,
     CHECK(counters[1] > 50);    // and still frozen for their children
+    // Each freed parent (on the stack) a reader less of its own parent, no other.
+    std::vector<uint32_t> expected = grandReaders;
+    for (uint32_t row : host.read<uint32_t>(host.rows.stack, counters[0]))
+        if (grandparentOf[row] != rt::kSkipRow) --expected[grandparentOf[row]];
+    CHECK(host.read<uint32_t>(host.rows.parentReaders, kGrandparents) == expected);
 }
 
 TEST_CASE("a child's parents: from the records, their values, whether they are alive and their ages, on the GPU as on the host") {

@@ -87,3 +87,14 @@ TEST_CASE("a step creates each type that emits nothing in one batch, however man
         CHECK(batches["puff"] == 1);
     }
 }
+
+TEST_CASE("a generation's runs are created type by type, in batches as one by one: an emitter of two types of emitters") {
+    // tests/programs/two_kinds_of_emitter_from_one.psys: e queues b, a, b, a, … (its sites'
+    // order, an emitter at a time); both create a's before b's, whose x's fill x's pool.
+    std::string text = test::readFile(std::string(PSYS_PROGRAMS_DIR) + "/two_kinds_of_emitter_from_one.psys");
+    rt::SystemOptions oneByOne;
+    oneByOne.createInBatches = false;
+    Run a(text, oneByOne), b(text);
+    CHECK(compareRuns(a, b, 120, bitwise) > 5000);
+    CHECK(b.stats("x").dropped > 0);
+}
