@@ -569,13 +569,13 @@ unsigned GlMemory::deviceRows(Buffer b, size_t first, size_t count) {
     return c.gl;
 }
 
-void GlMemory::adopt(Buffer b, size_t first, size_t count, unsigned words, size_t word) {
+void GlMemory::adopt(Buffer b, size_t first, size_t count, unsigned words, size_t word, const char* pass) {
     Column& c = at(b);
     flush(c);
     upload(c);
     size_t w = wordsPerRow(c.elem) * 4;
     staged += count * w;
-    PassTimer::Scope timed(timer, "adopt", count);
+    PassTimer::Scope timed(timer, pass, count);
     glCopyNamedBufferSubData(words, c.gl, static_cast<GLintptr>(word * 4), static_cast<GLintptr>(first * w),
                              static_cast<GLsizeiptr>(count * w));
     afterWrite(Write::Copy, kColumnReaders);

@@ -94,8 +94,9 @@ public:
     // the host sends those rows alone, and stays the host's.
     unsigned deviceRows(rt::Buffer buffer, size_t first, size_t count);
     // The GPU wrote `count` rows from `first` into `words` (a GL buffer) at word `word`:
-    // they become the column's, and the column's value is on the GPU from now on.
-    void adopt(rt::Buffer buffer, size_t first, size_t count, unsigned words, size_t word);
+    // they become the column's, and the column's value is on the GPU from now on (timed as
+    // `pass`).
+    void adopt(rt::Buffer buffer, size_t first, size_t count, unsigned words, size_t word, const char* pass = "adopt");
     // The GPU wrote rows of the column in its own GL buffer (bound in place): its value is
     // on the GPU from now on.
     void written(rt::Buffer buffer);

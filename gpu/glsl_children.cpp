@@ -46,6 +46,9 @@ std::vector<GlslBackend::RowField> GlslBackend::rowFields(const Program& p, cons
         addColumns(l.paramOffset[i], o.params[i].type.width, p.block.params + 4 * static_cast<uint32_t>(i));
     for (size_t i = 0; i < o.state.size(); ++i)
         addColumns(l.stateOffset[i], o.state[i].type.width, p.block.state + 4 * static_cast<uint32_t>(i));
+    if (!launch.parents)  // (a launch from records: each emitter's parent reads are columns, State::gatherSpawnParents)
+        for (size_t i = 0; i < l.parentColumns.size(); ++i)
+            addColumns(l.parentColumns[i].offset, l.parentColumns[i].width, p.block.parents + 4 * static_cast<uint32_t>(i));
     return fields;
 }
 
@@ -59,7 +62,7 @@ std::vector<uint32_t> GlslBackend::emitterBlock(GlMemory& memory, const Program&
     std::vector<uint32_t> block = blockHeader(p.block, launch.count, launch.clock, launch.seed, launch.draw);
     block[LaunchBlock::kFirstChild] = launch.firstChild;
     for (uint32_t e = 0; e < p.block.externCount; ++e) putValue(block, p.block.externs + 4 * e, launch.externs[e]);
-    for (size_t i = 0; i < launch.layout->parentColumns.size(); ++i)
+    for (size_t i = 0; launch.parents && i < launch.layout->parentColumns.size(); ++i)
         putValue(block, p.block.parents + 4 * static_cast<uint32_t>(i), launch.parents[i]);
     if (!base) return block;
     for (const RowField& f : rowFields(p, launch)) {
@@ -100,6 +103,7 @@ bool GlslBackend::blocksOnDevice(const rt::ChildrenLaunch& launch) {
 // site after site, make two dispatches, not 2·K.
 void GlslBackend::runChildren(std::span<const rt::ChildrenLaunch> all) {
     std::vector<rt::ChildrenLaunch> each;
+    std::vector<std::vector<rt::Value>> parents;  // (each launch's emitters' parent reads: the launches point into them)
     auto apart = [&](const rt::ChildrenLaunch& l) { return l.records.valid() && !blocksOnDevice(l); };
     if (std::any_of(all.begin(), all.end(), apart)) {
         for (const rt::ChildrenLaunch& l : all) {
@@ -107,7 +111,7 @@ void GlslBackend::runChildren(std::span<const rt::ChildrenLaunch> all) {
                 each.push_back(l);
                 continue;
             }
-            std::vector<rt::ChildrenLaunch> one = rt::eachEmitter(memory_, l);
+            std::vector<rt::ChildrenLaunch> one = rt::eachEmitter(memory_, l, parents.emplace_back());
             each.insert(each.end(), one.begin(), one.end());
         }
         all = each;
@@ -253,7 +257,8 @@ void GlslBackend::dispatchChildren(std::span<const rt::ChildrenLaunch> launches)
                                                     launches[next].args.end()) &&
                launches[next].argsFirst == a.argsFirst + count)
             count += launches[next++].count;
-        for (size_t c = 0; c < columns; ++c) memory_.adopt(a.args[c], a.argsFirst, count, words_, c * total + place);
+        for (size_t c = 0; c < columns; ++c)
+            memory_.adopt(a.args[c], a.argsFirst, count, words_, c * total + place, "arguments adopted");
         place += count;
         k = next;
     }

@@ -5,8 +5,10 @@
 
 namespace psys::rt {
 
-std::vector<ChildrenLaunch> eachEmitter(const Memory& memory, const ChildrenLaunch& launch) {
+std::vector<ChildrenLaunch> eachEmitter(const Memory& memory, const ChildrenLaunch& launch, std::vector<Value>& parents) {
     if (launch.recordCount == 0) return {};
+    static const std::vector<ColumnLayout::ParentColumn> none;
+    const std::vector<ColumnLayout::ParentColumn>& reads = launch.layout ? launch.layout->parentColumns : none;
     std::vector<uint32_t> records(((launch.recordCount - 1) * launch.recordStride + 1) * kRunWords), rows;
     std::vector<double> nows;
     if (launch.nows.valid()) {
@@ -19,6 +21,9 @@ std::vector<ChildrenLaunch> eachEmitter(const Memory& memory, const ChildrenLaun
         memory.read(launch.rows, launch.rowsFirst, rows.size(), rows.data());
     }
     std::vector<ChildrenLaunch> each;
+    size_t emitters = 0;
+    for (size_t k = 0; k < launch.recordCount; ++k) emitters += records[k * launch.recordStride * kRunWords + 1] != 0;
+    parents.assign(emitters * reads.size(), Value{});  // (sized once: the launches point into it)
     for (size_t k = 0; k < launch.recordCount; ++k) {
         const uint32_t* w = records.data() + k * launch.recordStride * kRunWords;
         if (w[1] == 0) continue;
@@ -33,6 +38,12 @@ std::vector<ChildrenLaunch> eachEmitter(const Memory& memory, const ChildrenLaun
         one.firstChild = w[2];
         one.count = w[1];
         one.argsFirst = launch.argsFirst + w[0];
+        Value* its = parents.data() + (each.size() - 1) * reads.size();
+        for (size_t i = 0; i < reads.size(); ++i)
+            for (int c = 0; c < reads[i].width; ++c)
+                memory.read(launch.columns[static_cast<size_t>(reads[i].offset + c)], one.row, 1,
+                            &its[i].f[static_cast<size_t>(c)]);
+        one.parents = its;
     }
     return each;
 }
@@ -43,7 +54,8 @@ void Backend::runChildren(std::span<const ChildrenLaunch> launches) {
             run(l);
             continue;
         }
-        for (const ChildrenLaunch& one : eachEmitter(memory(), l)) run(one);
+        std::vector<Value> parents;
+        for (const ChildrenLaunch& one : eachEmitter(memory(), l, parents)) run(one);
     }
 }
 

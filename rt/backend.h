@@ -127,8 +127,10 @@ struct ChildrenLaunch {
 };
 
 // A launch from records as one launch an emitter (those with children), read from the
-// memory: how a backend that does not build them where the records are runs them.
-std::vector<ChildrenLaunch> eachEmitter(const Memory& memory, const ChildrenLaunch& launch);
+// memory: how a backend that does not build them where the records are runs them. Each
+// one's parent reads (a launch from records has them in its parent columns, at each
+// emitter's row) go into `parents`, which the launches point into.
+std::vector<ChildrenLaunch> eachEmitter(const Memory& memory, const ChildrenLaunch& launch, std::vector<Value>& parents);
 
 // The folds of one neighbour group over every row of the folding type (rt/neighbours.cpp,
 // docs/language.md "Neighbours"): each fold of the group, for each object in self.mask,

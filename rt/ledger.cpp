@@ -116,7 +116,8 @@ void Ledger::listNow(LateKills& l) {
 }
 
 // (Where the backend clears kills, the update cleared them in the alive mask; the
-// updatable mask here, but a batch's, whose new rows are not updatable yet.)
+// updatable mask here, but a batch's, whose new rows are not updatable yet — and here
+// too where they were listed in the alive mask alone, a type children read: listNow.)
 void Ledger::takeOut(LateKills& l, Buffer into, Buffer batchMask) {
     listInMemory(l);
     LateKills::Part* gathered = nullptr;  // (deferGathered's)
@@ -128,11 +129,12 @@ void Ledger::takeOut(LateKills& l, Buffer into, Buffer batchMask) {
     PoolRows updatable, step;
     updatable.alive = pool.updatable.column;
     step.alive = batchMask;
+    const bool aliveOnly = s_.backend.clearsKilled() || s_.types[l.type].read;
     for (LateKills::Part& part : l.parts) {
         if (!part.killList.valid()) continue;
         if (!(part.counted && part.count == 0)) {
             auto [base, mapFirst] = listRows(l, part);
-            if (s_.backend.clearsKilled() && !l.map.valid()) s_.memory.clearRows(updatable, part.killList, 0, base, {}, 0);
+            if (aliveOnly && !l.map.valid()) s_.memory.clearRows(updatable, part.killList, 0, base, {}, 0);
             if (batchMask.valid()) s_.memory.clearRows(step, part.killList, 0, static_cast<uint32_t>(part.begin), {}, 0);
             s_.memory.appendKills(part.killList, 0, base, l.map, mapFirst, into);
         }

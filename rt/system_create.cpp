@@ -49,7 +49,7 @@ Creation::~Creation() {
 // A table over the batch's scratch columns for `layout`: the staging columns as the
 // parameters, the state at creation (bursts) or the state being advanced.
 void Creation::bindBatch(size_t type, Batch& b, const ColumnLayout& layout, Scratch& parents,
-                         std::vector<Buffer>& table, Table which) {
+                         std::vector<Buffer>& table, Table which, size_t parentsFirst) {
     const bool atCreation = which == Table::Bursts;
     const ir::Object& o = s_.module.objects[type];
     size_t rows = staging_[type].used;
@@ -86,7 +86,7 @@ void Creation::bindBatch(size_t type, Batch& b, const ColumnLayout& layout, Scra
     for (size_t p = 0; p < layout.parentColumns.size(); ++p)
         for (int c = 0; c < layout.parentColumns[p].width; ++c) {
             size_t column = static_cast<size_t>(layout.parentColumns[p].offset + c);
-            table[column] = parents.at(column - static_cast<size_t>(layout.parents), Elem::F32, rows);
+            table[column] = parents.at(parentsFirst + column - static_cast<size_t>(layout.parents), Elem::F32, rows);
         }
 }
 

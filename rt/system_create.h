@@ -104,7 +104,8 @@ private:
     // The spawn launch for `count` children of `emitter` at `site`, their arguments at
     // staging rows from `base`, the first child's draw `firstChild`.
     // (Null where the site has no spawn kernel: its children take no arguments.)
-    ChildrenLaunch* queueSpawn(const Emitter& emitter, int site, uint32_t firstChild, size_t count, size_t base);
+    ChildrenLaunch* queueSpawn(const Emitter& emitter, int site, uint32_t firstChild, size_t count, size_t base,
+                               bool fromRecords = false);
     // Queues `count` objects of `type` (a run, or one run an object where objects are not
     // created in batches).
     void enqueue(const Run& run);
@@ -154,7 +155,7 @@ private:
     // state at creation).
     enum class Table { Advanced, Init, Bursts };
     void bindBatch(size_t type, Batch& b, const ColumnLayout& layout, Scratch& parents, std::vector<Buffer>& table,
-                   Table which);
+                   Table which, size_t parentsFirst = 0);
 
     // A spawn launch waiting for runSpawns, with the parent values it reads.
     struct Spawn {
@@ -181,8 +182,11 @@ private:
 // Per type: the scratch columns a batch is created in, indexed like the staging rows (so
 // the staging columns are the batch's parameters as they are).
 struct Creation::Batch {
-    explicit Batch(Memory& m) : columns(m), initParents(m), updateParents(m), exportsParents(m), renderParents(m) {}
-    Scratch columns, initParents, updateParents, exportsParents, renderParents;
+    explicit Batch(Memory& m)
+        : columns(m), initParents(m), updateParents(m), exportsParents(m), renderParents(m), burstParents(m) {}
+    // (burstParents: each burst site's parent values its own, where the memory decides the
+    // bursts — their spawn launches read them from the columns after the batch.)
+    Scratch columns, initParents, updateParents, exportsParents, renderParents, burstParents;
     ColumnLayout initLayout;
     std::vector<Buffer> initTable, updateTable, exportsTable, renderTable;
     std::vector<std::vector<Buffer>> burstTables;  // per emit site: the state at creation, for bursts

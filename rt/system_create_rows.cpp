@@ -47,9 +47,12 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     if (info.exports) bindBatch(type, b, info.exportsLayout, b.exportsParents, b.exportsTable, Table::Advanced);
     const bool bursts = info.bursts && info.init;  // (a burst's count is init's)
     b.burstTables.assign(o.emits.size(), {});
-    for (size_t site = 0; bursts && site < o.emits.size(); ++site)
-        if (o.emits[site].atCreation() && info.spawn[site])
-            bindBatch(type, b, info.spawnLayout[site], b.initParents, b.burstTables[site], Table::Bursts);
+    for (size_t site = 0, parentsFirst = 0; bursts && site < o.emits.size(); ++site)
+        if (o.emits[site].atCreation() && info.spawn[site]) {
+            const ColumnLayout& layout = info.spawnLayout[site];
+            bindBatch(type, b, layout, b.burstParents, b.burstTables[site], Table::Bursts, parentsFirst);
+            parentsFirst += static_cast<size_t>(layout.total - layout.parents);
+        }
     if (info.init) emptyFolds(type, b.initLayout, b.initTable, first, n);
     emptyFolds(type, info.updateLayout, b.updateTable, first, n);
     if (info.exports) emptyFolds(type, info.exportsLayout, b.exportsTable, first, n);
@@ -105,6 +108,21 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
                 }
             break;
         }
+    for (size_t site = 0; bursts && site < o.emits.size(); ++site) {  // and their parents at each one's creation
+        if (b.burstTables[site].empty()) continue;
+        const ColumnLayout& layout = info.spawnLayout[site];
+        if (pool.parentRows.valid())
+            s_.gatherThrough(type, layout, b.burstTables[site], b.columns.at(kParents, Elem::U32, first + n), first,
+                             first, first + n, 0, table[ColumnLayout::kCreated]);
+        emptyFolds(type, layout, b.burstTables[site], first, n);
+    }
+    if (info.updateEmits) {  // (their spawn launches read the pool's columns at its rows: the parents' at t1 —
+                             // in sub-steps too, where they read no age: decideRows)
+        std::vector<size_t> sites;
+        for (size_t site = 0; site < o.emits.size(); ++site)
+            if (o.emits[site].inUpdate()) sites.push_back(site);
+        s_.gatherSpawnParents(type, sites, t1);
+    }
     LateKills late;
     columns.clear();
     const Clock toEnd = firstUpdateInMemory(type, b, n, rows, t1, late, columns);
@@ -223,18 +241,22 @@ Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows
     Buffer length = emits ? b.columns.at(kLength, Elem::F64, end) : Buffer{};
     Buffer taken;  // (the earlier sub-steps' kills, gathered: Ledger::takeOut)
     for (uint32_t k = 1; k <= most; ++k) {
-        // (An emitter's spawn launches, run after the batch, read each sub-step's ends: a
-        // column of each sub-step's own.)
-        if (emits) table[ColumnLayout::kNow] = subStepNows_.at(k - 1, Elem::F64, end);
         memory.subStepClocks(table[ColumnLayout::kCreated], mask, step, table[ColumnLayout::kNow],
                              table[ColumnLayout::kDt], length, b.first, n, k, most, t1, info.stepLimit);
+        // (An emitter's spawn launches, run after the batch, read each sub-step's ends: a
+        // copy of its own. The batch's column keeps each row's last, its exports' clock.)
+        Buffer nows;
+        if (emits) {
+            nows = subStepNows_.at(k - 1, Elem::F64, end);
+            memory.copy(table[ColumnLayout::kNow], b.first, nows, b.first, n);
+        }
         std::optional<LateKills> each;
         if (info.late && k < most) each = lateKills();
         LateKills* kills = !info.late ? nullptr : k < most ? &*each : &late;
         launchInMemory(type, b, n, *info.update, info.updateLayout, table, perRow, kills, step);
         if (emits || (bursts && k == 1))  // (in the first sub-step every object kept takes: step is mask)
             emitFromBatch(type, b, n, rows, t1,
-                          {bursts && k == 1, emits, k == 1, step, emits ? table[ColumnLayout::kNow] : Buffer{}, length},
+                          {bursts && k == 1, emits, k == 1, step, nows, length},
                           columns);
         if (!each) continue;
         if (!taken.valid()) {
@@ -349,7 +371,7 @@ void Creation::queueFromRecords(size_t type, const RateSites& in, std::span<cons
             const bool atCreation = in.sites[k].kind == Kind::AtCreation;
             Emitter emitter{type, 0, {}, 0, t1, false};
             if (atCreation) emitter = {type, 0, batch->burstTables[emitSite[k]], 0, t1, true};
-            ChildrenLaunch* launch = queueSpawn(emitter, static_cast<int>(emitSite[k]), 0, siteKept, base);
+            ChildrenLaunch* launch = queueSpawn(emitter, static_cast<int>(emitSite[k]), 0, siteKept, base, true);
             if (!launch) continue;
             launch->records = runs;
             launch->record = records.first[k];

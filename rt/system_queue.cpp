@@ -38,14 +38,15 @@ void Creation::queueChildren(const Emitter& e, int site, uint64_t count, uint64_
     s_.nextId += static_cast<uint32_t>(kept);
 }
 
-ChildrenLaunch* Creation::queueSpawn(const Emitter& e, int site, uint32_t firstChild, size_t count, size_t base) {
+ChildrenLaunch* Creation::queueSpawn(const Emitter& e, int site, uint32_t firstChild, size_t count, size_t base,
+                                     bool fromRecords) {
     const TypeInfo& info = s_.types[e.type];
     const ir::Kernel* spawn = info.spawn[static_cast<size_t>(site)];
     if (!spawn) return nullptr;
     size_t target = info.emitTarget[static_cast<size_t>(site)];
     const ColumnLayout& layout = info.spawnLayout[static_cast<size_t>(site)];
     Spawn& queued = spawns_.emplace_back();
-    s_.parentValues(e.type, e.row, layout, e.at, queued.parents);
+    if (!fromRecords) s_.parentValues(e.type, e.row, layout, e.at, queued.parents);
     ChildrenLaunch& launch = queued.launch;
     launch.object = &s_.pools[e.type].object();
     launch.spawn = spawn;
@@ -150,7 +151,8 @@ void Creation::runSpawns() {
     launches_.clear();
     for (Spawn& queued : spawns_) {
         launches_.push_back(queued.launch);
-        launches_.back().parents = queued.parents.data();
+        // (A launch from records reads each emitter's from the columns: gatherSpawnParents.)
+        launches_.back().parents = queued.launch.records.valid() ? nullptr : queued.parents.data();
     }
     s_.backend.runChildren(launches_);
     spawns_.clear();

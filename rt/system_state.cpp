@@ -129,12 +129,12 @@ void decideRows(std::vector<TypeInfo>& types, const ir::Module& module, const Sy
     // A type that only dies whose exports folds read (no children) is one too: its kills
     // late all the same — a fold reads the rows updatable at the step's start — and its
     // exports those of its survivors, from the kill flags where they are (Memory::survivors;
-    // not yet under @step).
+    // under @step, of the last sub-step's survivors, each row's at its own last clock).
     for (size_t t = 0; t < types.size(); ++t) {
         TypeInfo& info = types[t];
         bool silent = !info.kills && !info.unstable && !info.updateEmits && !info.read;
         bool folded = options.lateKills && (info.kills || info.unstable) && !info.updateEmits && !info.read &&
-                      info.exports && info.stepLimit == 0;
+                      info.exports;
         info.rowsInMemory = inMemory && (info.late || silent || folded) && !info.bursts && keptWhole(info);
         info.late = info.late || (info.rowsInMemory && folded);
     }
@@ -151,10 +151,12 @@ void decideRows(std::vector<TypeInfo>& types, const ir::Module& module, const Sy
     // children looks at them before the step's end — and the operation reads its update's
     // kill flags where they are (a row killed emits at no rate, and bursts); its exports,
     // where children or folds read them, are its survivors' (Memory::survivors). (Until no
-    // type changes: an emitter of emitters follows them in.) One in sub-steps (@step) is
-    // read by nobody and exports nothing: each sub-step's emissions follow its update, over
-    // its clock, before what it killed is taken out of the masks (runEmissions; a new
-    // object's first update: Creation::firstUpdateInMemory).
+    // type changes: an emitter of emitters follows them in.) In sub-steps (@step), each
+    // sub-step's emissions follow its update, over its clock, before what it killed is
+    // taken out of the masks (runEmissions; a new object's first update:
+    // Creation::firstUpdateInMemory) — where children read it, out of both at once
+    // (Ledger::takeOut); its exports are its last sub-step's survivors', each new one's
+    // at its own last clock.
     // Wherever rows are kept in the memory (a device's backend asks for it, any backend
     // with Rows::InMemory) and objects are created in batches. Where the emitters' rows are
     // on a device, the host still reads the operation's totals back in the step
@@ -215,12 +217,21 @@ void decideRows(std::vector<TypeInfo>& types, const ir::Module& module, const Sy
         bool emitter = inMemory && options.createInBatches &&
                        (info.updateEmits || info.bursts) &&
                        (!dies || options.lateKills) && (!info.read || parent) &&
-                       (keptWhole(info) || (childShape[t] && candidate[static_cast<size_t>(info.parentType)])) &&
-                       (info.stepLimit == 0 || (!info.read && !info.exports));
+                       (keptWhole(info) || (childShape[t] && candidate[static_cast<size_t>(info.parentType)]));
         for (size_t s = 0; emitter && s < o.emits.size(); ++s) {
             size_t target = info.emitTarget[s];
             bool itsChild = child(target) && types[target].parentType == static_cast<int>(t);
-            emitter = (inMemoryOr(target) || itsChild) && info.spawnLayout[s].parentColumns.empty();
+            // (Its arguments may read its parent as a child reads it, and its own folds: their
+            // values gathered for every row before the operation, State::gatherSpawnParents —
+            // in sub-steps, not its parent's age: a new emitter's sub-steps emit at clocks of
+            // their own, their launches after the batch, and what else they read of a parent
+            // is the same at each.)
+            const ColumnLayout& spawn = info.spawnLayout[s];
+            auto age = [](const ColumnLayout::ParentColumn& p) { return p.op == ir::Op::ParentAge; };
+            emitter = (inMemoryOr(target) || itsChild) &&
+                      (spawn.parentColumns.empty() ||
+                       (readsLikeAChild(spawn) && (info.stepLimit == 0 || std::none_of(spawn.parentColumns.begin(),
+                                                                                       spawn.parentColumns.end(), age))));
         }
         return emitter;
     };
@@ -428,6 +439,22 @@ void State::parentsToHost() {
         memory.read(pool.parentRows, 0, rows.size(), rows.data());
         for (size_t r = 0; r < rows.size(); ++r)
             pool.parent[r] = rows[r] < generation.size() ? Handle{rows[r], generation[rows[r]]} : Handle{};
+    }
+}
+
+void State::gatherSpawnParents(size_t type, std::span<const size_t> sites, double at) {
+    const size_t rows = pools[type].rows();
+    size_t first = 0;  // (each site's columns its own: launches of several sites wait together)
+    for (size_t site = 0; site < types[type].spawnLayout.size(); ++site) {
+        const ColumnLayout& layout = types[type].spawnLayout[site];
+        const auto width = static_cast<size_t>(layout.total - layout.parents);
+        if (width > 0 && rows > 0 && std::find(sites.begin(), sites.end(), site) != sites.end()) {
+            std::vector<Buffer>& table = work[type].spawnTables[site];
+            for (size_t c = 0; c < width; ++c)
+                table[static_cast<size_t>(layout.parents) + c] = work[type].spawnParents.at(first + c, Elem::F32, rows);
+            gatherParents(type, layout, table, nullptr, 0, rows, at, nullptr, nullptr, 0);
+        }
+        first += width;
     }
 }
 

@@ -83,8 +83,10 @@ struct DrawnInStep {
 
 // Per type: the scratch buffers and column tables of its launches over the pool.
 struct TypeWork {
-    explicit TypeWork(Memory& memory) : update(memory), exports(memory), masks(memory), render(memory) {}
+    explicit TypeWork(Memory& memory)
+        : update(memory), exports(memory), masks(memory), render(memory), spawnParents(memory) {}
     Scratch update, exports, masks, render;
+    Scratch spawnParents;  // the spawn tables' parent columns, each site's its own (State::gatherSpawnParents)
     std::vector<Buffer> updateTable, exportsTable, renderTable;
     DrawnInStep inStep;
     std::vector<LateKills::Part> killed;  // per chunk: the rows that died, in order (or a late launch's ticket)
@@ -169,6 +171,12 @@ struct State {
     // of its parent columns (but folds) through `parents` from row `parentsFirst` on, where
     // they are (Memory::gatherThrough, gatherAlive, gatherAge: at `at`, or atRows' row
     // by row from `begin` — a batch's per-row clocks).
+    // The spawn kernels' parent reads (its parent's exports, `alive` and `age`; its own
+    // folds) of `type`'s sites in `sites`, for every row of its pool at `at`: columns of its
+    // spawn tables, where a launch from records reads each emitter's at its row — the
+    // values parentValues gives the host's launches (rt::eachEmitter; the GPU builds its
+    // blocks from them). The pool's rows and its parents' are in the memory.
+    void gatherSpawnParents(size_t type, std::span<const size_t> sites, double at);
     void gatherThrough(size_t type, const ColumnLayout& layout, std::span<const Buffer> table, Buffer parents,
                        size_t parentsFirst, size_t begin, size_t end, double at, Buffer atRows = {});
     // The neighbour folds of a type's objects, for this step (rt/neighbours.cpp).

@@ -55,6 +55,7 @@ void runEmissions(State& s, Creation& creation, size_t type, double dt, double t
             if (o.emits[site].rate()) out.accumulated = pool.emitted[site];
             sites.push_back(site);
         }
+        s.gatherSpawnParents(type, sites, t1);  // (what its spawn kernels read of its parent, at t1)
         creation.emitInMemory(type, work.updateTable, &uniforms, std::move(in), sites, nullptr, {}, t1);
         creation.runSpawns();
         if (s.work[type].pass.untaken) {

@@ -35,10 +35,14 @@ namespace {
 struct ChildrenSeen : rt::Backend {
     rt::HostMemory host;
     std::vector<rt::ChildrenLaunch> seen;
+    std::vector<rt::Value> parents;  // each launch's first parent read, where it has one
     std::string name() const override { return "children seen"; }
     rt::Memory& memory() override { return host; }
     rt::RowsResult run(const rt::RowsLaunch&) override { return {}; }
-    void run(const rt::ChildrenLaunch& l) override { seen.push_back(l); }
+    void run(const rt::ChildrenLaunch& l) override {
+        seen.push_back(l);
+        if (l.parents) parents.push_back(l.parents[0]);
+    }
 };
 
 }  // namespace
@@ -71,6 +75,18 @@ TEST_CASE("a launch from records runs as one launch an emitter with children: it
     launch.recordCount = 3;
     launch.rows = rows;
     launch.rowsFirst = 1;
+    // Its spawn kernel reads a parent's vec2 export: each emitter's from two columns at its
+    // row (rt::detail::State::gatherSpawnParents), 10·row + component.
+    rt::ColumnLayout layout;
+    layout.parentColumns.push_back({ir::Op::ParentExport, 1, 0, 2, 0});
+    std::vector<rt::Buffer> columns = {memory.create(rt::Elem::F32, 12), memory.create(rt::Elem::F32, 12)};
+    for (size_t c = 0; c < 2; ++c)
+        for (uint32_t row = 0; row < 12; ++row) {
+            float value = static_cast<float>(10 * row + c);
+            memory.write(columns[c], row, 1, &value);
+        }
+    launch.layout = &layout;
+    launch.columns = columns;
     std::vector<rt::ChildrenLaunch> all = {launch};
     launch.records = {};  // an ordinary launch beside it runs as it is
     launch.row = 3;
@@ -82,9 +98,13 @@ TEST_CASE("a launch from records runs as one launch an emitter with children: it
     CHECK((s[1].row == 11 && s[1].count == 3 && s[1].argsFirst == 42 && s[1].firstChild == 9));
     CHECK_FALSE(s[0].records.valid());
     CHECK((s[2].row == 3 && s[2].count == 5));
+    REQUIRE(backend.parents.size() == 2);  // (the ordinary launch has none: its parents are the host's)
+    CHECK((backend.parents[0].f[0] == 50 && backend.parents[0].f[1] == 51));
+    CHECK((backend.parents[1].f[0] == 110 && backend.parents[1].f[1] == 111));
     // Without a row list, record k is row rowsFirst + k.
     all[0].rows = {};
-    std::vector<rt::ChildrenLaunch> each = rt::eachEmitter(memory, all[0]);
+    std::vector<rt::Value> parents;
+    std::vector<rt::ChildrenLaunch> each = rt::eachEmitter(memory, all[0], parents);
     REQUIRE(each.size() == 2);
     CHECK((each[0].row == 1 && each[1].row == 3));
     CHECK(each[0].clock.nowValue == all[0].clock.nowValue);
@@ -93,9 +113,10 @@ TEST_CASE("a launch from records runs as one launch an emitter with children: it
     all[0].recordCount = 2;
     all[0].recordStride = 2;
     all[0].nowFromRecords = true;
-    each = rt::eachEmitter(memory, all[0]);
+    each = rt::eachEmitter(memory, all[0], parents);
     REQUIRE(each.size() == 2);  // (records 1 and 3)
     CHECK((each[0].row == 1 && each[0].count == 2 && each[0].argsFirst == 40 && each[0].firstChild == 7));
     CHECK((each[1].row == 2 && each[1].count == 3 && each[1].argsFirst == 42 && each[1].firstChild == 9));
     CHECK(each[1].clock.nowValue == created);
+    CHECK((each[1].parents == &parents[1] && parents[1].f[0] == 20));
 }

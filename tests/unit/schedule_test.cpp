@@ -126,8 +126,9 @@ TEST_CASE("the schedule says which types keep their rows in the memory, and wher
                                                     "memory's operation") != std::string::npos);
     // Drops in sub-steps keep their rows in the memory: each sub-step's kills listed there
     // (an earlier one's taken out of the masks at once); so does their emitter in
-    // sub-steps, its emissions the memory's each sub-step — one whose children read it
-    // keeps its rows on the host.
+    // sub-steps, its emissions the memory's each sub-step, and one whose children read it,
+    // beside them — but not one in sub-steps whose arguments read its parent (the host
+    // reads them at each sub-step's clock).
     rt::System stepped(test::compileModule("@step(1/240) object d { point(vec3(age), white, 1); kill when age > rand(); }\n"
                                            "@step(1/240) object e { emit d at 100 per second; }\nspawn e;"),
                        backend, options);
@@ -136,7 +137,14 @@ TEST_CASE("the schedule says which types keep their rows in the memory, and wher
     rt::System read(test::compileModule("@step(1/240) object c { pos = vec3(age); emit t at 50 per second;\n"
                                         "object t { point(c.pos, white, 1); kill when age > 0.2; } }\nspawn c;"),
                     backend, options);
-    CHECK_FALSE(read.pool(static_cast<size_t>(read.typeIndex("c"))).rowsInMemory());
+    CHECK(read.pool(static_cast<size_t>(read.typeIndex("c"))).rowsInMemory());
+    CHECK(read.pool(static_cast<size_t>(read.typeIndex("c.t"))).rowsInMemory());
+    rt::System args(test::compileModule("object p { pos = vec3(age); emit c at 5 per second;\n"
+                                        "  @step(1/240) object c { emit d(vec3(p.age)) at 50 per second; } }\n"
+                                        "object d(x: vec3) { point(x, white, 1); kill when age > 0.2; }\nspawn p;"),
+                    backend, options);
+    CHECK_FALSE(args.pool(static_cast<size_t>(args.typeIndex("p.c"))).rowsInMemory());
+    CHECK(args.pool(static_cast<size_t>(args.typeIndex("d"))).rowsInMemory());
     printed = rt::printSchedule(stepped.schedule());
     CHECK(printed.find("d: the next 2 phases once per sub-step") != std::string::npos);
     CHECK(printed.find("  update     chunks on every thread   d: the update kernel over the pool, its kills listed in "
