@@ -126,7 +126,8 @@ GlMemory::~GlMemory() {
                              identifyProgram_, boundsProgram_, emitRowsProgram_, emitScanProgram_, identifyRecordsProgram_,
                              clearMappedProgram_, parentsProgram_, gatherAliveProgram_, survivorsProgram_,
                              readersGoneProgram_, releaseUnreadProgram_, releaseWaitingProgram_, gatherAgeProgram_,
-                             stampDeathsProgram_})
+                             stampDeathsProgram_, subStepProgram_, clearRowsProgram_, appendProgram_,
+                             appendedProgram_, ancestorRowsProgram_})
         if (program) glDeleteProgram(program);
     if (runsBuffer_) glDeleteBuffers(1, &runsBuffer_);
     if (rowsBuffer_) glDeleteBuffers(1, &rowsBuffer_);

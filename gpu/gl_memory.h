@@ -64,6 +64,8 @@ public:
                        size_t count) override;
     void gatherAlive(rt::Buffer alive, rt::Buffer to, size_t toFirst, rt::Buffer rows, size_t rowsFirst,
                      size_t count) override;
+    void ancestorRows(rt::Buffer parents, rt::Buffer to, size_t toFirst, rt::Buffer rows, size_t rowsFirst,
+                      size_t count) override;
     void gatherAge(rt::Buffer created, rt::Buffer frozenAt, rt::Buffer alive, rt::Buffer to, size_t toFirst,
                    rt::Buffer rows, size_t rowsFirst, size_t count, double now, rt::Buffer nowRows,
                    size_t nowFirst) override;
@@ -177,7 +179,7 @@ private:
     // gpu/gl_parents.cpp
     unsigned gatherAliveProgram_ = 0, gatherAgeProgram_ = 0, stampDeathsProgram_ = 0, survivorsProgram_ = 0,
              readersGoneProgram_ = 0, releaseUnreadProgram_ = 0, releaseWaitingProgram_ = 0, clearRowsProgram_ = 0,
-             appendProgram_ = 0, appendedProgram_ = 0;
+             appendProgram_ = 0, appendedProgram_ = 0, ancestorRowsProgram_ = 0;
     uint32_t killListGrid(rt::Buffer killed, size_t killedAt) const;
     void killListProgram(unsigned& program, const char* body, const char* name);
     void bindKillList(rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map, size_t mapFirst, uint32_t grid,

@@ -35,6 +35,19 @@ void main() {
 }
 )";
 
+// The rows one level further up (kSkipRow stays kSkipRow).
+const char* kAncestorRows = R"(
+layout(std430, binding = 0) readonly buffer Parents { uint parents[]; };
+layout(std430, binding = 1) buffer To { uint to[]; };
+layout(std430, binding = 2) readonly buffer Rows { uint rows[]; };
+void main() {
+    uint i = INVOCATION, count = param(0u), first = param(1u), rowsAt = param(2u);
+    if (i >= count) return;
+    uint row = rows[rowsAt + i];
+    to[first + i] = row == 0xFFFFFFFFu ? row : parents[row];
+}
+)";
+
 // A parent's age at the child's clock, or at its death where it is frozen: rt::ageAt over
 // doubles (two words a row, the low first), rounded as C rounds (psys_narrow).
 const char* kGatherAge = R"(
@@ -264,6 +277,21 @@ void GlMemory::gatherAlive(Buffer alive, Buffer to, size_t toFirst, Buffer rows,
     bindParams(paramsBuffer_, {static_cast<uint32_t>(count), static_cast<uint32_t>(toFirst),
                                static_cast<uint32_t>(rowsFirst)});
     dispatchRows(gatherAliveProgram_, count);
+}
+
+void GlMemory::ancestorRows(Buffer parents, Buffer to, size_t toFirst, Buffer rows, size_t rowsFirst, size_t count) {
+    if (count == 0) return;
+    if (!onDevice(rows) && allOnHost({parents, to}))
+        return rt::Memory::ancestorRows(parents, to, toFirst, rows, rowsFirst, count);
+    flushPending();
+    if (!ancestorRowsProgram_) ancestorRowsProgram_ = computeProgram(operationShader(kAncestorRows), "ancestors' rows");
+    PassTimer::Scope timed(timer, "gather", count);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceBuffer(parents));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, bound(to));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, deviceBuffer(rows));
+    bindParams(paramsBuffer_, {static_cast<uint32_t>(count), static_cast<uint32_t>(toFirst),
+                               static_cast<uint32_t>(rowsFirst)});
+    dispatchRows(ancestorRowsProgram_, count);
 }
 
 void GlMemory::gatherAge(Buffer created, Buffer frozenAt, Buffer alive, Buffer to, size_t toFirst, Buffer rows,

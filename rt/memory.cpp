@@ -153,6 +153,14 @@ void Memory::gatherThrough(Buffer from, Buffer to, size_t toFirst, Buffer rows, 
     gather(from, to, toFirst, std::span<const uint32_t>(list, count));
 }
 
+void Memory::ancestorRows(Buffer parents, Buffer to, size_t toFirst, Buffer rows, size_t rowsFirst, size_t count) {
+    if (count == 0) return;
+    const auto* list = static_cast<const uint32_t*>(view(rows)) + rowsFirst;
+    const auto* up = static_cast<const uint32_t*>(view(parents));
+    auto* out = static_cast<uint32_t*>(host(to)) + toFirst;
+    for (size_t i = 0; i < count; ++i) out[i] = list[i] == kSkipRow ? kSkipRow : up[list[i]];
+}
+
 void Memory::gatherAlive(Buffer alive, Buffer to, size_t toFirst, Buffer rows, size_t rowsFirst, size_t count) {
     if (count == 0) return;
     const auto* list = static_cast<const uint32_t*>(view(rows)) + rowsFirst;

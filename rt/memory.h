@@ -225,6 +225,10 @@ public:
     // as 1 or 0 (a child's `parent.alive`).
     virtual void gatherThrough(Buffer from, Buffer to, size_t toFirst, Buffer rows, size_t rowsFirst, size_t count);
     virtual void gatherAlive(Buffer alive, Buffer to, size_t toFirst, Buffer rows, size_t rowsFirst, size_t count);
+    // One level further up: to[toFirst + i] = parents[rows[rowsFirst + i]] (u32), kSkipRow
+    // where that is kSkipRow — a grandchild's grandparents' rows through its parents' rows
+    // and its parent pool's `parents`.
+    virtual void ancestorRows(Buffer parents, Buffer to, size_t toFirst, Buffer rows, size_t rowsFirst, size_t count);
     // A child's `parent.age` through its `parents` rows: to[toFirst + i] = ageAt(clock,
     // created[p]) (rt/clock.h) for p = rows[rowsFirst + i], the clock `now` — or
     // nowRows[nowFirst + i] where given (a batch's per-row clocks) — where the parent is

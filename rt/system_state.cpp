@@ -161,34 +161,24 @@ void decideRows(std::vector<TypeInfo>& types, const ir::Module& module, const Sy
     // with Rows::InMemory) and objects are created in batches. Where the emitters' rows are
     // on a device, the host still reads the operation's totals back in the step
     // (docs/gpu.md, "Emitters in the memory").
-    // Children in the memory beside their parents: a nested type that nobody reads, created
-    // in a batch, reading of its parent (one level up) only its exports, whether it is alive
-    // and its age, that emits nothing and whose kills are late or who never dies (as a type
-    // that only dies, in sub-steps too: its parents' values gathered at each sub-step's
-    // clock) — or that is an emitter in the memory itself — its parent type's rows in the
-    // memory too (below), so that the parents' rows, readers and frozen objects are the
-    // memory's (Memory::releaseUnread).
-    // Its parent type is then such an emitter with no parent of its own (a child is read by
-    // nobody), every type that reads it such a child. (A fold over it reads the rows updatable at the step's start,
-    // as on the host: a frozen parent is not among them.)
-    auto readsLikeAChild = [&](const ColumnLayout& layout) {
-        return std::all_of(layout.parentColumns.begin(), layout.parentColumns.end(), [](const ColumnLayout::ParentColumn& p) {
-            return p.op == ir::Op::Fold || (p.depth == 1 && (p.op == ir::Op::ParentExport || p.op == ir::Op::ParentAlive ||
-                                                             p.op == ir::Op::ParentAge));
-        });
-    };
+    // Children in the memory beside their parents: a nested type created in a batch — its
+    // ancestors' exports, whether they are alive and their ages gathered through its
+    // parents' rows where they are (State::gatherThrough: further up, through each
+    // ancestor pool's), at each sub-step's clock in sub-steps — that emits nothing and
+    // whose kills are late or who never dies (as a type that only dies), or that is an
+    // emitter in the memory itself (then children may read it: a grandparent's child), its
+    // parent type's rows in the memory too (below), so that the parents' rows, readers and
+    // frozen objects are the memory's (Memory::releaseUnread). Its parent type is then
+    // such an emitter, every type that reads it such a child. (A fold over it reads the
+    // rows updatable at the step's start, as on the host: a frozen parent is not among them.)
     // (A child that emits is such an emitter itself, below: `candidate`.)
     std::vector<bool> childShape(types.size(), false), quietChild(types.size(), false);
     for (size_t t = 0; t < types.size(); ++t) {
         const TypeInfo& info = types[t];
         const ir::Object& o = module.objects[t];
         bool silent = !info.kills && !info.unstable && !info.updateEmits;
-        std::vector<const ColumnLayout*> layouts = {&info.updateLayout, &info.exportsLayout, &info.renderLayout};
-        ColumnLayout init;
-        if (info.init) layouts.push_back(&(init = columnLayout(o, *info.init)));
         childShape[t] = inMemory && options.createInBatches && info.parentType >= 0 &&
-                        !(options.drawInStep && backend.rendersInStep() && info.render) &&
-                        std::all_of(layouts.begin(), layouts.end(), [&](const ColumnLayout* l) { return readsLikeAChild(*l); });
+                        !(options.drawInStep && backend.rendersInStep() && info.render);
         quietChild[t] = childShape[t] && !info.read && (info.late || silent) && o.emits.empty();
     }
     // Emitters are decided together, as the greatest set that holds: every type starts a
@@ -221,17 +211,15 @@ void decideRows(std::vector<TypeInfo>& types, const ir::Module& module, const Sy
         for (size_t s = 0; emitter && s < o.emits.size(); ++s) {
             size_t target = info.emitTarget[s];
             bool itsChild = child(target) && types[target].parentType == static_cast<int>(t);
-            // (Its arguments may read its parent as a child reads it, and its own folds: their
-            // values gathered for every row before the operation, State::gatherSpawnParents —
-            // in sub-steps, not its parent's age: a new emitter's sub-steps emit at clocks of
-            // their own, their launches after the batch, and what else they read of a parent
-            // is the same at each.)
-            const ColumnLayout& spawn = info.spawnLayout[s];
+            // (Its arguments may read its ancestors as a child reads them, and its own folds:
+            // their values gathered for every row before the operation,
+            // State::gatherSpawnParents — in sub-steps, not an ancestor's age: a new emitter's
+            // sub-steps emit at clocks of their own, their launches after the batch, and what
+            // else they read of an ancestor is the same at each.)
+            const std::vector<ColumnLayout::ParentColumn>& reads = info.spawnLayout[s].parentColumns;
             auto age = [](const ColumnLayout::ParentColumn& p) { return p.op == ir::Op::ParentAge; };
             emitter = (inMemoryOr(target) || itsChild) &&
-                      (spawn.parentColumns.empty() ||
-                       (readsLikeAChild(spawn) && (info.stepLimit == 0 || std::none_of(spawn.parentColumns.begin(),
-                                                                                       spawn.parentColumns.end(), age))));
+                      (info.stepLimit == 0 || std::none_of(reads.begin(), reads.end(), age));
         }
         return emitter;
     };
@@ -255,7 +243,12 @@ void decideRows(std::vector<TypeInfo>& types, const ir::Module& module, const Sy
 }  // namespace
 
 State::State(ir::Module m, Backend& b, SystemOptions o)
-    : module(std::move(m)), backend(b), memory(b.memory()), options(o), parallel(std::make_unique<Parallel>(o.threads)) {
+    : module(std::move(m)),
+      backend(b),
+      memory(b.memory()),
+      options(o),
+      ancestors(b.memory()),
+      parallel(std::make_unique<Parallel>(o.threads)) {
     for (const ir::Object& obj : module.objects) {
         size_t capacity = obj.attributes.capacity ? static_cast<size_t>(*obj.attributes.capacity) : options.capacity;
         pools.emplace_back(obj, capacity, memory);
@@ -460,18 +453,37 @@ void State::gatherSpawnParents(size_t type, std::span<const size_t> sites, doubl
 
 void State::gatherThrough(size_t type, const ColumnLayout& layout, std::span<const Buffer> table, Buffer parents,
                           size_t parentsFirst, size_t begin, size_t end, double at, Buffer atRows) {
-    const Pool& parent = pools[static_cast<size_t>(types[type].parentType)];
+    // The ancestors `depth` levels up, and their rows: a parent's through `parents`, one
+    // further up through that pool's parents (Memory::ancestorRows), and so on.
+    struct Up {
+        size_t type;
+        Buffer rows;
+        size_t first;
+    };
+    std::vector<Up> up = {{static_cast<size_t>(types[type].parentType), parents, parentsFirst}};
+    auto ancestor = [&](int depth) -> const Up& {
+        while (up.size() < static_cast<size_t>(depth)) {
+            const Up& below = up.back();
+            Buffer rows = ancestors.at(up.size() - 1, Elem::U32, end - begin);
+            memory.ancestorRows(pools[below.type].parentRows, rows, 0, below.rows, below.first, end - begin);
+            up.push_back({static_cast<size_t>(types[below.type].parentType), rows, 0});
+        }
+        return up[static_cast<size_t>(depth) - 1];
+    };
     for (const auto& p : layout.parentColumns) {
+        if (p.op == ir::Op::Fold) continue;  // (folds: gatherParents', emptyFolds')
+        const auto [parentType, parentRows, rowsFirst] = ancestor(p.depth);
+        const Pool& parent = pools[parentType];
         if (p.op == ir::Op::ParentAlive)
-            memory.gatherAlive(parent.alive.column, table[static_cast<size_t>(p.offset)], begin, parents, parentsFirst,
+            memory.gatherAlive(parent.alive.column, table[static_cast<size_t>(p.offset)], begin, parentRows, rowsFirst,
                                end - begin);
         if (p.op == ir::Op::ParentAge)
             memory.gatherAge(parent.created, parent.frozenAt, parent.alive.column, table[static_cast<size_t>(p.offset)],
-                             begin, parents, parentsFirst, end - begin, at, atRows, begin);
-        if (p.op != ir::Op::ParentExport) continue;  // (folds: gatherParents', emptyFolds')
+                             begin, parentRows, rowsFirst, end - begin, at, atRows, begin);
+        if (p.op != ir::Op::ParentExport) continue;
         for (int c = 0; c < p.width; ++c)
             memory.gatherThrough(parent.exports.column(static_cast<size_t>(p.exportIndex), static_cast<size_t>(c)),
-                                 table[static_cast<size_t>(p.offset + c)], begin, parents, parentsFirst, end - begin);
+                                 table[static_cast<size_t>(p.offset + c)], begin, parentRows, rowsFirst, end - begin);
     }
 }
 

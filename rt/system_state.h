@@ -129,6 +129,7 @@ struct State {
     // The types, the most deeply nested first (a parent after its children: Ledger::release).
     std::vector<size_t> deepestFirst;
     std::vector<TypeWork> work;
+    Scratch ancestors;  // the rows of ancestors further up than a parent (gatherThrough's)
     std::vector<Value> externs;
     uint64_t externsVersion = 0;
     std::vector<std::array<UniformCache, 3>> uniformCache;

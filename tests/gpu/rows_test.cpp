@@ -201,6 +201,31 @@ TEST_CASE("parents and their readers: the GPU frees and freezes the rows the hos
     CHECK(host.read<uint32_t>(host.rows.parentReaders, kGrandparents) == expected);
 }
 
+TEST_CASE("a grandchild's grandparents' rows through its parents' rows, on the GPU as on the host") {
+    // 5,000 grandchildren, each row a parent's (or none) of 700 parents, each of those a
+    // grandparent's (or none): one level further up, none staying none.
+    auto gpu = gpuBackend();
+    rt::HostMemory hostMemory;
+    constexpr size_t kChildren = 5000, kParents = 700;
+    std::mt19937 random(17);
+    std::vector<uint32_t> rows(kChildren), parents(kParents), expected(kChildren);
+    for (uint32_t& p : parents) p = random() % 6 == 0 ? rt::kSkipRow : static_cast<uint32_t>(random() % 300);
+    for (size_t i = 0; i < kChildren; ++i) {
+        rows[i] = random() % 9 == 0 ? rt::kSkipRow : static_cast<uint32_t>(random() % kParents);
+        expected[i] = rows[i] == rt::kSkipRow ? rt::kSkipRow : parents[rows[i]];
+    }
+    for (rt::Memory* m : {static_cast<rt::Memory*>(&hostMemory), &gpu->memory()}) {
+        rt::Buffer r = m->create(rt::Elem::U32, kChildren + 10), p = m->create(rt::Elem::U32, kParents),
+                   out = m->create(rt::Elem::U32, kChildren + 20);
+        m->write(r, 10, kChildren, rows.data());
+        m->write(p, 0, kParents, parents.data());
+        m->ancestorRows(p, out, 20, r, 10, kChildren);
+        std::vector<uint32_t> got(kChildren);
+        m->read(out, 20, kChildren, got.data());
+        CHECK(got == expected);
+    }
+}
+
 TEST_CASE("a child's parents: from the records, their values, whether they are alive and their ages, on the GPU as on the host") {
     auto gpu = gpuBackend();
     rt::HostMemory hostMemory;

@@ -153,8 +153,9 @@ private:
                 t.equations.push_back(fmt::format("pos = {} + vec3(age * {}, age * {}, {});", start, num(r_.real(-2, 2)),
                                                   num(r_.real(-2, 2)), pf.empty() ? num(r_.real(-1, 1)) : pf));
                 break;
-            case 3:  // follows its parent live (frozen after it dies)
-                t.equations.push_back(fmt::format("pos = {}.pos + {} * (1 + age);", parent, !p3.empty() ? p3 : vec(-0.5, 0.5)));
+            case 3:  // follows its parent live (frozen after it dies), and its grandparent's age
+                t.equations.push_back(fmt::format("pos = {}.pos + {} * (1 + age){};", parent, !p3.empty() ? p3 : vec(-0.5, 0.5),
+                                                  grandparentAge(t)));
                 break;
         }
         if (r_.chance(0.3)) t.equations.push_back("n = 0 -> prev(n) + 1;");
@@ -188,8 +189,24 @@ private:
         }
     }
 
-    // A condition a kill or an edge decides by.
+    // Reads of a grandparent (two levels up), drawn from the second stream, as the extra
+    // sites are: a program whose types are nested less deeply is the one it was.
+    std::string grandparent(const Type& t) const {
+        if (t.depth < 2) return "";
+        return m_.types[static_cast<size_t>(m_.types[static_cast<size_t>(t.parent)].parent)].name;
+    }
+    std::string grandparentAge(const Type& t) {
+        std::string g = grandparent(t);
+        return !g.empty() && more_.chance(0.4) ? fmt::format(" + vec3(0, {}.age * {}, 0)", g, num(more_.real(0.1, 1))) : "";
+    }
+
+    // A condition a kill or an edge decides by (or, sometimes, a grandparent's death).
     std::string condition(const Type& t, double lo, double hi) {
+        std::string c = ownCondition(t, lo, hi), g = grandparent(t);
+        if (!g.empty() && more_.chance(0.25)) c = fmt::format("{} || (!{}.alive && age > {})", c, g, num(more_.real(lo / 2, hi / 2)));
+        return c;
+    }
+    std::string ownCondition(const Type& t, double lo, double hi) {
         std::string c = fmt::format("age > {}", num(r_.real(lo, hi)));
         if (age_) {
             if (t.parent >= 0 && r_.chance(0.3))
