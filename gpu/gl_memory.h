@@ -70,7 +70,8 @@ public:
                    rt::Buffer rows, size_t rowsFirst, size_t count, double now, rt::Buffer nowRows,
                    size_t nowFirst) override;
     void stampDeaths(rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map, size_t mapFirst,
-                     rt::Buffer frozenAt, double t1, double dt, rt::Buffer created) override;
+                     rt::Buffer frozenAt, double t1, double dt, rt::Buffer created, rt::Buffer nows,
+                     rt::Buffer lengths, size_t clocksFirst) override;
     void survivors(rt::Buffer mask, rt::Buffer killed, rt::Buffer out, size_t first, size_t count) override;
     void clearRows(const rt::PoolRows& pool, rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map,
                    size_t mapFirst) override;
@@ -183,7 +184,7 @@ private:
     uint32_t killListGrid(rt::Buffer killed, size_t killedAt) const;
     void killListProgram(unsigned& program, const char* body, const char* name);
     void bindKillList(rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map, size_t mapFirst, uint32_t grid,
-                      uint32_t mode = 0, std::array<uint32_t, 2> value = {});
+                      uint32_t mode = 0, std::array<uint32_t, 2> value = {}, uint32_t extra = 0);
     void bindScanBlocks(const rt::PoolRows& pool);
 };
 

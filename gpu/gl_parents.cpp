@@ -86,7 +86,7 @@ void main() {
 )";
 
 // A kill list's rows (its count, then launch rows: rt::Memory::releaseRows) and the pool
-// row of its i-th; shared by the shaders below (params 1–5; 0, 6 and 7 are theirs).
+// row of its i-th; shared by the shaders below (params 1–5; 0, 6, 7 and 8 are theirs).
 const char* kKillList = R"(
 layout(std430, binding = 0) readonly buffer Killed { uint killed[]; };
 layout(std430, binding = 1) readonly buffer Map { uint map[]; };
@@ -139,20 +139,29 @@ void main() {
 }
 )";
 
-// Each listed row's death: `value` (t1 − dt), or where param 0 says so value − (value −
-// created[row]) (a batch's first update: t1 − its age), as the host rounds it.
+// Each listed row's death: `value` (t1 − dt); where param 0 is 1, value − (value −
+// created[row]) (a batch's first update: t1 − its age); where it is 2, nows[j] −
+// lengths[j] for j = param 8 + the map's first + the launch row (a batch's sub-step), as
+// the host rounds it.
 const char* kStampDeaths = R"(
 layout(std430, binding = 2) buffer FrozenAt { uint frozenAt[]; };
 layout(std430, binding = 3) readonly buffer Created { uint created[]; };
+layout(std430, binding = 4) readonly buffer Nows { uint nows[]; };
+layout(std430, binding = 5) readonly buffer Lengths { uint lengths[]; };
 void main() {
     uint count = killed[param(1u)], grid = param(5u);
     double value = packDouble2x32(uvec2(param(6u), param(7u)));
     for (uint i = INVOCATION; i < count; i += grid) {
         uint row = killedRow(i);
         precise double at = value;
-        if (param(0u) != 0u) {
+        if (param(0u) == 1u) {
             precise double age = value - packDouble2x32(uvec2(created[2u * row], created[2u * row + 1u]));
             at = value - age;
+        }
+        if (param(0u) == 2u) {
+            uint j = param(8u) + param(3u) + killed[param(1u) + 1u + i];
+            at = packDouble2x32(uvec2(nows[2u * j], nows[2u * j + 1u])) -
+                 packDouble2x32(uvec2(lengths[2u * j], lengths[2u * j + 1u]));
         }
         uvec2 w = unpackDouble2x32(at);
         frozenAt[2u * row] = w.x;
@@ -319,9 +328,10 @@ void GlMemory::gatherAge(Buffer created, Buffer frozenAt, Buffer alive, Buffer t
 }
 
 void GlMemory::stampDeaths(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, Buffer frozenAt,
-                           double t1, double dt, Buffer created) {
-    if (allOnHost({killed, map, frozenAt, created}))
-        return rt::Memory::stampDeaths(killed, killedAt, base, map, mapFirst, frozenAt, t1, dt, created);
+                           double t1, double dt, Buffer created, Buffer nows, Buffer lengths, size_t clocksFirst) {
+    if (allOnHost({killed, map, frozenAt, created, nows, lengths}))
+        return rt::Memory::stampDeaths(killed, killedAt, base, map, mapFirst, frozenAt, t1, dt, created, nows, lengths,
+                                       clocksFirst);
     flushPending();
     uint32_t grid = killListGrid(killed, killedAt);
     if (grid == 0) return;
@@ -332,7 +342,10 @@ void GlMemory::stampDeaths(Buffer killed, size_t killedAt, uint32_t base, Buffer
     std::memcpy(w.data(), &value, 8);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, bound(frozenAt));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, created.valid() ? deviceBuffer(created) : deviceBuffer(frozenAt));
-    bindKillList(killed, killedAt, base, map, mapFirst, grid, created.valid() ? 1u : 0u, w);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, nows.valid() ? deviceBuffer(nows) : deviceBuffer(frozenAt));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, nows.valid() ? deviceBuffer(lengths) : deviceBuffer(frozenAt));
+    bindKillList(killed, killedAt, base, map, mapFirst, grid, nows.valid() ? 2u : created.valid() ? 1u : 0u, w,
+                 static_cast<uint32_t>(clocksFirst));
     dispatchRows(stampDeathsProgram_, grid);
 }
 
@@ -363,12 +376,12 @@ void GlMemory::killListProgram(unsigned& program, const char* body, const char* 
 
 // The kill list's bindings and parameters (kKillList's).
 void GlMemory::bindKillList(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, uint32_t grid,
-                            uint32_t mode, std::array<uint32_t, 2> value) {
+                            uint32_t mode, std::array<uint32_t, 2> value, uint32_t extra) {
     unsigned list = deviceBuffer(killed);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, list);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, map.valid() ? deviceBuffer(map) : list);
     bindParams(paramsBuffer_, {mode, static_cast<uint32_t>(killedAt), base, static_cast<uint32_t>(mapFirst),
-                               map.valid() ? 1u : 0u, grid, value[0], value[1]});
+                               map.valid() ? 1u : 0u, grid, value[0], value[1], extra});
 }
 
 void GlMemory::clearRows(const rt::PoolRows& pool, Buffer killed, size_t killedAt, uint32_t base, Buffer map,

@@ -96,10 +96,12 @@ void markDrawn(Memory& memory, const RowsLaunch& launch, const uint8_t* mask, si
 struct ChildrenLaunch {
     const ir::Object* object = nullptr;     // the emitter's type
     const ir::Kernel* spawn = nullptr;
-    const ColumnLayout* layout = nullptr;   // of the spawn kernel (its parent reads are `parents`)
+    const ColumnLayout* layout = nullptr;   // of the spawn kernel
     std::span<const Buffer> columns;        // the emitter's columns, by layout position
     uint32_t row = 0;                       // the emitter's row
-    const Value* parents = nullptr;         // the spawn kernel's parent reads for the emitter
+    // The spawn kernel's parent reads for the emitter; null in a launch from records,
+    // whose emitters' are in its parent columns (at each one's row: eachEmitter).
+    const Value* parents = nullptr;
     Clock clock;                            // uniform
     const Value* externs = nullptr;
     uint32_t seed = 0, draw = 0;

@@ -103,7 +103,7 @@ void Ledger::listInMemory(LateKills& l, bool aliveOnly) {
 // (Only the alive mask: the update's mask still holds them for the emissions of their
 // deaths, after; the release clears it. And their deaths' times, where children read
 // their ages.)
-void Ledger::listNow(LateKills& l) {
+void Ledger::listNow(LateKills& l, Buffer nows, Buffer lengths) {
     listInMemory(l, true);
     Pool& pool = s_.pools[l.type];
     if (!pool.frozenAt.valid()) return;
@@ -111,7 +111,7 @@ void Ledger::listNow(LateKills& l) {
         if (!part.killList.valid() || (part.counted && part.count == 0)) continue;
         auto [base, mapFirst] = listRows(l, part);
         s_.memory.stampDeaths(part.killList, 0, base, l.map, mapFirst, pool.frozenAt, l.t1, l.dt,
-                              l.map.valid() ? pool.created : Buffer{});
+                              l.map.valid() ? pool.created : Buffer{}, nows, lengths, l.first);
     }
 }
 
@@ -202,49 +202,51 @@ void Ledger::releaseInMemory(LateKills& l) {
     l.map = {};
 }
 
+// A type at a time, the most deeply nested first (`release`'s order): its kill lists, then
+// its frozen rows whose readers went — before its parent's turn, whose readers they count.
 void Ledger::releaseForReload() {
-    std::vector<LateKills*> order;  // (children first: `release`'s order)
-    for (size_t type : s_.deepestFirst)
+    for (size_t type : s_.deepestFirst) {
         for (LateKills& l : late_)
-            if (l.type == type) order.push_back(&l);
-    for (LateKills* each : order) {
-        LateKills& l = *each;
-        if (!s_.types[l.type].rowsInMemory || l.released) continue;
-        l.released = true;
-        Pool& pool = s_.pools[l.type];
-        std::vector<uint32_t> rows, list;
-        for (LateKills::Part& part : l.parts) {
-            if (!part.killList.valid()) continue;
-            if (part.ticket) collect(l.type, part);  // (its unstable count: the kills are listed in the memory)
-            list = l.map.valid() ? s_.memory.killedRows(part.killList, 0, 0, l.map, part.begin - l.first)
-                                 : s_.memory.killedRows(part.killList, 0, static_cast<uint32_t>(part.begin), {}, 0);
-            rows.insert(rows.end(), list.begin(), list.end());
-            if (!part.counted) s_.typeStats[l.type].killed += list.size();
-            part.counted = true;
-            pool.recycle(part.killList);
-            part.killList = {};
-        }
-        if (l.map.valid()) pool.recycle(l.map);
-        l.map = {};
-        if (rows.empty()) continue;
-        std::sort(rows.begin(), rows.end());
-        Buffer sorted = pool.scratchRows(rows.size() + 1);
-        list.assign(1, static_cast<uint32_t>(rows.size()));
-        list.insert(list.end(), rows.begin(), rows.end());
-        s_.memory.write(sorted, 0, list.size(), list.data());
-        if (pool.memoryRows().readers.valid()) {
-            pool.releaseUnread(sorted, 0, 0, {}, 0);
-        } else {
-            pool.release(sorted, 0, 0, {}, 0);
-            pool.released(rows.size());
-        }
-        if (pool.parentRows.valid() && !pool.memoryRows().readers.valid())
-            s_.memory.readersGone(sorted, 0, 0, {}, 0, pool.parentRows,
-                                  s_.pools[static_cast<size_t>(s_.types[l.type].parentType)].memoryRows().readers);
-        pool.recycle(sorted);
+            if (l.type == type) releaseForReload(l);
+        s_.pools[type].releaseWaiting();
     }
-    for (size_t type : s_.deepestFirst) s_.pools[type].releaseWaiting();
     countParents();
+}
+
+void Ledger::releaseForReload(LateKills& l) {
+    if (!s_.types[l.type].rowsInMemory || l.released) return;
+    l.released = true;
+    Pool& pool = s_.pools[l.type];
+    std::vector<uint32_t> rows, list;
+    for (LateKills::Part& part : l.parts) {
+        if (!part.killList.valid()) continue;
+        if (part.ticket) collect(l.type, part);  // (its unstable count: the kills are listed in the memory)
+        list = l.map.valid() ? s_.memory.killedRows(part.killList, 0, 0, l.map, part.begin - l.first)
+                             : s_.memory.killedRows(part.killList, 0, static_cast<uint32_t>(part.begin), {}, 0);
+        rows.insert(rows.end(), list.begin(), list.end());
+        if (!part.counted) s_.typeStats[l.type].killed += list.size();
+        part.counted = true;
+        pool.recycle(part.killList);
+        part.killList = {};
+    }
+    if (l.map.valid()) pool.recycle(l.map);
+    l.map = {};
+    if (rows.empty()) return;
+    std::sort(rows.begin(), rows.end());
+    Buffer sorted = pool.scratchRows(rows.size() + 1);
+    list.assign(1, static_cast<uint32_t>(rows.size()));
+    list.insert(list.end(), rows.begin(), rows.end());
+    s_.memory.write(sorted, 0, list.size(), list.data());
+    if (pool.memoryRows().readers.valid()) {
+        pool.releaseUnread(sorted, 0, 0, {}, 0);
+    } else {
+        pool.release(sorted, 0, 0, {}, 0);
+        pool.released(rows.size());
+    }
+    if (pool.parentRows.valid() && !pool.memoryRows().readers.valid())
+        s_.memory.readersGone(sorted, 0, 0, {}, 0, pool.parentRows,
+                              s_.pools[static_cast<size_t>(s_.types[l.type].parentType)].memoryRows().readers);
+    pool.recycle(sorted);
 }
 
 void Ledger::countInMemory(LateKills& l) {

@@ -90,8 +90,9 @@ public:
     void releaseForReload();
     // A late launch's kills of a type whose rows are in the memory and that children read,
     // listed and cleared in its masks now (not at the step's end): the children's
-    // `parent.alive` in the same step sees them dead.
-    void listNow(LateKills& l);
+    // `parent.alive` in the same step sees them dead. Their deaths' times: a batch's
+    // sub-step's from each object's clock where `nows` is given (Memory::stampDeaths).
+    void listNow(LateKills& l, Buffer nows = {}, Buffer lengths = {});
     // A late launch's kills of a type whose rows are in the memory, listed and cleared in
     // both its masks now, freed at the step's end: an update before its last sub-step's
     // (the next sub-step must not update them), or a batch's (`batchMask`: its step mask,
@@ -107,6 +108,7 @@ public:
     void freeUnread();
 
 private:
+    void releaseForReload(LateKills& late);  // (one type's kill lists; its waiting rows after)
     using Deaths = std::vector<std::pair<size_t, uint32_t>>;
     struct Owed {
         Deaths dying;

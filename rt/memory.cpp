@@ -185,11 +185,15 @@ void Memory::gatherAge(Buffer created, Buffer frozenAt, Buffer alive, Buffer to,
 }
 
 void Memory::stampDeaths(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst, Buffer frozenAt,
-                         double t1, double dt, Buffer created) {
+                         double t1, double dt, Buffer created, Buffer nows, Buffer lengths, size_t clocksFirst) {
     auto* d = static_cast<double*>(host(frozenAt));
     const auto* c = created.valid() ? static_cast<const double*>(view(created)) : nullptr;
-    eachKilled(*this, killed, killedAt, base, map, mapFirst,
-               [&](uint32_t, uint32_t row) { d[row] = c ? t1 - (t1 - c[row]) : t1 - dt; });
+    const auto* list = static_cast<const uint32_t*>(view(killed)) + killedAt + 1;
+    const auto* now = nows.valid() ? static_cast<const double*>(view(nows)) + clocksFirst + mapFirst : nullptr;
+    const auto* length = nows.valid() ? static_cast<const double*>(view(lengths)) + clocksFirst + mapFirst : nullptr;
+    eachKilled(*this, killed, killedAt, base, map, mapFirst, [&](uint32_t i, uint32_t row) {
+        d[row] = now ? now[list[i]] - length[list[i]] : c ? t1 - (t1 - c[row]) : t1 - dt;
+    });
 }
 
 void Memory::subStepClocks(Buffer created, Buffer mask, Buffer step, Buffer now, Buffer dt, Buffer length,

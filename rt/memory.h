@@ -238,9 +238,12 @@ public:
                            size_t rowsFirst, size_t count, double now, Buffer nowRows, size_t nowFirst);
     // A parent pool's kill list (as releaseRows reads it): each row's death, the time of its
     // last values, into frozenAt — t1 − dt, or t1 − (t1 − created[row]) where `created` is
-    // given (a batch's first update, from each object's creation), as the host computes it.
+    // given (a batch's first update, from each object's creation), or where `nows` is given
+    // nows[j] − lengths[j] (f64) for j = clocksFirst + mapFirst + r, launch row r of the list
+    // (a batch's sub-step: each object's own clock), as the host computes it.
     virtual void stampDeaths(Buffer killed, size_t killedAt, uint32_t base, Buffer map, size_t mapFirst,
-                             Buffer frozenAt, double t1, double dt, Buffer created);
+                             Buffer frozenAt, double t1, double dt, Buffer created, Buffer nows = {},
+                             Buffer lengths = {}, size_t clocksFirst = 0);
     // Sub-step k (from 1) of a batch's first update, by rt/clock.h's rule, for rows
     // [first, first + n): each object's subStepCount(t1 − created, limit) sub-steps over
     // its span; step[r] (u8) = k ≤ its sub-steps and, for k = 1, mask[r], after that

@@ -104,6 +104,7 @@ private:
     // The spawn launch for `count` children of `emitter` at `site`, their arguments at
     // staging rows from `base`, the first child's draw `firstChild`.
     // (Null where the site has no spawn kernel: its children take no arguments.)
+    // (`fromRecords`: its parent reads are the columns', not the host's: gatherSpawnParents.)
     ChildrenLaunch* queueSpawn(const Emitter& emitter, int site, uint32_t firstChild, size_t count, size_t base,
                                bool fromRecords = false);
     // Queues `count` objects of `type` (a run, or one run an object where objects are not
@@ -113,11 +114,15 @@ private:
     // What emitInMemory's operation asked for, queued from its records (`total`: its totals).
     void queueFromRecords(size_t type, const RateSites& sites, std::span<const size_t> emitSite, const Batch* batch,
                           Buffer runs, const std::vector<uint32_t>& total, Buffer rows, double t1);
-    // A type that emits nothing (its creation queues nothing) and reads no parent.
+    // The runs queue_[from, to) (a generation) type by type, in the module's order.
     void groupByType(size_t from, size_t to);  // see rt/system_queue.cpp
     // createBatch for a type whose rows are in the memory (rt/system_create_rows.cpp).
     void createInMemory(size_t type, Batch& b, size_t n, double t1);
     // `columns`: what goes to the pool rows after it (an emitter's accumulators join them).
+    void exportSurvivors(size_t type, Batch& b, size_t n, Buffer mask, const Clock& clock);
+    void bindInMemory(size_t type, Batch& b, size_t n);
+    Buffer identifyInMemory(Batch& b, size_t n, size_t kept);
+    void burstTablesAtCreation(size_t type, Batch& b, size_t n);
     Clock firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows, double t1, LateKills& late,
                               std::vector<std::pair<Buffer, Buffer>>& columns);
     // A batch's emissions the memory decides (emitInMemory): its bursts at creation, its

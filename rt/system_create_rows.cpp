@@ -5,11 +5,12 @@
 // allocateRows, identify, scatter by a row list), so that on a device the host's work is
 // the batch's, not its objects'. Such a type dies late or never, has no parent but one
 // whose rows are there too (its objects' parent rows from the records of their parents'
-// emissions: Memory::parentsFromRecords), and emits nothing (then it may take sub-steps:
-// firstUpdateInMemory) or only what the memory decides (Creation::emitInMemory, here
-// too: Memory::emitAtRate): after its first update (and its exports, of the survivors)
-// an object only waits to be freed with the step's late kills (rt/ledger.h). What it folds over its neighbours is, for an object created in the
-// step, a fold over nothing: filled in, not gathered (rt/neighbours.cpp).
+// emissions: Memory::parentsFromRecords), and emits nothing or only what the memory
+// decides (Creation::emitInMemory, here too: Memory::emitAtRate), in sub-steps or not
+// (firstUpdateInMemory): after its first update (and its exports, of the survivors) an
+// object only waits to be freed with the step's late kills (rt/ledger.h). What it folds
+// over its neighbours is, for an object created in the step, a fold over nothing: filled
+// in, not gathered (rt/neighbours.cpp).
 #include "rt/system_create.h"
 
 #include <algorithm>
@@ -24,24 +25,12 @@
 
 namespace psys::rt::detail {
 
-void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
-    Pool& pool = s_.pools[type];
+// The batch's tables (its init, update and exports; each burst site's, with parent
+// columns of its own), a fold over nothing in their fold columns.
+void Creation::bindInMemory(size_t type, Batch& b, size_t n) {
     const TypeInfo& info = s_.types[type];
-    const ir::Object& o = pool.object();
+    const ir::Object& o = s_.pools[type].object();
     const size_t first = b.first;
-    // (What it queues into its own type sees the pool's free rows, the batch's taken: as
-    // the host's rule gives — the batch's later rows counted free less its later objects
-    // still queued — unless the batch dropped some, when no row is free either way.)
-    queued_[type] -= n;
-    Buffer rows = pool.scratchRows(n);
-    size_t kept = pool.allocate(n, rows, 0);  // the first `kept` objects: rows[0, kept)
-    s_.typeStats[type].dropped += n - kept;
-    if (kept == 0) {
-        pool.recycle(rows);
-        return;
-    }
-    s_.typeStats[type].created += kept;
-    pool.createdRows(rows, kept);  // updatable from the next step on
     if (info.init) bindBatch(type, b, b.initLayout, b.initParents, b.initTable, Table::Init);
     bindBatch(type, b, info.updateLayout, b.updateParents, b.updateTable, Table::Advanced);
     if (info.exports) bindBatch(type, b, info.exportsLayout, b.exportsParents, b.exportsTable, Table::Advanced);
@@ -56,6 +45,12 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     if (info.init) emptyFolds(type, b.initLayout, b.initTable, first, n);
     emptyFolds(type, info.updateLayout, b.updateTable, first, n);
     if (info.exports) emptyFolds(type, info.exportsLayout, b.exportsTable, first, n);
+}
+
+// The batch's ids and creation times (from its runs, and the records of the runs the
+// memory decided); returns its mask (its first `kept` objects).
+Buffer Creation::identifyInMemory(Batch& b, size_t n, size_t kept) {
+    const size_t first = b.first;
     std::vector<Buffer>& table = b.updateTable;
     ObjectRuns runs;
     for (size_t u = 0; u < b.runs.size(); ++u) {
@@ -75,6 +70,59 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
         if (const Run& run = b.runs[u]; run.runs.valid())
             memory.identifyRecords(run.runs, run.record, run.records, run.count, table[ColumnLayout::kCreated],
                                    table[ColumnLayout::kIds], first + b.runFirst[u]);
+    return mask;
+}
+
+// What a batch's bursts at creation read, in their tables: the state at creation (one
+// copy: every burst table's), and each site's ancestor reads at each object's creation.
+void Creation::burstTablesAtCreation(size_t type, Batch& b, size_t n) {
+    const TypeInfo& info = s_.types[type];
+    const ir::Object& o = s_.pools[type].object();
+    const size_t first = b.first;
+    const std::vector<Buffer>& table = b.updateTable;
+    Memory& memory = s_.memory;
+    for (const std::vector<Buffer>& t : b.burstTables) {
+        if (t.empty()) continue;
+        for (size_t s = 0; s < o.state.size(); ++s)
+            for (int c = 0; c < o.state[s].type.width; ++c) {
+                auto column = static_cast<size_t>(info.updateLayout.stateOffset[s] + c);
+                memory.copy(table[column], first, t[column], first, n);
+            }
+        break;
+    }
+    for (size_t site = 0; site < o.emits.size(); ++site) {
+        if (b.burstTables[site].empty()) continue;
+        const ColumnLayout& layout = info.spawnLayout[site];
+        if (s_.pools[type].parentRows.valid())
+            s_.gatherThrough(type, layout, b.burstTables[site], b.columns.at(kParents, Elem::U32, first + n), first,
+                             first, first + n, 0, table[ColumnLayout::kCreated]);
+        emptyFolds(type, layout, b.burstTables[site], first, n);
+    }
+}
+
+void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
+    Pool& pool = s_.pools[type];
+    const TypeInfo& info = s_.types[type];
+    const ir::Object& o = pool.object();
+    const size_t first = b.first;
+    // (What it queues into its own type sees the pool's free rows, the batch's taken: as
+    // the host's rule gives — the batch's later rows counted free less its later objects
+    // still queued — unless the batch dropped some, when no row is free either way.)
+    queued_[type] -= n;
+    Buffer rows = pool.scratchRows(n);
+    size_t kept = pool.allocate(n, rows, 0);  // the first `kept` objects: rows[0, kept)
+    s_.typeStats[type].dropped += n - kept;
+    if (kept == 0) {
+        pool.recycle(rows);
+        return;
+    }
+    s_.typeStats[type].created += kept;
+    pool.createdRows(rows, kept);  // updatable from the next step on
+    bindInMemory(type, b, n);
+    const bool bursts = info.bursts && info.init;  // (a burst's count is init's)
+    std::vector<Buffer>& table = b.updateTable;
+    Memory& memory = s_.memory;
+    Buffer mask = identifyInMemory(b, n, kept);
     std::vector<std::pair<Buffer, Buffer>> columns = identityColumns(type, table);
     if (pool.parentRows.valid()) columns.push_back({parentsOf(type, b, n, kept), pool.parentRows});
     memory.scatter(columns, first, rows, 0, kept);
@@ -98,24 +146,7 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
         launchInMemory(type, b, n, *info.exports, info.exportsLayout, b.exportsTable,
                        {Clock::Source::PerRow, Clock::Source::PerRow, 0, 0, true}, nullptr);
     }
-    if (bursts)  // their spawn launches read the state at creation (one copy: every burst table's)
-        for (const std::vector<Buffer>& t : b.burstTables) {
-            if (t.empty()) continue;
-            for (size_t s = 0; s < o.state.size(); ++s)
-                for (int c = 0; c < o.state[s].type.width; ++c) {
-                    auto column = static_cast<size_t>(info.updateLayout.stateOffset[s] + c);
-                    memory.copy(table[column], first, t[column], first, n);
-                }
-            break;
-        }
-    for (size_t site = 0; bursts && site < o.emits.size(); ++site) {  // and their parents at each one's creation
-        if (b.burstTables[site].empty()) continue;
-        const ColumnLayout& layout = info.spawnLayout[site];
-        if (pool.parentRows.valid())
-            s_.gatherThrough(type, layout, b.burstTables[site], b.columns.at(kParents, Elem::U32, first + n), first,
-                             first, first + n, 0, table[ColumnLayout::kCreated]);
-        emptyFolds(type, layout, b.burstTables[site], first, n);
-    }
+    if (bursts) burstTablesAtCreation(type, b, n);
     if (info.updateEmits) {  // (their spawn launches read the pool's columns at its rows: the parents' at t1 —
                              // in sub-steps too, where they read no age: decideRows)
         std::vector<size_t> sites;
@@ -126,20 +157,14 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     LateKills late;
     columns.clear();
     const Clock toEnd = firstUpdateInMemory(type, b, n, rows, t1, late, columns);
-    if (info.read) s_.ledger.listNow(late);  // its dead are dead to its children at once
+    const bool subSteps = toEnd.now == Clock::Source::PerRow;  // (their kills listed, their exports, each after its own)
+    if (info.read && !subSteps) s_.ledger.listNow(late);  // its dead are dead to its children at once
     for (size_t s = 0; s < o.state.size(); ++s)
         for (int c = 0; c < o.state[s].type.width; ++c)
             columns.push_back({table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)],
                                pool.state.column(s, static_cast<size_t>(c))});
-    if (info.exports) {  // of the survivors (a type that never dies: every object of the batch)
-        Buffer survivors = mask;
-        if (info.kills) {
-            survivors = b.columns.at(kExportMask, Elem::U8, first + n);
-            memory.survivors(mask, table[ColumnLayout::kKill], survivors, first, n);
-        }
-        b.exportsTable[ColumnLayout::kNow] = table[ColumnLayout::kNow];  // (sub-steps: each row's last clock)
-        b.exportsTable[ColumnLayout::kDt] = table[ColumnLayout::kDt];
-        launchInMemory(type, b, n, *info.exports, info.exportsLayout, b.exportsTable, toEnd, nullptr, survivors);
+    if (info.exports) {
+        if (!subSteps) exportSurvivors(type, b, n, mask, toEnd);
         for (size_t e = 0; e < o.exports.size(); ++e)
             for (int c = 0; c < o.exports[e].type.width; ++c)
                 columns.push_back({b.exportsTable[static_cast<size_t>(info.exportsLayout.exportOffset[e] + c)],
@@ -152,6 +177,21 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     memory.scatter(columns, first, rows, 0, kept);
     if (!info.late) return;
     s_.ledger.defer(std::move(late));
+}
+
+// The exports of the rows of `mask` the update just run left alive (of a type that never
+// dies: every one), at its clock; a row it killed keeps what it had.
+void Creation::exportSurvivors(size_t type, Batch& b, size_t n, Buffer mask, const Clock& clock) {
+    const TypeInfo& info = s_.types[type];
+    const std::vector<Buffer>& table = b.updateTable;
+    Buffer survivors = mask;
+    if (info.kills) {
+        survivors = b.columns.at(kExportMask, Elem::U8, b.first + n);
+        s_.memory.survivors(mask, table[ColumnLayout::kKill], survivors, b.first, n);
+    }
+    b.exportsTable[ColumnLayout::kNow] = table[ColumnLayout::kNow];  // (sub-steps: each row's own)
+    b.exportsTable[ColumnLayout::kDt] = table[ColumnLayout::kDt];
+    launchInMemory(type, b, n, *info.exports, info.exportsLayout, b.exportsTable, clock, nullptr, survivors);
 }
 
 void Creation::emitFromBatch(size_t type, Batch& b, size_t n, Buffer rows, double t1, const BatchSites& which,
@@ -238,7 +278,8 @@ Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows
     // bursts at creation with the first's, each object's just before its own emissions,
     // as the host queues them (Creation::firstUpdate).
     const bool emits = info.updateEmits, bursts = info.bursts && info.init;
-    Buffer length = emits ? b.columns.at(kLength, Elem::F64, end) : Buffer{};
+    // (A type children read: each sub-step's deaths at each object's own clock, now − length.)
+    Buffer length = emits || info.read ? b.columns.at(kLength, Elem::F64, end) : Buffer{};
     Buffer taken;  // (the earlier sub-steps' kills, gathered: Ledger::takeOut)
     for (uint32_t k = 1; k <= most; ++k) {
         memory.subStepClocks(table[ColumnLayout::kCreated], mask, step, table[ColumnLayout::kNow],
@@ -254,6 +295,10 @@ Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows
         if (info.late && k < most) each = lateKills();
         LateKills* kills = !info.late ? nullptr : k < most ? &*each : &late;
         launchInMemory(type, b, n, *info.update, info.updateLayout, table, perRow, kills, step);
+        // (Where children read it: its dead dead to them at once, each at its own clock; a
+        // row killed keeps its last sub-step's exports.)
+        if (info.read && kills) s_.ledger.listNow(*kills, table[ColumnLayout::kNow], length);
+        if (info.exports) exportSurvivors(type, b, n, step, perRow);
         if (emits || (bursts && k == 1))  // (in the first sub-step every object kept takes: step is mask)
             emitFromBatch(type, b, n, rows, t1,
                           {bursts && k == 1, emits, k == 1, step, nows, length},

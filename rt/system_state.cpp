@@ -105,10 +105,14 @@ std::vector<bool> burstChains(const std::vector<TypeInfo>& types, const ir::Modu
     return chained;
 }
 
-// Which types' kills are late and which keep their rows in the memory (TypeInfo::late,
-// rowsInMemory), decided once for the program.
-void decideRows(std::vector<TypeInfo>& types, const ir::Module& module, const SystemOptions& options,
-                const Backend& backend) {
+// A top-level type not drawn as the step goes (by a backend that draws on the host).
+bool keptWhole(const TypeInfo& info, const SystemOptions& options, const Backend& backend) {
+    return info.parentType < 0 && !(options.drawInStep && backend.rendersInStep() && info.render);
+}
+
+// The types that only die or never die: whose kills are late (TypeInfo::late) and which of
+// them keep their rows in the memory (rowsInMemory).
+void decideParticles(std::vector<TypeInfo>& types, const SystemOptions& options, bool inMemory, const Backend& backend) {
     // Nobody looks at the type's dead during the step: it emits nothing in its updates, has
     // no exports and no children.
     auto unwatched = [](const TypeInfo& t) { return !t.updateEmits && !t.exports && !t.read; };
@@ -120,24 +124,24 @@ void decideRows(std::vector<TypeInfo>& types, const ir::Module& module, const Sy
     // taken out of its masks at once, freed at the step's end (Ledger::takeOut), and a
     // batch's first update steps each object through its own sub-steps
     // (Memory::subStepClocks).
-    bool inMemory = options.rows == SystemOptions::Rows::InMemory ||
-                    (options.rows == SystemOptions::Rows::AsBackend && backend.keepsRowsInMemory());
     // (An emitter's bursts at creation, below, are the memory's too.)
-    auto keptWhole = [&](const TypeInfo& info) {
-        return info.parentType < 0 && !(options.drawInStep && backend.rendersInStep() && info.render);
-    };
     // A type that only dies whose exports folds read (no children) is one too: its kills
     // late all the same — a fold reads the rows updatable at the step's start — and its
     // exports those of its survivors, from the kill flags where they are (Memory::survivors;
-    // under @step, of the last sub-step's survivors, each row's at its own last clock).
+    // under @step, each sub-step's survivors', at its clock).
     for (size_t t = 0; t < types.size(); ++t) {
         TypeInfo& info = types[t];
         bool silent = !info.kills && !info.unstable && !info.updateEmits && !info.read;
         bool folded = options.lateKills && (info.kills || info.unstable) && !info.updateEmits && !info.read &&
                       info.exports;
-        info.rowsInMemory = inMemory && (info.late || silent || folded) && !info.bursts && keptWhole(info);
+        info.rowsInMemory = inMemory && (info.late || silent || folded) && !info.bursts && keptWhole(info, options, backend);
         info.late = info.late || (info.rowsInMemory && folded);
     }
+}
+
+// The emitters and children whose rows the memory keeps beside them (below).
+void decideEmitters(std::vector<TypeInfo>& types, const ir::Module& module, const SystemOptions& options, bool inMemory,
+                    const Backend& backend) {
     // Emitters whose emissions the memory decides (Memory::emitAtRate): every site emits —
     // at a rate, in a burst at creation, on an edge or on death — into a type that keeps its rows in the memory (one that emits nothing, or such an emitter
     // itself) and reads no parent, and whose arguments read no fold (a spawn launch from
@@ -204,10 +208,10 @@ void decideRows(std::vector<TypeInfo>& types, const ir::Module& module, const Sy
         const ir::Object& o = module.objects[t];
         bool dies = info.kills || info.unstable;
         bool parent = info.read && readByChildren(t);
-        bool emitter = inMemory && options.createInBatches &&
-                       (info.updateEmits || info.bursts) &&
+        bool whole = keptWhole(info, options, backend);
+        bool emitter = inMemory && options.createInBatches && (info.updateEmits || info.bursts) &&
                        (!dies || options.lateKills) && (!info.read || parent) &&
-                       (keptWhole(info) || (childShape[t] && candidate[static_cast<size_t>(info.parentType)]));
+                       (whole || (childShape[t] && candidate[static_cast<size_t>(info.parentType)]));
         for (size_t s = 0; emitter && s < o.emits.size(); ++s) {
             size_t target = info.emitTarget[s];
             bool itsChild = child(target) && types[target].parentType == static_cast<int>(t);
@@ -240,6 +244,16 @@ void decideRows(std::vector<TypeInfo>& types, const ir::Module& module, const Sy
     }
 }
 
+// Which types' kills are late and which keep their rows in the memory (TypeInfo::late,
+// rowsInMemory), decided once for the program.
+void decideRows(std::vector<TypeInfo>& types, const ir::Module& module, const SystemOptions& options,
+                const Backend& backend) {
+    bool inMemory = options.rows == SystemOptions::Rows::InMemory ||
+                    (options.rows == SystemOptions::Rows::AsBackend && backend.keepsRowsInMemory());
+    decideParticles(types, options, inMemory, backend);
+    decideEmitters(types, module, options, inMemory, backend);
+}
+
 }  // namespace
 
 State::State(ir::Module m, Backend& b, SystemOptions o)
@@ -270,7 +284,8 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         if (types[t].rowsInMemory && types[t].parentType >= 0)
             pools[t].countsDownParent(pools[static_cast<size_t>(types[t].parentType)].memoryRows().readers);
     // Spawn kernels read the emitter's own columns, whose buffers never change: their
-    // tables are bound once (the parent values come with each launch).
+    // tables are bound once (the parent values come with each launch from the host, or,
+    // for a launch from records, in parent columns gatherSpawnParents binds).
     for (size_t t = 0; t < pools.size(); ++t) {
         work.emplace_back(memory);
         for (const ColumnLayout& layout : types[t].spawnLayout) {
@@ -461,8 +476,10 @@ void State::gatherThrough(size_t type, const ColumnLayout& layout, std::span<con
         size_t first;
     };
     std::vector<Up> up = {{static_cast<size_t>(types[type].parentType), parents, parentsFirst}};
+    std::unique_lock<std::mutex> inUse(ancestorsInUse, std::defer_lock);  // (held from the first use of `ancestors` on)
     auto ancestor = [&](int depth) -> const Up& {
         while (up.size() < static_cast<size_t>(depth)) {
+            if (!inUse.owns_lock()) inUse.lock();
             const Up& below = up.back();
             Buffer rows = ancestors.at(up.size() - 1, Elem::U32, end - begin);
             memory.ancestorRows(pools[below.type].parentRows, rows, 0, below.rows, below.first, end - begin);

@@ -6,6 +6,7 @@
 #include <array>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <vector>
@@ -129,7 +130,10 @@ struct State {
     // The types, the most deeply nested first (a parent after its children: Ledger::release).
     std::vector<size_t> deepestFirst;
     std::vector<TypeWork> work;
-    Scratch ancestors;  // the rows of ancestors further up than a parent (gatherThrough's)
+    // The rows of ancestors further up than a parent (gatherThrough's), one launch's at a
+    // time: the chunks of a pool's launch gather on several threads.
+    Scratch ancestors;
+    std::mutex ancestorsInUse;
     std::vector<Value> externs;
     uint64_t externsVersion = 0;
     std::vector<std::array<UniformCache, 3>> uniformCache;
@@ -168,16 +172,17 @@ struct State {
     // The parents of child pools whose parents' rows are in the memory, read back into
     // the host's handles (Pool::parent: hot reload).
     void parentsToHost();
+    // The spawn kernels' ancestor reads (exports, `alive` and `age`) and own folds of
+    // `type`'s sites in `sites`, for every row of its pool at `at`: columns of its spawn
+    // tables, where a launch from records reads each emitter's at its row — the values
+    // parentValues gives the host's launches (rt::eachEmitter; the GPU builds its blocks
+    // from them). The pool's rows and its ancestors' are in the memory.
+    void gatherSpawnParents(size_t type, std::span<const size_t> sites, double at);
     // A child type's whose rows are in the memory beside its parents': rows [begin, end)
-    // of its parent columns (but folds) through `parents` from row `parentsFirst` on, where
+    // of its ancestor columns (not folds) through `parents` from row `parentsFirst` on —
+    // further up, through each ancestor pool's parent rows (Memory::ancestorRows) — where
     // they are (Memory::gatherThrough, gatherAlive, gatherAge: at `at`, or atRows' row
     // by row from `begin` — a batch's per-row clocks).
-    // The spawn kernels' parent reads (its parent's exports, `alive` and `age`; its own
-    // folds) of `type`'s sites in `sites`, for every row of its pool at `at`: columns of its
-    // spawn tables, where a launch from records reads each emitter's at its row — the
-    // values parentValues gives the host's launches (rt::eachEmitter; the GPU builds its
-    // blocks from them). The pool's rows and its parents' are in the memory.
-    void gatherSpawnParents(size_t type, std::span<const size_t> sites, double at);
     void gatherThrough(size_t type, const ColumnLayout& layout, std::span<const Buffer> table, Buffer parents,
                        size_t parentsFirst, size_t begin, size_t end, double at, Buffer atRows = {});
     // The neighbour folds of a type's objects, for this step (rt/neighbours.cpp).
