@@ -182,6 +182,8 @@ private:
              readersGoneProgram_ = 0, releaseUnreadProgram_ = 0, releaseWaitingProgram_ = 0, clearRowsProgram_ = 0,
              appendProgram_ = 0, appendedProgram_ = 0, ancestorRowsProgram_ = 0;
     uint32_t killListGrid(rt::Buffer killed, size_t killedAt) const;
+    void throughRows(unsigned& program, const char* shader, const char* name, rt::Buffer from, rt::Buffer to,
+                     size_t toFirst, rt::Buffer rows, size_t rowsFirst, size_t count);
     void killListProgram(unsigned& program, const char* body, const char* name);
     void bindKillList(rt::Buffer killed, size_t killedAt, uint32_t base, rt::Buffer map, size_t mapFirst, uint32_t grid,
                       uint32_t mode = 0, std::array<uint32_t, 2> value = {}, uint32_t extra = 0);

@@ -277,30 +277,28 @@ void GlMemory::gatherAlive(Buffer alive, Buffer to, size_t toFirst, Buffer rows,
     if (count == 0) return;
     if (!onDevice(rows) && allOnHost({alive, to}))
         return rt::Memory::gatherAlive(alive, to, toFirst, rows, rowsFirst, count);
-    flushPending();
-    if (!gatherAliveProgram_) gatherAliveProgram_ = computeProgram(operationShader(kGatherAlive), "parents alive");
-    PassTimer::Scope timed(timer, "gather", count);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceBuffer(alive));
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, bound(to));
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, deviceBuffer(rows));
-    bindParams(paramsBuffer_, {static_cast<uint32_t>(count), static_cast<uint32_t>(toFirst),
-                               static_cast<uint32_t>(rowsFirst)});
-    dispatchRows(gatherAliveProgram_, count);
+    throughRows(gatherAliveProgram_, kGatherAlive, "parents alive", alive, to, toFirst, rows, rowsFirst, count);
 }
 
 void GlMemory::ancestorRows(Buffer parents, Buffer to, size_t toFirst, Buffer rows, size_t rowsFirst, size_t count) {
     if (count == 0) return;
     if (!onDevice(rows) && allOnHost({parents, to}))
         return rt::Memory::ancestorRows(parents, to, toFirst, rows, rowsFirst, count);
+    throughRows(ancestorRowsProgram_, kAncestorRows, "ancestors' rows", parents, to, toFirst, rows, rowsFirst, count);
+}
+
+// A shader of kGatherAlive's form (from, to, rows; count, toFirst, rowsFirst) on the GPU.
+void GlMemory::throughRows(unsigned& program, const char* shader, const char* name, Buffer from, Buffer to,
+                           size_t toFirst, Buffer rows, size_t rowsFirst, size_t count) {
     flushPending();
-    if (!ancestorRowsProgram_) ancestorRowsProgram_ = computeProgram(operationShader(kAncestorRows), "ancestors' rows");
+    if (!program) program = computeProgram(operationShader(shader), name);
     PassTimer::Scope timed(timer, "gather", count);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceBuffer(parents));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceBuffer(from));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, bound(to));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, deviceBuffer(rows));
     bindParams(paramsBuffer_, {static_cast<uint32_t>(count), static_cast<uint32_t>(toFirst),
                                static_cast<uint32_t>(rowsFirst)});
-    dispatchRows(ancestorRowsProgram_, count);
+    dispatchRows(program, count);
 }
 
 void GlMemory::gatherAge(Buffer created, Buffer frozenAt, Buffer alive, Buffer to, size_t toFirst, Buffer rows,

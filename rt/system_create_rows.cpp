@@ -301,7 +301,7 @@ Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows
         if (info.exports) exportSurvivors(type, b, n, step, perRow);
         if (emits || (bursts && k == 1))  // (in the first sub-step every object kept takes: step is mask)
             emitFromBatch(type, b, n, rows, t1,
-                          {bursts && k == 1, emits, k == 1, step, nows, length},
+                          {bursts && k == 1, emits, k == 1, step, nows, emits ? length : Buffer{}},
                           columns);
         if (!each) continue;
         if (!taken.valid()) {

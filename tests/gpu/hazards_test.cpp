@@ -136,7 +136,7 @@ TEST_CASE("a burst chain creates an object at a time on the host side, its write
 TEST_CASE("the dispatches a step do not grow with the emitters when their children emit nothing") {
     // K sources, each emitting two types that emit nothing: the queue holds spark, puff,
     // spark, puff, … Each type is created in one batch a step (rt/system_queue.cpp,
-    // Creation::groupQuiet) and each spawn kernel's launches go in one dispatch
+    // Creation::groupByType) and each spawn kernel's launches go in one dispatch
     // (GlslBackend::runChildren) — the campfire's dispatches grew tenfold with its fires.
     // (40 and 432 dispatches a step before, 36 and 36 now.)
     auto perStep = [](int sources) {
