@@ -22,30 +22,28 @@ using rt::Buffer;
 
 namespace {
 
-// f32 1 or 0: whether the row's parent is alive (kSkipRow: none, 0).
-const char* kGatherAlive = R"(
-layout(std430, binding = 0) readonly buffer Alive { uint alive[]; };
+// A value a row through a list of rows (GlMemory::throughRows): to[first + i] = value(row)
+// for row = rows[rowsAt + i], each shader's `value` after this.
+const char* kThroughRows = R"(
+layout(std430, binding = 0) readonly buffer From { uint from[]; };
 layout(std430, binding = 1) buffer To { uint to[]; };
 layout(std430, binding = 2) readonly buffer Rows { uint rows[]; };
+uint value(uint row);
 void main() {
     uint i = INVOCATION, count = param(0u), first = param(1u), rowsAt = param(2u);
     if (i >= count) return;
-    uint row = rows[rowsAt + i];
-    to[first + i] = row != 0xFFFFFFFFu && alive[row] != 0u ? floatBitsToUint(1.0) : 0u;
+    to[first + i] = value(rows[rowsAt + i]);
 }
 )";
 
-// The rows one level further up (kSkipRow stays kSkipRow).
+// f32 1 or 0: whether the row's parent is alive (from: the alive mask; kSkipRow: none, 0).
+const char* kGatherAlive = R"(
+uint value(uint row) { return row != 0xFFFFFFFFu && from[row] != 0u ? floatBitsToUint(1.0) : 0u; }
+)";
+
+// The rows one level further up (from: the parents' parent rows; kSkipRow stays kSkipRow).
 const char* kAncestorRows = R"(
-layout(std430, binding = 0) readonly buffer Parents { uint parents[]; };
-layout(std430, binding = 1) buffer To { uint to[]; };
-layout(std430, binding = 2) readonly buffer Rows { uint rows[]; };
-void main() {
-    uint i = INVOCATION, count = param(0u), first = param(1u), rowsAt = param(2u);
-    if (i >= count) return;
-    uint row = rows[rowsAt + i];
-    to[first + i] = row == 0xFFFFFFFFu ? row : parents[row];
-}
+uint value(uint row) { return row == 0xFFFFFFFFu ? row : from[row]; }
 )";
 
 // A parent's age at the child's clock, or at its death where it is frozen: rt::ageAt over
@@ -287,11 +285,11 @@ void GlMemory::ancestorRows(Buffer parents, Buffer to, size_t toFirst, Buffer ro
     throughRows(ancestorRowsProgram_, kAncestorRows, "ancestors' rows", parents, to, toFirst, rows, rowsFirst, count);
 }
 
-// A shader of kGatherAlive's form (from, to, rows; count, toFirst, rowsFirst) on the GPU.
+// kThroughRows with `shader`'s value (from, to, rows; count, toFirst, rowsFirst) on the GPU.
 void GlMemory::throughRows(unsigned& program, const char* shader, const char* name, Buffer from, Buffer to,
                            size_t toFirst, Buffer rows, size_t rowsFirst, size_t count) {
     flushPending();
-    if (!program) program = computeProgram(operationShader(shader), name);
+    if (!program) program = computeProgram(operationShader(std::string(kThroughRows) + shader), name);
     PassTimer::Scope timed(timer, "gather", count);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceBuffer(from));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, bound(to));
