@@ -15,6 +15,7 @@
 #include <llvm/Analysis/TargetLibraryInfo.h>
 #include <llvm/ExecutionEngine/Orc/CompileUtils.h>
 #include <llvm/ExecutionEngine/Orc/ExecutionUtils.h>
+#include <llvm/ExecutionEngine/Orc/ExecutorProcessControl.h>
 #include <llvm/ExecutionEngine/Orc/JITTargetMachineBuilder.h>
 #include <unistd.h>
 
@@ -34,6 +35,7 @@
 #include <llvm/Target/TargetMachine.h>
 #include <llvm/TargetParser/Host.h>
 
+#include "codegen_llvm/compile_threads.h"
 #include "codegen_llvm/library_symbols.h"
 #include "codegen_llvm/link_observer.h"
 #include "codegen_llvm/optimize.h"
@@ -284,16 +286,21 @@ JitEngine::JitEngine(MathMode mode) : impl_(std::make_unique<Impl>()) {
     impl_->cpu = host->getCPU();
     impl_->host = *host;
     impl_->machine = impl_->cpu + " " + host->getFeatures().getString() + (mode == MathMode::Fast ? " fast" : " exact");
-    unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+    // Compile threads of our own (codegen_llvm/compile_threads.h): LLVM 19's own free a
+    // task after shutdown() may have returned.
+    auto control = llvm::orc::SelfExecutorProcessControl::Create(
+        nullptr, std::make_unique<CompileThreads>(std::max(1u, std::thread::hardware_concurrency())));
+    if (!control) throw std::runtime_error(llvm::toString(control.takeError()));
     auto jit = llvm::orc::LLJITBuilder()
                    .setJITTargetMachineBuilder(*host)
+                   .setExecutorProcessControl(std::move(*control))
                    .setCompileFunctionCreator([cache = impl_->cache ? &*impl_->cache : nullptr, impl = impl_.get()](
                                                   llvm::orc::JITTargetMachineBuilder builder)
                                                   -> llvm::Expected<std::unique_ptr<llvm::orc::IRCompileLayer::IRCompiler>> {
                        return std::make_unique<SizedCompiler>(std::move(builder), cache,
                                                               [impl](const llvm::Module& m) { return impl->remarksOf(m); });
                    })
-                   .setNumCompileThreads(threads)
+                   .setSupportConcurrentCompilation(true)
                    .create();
     if (!jit) throw std::runtime_error(llvm::toString(jit.takeError()));
     impl_->jit = std::move(*jit);
@@ -329,7 +336,8 @@ JitEngine::JitEngine(MathMode mode) : impl_(std::make_unique<Impl>()) {
 // waits for the threads after: the thread then finds its tracker defunct and frees into a
 // dylib being cleared (psys_bench's compile loop on a loaded machine: a session error in 3
 // runs of 120, once heap corruption in CI; 0 of 160 since). So the dispatcher is shut
-// down first, which waits for every task, then the JIT goes, before Impl's members.
+// down first, which waits for every task to have run and been freed (CompileThreads),
+// then the JIT goes, before Impl's members.
 JitEngine::~JitEngine() {
     impl_->jit->getExecutionSession().getExecutorProcessControl().getDispatcher().shutdown();
     impl_->jit.reset();

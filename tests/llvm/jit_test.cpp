@@ -19,6 +19,7 @@
 #include <llvm/ExecutionEngine/Orc/ExecutorProcessControl.h>
 #include <llvm/IR/IRBuilder.h>
 
+#include "codegen_llvm/compile_threads.h"
 #include "codegen_llvm/jit_engine.h"
 #include "codegen_llvm/library_symbols.h"
 #include "codegen_llvm/llvm_backend.h"
@@ -428,6 +429,31 @@ std::string stderrOf(const std::function<void()>& body) {
 }
 
 }  // namespace
+
+// What a task holds (a materialization unit's symbol names) must be gone when shutdown()
+// returns, or the session that goes next finds its names still referenced (an abort in
+// CI's ASan run: "Dangling references at pool destruction time"). LLVM 19's own
+// dispatcher frees a thread's last task after counting it done: with it in place of
+// CompileThreads this fails.
+TEST_CASE("the JIT's compile threads free every task before shutdown returns") {
+    struct Slow {
+        std::atomic<int>* freed;
+        ~Slow() {
+            if (!freed) return;
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+            ++*freed;
+        }
+        Slow(std::atomic<int>* f) : freed(f) {}
+        Slow(Slow&& o) noexcept : freed(o.freed) { o.freed = nullptr; }
+    };
+    std::atomic<int> freed = 0, ran = 0;
+    codegen_llvm::CompileThreads threads(2);
+    for (int i = 0; i < 6; ++i)
+        threads.dispatch(llvm::orc::makeGenericNamedTask([slow = Slow(&freed), &ran]() { ++ran; }, "slow to free"));
+    threads.shutdown();
+    CHECK(ran == 6);
+    CHECK(freed == 6);
+}
 
 // LLVM 19 completes a lookup in a task of its own: `add` can return while the compile
 // thread that emitted the last module still tears its link down, and an engine that goes
