@@ -34,6 +34,9 @@ constexpr unsigned kCommutative = 1;    // f(a, b) = f(b, a): operands are put i
 constexpr unsigned kComponentwise = 2;  // lane i of the result is a function of lane i of the
                                         // operands (select: of its branches; the condition is one bool)
 constexpr unsigned kOwnSite = 4;        // a call site of its own: never merged with an equal one
+constexpr unsigned kJumps = 8;          // a change in an operand's last bits may change the result
+                                        // by more than its last bits (comparisons, rounding to whole
+                                        // numbers, atan2's cut): what decides, not what approximates
 
 // What an op is in the language and on the backends, where that is a plain mapping.
 struct OpSpelling {
@@ -87,12 +90,12 @@ struct OpSpelling {
     X(Sub, "sub", 2, Pure, kComponentwise, 0, PSYS_NONE)                                                                                             \
     X(Mul, "mul", 2, Pure, kCommutative | kComponentwise, 0, PSYS_NONE)                                                                              \
     X(Div, "div", 2, Pure, kComponentwise, 0, PSYS_NONE)                                                                                             \
-    X(Mod, "mod", 2, Pure, kComponentwise, 0, PSYS_BUILTIN("mod(x: T, y: T|float) -> T"))                                                            \
+    X(Mod, "mod", 2, Pure, kComponentwise | kJumps, 0, PSYS_BUILTIN("mod(x: T, y: T|float) -> T"))                                                            \
     X(Neg, "neg", 1, Pure, kComponentwise, 0, PSYS_NONE)                                                                                             \
     X(Min, "min", 2, Pure, kCommutative | kComponentwise, 0, PSYS_BUILTIN("min(a: T, b: T|float) -> T"))                                             \
     X(Max, "max", 2, Pure, kCommutative | kComponentwise, 0, PSYS_BUILTIN("max(a: T, b: T|float) -> T"))                                             \
-    X(Step, "step", 2, Pure, kComponentwise, 0, PSYS_BUILTIN("step(edge: T|float, x: T) -> T"))     /* x < edge ? 0 : 1 */                           \
-    X(Atan2, "atan2", 2, Pure, kComponentwise, 0, PSYS_MAPS("atan2(y: T, x: T) -> T", "atan2f", "", "psys_atan2"))                                   \
+    X(Step, "step", 2, Pure, kComponentwise | kJumps, 0, PSYS_BUILTIN("step(edge: T|float, x: T) -> T"))     /* x < edge ? 0 : 1 */                           \
+    X(Atan2, "atan2", 2, Pure, kComponentwise | kJumps, 0, PSYS_MAPS("atan2(y: T, x: T) -> T", "atan2f", "", "psys_atan2"))                                   \
     X(Pow, "pow", 2, Pure, kComponentwise, 0, PSYS_MAPS("pow(x: T, y: T|float) -> T", "powf", "llvm.pow", "psys_pow"))                               \
     X(Sin, "sin", 1, Pure, kComponentwise, 0, PSYS_MAPS("sin(x: T) -> T", "sinf", "llvm.sin", "sin"))                                                \
     X(Cos, "cos", 1, Pure, kComponentwise, 0, PSYS_MAPS("cos(x: T) -> T", "cosf", "llvm.cos", "cos"))                                                \
@@ -105,17 +108,17 @@ struct OpSpelling {
     X(Log, "log", 1, Pure, kComponentwise, 0, PSYS_MAPS("log(x: T) -> T", "logf", "llvm.log", "psys_log"))                                           \
     X(Sqrt, "sqrt", 1, Pure, kComponentwise, 0, PSYS_MAPS("sqrt(x: T) -> T", "", "llvm.sqrt", "psys_sqrt"))                                          \
     X(Abs, "abs", 1, Pure, kComponentwise, 0, PSYS_MAPS("abs(x: T) -> T", "", "llvm.fabs", "abs"))                                                   \
-    X(Sign, "sign", 1, Pure, kComponentwise, 0, PSYS_BUILTIN("sign(x: T) -> T"))                                                                     \
-    X(Floor, "floor", 1, Pure, kComponentwise, 0, PSYS_MAPS("floor(x: T) -> T", "", "llvm.floor", "floor"))                                          \
-    X(Ceil, "ceil", 1, Pure, kComponentwise, 0, PSYS_MAPS("ceil(x: T) -> T", "", "llvm.ceil", "ceil"))                                               \
-    X(Round, "round", 1, Pure, kComponentwise, 0, PSYS_MAPS("round(x: T) -> T", "", "llvm.nearbyint", "roundEven"))   /* to nearest, ties to even */ \
-    X(Fract, "fract", 1, Pure, kComponentwise, 0, PSYS_BUILTIN("fract(x: T) -> T"))                                                                  \
-    X(Lt, "lt", 2, Pure, 0, 0, PSYS_NONE)                      /* floats → bool */                                                                   \
-    X(Le, "le", 2, Pure, 0, 0, PSYS_NONE)                                                                                                            \
-    X(Gt, "gt", 2, Pure, 0, 0, PSYS_NONE)                                                                                                            \
-    X(Ge, "ge", 2, Pure, 0, 0, PSYS_NONE)                                                                                                            \
-    X(Eq, "eq", 2, Pure, kCommutative, 0, PSYS_NONE)           /* any two values of one type → bool */                                               \
-    X(Ne, "ne", 2, Pure, kCommutative, 0, PSYS_NONE)                                                                                                 \
+    X(Sign, "sign", 1, Pure, kComponentwise | kJumps, 0, PSYS_BUILTIN("sign(x: T) -> T"))                                                                     \
+    X(Floor, "floor", 1, Pure, kComponentwise | kJumps, 0, PSYS_MAPS("floor(x: T) -> T", "", "llvm.floor", "floor"))                                          \
+    X(Ceil, "ceil", 1, Pure, kComponentwise | kJumps, 0, PSYS_MAPS("ceil(x: T) -> T", "", "llvm.ceil", "ceil"))                                               \
+    X(Round, "round", 1, Pure, kComponentwise | kJumps, 0, PSYS_MAPS("round(x: T) -> T", "", "llvm.nearbyint", "roundEven"))   /* to nearest, ties to even */ \
+    X(Fract, "fract", 1, Pure, kComponentwise | kJumps, 0, PSYS_BUILTIN("fract(x: T) -> T"))                                                                  \
+    X(Lt, "lt", 2, Pure, kJumps, 0, PSYS_NONE)                      /* floats → bool */                                                                   \
+    X(Le, "le", 2, Pure, kJumps, 0, PSYS_NONE)                                                                                                            \
+    X(Gt, "gt", 2, Pure, kJumps, 0, PSYS_NONE)                                                                                                            \
+    X(Ge, "ge", 2, Pure, kJumps, 0, PSYS_NONE)                                                                                                            \
+    X(Eq, "eq", 2, Pure, kCommutative | kJumps, 0, PSYS_NONE)           /* any two values of one type → bool */                                               \
+    X(Ne, "ne", 2, Pure, kCommutative | kJumps, 0, PSYS_NONE)                                                                                                 \
     X(And, "and", 2, Pure, kCommutative, 0, PSYS_NONE)                                                                                               \
     X(Or, "or", 2, Pure, kCommutative, 0, PSYS_NONE)                                                                                                 \
     X(Not, "not", 1, Pure, 0, 0, PSYS_NONE)                                                                                                          \
@@ -125,7 +128,7 @@ struct OpSpelling {
     X(Extract, "extract", 1, Pure, 0, 0, PSYS_NONE)            /* attr: component */                                                                 \
     X(Shuffle, "shuffle", 1, Pure, 0, 0, PSYS_NONE)            /* lanes: components */                                                               \
     X(Dot, "dot", 2, Pure, kCommutative, 0, PSYS_NONE)                                                                                               \
-    X(Hash, "hash", 1, Pure, 0, 0, PSYS_BUILTIN("hash(x: T) -> T")) /* a lattice point's random lanes in [-1, 1): core/hash.h */                    \
+    X(Hash, "hash", 1, Pure, kJumps, 0, PSYS_BUILTIN("hash(x: T) -> T")) /* a lattice point's random lanes in [-1, 1): core/hash.h */                    \
     X(Rand, "rand", -1, Random, kOwnSite, 0, PSYS_NONE)        /* in [0, 1); keyed: (object.id, draw.index) */                                       \
     X(NRand, "nrand", -1, Random, kOwnSite, 0, PSYS_NONE)      /* in [-1, 1) */                                                                      \
     X(Integrate, "integrate", 1, Temporal, kOwnSite, 1, PSYS_NONE)                                                                                   \
@@ -163,6 +166,7 @@ inline bool isInput(Op op) { return kindOf(op) == OpKind::Input; }
 // Constants and inputs: the instructions without operands.
 inline bool isLeaf(Op op) { return isConstant(op) || isInput(op); }
 inline bool isPure(Op op) { return kindOf(op) == OpKind::Pure; }
+inline bool jumps(Op op) { return (opInfo(op).flags & kJumps) != 0; }
 inline bool isRandom(Op op) { return kindOf(op) == OpKind::Random; }
 inline bool isTemporal(Op op) { return kindOf(op) == OpKind::Temporal; }
 inline bool isCommutative(Op op) { return opInfo(op).flags & kCommutative; }

@@ -16,6 +16,7 @@ using core::isConstant;
 using core::isInput;
 using core::isLeaf;
 using core::isPure;
+using core::jumps;
 using core::isRandom;
 using core::isTemporal;
 using core::isCommutative;

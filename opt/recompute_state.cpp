@@ -13,7 +13,12 @@
 // then drops the slot. The recomputed value starts where the stored one did only if the
 // slot's start (its `init` value) is the same function of the other slots' starts at age
 // 0, which is checked. `age − dt` is the previous step's age up to rounding, so the result
-// may differ in the last bits: relaxed maths only. Not recomputed: anything reading `dt`
+// may differ in the last bits: relaxed maths only. So nothing is recomputed through an
+// operation whose result can jump where its operands move by their last bits (a
+// comparison, floor, step …: core/ops.h's kJumps): `when age > 1.04`'s last value,
+// recomputed from `age − dt`, is true a step early wherever the previous age was 1.04 to
+// the last bit (ages on a 1/100 s grid, steps of 1/30 s), and the edge never fires. Not
+// recomputed either: anything reading `dt`
 // (the previous step's is not known), externs and parents (they may have changed),
 // random draws, parameters (the pool may not keep them: recomputing must never cost
 // bytes), and functions of more than kMaxOps operations.
@@ -53,7 +58,7 @@ bool recomputable(const Kernel& update, ValueId root, int slot, const std::map<V
         if (seen.size() > kMaxOps) return false;
         const Inst& i = update.at(v);
         if (i.op == Op::Const || i.op == Op::Age || i.op == Op::Time) return true;
-        if (!isPure(i.op)) return false;
+        if (!isPure(i.op) || jumps(i.op)) return false;
         for (ValueId o : i.operands)
             if (!walk(o, false)) return false;
         return true;

@@ -484,3 +484,40 @@ TEST_CASE("recompute-state: not when the value reads dt, or starts as another fu
     std::string otherStart = fireShaped("time.f32", "age.f32");
     CHECK(after(otherStart, opt::recomputeState) == after(otherStart, [](Module&, opt::PassErrors&) {}));
 }
+
+// `when age > 1.04`'s last value: recomputed from `age − dt`, a comparison turns a
+// rounding of the clock into a step early, and an edge that never fires (progen seed
+// 20164). Nothing is recomputed through an op that jumps (core/ops.h, kJumps).
+TEST_CASE("recompute-state: not through a comparison or a rounding to whole numbers") {
+    const std::string edge = R"(object p()
+  state prev#0: bool next
+  emit p edge
+  kernel init
+    %0 = age.f32
+    %1 = const.f32 1.04
+    %2 = gt.bool %0, %1
+    yield state #0 = %2
+  end
+  kernel update
+    %0 = age.f32
+    %1 = const.f32 1.04
+    %2 = gt.bool %0, %1
+    %3 = state.bool #0
+    %4 = not.bool %3
+    %5 = and.bool %2, %4
+    %6 = const.f32 0
+    %7 = const.f32 3
+    %8 = select.f32 %5, %7, %6
+    yield emit.count #0 = %8
+    yield state #0 = %2
+  end
+end
+)";
+    CHECK(after(edge, opt::recomputeState) == after(edge, [](Module&, opt::PassErrors&) {}));
+    // A value through floor: floor(age · 10) one step back may be off by one, not by its last bits.
+    std::string floored = fireShaped("age.f32", "age.f32");
+    floored.replace(floored.find("%8 = neg.f32 %7"), std::string("%8 = neg.f32 %7").size(), "%8 = floor.f32 %7");
+    floored.replace(floored.find("%4 = neg.f32 %3"), std::string("%4 = neg.f32 %3").size(), "%4 = floor.f32 %3");
+    CHECK(after(floored, opt::recomputeState) == after(floored, [](Module&, opt::PassErrors&) {}));
+    // (The same shape through neg, continuous, is recomputed: the test above.)
+}
