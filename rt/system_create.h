@@ -123,6 +123,7 @@ private:
     void bindInMemory(size_t type, Batch& b, size_t n);
     Buffer identifyInMemory(Batch& b, size_t n, size_t kept);
     void burstTablesAtCreation(size_t type, Batch& b, size_t n);
+    void countCappedSubSteps(size_t type, Batch& b, size_t n, double t1);
     Clock firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows, double t1, LateKills& late,
                               std::vector<std::pair<Buffer, Buffer>>& columns);
     // A batch's emissions the memory decides (emitInMemory): its bursts at creation, its

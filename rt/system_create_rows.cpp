@@ -230,6 +230,19 @@ void Creation::emitFromBatch(size_t type, Batch& b, size_t n, Buffer rows, doubl
 // object through its own (Memory::subStepClocks), the k-th of each at once, what one
 // kills taken out of the masks before the next (Ledger::takeOut) and freed at the step's
 // end. Returns the clock its exports are computed at: each row's last.
+// A hitch past kMaxSubSteps in a batch's first update: the objects whose own sub-steps
+// are capped, counted (a read of their creation times).
+void Creation::countCappedSubSteps(size_t type, Batch& b, size_t n, double t1) {
+    std::vector<double> created(n);
+    std::vector<uint8_t> kept(n);
+    s_.memory.read(b.updateTable[ColumnLayout::kCreated], b.first, n, created.data());
+    s_.memory.read(b.columns.at(kMask, Elem::U8, b.first + n), b.first, n, kept.data());
+    uint64_t count = 0;
+    for (size_t r = 0; r < n; ++r)
+        if (kept[r]) subStepCount(t1 - created[r], s_.types[type].stepLimit, count);
+    s_.typeStats[type].cappedSubSteps += count;
+}
+
 Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows, double t1, LateKills& late,
                                     std::vector<std::pair<Buffer, Buffer>>& columns) {
     const TypeInfo& info = s_.types[type];
@@ -262,16 +275,7 @@ Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows
     Memory& memory = s_.memory;
     const size_t end = b.first + n;
     Buffer mask = b.columns.at(kMask, Elem::U8, end), step = b.columns.at(kStepMask, Elem::U8, end);
-    if (capped) {  // a hitch past kMaxSubSteps: the objects whose own sub-steps are capped, counted (a read)
-        std::vector<double> created(n);
-        std::vector<uint8_t> kept(n);
-        memory.read(table[ColumnLayout::kCreated], b.first, n, created.data());
-        memory.read(mask, b.first, n, kept.data());
-        uint64_t count = 0;
-        for (size_t r = 0; r < n; ++r)
-            if (kept[r]) subStepCount(t1 - created[r], info.stepLimit, count);
-        s_.typeStats[type].cappedSubSteps += count;
-    }
+    if (capped) countCappedSubSteps(type, b, n, t1);
     const Clock perRow{Clock::Source::PerRow, Clock::Source::PerRow, 0, 0, false};
     // An emitter's: each sub-step's emissions after its update, over the sub-step's own
     // clock, before what it killed is taken out (its bursts on death are from them); its

@@ -139,61 +139,75 @@ void decideParticles(std::vector<TypeInfo>& types, const SystemOptions& options,
     }
 }
 
-// The emitters and children whose rows the memory keeps beside them (below).
-void decideEmitters(std::vector<TypeInfo>& types, const ir::Module& module, const SystemOptions& options, bool inMemory,
-                    const Backend& backend) {
-    // Emitters whose emissions the memory decides (Memory::emitAtRate): every site emits —
-    // at a rate, in a burst at creation, on an edge or on death — into a type that keeps its rows in the memory (one that emits nothing, or such an emitter
-    // itself) and reads no parent, and whose arguments read no fold (a spawn launch from
-    // records has no parent values) — so a step's emissions are one operation over the
-    // rows, and the objects they create batches of those types, whose bursts at creation
-    // and first updates emit by the same operation. Sites into one type share its room,
-    // their objects one batch in the host's order (rt::RateSites: a group); the batches of
-    // a step's generation go type by type, wherever its emissions were decided
-    // (Creation::groupByType).
-    // One that dies has its kills late, as a type's that only dies — nobody but its
-    // children looks at them before the step's end — and the operation reads its update's
-    // kill flags where they are (a row killed emits at no rate, and bursts); its exports,
-    // where children or folds read them, are its survivors' (Memory::survivors). (Until no
-    // type changes: an emitter of emitters follows them in.) In sub-steps (@step), each
-    // sub-step's emissions follow its update, over its clock, before what it killed is
-    // taken out of the masks (runEmissions; a new object's first update:
-    // Creation::firstUpdateInMemory) — where children read it, out of both at once
-    // (Ledger::takeOut); its exports are its last sub-step's survivors', each new one's
-    // at its own last clock.
-    // Wherever rows are kept in the memory (a device's backend asks for it, any backend
-    // with Rows::InMemory) and objects are created in batches. Where the emitters' rows are
-    // on a device, the host still reads the operation's totals back in the step
-    // (docs/gpu.md, "Emitters in the memory").
-    // Children in the memory beside their parents: a nested type created in a batch — its
-    // ancestors' exports, whether they are alive and their ages gathered through its
-    // parents' rows where they are (State::gatherThrough: further up, through each
-    // ancestor pool's), at each sub-step's clock in sub-steps — that emits nothing and
-    // whose kills are late or who never dies (as a type that only dies), or that is an
-    // emitter in the memory itself (then children may read it: a grandparent's child), its
-    // parent type's rows in the memory too (below), so that the parents' rows, readers and
-    // frozen objects are the memory's (Memory::releaseUnread). Its parent type is then
-    // such an emitter, every type that reads it such a child. (A fold over it reads the
-    // rows updatable at the step's start, as on the host: a frozen parent is not among them.)
-    // (A child that emits is such an emitter itself, below: `candidate`.)
-    std::vector<bool> childShape(types.size(), false), quietChild(types.size(), false);
+// The shapes of children that may keep their rows in the memory beside their parents
+// (decideEmitters): a nested type created in a batch and not drawn as the step goes —
+// `quiet` where it emits nothing, is read by no child, and its kills are late or it never
+// dies (as a type that only dies); else only if it is such an emitter itself.
+struct ChildShapes {
+    std::vector<bool> shape, quiet;
+};
+ChildShapes childShapes(const std::vector<TypeInfo>& types, const ir::Module& module, const SystemOptions& options,
+                        bool inMemory, const Backend& backend) {
+    ChildShapes c{std::vector<bool>(types.size(), false), std::vector<bool>(types.size(), false)};
     for (size_t t = 0; t < types.size(); ++t) {
         const TypeInfo& info = types[t];
-        const ir::Object& o = module.objects[t];
         bool silent = !info.kills && !info.unstable && !info.updateEmits;
-        childShape[t] = inMemory && options.createInBatches && info.parentType >= 0 &&
-                        !(options.drawInStep && backend.rendersInStep() && info.render);
-        quietChild[t] = childShape[t] && !info.read && (info.late || silent) && o.emits.empty();
+        c.shape[t] = inMemory && options.createInBatches && info.parentType >= 0 &&
+                     !(options.drawInStep && backend.rendersInStep() && info.render);
+        c.quiet[t] = c.shape[t] && !info.read && (info.late || silent) && module.objects[t].emits.empty();
     }
-    // Emitters are decided together, as the greatest set that holds: every type starts a
-    // candidate and one that fails its rules — a target outside the memory among them —
-    // leaves, until none does; so an emitter of its own type (a rocket of rockets), two
-    // emitters of each other, and a child that emits beside its parent keep their rows in
-    // the memory, as a chain of emitters does.
+    return c;
+}
+
+// Whether an emitter's arguments at site `s` can be gathered before the operation
+// (State::gatherSpawnParents: its ancestors' values and its own folds, for every row) —
+// all of them but an ancestor's age under @step: a new emitter's sub-steps emit at clocks
+// of their own, their launches after the batch, and what else they read of an ancestor
+// is the same at each.
+bool argumentsGathered(const TypeInfo& info, size_t s) {
+    const std::vector<ColumnLayout::ParentColumn>& reads = info.spawnLayout[s].parentColumns;
+    auto age = [](const ColumnLayout::ParentColumn& p) { return p.op == ir::Op::ParentAge; };
+    return info.stepLimit == 0 || std::none_of(reads.begin(), reads.end(), age);
+}
+
+// The emitters whose emissions the memory decides (Memory::emitAtRate), and the children
+// whose rows it keeps beside their parents. Every site of such an emitter emits — at a
+// rate, in a burst at creation, on an edge or on death — into a type whose rows are the
+// memory's (its arguments gathered before the operation: argumentsGathered), so a step's
+// emissions are one operation over the rows, and the objects they create batches of
+// those types, whose bursts at creation and first updates emit by the same operation.
+// Sites into one type share its room, their objects one batch in the host's order
+// (rt::RateSites: a group); the batches of a step's generation go type by type, wherever
+// its emissions were decided (Creation::groupByType).
+// One that dies has its kills late, as a type's that only dies — nobody but its children
+// looks at them before the step's end — and the operation reads its update's kill flags
+// where they are (a row killed emits at no rate, and bursts); its exports, where children
+// or folds read them, are its survivors' (Memory::survivors). In sub-steps (@step), each
+// sub-step's emissions follow its update, over its clock, before what it killed is taken
+// out of the masks (runEmissions; a new object's first update:
+// Creation::firstUpdateInMemory) — where children read it, out of both at once
+// (Ledger::takeOut); its exports are its last sub-step's survivors', each new one's at
+// its own last clock. Where the emitters' rows are on a device, the host still reads the
+// operation's totals back in the step (docs/gpu.md, "Emitters in the memory").
+// Children beside their parents (ChildShapes): their ancestors' exports, whether they are
+// alive and their ages gathered through their parents' rows (State::gatherThrough:
+// further up, through each ancestor pool's), at each sub-step's clock in sub-steps — the
+// parent type such an emitter, every type that reads it such a child, so that the
+// parents' rows, readers and frozen objects are the memory's (Memory::releaseUnread). (A
+// fold over it reads the rows updatable at the step's start, as on the host: a frozen
+// parent is not among them.)
+// They are decided together, as the greatest set that holds: every type starts a
+// candidate and one that fails its rules — a target outside the memory among them —
+// leaves, until none does; so an emitter of its own type (a rocket of rockets), two
+// emitters of each other, and a child that emits beside its parent keep their rows in the
+// memory, as a chain of emitters does. A chain of bursts at creation does not
+// (burstChains).
+void decideEmitters(std::vector<TypeInfo>& types, const ir::Module& module, const SystemOptions& options, bool inMemory,
+                    const Backend& backend) {
+    const ChildShapes shapes = childShapes(types, module, options, inMemory, backend);
     std::vector<bool> candidate(types.size(), true);
-    auto child = [&](size_t t) { return quietChild[t] || (childShape[t] && candidate[t]); };
-    // A type whose readers are all such children.
-    auto readByChildren = [&](size_t t) {
+    auto child = [&](size_t t) { return shapes.quiet[t] || (shapes.shape[t] && candidate[t]); };
+    auto readByChildren = [&](size_t t) {  // (every reader such a child)
         for (size_t c = 0; c < types.size(); ++c)
             if (types[c].parentType == static_cast<int>(t) && !child(c)) return false;
         return true;
@@ -205,25 +219,15 @@ void decideEmitters(std::vector<TypeInfo>& types, const ir::Module& module, cons
     };
     auto decidedInMemory = [&](size_t t) {
         const TypeInfo& info = types[t];
-        const ir::Object& o = module.objects[t];
         bool dies = info.kills || info.unstable;
-        bool parent = info.read && readByChildren(t);
         bool whole = keptWhole(info, options, backend);
         bool emitter = inMemory && options.createInBatches && (info.updateEmits || info.bursts) &&
-                       (!dies || options.lateKills) && (!info.read || parent) &&
-                       (whole || (childShape[t] && candidate[static_cast<size_t>(info.parentType)]));
-        for (size_t s = 0; emitter && s < o.emits.size(); ++s) {
+                       (!dies || options.lateKills) && (!info.read || readByChildren(t)) &&
+                       (whole || (shapes.shape[t] && candidate[static_cast<size_t>(info.parentType)]));
+        for (size_t s = 0; emitter && s < module.objects[t].emits.size(); ++s) {
             size_t target = info.emitTarget[s];
             bool itsChild = child(target) && types[target].parentType == static_cast<int>(t);
-            // (Its arguments may read its ancestors as a child reads them, and its own folds:
-            // their values gathered for every row before the operation,
-            // State::gatherSpawnParents — in sub-steps, not an ancestor's age: a new emitter's
-            // sub-steps emit at clocks of their own, their launches after the batch, and what
-            // else they read of an ancestor is the same at each.)
-            const std::vector<ColumnLayout::ParentColumn>& reads = info.spawnLayout[s].parentColumns;
-            auto age = [](const ColumnLayout::ParentColumn& p) { return p.op == ir::Op::ParentAge; };
-            emitter = (inMemoryOr(target) || itsChild) &&
-                      (info.stepLimit == 0 || std::none_of(reads.begin(), reads.end(), age));
+            emitter = (inMemoryOr(target) || itsChild) && argumentsGathered(info, s);
         }
         return emitter;
     };
