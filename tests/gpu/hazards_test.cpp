@@ -114,7 +114,8 @@ TEST_CASE("a burst chain creates an object at a time on the host side, its write
     // Each object emits the next in its first update: ten thousand waves of one object in
     // the first step. A wave is a batch of one row: it runs on the host side, and what it
     // writes into the pool's rows on the GPU goes up with the others, not a dispatch for
-    // each column of each object (the chain took 155 s for 30 frames at 100k, 1.4 s now).
+    // each column of each object (a dispatch a column an object: 155 s for 30 frames at 100k,
+    // against 1.4 s; docs/performance.md).
     const char* text = "@capacity(10000) object a { emit a; point(vec3(age, 0, 0), white, 1); kill when age > 0.5; }\n"
                        "spawn a;";
     Pair p(text, true, true);
@@ -138,7 +139,7 @@ TEST_CASE("the dispatches a step do not grow with the emitters when their childr
     // spark, puff, … Each type is created in one batch a step (rt/system_queue.cpp,
     // Creation::groupByType) and each spawn kernel's launches go in one dispatch
     // (GlslBackend::runChildren) — the campfire's dispatches grew tenfold with its fires.
-    // (40 and 432 dispatches a step before, 36 and 36 now.)
+    // (36 dispatches a step for 4 sources and for 40; a batch an emitter made 40 and 432.)
     auto perStep = [](int sources) {
         std::string text = R"(
             object spark(p: vec3) { pos = snapshot(p) + integrate(vec3(0, -1, 0)); point(pos, white, 1); kill when age > 0.3; }
@@ -165,7 +166,8 @@ TEST_CASE("the dispatches a step do not grow with the emitters when their childr
 TEST_CASE("many object types of a few objects each run on the host side: no dispatch a step") {
     // 100 types of one object: their updates (late or not) and draws run where their
     // columns are, on the host, as fast as the interpreter; a dispatch each would be 200
-    // dispatches a step and more (400 types took 42 s for 600 frames on llvmpipe, 0.9 s now).
+    // dispatches a step and more (400 types: 0.9 s for 600 frames on llvmpipe, 42 s with a
+    // dispatch each; docs/performance.md).
     std::string text;
     for (int t = 0; t < 100; ++t)
         text += "object t" + std::to_string(t) + " { p = integrate(vec3(" + std::to_string(t) +
