@@ -35,8 +35,10 @@ constexpr unsigned kComponentwise = 2;  // lane i of the result is a function of
                                         // operands (select: of its branches; the condition is one bool)
 constexpr unsigned kOwnSite = 4;        // a call site of its own: never merged with an equal one
 constexpr unsigned kJumps = 8;          // a change in an operand's last bits may change the result
-                                        // by more than its last bits (comparisons, rounding to whole
-                                        // numbers, atan2's cut): what decides, not what approximates
+                                        // by more than its last bits: comparisons, rounding to whole
+                                        // numbers, atan2's cut, and poles and the edges of a domain
+                                        // (a division, tan, sqrt, log, pow, asin, acos: sqrt(−0.0…1)
+                                        // is NaN where sqrt(0) is 0)
 
 // What an op is in the language and on the backends, where that is a plain mapping.
 struct OpSpelling {
@@ -66,77 +68,77 @@ struct OpSpelling {
 
 // X(id, text, arity (-1: any), kind, flags, delayed operands (bit i: operand i may refer to
 // a value defined later, closing a recursive equation), spelling)
-#define PSYS_OPS(X)                                                                                                                                  \
-    X(Const, "const", 0, Constant, 0, 0, PSYS_NONE)                                                                                                  \
-    X(Param, "param", 0, Input, 0, 0, PSYS_NONE)               /* attr: parameter */                                                                 \
-    X(StateRead, "state", 0, Input, 0, 0, PSYS_NONE)           /* attr: slot; its value before this update */                                        \
-    X(Age, "age", 0, Input, 0, 0, PSYS_NONE)                                                                                                         \
-    X(Dt, "dt", 0, Input, 0, 0, PSYS_NONE)                     /* the length of this update */                                                       \
-    X(Time, "time", 0, Input, 0, 0, PSYS_NONE)                                                                                                       \
-    X(First, "first", 0, Input, 0, 0, PSYS_NONE)               /* true while the object is being created */                                          \
-    X(Extern, "extern", 0, Input, 0, 0, PSYS_NONE)             /* attr: extern */                                                                    \
-    X(TriggerParam, "trigger.param", 0, Input, 0, 0, PSYS_NONE)                                                                                      \
-    X(ParentRead, "parent.read", 0, Input, 0, 0, PSYS_NONE)    /* attr: index into Object::parentReads */                                            \
-    X(ParentExport, "parent.export", 0, Input, 0, 0, PSYS_NONE) /* attr: export, attr2: levels up */                                                 \
-    X(ParentAlive, "parent.alive", 0, Input, 0, 0, PSYS_NONE)  /* attr2: levels up */                                                                \
-    X(ParentAge, "parent.age", 0, Input, 0, 0, PSYS_NONE)      /* attr2: levels up */                                                                \
-    X(ObjectId, "object.id", 0, Input, 0, 0, PSYS_NONE)        /* u32: this object's id */                                                           \
-    X(DrawIndex, "draw.index", 0, Input, 0, 0, PSYS_NONE)      /* u32: which draw of every random site */                                            \
-    X(Uniform, "uniform", 0, Input, 0, 0, PSYS_NONE)           /* attr: a value of the uniform kernel */                                             \
-    X(NeighbourRead, "neighbour.read", 0, Input, 0, 0, PSYS_NONE) /* pair kernels: attr: index into Object::neighbourReads */                        \
-    X(NeighbourExport, "neighbour.export", 0, Input, 0, 0, PSYS_NONE) /* pair kernels: attr: export; attr2: 0 this object, 1 the other */         \
-    X(Fold, "fold", 0, Input, 0, 0, PSYS_NONE)                 /* attr: fold (Object::folds): over the neighbours, this step */                     \
-    X(Add, "add", 2, Pure, kCommutative | kComponentwise, 0, PSYS_NONE)                                                                              \
-    X(Sub, "sub", 2, Pure, kComponentwise, 0, PSYS_NONE)                                                                                             \
-    X(Mul, "mul", 2, Pure, kCommutative | kComponentwise, 0, PSYS_NONE)                                                                              \
-    X(Div, "div", 2, Pure, kComponentwise, 0, PSYS_NONE)                                                                                             \
+#define PSYS_OPS(X)                                                                                                                                           \
+    X(Const, "const", 0, Constant, 0, 0, PSYS_NONE)                                                                                                           \
+    X(Param, "param", 0, Input, 0, 0, PSYS_NONE)               /* attr: parameter */                                                                          \
+    X(StateRead, "state", 0, Input, 0, 0, PSYS_NONE)           /* attr: slot; its value before this update */                                                 \
+    X(Age, "age", 0, Input, 0, 0, PSYS_NONE)                                                                                                                  \
+    X(Dt, "dt", 0, Input, 0, 0, PSYS_NONE)                     /* the length of this update */                                                                \
+    X(Time, "time", 0, Input, 0, 0, PSYS_NONE)                                                                                                                \
+    X(First, "first", 0, Input, 0, 0, PSYS_NONE)               /* true while the object is being created */                                                   \
+    X(Extern, "extern", 0, Input, 0, 0, PSYS_NONE)             /* attr: extern */                                                                             \
+    X(TriggerParam, "trigger.param", 0, Input, 0, 0, PSYS_NONE)                                                                                               \
+    X(ParentRead, "parent.read", 0, Input, 0, 0, PSYS_NONE)    /* attr: index into Object::parentReads */                                                     \
+    X(ParentExport, "parent.export", 0, Input, 0, 0, PSYS_NONE) /* attr: export, attr2: levels up */                                                          \
+    X(ParentAlive, "parent.alive", 0, Input, 0, 0, PSYS_NONE)  /* attr2: levels up */                                                                         \
+    X(ParentAge, "parent.age", 0, Input, 0, 0, PSYS_NONE)      /* attr2: levels up */                                                                         \
+    X(ObjectId, "object.id", 0, Input, 0, 0, PSYS_NONE)        /* u32: this object's id */                                                                    \
+    X(DrawIndex, "draw.index", 0, Input, 0, 0, PSYS_NONE)      /* u32: which draw of every random site */                                                     \
+    X(Uniform, "uniform", 0, Input, 0, 0, PSYS_NONE)           /* attr: a value of the uniform kernel */                                                      \
+    X(NeighbourRead, "neighbour.read", 0, Input, 0, 0, PSYS_NONE) /* pair kernels: attr: index into Object::neighbourReads */                                 \
+    X(NeighbourExport, "neighbour.export", 0, Input, 0, 0, PSYS_NONE) /* pair kernels: attr: export; attr2: 0 this object, 1 the other */                     \
+    X(Fold, "fold", 0, Input, 0, 0, PSYS_NONE)                 /* attr: fold (Object::folds): over the neighbours, this step */                               \
+    X(Add, "add", 2, Pure, kCommutative | kComponentwise, 0, PSYS_NONE)                                                                                       \
+    X(Sub, "sub", 2, Pure, kComponentwise, 0, PSYS_NONE)                                                                                                      \
+    X(Mul, "mul", 2, Pure, kCommutative | kComponentwise, 0, PSYS_NONE)                                                                                       \
+    X(Div, "div", 2, Pure, kComponentwise | kJumps, 0, PSYS_NONE)                                                                                             \
     X(Mod, "mod", 2, Pure, kComponentwise | kJumps, 0, PSYS_BUILTIN("mod(x: T, y: T|float) -> T"))                                                            \
-    X(Neg, "neg", 1, Pure, kComponentwise, 0, PSYS_NONE)                                                                                             \
-    X(Min, "min", 2, Pure, kCommutative | kComponentwise, 0, PSYS_BUILTIN("min(a: T, b: T|float) -> T"))                                             \
-    X(Max, "max", 2, Pure, kCommutative | kComponentwise, 0, PSYS_BUILTIN("max(a: T, b: T|float) -> T"))                                             \
+    X(Neg, "neg", 1, Pure, kComponentwise, 0, PSYS_NONE)                                                                                                      \
+    X(Min, "min", 2, Pure, kCommutative | kComponentwise, 0, PSYS_BUILTIN("min(a: T, b: T|float) -> T"))                                                      \
+    X(Max, "max", 2, Pure, kCommutative | kComponentwise, 0, PSYS_BUILTIN("max(a: T, b: T|float) -> T"))                                                      \
     X(Step, "step", 2, Pure, kComponentwise | kJumps, 0, PSYS_BUILTIN("step(edge: T|float, x: T) -> T"))     /* x < edge ? 0 : 1 */                           \
     X(Atan2, "atan2", 2, Pure, kComponentwise | kJumps, 0, PSYS_MAPS("atan2(y: T, x: T) -> T", "atan2f", "", "psys_atan2"))                                   \
-    X(Pow, "pow", 2, Pure, kComponentwise, 0, PSYS_MAPS("pow(x: T, y: T|float) -> T", "powf", "llvm.pow", "psys_pow"))                               \
-    X(Sin, "sin", 1, Pure, kComponentwise, 0, PSYS_MAPS("sin(x: T) -> T", "sinf", "llvm.sin", "sin"))                                                \
-    X(Cos, "cos", 1, Pure, kComponentwise, 0, PSYS_MAPS("cos(x: T) -> T", "cosf", "llvm.cos", "cos"))                                                \
-    X(Tan, "tan", 1, Pure, kComponentwise, 0, PSYS_MAPS("tan(x: T) -> T", "tanf", "llvm.tan", "tan"))                                                \
-    X(Asin, "asin", 1, Pure, kComponentwise, 0, PSYS_MAPS("asin(x: T) -> T", "asinf", "llvm.asin", "psys_asin"))                                     \
-    X(Acos, "acos", 1, Pure, kComponentwise, 0, PSYS_MAPS("acos(x: T) -> T", "acosf", "llvm.acos", "psys_acos"))                                     \
-    X(Atan, "atan", 1, Pure, kComponentwise, 0, PSYS_MAPS("atan(x: T) -> T", "atanf", "llvm.atan", "atan"))                                          \
-    X(Tanh, "tanh", 1, Pure, kComponentwise, 0, PSYS_MAPS("tanh(x: T) -> T", "tanhf", "llvm.tanh", "tanh"))                                          \
-    X(Exp, "exp", 1, Pure, kComponentwise, 0, PSYS_MAPS("exp(x: T) -> T", "expf", "llvm.exp", "exp"))                                                \
-    X(Log, "log", 1, Pure, kComponentwise, 0, PSYS_MAPS("log(x: T) -> T", "logf", "llvm.log", "psys_log"))                                           \
-    X(Sqrt, "sqrt", 1, Pure, kComponentwise, 0, PSYS_MAPS("sqrt(x: T) -> T", "", "llvm.sqrt", "psys_sqrt"))                                          \
-    X(Abs, "abs", 1, Pure, kComponentwise, 0, PSYS_MAPS("abs(x: T) -> T", "", "llvm.fabs", "abs"))                                                   \
+    X(Pow, "pow", 2, Pure, kComponentwise | kJumps, 0, PSYS_MAPS("pow(x: T, y: T|float) -> T", "powf", "llvm.pow", "psys_pow"))                               \
+    X(Sin, "sin", 1, Pure, kComponentwise, 0, PSYS_MAPS("sin(x: T) -> T", "sinf", "llvm.sin", "sin"))                                                         \
+    X(Cos, "cos", 1, Pure, kComponentwise, 0, PSYS_MAPS("cos(x: T) -> T", "cosf", "llvm.cos", "cos"))                                                         \
+    X(Tan, "tan", 1, Pure, kComponentwise | kJumps, 0, PSYS_MAPS("tan(x: T) -> T", "tanf", "llvm.tan", "tan"))                                                \
+    X(Asin, "asin", 1, Pure, kComponentwise | kJumps, 0, PSYS_MAPS("asin(x: T) -> T", "asinf", "llvm.asin", "psys_asin"))                                     \
+    X(Acos, "acos", 1, Pure, kComponentwise | kJumps, 0, PSYS_MAPS("acos(x: T) -> T", "acosf", "llvm.acos", "psys_acos"))                                     \
+    X(Atan, "atan", 1, Pure, kComponentwise, 0, PSYS_MAPS("atan(x: T) -> T", "atanf", "llvm.atan", "atan"))                                                   \
+    X(Tanh, "tanh", 1, Pure, kComponentwise, 0, PSYS_MAPS("tanh(x: T) -> T", "tanhf", "llvm.tanh", "tanh"))                                                   \
+    X(Exp, "exp", 1, Pure, kComponentwise, 0, PSYS_MAPS("exp(x: T) -> T", "expf", "llvm.exp", "exp"))                                                         \
+    X(Log, "log", 1, Pure, kComponentwise | kJumps, 0, PSYS_MAPS("log(x: T) -> T", "logf", "llvm.log", "psys_log"))                                           \
+    X(Sqrt, "sqrt", 1, Pure, kComponentwise | kJumps, 0, PSYS_MAPS("sqrt(x: T) -> T", "", "llvm.sqrt", "psys_sqrt"))                                          \
+    X(Abs, "abs", 1, Pure, kComponentwise, 0, PSYS_MAPS("abs(x: T) -> T", "", "llvm.fabs", "abs"))                                                            \
     X(Sign, "sign", 1, Pure, kComponentwise | kJumps, 0, PSYS_BUILTIN("sign(x: T) -> T"))                                                                     \
     X(Floor, "floor", 1, Pure, kComponentwise | kJumps, 0, PSYS_MAPS("floor(x: T) -> T", "", "llvm.floor", "floor"))                                          \
     X(Ceil, "ceil", 1, Pure, kComponentwise | kJumps, 0, PSYS_MAPS("ceil(x: T) -> T", "", "llvm.ceil", "ceil"))                                               \
     X(Round, "round", 1, Pure, kComponentwise | kJumps, 0, PSYS_MAPS("round(x: T) -> T", "", "llvm.nearbyint", "roundEven"))   /* to nearest, ties to even */ \
     X(Fract, "fract", 1, Pure, kComponentwise | kJumps, 0, PSYS_BUILTIN("fract(x: T) -> T"))                                                                  \
-    X(Lt, "lt", 2, Pure, kJumps, 0, PSYS_NONE)                      /* floats → bool */                                                                   \
-    X(Le, "le", 2, Pure, kJumps, 0, PSYS_NONE)                                                                                                            \
-    X(Gt, "gt", 2, Pure, kJumps, 0, PSYS_NONE)                                                                                                            \
-    X(Ge, "ge", 2, Pure, kJumps, 0, PSYS_NONE)                                                                                                            \
+    X(Lt, "lt", 2, Pure, kJumps, 0, PSYS_NONE)                      /* floats → bool */                                                                       \
+    X(Le, "le", 2, Pure, kJumps, 0, PSYS_NONE)                                                                                                                \
+    X(Gt, "gt", 2, Pure, kJumps, 0, PSYS_NONE)                                                                                                                \
+    X(Ge, "ge", 2, Pure, kJumps, 0, PSYS_NONE)                                                                                                                \
     X(Eq, "eq", 2, Pure, kCommutative | kJumps, 0, PSYS_NONE)           /* any two values of one type → bool */                                               \
     X(Ne, "ne", 2, Pure, kCommutative | kJumps, 0, PSYS_NONE)                                                                                                 \
-    X(And, "and", 2, Pure, kCommutative, 0, PSYS_NONE)                                                                                               \
-    X(Or, "or", 2, Pure, kCommutative, 0, PSYS_NONE)                                                                                                 \
-    X(Not, "not", 1, Pure, 0, 0, PSYS_NONE)                                                                                                          \
-    X(Select, "select", 3, Pure, kComponentwise, 0, PSYS_NONE) /* cond ? a : b */                                                                    \
-    X(Splat, "splat", 1, Pure, 0, 0, PSYS_NONE)                /* float → every component */                                                         \
-    X(Compose, "compose", -1, Pure, 0, 0, PSYS_NONE)           /* components (floats or vectors) → vector */                                         \
-    X(Extract, "extract", 1, Pure, 0, 0, PSYS_NONE)            /* attr: component */                                                                 \
-    X(Shuffle, "shuffle", 1, Pure, 0, 0, PSYS_NONE)            /* lanes: components */                                                               \
-    X(Dot, "dot", 2, Pure, kCommutative, 0, PSYS_NONE)                                                                                               \
-    X(Hash, "hash", 1, Pure, kJumps, 0, PSYS_BUILTIN("hash(x: T) -> T")) /* a lattice point's random lanes in [-1, 1): core/hash.h */                    \
-    X(Rand, "rand", -1, Random, kOwnSite, 0, PSYS_NONE)        /* in [0, 1); keyed: (object.id, draw.index) */                                       \
-    X(NRand, "nrand", -1, Random, kOwnSite, 0, PSYS_NONE)      /* in [-1, 1) */                                                                      \
-    X(Integrate, "integrate", 1, Temporal, kOwnSite, 1, PSYS_NONE)                                                                                   \
-    X(Derive, "derive", 1, Temporal, kOwnSite, 0, PSYS_NONE)                                                                                         \
-    X(Snapshot, "snapshot", 1, Temporal, kOwnSite, 0, PSYS_NONE)                                                                                     \
-    X(Prev, "prev", 1, Temporal, kOwnSite, 1, PSYS_NONE)                                                                                             \
-    X(FollowedBy, "fby", 2, Temporal, kOwnSite, 2, PSYS_NONE)  /* init -> next: the next side is delayed */                                          \
-    X(Recur, "recur", 1, Temporal, kOwnSite, 1, PSYS_NONE)     /* closes a cycle: the value of a later                                               \
+    X(And, "and", 2, Pure, kCommutative, 0, PSYS_NONE)                                                                                                        \
+    X(Or, "or", 2, Pure, kCommutative, 0, PSYS_NONE)                                                                                                          \
+    X(Not, "not", 1, Pure, 0, 0, PSYS_NONE)                                                                                                                   \
+    X(Select, "select", 3, Pure, kComponentwise, 0, PSYS_NONE) /* cond ? a : b */                                                                             \
+    X(Splat, "splat", 1, Pure, 0, 0, PSYS_NONE)                /* float → every component */                                                                  \
+    X(Compose, "compose", -1, Pure, 0, 0, PSYS_NONE)           /* components (floats or vectors) → vector */                                                  \
+    X(Extract, "extract", 1, Pure, 0, 0, PSYS_NONE)            /* attr: component */                                                                          \
+    X(Shuffle, "shuffle", 1, Pure, 0, 0, PSYS_NONE)            /* lanes: components */                                                                        \
+    X(Dot, "dot", 2, Pure, kCommutative, 0, PSYS_NONE)                                                                                                        \
+    X(Hash, "hash", 1, Pure, kJumps, 0, PSYS_BUILTIN("hash(x: T) -> T")) /* a lattice point's random lanes in [-1, 1): core/hash.h */                         \
+    X(Rand, "rand", -1, Random, kOwnSite, 0, PSYS_NONE)        /* in [0, 1); keyed: (object.id, draw.index) */                                                \
+    X(NRand, "nrand", -1, Random, kOwnSite, 0, PSYS_NONE)      /* in [-1, 1) */                                                                               \
+    X(Integrate, "integrate", 1, Temporal, kOwnSite, 1, PSYS_NONE)                                                                                            \
+    X(Derive, "derive", 1, Temporal, kOwnSite, 0, PSYS_NONE)                                                                                                  \
+    X(Snapshot, "snapshot", 1, Temporal, kOwnSite, 0, PSYS_NONE)                                                                                              \
+    X(Prev, "prev", 1, Temporal, kOwnSite, 1, PSYS_NONE)                                                                                                      \
+    X(FollowedBy, "fby", 2, Temporal, kOwnSite, 2, PSYS_NONE)  /* init -> next: the next side is delayed */                                                   \
+    X(Recur, "recur", 1, Temporal, kOwnSite, 1, PSYS_NONE)     /* closes a cycle: the value of a later                                                        \
                                                        equation (resolved by opt/) */
 
 enum class Op : uint8_t {

@@ -488,7 +488,7 @@ TEST_CASE("recompute-state: not when the value reads dt, or starts as another fu
 // `when age > 1.04`'s last value: recomputed from `age − dt`, a comparison turns a
 // rounding of the clock into a step early, and an edge that never fires (progen seed
 // 20164). Nothing is recomputed through an op that jumps (core/ops.h, kJumps).
-TEST_CASE("recompute-state: not through a comparison or a rounding to whole numbers") {
+TEST_CASE("recompute-state: not through a comparison, a rounding to whole numbers or the edge of a domain") {
     const std::string edge = R"(object p()
   state prev#0: bool next
   emit p edge
@@ -514,10 +514,16 @@ TEST_CASE("recompute-state: not through a comparison or a rounding to whole numb
 end
 )";
     CHECK(after(edge, opt::recomputeState) == after(edge, [](Module&, opt::PassErrors&) {}));
-    // A value through floor: floor(age · 10) one step back may be off by one, not by its last bits.
+    // A value through floor: floor(age) one step back may be off by one, not by its last bits.
     std::string floored = fireShaped("age.f32", "age.f32");
     floored.replace(floored.find("%8 = neg.f32 %7"), std::string("%8 = neg.f32 %7").size(), "%8 = floor.f32 %7");
     floored.replace(floored.find("%4 = neg.f32 %3"), std::string("%4 = neg.f32 %3").size(), "%4 = floor.f32 %3");
     CHECK(after(floored, opt::recomputeState) == after(floored, [](Module&, opt::PassErrors&) {}));
+    // Nor through the edge of a domain: sqrt(age) recomputed from age − dt where the
+    // previous age was 0 may be the root of a rounding below 0, NaN where 0 was stored.
+    std::string rooted = fireShaped("age.f32", "age.f32");
+    rooted.replace(rooted.find("%8 = neg.f32 %7"), std::string("%8 = neg.f32 %7").size(), "%8 = sqrt.f32 %7");
+    rooted.replace(rooted.find("%4 = neg.f32 %3"), std::string("%4 = neg.f32 %3").size(), "%4 = sqrt.f32 %3");
+    CHECK(after(rooted, opt::recomputeState) == after(rooted, [](Module&, opt::PassErrors&) {}));
     // (The same shape through neg, continuous, is recomputed: the test above.)
 }
