@@ -1,5 +1,6 @@
 #include "codegen_llvm/compile_threads.h"
 
+#include <system_error>
 #include <thread>
 #include <utility>
 
@@ -25,9 +26,15 @@ void CompileThreads::dispatch(std::unique_ptr<llvm::orc::Task> task) {
         ++outstanding_;
     }
     // Other tasks get a thread each, whatever runs: a lookup's completion may be what a
-    // materialization waits for.
-    std::thread([this, task = std::move(task), materialization]() mutable { work(std::move(task), materialization); })
-        .detach();
+    // materialization waits for. Where no thread can be had, the task runs here, as
+    // LLVM's in-place dispatcher runs every task (it is counted: work counts it done).
+    llvm::orc::Task* owned = task.release();
+    try {
+        std::thread([this, owned, materialization] { work(std::unique_ptr<llvm::orc::Task>(owned), materialization); })
+            .detach();
+    } catch (const std::system_error&) {
+        work(std::unique_ptr<llvm::orc::Task>(owned), materialization);
+    }
 }
 
 // A thread's tasks: its own, then waiting materializations while there are any. Each is

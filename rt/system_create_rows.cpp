@@ -225,11 +225,6 @@ void Creation::emitFromBatch(size_t type, Batch& b, size_t n, Buffer rows, doubl
     emitInMemory(type, b.updateTable, nullptr, std::move(in), sites, &b, rows, t1);
 }
 
-// The batch's first update to t1, its kills late (the last sub-step's into `late`); in
-// sub-steps no longer than @step where an object's span may take more than one, each
-// object through its own (Memory::subStepClocks), the k-th of each at once, what one
-// kills taken out of the masks before the next (Ledger::takeOut) and freed at the step's
-// end. Returns the clock its exports are computed at: each row's last.
 // A hitch past kMaxSubSteps in a batch's first update: the objects whose own sub-steps
 // are capped, counted (a read of their creation times).
 void Creation::countCappedSubSteps(size_t type, Batch& b, size_t n, double t1) {
@@ -243,6 +238,11 @@ void Creation::countCappedSubSteps(size_t type, Batch& b, size_t n, double t1) {
     s_.typeStats[type].cappedSubSteps += count;
 }
 
+// The batch's first update to t1, its kills late (the last sub-step's into `late`); in
+// sub-steps no longer than @step where an object's span may take more than one, each
+// object through its own (Memory::subStepClocks), the k-th of each at once, what one
+// kills taken out of the masks before the next (Ledger::takeOut) and freed at the step's
+// end. Returns the clock its exports are computed at: each row's last.
 Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows, double t1, LateKills& late,
                                     std::vector<std::pair<Buffer, Buffer>>& columns) {
     const TypeInfo& info = s_.types[type];

@@ -171,9 +171,11 @@ bool argumentsGathered(const TypeInfo& info, size_t s) {
 }
 
 // The emitters whose emissions the memory decides (Memory::emitAtRate), and the children
-// whose rows it keeps beside their parents. Every site of such an emitter emits — at a
-// rate, in a burst at creation, on an edge or on death — into a type whose rows are the
-// memory's (its arguments gathered before the operation: argumentsGathered), so a step's
+// whose rows it keeps beside their parents — where rows are kept in the memory (a
+// device's backend asks for it, any backend with Rows::InMemory) and objects are created
+// in batches. Every site of such an emitter emits — at a rate, in a burst at creation, on
+// an edge or on death — into a type whose rows are the memory's, with arguments that can
+// be gathered before the operation (argumentsGathered), so a step's
 // emissions are one operation over the rows, and the objects they create batches of
 // those types, whose bursts at creation and first updates emit by the same operation.
 // Sites into one type share its room, their objects one batch in the host's order
