@@ -124,6 +124,7 @@ private:
     Buffer identifyInMemory(Batch& b, size_t n, size_t kept);
     void burstTablesAtCreation(size_t type, Batch& b, size_t n);
     void countCappedSubSteps(size_t type, Batch& b, size_t n, double t1);
+    void agesAtSubStep(size_t type, Batch& b, size_t n, Buffer rows, uint32_t k, Buffer nows);
     Clock firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows, double t1, LateKills& late,
                               std::vector<std::pair<Buffer, Buffer>>& columns);
     // A batch's emissions the memory decides (emitInMemory): its bursts at creation, its
@@ -189,10 +190,18 @@ private:
 // the staging columns are the batch's parameters as they are).
 struct Creation::Batch {
     explicit Batch(Memory& m)
-        : columns(m), initParents(m), updateParents(m), exportsParents(m), renderParents(m), burstParents(m) {}
+        : columns(m), initParents(m), updateParents(m), exportsParents(m), renderParents(m), burstParents(m),
+          subStepAges(m) {}
     // (burstParents: each burst site's parent values its own, where the memory decides the
     // bursts — their spawn launches read them from the columns after the batch.)
     Scratch columns, initParents, updateParents, exportsParents, renderParents, burstParents;
+    // A new emitter's sub-steps whose spawn arguments read an ancestor's age: per sub-step
+    // and site, the site's spawn table with those ages as of each object's own sub-step end
+    // (Creation::agesAtSubStep; empty: the pool's table), and the columns they are in —
+    // the launches run after the batch, each sub-step's with its own.
+    Scratch subStepAges;
+    std::vector<std::vector<std::vector<Buffer>>> subStepTables;
+    const std::vector<std::vector<Buffer>>* inUpdateTables = nullptr;  // the sub-step's now emitting
     ColumnLayout initLayout;
     std::vector<Buffer> initTable, updateTable, exportsTable, renderTable;
     std::vector<std::vector<Buffer>> burstTables;  // per emit site: the state at creation, for bursts

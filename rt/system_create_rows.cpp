@@ -25,6 +25,19 @@
 
 namespace psys::rt::detail {
 
+namespace {
+
+// Whether a spawn kernel of the type reads an ancestor's age (a new emitter's sub-steps
+// then gather it at each one's own clock: Creation::agesAtSubStep).
+bool readsAncestorAge(const TypeInfo& info) {
+    for (const ColumnLayout& layout : info.spawnLayout)
+        for (const ColumnLayout::ParentColumn& p : layout.parentColumns)
+            if (p.op == ir::Op::ParentAge) return true;
+    return false;
+}
+
+}  // namespace
+
 // The batch's tables (its init, update and exports; each burst site's, with parent
 // columns of its own), a fold over nothing in their fold columns.
 void Creation::bindInMemory(size_t type, Batch& b, size_t n) {
@@ -148,7 +161,7 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     }
     if (bursts) burstTablesAtCreation(type, b, n);
     if (info.updateEmits) {  // (their spawn launches read the pool's columns at its rows: the parents' at t1 —
-                             // in sub-steps too, where they read no age: decideRows)
+                             // in sub-steps too, but for an ancestor's age: agesAtSubStep)
         std::vector<size_t> sites;
         for (size_t site = 0; site < o.emits.size(); ++site)
             if (o.emits[site].inUpdate()) sites.push_back(site);
@@ -238,6 +251,46 @@ void Creation::countCappedSubSteps(size_t type, Batch& b, size_t n, double t1) {
     s_.typeStats[type].cappedSubSteps += count;
 }
 
+// Sub-step k of a new emitter batch (its ends `nows`, by batch row): for each site whose
+// spawn arguments read an ancestor's age, the site's spawn table with those ages as of
+// each object's own sub-step end — gathered through the batch's parents
+// (State::gatherThrough), put at the objects' pool rows (`rows`, where a launch from
+// records reads its emitters) in columns of this sub-step's own — as the host clocks each
+// object's emissions (Creation::killOrEmit). What else the arguments read of an ancestor
+// is the same at every sub-step, gathered once (State::gatherSpawnParents).
+void Creation::agesAtSubStep(size_t type, Batch& b, size_t n, Buffer rows, uint32_t k, Buffer nows) {
+    const TypeInfo& info = s_.types[type];
+    const size_t sites = info.spawnLayout.size(), end = b.first + n;
+    std::vector<std::vector<Buffer>>& tables = b.subStepTables[k - 1];
+    tables.assign(sites, {});
+    auto onlyAges = [](const ColumnLayout& layout) {
+        ColumnLayout ages = layout;
+        std::erase_if(ages.parentColumns, [](const ColumnLayout::ParentColumn& p) { return p.op != ir::Op::ParentAge; });
+        return ages;
+    };
+    size_t perSubStep = 0;  // (two columns an age a site: by batch row, by pool row)
+    for (const ColumnLayout& layout : info.spawnLayout) perSubStep += 2 * onlyAges(layout).parentColumns.size();
+    size_t used = (k - 1) * perSubStep;
+    for (size_t site = 0; site < sites; ++site) {
+        const ColumnLayout& layout = info.spawnLayout[site];
+        const ColumnLayout ages = onlyAges(layout);
+        if (ages.parentColumns.empty() || !s_.pools[type].object().emits[site].inUpdate()) continue;
+        std::vector<Buffer> gathered(static_cast<size_t>(layout.total));
+        tables[site] = s_.work[type].spawnTables[site];
+        for (const ColumnLayout::ParentColumn& p : ages.parentColumns) {
+            auto at = static_cast<size_t>(p.offset);
+            gathered[at] = b.subStepAges.at(used++, Elem::F32, end);
+            tables[site][at] = b.subStepAges.at(used++, Elem::F32, s_.pools[type].rows());
+        }
+        s_.gatherThrough(type, ages, gathered, b.columns.at(kParents, Elem::U32, end), b.first, b.first, end, 0, nows);
+        std::vector<std::pair<Buffer, Buffer>> moved;
+        for (const ColumnLayout::ParentColumn& p : ages.parentColumns)
+            moved.push_back({gathered[static_cast<size_t>(p.offset)], tables[site][static_cast<size_t>(p.offset)]});
+        s_.memory.scatter(moved, b.first, rows, 0, n);
+    }
+    b.inUpdateTables = &tables;
+}
+
 // The batch's first update to t1, its kills late (the last sub-step's into `late`); in
 // sub-steps no longer than @step where an object's span may take more than one, each
 // object through its own (Memory::subStepClocks), the k-th of each at once, what one
@@ -285,6 +338,8 @@ Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows
     // (A type children read: each sub-step's deaths at each object's own clock, now − length.)
     Buffer length = emits || info.read ? b.columns.at(kLength, Elem::F64, end) : Buffer{};
     Buffer taken;  // (the earlier sub-steps' kills, gathered: Ledger::takeOut)
+    const bool agedArguments = emits && readsAncestorAge(info);
+    if (agedArguments && b.subStepTables.size() < most) b.subStepTables.resize(most);
     for (uint32_t k = 1; k <= most; ++k) {
         memory.subStepClocks(table[ColumnLayout::kCreated], mask, step, table[ColumnLayout::kNow],
                              table[ColumnLayout::kDt], length, b.first, n, k, most, t1, info.stepLimit);
@@ -294,6 +349,7 @@ Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows
         if (emits) {
             nows = subStepNows_.at(k - 1, Elem::F64, end);
             memory.copy(table[ColumnLayout::kNow], b.first, nows, b.first, n);
+            if (agedArguments) agesAtSubStep(type, b, n, rows, k, nows);
         }
         std::optional<LateKills> each;
         if (info.late && k < most) each = lateKills();
@@ -307,6 +363,7 @@ Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows
             emitFromBatch(type, b, n, rows, t1,
                           {bursts && k == 1, emits, k == 1, step, nows, emits ? length : Buffer{}},
                           columns);
+        b.inUpdateTables = nullptr;
         if (!each) continue;
         if (!taken.valid()) {
             taken = pool.scratchRows(n + 1);
@@ -420,6 +477,9 @@ void Creation::queueFromRecords(size_t type, const RateSites& in, std::span<cons
             const bool atCreation = in.sites[k].kind == Kind::AtCreation;
             Emitter emitter{type, 0, {}, 0, t1, false};
             if (atCreation) emitter = {type, 0, batch->burstTables[emitSite[k]], 0, t1, true};
+            // (A new emitter's sub-step whose arguments read an ancestor's age: its own table.)
+            else if (batch && batch->inUpdateTables && !(*batch->inUpdateTables)[emitSite[k]].empty())
+                emitter.columns = (*batch->inUpdateTables)[emitSite[k]];
             ChildrenLaunch* launch = queueSpawn(emitter, static_cast<int>(emitSite[k]), 0, siteKept, base, true);
             if (!launch) continue;
             launch->records = runs;

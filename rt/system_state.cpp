@@ -159,23 +159,14 @@ ChildShapes childShapes(const std::vector<TypeInfo>& types, const ir::Module& mo
     return c;
 }
 
-// Whether an emitter's arguments at site `s` can be gathered before the operation
-// (State::gatherSpawnParents: its ancestors' values and its own folds, for every row) —
-// all of them but an ancestor's age under @step: a new emitter's sub-steps emit at clocks
-// of their own, their launches after the batch, and what else they read of an ancestor
-// is the same at each.
-bool argumentsGathered(const TypeInfo& info, size_t s) {
-    const std::vector<ColumnLayout::ParentColumn>& reads = info.spawnLayout[s].parentColumns;
-    auto age = [](const ColumnLayout::ParentColumn& p) { return p.op == ir::Op::ParentAge; };
-    return info.stepLimit == 0 || std::none_of(reads.begin(), reads.end(), age);
-}
-
 // The emitters whose emissions the memory decides (Memory::emitAtRate), and the children
 // whose rows it keeps beside their parents — where rows are kept in the memory (a
 // device's backend asks for it, any backend with Rows::InMemory) and objects are created
 // in batches. Every site of such an emitter emits — at a rate, in a burst at creation, on
-// an edge or on death — into a type whose rows are the memory's, with arguments that can
-// be gathered before the operation (argumentsGathered), so a step's
+// an edge or on death — into a type whose rows are the memory's, its arguments' reads
+// of its ancestors and its own folds gathered into columns before the operation
+// (State::gatherSpawnParents; a new emitter's ancestors' ages at each of its own
+// sub-steps: Creation::agesAtSubStep), so a step's
 // emissions are one operation over the rows, and the objects they create batches of
 // those types, whose bursts at creation and first updates emit by the same operation.
 // Sites into one type share its room, their objects one batch in the host's order
@@ -229,7 +220,7 @@ void decideEmitters(std::vector<TypeInfo>& types, const ir::Module& module, cons
         for (size_t s = 0; emitter && s < module.objects[t].emits.size(); ++s) {
             size_t target = info.emitTarget[s];
             bool itsChild = child(target) && types[target].parentType == static_cast<int>(t);
-            emitter = (inMemoryOr(target) || itsChild) && argumentsGathered(info, s);
+            emitter = inMemoryOr(target) || itsChild;
         }
         return emitter;
     };
