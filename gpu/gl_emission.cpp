@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "gpu/gl_context.h"
 #include "gpu/gl_memory.h"
 #include "gpu/gl_programs.h"
@@ -291,6 +293,19 @@ void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs) {
     if (n == 0 || std::all_of(used.begin(), used.end(), [&](Buffer b) { return allOnHost({b}); })) {
         overwriteOnHost(runs);
         return rt::Memory::emitAtRate(in, runs);
+    }
+    // (Its records are one storage block: past the GL's largest, the GL would drop the
+    // records beyond it, and the objects they ask for, without a word.)
+    if (const size_t bytes = rt::runsWords(n, sites) * 4; bytes > maxBlockBytes) {
+        auto size = [](size_t b) {
+            return b >= (size_t{1} << 20) ? fmt::format("{:.1f} MiB", static_cast<double>(b) / (1 << 20))
+                                          : fmt::format("{} bytes", b);
+        };
+        throw std::runtime_error(fmt::format(
+            "the GLSL backend cannot decide the emissions of {} emitters at {} emit site{} at once: their records "
+            "take {}, past this GL's largest storage block ({}); fewer emitters of the type (or fewer sites) "
+            "fit, as would a GL with larger blocks",
+            n, sites, sites == 1 ? "" : "s", size(bytes), size(maxBlockBytes)));
     }
     flushPending();
     if (!emitRowsProgram_) emitRowsProgram_ = computeProgram(emissionShader(kEmitRows, true), "rate emissions");

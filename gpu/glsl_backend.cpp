@@ -42,6 +42,7 @@ std::unique_ptr<GlslBackend> GlslBackend::create(std::string& error) {
     GLint64 maxBlock = 0;
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBlock);
     b->maxWords_ = static_cast<size_t>(std::min<GLint64>(maxBlock, GLint64{1} << 31)) / 4;
+    b->memory_.maxBlockBytes = static_cast<size_t>(std::max<GLint64>(maxBlock, 0));
     GLint alignment = 0, blocks = 0;
     glGetIntegerv(GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT, &alignment);
     b->storageAlignment_ = static_cast<size_t>(std::max(alignment, 1));
