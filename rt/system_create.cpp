@@ -28,7 +28,7 @@ size_t components(const std::vector<ir::StateSlot>& slots) {
 
 }  // namespace
 
-Creation::Creation(State& state) : s_(state), emissions_(state.memory), runs_(state.memory), subStepNows_(state.memory) {
+Creation::Creation(State& state) : s_(state), emissions_(state.memory), runs_(state.memory) {
     queued_.assign(s_.pools.size(), 0);
     pending_.assign(s_.pools.size(), 0);
     staging_.resize(s_.pools.size());
@@ -385,6 +385,8 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
             if (k == 1) queueBursts(type, b, r);
             if (stepMask[first + r]) killOrEmit(type, b, r, b.spans[r] / b.subSteps[r], now[first + r]);
         });
+        // (What it emitted read its values as of this sub-step: before the next moves it on.)
+        if (info.updateEmits && k < most) runSpawns();
     }
 }
 

@@ -124,9 +124,11 @@ private:
     Buffer identifyInMemory(Batch& b, size_t n, size_t kept);
     void burstTablesAtCreation(size_t type, Batch& b, size_t n);
     void countCappedSubSteps(size_t type, Batch& b, size_t n, double t1);
-    void agesAtSubStep(size_t type, Batch& b, size_t n, Buffer rows, uint32_t k, Buffer nows);
-    Clock firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows, double t1, LateKills& late,
+    void agesAtSubStep(size_t type, Batch& b, size_t n, Buffer rows, Buffer nows);
+    Clock firstUpdateInMemory(size_t type, Batch& b, size_t n, size_t kept, Buffer rows, double t1, LateKills& late,
                               std::vector<std::pair<Buffer, Buffer>>& columns);
+    // The batch's state and exports with the pool's columns they go to, onto `columns`.
+    void valueColumns(size_t type, const Batch& b, std::vector<std::pair<Buffer, Buffer>>& columns) const;
     // A batch's emissions the memory decides (emitInMemory): its bursts at creation, its
     // first update's (`inUpdate`) of the rows `mask` selects — to t1 from each one's
     // creation, or over each one's sub-step (`now`, `length`: RateSites) — the rates'
@@ -182,7 +184,6 @@ private:
     std::vector<float> rate_, count_;
     Scratch emissions_;  // emitInMemory's: a new batch's accumulators by site,
     Scratch runs_;       // and the runs of each call in a drain (runsUsed_ of them so far)
-    Scratch subStepNows_;  // a new emitter batch's sub-step ends, by sub-step (its spawn launches')
     size_t runsUsed_ = 0;
 };
 
@@ -193,14 +194,14 @@ struct Creation::Batch {
         : columns(m), initParents(m), updateParents(m), exportsParents(m), renderParents(m), burstParents(m),
           subStepAges(m) {}
     // (burstParents: each burst site's parent values its own, where the memory decides the
-    // bursts — their spawn launches read them from the columns after the batch.)
+    // bursts — their spawn launches read them from the columns after the operation.)
     Scratch columns, initParents, updateParents, exportsParents, renderParents, burstParents;
-    // A new emitter's sub-steps whose spawn arguments read an ancestor's age: per sub-step
-    // and site, the site's spawn table with those ages as of each object's own sub-step end
+    // A new emitter's sub-steps whose spawn arguments read an ancestor's age: per site, the
+    // site's spawn table with those ages as of each object's own sub-step end
     // (Creation::agesAtSubStep; empty: the pool's table), and the columns they are in —
-    // the launches run after the batch, each sub-step's with its own.
+    // each sub-step's launches run before the next.
     Scratch subStepAges;
-    std::vector<std::vector<std::vector<Buffer>>> subStepTables;
+    std::vector<std::vector<Buffer>> agedTables;
     const std::vector<std::vector<Buffer>>* inUpdateTables = nullptr;  // the sub-step's now emitting
     ColumnLayout initLayout;
     std::vector<Buffer> initTable, updateTable, exportsTable, renderTable;

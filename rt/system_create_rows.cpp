@@ -161,7 +161,8 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     }
     if (bursts) burstTablesAtCreation(type, b, n);
     if (info.updateEmits) {  // (their spawn launches read the pool's columns at its rows: the parents' at t1 —
-                             // in sub-steps too, but for an ancestor's age: agesAtSubStep)
+                             // in sub-steps too, but for an ancestor's age: agesAtSubStep —
+                             // and its own values as of the sub-step: firstUpdateInMemory)
         std::vector<size_t> sites;
         for (size_t site = 0; site < o.emits.size(); ++site)
             if (o.emits[site].inUpdate()) sites.push_back(site);
@@ -169,20 +170,11 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     }
     LateKills late;
     columns.clear();
-    const Clock toEnd = firstUpdateInMemory(type, b, n, rows, t1, late, columns);
+    const Clock toEnd = firstUpdateInMemory(type, b, n, kept, rows, t1, late, columns);
     const bool subSteps = toEnd.now == Clock::Source::PerRow;  // (their kills listed, their exports, each after its own)
     if (info.read && !subSteps) s_.ledger.listNow(late);  // its dead are dead to its children at once
-    for (size_t s = 0; s < o.state.size(); ++s)
-        for (int c = 0; c < o.state[s].type.width; ++c)
-            columns.push_back({table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)],
-                               pool.state.column(s, static_cast<size_t>(c))});
-    if (info.exports) {
-        if (!subSteps) exportSurvivors(type, b, n, mask, toEnd);
-        for (size_t e = 0; e < o.exports.size(); ++e)
-            for (int c = 0; c < o.exports[e].type.width; ++c)
-                columns.push_back({b.exportsTable[static_cast<size_t>(info.exportsLayout.exportOffset[e] + c)],
-                                   pool.exports.column(e, static_cast<size_t>(c))});
-    }
+    if (info.exports && !subSteps) exportSurvivors(type, b, n, mask, toEnd);
+    valueColumns(type, b, columns);
     // Each object's bursts at creation, then its first update's emissions (in sub-steps:
     // firstUpdateInMemory's, each after its sub-step).
     if ((info.updateEmits || bursts) && toEnd.now == Clock::Source::Uniform)
@@ -190,6 +182,21 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     memory.scatter(columns, first, rows, 0, kept);
     if (!info.late) return;
     s_.ledger.defer(std::move(late));
+}
+
+// The batch's state and exports, with the pool's columns they go to.
+void Creation::valueColumns(size_t type, const Batch& b, std::vector<std::pair<Buffer, Buffer>>& columns) const {
+    const TypeInfo& info = s_.types[type];
+    const Pool& pool = s_.pools[type];
+    const ir::Object& o = pool.object();
+    for (size_t s = 0; s < o.state.size(); ++s)
+        for (int c = 0; c < o.state[s].type.width; ++c)
+            columns.push_back({b.updateTable[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)],
+                               pool.state.column(s, static_cast<size_t>(c))});
+    for (size_t e = 0; info.exports && e < o.exports.size(); ++e)
+        for (int c = 0; c < o.exports[e].type.width; ++c)
+            columns.push_back({b.exportsTable[static_cast<size_t>(info.exportsLayout.exportOffset[e] + c)],
+                               pool.exports.column(e, static_cast<size_t>(c))});
 }
 
 // The exports of the rows of `mask` the update just run left alive (of a type that never
@@ -251,26 +258,25 @@ void Creation::countCappedSubSteps(size_t type, Batch& b, size_t n, double t1) {
     s_.typeStats[type].cappedSubSteps += count;
 }
 
-// Sub-step k of a new emitter batch (its ends `nows`, by batch row): for each site whose
+// A sub-step of a new emitter batch (its ends `nows`, by batch row): for each site whose
 // spawn arguments read an ancestor's age, the site's spawn table with those ages as of
 // each object's own sub-step end — gathered through the batch's parents
 // (State::gatherThrough), put at the objects' pool rows (`rows`, where a launch from
-// records reads its emitters) in columns of this sub-step's own — as the host clocks each
-// object's emissions (Creation::killOrEmit). What else the arguments read of an ancestor
-// is the same at every sub-step, gathered once (State::gatherSpawnParents).
-void Creation::agesAtSubStep(size_t type, Batch& b, size_t n, Buffer rows, uint32_t k, Buffer nows) {
+// records reads its emitters) in columns of the batch's own — as the host clocks each
+// object's emissions (Creation::killOrEmit); the sub-step's spawn launches run before the
+// next (firstUpdateInMemory). What else the arguments read of an ancestor is the same at
+// every sub-step, gathered once (State::gatherSpawnParents).
+void Creation::agesAtSubStep(size_t type, Batch& b, size_t n, Buffer rows, Buffer nows) {
     const TypeInfo& info = s_.types[type];
     const size_t sites = info.spawnLayout.size(), end = b.first + n;
-    std::vector<std::vector<Buffer>>& tables = b.subStepTables[k - 1];
+    std::vector<std::vector<Buffer>>& tables = b.agedTables;
     tables.assign(sites, {});
     auto onlyAges = [](const ColumnLayout& layout) {
         ColumnLayout ages = layout;
         std::erase_if(ages.parentColumns, [](const ColumnLayout::ParentColumn& p) { return p.op != ir::Op::ParentAge; });
         return ages;
     };
-    size_t perSubStep = 0;  // (two columns an age a site: by batch row, by pool row)
-    for (const ColumnLayout& layout : info.spawnLayout) perSubStep += 2 * onlyAges(layout).parentColumns.size();
-    size_t used = (k - 1) * perSubStep;
+    size_t used = 0;  // (two columns an age a site: by batch row, by pool row)
     for (size_t site = 0; site < sites; ++site) {
         const ColumnLayout& layout = info.spawnLayout[site];
         const ColumnLayout ages = onlyAges(layout);
@@ -296,8 +302,8 @@ void Creation::agesAtSubStep(size_t type, Batch& b, size_t n, Buffer rows, uint3
 // object through its own (Memory::subStepClocks), the k-th of each at once, what one
 // kills taken out of the masks before the next (Ledger::takeOut) and freed at the step's
 // end. Returns the clock its exports are computed at: each row's last.
-Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows, double t1, LateKills& late,
-                                    std::vector<std::pair<Buffer, Buffer>>& columns) {
+Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, size_t kept, Buffer rows, double t1,
+                                    LateKills& late, std::vector<std::pair<Buffer, Buffer>>& columns) {
     const TypeInfo& info = s_.types[type];
     Pool& pool = s_.pools[type];
     std::vector<Buffer>& table = b.updateTable;
@@ -331,7 +337,8 @@ Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows
     if (capped) countCappedSubSteps(type, b, n, t1);
     const Clock perRow{Clock::Source::PerRow, Clock::Source::PerRow, 0, 0, false};
     // An emitter's: each sub-step's emissions after its update, over the sub-step's own
-    // clock, before what it killed is taken out (its bursts on death are from them); its
+    // clock, before what it killed is taken out (its bursts on death are from them), and
+    // their spawn launches before the next sub-step, reading its values as of this one; its
     // bursts at creation with the first's, each object's just before its own emissions,
     // as the host queues them (Creation::firstUpdate).
     const bool emits = info.updateEmits, bursts = info.bursts && info.init;
@@ -339,18 +346,12 @@ Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows
     Buffer length = emits || info.read ? b.columns.at(kLength, Elem::F64, end) : Buffer{};
     Buffer taken;  // (the earlier sub-steps' kills, gathered: Ledger::takeOut)
     const bool agedArguments = emits && readsAncestorAge(info);
-    if (agedArguments && b.subStepTables.size() < most) b.subStepTables.resize(most);
     for (uint32_t k = 1; k <= most; ++k) {
         memory.subStepClocks(table[ColumnLayout::kCreated], mask, step, table[ColumnLayout::kNow],
                              table[ColumnLayout::kDt], length, b.first, n, k, most, t1, info.stepLimit);
-        // (An emitter's spawn launches, run after the batch, read each sub-step's ends: a
-        // copy of its own. The batch's column keeps each row's last, its exports' clock.)
-        Buffer nows;
-        if (emits) {
-            nows = subStepNows_.at(k - 1, Elem::F64, end);
-            memory.copy(table[ColumnLayout::kNow], b.first, nows, b.first, n);
-            if (agedArguments) agesAtSubStep(type, b, n, rows, k, nows);
-        }
+        // (The batch's column keeps each row's last sub-step end, its exports' clock.)
+        const Buffer nows = emits ? table[ColumnLayout::kNow] : Buffer{};
+        if (agedArguments) agesAtSubStep(type, b, n, rows, nows);
         std::optional<LateKills> each;
         if (info.late && k < most) each = lateKills();
         LateKills* kills = !info.late ? nullptr : k < most ? &*each : &late;
@@ -364,6 +365,12 @@ Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, Buffer rows
                           {bursts && k == 1, emits, k == 1, step, nows, emits ? length : Buffer{}},
                           columns);
         b.inUpdateTables = nullptr;
+        if (emits && k < most) {  // what it emitted reads its values as of this sub-step: before the next moves it on
+            std::vector<std::pair<Buffer, Buffer>> values;
+            valueColumns(type, b, values);
+            memory.scatter(values, b.first, rows, 0, kept);
+            runSpawns();
+        }
         if (!each) continue;
         if (!taken.valid()) {
             taken = pool.scratchRows(n + 1);

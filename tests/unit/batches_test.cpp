@@ -98,3 +98,38 @@ TEST_CASE("a generation's runs are created type by type, in batches as one by on
     CHECK(compareRuns(a, b, 120, bitwise) > 5000);
     CHECK(b.stats("x").dropped > 0);
 }
+
+TEST_CASE("a new emitter in sub-steps emits with its values as of each sub-step, its rows on the host or in the memory") {
+    // Each b is created inside a step of 1/20 s and takes its first update in sub-steps of
+    // 1/200 s, emitting a c every 1/100 s with its x (an integral: a value of its state,
+    // not recomputed from its age). A c's x0 − (b.age − age) is b's age at the end of
+    // the sub-step that emitted it less b's age at the c's creation: in [0, 1/200). Where
+    // the sub-steps' emissions read b's values after the batch, they read the last
+    // sub-step's: up to 1/20 s.
+    std::string text = R"(
+        object src { emit b at 7 per second; }
+        @step(1 / 200)
+        object b {
+            x = integrate(1);
+            emit c(x) at 100 per second;
+            object c(x0: float) {
+                point(vec3(x0 - (b.age - age), 0, 0), white, 1);
+                kill when age > 0.04;
+            }
+        }
+        spawn src;)";
+    for (bool inMemory : {false, true}) {
+        INFO("rows in the memory: " << inMemory);
+        Run run(text, inMemory ? test::rowsInMemory() : rt::SystemOptions{});
+        size_t seen = 0;
+        for (int f = 0; f < 12; ++f) {
+            run.steps(1, 1.0 / 20);
+            for (const rt::RenderPoint& p : run.points("b.c")) {
+                CHECK(p.position[0] > -1e-5f);
+                CHECK(p.position[0] < 1.0f / 200 + 1e-5f);
+                ++seen;
+            }
+        }
+        CHECK(seen > 20);
+    }
+}

@@ -59,7 +59,11 @@ struct Run {
     void steps(int n, double dt) {
         for (int i = 0; i < n; ++i) REQUIRE_FALSE(system->step(dt).has_value());
     }
-    size_t type(const std::string& name) const { return static_cast<size_t>(system->typeIndex(name)); }
+    size_t type(const std::string& name) const {
+        int index = system->typeIndex(name);
+        REQUIRE_MESSAGE(index >= 0, "no type " << name << " (a nested type's name is its path: a.b)");
+        return static_cast<size_t>(index);
+    }
     std::vector<rt::RenderPoint> points(const std::string& name) { return system->points(type(name)); }
     rt::TypeStats stats(const std::string& name) const { return system->stats().types[type(name)]; }
 };
