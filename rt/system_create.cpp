@@ -386,7 +386,7 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
             if (stepMask[first + r]) killOrEmit(type, b, r, b.spans[r] / b.subSteps[r], now[first + r]);
         });
         // (What it emitted read its values as of this sub-step: before the next moves it on.)
-        if (info.updateEmits && k < most) runSpawns();
+        if (info.updateEmits && k < most) runSpawns();  // (nothing queued: nothing run)
     }
 }
 

@@ -63,8 +63,8 @@ public:
     // Creates everything queued (and what that queues), each advanced to t1.
     void drain(double t1);
     // Runs the spawn launches queued since the last call, together (Backend::runChildren):
-    // before anything they read changes — the end of a type's emissions, a batch's
-    // creation.
+    // before anything they read changes — the end of a type's emissions (each sub-step's),
+    // a batch's creation, each but the last sub-step of a new emitter batch's first update.
     void runSpawns();
 
 private:

@@ -365,7 +365,8 @@ Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, size_t kept
                           {bursts && k == 1, emits, k == 1, step, nows, emits ? length : Buffer{}},
                           columns);
         b.inUpdateTables = nullptr;
-        if (emits && k < most) {  // what it emitted reads its values as of this sub-step: before the next moves it on
+        if (emits && k < most && !spawns_.empty()) {  // what it emitted reads its values as of this sub-step:
+                                                       // before the next moves it on
             std::vector<std::pair<Buffer, Buffer>> values;
             valueColumns(type, b, values);
             memory.scatter(values, b.first, rows, 0, kept);
@@ -497,7 +498,9 @@ void Creation::queueFromRecords(size_t type, const RateSites& in, std::span<cons
             launch->rows = atCreation ? Buffer{} : rows;
             launch->rowsFirst = atCreation ? batch->first : 0;
             launch->nowFromRecords = atCreation;
-            if (!atCreation && in.now.valid()) {  // (each emitter's sub-step end: a buffer of this sub-step's)
+            if (!atCreation && in.now.valid()) {  // (each emitter's sub-step end: the batch's column, which
+                                                  // holds it until the launch runs, before the next sub-step
+                                                  // or, after the last, at the next batch: firstUpdateInMemory)
                 launch->nows = in.now;
                 launch->nowsFirst = in.first;
             }

@@ -121,6 +121,7 @@ TEST_CASE("a new emitter in sub-steps emits with its values as of each sub-step,
     for (bool inMemory : {false, true}) {
         INFO("rows in the memory: " << inMemory);
         Run run(text, inMemory ? test::rowsInMemory() : rt::SystemOptions{});
+        CHECK(run.system->pool(run.type("b")).rowsInMemory() == inMemory);
         size_t seen = 0;
         for (int f = 0; f < 12; ++f) {
             run.steps(1, 1.0 / 20);
