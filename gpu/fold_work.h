@@ -18,13 +18,14 @@ struct FoldWork {
     enum { kSelf, kOther, kBucketOf, kCounts, kStart, kGroups, kCursor, kSorted, kPlaced, kResults, kWords, kBuffers };
     unsigned buffers[kBuffers] = {};
     size_t capacity[kBuffers] = {};
-    unsigned params = 0;
+    unsigned params = 0, upload = 0;  // (upload: what the host sends into kWords goes through it: sendThrough)
     ~FoldWork() {
         for (unsigned p : {count, scan, scatter, sort, place})
             if (p) glDeleteProgram(p);
         for (auto& [k, f] : folds) glDeleteProgram(f.first);
         glDeleteBuffers(kBuffers, buffers);
         if (params) glDeleteBuffers(1, &params);
+        if (upload) glDeleteBuffers(1, &upload);
     }
 };
 

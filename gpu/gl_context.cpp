@@ -105,6 +105,13 @@ void bindParams(unsigned& buffer, std::initializer_list<uint32_t> values) {
     glBindBufferBase(GL_UNIFORM_BUFFER, 1, buffer);
 }
 
+void sendThrough(unsigned& staging, unsigned target, size_t offset, size_t bytes, const void* data) {
+    if (bytes == 0) return;
+    if (!staging) glCreateBuffers(1, &staging);
+    glNamedBufferData(staging, static_cast<GLsizeiptr>(bytes), data, GL_STREAM_COPY);  // a new store
+    glCopyNamedBufferSubData(staging, target, 0, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes));
+}
+
 std::string rendererName() {
     auto text = [](GLenum e) {
         const auto* s = reinterpret_cast<const char*>(glGetString(e));

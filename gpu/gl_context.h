@@ -69,6 +69,14 @@ inline constexpr const char* kParamsBlock =
 // binds it as the Params block.
 void bindParams(unsigned& buffer, std::initializer_list<uint32_t> values);
 
+// Writes `bytes` of `data` into `target` at `offset` through a new store of `staging`
+// (created on first use: the caller owns it) and a copy on the GPU, not with
+// glNamedBufferSubData into `target`: a buffer earlier commands may still use is never
+// written by the host. The GL orders such a write after them; zink over lavapipe, with two
+// backends' commands interleaved in one context, gave other values now and then where the
+// host wrote launch words, counts and columns so (docs/gpu.md, "A second GL").
+void sendThrough(unsigned& staging, unsigned target, size_t offset, size_t bytes, const void* data);
+
 // "llvmpipe (LLVM 15.0.6, 256 bits), OpenGL 4.5 (Core Profile) Mesa 22.3.6", …
 std::string rendererName();
 

@@ -279,7 +279,7 @@ bool GlslBackend::fold(const rt::FoldLaunch& l) {
     for (size_t e = 0; e < l.externCount; ++e)
         for (int c = 0; c < 4; ++c) words.push_back(std::bit_cast<uint32_t>(l.externs[e].f[static_cast<size_t>(c)]));
     ensure(w.buffers[FoldWork::kWords], w.capacity[FoldWork::kWords], words.size());
-    glNamedBufferSubData(w.buffers[FoldWork::kWords], 0, static_cast<GLsizeiptr>(words.size() * 4), words.data());
+    sendThrough(w.upload, w.buffers[FoldWork::kWords], 0, words.size() * 4, words.data());
     memory_.transferred += words.size() * 4;
     afterWrite(Write::Upload, kStorageBlock);
     ensure(w.buffers[FoldWork::kResults], w.capacity[FoldWork::kResults],

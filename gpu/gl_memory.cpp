@@ -133,6 +133,7 @@ GlMemory::~GlMemory() {
     if (rowsBuffer_) glDeleteBuffers(1, &rowsBuffer_);
     if (paramsBuffer_) glDeleteBuffers(1, &paramsBuffer_);
     if (pendingBuffer_) glDeleteBuffers(1, &pendingBuffer_);
+    if (uploadBuffer_) glDeleteBuffers(1, &uploadBuffer_);
     if (boxBuffer_) glDeleteBuffers(1, &boxBuffer_);
     if (metaBuffer_) glDeleteBuffers(1, &metaBuffer_);
 }
@@ -266,8 +267,7 @@ void GlMemory::uploadRows(Column& c, size_t first, size_t count) const {
     PassTimer::Scope timed(timer, "upload", count);
     std::vector<uint32_t> staging(count * w);
     toWords(c.hostCopy.data() + first * rt::elemSize(c.elem), c.elem, count, staging.data());
-    glNamedBufferSubData(c.gl, static_cast<GLintptr>(first * w * 4), static_cast<GLsizeiptr>(staging.size() * 4),
-                         staging.data());
+    sendThrough(uploadBuffer_, c.gl, first * w * 4, staging.size() * 4, staging.data());
     afterWrite(Write::Upload, kColumnReaders);
     transferred += staging.size() * 4;
 }
@@ -301,9 +301,7 @@ void GlMemory::write(Buffer b, size_t first, size_t count, const void* in) {
     size_t w = wordsPerRow(c.elem);
     std::vector<uint32_t> words(count * w);
     toWords(in, c.elem, count, words.data());
-    if (count)
-        glNamedBufferSubData(c.gl, static_cast<GLintptr>(first * w * 4), static_cast<GLsizeiptr>(words.size() * 4),
-                             words.data());
+    sendThrough(uploadBuffer_, c.gl, first * w * 4, words.size() * 4, words.data());
     afterWrite(Write::Upload, kColumnReaders);
     transferred += words.size() * 4;
 }

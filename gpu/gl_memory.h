@@ -175,6 +175,7 @@ private:
     static constexpr size_t kPendingScatter = 64, kPendingFlush = 65536;
     mutable unsigned scatterProgram_ = 0, gatherProgram_ = 0, rowsBuffer_ = 0, paramsBuffer_ = 0, pendingBuffer_ = 0,
                      scatterColumnsProgram_ = 0;
+    mutable unsigned uploadBuffer_ = 0;  // what the host sends into a column goes through it (sendThrough)
     // gpu/gl_rows.cpp: its programs (made on first use) and the runs' buffer.
     unsigned allocateProgram_ = 0, releaseProgram_ = 0, pushedProgram_ = 0, freshProgram_ = 0, identifyProgram_ = 0, runsBuffer_ = 0;
     unsigned bound(rt::Buffer b);  // deviceBuffer, for a column the dispatch writes

@@ -85,8 +85,8 @@ GlslBackend::~GlslBackend() {
     fold_.reset();  // (its GL objects, while the context is current)
     for (auto& [ticket, late] : late_) fetch(*late);  // its fence deleted
     glDeleteTextures(static_cast<GLsizei>(textures_.size()), textures_.data());
-    GLuint buffers[] = {words_, counts_, block_, readback_, params_};
-    glDeleteBuffers(5, buffers);
+    GLuint buffers[] = {words_, counts_, block_, readback_, params_, upload_};
+    glDeleteBuffers(6, buffers);
     timer_.release();
 }
 
@@ -99,8 +99,8 @@ void GlslBackend::ensureWords(size_t words) {
 
 void GlslBackend::dispatch(Program& program, const std::vector<uint32_t>& block, size_t count, const std::string& pass,
                            std::span<const BlockFill> fill) {
-    uint32_t zero[4] = {0, 0, 0, 0};
-    if (program.counts) glNamedBufferSubData(counts_, 0, sizeof zero, zero);
+    uint32_t zero = 0;
+    if (program.counts) glClearNamedBufferSubData(counts_, GL_R32UI, 0, 16, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     glNamedBufferData(block_, static_cast<GLsizeiptr>(block.size() * 4), block.data(), GL_STREAM_DRAW);
     afterWrite(Write::Upload, kStorageBlock | kUniformBlock);
     for (const BlockFill& f : fill)
@@ -309,7 +309,7 @@ rt::RowsResult GlslBackend::runRows(const rt::RowsLaunch& launch, Program& p, si
         }
         staging_.resize(n * w);
         toWords(static_cast<const char*>(memory_.view(s.buffer)) + begin * rt::elemSize(e), e, n, staging_.data());
-        glNamedBufferSubData(words_, static_cast<GLintptr>(s.word * 4), static_cast<GLsizeiptr>(n * w * 4), staging_.data());
+        sendThrough(upload_, words_, s.word * 4, n * w * 4, staging_.data());
         afterWrite(Write::Upload, kStorageBlock);
         memory_.transferred += n * w * 4;
     }

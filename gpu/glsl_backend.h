@@ -196,6 +196,7 @@ private:
     mutable std::mutex programsMutex_;
     size_t sharedPrograms_ = 0;
     unsigned words_ = 0, counts_ = 0, block_ = 0, readback_ = 0, params_ = 0;
+    unsigned upload_ = 0;  // what the host sends into words_ goes through it (sendThrough)
     std::vector<uint32_t> readCopy_;  // readRegion's words
     size_t readbackWords_ = 0;
     size_t wordsCapacity_ = 0;

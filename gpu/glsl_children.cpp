@@ -327,7 +327,7 @@ size_t GlslBackend::sendBlocks(const Program& p, std::span<const rt::ChildrenLau
     ensureWords(extra);
     size_t at = 0;
     for (auto [word, words] : runs) {
-        glNamedBufferSubData(words_, static_cast<GLintptr>(word * 4), static_cast<GLsizeiptr>(words * 4), sent.data() + at);
+        sendThrough(upload_, words_, word * 4, words * 4, sent.data() + at);
         at += words;
     }
     memory_.transferred += sent.size() * 4;
