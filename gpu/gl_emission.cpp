@@ -6,8 +6,10 @@
 // clamped), each site's places among its own, the ids of the kept in row order, sites in
 // order (prefix sums of the kept); the totals after the records. Counts past 2³² are two
 // words (GLSL 4.50 has no 64-bit integers): what a row asks for is at most kMaxCount, a
-// sum saturates. The differential test (tests/gpu/emission_test.cpp) holds this to the
-// host's rule.
+// sum saturates. More rows than one storage block's records (or columns) hold go as
+// windows (rt::Memory::emissionWindow), each scan going on from the totals of the one
+// before, on the GPU: nothing waits between them. The differential test
+// (tests/gpu/emission_test.cpp) holds this to the host's rule.
 #include <epoxy/gl.h>
 
 #include <algorithm>
@@ -15,8 +17,6 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <fmt/format.h>
 
 #include "gpu/gl_context.h"
 #include "gpu/gl_memory.h"
@@ -33,7 +33,7 @@ namespace {
 // flags, 8 creation times, 16 fresh accumulators, 32 a burst at t1, 64 a burst at each
 // row's creation time, 128 each row's end and length of its update; the site from bit
 // 8: its record at meta's rt::RecordLayout), the shared rate and count, dt, t1; the rows
-// from meta[3] on in the columns.
+// from meta[3] on in the columns (each bound from the window's aligned first row).
 // The rule's operations are `precise` and in the host's order: the same doubles.
 const char* kEmitRows = R"(
 layout(std430, binding = 0) readonly buffer Mask { uint mask[]; };
@@ -133,12 +133,16 @@ void main() {
 // adds), then each record's place and kept; per site, the same over its records' kept
 // for their places among the site's; then over the chunks' kept for the ids (rows in
 // order, a row's sites in order). `meta`: rows, sites, next id, the first row, then per
-// site: its group's room, its group, its first record and stride (rt::RecordLayout). The
-// totals from word rows · sites · RUN_WORDS of the runs.
+// site: its group's room, its group, its first record and stride (rt::RecordLayout), then,
+// only where a window goes before, where its totals are in `carry`: what its groups asked
+// before these rows (their places start from it, less what it kept: a window's places are
+// its own), the ids it took, its totals added to these. The totals from word
+// rows · sites · RUN_WORDS of the runs.
 const char* kEmitScan = R"(
 layout(local_size_x = 256) in;
 layout(std430, binding = 0) readonly buffer Meta { uint meta[]; };
 layout(std430, binding = 6) buffer Runs { uint runs[]; };
+layout(std430, binding = 7) readonly buffer Carry { uint carry[]; };
 shared uvec2 partial[256];
 shared uint keptBefore[256];
 shared uvec2 counted[256];  // invalid, clamped
@@ -154,6 +158,9 @@ uint atMost(uvec2 a, uint room) { return a.y != 0u ? room : min(a.x, room); }
 uint room(uint s) { return meta[4u + 4u * s]; }
 uint group(uint s) { return meta[5u + 4u * s]; }
 uint record(uint s, uint r) { return (meta[6u + 4u * s] + r * meta[7u + 4u * s]) * RUN_WORDS; }
+// A total of the windows before (rt::kTotals…; 0 for the first).
+uint carried(uint k) { uint c = 4u + 4u * meta[1]; return uint(meta.length()) > c ? carry[meta[c] + k] : 0u; }
+uvec2 askedBefore(uint s) { return uvec2(carried(4u + 3u * s), carried(5u + 3u * s)); }
 // An exclusive scan of partial[] in place, by invocation 0, which gets the sum back.
 uvec2 scanPartial(uint l) {
     uvec2 before = uvec2(0u);
@@ -182,6 +189,7 @@ void main() {
         uvec2 all = scanPartial(l);
         if (l == 0u) {
             uint t = totals + 3u + 3u * s;
+            all = add64(all, askedBefore(s));
             runs[t + 1u] = all.x;
             runs[t + 2u] = all.y;
         }
@@ -192,17 +200,21 @@ void main() {
         if (group(g) != g) continue;  // (uniform: every invocation skips it)
         uint stride = meta[7u + 4u * g], first = record(g, 0u) + begin * stride * RUN_WORDS;
         uint last = record(g, 0u) + end * stride * RUN_WORDS, space = room(g);
+        uvec2 start = uvec2(0u);  // what the group asked in the windows before
+        for (uint s = g; s < sites; ++s)
+            if (group(s) == g) start = add64(start, askedBefore(s));
+        uint from = atMost(start, space);
         uvec2 sum = uvec2(0u);
         for (uint w = first; w < last; w += RUN_WORDS) sum = add64(sum, uvec2(runs[w], runs[w + 1u]));
         partial[l] = sum;
         barrier();
         scanPartial(l);
         barrier();
-        uvec2 asked = partial[l];
+        uvec2 asked = add64(start, partial[l]);
         for (uint w = first; w < last; w += RUN_WORDS) {
             uint place = atMost(asked, space);
             asked = add64(asked, uvec2(runs[w], runs[w + 1u]));
-            runs[w] = place;
+            runs[w] = place - from;
             runs[w + 1u] = atMost(asked, space) - place;
         }
         barrier();
@@ -222,7 +234,7 @@ void main() {
                 keptBefore[k] = before;
                 before = next;
             }
-            runs[totals + 3u + 3u * s] = before;
+            runs[totals + 3u + 3u * s] = before + carried(3u + 3u * s);
         }
         barrier();
         uint place = keptBefore[l];
@@ -239,18 +251,18 @@ void main() {
     if (l == 0u) {
         uvec2 all = uvec2(0u);
         for (uint k = 0u; k < 256u; ++k) all += counted[k];
-        runs[totals] = all.x;
-        runs[totals + 1u] = all.y;
+        runs[totals] = all.x + carried(0u);
+        runs[totals + 1u] = all.y + carried(1u);
         uint before = 0u;
         for (uint k = 0u; k < 256u; ++k) {
             uint next = before + keptBefore[k];
             keptBefore[k] = before;
             before = next;
         }
-        runs[totals + 2u] = before;
+        runs[totals + 2u] = before + carried(2u);
     }
     barrier();
-    uint id = meta[2] + keptBefore[l];
+    uint id = meta[2] + carried(2u) + keptBefore[l];
     for (uint r = begin; r < end; ++r)
         for (uint s = 0u; s < sites; ++s) {
             uint w = record(s, r);
@@ -294,49 +306,48 @@ void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs) {
         overwriteOnHost(runs);
         return rt::Memory::emitAtRate(in, runs);
     }
-    // (Its records are one storage block: past the GL's largest, the GL would drop the
-    // records beyond it, and the objects they ask for, without a word.)
-    if (const size_t bytes = rt::runsWords(n, sites) * 4; bytes > maxBlockBytes) {
-        auto size = [](size_t b) {
-            return b >= (size_t{1} << 20) ? fmt::format("{:.1f} MiB", static_cast<double>(b) / (1 << 20))
-                                          : fmt::format("{} bytes", b);
-        };
-        throw std::runtime_error(fmt::format(
-            "the GLSL backend cannot decide the emissions of {} emitters at {} emit site{} at once: their records "
-            "take {}, past this GL's largest storage block ({}); fewer emitters of the type (or fewer sites) "
-            "fit, as would a GL with larger blocks",
-            n, sites, sites == 1 ? "" : "s", size(bytes), size(maxBlockBytes)));
-    }
+    if (n > emissionWindow(sites)) throw std::logic_error("an emission operation past one storage block");
     flushPending();
     if (!emitRowsProgram_) emitRowsProgram_ = computeProgram(emissionShader(kEmitRows, true), "rate emissions");
     if (!emitScanProgram_) emitScanProgram_ = computeProgram(emissionShader(kEmitScan, false), "rate emissions' scan");
     PassTimer::Scope timed(timer, "emissions", n * sites);
     unsigned runsGl = overwriteOnDevice(runs);
+    // Each column's rows from a multiple of 64 at or before the window's first (an offset
+    // every GL takes), so that a window binds no more of a column than a block holds.
+    const size_t base = in.first / 64 * 64, end = in.first + n;
     std::vector<uint32_t> meta = {static_cast<uint32_t>(n), static_cast<uint32_t>(sites), in.nextId,
-                                  static_cast<uint32_t>(in.first)};
+                                  static_cast<uint32_t>(in.first - base)};
     const rt::RecordLayout layout(in);
     for (size_t k = 0; k < sites; ++k)
         meta.insert(meta.end(), {in.sites[in.sites[k].group].room, in.sites[k].group, static_cast<uint32_t>(layout.first[k]),
                                  static_cast<uint32_t>(layout.stride[k])});
+    if (in.carry.valid()) meta.push_back(static_cast<uint32_t>(in.carryAt));
     if (!metaBuffer_) glCreateBuffers(1, &metaBuffer_);
     glNamedBufferData(metaBuffer_, static_cast<GLsizeiptr>(meta.size() * 4), meta.data(), GL_STREAM_DRAW);
     afterWrite(Write::Upload, kStorageBlock);
     transferred += meta.size() * 4;
     auto [dt0, dt1] = doubleWords(in.dt);
     auto [t10, t11] = doubleWords(in.t1);
+    // A column's rows [base, end) at `binding` (`written`: the dispatch writes them); the
+    // runs where it has none (a block must be bound).
+    auto bindRows = [&](GLuint binding, Buffer b, bool written = false) {
+        if (!b.valid()) return glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, runsGl);
+        const auto row = static_cast<GLsizeiptr>(wordsPerRow(elem(b)) * 4);
+        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, binding, written ? bound(b) : deviceBuffer(b),
+                          static_cast<GLintptr>(base) * row, static_cast<GLsizeiptr>(end - base) * row);
+    };
     for (size_t k = 0; k < sites; ++k) {
         const rt::RateSites::Site& s = in.sites[k];
-        auto or_ = [&](Buffer b) { return b.valid() ? deviceBuffer(b) : runsGl; };  // (a block must be bound)
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, deviceBuffer(in.mask));
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, or_(in.killed));
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, or_(in.created));
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, or_(s.rate));
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, or_(s.count));
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, s.accumulated.valid() ? bound(s.accumulated) : runsGl);
+        bindRows(0, in.mask);
+        bindRows(1, in.killed);
+        bindRows(2, in.created);
+        bindRows(3, s.rate);
+        bindRows(4, s.count);
+        bindRows(5, s.accumulated, true);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, runsGl);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, or_(in.now));
+        bindRows(7, in.now);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, metaBuffer_);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, or_(in.length));
+        bindRows(9, in.length);
         using Kind = rt::RateSites::Site::Kind;
         uint32_t flags = (s.rate.valid() ? 1u : 0u) | (s.count.valid() ? 2u : 0u) | (in.killed.valid() ? 4u : 0u) |
                          (in.created.valid() ? 8u : 0u) | (in.fresh ? 16u : 0u) | (s.kind == Kind::Burst ? 32u : 0u) |
@@ -348,6 +359,7 @@ void GlMemory::emitAtRate(const rt::RateSites& in, Buffer runs) {
     }
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, metaBuffer_);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, runsGl);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, in.carry.valid() ? deviceBuffer(in.carry) : metaBuffer_);
     glUseProgram(emitScanProgram_);
     glDispatchCompute(1, 1, 1);
     ++dispatches;

@@ -136,12 +136,6 @@ public:
     size_t hostRows = 0;
     // Where its work on the GPU is timed, by pass (the backend's; null: nowhere).
     PassTimer* timer = nullptr;
-    // The largest storage block the GL binds, in bytes (GL_MAX_SHADER_STORAGE_BLOCK_SIZE:
-    // 128 MiB on llvmpipe; the backend sets it, a test lowers it). An emission operation
-    // whose records would not fit is refused with an error rather than run: the GL would
-    // drop what lies past the block, and with it objects (emitAtRate).
-    size_t maxBlockBytes = SIZE_MAX;
-
     static size_t wordsPerRow(rt::Elem e) { return e == rt::Elem::F64 ? 2 : 1; }
     // Pairs of columns one scatter dispatch moves (scatter by a row list in a buffer): two
     // storage blocks each, and the list's, of the 16 a compute shader has.

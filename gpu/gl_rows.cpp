@@ -176,7 +176,7 @@ void main() {
     uint stride = param(4u), mapped = param(5u), mapFirst = param(6u), kept = param(7u);
     if (r >= n) return;
     uint j = (runOf(r, base, records) - base) / RUN_WORDS / stride;
-    uint row = mapped != 0u ? map[mapFirst + j] : j;
+    uint row = mapped != 0u ? map[mapFirst + j] : mapFirst + j;
     parents[first + r] = row;
     if (r < kept) atomicAdd(readers[row], 1u);
 }

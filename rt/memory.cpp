@@ -11,6 +11,8 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <fmt/format.h>
+
 #include "rt/clock.h"
 #include "rt/emission.h"
 
@@ -139,7 +141,7 @@ void Memory::parentsFromRecords(Buffer runs, size_t firstRecord, size_t records,
     for (size_t u = 0; u < records; ++u) {
         const uint32_t* w = record + u * kRunWords;
         auto j = static_cast<uint32_t>(u / stride);
-        uint32_t row = through ? through[j] : j;
+        uint32_t row = through ? through[j] : static_cast<uint32_t>(mapFirst + j);
         for (uint32_t k = 0; k < w[1]; ++k) {
             out[w[0] + k] = row;
             if (w[0] + k < kept) ++count[row];
@@ -341,15 +343,34 @@ RecordLayout::RecordLayout(const RateSites& in) : first(in.sites.size()), stride
     }
 }
 
+// A window's rows: its runs buffer within the block, and each column's rows it reads
+// from a block-aligned row at most 63 before its first (GlMemory binds them so: an
+// offset of 64 rows is 256 or 512 bytes, the most any GL asks) within it too.
+size_t Memory::emissionWindow(size_t sites) const {
+    if (maxBlockBytes == SIZE_MAX || sites == 0) return SIZE_MAX;
+    const size_t words = maxBlockBytes / 4, totals = kTotalsSites + kTotalsPerSite * sites;
+    const size_t byRuns = words > totals ? (words - totals) / (sites * kRunWords) : 0;
+    const size_t byColumns = maxBlockBytes / 8 > 63 ? maxBlockBytes / 8 - 63 : 0;
+    const size_t rows = std::min(byRuns, byColumns);
+    if (rows == 0)
+        throw std::runtime_error(fmt::format("a storage block of {} bytes holds no emitter's records at {} sites",
+                                             maxBlockBytes, sites));
+    return rows;
+}
+
 // The rate emissions (and bursts) of emitter rows (Memory::emitAtRate):
 // rt/emission.h's rules row by row, each group's objects kept while its room lasts, the
-// ids in row order.
+// ids in row order; a window goes on from the totals of the one before it.
 void Memory::emitAtRate(const RateSites& in, Buffer runs) {
     if (in.now.valid() != in.length.valid()) throw std::logic_error("rate sites with a row's end but not its length");
     const size_t n = in.rows, sites = in.sites.size();
     auto* record = static_cast<uint32_t*>(host(runs));
     uint32_t* total = record + runsTotalsAt(n, sites);
-    std::fill(total, total + kTotalsSites + kTotalsPerSite * sites, 0u);
+    const size_t totalWords = kTotalsSites + kTotalsPerSite * sites;
+    if (in.carry.valid())
+        read(in.carry, in.carryAt, totalWords, total);
+    else
+        std::fill(total, total + totalWords, 0u);
     if (n == 0) return;
     const size_t f = in.first;
     const auto* mask = static_cast<const uint8_t*>(view(in.mask)) + f;
@@ -370,8 +391,19 @@ void Memory::emitAtRate(const RateSites& in, Buffer runs) {
         site.push_back({s.rate.valid() ? static_cast<const float*>(view(s.rate)) + f : nullptr,
                         s.count.valid() ? static_cast<const float*>(view(s.count)) + f : nullptr,
                         s.accumulated.valid() ? static_cast<double*>(host(s.accumulated)) + f : nullptr});
-    uint64_t invalid = 0, clamped = 0;
-    uint32_t id = in.nextId;
+    // What the windows before asked and kept (none before the first): the totals so far.
+    std::vector<uint64_t> groupStart(sites, 0);  // a group's objects asked before this window
+    for (size_t k = 0; k < sites; ++k) {
+        const uint32_t* t = total + kTotalsSites + kTotalsPerSite * k;
+        site[k].asked = t[1] | uint64_t{t[2]} << 32;
+        addSaturating(site[in.sites[k].group].groupAsked, site[k].asked);
+    }
+    for (size_t k = 0; k < sites; ++k) groupStart[k] = site[k].groupAsked;
+    std::vector<uint32_t> keptBefore(sites);
+    for (size_t k = 0; k < sites; ++k) keptBefore[k] = total[kTotalsSites + kTotalsPerSite * k];
+    uint64_t invalid = total[kTotalsInvalid], clamped = total[kTotalsClamped];
+    const uint32_t idsBefore = total[kTotalsIds];
+    uint32_t id = in.nextId + idsBefore;
     for (size_t r = 0; r < n; ++r)
         for (size_t k = 0; k < sites; ++k) {
             const RateSites::Site& s = in.sites[k];
@@ -398,7 +430,7 @@ void Memory::emitAtRate(const RateSites& in, Buffer runs) {
             auto place = static_cast<uint32_t>(std::min<uint64_t>(before, room));
             auto kept = static_cast<uint32_t>(std::min<uint64_t>(asked, room)) - place;
             uint32_t* w = record + layout.record(k, r) * kRunWords;
-            w[0] = place;
+            w[0] = place - static_cast<uint32_t>(std::min<uint64_t>(groupStart[s.group], room));
             w[1] = kept;
             w[2] = id;
             w[3] = static_cast<uint32_t>(std::min<uint64_t>(e.perEvent, UINT32_MAX));
@@ -413,7 +445,7 @@ void Memory::emitAtRate(const RateSites& in, Buffer runs) {
     total[kTotalsIds] = id - in.nextId;
     for (size_t k = 0; k < sites; ++k) {
         uint32_t* t = total + kTotalsSites + kTotalsPerSite * k;
-        t[0] = site[k].kept;
+        t[0] = keptBefore[k] + site[k].kept;
         t[1] = static_cast<uint32_t>(site[k].asked);
         t[2] = static_cast<uint32_t>(site[k].asked >> 32);
     }

@@ -108,6 +108,14 @@ struct RateSites {
     bool fresh = false;  // the rows' objects were just created: their accumulators start at 0 (not read)
     double dt = 0, t1 = 0;
     uint32_t nextId = 0;  // the first id the emissions take
+    // One window of a larger operation (Memory::emissionWindow): where valid, the runs of
+    // the window before it over the rows just before these (the same sites, rooms and
+    // next id), whose totals start at word `carryAt` (runsTotalsAt of its rows). These rows
+    // go on from them: each group's room as that window left it, the ids after its, and
+    // its totals added to these (so the last window's are the whole operation's); places
+    // (a record's words 0 and kRunSitePlace) start again at 0, among this window's objects.
+    Buffer carry;
+    size_t carryAt = 0;
 };
 
 // Where emitAtRate's records are: a group's records one range, in row order and a row's
@@ -216,7 +224,7 @@ public:
     // Objects r < objects of a batch from a group's records (identifyRecords' arguments;
     // `stride` records a row): parents[first + r] the pool row of its record's emitter —
     // map[mapFirst + j] for the j-th row of the records where `map` is given (an emitter
-    // batch's rows), else j; and each of the first `kept` a reader more of it.
+    // batch's rows), else mapFirst + j; and each of the first `kept` a reader more of it.
     virtual void parentsFromRecords(Buffer runs, size_t firstRecord, size_t records, size_t stride, Buffer map,
                                     size_t mapFirst, size_t objects, size_t kept, Buffer parents, size_t first,
                                     Buffer readers);
@@ -290,6 +298,14 @@ public:
     // buffer). Written here through `host`; a device does it where the rows are (GlMemory:
     // a dispatch a site and one scan, unless the rows are a few on the host).
     virtual void emitAtRate(const RateSites& sites, Buffer runs);
+    // The most rows of `sites` emitters one emitAtRate takes: a larger operation runs as
+    // windows of rows, each carrying on from the one before (RateSites::carry), so that no
+    // runs buffer, nor the rows of a column one window reads, passes maxBlockBytes.
+    size_t emissionWindow(size_t sites) const;
+    // The largest buffer (or range of one) an operation of this memory binds, in bytes: a
+    // device's largest storage block (GL_MAX_SHADER_STORAGE_BLOCK_SIZE: 128 MiB on
+    // llvmpipe; the backend sets it), unlimited on the host, lowered by tests to a few rows.
+    size_t maxBlockBytes = SIZE_MAX;
     // Objects r < objects of a batch from a group's records of `runs` (emitAtRate's,
     // records [firstRecord, firstRecord + records): the objects the record's count says
     // from its first on): created[first + r] and ids[first + r], where the records are.

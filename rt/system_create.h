@@ -87,10 +87,11 @@ private:
         Buffer runs = {};
         size_t record = 0, records = 0;
         // Their emitters (a child type's parents, Memory::parentsFromRecords): `stride`
-        // records a row of emitters; row j the pool row emitters[j] where given (a batch's
-        // rows), else j.
+        // records a row of emitters; row j the pool row emitters[emittersFirst + j] where
+        // given (a batch's rows), else emittersFirst + j (a window's rows: from its first).
         size_t stride = 1;
         Buffer emitters = {};
+        size_t emittersFirst = 0;
     };
     // Per type: the arguments of queued objects, one f32 column per component of the
     // type's parameters (kept or not); an object's row is its place among the type's
@@ -111,9 +112,21 @@ private:
     // created in batches).
     void enqueue(const Run& run);
     void createBatch(size_t type, size_t from, size_t to, double t1);
-    // What emitInMemory's operation asked for, queued from its records (`total`: its totals).
+    // One window of rows of emitInMemory's operation (Memory::emissionWindow): its records
+    // and its totals, read back (those of the windows so far: the last one's are the
+    // operation's).
+    struct Window {
+        Buffer runs;
+        size_t at = 0, rows = 0;  // its rows are the operation's [at, at + rows)
+        std::vector<uint32_t> total;
+        uint32_t kept(size_t site) const { return total[kTotalsSites + kTotalsPerSite * site]; }
+    };
+    // What emitInMemory's operation asked for, queued from its windows' records.
     void queueFromRecords(size_t type, const RateSites& sites, std::span<const size_t> emitSite, const Batch* batch,
-                          Buffer runs, const std::vector<uint32_t>& total, Buffer rows, double t1);
+                          const std::vector<Window>& windows, Buffer rows, double t1);
+    void queueSiteLaunches(size_t type, const RateSites& sites, std::span<const size_t> emitSite, const Batch* batch,
+                           const Window& w, const Window* before, size_t group, size_t base, size_t its, Buffer rows,
+                           double t1);
     // The runs queue_[from, to) (a generation) type by type, in the module's order.
     void groupByType(size_t from, size_t to);  // see rt/system_queue.cpp
     // createBatch for a type whose rows are in the memory (rt/system_create_rows.cpp).

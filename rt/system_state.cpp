@@ -82,7 +82,7 @@ TypeInfo typeInfo(const ir::Module& module, const ir::Object& o) {
 // bursting each other), which are no emitters the memory decides: every object makes the
 // next wave as it is created, so where the memory decides, a wave of one object is a batch
 // of a dozen dispatches and a wait on a GPU — 10,000 waves took 9.2 s for 600 frames,
-// 0.26 s where the host decides (docs/gpu.md). (A chain through bursts on edges or deaths
+// 0.26 s where the host decides (docs/performance.md, "A chain of bursts at creation"). (A chain through bursts on edges or deaths
 // makes such waves only where objects fire them as they are created or in their first
 // update.)
 std::vector<bool> burstChains(const std::vector<TypeInfo>& types, const ir::Module& module) {

@@ -8,6 +8,7 @@
 
 #include "rt/system.h"
 #include "run.h"
+#include "tests/differential.h"
 #include "test_support.h"
 
 using namespace psys;
@@ -133,4 +134,34 @@ TEST_CASE("a new emitter in sub-steps emits with its values as of each sub-step,
         }
         CHECK(seen > 20);
     }
+}
+
+// A memory whose buffers an operation binds are limited (a GPU's storage blocks) decides
+// a large emission operation as windows of rows, each on from the totals of the one
+// before (rt::Memory::emissionWindow, RateSites::carry). On the host the limit is lowered
+// to a dozen emitters a window: the same objects, ids, rows and values as one operation,
+// through bursts on death and a rate, sites sharing a room that runs out part-way, new
+// emitters' bursts at creation, and children reading their emitter.
+TEST_CASE("an emission operation in windows of rows gives the objects of one operation, bit for bit") {
+    const char* text = R"(
+        object drop(v: float) {
+            x = v + integrate(rand() - 0.5);
+            kill when age > 0.2 + 0.1 * rand();
+            on death { emit splash(x) count 2; emit splash(-x) count 1; emit bit count 1; }
+            emit bit at 40 per second;
+            @capacity(900)
+            object bit { point(vec3(drop.x, age, 0), white, 1); kill when age > 0.1; }
+        }
+        @capacity(700)
+        object splash(v: float) { point(vec3(v, age, 0), white, 1); kill when age > 0.1; emit puff count 1; }
+        object puff { point(vec3(age), white, 1); kill when age > 0.05; }
+        trigger rain() { emit drop(rand()) count 400; })";
+    test::Run whole(text, test::rowsInMemory()), windows(text, test::rowsInMemory());
+    windows.backend.memory().maxBlockBytes = 2048;
+    REQUIRE(windows.backend.memory().emissionWindow(4) == 13);
+    const size_t points = test::compareRuns(whole, windows, 20, test::bitwise);
+    CHECK(points > 1000);
+    CHECK(test::sameRows(*whole.system, *windows.system));
+    CHECK(windows.stats("splash").dropped > 0);
+    CHECK(windows.system->pool(windows.type("drop")).rowsInMemory());
 }
