@@ -19,7 +19,7 @@ namespace psys::gpu {
 enum class Write : uint8_t {
     Dispatch,  // a compute shader's stores and atomics (storage blocks)
     Copy,      // glCopyNamedBufferSubData
-    Upload,    // glNamedBufferSubData / glNamedBufferData with data
+    Upload,    // the host's data: glNamedBufferData with data, or a new store and a copy (sendThrough)
     Clear,     // glClearNamedBufferSubData
 };
 

@@ -8,9 +8,6 @@
 #include <new>
 #include <stdexcept>
 
-#include <sys/mman.h>
-#include <unistd.h>
-
 #include <fmt/format.h>
 
 #include "rt/clock.h"
@@ -348,9 +345,11 @@ RecordLayout::RecordLayout(const RateSites& in) : first(in.sites.size()), stride
 // offset of 64 rows is 256 or 512 bytes, the most any GL asks) within it too.
 size_t Memory::emissionWindow(size_t sites) const {
     if (maxBlockBytes == SIZE_MAX || sites == 0) return SIZE_MAX;
-    const size_t words = maxBlockBytes / 4, totals = kTotalsSites + kTotalsPerSite * sites;
+    // (At most 2³¹ bytes: a shader's word indices are 32-bit.)
+    const size_t block = std::min<size_t>(maxBlockBytes, size_t{1} << 31);
+    const size_t words = block / 4, totals = kTotalsSites + kTotalsPerSite * sites;
     const size_t byRuns = words > totals ? (words - totals) / (sites * kRunWords) : 0;
-    const size_t byColumns = maxBlockBytes / 8 > 63 ? maxBlockBytes / 8 - 63 : 0;
+    const size_t byColumns = block / 8 > 63 ? block / 8 - 63 : 0;
     const size_t rows = std::min(byRuns, byColumns);
     if (rows == 0)
         throw std::runtime_error(fmt::format("a storage block of {} bytes holds no emitter's records at {} sites",
@@ -449,159 +448,6 @@ void Memory::emitAtRate(const RateSites& in, Buffer runs) {
         t[1] = static_cast<uint32_t>(site[k].asked);
         t[2] = static_cast<uint32_t>(site[k].asked >> 32);
     }
-}
-
-// One column: a 64-byte aligned array that grows by doubling, so that appending rows one
-// at a time costs amortized O(1). A large column is its own anonymous mapping, grown with
-// mremap: the kernel moves its pages instead of copying them, pages past the rows in use
-// are never touched (so they take no memory), and no second copy exists while it grows —
-// a pool of 10M rows holds what its rows need, not twice that at its peak.
-struct HostMemory::Column {
-    static constexpr size_t kMapped = size_t{1} << 20;  // bytes from which a column is a mapping
-
-    Elem elem;
-    size_t rows = 0, capacity = 0;
-    std::byte* data = nullptr;
-    size_t mappedBytes = 0;  // 0: data is from aligned_alloc
-
-    ~Column() {
-        if (mappedBytes) ::munmap(data, mappedBytes);
-        else std::free(data);
-    }
-    size_t size() const { return elemSize(elem); }
-    void reserve(size_t wanted) {
-        if (wanted <= capacity) return;
-        size_t grown = std::max(wanted, capacity * 2);
-        size_t bytes = (grown * size() + 63) / 64 * 64;
-        if (bytes >= kMapped) {
-            const size_t page = static_cast<size_t>(::sysconf(_SC_PAGESIZE));
-            bytes = (bytes + page - 1) / page * page;
-            void* fresh = mappedBytes ? ::mremap(data, mappedBytes, bytes, MREMAP_MAYMOVE)
-                                      : ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-            if (fresh == MAP_FAILED) throw std::bad_alloc();
-            if (!mappedBytes) {
-                if (data) std::memcpy(fresh, data, rows * size());
-                std::free(data);
-            }
-            data = static_cast<std::byte*>(fresh);
-            mappedBytes = bytes;
-            capacity = bytes / size();
-            return;
-        }
-        auto* fresh = static_cast<std::byte*>(std::aligned_alloc(64, std::max<size_t>(bytes, 64)));
-        if (!fresh) throw std::bad_alloc();
-        if (data) std::memcpy(fresh, data, rows * size());
-        std::free(data);
-        data = fresh;
-        capacity = grown;
-    }
-    void resize(size_t n) {
-        reserve(n);
-        if (n > rows) std::memset(data + rows * size(), 0, (n - rows) * size());
-        rows = n;
-    }
-};
-
-HostMemory::HostMemory() = default;
-HostMemory::~HostMemory() = default;
-
-Buffer HostMemory::create(Elem elem, size_t rows) {
-    auto column = std::make_unique<Column>();
-    column->elem = elem;
-    column->resize(rows);
-    if (!free_.empty()) {
-        uint32_t id = free_.back();
-        free_.pop_back();
-        columns_[id] = std::move(column);
-        return {id};
-    }
-    columns_.push_back(std::move(column));
-    return {static_cast<uint32_t>(columns_.size() - 1)};
-}
-
-void HostMemory::resize(Buffer b, size_t rows) { columns_.at(b.id)->resize(rows); }
-
-void HostMemory::release(Buffer b) {
-    if (!b.valid() || b.id >= columns_.size() || !columns_[b.id]) return;
-    columns_[b.id].reset();
-    free_.push_back(b.id);
-}
-
-size_t HostMemory::rows(Buffer b) const { return columns_.at(b.id)->rows; }
-Elem HostMemory::elem(Buffer b) const { return columns_.at(b.id)->elem; }
-
-void HostMemory::read(Buffer b, size_t first, size_t count, void* out) const {
-    const Column& c = *columns_.at(b.id);
-    if (first + count > c.rows) throw std::out_of_range("HostMemory::read past the end of a buffer");
-    if (count == 0) return;  // an empty buffer has no address
-    std::memcpy(out, c.data + first * c.size(), count * c.size());
-}
-
-void HostMemory::write(Buffer b, size_t first, size_t count, const void* in) {
-    Column& c = *columns_.at(b.id);
-    if (first + count > c.rows) throw std::out_of_range("HostMemory::write past the end of a buffer");
-    if (count == 0) return;
-    std::memcpy(c.data + first * c.size(), in, count * c.size());
-}
-
-void HostMemory::copy(Buffer from, size_t fromFirst, Buffer to, size_t toFirst, size_t count) {
-    Column &f = *columns_.at(from.id), &t = *columns_.at(to.id);
-    if (f.elem != t.elem || fromFirst + count > f.rows || toFirst + count > t.rows)
-        throw std::out_of_range("HostMemory::copy between mismatched buffers");
-    if (count == 0) return;
-    std::memmove(t.data + toFirst * t.size(), f.data + fromFirst * f.size(), count * f.size());
-}
-
-void HostMemory::scatter(Buffer from, size_t fromFirst, Buffer to, std::span<const uint32_t> rows) {
-    Column &f = *columns_.at(from.id), &t = *columns_.at(to.id);
-    if (f.elem != t.elem || fromFirst + rows.size() > f.rows)
-        throw std::out_of_range("HostMemory::scatter between mismatched buffers");
-    for (uint32_t row : rows)
-        if (row != kSkipRow && row >= t.rows) throw std::out_of_range("HostMemory::scatter past the end of a buffer");
-    // Typed moves for the element sizes columns have (a memcpy call per row costs more
-    // than the move).
-    auto move = [&](auto word) {
-        using W = decltype(word);
-        const auto* in = reinterpret_cast<const W*>(f.data) + fromFirst;
-        auto* out = reinterpret_cast<W*>(t.data);
-        for (size_t i = 0; i < rows.size(); ++i)
-            if (rows[i] != kSkipRow) out[rows[i]] = in[i];
-    };
-    switch (f.size()) {
-        case 1: move(uint8_t{}); break;
-        case 4: move(uint32_t{}); break;
-        case 8: move(uint64_t{}); break;
-        default: {
-            size_t n = f.size();
-            for (size_t i = 0; i < rows.size(); ++i)
-                if (rows[i] != kSkipRow) std::memcpy(t.data + rows[i] * n, f.data + (fromFirst + i) * n, n);
-        }
-    }
-}
-
-void HostMemory::gather(Buffer from, Buffer to, size_t toFirst, std::span<const uint32_t> rows) {
-    Column &f = *columns_.at(from.id), &t = *columns_.at(to.id);
-    if (f.elem != t.elem || toFirst + rows.size() > t.rows)
-        throw std::out_of_range("HostMemory::gather between mismatched buffers");
-    size_t n = f.size();
-    for (size_t i = 0; i < rows.size(); ++i) {
-        std::byte* out = t.data + (toFirst + i) * n;
-        if (rows[i] == kSkipRow) {
-            std::memset(out, 0, n);
-            continue;
-        }
-        if (rows[i] >= f.rows) throw std::out_of_range("HostMemory::gather past the end of a buffer");
-        std::memcpy(out, f.data + rows[i] * n, n);
-    }
-}
-
-void* HostMemory::host(Buffer b) { return columns_.at(b.id)->data; }
-
-size_t HostMemory::bytes() const {
-    size_t total = 0;
-    for (const auto& c : columns_)
-        if (c) total += c->capacity * c->size();
-    return total;
 }
 
 }  // namespace psys::rt

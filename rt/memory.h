@@ -299,8 +299,9 @@ public:
     // a dispatch a site and one scan, unless the rows are a few on the host).
     virtual void emitAtRate(const RateSites& sites, Buffer runs);
     // The most rows of `sites` emitters one emitAtRate takes: a larger operation runs as
-    // windows of rows, each carrying on from the one before (RateSites::carry), so that no
-    // runs buffer, nor the rows of a column one window reads, passes maxBlockBytes.
+    // windows of rows, each carrying on from the one before (RateSites::carry), so that
+    // neither the words of a window's runs nor the rows of a column it reads pass
+    // maxBlockBytes (nor 2³¹ bytes).
     size_t emissionWindow(size_t sites) const;
     // The largest buffer (or range of one) an operation of this memory binds, in bytes: a
     // device's largest storage block (GL_MAX_SHADER_STORAGE_BLOCK_SIZE: 128 MiB on

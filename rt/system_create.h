@@ -215,7 +215,7 @@ struct Creation::Batch {
     // each sub-step's launches run before the next.
     Scratch subStepAges;
     std::vector<std::vector<Buffer>> agedTables;
-    const std::vector<std::vector<Buffer>>* inUpdateTables = nullptr;  // the sub-step's now emitting
+    bool inUpdateAged = false;  // the sub-step now emitting reads agedTables
     ColumnLayout initLayout;
     std::vector<Buffer> initTable, updateTable, exportsTable, renderTable;
     std::vector<std::vector<Buffer>> burstTables;  // per emit site: the state at creation, for bursts

@@ -534,10 +534,12 @@ TEST_CASE("emitters the GPU decides: a step moves and waits as much for 2,000 of
 // the objects they asked for — 5 million drops bursting on death made 6,413 of their 5
 // million splashes, without a word. Such an operation goes as windows of rows now, each on
 // from the one before (rt::Memory::emissionWindow); a lowered limit makes windows of a
-// few dozen emitters here, through every use of the records: ids, places at capacity
-// (sites sharing a room), spawn launches' arguments, children reading their emitter.
+// dozen emitters here, through every use of the records: ids, places at capacity (sites
+// sharing a room), spawn launches' arguments, children reading their emitter, bursts at
+// creation, new emitters in sub-steps.
 TEST_CASE("an emission operation past the GL's largest storage block goes as windows: the interpreter's objects") {
     const char* text = R"(
+        @step(1 / 100)
         object drop {
             x = integrate(rand() - 0.5);
             kill when age > 0.2 + 0.1 * rand();
@@ -547,7 +549,8 @@ TEST_CASE("an emission operation past the GL's largest storage block goes as win
             object bit { point(vec3(drop.x, age, 0), white, 1); kill when age > 0.1; }
         }
         @capacity(700)
-        object splash(v: float) { point(vec3(v, age, 0), white, 1); kill when age > 0.1; }
+        object splash(v: float) { point(vec3(v, age, 0), white, 1); kill when age > 0.1; emit puff count 1; }
+        object puff { point(vec3(age), white, 1); kill when age > 0.05; }
         trigger rain(n: float) { emit drop count n; })";
     rt::SystemOptions kept;
     kept.rows = rt::SystemOptions::Rows::InMemory;

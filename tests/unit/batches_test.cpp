@@ -140,10 +140,11 @@ TEST_CASE("a new emitter in sub-steps emits with its values as of each sub-step,
 // a large emission operation as windows of rows, each on from the totals of the one
 // before (rt::Memory::emissionWindow, RateSites::carry). On the host the limit is lowered
 // to a dozen emitters a window: the same objects, ids, rows and values as one operation,
-// through bursts on death and a rate, sites sharing a room that runs out part-way, new
-// emitters' bursts at creation, and children reading their emitter.
+// through bursts on death and a rate, sites sharing a room that runs out part-way, bursts
+// at creation, new emitters in sub-steps, and children reading their emitter.
 TEST_CASE("an emission operation in windows of rows gives the objects of one operation, bit for bit") {
     const char* text = R"(
+        @step(1 / 100)
         object drop(v: float) {
             x = v + integrate(rand() - 0.5);
             kill when age > 0.2 + 0.1 * rand();
