@@ -529,38 +529,21 @@ TEST_CASE("emitters the GPU decides: a step moves and waits as much for 2,000 of
     }
 }
 
-// An emission operation's records are one storage block: past the GL's largest (128 MiB
-// on llvmpipe: 3.7 million emitters at one site) the GL dropped the records beyond it and
-// the objects they asked for — 5 million drops bursting on death made 6,413 of their 5
-// million splashes, without a word. Such an operation goes as windows of rows now, each on
-// from the one before (rt::Memory::emissionWindow); a lowered limit makes windows of a
-// dozen emitters here, through every use of the records: ids, places at capacity (sites
-// sharing a room), spawn launches' arguments, children reading their emitter, bursts at
-// creation, new emitters in sub-steps.
+// An emission operation whose records or columns pass the GL's largest storage block
+// (128 MiB on llvmpipe: 3.7 million emitters at one site; bound whole, the GL drops what
+// lies past it, and with it objects) goes as windows of rows, each on from the one before
+// (rt::Memory::emissionWindow); a lowered limit makes windows of a dozen emitters here,
+// through every use of the records (tests/programs/emissions_in_windows.psys).
 TEST_CASE("an emission operation past the GL's largest storage block goes as windows: the interpreter's objects") {
-    const char* text = R"(
-        @step(1 / 100)
-        object drop {
-            x = integrate(rand() - 0.5);
-            kill when age > 0.2 + 0.1 * rand();
-            on death { emit splash(x) count 2; emit splash(-x) count 1; emit bit count 1; }
-            emit bit at 40 per second;
-            @capacity(900)
-            object bit { point(vec3(drop.x, age, 0), white, 1); kill when age > 0.1; }
-        }
-        @capacity(700)
-        object splash(v: float) { point(vec3(v, age, 0), white, 1); kill when age > 0.1; emit puff count 1; }
-        object puff { point(vec3(age), white, 1); kill when age > 0.05; }
-        trigger rain(n: float) { emit drop count n; })";
+    const std::string text = test::readFile(test::programsDir() + "/emissions_in_windows.psys");
     rt::SystemOptions kept;
     kept.rows = rt::SystemOptions::Rows::InMemory;
     test::Pair pair(text, true, false, kept);
     REQUIRE(pair.gl->pool(static_cast<size_t>(pair.gl->typeIndex("drop"))).rowsInMemory());
     pair.gpu->memory().maxBlockBytes = 2048;  // (4 sites: 13 emitters a window)
     REQUIRE(pair.gpu->memory().emissionWindow(4) == 13);
-    float n = 400;
-    REQUIRE_FALSE(pair.cpu->fire("rain", {&n, 1}));
-    REQUIRE_FALSE(pair.gl->fire("rain", {&n, 1}));
+    REQUIRE_FALSE(pair.cpu->fire("rain", {}));
+    REQUIRE_FALSE(pair.gl->fire("rain", {}));
     for (int f = 0; f < 12; ++f) {
         INFO("frame " << f);
         pair.steps(1, 1.0 / 30);

@@ -139,24 +139,10 @@ TEST_CASE("a new emitter in sub-steps emits with its values as of each sub-step,
 // A memory whose buffers an operation binds are limited (a GPU's storage blocks) decides
 // a large emission operation as windows of rows, each on from the totals of the one
 // before (rt::Memory::emissionWindow, RateSites::carry). On the host the limit is lowered
-// to a dozen emitters a window: the same objects, ids, rows and values as one operation,
-// through bursts on death and a rate, sites sharing a room that runs out part-way, bursts
-// at creation, new emitters in sub-steps, and children reading their emitter.
+// to a dozen emitters a window: the same objects, ids, rows and values as one operation
+// (tests/programs/emissions_in_windows.psys says what it goes through).
 TEST_CASE("an emission operation in windows of rows gives the objects of one operation, bit for bit") {
-    const char* text = R"(
-        @step(1 / 100)
-        object drop(v: float) {
-            x = v + integrate(rand() - 0.5);
-            kill when age > 0.2 + 0.1 * rand();
-            on death { emit splash(x) count 2; emit splash(-x) count 1; emit bit count 1; }
-            emit bit at 40 per second;
-            @capacity(900)
-            object bit { point(vec3(drop.x, age, 0), white, 1); kill when age > 0.1; }
-        }
-        @capacity(700)
-        object splash(v: float) { point(vec3(v, age, 0), white, 1); kill when age > 0.1; emit puff count 1; }
-        object puff { point(vec3(age), white, 1); kill when age > 0.05; }
-        trigger rain() { emit drop(rand()) count 400; })";
+    const std::string text = test::readFile(std::string(PSYS_PROGRAMS_DIR) + "/emissions_in_windows.psys");
     test::Run whole(text, test::rowsInMemory()), windows(text, test::rowsInMemory());
     windows.backend.memory().maxBlockBytes = 2048;
     REQUIRE(windows.backend.memory().emissionWindow(4) == 13);
