@@ -119,6 +119,7 @@ private:
         Buffer runs;
         size_t at = 0, rows = 0;  // its rows are the operation's [at, at + rows)
         std::vector<uint32_t> total;
+        RecordLayout layout;  // where its records are
         uint32_t kept(size_t site) const { return total[kTotalsSites + kTotalsPerSite * site]; }
     };
     // What emitInMemory's operation asked for, queued from its windows' records.

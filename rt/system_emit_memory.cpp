@@ -61,7 +61,8 @@ void Creation::emitInMemory(size_t type, const std::vector<Buffer>& table, const
             part.carry = windows.back().runs;
             part.carryAt = runsTotalsAt(windows.back().rows, sites);
         }
-        windows.push_back({runs_.at(runsUsed_++, Elem::U32, runsWords(part.rows, sites)), at, part.rows, {}});
+        windows.push_back({runs_.at(runsUsed_++, Elem::U32, runsWords(part.rows, sites)), at, part.rows, {},
+                           RecordLayout(part)});
         s_.memory.emitAtRate(part, windows.back().runs);
     }
     // Every window's totals in one read (one wait on a device): copied after one another
@@ -119,9 +120,7 @@ void Creation::queueFromRecords(size_t type, const RateSites& in, std::span<cons
             const Window* before = u ? &windows[u - 1] : nullptr;
             const size_t from = groupKept(before, group), its = groupKept(&w, group) - from;
             if (its == 0) continue;
-            RateSites part = in;
-            part.rows = w.rows;
-            const RecordLayout records(part);  // (the window's)
+            const RecordLayout& records = w.layout;
             queueSiteLaunches(type, in, emitSite, batch, w, before, group, base + from, its, rows, t1);
             enqueue({target, base + from, its, {}, 0, 0, 1, 0, w.runs, records.first[group], w.rows * records.stride[group],
                      records.stride[group], rows, w.at});
@@ -134,9 +133,7 @@ void Creation::queueSiteLaunches(size_t type, const RateSites& in, std::span<con
                                  const Batch* batch, const Window& w, const Window* before, size_t group, size_t base,
                                  size_t its, Buffer rows, double t1) {
     using Kind = RateSites::Site::Kind;
-    RateSites part = in;
-    part.rows = w.rows;
-    const RecordLayout records(part);
+    const RecordLayout& records = w.layout;
     for (size_t k = group; k < in.sites.size(); ++k) {
         if (in.sites[k].group != group) continue;
         const uint32_t siteKept = w.kept(k) - (before ? before->kept(k) : 0);
