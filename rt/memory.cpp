@@ -347,7 +347,7 @@ size_t Memory::emissionWindow(size_t sites) const {
     if (maxBlockBytes == SIZE_MAX || sites == 0) return SIZE_MAX;
     // (At most 2³¹ bytes: a shader's word indices are 32-bit.)
     const size_t block = std::min<size_t>(maxBlockBytes, size_t{1} << 31);
-    const size_t words = block / 4, totals = kTotalsSites + kTotalsPerSite * sites;
+    const size_t words = block / 4, totals = runsWords(0, sites);
     const size_t byRuns = words > totals ? (words - totals) / (sites * kRunWords) : 0;
     const size_t byColumns = block / 8 > 63 ? block / 8 - 63 : 0;
     const size_t rows = std::min(byRuns, byColumns);
@@ -365,7 +365,7 @@ void Memory::emitAtRate(const RateSites& in, Buffer runs) {
     const size_t n = in.rows, sites = in.sites.size();
     auto* record = static_cast<uint32_t*>(host(runs));
     uint32_t* total = record + runsTotalsAt(n, sites);
-    const size_t totalWords = kTotalsSites + kTotalsPerSite * sites;
+    const size_t totalWords = runsWords(0, sites);  // (the totals alone)
     if (in.carry.valid())
         read(in.carry, in.carryAt, totalWords, total);
     else
