@@ -183,6 +183,59 @@ int memoryTable(const std::vector<std::string>& effects, const std::vector<doubl
     return 0;
 }
 
+// Hitches: `effect` at its knob `value` from its first step, `frames` steps of 1/60 s timed
+// one by one on every core, as a game runs it: the pools grow from nothing to the steady
+// population while it runs. Prints the median, the 99th percentile and the worst step, the
+// worst ÷ the median, the worst step ÷ the median of the 21 steps around it (a hitch, apart
+// from the population's growth: the last steps update twice the median's objects), and
+// the frames of the five worst.
+int hitchTable(const std::vector<std::string>& effects, double value, int frames, size_t capacity, const std::string& json) {
+    nlohmann::json rows = nlohmann::json::array();
+    codegen_llvm::LlvmBackend jit;
+    std::cout << fmt::format("Steps from the first, {} of 1/60 s each, on {} cores (extern at {:g}{}):\n\n", frames,
+                             std::max(1u, std::thread::hardware_concurrency()), value,
+                             capacity ? fmt::format(", capacity {}", capacity) : std::string(", the default capacity"))
+              << "| effect | live at the end | median (ms) | 99th percentile (ms) | worst (ms) | worst ÷ median | "
+                 "worst ÷ the median around it | the five worst (frame: ms) |\n|---|---:|---:|---:|---:|---:|---:|---|\n";
+    for (const std::string& name : effects) {
+        const Effect* effect = bench::findEffect(name);
+        if (!effect) return 2;
+        rt::SystemOptions options;
+        if (capacity) options.capacity = capacity;
+        rt::System system(bench::compileEffect(name, true), jit, options);
+        float v = static_cast<float>(value);
+        system.setExtern(effect->knob, {&v, 1});
+        std::vector<double> times;
+        for (int f = 0; f < frames; ++f) {
+            auto start = Clock::now();
+            system.step(1.0 / 60);
+            times.push_back(seconds(start, Clock::now()) * 1e3);
+            rows.push_back({{"effect", name}, {"frame", f}, {"ms", times.back()},
+                            {"live", system.pool(static_cast<size_t>(system.typeIndex(effect->particles))).live()}});
+        }
+        std::vector<size_t> order(times.size());
+        for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+        std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return times[a] > times[b]; });
+        std::vector<double> sorted = times;
+        std::sort(sorted.begin(), sorted.end());
+        std::string worst;
+        for (size_t i = 0; i < std::min<size_t>(5, order.size()); ++i)
+            worst += fmt::format("{}{}: {:.1f}", i ? ", " : "", order[i], times[order[i]]);
+        double med = median(times), local = 0;
+        for (size_t f = 0; f < times.size(); ++f) {
+            size_t from = f < 10 ? 0 : f - 10, to = std::min(times.size(), f + 11);
+            local = std::max(local, times[f] / median({times.begin() + static_cast<std::ptrdiff_t>(from),
+                                                         times.begin() + static_cast<std::ptrdiff_t>(to)}));
+        }
+        std::cout << fmt::format("| {} | {} | {:.2f} | {:.2f} | {:.2f} | {:.1f} | {:.1f} | {} |\n", name,
+                                 system.pool(static_cast<size_t>(system.typeIndex(effect->particles))).live(), med,
+                                 sorted[sorted.size() * 99 / 100], sorted.back(), sorted.back() / med, local, worst);
+        std::cout.flush();
+    }
+    if (!json.empty() && !bench::writeJson(json, rows.dump(1), "psys_bench")) return 1;
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -197,6 +250,9 @@ int main(int argc, char** argv) {
     bool memory = false;
     int compileRuns = 5;
     std::string json;
+    bool hitches = false;
+    double hitchValue = 1e5;
+    size_t hitchCapacity = 0;
     app.add_option("--particles", sizes, "Live particles per effect (1e6 1e7)");
     app.add_option("--frames", frames, "Timed steps per measurement; the median counts (15)")->check(CLI::Range(5, 100000));
     app.add_option("--effects", effects, "fountain fire fireworks");
@@ -207,8 +263,13 @@ int main(int argc, char** argv) {
     app.add_flag("--memory", memory, "Only the peak memory of each effect and size, each in a process of its own");
     app.add_option("--compile-runs", compileRuns, "Compiles per sample; the median counts (5)")->check(CLI::PositiveNumber);
     app.add_option("--json", json, "Also write the JIT's figures as JSON, a list of rows (bench/README.md names the fields)");
+    app.add_flag("--hitches", hitches,
+                 "Only the steps of each effect from its first, the pools growing as it runs: median, worst, worst ÷ median");
+    app.add_option("--hitch-value", hitchValue, "--hitches: the effects' extern (1e5: the fire's rate per second)");
+    app.add_option("--hitch-capacity", hitchCapacity, "--hitches: the pools' capacity (0: the default)");
     CLI11_PARSE(app, argc, argv);
     if (memory) return memoryTable(effects, sizes, frames);
+    if (hitches) return hitchTable(effects, hitchValue, frames, hitchCapacity, json);
 
     unsigned cores = std::max(1u, std::thread::hardware_concurrency());
     codegen_llvm::LlvmBackend jit;

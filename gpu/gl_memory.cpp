@@ -1,4 +1,5 @@
 #include "gpu/gl_memory.h"
+#include "gpu/gl_column.h"
 
 #include "gpu/gl_context.h"
 #include "gpu/gl_programs.h"
@@ -35,23 +36,6 @@ void fromWords(const uint32_t* from, Elem e, size_t rows, void* to) {
         std::memcpy(to, from, rows * rt::elemSize(e));
     }
 }
-
-struct GlMemory::Column {
-    Elem elem = Elem::F32;
-    size_t rows = 0;
-    std::vector<uint8_t> hostCopy;
-    GLuint gl = 0;
-    size_t glRows = 0;    // rows the GL buffer has room for (pools grow a row at a time: doubled)
-    bool device = false;  // the value is the GL buffer's (the host copy is stale)
-    size_t zeroFrom = 0;  // on the GPU: the GL buffer holds zeros from this row on
-    bool live = false;
-    // Rows the host scattered into it while it is on the GPU, not sent yet (each row's
-    // words after it, in the order written): sent in one scatter when the GPU next uses
-    // the column or the host reads it (GlMemory::flush).
-    std::vector<uint32_t> pending;
-    size_t pendingRows = 0;
-    size_t words() const { return rows * wordsPerRow(elem); }
-};
 
 namespace {
 

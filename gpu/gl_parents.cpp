@@ -12,6 +12,7 @@
 #include <epoxy/gl.h>
 
 #include "codegen_glsl/glsl_shaders.h"
+#include "gpu/gl_column.h"
 #include "gpu/gl_context.h"
 #include "gpu/gl_memory.h"
 #include "gpu/gl_programs.h"

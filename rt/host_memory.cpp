@@ -17,7 +17,9 @@ namespace psys::rt {
 // at a time costs amortized O(1). A large column is its own anonymous mapping, grown with
 // mremap: the kernel moves its pages instead of copying them, pages past the rows in use
 // are never touched (so they take no memory), and no second copy exists while it grows —
-// a pool of 10M rows holds what its rows need, not twice that at its peak.
+// a pool of 10M rows holds what its rows need, not twice that at its peak. A pool's columns
+// reserve their capacity's address space at once (HostMemory::reserve: MAP_NORESERVE, no
+// page touched), so that a pool growing inside a step moves and copies nothing.
 struct HostMemory::Column {
     static constexpr size_t kMapped = size_t{1} << 20;  // bytes from which a column is a mapping
 
@@ -31,15 +33,16 @@ struct HostMemory::Column {
         else std::free(data);
     }
     size_t size() const { return elemSize(elem); }
-    void reserve(size_t wanted) {
+    // Room for `wanted` rows; `exactly`: that many (a pool's capacity), else doubled.
+    void reserve(size_t wanted, bool exactly = false) {
         if (wanted <= capacity) return;
-        size_t grown = std::max(wanted, capacity * 2);
+        size_t grown = exactly ? wanted : std::max(wanted, capacity * 2);
         size_t bytes = (grown * size() + 63) / 64 * 64;
         if (bytes >= kMapped) {
             const size_t page = static_cast<size_t>(::sysconf(_SC_PAGESIZE));
             bytes = (bytes + page - 1) / page * page;
             void* fresh = mappedBytes ? ::mremap(data, mappedBytes, bytes, MREMAP_MAYMOVE)
-                                      : ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+                                      : ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
             if (fresh == MAP_FAILED) throw std::bad_alloc();
             if (!mappedBytes) {
                 if (data) std::memcpy(fresh, data, rows * size());
@@ -82,6 +85,13 @@ Buffer HostMemory::create(Elem elem, size_t rows) {
 }
 
 void HostMemory::resize(Buffer b, size_t rows) { columns_.at(b.id)->resize(rows); }
+
+void HostMemory::reserve(Buffer b, size_t rows) {
+    try {
+        columns_.at(b.id)->reserve(rows, true);
+    } catch (const std::bad_alloc&) {  // (no address space for it: it grows when it must)
+    }
+}
 
 void HostMemory::release(Buffer b) {
     if (!b.valid() || b.id >= columns_.size() || !columns_[b.id]) return;

@@ -152,6 +152,11 @@ public:
     virtual Buffer create(Elem elem, size_t rows) = 0;
     // Keeps the first min(old, rows) elements; new ones are zero.
     virtual void resize(Buffer buffer, size_t rows) = 0;
+    // Room for the `rows` rows a column may grow to (a pool's capacity): growing to them
+    // later moves nothing and copies nothing. The host's memory takes the address space
+    // now and no memory (no page is touched before its rows are used); a device's may do
+    // nothing.
+    virtual void reserve(Buffer, size_t) {}
     virtual void release(Buffer buffer) = 0;
     virtual size_t rows(Buffer buffer) const = 0;
     virtual Elem elem(Buffer buffer) const = 0;
@@ -328,6 +333,7 @@ public:
     ~HostMemory() override;
     Buffer create(Elem elem, size_t rows) override;
     void resize(Buffer buffer, size_t rows) override;
+    void reserve(Buffer buffer, size_t rows) override;
     void release(Buffer buffer) override;
     size_t rows(Buffer buffer) const override;
     Elem elem(Buffer buffer) const override;

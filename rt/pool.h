@@ -27,6 +27,7 @@
 #include "ir/ir.h"
 #include "ir/value.h"
 #include "rt/allocation.h"
+#include "rt/host_array.h"
 #include "rt/memory.h"
 
 namespace psys::rt {
@@ -49,6 +50,7 @@ public:
     void create(Memory& memory);
     void release(Memory& memory);
     void grow(Memory& memory, size_t rows);
+    void reserved(Memory& memory);  // after Memory::reserve of the column
     void set(uint32_t row, uint8_t value) {
         uint8_t* h = data();
         if (h[row] == value) return;
@@ -203,9 +205,9 @@ public:
 
     // Host bookkeeping (where the rows are in the memory, parentRows and
     // PoolRows::readers hold the parents and readers; these are a reload's copies).
-    std::vector<Handle> parent;
-    std::vector<uint32_t> readers;   // children that read this object live
-    std::vector<double> diedAt;      // a frozen object's time of its last values
+    HostArray<Handle> parent;
+    HostArray<uint32_t> readers;     // children that read this object live
+    HostArray<double> diedAt;        // a frozen object's time of its last values
     // The time a child reading `row`'s age reads it at: `now`, or its death for a frozen
     // object (frozen with its last values, its age too).
     double ageClock(uint32_t row, double now) const { return status_[row] == Status::Frozen ? diedAt[row] : now; }
@@ -218,12 +220,12 @@ public:
 
     Memory& memory() const { return *memory_; }
     // Rebuilds the host bookkeeping of rows as given (hot reload, rt/reload.cpp).
-    void restore(std::vector<Status> status, std::vector<uint32_t> generation, std::vector<uint32_t> freeRows);
-    const std::vector<uint32_t>& generations() const {
+    void restore(std::span<const Status> status, std::span<const uint32_t> generation, std::span<const uint32_t> freeRows);
+    const HostArray<uint32_t>& generations() const {
         fetch();
         return generation_;
     }
-    const std::vector<uint32_t>& freeRows() const {
+    const HostArray<uint32_t>& freeRows() const {
         fetch();
         return freeRows_;
     }
@@ -232,15 +234,19 @@ public:
     static size_t rowBytes(const ir::Object& object);
     // Grows every column to `rows` rows (new rows free).
     void grow(size_t rows);
+    // The rows its columns and host arrays have room for (reservableRows of its capacity):
+    // a scratch column over its rows takes as much (Scratch::at), so it never moves either.
+    size_t room() const { return room_; }
 
 private:
     const ir::Object* object_;
     size_t capacity_;
+    size_t room_ = 0;
     Memory* memory_;
     // On the host, or (rows in the memory) what was last read back: fetch().
-    mutable std::vector<Status> status_;
-    mutable std::vector<uint32_t> generation_;
-    mutable std::vector<uint32_t> freeRows_;
+    mutable HostArray<Status> status_;
+    mutable HostArray<uint32_t> generation_;
+    mutable HostArray<uint32_t> freeRows_;
     mutable size_t live_ = 0, frozen_ = 0;
     // The rows in the memory: its buffers and the host's counts; what changed them since
     // the host copies were read back (a version each change, the one read back).
@@ -260,6 +266,7 @@ private:
     mutable uint64_t fetched_ = 0;
     mutable std::vector<uint8_t> mask_;
     void fetch() const;  // the host copies of the rows in the memory, where they are stale
+    void reserveRows();
     void restoreInMemory();
     void writeRows();
 };

@@ -18,7 +18,7 @@ Scratch::~Scratch() {
     for (Buffer b : buffers_) memory_->release(b);
 }
 
-Buffer Scratch::at(size_t index, Elem elem, size_t rows) {
+Buffer Scratch::at(size_t index, Elem elem, size_t rows, size_t room) {
     while (buffers_.size() <= index) buffers_.push_back({});
     Buffer& b = buffers_[index];
     if (!b.valid() || memory_->elem(b) != elem) {
@@ -27,6 +27,7 @@ Buffer Scratch::at(size_t index, Elem elem, size_t rows) {
     } else if (memory_->rows(b) < rows) {
         memory_->resize(b, rows);
     }
+    if (room > rows) memory_->reserve(b, room);
     return b;
 }
 
@@ -439,7 +440,7 @@ void State::parentsToHost() {
         Pool& pool = pools[t];
         if (pool.frozenAt.valid() && pool.rows() > 0) memory.read(pool.frozenAt, 0, pool.rows(), pool.diedAt.data());
         if (!pool.parentRows.valid() || pool.rows() == 0) continue;
-        const std::vector<uint32_t>& generation = pools[static_cast<size_t>(types[t].parentType)].generations();
+        const HostArray<uint32_t>& generation = pools[static_cast<size_t>(types[t].parentType)].generations();
         std::vector<uint32_t> rows(pool.rows());
         memory.read(pool.parentRows, 0, rows.size(), rows.data());
         for (size_t r = 0; r < rows.size(); ++r)
@@ -516,7 +517,7 @@ void State::bindPool(size_t type, const ColumnLayout& layout, Scratch& scratch, 
     table.assign(static_cast<size_t>(layout.total), Buffer{});
     table[ColumnLayout::kCreated] = pool.created;
     table[ColumnLayout::kIds] = pool.ids;
-    table[ColumnLayout::kKill] = scratch.at(0, Elem::U8, rows);
+    table[ColumnLayout::kKill] = scratch.at(0, Elem::U8, rows, pool.room());
     for (size_t s = 0; s < o.state.size(); ++s)
         for (int c = 0; c < o.state[s].type.width; ++c)
             table[static_cast<size_t>(layout.stateOffset[s] + c)] = pool.state.column(s, static_cast<size_t>(c));
@@ -530,7 +531,8 @@ void State::bindPool(size_t type, const ColumnLayout& layout, Scratch& scratch, 
             table[static_cast<size_t>(layout.exportOffset[e] + c)] = pool.exports.column(e, static_cast<size_t>(c));
     for (int column = layout.emits; column < layout.total; ++column)
         if (layout.needs(column))
-            table[static_cast<size_t>(column)] = scratch.at(static_cast<size_t>(1 + column - layout.emits), Elem::F32, rows);
+            table[static_cast<size_t>(column)] =
+                scratch.at(static_cast<size_t>(1 + column - layout.emits), Elem::F32, rows, pool.room());
 }
 
 size_t State::chunkCount(size_t rows) const {

@@ -28,8 +28,9 @@ public:
     Scratch(Scratch&& other) noexcept : memory_(other.memory_), buffers_(std::move(other.buffers_)) { other.buffers_.clear(); }
     Scratch(const Scratch&) = delete;
     Scratch& operator=(const Scratch&) = delete;
-    // Buffer `index`, of `elem`, with at least `rows` rows.
-    Buffer at(size_t index, Elem elem, size_t rows);
+    // Buffer `index`, of `elem`, with at least `rows` rows, and room for `room` rows
+    // (Memory::reserve: a pool's table takes its capacity, so it never moves as it grows).
+    Buffer at(size_t index, Elem elem, size_t rows, size_t room = 0);
 
 private:
     Memory* memory_;

@@ -197,7 +197,7 @@ void runUpdate(State& s, const Phase& phase, double dt, double t1, bool last) {
     if (info.exports) {
         s.bindPool(type, info.exportsLayout, work.exports, work.exportsTable);
         // Exports of the survivors: of a type that never dies, every row updated.
-        exportMask = info.kills ? work.masks.at(0, Elem::U8, rows) : pool.updatable.column;
+        exportMask = info.kills ? work.masks.at(0, Elem::U8, rows, pool.room()) : pool.updatable.column;
         exports.kernel = info.exports;
         exports.layout = &info.exportsLayout;
         exports.columns = work.exportsTable;
