@@ -16,6 +16,13 @@ void Ledger::kill(size_t type, uint32_t row, double at) {
     dying_.push_back({type, row});
 }
 
+void Ledger::kill(size_t type, std::span<const uint32_t> rows, std::span<const double> at) {
+    if (rows.empty()) return;
+    s_.typeStats[type].killed += rows.size();
+    s_.pools[type].freeze(rows, at);
+    for (uint32_t row : rows) dying_.push_back({type, row});
+}
+
 void Ledger::record(LateKills::Part& part, const RowsResult& result, Buffer flags, size_t begin, size_t end) const {
     part.ticket = result.ticket;
     part.begin = begin;

@@ -66,6 +66,9 @@ public:
     // An object is dead: frozen now, freed at the end of the step unless children read it.
     // `at`: the time of its last values (those of the update before the one that killed it).
     void kill(size_t type, uint32_t row, double at);
+    // The same for many (distinct rows: a launch's kills), in their order: at[k] row k's
+    // time, or at[0] every row's (Pool::freeze of many, on every thread).
+    void kill(size_t type, std::span<const uint32_t> rows, std::span<const double> at);
     // A launch's kills as a part of a LateKills: its ticket, or the rows it listed, else
     // those of [begin, end) its kill flags (`flags`) mark.
     void record(LateKills::Part& part, const RowsResult& result, Buffer flags, size_t begin, size_t end) const;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <stdexcept>
 
 #include <unistd.h>
@@ -175,7 +176,7 @@ Pool::Pool(Pool&& other) noexcept
       countPending_(other.countPending_),
       freshRows_(std::move(other.freshRows_)), spare_(std::move(other.spare_)), held_(std::move(other.held_)),
       version_(other.version_),
-      fetched_(other.fetched_), mask_(std::move(other.mask_)) {
+      fetched_(other.fetched_), mask_(std::move(other.mask_)), runPieces_(std::move(other.runPieces_)) {
     other.memory_ = nullptr;
 }
 
@@ -224,25 +225,43 @@ void Pool::countsDownParent(Buffer parentReaders) {
 size_t Pool::allocate(size_t n, uint32_t* out) {
     FreeRows free{freeRows_.data(), freeRows_.size(), rows(), capacity_};
     size_t kept = std::min(n, free.room());
-    for (size_t k = 0; k < kept; ++k) out[k] = free.row(k);
-    std::fill(out + kept, out + n, kSkipRow);
     if (kept > free.top) grow(free.highWater + (kept - free.top));  // once, for the whole batch
+    std::vector<double*> accumulated;
+    for (Buffer e : emitted) accumulated.push_back(hostData<double>(*memory_, e));
+    forPieces(n, [&](size_t begin, size_t end) {  // (row k depends on k alone: rt/allocation.h)
+        for (size_t k = begin; k < end; ++k) {
+            if (k >= kept) {
+                out[k] = kSkipRow;
+                continue;
+            }
+            uint32_t row = free.row(k);
+            out[k] = row;
+            status_[row] = Status::Alive;
+            readers[row] = 0;
+            parent[row] = {};
+            for (double* a : accumulated) a[row] = 0;
+            updatable.set(row, 0);
+            alive.set(row, 1);
+        }
+    });
     freeRows_.resize(free.top - std::min(kept, free.top));
-    std::span<const uint32_t> rows(out, kept);
-    for (uint32_t row : rows) {
-        status_[row] = Status::Alive;
-        readers[row] = 0;
-        parent[row] = {};
-    }
-    for (Buffer e : emitted) {
-        auto* accumulated = hostData<double>(*memory_, e);
-        for (uint32_t row : rows) accumulated[row] = 0;
-    }
-    updatable.set(rows, 0);
-    alive.set(rows, 1);
-    fresh.insert(fresh.end(), rows.begin(), rows.end());
+    fresh.insert(fresh.end(), out, out + kept);
     live_ += kept;
     return kept;
+}
+
+namespace {
+constexpr size_t kPieceRows = 16384;  // rows of bookkeeping a piece (a few cache-sized pieces of each array)
+}
+
+void Pool::forPieces(size_t n, const std::function<void(size_t, size_t)>& fn) const {
+    size_t pieces = (n + kPieceRows - 1) / kPieceRows;
+    auto piece = [&](size_t p) { fn(p * kPieceRows, std::min(n, (p + 1) * kPieceRows)); };
+    if (pieces > 1 && runPieces_ && updatable.direct() && alive.direct()) {
+        runPieces_(pieces, piece);
+        return;
+    }
+    for (size_t p = 0; p < pieces; ++p) piece(p);
 }
 
 void Pool::freeze(uint32_t row, double at) {
@@ -266,19 +285,57 @@ void Pool::release(uint32_t row) {
     freeRows_.push_back(row);
 }
 
-void Pool::releaseKilled(std::span<const uint32_t> rows) {
-    size_t freed = 0;
-    for (uint32_t row : rows) {
-        if (status_[row] != Status::Alive) continue;  // as release() of a row not alive
-        status_[row] = Status::Free;
-        ++generation_[row];
-        freeRows_.push_back(row);
-        ++freed;
-    }
-    live_ -= freed;
-    updatable.set(rows, 0);
-    alive.set(rows, 0);
+void Pool::freeze(std::span<const uint32_t> rows, std::span<const double> at) {
+    std::atomic<size_t> frozen = 0;
+    forPieces(rows.size(), [&](size_t begin, size_t end) {
+        size_t its = 0;
+        for (size_t k = begin; k < end; ++k) {
+            uint32_t row = rows[k];
+            if (status_[row] != Status::Alive) continue;
+            status_[row] = Status::Frozen;
+            diedAt[row] = at[at.size() == 1 ? 0 : k];
+            updatable.set(row, 0);
+            alive.set(row, 0);
+            ++its;
+        }
+        frozen += its;
+    });
+    live_ -= frozen;
+    frozen_ += frozen;
 }
+
+// In two passes over the same pieces: how many rows each frees, then each piece's rows at
+// its place on the stack (the places a prefix sum of the counts). The rows are distinct (a
+// launch's kill list): no two pieces touch one row.
+size_t Pool::releaseRows(std::span<const uint32_t> rows, Status from) {
+    size_t pieces = (rows.size() + kPieceRows - 1) / kPieceRows;
+    std::vector<size_t> at(pieces + 1, 0);
+    forPieces(rows.size(), [&](size_t begin, size_t end) {
+        size_t its = 0;
+        for (size_t k = begin; k < end; ++k) its += status_[rows[k]] == from;
+        at[begin / kPieceRows + 1] = its;
+    });
+    for (size_t p = 0; p < pieces; ++p) at[p + 1] += at[p];
+    size_t top = freeRows_.size();
+    freeRows_.resize(top + at[pieces]);
+    forPieces(rows.size(), [&](size_t begin, size_t end) {
+        uint32_t* stack = freeRows_.data() + top + at[begin / kPieceRows];
+        for (size_t k = begin; k < end; ++k) {
+            uint32_t row = rows[k];
+            if (from == Status::Alive) {  // (releaseKilled: every row's masks cleared)
+                updatable.set(row, 0);
+                alive.set(row, 0);
+            }
+            if (status_[row] != from) continue;
+            status_[row] = Status::Free;
+            ++generation_[row];
+            *stack++ = row;
+        }
+    });
+    return at[pieces];
+}
+
+void Pool::releaseKilled(std::span<const uint32_t> rows) { live_ -= releaseRows(rows, Status::Alive); }
 
 void Pool::keepRowsInMemory(bool child, bool read) {
     if (inMemory_) return;
@@ -416,8 +473,10 @@ void Pool::beginStep() {
         freshRows_.clear();
         return;
     }
-    for (uint32_t row : fresh)
-        if (status_[row] == Status::Alive) updatable.set(row, 1);
+    forPieces(fresh.size(), [&](size_t begin, size_t end) {
+        for (size_t k = begin; k < end; ++k)
+            if (status_[fresh[k]] == Status::Alive) updatable.set(fresh[k], 1);
+    });
     fresh.clear();
 }
 

@@ -19,6 +19,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <span>
@@ -51,6 +52,9 @@ public:
     void release(Memory& memory);
     void grow(Memory& memory, size_t rows);
     void reserved(Memory& memory);  // after Memory::reserve of the column
+    // The column is the host's copy itself: rows may be set from several threads at once
+    // (each row by one), nothing being listed.
+    bool direct() const { return resident_; }
     void set(uint32_t row, uint8_t value) {
         uint8_t* h = data();
         if (h[row] == value) return;
@@ -123,9 +127,20 @@ public:
     size_t allocate(size_t n, uint32_t* rows);
     void release(uint32_t row);  // back to the free list; the generation moves on
     // Objects that died alive and nobody reads, freed at once (no frozen state between):
-    // onto the free stack in the order given, each row's generation moved on.
+    // onto the free stack in the order given, each row's generation moved on (distinct
+    // rows: a launch's kill list).
     void releaseKilled(std::span<const uint32_t> rows);
     void freeze(uint32_t row, double at);  // `at`: the time of its last values; its age stays what it was then
+    // freeze of each row (distinct rows: a launch's kills), `at[k]` row k's time (or at[0]
+    // every row's).
+    void freeze(std::span<const uint32_t> rows, std::span<const double> at);
+    // How the bookkeeping of many rows at once runs (allocate, beginStep, freeze of many,
+    // releaseKilled): `run(pieces, piece)` calls piece(p) for every p < pieces, on every thread
+    // (System's executor). Each row is written by one piece and what goes in order (the
+    // free stack) goes at places a count of each piece gives, so the results are the same
+    // bits on any number of threads. Unset: in order on this thread.
+    using PieceRunner = std::function<void(size_t, const std::function<void(size_t)>&)>;
+    void runPiecesWith(PieceRunner run) { runPieces_ = std::move(run); }
     bool matches(Handle h) const {
         fetch();
         return h.row < rows() && generation_[h.row] == h.generation && status_[h.row] != Status::Free;
@@ -267,6 +282,12 @@ private:
     mutable std::vector<uint8_t> mask_;
     void fetch() const;  // the host copies of the rows in the memory, where they are stale
     void reserveRows();
+    PieceRunner runPieces_;
+    // fn(begin, end) over pieces of [0, n): on every thread where runPieces_ is set and the
+    // masks are the host's (SyncedMask::direct), else in order.
+    void forPieces(size_t n, const std::function<void(size_t, size_t)>& fn) const;
+    // Frees the rows of `rows` (distinct) whose status is `from`, onto the stack in order.
+    size_t releaseRows(std::span<const uint32_t> rows, Status from);
     void restoreInMemory();
     void writeRows();
 };

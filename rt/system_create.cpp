@@ -349,10 +349,16 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
             });
         } else {  // they emit nothing: no room to account for, only their kills in queue order
             queued_[type] -= n;
-            if (!late && info.kills) {
+            if (!late && info.kills) {  // (listed in queue order, then frozen on every thread)
                 const auto* kill = s_.view<uint8_t>(b.updateTable[ColumnLayout::kKill]);
+                std::vector<uint32_t> rows;
+                std::vector<double> at;
                 for (size_t r = 0; r < n; ++r)
-                    if (b.poolRows[r] != kSkipRow && kill[first + r]) s_.ledger.kill(type, b.poolRows[r], t1 - b.spans[r]);
+                    if (b.poolRows[r] != kSkipRow && kill[first + r]) {
+                        rows.push_back(b.poolRows[r]);
+                        at.push_back(t1 - b.spans[r]);
+                    }
+                s_.ledger.kill(type, rows, at);
             }
         }
         if (late) {

@@ -264,6 +264,9 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     for (const ir::Object& obj : module.objects) {
         size_t capacity = obj.attributes.capacity ? static_cast<size_t>(*obj.attributes.capacity) : options.capacity;
         pools.emplace_back(obj, capacity, memory);
+        pools.back().runPiecesWith([this](size_t pieces, const std::function<void(size_t)>& piece) {
+            parallel->forEach(pieces, true, piece);
+        });
         types.push_back(typeInfo(module, obj));
         typeStats.push_back({obj.name, 0, 0, 0, 0, 0});
     }

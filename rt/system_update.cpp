@@ -121,8 +121,8 @@ void runKills(State& s, size_t type, double dt, double t1) {
         return;
     }
     if (work.pass.listed) {
-        for (size_t c = 0; c < chunks; ++c)
-            for (uint32_t row : work.killed[c].rows) s.ledger.kill(type, row, t1 - dt);
+        const double at = t1 - dt;
+        for (size_t c = 0; c < chunks; ++c) s.ledger.kill(type, work.killed[c].rows, {&at, 1});
         return;
     }
     if (!info.kills) return;
