@@ -8,6 +8,10 @@
 
 namespace psys::rt::detail {
 
+// Rows of host bookkeeping a piece run on one thread (a few cache-sized pieces of each
+// array): State::forRows' and the pools' (Pool::forPieces).
+constexpr size_t kHostRows = 16384;
+
 class Parallel {
 public:
     explicit Parallel(unsigned threads);  // 0: every core

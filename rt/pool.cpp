@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "core/fold.h"
+#include "rt/parallel.h"
 
 namespace psys::rt {
 
@@ -250,13 +251,9 @@ size_t Pool::allocate(size_t n, uint32_t* out) {
     return kept;
 }
 
-namespace {
-constexpr size_t kPieceRows = 16384;  // rows of bookkeeping a piece (a few cache-sized pieces of each array)
-}
-
 void Pool::forPieces(size_t n, const std::function<void(size_t, size_t)>& fn) const {
-    size_t pieces = (n + kPieceRows - 1) / kPieceRows;
-    auto piece = [&](size_t p) { fn(p * kPieceRows, std::min(n, (p + 1) * kPieceRows)); };
+    size_t pieces = (n + detail::kHostRows - 1) / detail::kHostRows;
+    auto piece = [&](size_t p) { fn(p * detail::kHostRows, std::min(n, (p + 1) * detail::kHostRows)); };
     if (pieces > 1 && runPieces_ && updatable.direct() && alive.direct()) {
         runPieces_(pieces, piece);
         return;
@@ -308,18 +305,18 @@ void Pool::freeze(std::span<const uint32_t> rows, std::span<const double> at) {
 // its place on the stack (the places a prefix sum of the counts). The rows are distinct (a
 // launch's kill list): no two pieces touch one row.
 size_t Pool::releaseRows(std::span<const uint32_t> rows, Status from) {
-    size_t pieces = (rows.size() + kPieceRows - 1) / kPieceRows;
+    size_t pieces = (rows.size() + detail::kHostRows - 1) / detail::kHostRows;
     std::vector<size_t> at(pieces + 1, 0);
     forPieces(rows.size(), [&](size_t begin, size_t end) {
         size_t its = 0;
         for (size_t k = begin; k < end; ++k) its += status_[rows[k]] == from;
-        at[begin / kPieceRows + 1] = its;
+        at[begin / detail::kHostRows + 1] = its;
     });
     for (size_t p = 0; p < pieces; ++p) at[p + 1] += at[p];
     size_t top = freeRows_.size();
     freeRows_.resize(top + at[pieces]);
     forPieces(rows.size(), [&](size_t begin, size_t end) {
-        uint32_t* stack = freeRows_.data() + top + at[begin / kPieceRows];
+        uint32_t* stack = freeRows_.data() + top + at[begin / detail::kHostRows];
         for (size_t k = begin; k < end; ++k) {
             uint32_t row = rows[k];
             if (from == Status::Alive) {  // (releaseKilled: every row's masks cleared)

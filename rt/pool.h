@@ -61,9 +61,6 @@ public:
         h[row] = value;
         if (!direct_) changed_.push_back(row);
     }
-    void set(std::span<const uint32_t> rows, uint8_t value) {
-        for (uint32_t row : rows) set(row, value);
-    }
     const uint8_t* host() const { return direct_ ? direct_ : host_.data(); }
     void sync(Memory& memory);
     void restore(Memory& memory, std::vector<uint8_t> values);  // every row at once

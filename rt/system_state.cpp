@@ -543,10 +543,6 @@ size_t State::chunkCount(size_t rows) const {
     return rows / per + (rows % per != 0);
 }
 
-namespace {
-constexpr size_t kHostRows = 16384;  // rows of host bookkeeping a chunk (a few cache-sized pieces of each array)
-}
-
 void State::forRows(size_t first, size_t end, const std::function<void(size_t, size_t)>& fn) {
     if (end <= first) return;
     size_t chunks = (end - first + kHostRows - 1) / kHostRows;
