@@ -11,16 +11,22 @@
 namespace psys::rt::detail {
 
 void Ledger::kill(size_t type, uint32_t row, double at) {
+    if (s_.pools[type].status(row) != Status::Alive) return;  // (the deaths' rows distinct: Pool::releaseFrozen)
     ++s_.typeStats[type].killed;
     s_.pools[type].freeze(row, at);  // no longer alive; freed at the end of the step if nobody reads it
     dying_.push_back({type, row});
 }
 
-void Ledger::kill(size_t type, std::span<const uint32_t> rows, std::span<const double> at) {
-    if (rows.empty()) return;
-    s_.typeStats[type].killed += rows.size();
-    s_.pools[type].freeze(rows, at);
-    for (uint32_t row : rows) dying_.push_back({type, row});
+void Ledger::kill(size_t type, Pool::RowLists lists, std::span<const double> at) {
+    size_t total = 0;
+    for (std::span<const uint32_t> rows : lists) total += rows.size();
+    if (total == 0) return;
+    s_.typeStats[type].killed += total;
+    s_.pools[type].freeze(lists, at);
+    size_t next = dying_.size();
+    dying_.resize(next + total);
+    for (std::span<const uint32_t> rows : lists)  // (8 bytes a row, in order)
+        for (uint32_t row : rows) dying_[next++] = {type, row};
 }
 
 void Ledger::record(LateKills::Part& part, const RowsResult& result, Buffer flags, size_t begin, size_t end) const {
@@ -355,20 +361,26 @@ void Ledger::free(Deaths& deaths, std::vector<LateKills>& lates) {
             kept.insert(kept.end(), its.begin(), its.end());
             continue;
         }
-        Pool& pool = s_.pools[l.type];
-        std::vector<uint32_t> rows;
+        // Every part's list at once (Pool::releaseKilled in pieces on every thread): a
+        // device's lists copied (a collect's rows live until the next), a batch's mapped
+        // from its launch rows to its pool rows.
+        std::vector<std::span<const uint32_t>> lists;
+        std::vector<std::vector<uint32_t>> copies;
+        copies.reserve(l.parts.size());
         for (LateKills::Part& part : l.parts) {
+            bool held = !part.ticket;
             std::span<const uint32_t> listed = collect(l.type, part).killedRows;
-            if (l.poolRows.empty()) {
-                s_.typeStats[l.type].killed += listed.size();
-                pool.releaseKilled(listed);
+            s_.typeStats[l.type].killed += listed.size();
+            if (l.poolRows.empty() && held) {
+                lists.push_back(listed);
                 continue;
             }
-            rows.clear();
-            for (uint32_t launchRow : listed) rows.push_back(l.poolRows[launchRow - l.first]);
-            s_.typeStats[l.type].killed += rows.size();
-            pool.releaseKilled(rows);
+            std::vector<uint32_t>& rows = copies.emplace_back(listed.begin(), listed.end());
+            if (!l.poolRows.empty())
+                for (uint32_t& row : rows) row = l.poolRows[row - l.first];
+            lists.push_back(rows);
         }
+        s_.pools[l.type].releaseKilled(lists);
     }
     releaseUpTo(deaths.size());
     release(kept);
@@ -402,6 +414,11 @@ void Ledger::release(Deaths& deaths) {
         waited[static_cast<size_t>(up)].push_back(parent.row);
     };
     for (size_t type : s_.deepestFirst) {
+        if (!s_.types[type].read && s_.types[type].parentType < 0) {  // (rows of its own: on every thread)
+            std::span<const uint32_t> rows = own[type];
+            s_.pools[type].releaseFrozen(Pool::RowLists(&rows, 1));
+            continue;
+        }
         for (uint32_t row : own[type]) free(type, row);
         std::vector<uint32_t>& rows = waited[type];
         std::sort(rows.begin(), rows.end());

@@ -66,9 +66,12 @@ public:
     // An object is dead: frozen now, freed at the end of the step unless children read it.
     // `at`: the time of its last values (those of the update before the one that killed it).
     void kill(size_t type, uint32_t row, double at);
-    // The same for many (distinct rows: a launch's kills), in their order: at[k] row k's
-    // time, or at[0] every row's (Pool::freeze of many, on every thread).
-    void kill(size_t type, std::span<const uint32_t> rows, std::span<const double> at);
+    // The same for many (distinct rows: a launch's kill lists, one a chunk), in their order:
+    // at[k] the k-th row's time, or at[0] every row's (Pool::freeze of many, on every thread).
+    void kill(size_t type, Pool::RowLists lists, std::span<const double> at);
+    void kill(size_t type, std::span<const uint32_t> rows, std::span<const double> at) {
+        kill(type, Pool::RowLists(&rows, 1), at);
+    }
     // A launch's kills as a part of a LateKills: its ticket, or the rows it listed, else
     // those of [begin, end) its kill flags (`flags`) mark.
     void record(LateKills::Part& part, const RowsResult& result, Buffer flags, size_t begin, size_t end) const;
@@ -112,6 +115,8 @@ public:
 
 private:
     void releaseForReload(LateKills& late);  // (one type's kill lists; its waiting rows after)
+    // (type, row) of each death, in order; no row twice (a row dies once: kill takes only
+    // the living), so a type's rows free in pieces on every thread (Pool::releaseFrozen).
     using Deaths = std::vector<std::pair<size_t, uint32_t>>;
     struct Owed {
         Deaths dying;

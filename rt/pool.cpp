@@ -282,15 +282,30 @@ void Pool::release(uint32_t row) {
     freeRows_.push_back(row);
 }
 
-void Pool::freeze(std::span<const uint32_t> rows, std::span<const double> at) {
+void Pool::forListPieces(RowLists lists, const std::function<void(size_t, const ListPiece&)>& fn) const {
+    std::vector<ListPiece> pieces;
+    size_t first = 0;
+    for (std::span<const uint32_t> list : lists) {
+        for (size_t at = 0; at < list.size(); at += detail::kHostRows)
+            pieces.push_back({list.subspan(at, std::min(detail::kHostRows, list.size() - at)), first + at});
+        first += list.size();
+    }
+    if (pieces.size() > 1 && runPieces_ && updatable.direct() && alive.direct()) {
+        runPieces_(pieces.size(), [&](size_t p) { fn(p, pieces[p]); });
+        return;
+    }
+    for (size_t p = 0; p < pieces.size(); ++p) fn(p, pieces[p]);
+}
+
+void Pool::freeze(RowLists lists, std::span<const double> at) {
     std::atomic<size_t> frozen = 0;
-    forPieces(rows.size(), [&](size_t begin, size_t end) {
+    forListPieces(lists, [&](size_t, const ListPiece& piece) {
         size_t its = 0;
-        for (size_t k = begin; k < end; ++k) {
-            uint32_t row = rows[k];
+        for (size_t k = 0; k < piece.rows.size(); ++k) {
+            uint32_t row = piece.rows[k];
             if (status_[row] != Status::Alive) continue;
             status_[row] = Status::Frozen;
-            diedAt[row] = at[at.size() == 1 ? 0 : k];
+            diedAt[row] = at[at.size() == 1 ? 0 : piece.first + k];
             updatable.set(row, 0);
             alive.set(row, 0);
             ++its;
@@ -303,22 +318,22 @@ void Pool::freeze(std::span<const uint32_t> rows, std::span<const double> at) {
 
 // In two passes over the same pieces: how many rows each frees, then each piece's rows at
 // its place on the stack (the places a prefix sum of the counts). The rows are distinct (a
-// launch's kill list): no two pieces touch one row.
-size_t Pool::releaseRows(std::span<const uint32_t> rows, Status from) {
-    size_t pieces = (rows.size() + detail::kHostRows - 1) / detail::kHostRows;
-    std::vector<size_t> at(pieces + 1, 0);
-    forPieces(rows.size(), [&](size_t begin, size_t end) {
+// launch's kill lists): no two pieces touch one row.
+size_t Pool::releaseRows(RowLists lists, Status from) {
+    std::vector<size_t> at(1, 0);
+    for (std::span<const uint32_t> list : lists) at.resize(at.size() + (list.size() + detail::kHostRows - 1) / detail::kHostRows);
+    const size_t pieces = at.size() - 1;
+    forListPieces(lists, [&](size_t p, const ListPiece& piece) {
         size_t its = 0;
-        for (size_t k = begin; k < end; ++k) its += status_[rows[k]] == from;
-        at[begin / detail::kHostRows + 1] = its;
+        for (uint32_t row : piece.rows) its += status_[row] == from;
+        at[p + 1] = its;
     });
     for (size_t p = 0; p < pieces; ++p) at[p + 1] += at[p];
     size_t top = freeRows_.size();
     freeRows_.resize(top + at[pieces]);
-    forPieces(rows.size(), [&](size_t begin, size_t end) {
-        uint32_t* stack = freeRows_.data() + top + at[begin / detail::kHostRows];
-        for (size_t k = begin; k < end; ++k) {
-            uint32_t row = rows[k];
+    forListPieces(lists, [&](size_t p, const ListPiece& piece) {
+        uint32_t* stack = freeRows_.data() + top + at[p];
+        for (uint32_t row : piece.rows) {
             if (from == Status::Alive) {  // (releaseKilled: every row's masks cleared)
                 updatable.set(row, 0);
                 alive.set(row, 0);
@@ -332,7 +347,7 @@ size_t Pool::releaseRows(std::span<const uint32_t> rows, Status from) {
     return at[pieces];
 }
 
-void Pool::releaseKilled(std::span<const uint32_t> rows) { live_ -= releaseRows(rows, Status::Alive); }
+void Pool::releaseKilled(RowLists lists) { live_ -= releaseRows(lists, Status::Alive); }
 
 void Pool::keepRowsInMemory(bool child, bool read) {
     if (inMemory_) return;

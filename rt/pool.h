@@ -123,14 +123,18 @@ public:
     // for the k-th, kSkipRow for those past capacity; returns how many got one.
     size_t allocate(size_t n, uint32_t* rows);
     void release(uint32_t row);  // back to the free list; the generation moves on
+    // Lists of distinct rows taken as one list, in order: a launch's kill lists, one a chunk.
+    using RowLists = std::span<const std::span<const uint32_t>>;
     // Objects that died alive and nobody reads, freed at once (no frozen state between):
-    // onto the free stack in the order given, each row's generation moved on (distinct
-    // rows: a launch's kill list).
-    void releaseKilled(std::span<const uint32_t> rows);
+    // onto the free stack in the order given, each row's generation moved on.
+    void releaseKilled(RowLists lists);
+    void releaseKilled(std::span<const uint32_t> rows) { releaseKilled(RowLists(&rows, 1)); }
+    // The frozen rows of `lists` (of a type nobody reads) freed, onto the stack in order.
+    void releaseFrozen(RowLists lists) { frozen_ -= releaseRows(lists, Status::Frozen); }
     void freeze(uint32_t row, double at);  // `at`: the time of its last values; its age stays what it was then
-    // freeze of each row (distinct rows: a launch's kills), `at[k]` row k's time (or at[0]
-    // every row's).
-    void freeze(std::span<const uint32_t> rows, std::span<const double> at);
+    // freeze of each row, `at[k]` the k-th row's time (or at[0] every row's).
+    void freeze(RowLists lists, std::span<const double> at);
+    void freeze(std::span<const uint32_t> rows, std::span<const double> at) { freeze(RowLists(&rows, 1), at); }
     // How the bookkeeping of many rows at once runs (allocate, beginStep, freeze of many,
     // releaseKilled): `run(pieces, piece)` calls piece(p) for every p < pieces, on every thread
     // (System's executor). Each row is written by one piece and what goes in order (the
@@ -283,8 +287,16 @@ private:
     // fn(begin, end) over pieces of [0, n): on every thread where runPieces_ is set and the
     // masks are the host's (SyncedMask::direct), else in order.
     void forPieces(size_t n, const std::function<void(size_t, size_t)>& fn) const;
-    // Frees the rows of `rows` (distinct) whose status is `from`, onto the stack in order.
-    size_t releaseRows(std::span<const uint32_t> rows, Status from);
+    // A piece of row lists: rows, and the place of its first in the lists taken as one.
+    struct ListPiece {
+        std::span<const uint32_t> rows;
+        size_t first;
+    };
+    // The lists in pieces of at most detail::kHostRows rows, in order: fn(p, piece) for each,
+    // on every thread as forPieces.
+    void forListPieces(RowLists lists, const std::function<void(size_t, const ListPiece&)>& fn) const;
+    // Frees the rows of `lists` (distinct) whose status is `from`, onto the stack in order.
+    size_t releaseRows(RowLists lists, Status from);
     void restoreInMemory();
     void writeRows();
 };

@@ -30,7 +30,8 @@ namespace {
 const char* parallelismName(Parallelism p) {
     switch (p) {
         case Parallelism::Chunks: return "chunks on every thread";
-        case Parallelism::Ordered: return "in order";
+        case Parallelism::Pieces: return "pieces on every thread";
+        case Parallelism::Memory: return "in the memory";
         case Parallelism::Host: return "host";
     }
     return "?";
@@ -78,7 +79,8 @@ std::string describe(const Schedule& s, const Phase& p) {
                 return fmt::format("{}: the last sub-step's listed kills kept for the step's end (nobody looks at them "
                                    "before); an earlier sub-step's killed rows frozen at once, in row order", type);
             return p.late ? fmt::format("{}: the listed kills kept for the step's end (nobody looks at them before)", type)
-                          : fmt::format("{}: the killed rows frozen, in row order", type);
+                          : fmt::format("{}: the killed rows ({}) frozen, then among the step's deaths in row order", type,
+                                        p.listed ? "its chunks' lists" : "its kill flags read a piece at a time");
         case PhaseKind::Emissions: {
             if (p.inMemory)
                 return fmt::format("{}: {} ({}) decided by the memory's operation over the rows — events, "
@@ -86,7 +88,8 @@ std::string describe(const Schedule& s, const Phase& p) {
                                    "target's objects one run, each site's spawn launches one launch, from the records",
                                    type, p.events ? "rate emissions of the survivors, bursts on edges and deaths" : "rate emissions",
                                    names(s, p.targets));
-            return fmt::format("{}: {} ({}): events, times, ids, the queue", type,
+            return fmt::format("{}: {} ({}): each row's events and times a piece at a time, then the rows that "
+                               "emit queued in row order: ids, the queue", type,
                                p.events ? "rate emissions of the survivors, bursts on edges and deaths" : "rate emissions of the survivors",
                                names(s, p.targets));
         }
@@ -96,8 +99,8 @@ std::string describe(const Schedule& s, const Phase& p) {
                 if (static_cast<size_t>(t) < s.inMemory.size() && s.inMemory[static_cast<size_t>(t)]) kept.push_back(t);
             std::string memory = kept.empty() ? "" : fmt::format(" ({}: rows, ids and creation times by the memory's "
                                                                  "operations)", names(s, kept));
-            return fmt::format("what {} queued ({}) and what that queues: rows, init, bursts, the first update, its kills "
-                               "and emissions{}",
+            return fmt::format("what {} queued ({}) and what that queues: rows (pieces), init and the first update "
+                               "(chunks); bursts, kills and emissions of the new objects in queue order{}",
                                type, names(s, p.targets), memory);
         }
         case PhaseKind::Release: {
@@ -108,7 +111,8 @@ std::string describe(const Schedule& s, const Phase& p) {
                     kept.push_back(q.type);
             std::string memory = kept.empty() ? "" : fmt::format("; {}: the kill lists freed in the memory, counted "
                                                                  "when the backend's counts come", names(s, kept));
-            return "late kills taken in their place; the dead nobody reads freed onto the free stack" + memory;
+            return "late kills taken in their place; the dead nobody reads freed onto the free stack (each piece's "
+                   "rows at the place the counts before it give; a child's parent counted down in order)" + memory;
         }
     }
     return "";
@@ -145,8 +149,8 @@ Schedule stepSchedule(const State& s) {
         p.parallelism = parallelism;
         return p;
     };
-    add(PhaseKind::Settle, -1, Parallelism::Ordered);  // first: a step of no time runs it alone (System::step)
-    add(PhaseKind::Ready, -1, Parallelism::Ordered);
+    add(PhaseKind::Settle, -1, Parallelism::Pieces);  // first: a step of no time runs it alone (System::step)
+    add(PhaseKind::Ready, -1, Parallelism::Pieces);
     // Every type's folds before any update: each sees the others as the last step left them.
     for (size_t t = 0; t < s.types.size(); ++t) {
         const ir::Object& o = s.module.objects[t];
@@ -171,7 +175,7 @@ Schedule stepSchedule(const State& s) {
         update.render = info.render != nullptr && info.drawn[0] && s.options.drawInStep && s.backend.rendersInStep();
         update.inMemory = info.rowsInMemory;
         if (info.kills || info.late) {
-            Phase& kills = add(PhaseKind::Kills, type, Parallelism::Ordered);
+            Phase& kills = add(PhaseKind::Kills, type, info.rowsInMemory ? Parallelism::Memory : Parallelism::Pieces);
             kills.late = info.late;
             kills.listed = listed;
             kills.inMemory = info.rowsInMemory;
@@ -183,7 +187,8 @@ Schedule stepSchedule(const State& s) {
             targets.push_back(target);
         }
         if (info.updateEmits) {
-            Phase& emissions = add(PhaseKind::Emissions, type, Parallelism::Ordered);
+            Phase& emissions =
+                add(PhaseKind::Emissions, type, info.rowsInMemory ? Parallelism::Memory : Parallelism::Pieces);
             emissions.targets = rated;
             emissions.events = info.emitsWhenKilled;
             emissions.inMemory = info.rowsInMemory;  // Memory::emitAtRate
@@ -202,11 +207,11 @@ Schedule stepSchedule(const State& s) {
                                return s.module.objects[static_cast<size_t>(target)].emits.empty() &&
                                       to.parentType < 0 && to.stepLimit == 0;
                            });
-        if (eachSubStep) add(PhaseKind::Create, type, Parallelism::Ordered).targets = targets;
+        if (eachSubStep) add(PhaseKind::Create, type, Parallelism::Pieces).targets = targets;
         if (info.stepLimit > 0) out.phases[group].span = out.phases.size() - group - 1;
-        if (info.updateEmits && !eachSubStep) add(PhaseKind::Create, type, Parallelism::Ordered).targets = targets;
+        if (info.updateEmits && !eachSubStep) add(PhaseKind::Create, type, Parallelism::Pieces).targets = targets;
     }
-    add(PhaseKind::Release, -1, Parallelism::Ordered);
+    add(PhaseKind::Release, -1, Parallelism::Pieces);
     return out;
 }
 

@@ -1,6 +1,7 @@
 // A step as data: the phases System::step runs, in order — per object type, parents
 // before children — each naming the type it works on, what it reads and decides, and how
-// an executor runs it (over chunks of rows on every thread, or in the order a rule needs).
+// an executor runs it (chunks of rows, or pieces of the host's bookkeeping, on every
+// thread; or the memory's operations, where the rows are in the memory).
 // The run-time builds it once per System from what each type's kernels yield (a type
 // that never dies has no kills phase, one that emits nothing no emissions), and
 // System::step walks it; `psysc run --print-schedule` prints it (docs/architecture.md,
@@ -28,7 +29,12 @@ enum class PhaseKind : unsigned char {
 // How an executor runs a phase.
 enum class Parallelism : unsigned char {
     Chunks,   // chunks of rows on every thread the backend allows, independent of their number
-    Ordered,  // in row or queue order (the rules that give ids and rows)
+    // The host's bookkeeping in pieces of rows (detail::kHostRows) on every thread: what goes
+    // in order (ids, the free stack, the deaths, the queue) goes at the places each piece's
+    // count gives, or, for the few rows that emit, queued in row order after the pieces.
+    Pieces,
+    Memory,   // the memory's operations over every row (a device's threads; the host's memory's in
+              // order), only totals to the host
     Host,     // on the host, a few values (no rows)
 };
 

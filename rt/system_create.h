@@ -10,6 +10,7 @@
 #include <span>
 #include <vector>
 
+#include "rt/emission.h"
 #include "rt/system_state.h"
 
 namespace psys::rt::detail {
@@ -44,6 +45,14 @@ public:
     // count, at t1 — a dying object's too (its death is this update's event).
     void emitInUpdate(const Emitter& emitter, std::span<const float> rate, std::span<const float> count, double dt,
                       double t1, bool dying);
+    // emitInUpdate in two halves. The first decides row `row`'s emission at each site of
+    // `o` (out[site]; children 0 where it emits nothing), moving on the row's own rate
+    // accumulators alone (accumulated[site], null where the site has none): rows decide
+    // theirs on every thread. The second queues them, sites in order, and counts their
+    // invalid and clamped values; queued in row order, they give emitInUpdate's ids.
+    static void emissionsOf(const ir::Object& o, double* const* accumulated, uint32_t row, std::span<const float> rate,
+                            std::span<const float> count, double dt, double t1, bool dying, RateEmission* out);
+    void queueEmissions(const Emitter& emitter, std::span<const RateEmission> emissions);
     // The emissions of `type`'s rows that the memory decides (TypeInfo::rowsInMemory,
     // Memory::emitAtRate): its pool's after an update (`table` its update table), or a
     // batch's just created (`batch`: its rows [first, first + n) of `table`, clocked from

@@ -79,20 +79,32 @@ void Creation::enqueue(const Run& run) {
 
 void Creation::emitInUpdate(const Emitter& e, std::span<const float> rate, std::span<const float> count, double dt,
                             double t1, bool dying) {
-    Pool& pool = s_.pools[e.type];
+    const Pool& pool = s_.pools[e.type];
     const ir::Object& o = pool.object();
+    std::vector<double*> accumulated(o.emits.size(), nullptr);
+    for (size_t site = 0; site < o.emits.size(); ++site)
+        if (o.emits[site].rate()) accumulated[site] = s_.host<double>(pool.emitted[site]);
+    std::vector<RateEmission> emissions(o.emits.size());
+    emissionsOf(o, accumulated.data(), e.row, rate, count, dt, t1, dying, emissions.data());
+    queueEmissions(e, emissions);
+}
+
+void Creation::emissionsOf(const ir::Object& o, double* const* accumulated, uint32_t row, std::span<const float> rate,
+                           std::span<const float> count, double dt, double t1, bool dying, RateEmission* out) {
     for (size_t site = 0; site < o.emits.size(); ++site) {
+        out[site] = {};
         if (o.emits[site].whenKilled()) {  // (an edge's burst too: the update yields its count where it fired)
-            RateEmission b = burst(count[site], t1);
-            s_.stats.invalidEmissions += b.invalid;
-            s_.stats.clampedEmissions += b.clamped;
-            if (b.children) queueChildren(e, static_cast<int>(site), b.children, b.perEvent, b.firstTime, b.spacing);
-            continue;
+            out[site] = burst(count[site], t1);
+        } else if (o.emits[site].rate() && !dying) {
+            out[site] = rateEmission(accumulated[site][row], rate[site], count[site], dt, t1);
+            accumulated[site][row] = out[site].accumulated;
         }
-        if (!o.emits[site].rate() || dying) continue;
-        double& accumulated = s_.host<double>(pool.emitted[site])[e.row];
-        RateEmission r = rateEmission(accumulated, rate[site], count[site], dt, t1);
-        accumulated = r.accumulated;
+    }
+}
+
+void Creation::queueEmissions(const Emitter& e, std::span<const RateEmission> emissions) {
+    for (size_t site = 0; site < emissions.size(); ++site) {
+        const RateEmission& r = emissions[site];
         s_.stats.invalidEmissions += r.invalid;
         s_.stats.clampedEmissions += r.clamped;
         if (r.children) queueChildren(e, static_cast<int>(site), r.children, r.perEvent, r.firstTime, r.spacing);

@@ -82,17 +82,44 @@ void runEmissions(State& s, Creation& creation, size_t type, double dt, double t
         source(info.rated[site], layout.emitRate(i), rate[site], rates[site]);
         source(info.counted[site], layout.emitCount(i), count[site], counts[site]);
     }
-    auto dying = work.pass.dying.begin();  // (in row order)
-    for (uint32_t row = 0; row < pool.rows(); ++row) {
-        bool died = dying != work.pass.dying.end() && *dying == row;
-        if (died) ++dying;
-        if (!updatable[row] && !died) continue;
-        for (size_t site = 0; site < o.emits.size(); ++site) {
-            if (rates[site]) rate[site] = rates[site][row];
-            if (counts[site]) count[site] = counts[site][row];
+    // Each row's emissions decided a piece of rows at a time on every thread (each moves
+    // its own accumulators on), those that emit kept; then queued in row order: ids, rows
+    // and the queue as one row at a time would give them.
+    const size_t sites = o.emits.size();
+    std::vector<double*> accumulated(sites, nullptr);
+    for (size_t site = 0; site < sites; ++site)
+        if (o.emits[site].rate()) accumulated[site] = s.host<double>(pool.emitted[site]);
+    struct Piece {
+        std::vector<uint32_t> rows;            // the rows that emit or count something, in order
+        std::vector<RateEmission> emissions;   // theirs, `sites` a row
+    };
+    std::vector<Piece> pieces((pool.rows() + kHostRows - 1) / kHostRows);
+    const std::vector<uint32_t>& died = work.pass.dying;  // (in row order)
+    s.forRows(0, pool.rows(), [&](size_t begin, size_t end) {
+        Piece& piece = pieces[begin / kHostRows];
+        std::vector<float> rowRate = rate, rowCount = count;
+        std::vector<RateEmission> e(sites);
+        auto dying = std::lower_bound(died.begin(), died.end(), begin);
+        for (size_t row = begin; row < end; ++row) {
+            bool dies = dying != died.end() && *dying == row;
+            if (dies) ++dying;
+            if (!updatable[row] && !dies) continue;
+            for (size_t site = 0; site < sites; ++site) {
+                if (rates[site]) rowRate[site] = rates[site][row];
+                if (counts[site]) rowCount[site] = counts[site][row];
+            }
+            Creation::emissionsOf(o, accumulated.data(), static_cast<uint32_t>(row), rowRate, rowCount, dt, t1, dies,
+                                  e.data());
+            if (std::none_of(e.begin(), e.end(), [](const RateEmission& x) { return x.children || x.invalid || x.clamped; }))
+                continue;
+            piece.rows.push_back(static_cast<uint32_t>(row));
+            piece.emissions.insert(piece.emissions.end(), e.begin(), e.end());
         }
-        creation.emitInUpdate({type, row, {}, row, t1, false}, rate, count, dt, t1, died);
-    }
+    });
+    for (const Piece& piece : pieces)
+        for (size_t i = 0; i < piece.rows.size(); ++i)
+            creation.queueEmissions({type, piece.rows[i], {}, piece.rows[i], t1, false},
+                                    std::span(piece.emissions).subspan(i * sites, sites));
     creation.runSpawns();  // before the next sub-step's update moves the emitters on
 }
 
@@ -122,18 +149,29 @@ void runKills(State& s, size_t type, double dt, double t1) {
     }
     if (work.pass.listed) {
         const double at = t1 - dt;
-        for (size_t c = 0; c < chunks; ++c) s.ledger.kill(type, work.killed[c].rows, {&at, 1});
+        std::vector<std::span<const uint32_t>> lists;  // (taken at once: on every thread)
+        for (size_t c = 0; c < chunks; ++c) lists.push_back(work.killed[c].rows);
+        s.ledger.kill(type, lists, {&at, 1});
         return;
     }
     if (!info.kills) return;
+    // The flags read a piece at a time on every thread, each piece's killed rows a list;
+    // the lists taken as one, in row order.
     const Pool& pool = s.pools[type];
     const uint8_t* updatable = pool.mask();
     const auto* kill = s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]);
-    for (uint32_t row = 0; row < pool.rows(); ++row)
-        if (updatable[row] && kill[row]) {
-            if (info.emitsWhenKilled) work.pass.dying.push_back(row);
-            s.ledger.kill(type, row, t1 - dt);
-        }
+    std::vector<std::vector<uint32_t>> pieces((pool.rows() + kHostRows - 1) / kHostRows);
+    s.forRows(0, pool.rows(), [&](size_t begin, size_t end) {
+        std::vector<uint32_t>& killed = pieces[begin / kHostRows];
+        for (size_t row = begin; row < end; ++row)
+            if (updatable[row] && kill[row]) killed.push_back(static_cast<uint32_t>(row));
+    });
+    std::vector<std::span<const uint32_t>> lists(pieces.begin(), pieces.end());
+    if (info.emitsWhenKilled)
+        for (const std::vector<uint32_t>& killed : pieces)
+            work.pass.dying.insert(work.pass.dying.end(), killed.begin(), killed.end());
+    const double at = t1 - dt;
+    s.ledger.kill(type, lists, {&at, 1});
 }
 
 namespace {

@@ -47,8 +47,9 @@ TEST_CASE("a step's schedule has a phase for what each type does, and none for w
     // The rocket emits: its kills come from the kill flags, in row order, before it emits.
     CHECK_FALSE(s.phases[6].late);
     CHECK(s.phases[8].targets == std::vector<int>{0});
+    // Every phase on every thread: updates in chunks, the bookkeeping in pieces.
     CHECK(s.phases[2].parallelism == rt::Parallelism::Chunks);
-    CHECK(s.phases[7].parallelism == rt::Parallelism::Ordered);
+    for (size_t p : {0, 1, 3, 6, 7, 8, 9}) CHECK(s.phases[p].parallelism == rt::Parallelism::Pieces);
 }
 
 TEST_CASE("under @step a type's update, kills and emissions repeat per sub-step — its creation does not") {
@@ -151,7 +152,7 @@ TEST_CASE("the schedule says which types keep their rows in the memory, and wher
                        "the memory") != std::string::npos);
     CHECK(printed.find("d: the kill lists kept for the step's end, where the memory frees them; an earlier sub-step's "
                        "taken out of the masks there at once") != std::string::npos);
-    CHECK(printed.find("  emissions  in order                 e: rate emissions (d) decided by the memory's operation") !=
+    CHECK(printed.find("  emissions  in the memory            e: rate emissions (d) decided by the memory's operation") !=
           std::string::npos);
     // An emitter of two types of emitters: the memory decides its emissions too (a
     // generation's batches go type by type wherever its runs were decided).
