@@ -279,7 +279,7 @@ int main(int argc, char** argv) {
     std::cout << fmt::format("STREAM triad: {:.1f} GB/s on 1 thread, {:.1f} GB/s on {} threads\n\n", bandwidth1 / 1e9,
                              bandwidthAll / 1e9, cores);
 
-    std::string breakdown;
+    std::string breakdown, scaling;
     nlohmann::json rows = nlohmann::json::array();
     std::map<std::pair<std::string, double>, Rate> jitAllCores;  // for --gpu
     std::cout << "| effect | live | threads | psys JIT | hand SoA | hand AoS | JIT / SoA | JIT / AoS | bound | JIT / bound |\n";
@@ -307,6 +307,7 @@ int main(int argc, char** argv) {
                 aos->step(1.0f / 60);
             }
             double bytes = stateBytes(system.module().objects[type]);  // of the relaxed program the JIT runs
+            double oneThread = 0;  // the JIT's updates a second on 1 thread (for the scaling)
             for (unsigned threads : {1u, cores}) {
                 system.setThreads(threads);
                 soa->setThreads(threads);
@@ -380,6 +381,11 @@ int main(int argc, char** argv) {
                                 {"creation_ns", created > 0 ? (after.createSeconds - before.createSeconds) * 1e9 / created : 0.0},
                                 {"drawing_ms", drawMs},
                                 {"drawing_share", drawMs / stepMs}});
+                if (threads == 1) oneThread = j.perSecond;
+                else
+                    scaling += fmt::format("| {} | {:.2g} | {:.2f} | {:.2f} | {:.2f} |\n", name, j.live,
+                                           j.perSecond / oneThread, bandwidthAll / bandwidth1,
+                                           j.perSecond / oneThread / (bandwidthAll / bandwidth1));
                 std::cout << fmt::format("| {} | {:.2g} | {} | {:.0f} | {:.0f} | {:.0f} | {:.2f} | {:.2f} | {:.0f} | {:.0f}% |\n",
                                          name, j.live, threads, j.perSecond / 1e6, s.perSecond / 1e6,
                                          a.perSecond / 1e6, j.perSecond / s.perSecond, j.perSecond / a.perSecond,
@@ -397,6 +403,11 @@ int main(int argc, char** argv) {
                  "drawing | in draw() | drawing / step | live SoA / AoS |\n"
                  "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n"
               << breakdown << "\n";
+    if (cores > 1)
+        std::cout << fmt::format("How the JIT's steps scale from 1 thread to {} beside the STREAM triad's own scaling:\n\n"
+                                 "| effect | live | JIT {}t ÷ 1t | triad {}t ÷ 1t | JIT's ÷ triad's |\n|---|---:|---:|---:|---:|\n",
+                                 cores, cores, cores)
+                  << scaling << "\n";
 
     if (gpuToo) {
         auto gpu = bench::gpuBackend("psys_bench: --gpu");

@@ -333,15 +333,20 @@ void Ledger::free(Deaths& deaths, std::vector<LateKills>& lates) {
     // rule of `release`, after.
     size_t next = 0;
     Deaths kept;
-    auto releaseUpTo = [&](size_t at) {
+    std::vector<std::vector<uint32_t>> own(s_.types.size());
+    auto releaseUpTo = [&](size_t at) {  // (each simple type's rows in their order: a list freed in pieces)
+        for (auto& rows : own) rows.clear();
         for (; next < at; ++next) {
             auto [type, row] = deaths[next];
             const TypeInfo& info = s_.types[type];
-            Pool& pool = s_.pools[type];
             if (info.read || info.parentType >= 0)
                 kept.push_back(deaths[next]);
-            else if (pool.status(row) == Status::Frozen)
-                pool.release(row);
+            else
+                own[type].push_back(row);
+        }
+        for (size_t type = 0; type < own.size(); ++type) {
+            std::span<const uint32_t> rows = own[type];
+            if (!rows.empty()) s_.pools[type].releaseFrozen(Pool::RowLists(&rows, 1));
         }
     };
     for (LateKills& l : lates) {

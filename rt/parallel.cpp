@@ -1,5 +1,8 @@
 #include "rt/parallel.h"
 
+#include <algorithm>
+
+#include <tbb/info.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -7,7 +10,11 @@ namespace psys::rt::detail {
 
 struct Parallel::Arena {
     tbb::task_arena arena;
-    explicit Arena(unsigned threads) : arena(threads ? static_cast<int>(threads) : tbb::task_arena::automatic) {}
+    // (More threads than TBB's workers and this one, the machine's cores, run on no more of
+    // them, and TBB warns on stderr at each request: asked for as many as there are.)
+    explicit Arena(unsigned threads)
+        : arena(threads ? std::min(static_cast<int>(threads), tbb::info::default_concurrency())
+                        : tbb::task_arena::automatic) {}
 };
 
 // The arena's threads asked for now, not by the first step with two chunks: starting them
