@@ -331,6 +331,7 @@ size_t Pool::releaseRows(RowLists lists, Status from) {
     for (size_t p = 0; p < pieces; ++p) at[p + 1] += at[p];
     size_t top = freeRows_.size();
     freeRows_.resize(top + at[pieces]);
+    std::atomic<bool> twice = false;  // a piece that freed fewer than it counted: a row twice in it
     forListPieces(lists, [&](size_t p, const ListPiece& piece) {
         uint32_t* stack = freeRows_.data() + top + at[p];
         for (uint32_t row : piece.rows) {
@@ -343,7 +344,10 @@ size_t Pool::releaseRows(RowLists lists, Status from) {
             ++generation_[row];
             *stack++ = row;
         }
+        if (stack != freeRows_.data() + top + at[p + 1]) twice = true;
     });
+    // (The stack would hold rows never written: a broken rule of the caller's, said, not used.)
+    if (twice) throw std::logic_error("Pool::releaseRows: a row listed twice");
     return at[pieces];
 }
 
