@@ -115,8 +115,10 @@ public:
 
 private:
     void releaseForReload(LateKills& late);  // (one type's kill lists; its waiting rows after)
-    // (type, row) of each death, in order; no row twice (a row dies once: kill takes only
-    // the living), so a type's rows free in pieces on every thread (Pool::releaseFrozen).
+    // (type, row) of each death, in order; no row twice, so a type's rows free in pieces on
+    // every thread (Pool::releaseFrozen): kill of a row takes only the living, and the
+    // lists kill and take are of living rows (an update's kill lists: its updatable rows;
+    // a batch's: rows it just created).
     using Deaths = std::vector<std::pair<size_t, uint32_t>>;
     struct Owed {
         Deaths dying;

@@ -284,11 +284,17 @@ void Pool::release(uint32_t row) {
 
 void Pool::forListPieces(RowLists lists, const std::function<void(size_t, const ListPiece&)>& fn) const {
     std::vector<ListPiece> pieces;
-    size_t first = 0;
-    for (std::span<const uint32_t> list : lists) {
-        for (size_t at = 0; at < list.size(); at += detail::kHostRows)
-            pieces.push_back({list.subspan(at, std::min(detail::kHostRows, list.size() - at)), first + at});
-        first += list.size();
+    size_t total = 0;
+    for (std::span<const uint32_t> list : lists) total += list.size();
+    // Where each piece starts: a walk over the lists' sizes (a list a chunk: few).
+    for (size_t l = 0, at = 0, first = 0; first < total; first += detail::kHostRows) {
+        while (at == lists[l].size()) ++l, at = 0;
+        pieces.push_back({lists, l, at, first, std::min(detail::kHostRows, total - first)});
+        for (size_t left = pieces.back().count; left > 0;) {  // on past this piece's rows
+            size_t take = std::min(left, lists[l].size() - at);
+            left -= take, at += take;
+            if (left > 0) ++l, at = 0;
+        }
     }
     if (pieces.size() > 1 && runPieces_ && updatable.direct() && alive.direct()) {
         runPieces_(pieces.size(), [&](size_t p) { fn(p, pieces[p]); });
@@ -301,15 +307,14 @@ void Pool::freeze(RowLists lists, std::span<const double> at) {
     std::atomic<size_t> frozen = 0;
     forListPieces(lists, [&](size_t, const ListPiece& piece) {
         size_t its = 0;
-        for (size_t k = 0; k < piece.rows.size(); ++k) {
-            uint32_t row = piece.rows[k];
-            if (status_[row] != Status::Alive) continue;
+        piece.each([&](size_t k, uint32_t row) {
+            if (status_[row] != Status::Alive) return;
             status_[row] = Status::Frozen;
-            diedAt[row] = at[at.size() == 1 ? 0 : piece.first + k];
+            diedAt[row] = at[at.size() == 1 ? 0 : k];
             updatable.set(row, 0);
             alive.set(row, 0);
             ++its;
-        }
+        });
         frozen += its;
     });
     live_ -= frozen;
@@ -320,12 +325,13 @@ void Pool::freeze(RowLists lists, std::span<const double> at) {
 // its place on the stack (the places a prefix sum of the counts). The rows are distinct (a
 // launch's kill lists): no two pieces touch one row.
 size_t Pool::releaseRows(RowLists lists, Status from) {
-    std::vector<size_t> at(1, 0);
-    for (std::span<const uint32_t> list : lists) at.resize(at.size() + (list.size() + detail::kHostRows - 1) / detail::kHostRows);
-    const size_t pieces = at.size() - 1;
+    size_t total = 0;
+    for (std::span<const uint32_t> list : lists) total += list.size();
+    const size_t pieces = (total + detail::kHostRows - 1) / detail::kHostRows;
+    std::vector<size_t> at(pieces + 1, 0);
     forListPieces(lists, [&](size_t p, const ListPiece& piece) {
         size_t its = 0;
-        for (uint32_t row : piece.rows) its += status_[row] == from;
+        piece.each([&](size_t, uint32_t row) { its += status_[row] == from; });
         at[p + 1] = its;
     });
     for (size_t p = 0; p < pieces; ++p) at[p + 1] += at[p];
@@ -334,16 +340,16 @@ size_t Pool::releaseRows(RowLists lists, Status from) {
     std::atomic<bool> twice = false;  // a piece that freed fewer than it counted: a row twice in it
     forListPieces(lists, [&](size_t p, const ListPiece& piece) {
         uint32_t* stack = freeRows_.data() + top + at[p];
-        for (uint32_t row : piece.rows) {
+        piece.each([&](size_t, uint32_t row) {
             if (from == Status::Alive) {  // (releaseKilled: every row's masks cleared)
                 updatable.set(row, 0);
                 alive.set(row, 0);
             }
-            if (status_[row] != from) continue;
+            if (status_[row] != from) return;
             status_[row] = Status::Free;
             ++generation_[row];
             *stack++ = row;
-        }
+        });
         if (stack != freeRows_.data() + top + at[p + 1]) twice = true;
     });
     // (The stack would hold rows never written: a broken rule of the caller's, said, not used.)

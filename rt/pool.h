@@ -287,13 +287,21 @@ private:
     // fn(begin, end) over pieces of [0, n): on every thread where runPieces_ is set and the
     // masks are the host's (SyncedMask::direct), else in order.
     void forPieces(size_t n, const std::function<void(size_t, size_t)>& fn) const;
-    // A piece of row lists: rows, and the place of its first in the lists taken as one.
+    // Rows [first, first + count) of row lists taken as one list, the first of them at
+    // lists[list][at]: a piece spans as many lists as it takes (a chunk's kill list is
+    // often a few rows), so the pieces are detail::kHostRows rows whatever the lists.
     struct ListPiece {
-        std::span<const uint32_t> rows;
-        size_t first;
+        RowLists lists;
+        size_t list, at, first, count;
+        template <typename F>  // f(k, row) for each row, k its place in the lists taken as one
+        void each(F&& f) const {
+            for (size_t l = list, i = at, k = first; k < first + count; ++k, ++i) {
+                while (i == lists[l].size()) ++l, i = 0;
+                f(k, lists[l][i]);
+            }
+        }
     };
-    // The lists in pieces of at most detail::kHostRows rows, in order: fn(p, piece) for each,
-    // on every thread as forPieces.
+    // fn(p, piece) for the lists' pieces in order, on every thread as forPieces.
     void forListPieces(RowLists lists, const std::function<void(size_t, const ListPiece&)>& fn) const;
     // Frees the rows of `lists` (distinct) whose status is `from`, onto the stack in order.
     size_t releaseRows(RowLists lists, Status from);

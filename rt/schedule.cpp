@@ -175,7 +175,9 @@ Schedule stepSchedule(const State& s) {
         update.render = info.render != nullptr && info.drawn[0] && s.options.drawInStep && s.backend.rendersInStep();
         update.inMemory = info.rowsInMemory;
         if (info.kills || info.late) {
-            Phase& kills = add(PhaseKind::Kills, type, info.rowsInMemory ? Parallelism::Memory : Parallelism::Pieces);
+            // (late kills on the host: their lists handed to the ledger, no rows touched)
+            Phase& kills = add(PhaseKind::Kills, type,
+                               info.rowsInMemory ? Parallelism::Memory : info.late ? Parallelism::Host : Parallelism::Pieces);
             kills.late = info.late;
             kills.listed = listed;
             kills.inMemory = info.rowsInMemory;

@@ -47,9 +47,11 @@ TEST_CASE("a step's schedule has a phase for what each type does, and none for w
     // The rocket emits: its kills come from the kill flags, in row order, before it emits.
     CHECK_FALSE(s.phases[6].late);
     CHECK(s.phases[8].targets == std::vector<int>{0});
-    // Every phase on every thread: updates in chunks, the bookkeeping in pieces.
+    // Every phase on every thread: updates in chunks, the bookkeeping in pieces; late kills
+    // are only handed to the ledger (the host's: no rows).
     CHECK(s.phases[2].parallelism == rt::Parallelism::Chunks);
-    for (size_t p : {0, 1, 3, 6, 7, 8, 9}) CHECK(s.phases[p].parallelism == rt::Parallelism::Pieces);
+    CHECK(s.phases[3].parallelism == rt::Parallelism::Host);
+    for (size_t p : {0, 1, 6, 7, 8, 9}) CHECK(s.phases[p].parallelism == rt::Parallelism::Pieces);
 }
 
 TEST_CASE("under @step a type's update, kills and emissions repeat per sub-step — its creation does not") {
