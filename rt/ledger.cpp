@@ -18,8 +18,7 @@ void Ledger::kill(size_t type, uint32_t row, double at) {
 }
 
 void Ledger::kill(size_t type, Pool::RowLists lists, std::span<const double> at) {
-    size_t total = 0;
-    for (std::span<const uint32_t> rows : lists) total += rows.size();
+    const size_t total = Pool::rowCount(lists);
     if (total == 0) return;
     s_.typeStats[type].killed += total;
     s_.pools[type].freeze(lists, at);

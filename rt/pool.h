@@ -125,6 +125,11 @@ public:
     void release(uint32_t row);  // back to the free list; the generation moves on
     // Lists of distinct rows taken as one list, in order: a launch's kill lists, one a chunk.
     using RowLists = std::span<const std::span<const uint32_t>>;
+    static size_t rowCount(RowLists lists) {
+        size_t n = 0;
+        for (std::span<const uint32_t> list : lists) n += list.size();
+        return n;
+    }
     // Objects that died alive and nobody reads, freed at once (no frozen state between):
     // onto the free stack in the order given, each row's generation moved on.
     void releaseKilled(RowLists lists);

@@ -75,8 +75,7 @@ void Pool::release(uint32_t row) {
 
 void Pool::forListPieces(RowLists lists, const std::function<void(size_t, const ListPiece&)>& fn) const {
     std::vector<ListPiece> pieces;
-    size_t total = 0;
-    for (std::span<const uint32_t> list : lists) total += list.size();
+    const size_t total = rowCount(lists);
     // Where each piece starts: a walk over the lists' sizes (a list a chunk: few).
     for (size_t l = 0, at = 0, first = 0; first < total; first += detail::kHostRows) {
         while (at == lists[l].size()) ++l, at = 0;
@@ -116,8 +115,7 @@ void Pool::freeze(RowLists lists, std::span<const double> at) {
 // its place on the stack (the places a prefix sum of the counts). The rows are distinct (a
 // launch's kill lists): no two pieces touch one row.
 size_t Pool::releaseRows(RowLists lists, Status from) {
-    size_t total = 0;
-    for (std::span<const uint32_t> list : lists) total += list.size();
+    const size_t total = rowCount(lists);
     const size_t pieces = (total + detail::kHostRows - 1) / detail::kHostRows;
     std::vector<size_t> at(pieces + 1, 0);
     forListPieces(lists, [&](size_t p, const ListPiece& piece) {

@@ -53,6 +53,8 @@ public:
     static void emissionsOf(const ir::Object& o, double* const* accumulated, uint32_t row, std::span<const float> rate,
                             std::span<const float> count, double dt, double t1, bool dying, RateEmission* out);
     void queueEmissions(const Emitter& emitter, std::span<const RateEmission> emissions);
+    // `type`'s rate accumulators, a column a site (null where a site has none): emissionsOf's.
+    std::vector<double*> accumulators(size_t type) const;
     // The emissions of `type`'s rows that the memory decides (TypeInfo::rowsInMemory,
     // Memory::emitAtRate): its pool's after an update (`table` its update table), or a
     // batch's just created (`batch`: its rows [first, first + n) of `table`, clocked from

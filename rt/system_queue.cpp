@@ -81,12 +81,18 @@ void Creation::emitInUpdate(const Emitter& e, std::span<const float> rate, std::
                             double t1, bool dying) {
     const Pool& pool = s_.pools[e.type];
     const ir::Object& o = pool.object();
-    std::vector<double*> accumulated(o.emits.size(), nullptr);
-    for (size_t site = 0; site < o.emits.size(); ++site)
-        if (o.emits[site].rate()) accumulated[site] = s_.host<double>(pool.emitted[site]);
+    std::vector<double*> accumulated = accumulators(e.type);
     std::vector<RateEmission> emissions(o.emits.size());
     emissionsOf(o, accumulated.data(), e.row, rate, count, dt, t1, dying, emissions.data());
     queueEmissions(e, emissions);
+}
+
+std::vector<double*> Creation::accumulators(size_t type) const {
+    const Pool& pool = s_.pools[type];
+    std::vector<double*> out(pool.object().emits.size(), nullptr);
+    for (size_t site = 0; site < out.size(); ++site)
+        if (pool.object().emits[site].rate()) out[site] = s_.host<double>(pool.emitted[site]);
+    return out;
 }
 
 void Creation::emissionsOf(const ir::Object& o, double* const* accumulated, uint32_t row, std::span<const float> rate,

@@ -86,9 +86,7 @@ void runEmissions(State& s, Creation& creation, size_t type, double dt, double t
     // its own accumulators on), those that emit kept; then queued in row order: ids, rows
     // and the queue as one row at a time would give them.
     const size_t sites = o.emits.size();
-    std::vector<double*> accumulated(sites, nullptr);
-    for (size_t site = 0; site < sites; ++site)
-        if (o.emits[site].rate()) accumulated[site] = s.host<double>(pool.emitted[site]);
+    const std::vector<double*> accumulated = creation.accumulators(type);
     struct Piece {
         std::vector<uint32_t> rows;            // the rows that emit or count something, in order
         std::vector<RateEmission> emissions;   // theirs, `sites` a row
