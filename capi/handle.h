@@ -19,6 +19,9 @@ struct psys_system {
     std::vector<psys::capi::OwnedDiagnostic> warnings;  // of the latest compilation that took
     // The spelled types of externs and triggers (psys_input::type), made at each compilation.
     std::vector<std::string> externTypes, triggerTypes;
+    // The stats read last (psys_get_stats, psys_get_type_stats): kept, so that reading them
+    // every frame allocates nothing.
+    mutable psys::rt::Stats stats;
     // Fills the spelled types from the system's module.
     void describe();
 };

@@ -222,7 +222,8 @@ psys_error* psys_get_stats(const psys_system* s, psys_stats* out) {
     if (!s) return nullArgument("psys_get_stats", "the system");
     if (!out) return nullArgument("psys_get_stats", "the place for the stats (out)");
     return guarded("psys_get_stats", [&]() -> psys_error* {
-        rt::Stats st = s->system().stats();
+        rt::Stats& st = s->stats;
+        s->system().stats(st);
         *out = {st.steps,          st.rejectedSteps,   st.nonFiniteExterns + st.outOfRangeExterns,
                 st.invalidEmissions, st.nonFiniteRender, st.loopSeconds,
                 st.emitSeconds,    st.createSeconds,   st.drawSeconds,
@@ -236,7 +237,8 @@ psys_error* psys_get_type_stats(const psys_system* s, size_t type, psys_type_sta
     if (!out) return nullArgument("psys_get_type_stats", "the place for the stats (out)");
     if (type >= s->system().typeCount()) return badType("psys_get_type_stats", s, type);
     return guarded("psys_get_type_stats", [&]() -> psys_error* {
-        rt::Stats st = s->system().stats();
+        rt::Stats& st = s->stats;
+        s->system().stats(st);
         const rt::TypeStats& t = st.types.at(type);
         *out = {t.live, t.created, t.killed, t.dropped, t.unstable};
         return nullptr;

@@ -11,11 +11,16 @@ using namespace ir;
 using rt::Buffer;
 using rt::ColumnLayout;
 
+// Each thread's addresses of the launch it runs, kept from launch to launch (a step
+// allocates nothing); one launch at a time on a thread.
+thread_local std::vector<void*> launchAddresses;
+
 // The columns of a launch's table on host memory, their addresses looked up once.
 struct Columns {
-    std::vector<void*> address;
+    std::vector<void*>& address = launchAddresses;
 
-    Columns(rt::Memory& memory, std::span<const Buffer> table) : address(table.size(), nullptr) {
+    Columns(rt::Memory& memory, std::span<const Buffer> table) {
+        address.assign(table.size(), nullptr);
         for (size_t i = 0; i < table.size(); ++i)
             if (table[i].valid()) address[i] = memory.host(table[i]);
     }
@@ -182,7 +187,9 @@ void Interpreter::run(const rt::ChildrenLaunch& launch) {
     columns.inputs(*launch.object, *launch.layout, launch.row, params_.data(), state_.data());
     const auto* created = rt::hostData<double>(*memory_, launch.columns[ColumnLayout::kCreated]);
     const auto* ids = rt::hostData<uint32_t>(*memory_, launch.columns[ColumnLayout::kIds]);
-    const std::vector<size_t> firstColumn = rt::argumentColumns(spawn).first;
+    thread_local rt::ArgumentColumns arguments;  // (kept from launch to launch)
+    rt::argumentColumns(spawn, arguments);
+    const std::vector<size_t>& firstColumn = arguments.first;
     KernelInputs in;
     in.params = params_.data();
     in.state = state_.data();

@@ -73,16 +73,21 @@ void* CompiledBackend::function(const Object& o, const Kernel& k, bool children,
     return functions_.at(shape);
 }
 
-std::vector<void*> CompiledBackend::addresses(std::span<const rt::Buffer> columns) {
-    std::vector<void*> out(columns.size(), nullptr);
+void CompiledBackend::addresses(std::span<const rt::Buffer> columns, std::vector<void*>& out) {
+    out.assign(columns.size(), nullptr);
     for (size_t i = 0; i < columns.size(); ++i)
         if (columns[i].valid()) out[i] = memory_.host(columns[i]);
-    return out;
 }
+
+namespace {
+// Each thread's addresses of a launch's columns and arguments (launches run on every thread).
+thread_local std::vector<void*> launchColumns, launchArgs;
+}  // namespace
 
 rt::RowsResult CompiledBackend::run(const rt::RowsLaunch& l) {
     auto fn = reinterpret_cast<RowsFn>(function(*l.object, *l.kernel, false, l.clock.now, l.clock.dt));
-    std::vector<void*> columns = addresses(l.columns);
+    std::vector<void*>& columns = launchColumns;
+    addresses(l.columns, columns);
     const auto* mask = static_cast<const uint8_t*>(memory_.host(l.mask));
     RowCounts counts = fn(columns.data(), mask, static_cast<int64_t>(l.begin), static_cast<int64_t>(l.end), l.externs,
                           l.uniforms, l.clock.nowValue, l.clock.dtValue, l.clock.first ? 1u : 0u, l.seed, l.draw);
@@ -101,8 +106,9 @@ rt::PairFunction CompiledBackend::pairFunction(const Object& object, const Kerne
 
 void CompiledBackend::run(const rt::ChildrenLaunch& l) {
     auto fn = reinterpret_cast<ChildrenFn>(function(*l.object, *l.spawn, true, Clock::Source::Uniform, Clock::Source::Uniform));
-    std::vector<void*> columns = addresses(l.columns);
-    std::vector<void*> args = addresses(l.args);
+    std::vector<void*>&columns = launchColumns, &args = launchArgs;
+    addresses(l.columns, columns);
+    addresses(l.args, args);
     fn(columns.data(), static_cast<int64_t>(l.row), l.parents, l.externs, l.clock.nowValue, l.clock.dtValue,
        l.clock.first ? 1u : 0u, l.seed, l.draw, l.firstChild, static_cast<int64_t>(l.count),
        reinterpret_cast<float* const*>(args.data()), static_cast<int64_t>(l.argsFirst));

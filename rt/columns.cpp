@@ -71,6 +71,13 @@ ColumnLayout columnLayout(const ir::Object& object, const ir::Kernel& kernel) {
 
 ArgumentColumns argumentColumns(const ir::Kernel& spawn) {
     ArgumentColumns a;
+    argumentColumns(spawn, a);
+    return a;
+}
+
+void argumentColumns(const ir::Kernel& spawn, ArgumentColumns& a) {
+    a.first.clear();
+    a.total = 0;
     for (const ir::Yield& y : spawn.yields)
         if (y.kind == ir::YieldKind::EmitArg) {
             auto sub = static_cast<size_t>(y.sub);
@@ -82,7 +89,6 @@ ArgumentColumns argumentColumns(const ir::Kernel& spawn) {
         c = a.total;
         a.total += width;
     }
-    return a;
 }
 
 int ColumnLayout::renderColumn(ir::YieldKind kind, int index) { return ir::drawnColumn(kind, index); }

@@ -127,6 +127,8 @@ struct ArgumentColumns {
     size_t total = 0;
 };
 ArgumentColumns argumentColumns(const ir::Kernel& spawn);
+// The same into `out`, reusing its vector (a launch allocates nothing).
+void argumentColumns(const ir::Kernel& spawn, ArgumentColumns& out);
 
 // Rows per chunk when a launch over a pool is split over threads. Chunks never depend on
 // the number of threads, so every row is computed by the same code path (vector body or

@@ -35,6 +35,11 @@ void Ledger::record(LateKills::Part& part, const RowsResult& result, Buffer flag
     part.counted = false;
     part.rows.clear();
     if (result.ticket || result.killed == 0) return;
+    // (A part's vector is taken again step after step, and the kills of a chunk vary from
+    // step to step: it grows to twice what it needs at least, up to the launch's rows, so
+    // that it grows a few times at most.)
+    if (part.rows.capacity() < result.killed)
+        part.rows.reserve(std::min(std::max(2 * result.killed, 2 * part.rows.capacity()), end - begin));
     if (result.killedRows.size() == result.killed)
         part.rows.assign(result.killedRows.begin(), result.killedRows.end());
     else
@@ -44,6 +49,42 @@ void Ledger::record(LateKills::Part& part, const RowsResult& result, Buffer flag
 void Ledger::defer(LateKills late) {
     late.at = dying_.size();
     late_.push_back(std::move(late));
+}
+
+LateKills Ledger::fresh(size_t parts) {
+    LateKills l;
+    if (!spare_.empty()) {
+        l = std::move(spare_.back());
+        spare_.pop_back();
+    }
+    std::vector<LateKills::Part> kept = std::move(l.parts);
+    std::vector<uint32_t> poolRows = std::move(l.poolRows);
+    std::vector<double> spans = std::move(l.spans);
+    l = {};
+    for (LateKills::Part& part : kept) part.reset();
+    l.parts = std::move(kept);
+    l.poolRows = std::move(poolRows);
+    l.poolRows.clear();
+    l.spans = std::move(spans);
+    l.spans.clear();
+    resizeParts(l, parts);
+    return l;
+}
+
+void Ledger::resizeParts(LateKills& l, size_t parts) {
+    for (; l.parts.size() > parts; l.parts.pop_back()) spareRows_.push_back(std::move(l.parts.back().rows));
+    while (l.parts.size() < parts) {
+        LateKills::Part& part = l.parts.emplace_back();
+        if (spareRows_.empty()) continue;
+        part.rows = std::move(spareRows_.back());
+        part.rows.clear();
+        spareRows_.pop_back();
+    }
+}
+
+void Ledger::recycle(std::vector<LateKills>& lates) {
+    for (LateKills& l : lates) spare_.push_back(std::move(l));
+    lates.clear();
 }
 
 void Ledger::settle(Wait wait) {
@@ -161,9 +202,9 @@ void Ledger::takeOut(LateKills& l, Buffer into, Buffer batchMask) {
 
 void Ledger::deferGathered(size_t type, Buffer into) {
     s_.memory.fill(into, 0, 1, 0);
-    LateKills l;
+    LateKills l = fresh(1);
     l.type = type;
-    LateKills::Part& part = l.parts.emplace_back();
+    LateKills::Part& part = l.parts[0];
     part.killList = into;
     part.listed = part.counted = part.gathered = true;
     defer(std::move(l));
@@ -282,10 +323,11 @@ void Ledger::countParents() {
 
 void Ledger::take(Deaths& dying, std::vector<LateKills>& late) {
     if (late.empty()) return;
-    Deaths merged;
-    merged.reserve(dying.size());
+    Deaths& merged = lists_.merged;
+    merged.clear();
     size_t next = 0;
-    std::vector<LateKills> kept;  // those of types whose rows are in the memory, not freed yet
+    std::vector<LateKills>& kept = lists_.keptLates;  // those of types whose rows are in the memory, not freed yet
+    kept.clear();
     for (LateKills& l : late) {
         if (s_.types[l.type].rowsInMemory) {
             if (l.released) {
@@ -314,8 +356,9 @@ void Ledger::take(Deaths& dying, std::vector<LateKills>& late) {
         }
     }
     for (; next < dying.size(); ++next) merged.push_back(dying[next]);
-    dying = std::move(merged);
-    late = std::move(kept);
+    dying.swap(merged);  // (each keeps its vector for the next)
+    recycle(late);  // (those kept were moved out: their husks are taken again by fresh)
+    late.swap(kept);
 }
 
 void Ledger::free(Deaths& deaths, std::vector<LateKills>& lates) {
@@ -331,8 +374,10 @@ void Ledger::free(Deaths& deaths, std::vector<LateKills>& lates) {
     // in that order: each part goes as one run; the deaths of parents and children by the
     // rule of `release`, after.
     size_t next = 0;
-    Deaths kept;
-    std::vector<std::vector<uint32_t>> own(s_.types.size());
+    Deaths& kept = lists_.kept;
+    kept.clear();
+    std::vector<std::vector<uint32_t>>& own = lists_.own;
+    own.resize(s_.types.size());
     auto releaseUpTo = [&](size_t at) {  // (each simple type's rows in their order: a list freed in pieces)
         for (auto& rows : own) rows.clear();
         for (; next < at; ++next) {
@@ -358,19 +403,23 @@ void Ledger::free(Deaths& deaths, std::vector<LateKills>& lates) {
             // A list of its own each time: take leaves the list it settles holding only what
             // it keeps (nothing here: the type's rows are not in the memory).
             Deaths its;
-            std::vector<LateKills> single;
+            std::vector<LateKills>& single = lists_.single;
+            single.clear();
             single.push_back(std::move(l));
             single[0].at = 0;
             take(its, single);
             kept.insert(kept.end(), its.begin(), its.end());
+            recycle(single);
             continue;
         }
         // Every part's list at once (Pool::releaseKilled in pieces on every thread): a
         // device's lists copied (a collect's rows live until the next), a batch's mapped
         // from its launch rows to its pool rows.
-        std::vector<std::span<const uint32_t>> lists;
-        std::vector<std::vector<uint32_t>> copies;
-        copies.reserve(l.parts.size());
+        std::vector<std::span<const uint32_t>>& lists = lists_.spans;
+        lists.clear();
+        std::vector<std::vector<uint32_t>>& copies = lists_.copies;
+        if (copies.size() < l.parts.size()) copies.resize(l.parts.size());
+        size_t copied = 0;
         for (LateKills::Part& part : l.parts) {
             bool held = !part.ticket;
             std::span<const uint32_t> listed = collect(l.type, part).killedRows;
@@ -379,7 +428,8 @@ void Ledger::free(Deaths& deaths, std::vector<LateKills>& lates) {
                 lists.push_back(listed);
                 continue;
             }
-            std::vector<uint32_t>& rows = copies.emplace_back(listed.begin(), listed.end());
+            std::vector<uint32_t>& rows = copies[copied++];
+            rows.assign(listed.begin(), listed.end());
             if (!l.poolRows.empty())
                 for (uint32_t& row : rows) row = l.poolRows[row - l.first];
             lists.push_back(rows);
@@ -389,7 +439,7 @@ void Ledger::free(Deaths& deaths, std::vector<LateKills>& lates) {
     releaseUpTo(deaths.size());
     release(kept);
     deaths.clear();
-    lates.clear();
+    recycle(lates);
     countParents();
 }
 
@@ -403,7 +453,13 @@ void Ledger::free(Deaths& deaths, std::vector<LateKills>& lates) {
 void Ledger::release(Deaths& deaths) {
     if (deaths.empty()) return;
     const size_t types = s_.types.size();
-    std::vector<std::vector<uint32_t>> own(types), waited(types);
+    std::vector<std::vector<uint32_t>>&own = lists_.own, &waited = lists_.waited;
+    own.resize(types);
+    waited.resize(types);
+    for (size_t type = 0; type < types; ++type) {
+        own[type].clear();
+        waited[type].clear();
+    }
     for (auto [type, row] : deaths) own[type].push_back(row);
     auto free = [&](size_t type, uint32_t row) {
         Pool& pool = s_.pools[type];

@@ -45,6 +45,13 @@ struct LateKills {
         // are counted as the others' parts, where they were taken).
         bool taken = false, gathered = false;
         size_t lists = 0;  // gathered: the parts taken into it (each counts its own)
+        // Empty, as made, its list's vector kept (Ledger::fresh).
+        void reset() {
+            std::vector<uint32_t> kept = std::move(rows);
+            kept.clear();
+            *this = {};
+            rows = std::move(kept);
+        }
     };
     std::vector<Part> parts;
     // A type whose rows are in the memory: its kills freed there at the end of the step,
@@ -77,6 +84,11 @@ public:
     void record(LateKills::Part& part, const RowsResult& result, Buffer flags, size_t begin, size_t end) const;
     // Kills to take late, placed after the deaths known so far.
     void defer(LateKills late);
+    // An empty LateKills with the vectors of one taken before (with `parts` parts, each
+    // empty): a steady-state step allocates none (tests/capi/allocation_test.cpp).
+    LateKills fresh(size_t parts = 0);
+    // l.parts resized to `parts`, a new part with the vector of one dropped before.
+    void resizeParts(LateKills& l, size_t parts);
 
     // Where the backend must be waited for: `Yes` takes everything (what the last step
     // owes and every late kill; before anything takes rows or reads the pools whole: the
@@ -147,11 +159,23 @@ private:
     void releaseInMemory(LateKills& l);
     void countInMemory(LateKills& l);
     void countParents();
+    // The LateKills of `lates` kept for their vectors (fresh gives them again); `lates` emptied.
+    void recycle(std::vector<LateKills>& lates);
 
     State& s_;
     Deaths dying_;
     std::vector<LateKills> late_;
     std::optional<Owed> owed_;
+    // Kept from step to step for their vectors: LateKills taken (fresh), and take's, free's
+    // and release's lists.
+    std::vector<LateKills> spare_;
+    std::vector<std::vector<uint32_t>> spareRows_;  // resizeParts'
+    struct Lists {
+        Deaths merged, kept;
+        std::vector<LateKills> keptLates, single;
+        std::vector<std::vector<uint32_t>> own, waited, copies;
+        std::vector<std::span<const uint32_t>> spans;
+    } lists_;
 };
 
 }  // namespace psys::rt::detail

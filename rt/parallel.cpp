@@ -27,7 +27,7 @@ Parallel::Parallel(unsigned threads) : arena_(std::make_unique<Arena>(threads)) 
 }
 Parallel::~Parallel() = default;
 
-void Parallel::forEach(size_t chunks, bool concurrent, const std::function<void(size_t)>& chunk) {
+void Parallel::forEach(size_t chunks, bool concurrent, core::FunctionRef<void(size_t)> chunk) {
     if (chunks > 1 && concurrent && arena_->arena.max_concurrency() > 1) {
         arena_->arena.execute([&] { tbb::parallel_for(size_t{0}, chunks, chunk); });
         return;

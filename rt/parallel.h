@@ -3,7 +3,7 @@
 #pragma once
 
 #include <cstddef>
-#include <functional>
+#include "core/function_ref.h"
 #include <memory>
 
 namespace psys::rt::detail {
@@ -18,7 +18,7 @@ public:
     ~Parallel();
     // chunk(c) for c in [0, chunks): on several threads when `concurrent` and there is more
     // than one chunk, else in order on this thread.
-    void forEach(size_t chunks, bool concurrent, const std::function<void(size_t)>& chunk);
+    void forEach(size_t chunks, bool concurrent, core::FunctionRef<void(size_t)> chunk);
 
 private:
     struct Arena;

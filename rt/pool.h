@@ -25,6 +25,7 @@
 #include <span>
 #include <vector>
 
+#include "core/function_ref.h"
 #include "ir/ir.h"
 #include "ir/value.h"
 #include "rt/allocation.h"
@@ -145,7 +146,7 @@ public:
     // (System's executor). Each row is written by one piece and what goes in order (the
     // free stack) goes at places a count of each piece gives, so the results are the same
     // bits on any number of threads. Unset: in order on this thread.
-    using PieceRunner = std::function<void(size_t, const std::function<void(size_t)>&)>;
+    using PieceRunner = std::function<void(size_t, core::FunctionRef<void(size_t)>)>;
     void runPiecesWith(PieceRunner run) { runPieces_ = std::move(run); }
     bool matches(Handle h) const {
         fetch();
@@ -291,7 +292,7 @@ private:
     PieceRunner runPieces_;
     // fn(begin, end) over pieces of [0, n): on every thread where runPieces_ is set and the
     // masks are the host's (SyncedMask::direct), else in order.
-    void forPieces(size_t n, const std::function<void(size_t, size_t)>& fn) const;
+    void forPieces(size_t n, core::FunctionRef<void(size_t, size_t)> fn) const;
     // Rows [first, first + count) of row lists taken as one list, the first of them at
     // lists[list][at]: a piece spans as many lists as it takes (a chunk's kill list is
     // often a few rows), so the pieces are detail::kHostRows rows whatever the lists.
@@ -307,7 +308,12 @@ private:
         }
     };
     // fn(p, piece) for the lists' pieces in order, on every thread as forPieces.
-    void forListPieces(RowLists lists, const std::function<void(size_t, const ListPiece&)>& fn) const;
+    void forListPieces(RowLists lists, core::FunctionRef<void(size_t, const ListPiece&)> fn) const;
+    // forListPieces' pieces and releaseRows' places, kept from call to call (a step
+    // allocates nothing); one call at a time.
+    mutable std::vector<ListPiece> listPieces_;
+    std::vector<size_t> pieceStarts_;
+    std::vector<double*> accumulated_;  // allocate's
     // Frees the rows of `lists` (distinct) whose status is `from`, onto the stack in order.
     size_t releaseRows(RowLists lists, Status from);
     void restoreInMemory();

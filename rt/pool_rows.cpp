@@ -18,7 +18,8 @@ size_t Pool::allocate(size_t n, uint32_t* out) {
     FreeRows free{freeRows_.data(), freeRows_.size(), rows(), capacity_};
     size_t kept = std::min(n, free.room());
     if (kept > free.top) grow(free.highWater + (kept - free.top));  // once, for the whole batch
-    std::vector<double*> accumulated;
+    std::vector<double*>& accumulated = accumulated_;  // (kept from call to call: no allocation)
+    accumulated.clear();
     for (Buffer e : emitted) accumulated.push_back(hostData<double>(*memory_, e));
     forPieces(n, [&](size_t begin, size_t end) {  // (row k depends on k alone: rt/allocation.h)
         for (size_t k = begin; k < end; ++k) {
@@ -42,7 +43,7 @@ size_t Pool::allocate(size_t n, uint32_t* out) {
     return kept;
 }
 
-void Pool::forPieces(size_t n, const std::function<void(size_t, size_t)>& fn) const {
+void Pool::forPieces(size_t n, core::FunctionRef<void(size_t, size_t)> fn) const {
     size_t pieces = (n + detail::kHostRows - 1) / detail::kHostRows;
     auto piece = [&](size_t p) { fn(p * detail::kHostRows, std::min(n, (p + 1) * detail::kHostRows)); };
     if (pieces > 1 && runPieces_ && updatable.direct() && alive.direct()) {
@@ -73,8 +74,9 @@ void Pool::release(uint32_t row) {
     freeRows_.push_back(row);
 }
 
-void Pool::forListPieces(RowLists lists, const std::function<void(size_t, const ListPiece&)>& fn) const {
-    std::vector<ListPiece> pieces;
+void Pool::forListPieces(RowLists lists, core::FunctionRef<void(size_t, const ListPiece&)> fn) const {
+    std::vector<ListPiece>& pieces = listPieces_;  // (kept from call to call: no allocation)
+    pieces.clear();
     const size_t total = rowCount(lists);
     // Where each piece starts: a walk over the lists' sizes (a list a chunk: few).
     for (size_t l = 0, at = 0, first = 0; first < total; first += detail::kHostRows) {
@@ -117,7 +119,8 @@ void Pool::freeze(RowLists lists, std::span<const double> at) {
 size_t Pool::releaseRows(RowLists lists, Status from) {
     const size_t total = rowCount(lists);
     const size_t pieces = (total + detail::kHostRows - 1) / detail::kHostRows;
-    std::vector<size_t> at(pieces + 1, 0);
+    std::vector<size_t>& at = pieceStarts_;  // (kept from call to call: no allocation)
+    at.assign(pieces + 1, 0);
     forListPieces(lists, [&](size_t p, const ListPiece& piece) {
         size_t its = 0;
         piece.each([&](size_t, uint32_t row) { its += status_[row] == from; });

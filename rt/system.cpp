@@ -371,16 +371,23 @@ std::vector<RenderPoint> System::points(size_t type) {
 }
 
 Stats System::stats() const {
+    Stats out;
+    stats(out);
+    return out;
+}
+
+void System::stats(Stats& out) const {
     state_->ledger.settle(Wait::No);  // what is ready: else a step late
     drawing_->takeCounts();
     const detail::State& s = *state_;
-    Stats out = s.stats;
-    out.types = s.typeStats;
+    std::vector<TypeStats> types = std::move(out.types);
+    out = s.stats;
+    types = s.typeStats;  // (into the vector and names it had: no allocation when they fit)
+    out.types = std::move(types);
     for (size_t t = 0; t < s.pools.size(); ++t) {
         out.types[t].live = s.pools[t].live();
         out.types[t].frozen = s.pools[t].frozen();
     }
-    return out;
 }
 
 }  // namespace psys::rt

@@ -230,6 +230,8 @@ public:
     // kills a device still owes from the last step (RowsLaunch::late) are counted once it
     // has them ready, without waiting: until then `killed` and `live` are a step behind.
     Stats stats() const;
+    // The same into `out`, reusing its vectors: a host that reads them every frame allocates nothing.
+    void stats(Stats& out) const;
     // Takes everything a device still owes — the last step's late kills, draws' counts —
     // waiting for it: the stats and pools are then exact (before a final report, a
     // comparison of rows).

@@ -163,7 +163,8 @@ void Creation::drawBatch(size_t type, Batch& b, size_t n, double t1) {
     work.inStep.drawn += drawn;
     work.inStep.nonFinite += nonFinite;
     s_.bindPool(type, layout, work.render, work.renderTable);
-    std::vector<std::pair<Buffer, Buffer>> columns;
+    std::vector<std::pair<Buffer, Buffer>>& columns = b.scattered;
+    columns.clear();
     for (int c = 0; c < layout.renderColumns; ++c)
         if (int column = layout.render + c; layout.needs(column))
             columns.push_back({b.renderTable[static_cast<size_t>(column)], work.renderTable[static_cast<size_t>(column)]});
@@ -206,7 +207,8 @@ void Creation::identify(size_t type, Batch& b, size_t n) {
             s_.pools[static_cast<size_t>(info.parentType)].readers[run.parent.row] += static_cast<uint32_t>(kept);
         }
     // Into the pool rows through the memory (the pool's columns may live on a device).
-    s_.scatter(identityColumns(type, table), first, b.poolRows);
+    identityColumns(type, table, b.scattered);
+    s_.scatter(b.scattered, first, b.poolRows);
     for (size_t s : info.zeroedState)  // (what init sets is not)
         for (int c = 0; c < o.state[s].type.width; ++c)
             s_.memory.clear(table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)], first, n);
@@ -214,18 +216,17 @@ void Creation::identify(size_t type, Batch& b, size_t n) {
 
 // A batch's columns that identify its objects in their pool rows — creation times, ids,
 // kept parameters — each with the pool's column it goes to.
-std::vector<std::pair<Buffer, Buffer>> Creation::identityColumns(size_t type, const std::vector<Buffer>& table) const {
+void Creation::identityColumns(size_t type, const std::vector<Buffer>& table,
+                               std::vector<std::pair<Buffer, Buffer>>& columns) const {
     const Pool& pool = s_.pools[type];
     const ir::Object& o = pool.object();
     const ColumnLayout& layout = s_.types[type].updateLayout;
-    std::vector<std::pair<Buffer, Buffer>> columns = {{table[ColumnLayout::kCreated], pool.created},
-                                                      {table[ColumnLayout::kIds], pool.ids}};
+    columns.assign({{table[ColumnLayout::kCreated], pool.created}, {table[ColumnLayout::kIds], pool.ids}});
     for (size_t p = 0; p < o.params.size(); ++p)
         if (pool.paramColumn[p] >= 0)
             for (int c = 0; c < o.params[p].type.width; ++c)
                 columns.push_back({table[static_cast<size_t>(layout.paramOffset[p] + c)],
                                    pool.params.column(static_cast<size_t>(pool.paramColumn[p]), static_cast<size_t>(c))});
-    return columns;
 }
 
 // At creation: init (the state, the bursts' sizes) and the exports, at each object's
@@ -276,7 +277,7 @@ void Creation::atCreation(size_t type, Batch& b, size_t n) {
 // backend allows).
 void Creation::runBatch(const RowsLaunch& launch, size_t first, size_t end, size_t type, LateKills* late) {
     std::atomic<uint64_t> unstable = 0;
-    if (late) late->parts.resize(s_.chunkCount(end - first));
+    if (late) s_.ledger.resizeParts(*late, s_.chunkCount(end - first));
     s_.forChunks(first, end, [&](size_t c, size_t begin, size_t stop) {
         RowsLaunch part = launch;
         part.begin = begin;
@@ -338,7 +339,7 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
         // whether at their creation (after their type's update) or in that update (they
         // were created before it): it takes them at once.
         std::optional<LateKills> late;
-        if (info.late && !s_.work[type].inStep.on) late.emplace();
+        if (info.late && !s_.work[type].inStep.on) late.emplace(s_.ledger.fresh());
         // One update to t1: dt is each object's age then (Clock::Source::SinceCreated).
         advance(type, b, n, kMask, {Clock::Source::Uniform, Clock::Source::SinceCreated, t1, 0, false},
                 late ? &*late : nullptr);
@@ -351,8 +352,10 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
             queued_[type] -= n;
             if (!late && info.kills) {  // (listed in queue order, then frozen on every thread)
                 const auto* kill = s_.view<uint8_t>(b.updateTable[ColumnLayout::kKill]);
-                std::vector<uint32_t> rows;
-                std::vector<double> at;
+                std::vector<uint32_t>& rows = b.killRows;
+                std::vector<double>& at = b.killAt;
+                rows.clear();
+                at.clear();
                 for (size_t r = 0; r < n; ++r)
                     if (b.poolRows[r] != kSkipRow && kill[first + r]) {
                         rows.push_back(b.poolRows[r]);
@@ -442,7 +445,8 @@ void Creation::advance(size_t type, Batch& b, size_t n, size_t maskColumn, const
         launchOn(*info.exports, info.exportsLayout, b.exportsTable, exportMask, nullptr);
     }
     Pool& pool = s_.pools[type];
-    std::vector<std::pair<Buffer, Buffer>> columns;
+    std::vector<std::pair<Buffer, Buffer>>& columns = b.scattered;
+    columns.clear();
     for (size_t s = 0; s < o.state.size(); ++s)
         for (int c = 0; c < o.state[s].type.width; ++c)
             columns.push_back({table[static_cast<size_t>(info.updateLayout.stateOffset[s] + c)],

@@ -54,7 +54,7 @@ public:
                             std::span<const float> count, double dt, double t1, bool dying, RateEmission* out);
     void queueEmissions(const Emitter& emitter, std::span<const RateEmission> emissions);
     // `type`'s rate accumulators, a column a site (null where a site has none): emissionsOf's.
-    std::vector<double*> accumulators(size_t type) const;
+    void accumulators(size_t type, std::vector<double*>& out) const;
     // The emissions of `type`'s rows that the memory decides (TypeInfo::rowsInMemory,
     // Memory::emitAtRate): its pool's after an update (`table` its update table), or a
     // batch's just created (`batch`: its rows [first, first + n) of `table`, clocked from
@@ -171,7 +171,7 @@ private:
     // a fold over nothing: what an object created in the step reads.
     void emptyFolds(size_t type, const ColumnLayout& layout, const std::vector<Buffer>& table, size_t first, size_t n);
     void identify(size_t type, Batch& b, size_t n);
-    std::vector<std::pair<Buffer, Buffer>> identityColumns(size_t type, const std::vector<Buffer>& table) const;
+    void identityColumns(size_t type, const std::vector<Buffer>& table, std::vector<std::pair<Buffer, Buffer>>& out) const;
     void atCreation(size_t type, Batch& b, size_t n);
     // Counts the updates beyond the stability limit in `type`'s stats.
     // `late`: its kills taken at the end of the step, or later (LateKills), listed there.
@@ -198,15 +198,20 @@ private:
     };
 
     State& s_;
-    std::vector<Spawn> spawns_;
+    std::vector<Spawn> spawns_;  // the first spawnsUsed_ queued: the rest kept for their vectors
+    size_t spawnsUsed_ = 0;
     std::vector<ChildrenLaunch> launches_;  // runSpawns' list
     std::vector<Run> queue_;
+    std::vector<Run> grouped_;         // groupByType's
+    std::vector<size_t> groupStart_;   // groupByType's
     std::vector<size_t> queued_;   // per type: objects waiting in the queue
     std::vector<size_t> pending_;  // per type: rows a batch allocated for objects not yet created in order
     std::vector<Staging> staging_;
     std::vector<Batch> batches_;
     std::vector<Value> yields_;
     std::vector<float> rate_, count_;
+    std::vector<double*> accumulated_;       // emitInUpdate's
+    std::vector<RateEmission> rowEmissions_;  // emitInUpdate's
     Scratch emissions_;  // emitInMemory's: a new batch's accumulators by site,
     Scratch runs_;       // and the runs of each call in a drain (runsUsed_ of them so far)
     size_t runsUsed_ = 0;
@@ -237,6 +242,11 @@ struct Creation::Batch {
     std::vector<uint32_t> poolRows;    // per object of the batch: its pool row, or kSkipRow (dropped)
     std::vector<uint32_t> subSteps;    // per object: the sub-steps of its first update
     std::vector<double> spans;         // per object: the length of its first update
+    // Kept from batch to batch for their vectors: the columns scattered to the pool, and
+    // the rows its first update killed with their times.
+    std::vector<std::pair<Buffer, Buffer>> scattered;
+    std::vector<uint32_t> killRows;
+    std::vector<double> killAt;
 };
 
 // Scratch column indices of a batch.

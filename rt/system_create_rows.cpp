@@ -136,7 +136,8 @@ void Creation::createInMemory(size_t type, Batch& b, size_t n, double t1) {
     std::vector<Buffer>& table = b.updateTable;
     Memory& memory = s_.memory;
     Buffer mask = identifyInMemory(b, n, kept);
-    std::vector<std::pair<Buffer, Buffer>> columns = identityColumns(type, table);
+    std::vector<std::pair<Buffer, Buffer>> columns;
+    identityColumns(type, table, columns);
     if (pool.parentRows.valid()) columns.push_back({parentsOf(type, b, n, kept), pool.parentRows});
     memory.scatter(columns, first, rows, 0, kept);
 
@@ -365,7 +366,7 @@ Clock Creation::firstUpdateInMemory(size_t type, Batch& b, size_t n, size_t kept
                           {bursts && k == 1, emits, k == 1, step, nows, emits ? length : Buffer{}},
                           columns);
         b.inUpdateAged = false;
-        if (emits && k < most && !spawns_.empty()) {  // what it emitted reads its values as of this sub-step:
+        if (emits && k < most && spawnsUsed_ != 0) {  // what it emitted reads its values as of this sub-step:
                                                        // before the next moves it on
             std::vector<std::pair<Buffer, Buffer>> values;
             valueColumns(type, b, values);

@@ -16,7 +16,10 @@ void markDrawn(Memory& memory, const RowsLaunch& launch, const uint8_t* mask, si
     const ColumnLayout& layout = *launch.layout;
     auto column = [&](int c) { return launch.columns[static_cast<size_t>(layout.drawnFrom(c))]; };
     float* visible = hostData<float>(memory, column(ColumnLayout::kVisible));
-    std::vector<const float*> values;  // every drawn value's column: position … a trail's last point
+    // Every drawn value's column: position … a trail's last point (each thread's vector,
+    // kept from launch to launch).
+    thread_local std::vector<const float*> values;
+    values.clear();
     bool constantsFinite = true;       // the constant components: the same for every row
     for (int c = ColumnLayout::kPosition; c < layout.renderColumns; ++c) {
         if (auto k = layout.constant(c)) constantsFinite &= std::isfinite(*k);

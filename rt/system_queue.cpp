@@ -45,7 +45,10 @@ ChildrenLaunch* Creation::queueSpawn(const Emitter& e, int site, uint32_t firstC
     if (!spawn) return nullptr;
     size_t target = info.emitTarget[static_cast<size_t>(site)];
     const ColumnLayout& layout = info.spawnLayout[static_cast<size_t>(site)];
-    Spawn& queued = spawns_.emplace_back();
+    if (spawnsUsed_ == spawns_.size()) spawns_.emplace_back();
+    Spawn& queued = spawns_[spawnsUsed_++];
+    queued.launch = {};
+    queued.parents.clear();
     if (!fromRecords) s_.parentValues(e.type, e.row, layout, e.at, queued.parents);
     ChildrenLaunch& launch = queued.launch;
     launch.object = &s_.pools[e.type].object();
@@ -81,18 +84,17 @@ void Creation::emitInUpdate(const Emitter& e, std::span<const float> rate, std::
                             double t1, bool dying) {
     const Pool& pool = s_.pools[e.type];
     const ir::Object& o = pool.object();
-    std::vector<double*> accumulated = accumulators(e.type);
-    std::vector<RateEmission> emissions(o.emits.size());
-    emissionsOf(o, accumulated.data(), e.row, rate, count, dt, t1, dying, emissions.data());
-    queueEmissions(e, emissions);
+    accumulators(e.type, accumulated_);
+    rowEmissions_.resize(o.emits.size());
+    emissionsOf(o, accumulated_.data(), e.row, rate, count, dt, t1, dying, rowEmissions_.data());
+    queueEmissions(e, rowEmissions_);
 }
 
-std::vector<double*> Creation::accumulators(size_t type) const {
+void Creation::accumulators(size_t type, std::vector<double*>& out) const {
     const Pool& pool = s_.pools[type];
-    std::vector<double*> out(pool.object().emits.size(), nullptr);
+    out.assign(pool.object().emits.size(), nullptr);
     for (size_t site = 0; site < out.size(); ++site)
         if (pool.object().emits[site].rate()) out[site] = s_.host<double>(pool.emitted[site]);
-    return out;
 }
 
 void Creation::emissionsOf(const ir::Object& o, double* const* accumulated, uint32_t row, std::span<const float> rate,
@@ -165,15 +167,16 @@ void Creation::emitFromKernel(const ir::Trigger& trigger, std::span<const Value>
 }
 
 void Creation::runSpawns() {
-    if (spawns_.empty()) return;
+    if (spawnsUsed_ == 0) return;
     launches_.clear();
-    for (Spawn& queued : spawns_) {
+    for (size_t i = 0; i < spawnsUsed_; ++i) {
+        const Spawn& queued = spawns_[i];
         launches_.push_back(queued.launch);
         // (A launch from records reads each emitter's from the columns: gatherSpawnParents.)
         launches_.back().parents = queued.launch.records.valid() ? nullptr : queued.parents.data();
     }
     s_.backend.runChildren(launches_);
-    spawns_.clear();
+    spawnsUsed_ = 0;
 }
 
 // The queue is created a generation at a time — the runs queued before the drain, then
@@ -189,8 +192,14 @@ void Creation::runSpawns() {
 // queues them an emitter row at a time — so an emitter of two types of emitters, or of
 // an emitter in sub-steps beside another type, may be the memory's (decideRows).
 void Creation::groupByType(size_t from, size_t to) {
-    std::stable_sort(queue_.begin() + static_cast<std::ptrdiff_t>(from), queue_.begin() + static_cast<std::ptrdiff_t>(to),
-                     [](const Run& a, const Run& b) { return a.type < b.type; });
+    // A stable counting sort into vectors kept from drain to drain (std::stable_sort takes
+    // a buffer from the heap at each call).
+    groupStart_.assign(s_.pools.size() + 1, 0);
+    for (size_t i = from; i < to; ++i) ++groupStart_[queue_[i].type + 1];
+    for (size_t t = 1; t < groupStart_.size(); ++t) groupStart_[t] += groupStart_[t - 1];
+    grouped_.resize(to - from);
+    for (size_t i = from; i < to; ++i) grouped_[groupStart_[queue_[i].type]++] = queue_[i];
+    std::copy(grouped_.begin(), grouped_.end(), queue_.begin() + static_cast<std::ptrdiff_t>(from));
 }
 
 void Creation::drain(double t1) {

@@ -264,7 +264,7 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     for (const ir::Object& obj : module.objects) {
         size_t capacity = obj.attributes.capacity ? static_cast<size_t>(*obj.attributes.capacity) : options.capacity;
         pools.emplace_back(obj, capacity, memory);
-        pools.back().runPiecesWith([this](size_t pieces, const std::function<void(size_t)>& piece) {
+        pools.back().runPiecesWith([this](size_t pieces, core::FunctionRef<void(size_t)> piece) {
             parallel->forEach(pieces, true, piece);
         });
         types.push_back(typeInfo(module, obj));
@@ -334,7 +334,7 @@ const Value* State::uniforms(size_t type, const ir::Kernel& kernel, float dt, fl
         in.dt = dt;
         in.time = time;
         in.seed = options.seed;
-        std::vector<Value> values;
+        std::vector<Value>& values = uniformValues;
         evaluator.run(*u, in, values);
         cache.values.assign(values.size(), Value{});
         for (size_t i = 0; i < u->yields.size(); ++i) cache.values.at(static_cast<size_t>(u->yields[i].index)) = values[i];
@@ -376,8 +376,11 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
     if (pools[type].parentRows.valid() && !poolRows)
         gatherThrough(type, layout, table, pools[type].parentRows, begin, begin, end, at,
                       atRows ? pools[type].created : Buffer{});
-    std::vector<uint32_t> rows(end - begin);
-    std::vector<float> values;
+    // (Each thread's, kept from launch to launch: chunks gather on every thread, and a
+    // step allocates nothing.)
+    thread_local std::vector<uint32_t> rows;
+    thread_local std::vector<float> values;
+    rows.resize(end - begin);
     int rowsDepth = -1;
     for (const auto& p : layout.parentColumns) {
         // A pool's launch: its folds copied row for row (on a device, no list sent; no mask
@@ -543,7 +546,7 @@ size_t State::chunkCount(size_t rows) const {
     return rows / per + (rows % per != 0);
 }
 
-void State::forRows(size_t first, size_t end, const std::function<void(size_t, size_t)>& fn) {
+void State::forRows(size_t first, size_t end, core::FunctionRef<void(size_t, size_t)> fn) {
     if (end <= first) return;
     size_t chunks = (end - first + kHostRows - 1) / kHostRows;
     parallel->forEach(chunks, true, [&](size_t c) {
@@ -562,7 +565,7 @@ void State::scatter(std::span<const std::pair<Buffer, Buffer>> columns, size_t f
     });
 }
 
-void State::forChunks(size_t first, size_t end, const std::function<void(size_t, size_t, size_t)>& chunk) {
+void State::forChunks(size_t first, size_t end, core::FunctionRef<void(size_t, size_t, size_t)> chunk) {
     size_t per = backend.chunkRows();
     parallel->forEach(chunkCount(end - first), backend.concurrent(), [&](size_t c) {
         size_t begin = first + c * per;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "ir/evaluate.h"
+#include "rt/emission.h"
 #include "rt/ledger.h"
 #include "rt/parallel.h"
 #include "rt/schedule.h"
@@ -84,6 +85,21 @@ struct DrawnInStep {
 };
 
 // Per type: the scratch buffers and column tables of its launches over the pool.
+// runEmissions' vectors for one type (the host's path), kept from step to step: a
+// steady-state step allocates nothing (tests/capi/allocation_test.cpp).
+struct EmissionWork {
+    std::vector<float> rate, count;            // a rate or count every row shares, by site
+    std::vector<const float*> rates, counts;   // else its column, by site
+    std::vector<double*> accumulated;          // Creation::accumulators
+    struct Piece {                             // a piece of rows (kHostRows), on its thread
+        std::vector<uint32_t> rows;            // the rows that emit or count something, in order
+        std::vector<RateEmission> emissions;   // theirs, a site a row
+        std::vector<float> rate, count;        // the row's
+        std::vector<RateEmission> row;         // the row's emissions, by site
+    };
+    std::vector<Piece> pieces;
+};
+
 struct TypeWork {
     explicit TypeWork(Memory& memory)
         : update(memory), exports(memory), masks(memory), render(memory), spawnParents(memory) {}
@@ -107,6 +123,11 @@ struct TypeWork {
         std::optional<LateKills> untaken;
     } pass;
     std::vector<std::vector<Buffer>> spawnTables;  // per emit site: the pool's columns for its spawn kernel
+    EmissionWork emission;
+    // runKills': a piece's killed rows, and the pieces' (or chunks') lists handed to the
+    // ledger, kept from step to step.
+    std::vector<std::vector<uint32_t>> killPieces;
+    std::vector<std::span<const uint32_t>> killLists;
 };
 
 // Per type and served kernel (update, render, exports): the uniform values and the
@@ -138,6 +159,7 @@ struct State {
     std::vector<Value> externs;
     uint64_t externsVersion = 0;
     std::vector<std::array<UniformCache, 3>> uniformCache;
+    std::vector<Value> uniformValues;  // (uniforms': kept from step to step)
     std::vector<TypeStats> typeStats;
     Stats stats;
     double now = 0;
@@ -203,11 +225,11 @@ struct State {
     // fn(begin, end) over chunks of rows [first, end) of the host's bookkeeping (its own
     // arrays, not a backend's memory), on every thread: chunks write rows of their own, so
     // results do not depend on the split.
-    void forRows(size_t first, size_t end, const std::function<void(size_t, size_t)>& fn);
+    void forRows(size_t first, size_t end, core::FunctionRef<void(size_t, size_t)> fn);
     // Memory::scatter of several columns by the same rows: to[rows[i]] = from[fromFirst + i]
     // for each (from, to), split by rows over every thread where the backend is concurrent.
     void scatter(std::span<const std::pair<Buffer, Buffer>> columns, size_t fromFirst, std::span<const uint32_t> rows);
-    void forChunks(size_t first, size_t end, const std::function<void(size_t, size_t, size_t)>& chunk);
+    void forChunks(size_t first, size_t end, core::FunctionRef<void(size_t, size_t, size_t)> chunk);
 
     // A column's values on the host: to change (host) or to read (view).
     template <typename T>

@@ -67,8 +67,13 @@ void runEmissions(State& s, Creation& creation, size_t type, double dt, double t
         return;
     }
     const uint8_t* updatable = pool.mask();
-    std::vector<float> rate(o.emits.size(), 0), count(o.emits.size(), 1);
-    std::vector<const float*> rates(o.emits.size()), counts(o.emits.size());
+    // (Every vector below is the type's, kept from step to step: a step allocates nothing.)
+    EmissionWork& w = s.work[type].emission;
+    const size_t sites = o.emits.size();
+    w.rate.assign(sites, 0);
+    w.count.assign(sites, 1);
+    w.rates.assign(sites, nullptr);
+    w.counts.assign(sites, nullptr);
     const ColumnLayout& layout = info.updateLayout;
     auto source = [&](bool yielded, int column, float& shared, const float*& perRow) {
         if (!yielded) return;
@@ -77,47 +82,49 @@ void runEmissions(State& s, Creation& creation, size_t type, double dt, double t
         else
             perRow = s.view<float>(work.updateTable[static_cast<size_t>(column)]);
     };
-    for (size_t site = 0; site < o.emits.size(); ++site) {
+    for (size_t site = 0; site < sites; ++site) {
         auto i = static_cast<int>(site);
-        source(info.rated[site], layout.emitRate(i), rate[site], rates[site]);
-        source(info.counted[site], layout.emitCount(i), count[site], counts[site]);
+        source(info.rated[site], layout.emitRate(i), w.rate[site], w.rates[site]);
+        source(info.counted[site], layout.emitCount(i), w.count[site], w.counts[site]);
     }
     // Each row's emissions decided a piece of rows at a time on every thread (each moves
     // its own accumulators on), those that emit kept; then queued in row order: ids, rows
     // and the queue as one row at a time would give them.
-    const size_t sites = o.emits.size();
-    const std::vector<double*> accumulated = creation.accumulators(type);
-    struct Piece {
-        std::vector<uint32_t> rows;            // the rows that emit or count something, in order
-        std::vector<RateEmission> emissions;   // theirs, `sites` a row
-    };
-    std::vector<Piece> pieces((pool.rows() + kHostRows - 1) / kHostRows);
+    creation.accumulators(type, w.accumulated);
+    const size_t pieces = (pool.rows() + kHostRows - 1) / kHostRows;
+    if (w.pieces.size() < pieces) w.pieces.resize(pieces);
     const std::vector<uint32_t>& died = work.pass.dying;  // (in row order)
     s.forRows(0, pool.rows(), [&](size_t begin, size_t end) {
-        Piece& piece = pieces[begin / kHostRows];
-        std::vector<float> rowRate = rate, rowCount = count;
-        std::vector<RateEmission> e(sites);
+        EmissionWork::Piece& piece = w.pieces[begin / kHostRows];
+        piece.rows.clear();
+        piece.emissions.clear();
+        piece.rate = w.rate;
+        piece.count = w.count;
+        piece.row.resize(sites);
         auto dying = std::lower_bound(died.begin(), died.end(), begin);
         for (size_t row = begin; row < end; ++row) {
             bool dies = dying != died.end() && *dying == row;
             if (dies) ++dying;
             if (!updatable[row] && !dies) continue;
             for (size_t site = 0; site < sites; ++site) {
-                if (rates[site]) rowRate[site] = rates[site][row];
-                if (counts[site]) rowCount[site] = counts[site][row];
+                if (w.rates[site]) piece.rate[site] = w.rates[site][row];
+                if (w.counts[site]) piece.count[site] = w.counts[site][row];
             }
-            Creation::emissionsOf(o, accumulated.data(), static_cast<uint32_t>(row), rowRate, rowCount, dt, t1, dies,
-                                  e.data());
-            if (std::none_of(e.begin(), e.end(), [](const RateEmission& x) { return x.children || x.invalid || x.clamped; }))
+            Creation::emissionsOf(o, w.accumulated.data(), static_cast<uint32_t>(row), piece.rate, piece.count, dt, t1,
+                                  dies, piece.row.data());
+            if (std::none_of(piece.row.begin(), piece.row.end(),
+                             [](const RateEmission& x) { return x.children || x.invalid || x.clamped; }))
                 continue;
             piece.rows.push_back(static_cast<uint32_t>(row));
-            piece.emissions.insert(piece.emissions.end(), e.begin(), e.end());
+            piece.emissions.insert(piece.emissions.end(), piece.row.begin(), piece.row.end());
         }
     });
-    for (const Piece& piece : pieces)
+    for (size_t p = 0; p < pieces; ++p) {
+        const EmissionWork::Piece& piece = w.pieces[p];
         for (size_t i = 0; i < piece.rows.size(); ++i)
             creation.queueEmissions({type, piece.rows[i], {}, piece.rows[i], t1, false},
                                     std::span(piece.emissions).subspan(i * sites, sites));
+    }
     creation.runSpawns();  // before the next sub-step's update moves the emitters on
 }
 
@@ -131,11 +138,11 @@ void runKills(State& s, size_t type, double dt, double t1) {
     if (!work.pass.ran) return;
     size_t chunks = work.pass.chunks;
     if (work.pass.late) {
-        LateKills l;
+        LateKills l = s.ledger.fresh(chunks);
         l.type = type;
         l.t1 = t1;
         l.dt = dt;
-        for (size_t c = 0; c < chunks; ++c) l.parts.push_back(std::move(work.killed[c]));
+        for (size_t c = 0; c < chunks; ++c) std::swap(l.parts[c], work.killed[c]);  // (each keeps a vector)
         if (info.read && info.rowsInMemory) s.ledger.listNow(l);  // its dead are dead to its children at once
         if (work.pass.takeOut && info.updateEmits) {  // (after its emissions: takeOutKills)
             work.pass.untaken = std::move(l);
@@ -147,9 +154,9 @@ void runKills(State& s, size_t type, double dt, double t1) {
     }
     if (work.pass.listed) {
         const double at = t1 - dt;
-        std::vector<std::span<const uint32_t>> lists;  // (taken at once: on every thread)
-        for (size_t c = 0; c < chunks; ++c) lists.push_back(work.killed[c].rows);
-        s.ledger.kill(type, lists, {&at, 1});
+        work.killLists.clear();  // (taken at once: on every thread)
+        for (size_t c = 0; c < chunks; ++c) work.killLists.push_back(work.killed[c].rows);
+        s.ledger.kill(type, work.killLists, {&at, 1});
         return;
     }
     if (!info.kills) return;
@@ -158,18 +165,20 @@ void runKills(State& s, size_t type, double dt, double t1) {
     const Pool& pool = s.pools[type];
     const uint8_t* updatable = pool.mask();
     const auto* kill = s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]);
-    std::vector<std::vector<uint32_t>> pieces((pool.rows() + kHostRows - 1) / kHostRows);
+    const size_t pieces = (pool.rows() + kHostRows - 1) / kHostRows;  // (the type's lists, kept from step to step)
+    if (work.killPieces.size() < pieces) work.killPieces.resize(pieces);
     s.forRows(0, pool.rows(), [&](size_t begin, size_t end) {
-        std::vector<uint32_t>& killed = pieces[begin / kHostRows];
+        std::vector<uint32_t>& killed = work.killPieces[begin / kHostRows];
+        killed.clear();
         for (size_t row = begin; row < end; ++row)
             if (updatable[row] && kill[row]) killed.push_back(static_cast<uint32_t>(row));
     });
-    std::vector<std::span<const uint32_t>> lists(pieces.begin(), pieces.end());
+    work.killLists.assign(work.killPieces.begin(), work.killPieces.begin() + static_cast<std::ptrdiff_t>(pieces));
     if (info.emitsWhenKilled)
-        for (const std::vector<uint32_t>& killed : pieces)
-            work.pass.dying.insert(work.pass.dying.end(), killed.begin(), killed.end());
+        for (size_t p = 0; p < pieces; ++p)
+            work.pass.dying.insert(work.pass.dying.end(), work.killPieces[p].begin(), work.killPieces[p].end());
     const double at = t1 - dt;
-    s.ledger.kill(type, lists, {&at, 1});
+    s.ledger.kill(type, work.killLists, {&at, 1});
 }
 
 namespace {
@@ -210,7 +219,10 @@ void runUpdate(State& s, const Phase& phase, double dt, double t1, bool last) {
     Pool& pool = s.pools[type];
     TypeInfo& info = s.types[type];
     TypeWork& work = s.work[type];
+    std::vector<uint32_t> dying = std::move(work.pass.dying);
     work.pass = {};
+    work.pass.dying = std::move(dying);
+    work.pass.dying.clear();
     size_t rows = pool.rows();
     if (rows == 0) return;
     // Drawing as it goes (rt/system_draw.h): each chunk rendered after its update.
@@ -246,7 +258,11 @@ void runUpdate(State& s, const Phase& phase, double dt, double t1, bool last) {
     // (Phase::listed); late, a device need not wait for them.
     const bool listKills = phase.listed;
     size_t chunks = s.chunkCount(rows);
-    work.pass = {true, late, listKills && !late, late && !last, chunks, {}, {}};
+    work.pass.ran = true;  // (dying, cleared above, keeps its vector)
+    work.pass.late = late;
+    work.pass.listed = listKills && !late;
+    work.pass.takeOut = late && !last;
+    work.pass.chunks = chunks;
     if (listKills || late) work.killed.resize(chunks);  // each chunk sets its own (Ledger::record)
     if (late && phase.inMemory)
         for (size_t c = 0; c < chunks; ++c)
