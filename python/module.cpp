@@ -27,6 +27,16 @@ py::object& errorType() {
     static py::object* type = new py::object();
     return *type;
 }
+// psys.UnknownNameError (a psys.Error and a KeyError) and psys.ValueTypeError (a
+// psys.Error and a TypeError).
+py::object& unknownNameType() {
+    static py::object* type = new py::object();
+    return *type;
+}
+py::object& valueTypeType() {
+    static py::object* type = new py::object();
+    return *type;
+}
 
 py::dict diagnostic(const psys_diagnostic& d) {
     static const char* severities[] = {"error", "warning", "note", "remark"};
@@ -106,10 +116,23 @@ void refuseNul(const std::string& source, const std::string& name) {
     throw py::error_already_set();
 }
 
+[[noreturn]] void raiseAs(const py::object& type, const std::string& message) {
+    PyErr_SetObject(type.ptr(), type(message).ptr());
+    throw py::error_already_set();
+}
+
+std::string reprOf(const py::object& value) { return py::repr(value).cast<std::string>(); }
+
 class System {
 public:
     explicit System(psys_system* s) : s_(s) {}
     ~System() { psys_system_free(s_); }
+    // Frees the system now (a second close does nothing); every later call raises.
+    void close() {
+        psys_system_free(s_);
+        s_ = nullptr;
+    }
+    bool closed() const { return s_ == nullptr; }
     System(const System&) = delete;
     System& operator=(const System&) = delete;
 
@@ -136,21 +159,32 @@ public:
         return std::make_unique<System>(s);
     }
 
+    // Steps without the GIL: other Python threads run meanwhile (another system's steps too).
     void step(double dt, int steps) {
         if (steps < 0) raise(PyExc_ValueError, "step: steps is 0 or more, not " + std::to_string(steps));
-        for (int i = 0; i < steps; ++i) check(psys_step(s_, dt));
+        psys_system* s = open();
+        psys_error* e = nullptr;
+        {
+            py::gil_scoped_release unlocked;
+            for (int i = 0; i < steps && !e; ++i) e = psys_step(s, dt);
+        }
+        check(e);
     }
     void set(const std::string& name, const py::object& values) {
         std::vector<float> v = floats(values, "set");
+        float current[4];
+        int width = psys_get_extern(open(), name.c_str(), current);
+        if (width < 0) raiseAs(unknownNameType(), "there is no extern `" + name + "`" + known(externs()));
+        if (v.size() != static_cast<size_t>(width))
+            raiseAs(valueTypeType(), "set: extern `" + name + "` is a " + externs()[name.c_str()].cast<std::string>() +
+                                         " (" + std::to_string(width) + (width == 1 ? " number" : " numbers") +
+                                         "), not " + reprOf(values));
         check(psys_set_extern(s_, name.c_str(), v.data(), v.size()));
     }
     py::object get(const std::string& name) const {
         float v[4];
-        int width = psys_get_extern(s_, name.c_str(), v);
-        if (width < 0) {
-            PyErr_SetString(PyExc_KeyError, ("there is no extern `" + name + "`").c_str());
-            throw py::error_already_set();
-        }
+        int width = psys_get_extern(open(), name.c_str(), v);
+        if (width < 0) raiseAs(unknownNameType(), "there is no extern `" + name + "`" + known(externs()));
         if (width == 1) return py::float_(v[0]);
         return py::tuple(py::cast(std::vector<float>(v, v + width)));
     }
@@ -160,47 +194,63 @@ public:
             std::vector<float> v = floats(py::reinterpret_borrow<py::object>(a), "fire");
             all.insert(all.end(), v.begin(), v.end());
         }
+        psys_input in{};
+        bool found = false;
+        for (size_t i = 0; !found && psys_trigger_info(open(), i, &in) == 0; ++i) found = trigger == in.name;
+        if (!found) raiseAs(unknownNameType(), "there is no trigger `" + trigger + "`" + known(triggers()));
+        if (all.size() != in.values)
+            raiseAs(valueTypeType(), "fire: trigger `" + trigger + "` takes (" + in.type + "): " +
+                                         std::to_string(in.values) + " numbers, not " + std::to_string(all.size()) +
+                                         " in " + reprOf(args));
         check(psys_fire(s_, trigger.c_str(), all.data(), all.size()));
     }
     void reload(std::optional<std::string> source) {
         if (source) refuseNul(*source, "<string>");
-        check(psys_reload(s_, source ? source->c_str() : nullptr));
+        psys_system* s = open();
+        psys_error* e = nullptr;
+        {
+            py::gil_scoped_release unlocked;  // compiling takes a while: other Python threads run
+            e = psys_reload(s, source ? source->c_str() : nullptr);
+        }
+        check(e);
     }
 
     std::vector<std::string> types() const {
         std::vector<std::string> out;
-        for (size_t t = 0; t < psys_type_count(s_); ++t) out.push_back(psys_type_name(s_, t));
+        psys_system* s = open();
+        for (size_t t = 0; t < psys_type_count(s); ++t) out.push_back(psys_type_name(s, t));
         return out;
     }
     py::dict externs() const {
         py::dict out;
         psys_input in;
-        for (size_t i = 0; psys_extern_info(s_, i, &in) == 0; ++i) out[in.name] = in.type;
+        for (size_t i = 0; psys_extern_info(open(), i, &in) == 0; ++i) out[in.name] = in.type;
         return out;
     }
     py::dict triggers() const {
         py::dict out;
         psys_input in;
-        for (size_t i = 0; psys_trigger_info(s_, i, &in) == 0; ++i) out[in.name] = in.type;
+        for (size_t i = 0; psys_trigger_info(open(), i, &in) == 0; ++i) out[in.name] = in.type;
         return out;
     }
     py::list warnings() const {
         py::list out;
         psys_diagnostic d;
-        for (size_t i = 0; psys_warning(s_, i, &d) == 0; ++i) out.append(diagnostic(d));
+        for (size_t i = 0; psys_warning(open(), i, &d) == 0; ++i) out.append(diagnostic(d));
         return out;
     }
 
     size_t typeOf(const py::object& type) const {
         if (py::isinstance<py::str>(type)) {
-            int t = psys_type_index(s_, type.cast<std::string>().c_str());
+            int t = psys_type_index(open(), type.cast<std::string>().c_str());
             if (t < 0) {
-                PyErr_SetString(PyExc_KeyError, ("there is no object type `" + type.cast<std::string>() + "`").c_str());
-                throw py::error_already_set();
+                py::dict names;
+                for (const std::string& name : types()) names[name.c_str()] = py::none();
+                raiseAs(unknownNameType(), "there is no object type `" + type.cast<std::string>() + "`" + known(names));
             }
             return static_cast<size_t>(t);
         }
-        size_t count = psys_type_count(s_);
+        size_t count = psys_type_count(open());
         long long index = 0;
         try {
             index = type.cast<long long>();
@@ -256,7 +306,8 @@ public:
         return out;
     }
 
-    // The drawn points copied out (any backend): id (n), position (n×3), color (n×4), size (n).
+    // The drawn points copied out (any backend): id (n), position (n×3), color (n×4), size (n),
+    // written through raw pointers (what a NumPy copy of the columns costs, about).
     py::dict points(const py::object& type) {
         size_t t = typeOf(type), n = 0;
         check(psys_read_points(s_, t, nullptr, 0, &n));
@@ -265,12 +316,14 @@ public:
         auto rows = static_cast<py::ssize_t>(n);
         py::array_t<uint32_t> id(rows);
         py::array_t<float> position({rows, py::ssize_t{3}}), color({rows, py::ssize_t{4}}), size(rows);
-        for (py::ssize_t i = 0; i < rows; ++i) {
-            const psys_point& q = p[static_cast<size_t>(i)];
-            id.mutable_at(i) = q.id;
-            for (py::ssize_t k = 0; k < 3; ++k) position.mutable_at(i, k) = q.position[k];
-            for (py::ssize_t k = 0; k < 4; ++k) color.mutable_at(i, k) = q.color[k];
-            size.mutable_at(i) = q.size;
+        uint32_t* ids = id.mutable_data();
+        float *xyz = position.mutable_data(), *rgba = color.mutable_data(), *sizes = size.mutable_data();
+        for (size_t i = 0; i < n; ++i) {
+            const psys_point& q = p[i];
+            ids[i] = q.id;
+            std::memcpy(xyz + 3 * i, q.position, sizeof q.position);
+            std::memcpy(rgba + 4 * i, q.color, sizeof q.color);
+            sizes[i] = q.size;
         }
         py::dict out;
         out["id"] = id;
@@ -280,9 +333,32 @@ public:
         return out;
     }
 
+    // The drawn points' positions as an n×3 array (a copy: the columns are one a
+    // component), in row order; on the glsl backend read back as points() reads them.
+    py::array_t<float> positions(const py::object& type) {
+        size_t t = typeOf(type);
+        psys_draw d;
+        check(psys_get_draw(s_, t, &d));
+        bool onGpu = d.visible.gl_buffer != 0;
+        for (const psys_column& c : d.position) onGpu |= c.gl_buffer != 0;
+        if (onGpu) return points(type)["position"].cast<py::array_t<float>>();
+        auto column = [&](const psys_column& c, size_t row) {
+            return c.data ? static_cast<const float*>(c.data)[row] : c.constant;
+        };
+        size_t n = 0;
+        for (size_t row = 0; row < d.rows; ++row) n += column(d.visible, row) == 1.0f;
+        py::array_t<float> out({static_cast<py::ssize_t>(n), py::ssize_t{3}});
+        float* xyz = out.mutable_data();
+        for (size_t row = 0; row < d.rows; ++row) {
+            if (column(d.visible, row) != 1.0f) continue;
+            for (int k = 0; k < 3; ++k) *xyz++ = column(d.position[k], row);
+        }
+        return out;
+    }
+
     py::dict stats() const {
         psys_stats st;
-        check(psys_get_stats(s_, &st));
+        check(psys_get_stats(open(), &st));
         py::dict out, types;
         out["steps"] = st.steps;
         out["rejected_steps"] = st.rejected_steps;
@@ -309,11 +385,28 @@ public:
         return out;
     }
 
-    double time() const { return psys_time(s_); }
-    uint64_t stepCount() const { return psys_step_count(s_); }
-    bool finished() const { return psys_finished(s_) != 0; }
+    double time() const { return psys_time(open()); }
+    uint64_t stepCount() const { return psys_step_count(open()); }
+    bool finished() const { return psys_finished(open()) != 0; }
 
 private:
+    // The system, or the error of a call after close().
+    psys_system* open() const {
+        if (!s_) raise(PyExc_ValueError, "the system is closed");
+        return s_;
+    }
+    // ": the program's are `a`, `b`" (or "s: it has none"), for an unknown name's message.
+    static std::string known(const py::dict& names) {
+        if (names.empty()) return ": it has none";
+        std::string out = ": the program's are ";
+        bool first = true;
+        for (auto item : names) {
+            out += (first ? "`" : ", `") + item.first.cast<std::string>() + "`";
+            first = false;
+        }
+        return out;
+    }
+
     psys_system* s_;
 };
 
@@ -322,9 +415,11 @@ private:
 PYBIND11_MODULE(_psys, m) {
     m.doc() = "psys: particle systems compiled from .psys programs (docs/embedding.md)";
     m.attr("version") = psys_version();
-    m.def("_set_errors", [](py::object compileError, py::object error) {
+    m.def("_set_errors", [](py::object compileError, py::object error, py::object unknownName, py::object valueType) {
         compileErrorType() = std::move(compileError);
         errorType() = std::move(error);
+        unknownNameType() = std::move(unknownName);
+        valueTypeType() = std::move(valueType);
     });
     m.def("_compile", &System::compile, py::arg("what"), py::arg("is_source"), py::arg("name"), py::arg("backend"),
           py::arg("math"), py::arg("seed"), py::arg("capacity"), py::arg("threads"), py::arg("optimize"));
@@ -339,7 +434,12 @@ PYBIND11_MODULE(_psys, m) {
         .def("columns", &System::columns, py::arg("type"),
              "The draw columns, each copied into a read-only array of its own: visible, id, x y z, r g b a, size.")
         .def("points", &System::points, py::arg("type"), "The drawn points, copied: id, position, color, size.")
+        .def("positions", &System::positions, py::arg("type"), "The drawn points' positions, copied: an n×3 array.")
         .def("stats", &System::stats)
+        .def("close", &System::close, "Frees the system now; any later call raises ValueError.")
+        .def_property_readonly("closed", &System::closed)
+        .def("__enter__", [](py::object self) { return self; })
+        .def("__exit__", [](System& s, py::args) { s.close(); })
         .def_property_readonly("types", &System::types)
         .def_property_readonly("externs", &System::externs)
         .def_property_readonly("triggers", &System::triggers)

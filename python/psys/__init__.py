@@ -7,7 +7,11 @@
     cols = fountain.columns("drop")                           # visible, id, x y z, r g b a, size (copies)
 
 Errors are exceptions: psys.CompileError carries the compiler's diagnostics (a list of
-dicts: severity, file, line, column, end_line, end_column, message); psys.Error the rest.
+dicts: severity, file, line, column, end_line, end_column, message); an unknown extern,
+trigger or type is psys.UnknownNameError (a KeyError), a value of the wrong size
+psys.ValueTypeError (a TypeError), a file that cannot be read the OSError open() gives;
+psys.Error the rest. A System is a context manager: `with psys.compile(...) as s:` closes
+it at the end (close() does it at once; a closed system's calls raise ValueError).
 docs/embedding.md has the whole story.
 """
 
@@ -26,7 +30,18 @@ class CompileError(Error):
     """A program that does not compile; `diagnostics` says where and why."""
 
 
-_psys._set_errors(CompileError, Error)
+class UnknownNameError(Error, KeyError):
+    """An extern, trigger or object type the program does not have (a KeyError too)."""
+
+    def __str__(self):  # a KeyError's str is the repr of its key: this one is a sentence
+        return str(self.args[0]) if self.args else ""
+
+
+class ValueTypeError(Error, TypeError):
+    """A value of the wrong size for an extern or a trigger (a TypeError too)."""
+
+
+_psys._set_errors(CompileError, Error, UnknownNameError, ValueTypeError)
 
 System = _psys.System
 version = _psys.version
@@ -56,8 +71,10 @@ def compile(path=None, *, source=None, name="<string>", backend="llvm", math="fa
     path = os.fsdecode(path)
     if "\0" in path:  # the C API would read the path up to it: another file
         raise ValueError("psys.compile: a path has no NUL character")
+    with open(path, "rb"):  # a missing or unreadable file: the OSError Python gives (FileNotFoundError, …)
+        pass
     return _psys._compile(path, False, "", backend, math, seed, capacity, threads, optimize)
 
 
 
-__all__ = ["compile", "System", "Error", "CompileError", "version"]
+__all__ = ["compile", "System", "Error", "CompileError", "UnknownNameError", "ValueTypeError", "version"]
