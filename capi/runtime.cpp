@@ -108,6 +108,12 @@ psys_error* psys_step(psys_system* s, double dt) {
     return guarded("psys_step", [&] { return orError("psys_step", s->system().step(dt)); });
 }
 
+psys_error* psys_reserve(psys_system* s, size_t type, size_t rows) {
+    if (!s) return nullArgument("psys_reserve", "the system");
+    if (type >= s->system().typeCount()) return badType("psys_reserve", s, type);
+    return guarded("psys_reserve", [&] { return orError("psys_reserve", s->system().reserve(type, rows)); });
+}
+
 double psys_time(const psys_system* s) { return s ? s->system().time() : 0; }
 uint64_t psys_step_count(const psys_system* s) { return s ? s->system().stepCount() : 0; }
 

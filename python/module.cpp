@@ -204,6 +204,7 @@ public:
                                          " in " + reprOf(args));
         check(psys_fire(s_, trigger.c_str(), all.data(), all.size()));
     }
+    void reserve(const py::object& type, size_t rows) { check(psys_reserve(open(), typeOf(type), rows)); }
     void reload(std::optional<std::string> source) {
         if (source) refuseNul(*source, "<string>");
         psys_system* s = open();
@@ -436,6 +437,8 @@ PYBIND11_MODULE(_psys, m) {
         .def("points", &System::points, py::arg("type"), "The drawn points, copied: id, position, color, size.")
         .def("positions", &System::positions, py::arg("type"), "The drawn points' positions, copied: an n×3 array.")
         .def("stats", &System::stats)
+        .def("reserve", &System::reserve, py::arg("type"), py::arg("rows"),
+             "Room for `rows` objects of `type` made now: steps up to that many take nothing more.")
         .def("close", &System::close, "Frees the system now; any later call raises ValueError.")
         .def_property_readonly("closed", &System::closed)
         .def("__enter__", [](py::object self) { return self; })

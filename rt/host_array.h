@@ -55,6 +55,15 @@ void reserveRoom(HostArray<T>& v, size_t rows) {
     }
 }
 
+// The pages of [data, data + bytes) given memory now (MADV_POPULATE_WRITE, else a write
+// to each page of what is there): reserved rows filled later fault no page.
+void populatePages(void* data, size_t bytes);
+
+template <class T>
+void populateRoom(HostArray<T>& v, size_t rows) {
+    if (v.capacity() >= rows) populatePages(v.data(), rows * sizeof(T));
+}
+
 // The rows a pool of `rowBytes` a row can ever touch on this machine: its capacity, or as
 // many as its physical memory holds (a reservation past them takes address space for rows
 // that could never be used).

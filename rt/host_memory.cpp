@@ -3,6 +3,7 @@
 #include "rt/memory.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <new>
@@ -10,6 +11,8 @@
 
 #include <sys/mman.h>
 #include <unistd.h>
+
+#include "rt/host_array.h"
 
 namespace psys::rt {
 
@@ -90,6 +93,26 @@ void HostMemory::reserve(Buffer b, size_t rows) {
     try {
         columns_.at(b.id)->reserve(rows, true);
     } catch (const std::bad_alloc&) {  // (no address space for it: it grows when it must)
+    }
+}
+
+void HostMemory::populate(Buffer b, size_t rows) {
+    Column& c = *columns_.at(b.id);
+    populatePages(c.data, std::min(rows, c.capacity) * c.size());
+}
+
+void populatePages(void* data, size_t bytes) {
+    if (!data || bytes == 0) return;
+    const auto page = static_cast<uintptr_t>(::sysconf(_SC_PAGESIZE));
+    auto begin = reinterpret_cast<uintptr_t>(data) / page * page;
+    auto end = reinterpret_cast<uintptr_t>(data) + bytes;
+#ifdef MADV_POPULATE_WRITE
+    if (::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE) == 0) return;
+#endif
+    // (A kernel before 5.14: each page written with what it holds.)
+    for (uintptr_t p = std::max(begin, reinterpret_cast<uintptr_t>(data)); p < end; p = (p / page + 1) * page) {
+        auto* byte = reinterpret_cast<volatile std::byte*>(p);
+        *byte = *byte;
     }
 }
 

@@ -51,16 +51,23 @@ void Ledger::defer(LateKills late) {
     late_.push_back(std::move(late));
 }
 
-LateKills Ledger::fresh(size_t parts) {
+Ledger::Spares& Ledger::spares(size_t type) {
+    if (spares_.size() <= type) spares_.resize(s_.types.size() > type ? s_.types.size() : type + 1);
+    return spares_[type];
+}
+
+LateKills Ledger::fresh(size_t type, size_t parts) {
     LateKills l;
-    if (!spare_.empty()) {
-        l = std::move(spare_.back());
-        spare_.pop_back();
+    Spares& spare = spares(type);
+    if (!spare.lates.empty()) {
+        l = std::move(spare.lates.back());
+        spare.lates.pop_back();
     }
     std::vector<LateKills::Part> kept = std::move(l.parts);
     std::vector<uint32_t> poolRows = std::move(l.poolRows);
     std::vector<double> spans = std::move(l.spans);
     l = {};
+    l.type = type;
     for (LateKills::Part& part : kept) part.reset();
     l.parts = std::move(kept);
     l.poolRows = std::move(poolRows);
@@ -72,19 +79,29 @@ LateKills Ledger::fresh(size_t parts) {
 }
 
 void Ledger::resizeParts(LateKills& l, size_t parts) {
-    for (; l.parts.size() > parts; l.parts.pop_back()) spareRows_.push_back(std::move(l.parts.back().rows));
+    std::vector<std::vector<uint32_t>>& rows = spares(l.type).rows;
+    for (; l.parts.size() > parts; l.parts.pop_back()) rows.push_back(std::move(l.parts.back().rows));
     while (l.parts.size() < parts) {
         LateKills::Part& part = l.parts.emplace_back();
-        if (spareRows_.empty()) continue;
-        part.rows = std::move(spareRows_.back());
+        if (rows.empty()) continue;
+        part.rows = std::move(rows.back());
         part.rows.clear();
-        spareRows_.pop_back();
+        rows.pop_back();
     }
 }
 
 void Ledger::recycle(std::vector<LateKills>& lates) {
-    for (LateKills& l : lates) spare_.push_back(std::move(l));
+    for (LateKills& l : lates) spares(l.type).lates.push_back(std::move(l));
     lates.clear();
+}
+
+void Ledger::reserve(size_t type, size_t parts, size_t rowsEach, size_t lates) {
+    std::vector<LateKills> made;
+    for (size_t i = 0; i < lates; ++i) {
+        LateKills& l = made.emplace_back(fresh(type, parts));
+        for (LateKills::Part& part : l.parts) part.rows.reserve(rowsEach);
+    }
+    recycle(made);
 }
 
 void Ledger::settle(Wait wait) {
@@ -202,8 +219,7 @@ void Ledger::takeOut(LateKills& l, Buffer into, Buffer batchMask) {
 
 void Ledger::deferGathered(size_t type, Buffer into) {
     s_.memory.fill(into, 0, 1, 0);
-    LateKills l = fresh(1);
-    l.type = type;
+    LateKills l = fresh(type, 1);
     LateKills::Part& part = l.parts[0];
     part.killList = into;
     part.listed = part.counted = part.gathered = true;

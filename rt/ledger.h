@@ -84,11 +84,16 @@ public:
     void record(LateKills::Part& part, const RowsResult& result, Buffer flags, size_t begin, size_t end) const;
     // Kills to take late, placed after the deaths known so far.
     void defer(LateKills late);
-    // An empty LateKills with the vectors of one taken before (with `parts` parts, each
-    // empty): a steady-state step allocates none (tests/capi/allocation_test.cpp).
-    LateKills fresh(size_t parts = 0);
-    // l.parts resized to `parts`, a new part with the vector of one dropped before.
+    // An empty LateKills of `type` with the vectors of one of its type taken before (with
+    // `parts` parts, each empty): a steady-state step allocates none
+    // (tests/capi/allocation_test.cpp). A type's vectors stay with it, so that they grow
+    // to what its steps need and no more.
+    LateKills fresh(size_t type, size_t parts = 0);
+    // l.parts resized to `parts`, a new part with the vector of one of its type dropped before.
     void resizeParts(LateKills& l, size_t parts);
+    // `lates` LateKills of `type` made now, each with `parts` parts, each with room for
+    // `rowsEach` rows, for fresh to give (System::reserve).
+    void reserve(size_t type, size_t parts, size_t rowsEach, size_t lates);
 
     // Where the backend must be waited for: `Yes` takes everything (what the last step
     // owes and every late kill; before anything takes rows or reads the pools whole: the
@@ -166,10 +171,14 @@ private:
     Deaths dying_;
     std::vector<LateKills> late_;
     std::optional<Owed> owed_;
-    // Kept from step to step for their vectors: LateKills taken (fresh), and take's, free's
-    // and release's lists.
-    std::vector<LateKills> spare_;
-    std::vector<std::vector<uint32_t>> spareRows_;  // resizeParts'
+    // Kept from step to step for their vectors, per type: LateKills taken (fresh) and the
+    // parts' lists resizeParts dropped; and take's, free's and release's lists.
+    struct Spares {
+        std::vector<LateKills> lates;
+        std::vector<std::vector<uint32_t>> rows;
+    };
+    std::vector<Spares> spares_;
+    Spares& spares(size_t type);
     struct Lists {
         Deaths merged, kept;
         std::vector<LateKills> keptLates, single;

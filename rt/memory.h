@@ -157,6 +157,9 @@ public:
     // now and no memory (no page is touched before its rows are used); a device's may do
     // nothing.
     virtual void reserve(Buffer, size_t) {}
+    // The pages of the first `rows` rows of what reserve took given now (System::reserve),
+    // so that filling them later faults no page in a step; a device's may do nothing.
+    virtual void populate(Buffer, size_t) {}
     virtual void release(Buffer buffer) = 0;
     virtual size_t rows(Buffer buffer) const = 0;
     virtual Elem elem(Buffer buffer) const = 0;
@@ -334,6 +337,7 @@ public:
     Buffer create(Elem elem, size_t rows) override;
     void resize(Buffer buffer, size_t rows) override;
     void reserve(Buffer buffer, size_t rows) override;
+    void populate(Buffer buffer, size_t rows) override;
     void release(Buffer buffer) override;
     size_t rows(Buffer buffer) const override;
     Elem elem(Buffer buffer) const override;

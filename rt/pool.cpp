@@ -149,6 +149,27 @@ void Pool::reserveRows() {
     reserveRoom(diedAt, room_);
 }
 
+void Pool::populate(size_t rows) {
+    rows = std::min(rows, room_);
+    auto populate = [&](Buffer b) {
+        if (b.valid()) memory_->populate(b, rows);
+    };
+    for (Buffer b : {created, ids, updatable.column, alive.column, rows_.stack, rows_.generation, rows_.readers,
+                     rows_.waiting, parentRows, frozenAt})
+        populate(b);
+    for (Buffer b : emitted) populate(b);
+    for (const ValueColumns* v : {&state, &params, &exports})
+        for (size_t i = 0; i < v->count(); ++i)
+            for (int c = 0; c < v->type(i).width; ++c) populate(v->column(i, static_cast<size_t>(c)));
+    if (inMemory_) return;
+    populateRoom(status_, rows);
+    populateRoom(generation_, rows);
+    populateRoom(freeRows_, rows);
+    populateRoom(parent, rows);
+    populateRoom(readers, rows);
+    populateRoom(diedAt, rows);
+}
+
 size_t reservableRows(size_t capacity, size_t rowBytes) {
     auto pages = static_cast<size_t>(::sysconf(_SC_PHYS_PAGES)), page = static_cast<size_t>(::sysconf(_SC_PAGESIZE));
     return std::min(capacity, pages * page / std::max<size_t>(rowBytes, 1));

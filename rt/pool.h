@@ -259,6 +259,8 @@ public:
     // The rows its columns and host arrays have room for (reservableRows of its capacity):
     // a scratch column over its rows takes as much (Scratch::at), so it never moves either.
     size_t room() const { return room_; }
+    // The pages of its first `rows` rows (at most its room) given now: System::reserve.
+    void populate(size_t rows);
 
 private:
     const ir::Object* object_;

@@ -247,6 +247,25 @@ std::string languageName(const ir::Type& t) {
 
 std::string languageName(const ir::Extern& e) { return e.spelling.empty() ? languageName(e.type) : e.spelling; }
 
+std::optional<std::string> System::reserve(size_t type, size_t rows) {
+    detail::State& s = *state_;
+    if (type >= s.pools.size()) return fmt::format("there is no object type {}", type);
+    Pool& pool = s.pools[type];
+    if (rows > pool.capacity())
+        return fmt::format("{} holds at most {} objects (its @capacity, else the options' capacity), not {}",
+                           pool.object().name, pool.capacity(), rows);
+    pool.populate(rows);
+    const detail::TypeInfo& info = s.types[type];
+    if (!info.kills || rows == 0) return std::nullopt;
+    // (Its kill lists: the update's chunks', taking turns with the ledger's — Ledger::fresh.)
+    const size_t chunks = s.chunkCount(rows), per = s.backend.chunkRows();
+    detail::TypeWork& work = s.work[type];
+    if (work.killed.size() < chunks) work.killed.resize(chunks);
+    for (size_t c = 0; c < chunks; ++c) work.killed[c].rows.reserve(std::min(per, rows - c * per));
+    s.ledger.reserve(type, chunks, per, 1);
+    return std::nullopt;
+}
+
 std::optional<std::string> System::setExtern(std::string_view name, std::span<const float> value) {
     int index = externHandle(name);
     if (index < 0) return fmt::format("there is no extern `{}`", name);

@@ -197,6 +197,11 @@ public:
     std::optional<std::string> step(double dt);
     // The latest time a step may reach: 2^32 s, where a double still counts microseconds.
     static constexpr double kLatestTime = 4294967296.0;
+    // Room for `rows` objects of `type` made now (at most its capacity), so that steps with
+    // that many need no more: each chunk's list of deaths with room for the whole chunk
+    // (where its deaths are listed as they happen: 8 bytes a row more, in two sets that
+    // take turns), and the pool's columns given their pages. Results do not change.
+    std::optional<std::string> reserve(size_t type, size_t rows);
     // Threads for launches over pools from now on: 0 for every core. Results do not change.
     void setThreads(unsigned threads);
 

@@ -339,7 +339,7 @@ void Creation::firstUpdate(size_t type, Batch& b, size_t n, size_t allocated, do
         // whether at their creation (after their type's update) or in that update (they
         // were created before it): it takes them at once.
         std::optional<LateKills> late;
-        if (info.late && !s_.work[type].inStep.on) late.emplace(s_.ledger.fresh());
+        if (info.late && !s_.work[type].inStep.on) late.emplace(s_.ledger.fresh(type));
         // One update to t1: dt is each object's age then (Clock::Source::SinceCreated).
         advance(type, b, n, kMask, {Clock::Source::Uniform, Clock::Source::SinceCreated, t1, 0, false},
                 late ? &*late : nullptr);

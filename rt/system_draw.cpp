@@ -80,7 +80,7 @@ DrawnCount renderRows(State& s, size_t type, const RowsLaunch& launch, const uin
 ChunkDrawing::ChunkDrawing(State& s, size_t type, double now) : s_(s), type_(type), rows_(s.pools[type].rows()) {
     TypeWork& work = s.work[type];
     s.bindPool(type, s.types[type].renderLayout, work.render, work.renderTable);
-    Buffer mask = work.masks.at(1, Elem::U8, rows_);
+    Buffer mask = work.masks.at(1, Elem::U8, rows_, s.pools[type].room());  // (its capacity's room: it never moves)
     shown_ = s.host<uint8_t>(mask);
     alive_ = s.pools[type].alive.host();
     launch_ = renderLaunch(s, type, work.renderTable, mask, now);

@@ -138,8 +138,7 @@ void runKills(State& s, size_t type, double dt, double t1) {
     if (!work.pass.ran) return;
     size_t chunks = work.pass.chunks;
     if (work.pass.late) {
-        LateKills l = s.ledger.fresh(chunks);
-        l.type = type;
+        LateKills l = s.ledger.fresh(type, chunks);
         l.t1 = t1;
         l.dt = dt;
         for (size_t c = 0; c < chunks; ++c) std::swap(l.parts[c], work.killed[c]);  // (each keeps a vector)
@@ -263,7 +262,9 @@ void runUpdate(State& s, const Phase& phase, double dt, double t1, bool last) {
     work.pass.listed = listKills && !late;
     work.pass.takeOut = late && !last;
     work.pass.chunks = chunks;
-    if (listKills || late) work.killed.resize(chunks);  // each chunk sets its own (Ledger::record)
+    // Each chunk sets its own (Ledger::record); past `chunks`, parts kept for the rows the
+    // pool may reach (System::reserve).
+    if ((listKills || late) && work.killed.size() < chunks) work.killed.resize(chunks);
     if (late && phase.inMemory)
         for (size_t c = 0; c < chunks; ++c)
             work.killed[c].killList = pool.scratchRows(std::min(s.backend.chunkRows(), rows - c * s.backend.chunkRows()) + 1);

@@ -159,6 +159,13 @@ PSYS_API psys_error* psys_open_aot(const psys_aot* aot, const psys_options* opti
 
 /* Advances every object by dt seconds: finite and not negative (0 moves nothing). */
 PSYS_API psys_error* psys_step(psys_system* system, double dt);
+/* Room for `rows` objects of `type` made now (at most its capacity: else an error), so
+ * that steps with up to that many take nothing more: the pool's pages given at once, and
+ * each chunk's list of deaths with room for the whole chunk (8 bytes a row more where a
+ * type's deaths are listed as they happen). With it, a steady-state step allocates
+ * nothing and faults no page however the pool's population wanders. Results do not
+ * change. */
+PSYS_API psys_error* psys_reserve(psys_system* system, size_t type, size_t rows);
 /* Seconds since the start, and steps taken. */
 PSYS_API double psys_time(const psys_system* system);
 PSYS_API uint64_t psys_step_count(const psys_system* system);

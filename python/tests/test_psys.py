@@ -262,3 +262,17 @@ def test_step_releases_the_gil_other_python_threads_run_meanwhile():
     # Held, the worker's 60 steps would run with this loop stopped (a few turns at most,
     # before and after); released, it turns all the while (millions of times).
     assert counted > 10000, counted
+
+
+def test_reserve_takes_room_ahead_and_changes_nothing_else():
+    a = psys.compile(SAMPLES / "fire.psys", math="exact")
+    b = psys.compile(SAMPLES / "fire.psys", math="exact")
+    b.reserve("part", 100000)
+    for s in (a, b):
+        s.set("rate", 20000)
+        s.step(1 / 60, steps=60)
+    assert np.array_equal(a.points("part")["position"], b.points("part")["position"])
+    with pytest.raises(psys.Error, match="part holds at most 1048576 objects"):
+        b.reserve("part", 2**21)
+    with pytest.raises(KeyError):
+        b.reserve("nothing", 1)

@@ -377,3 +377,24 @@ TEST_CASE("an ahead-of-time build's IR runs on the interpreter, and a build that
     o = options("vulkan");
     CHECK(take(psys_open_aot(&aot, &o, &out)).find("no backend `vulkan`") != std::string::npos);
 }
+
+TEST_CASE("reserve takes room ahead, refuses more than the capacity or an unknown type, and changes no result") {
+    psys_options o = options("interp", "exact");
+    o.capacity = 5000;
+    System a, b;
+    REQUIRE(take(psys_compile_string(kDots, "beads.psys", &o, &a.s)).empty());
+    REQUIRE(take(psys_compile_string(kDots, "beads.psys", &o, &b.s)).empty());
+    CHECK(take(psys_reserve(b.s, 0, 5000)).empty());
+    CHECK(take(psys_reserve(b.s, 0, 5001)) == "psys_reserve: bead holds at most 5000 objects (its @capacity, else the "
+                                               "options' capacity), not 5001");
+    CHECK(take(psys_reserve(b.s, 7, 1)).find("psys_reserve: there is no object type 7") == 0);
+    CHECK(take(psys_reserve(nullptr, 0, 1)).find("psys_reserve") == 0);
+    for (psys_system* s : {a.s, b.s}) {
+        const float args[] = {0, 0, 0, 400};
+        REQUIRE(take(psys_fire(s, "burst", args, 4)).empty());
+        for (int i = 0; i < 30; ++i) REQUIRE(take(psys_step(s, 1.0 / 60)).empty());
+    }
+    std::vector<psys_point> pa = points(a.s, 0), pb = points(b.s, 0);
+    REQUIRE(pa.size() == pb.size());
+    CHECK(std::memcmp(pa.data(), pb.data(), pa.size() * sizeof(psys_point)) == 0);
+}
