@@ -103,6 +103,8 @@ psys_error* open(const char* function, const std::string& path, const std::strin
     so.backend.math = o.math;
     so.system = o.system;
     so.compile.pipeline.optimize = o.optimize;
+    so.compile.libraryPath = o.libraryPath;
+    so.backend.jitCache = o.jitCache;
     so = host::Session::resolved(so);
     auto s = std::make_unique<CompiledSystem>();
     std::optional<psys::ir::Module> module;

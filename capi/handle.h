@@ -3,6 +3,7 @@
 // and reads a system (capi/runtime.cpp) sees only rt::System.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,8 @@ struct Options {
     std::string backend = "llvm", math = "fast";
     rt::SystemOptions system;
     bool optimize = true;
+    std::optional<std::string> jitCache;   // psys_options.jit_cache (unset: NULL)
+    std::vector<std::string> libraryPath;  // psys_options.library_path, split at ':'
 };
 psys_error* readOptions(const char* function, const psys_options* given, Options& out);
 

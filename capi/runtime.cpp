@@ -2,15 +2,18 @@
 // stepped, set, fired, drawn and read by a C host. Every entry point checks its arguments
 // and turns what the layers below throw into an error value.
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <fmt/format.h>
 
 #include "capi/handle.h"
+#include "core/log.h"
 
 using psys::capi::guarded;
 using psys::capi::makeError;
@@ -61,7 +64,19 @@ namespace psys::capi {
 psys_error* readOptions(const char* function, const psys_options* given, Options& out) {
     psys_options o;
     psys_options_init(&o);
-    if (given) o = *given;
+    if (given) {
+        // An earlier header's options are a prefix of these (the rest keep the defaults);
+        // a later header's are not this library's to read.
+        if (given->size < offsetof(psys_options, backend))
+            return makeError(fmt::format("{}: psys_options.size is {}: psys_options_init(&options) sets it before the "
+                                         "fields are changed",
+                                         function, given->size));
+        if (given->size > sizeof(psys_options))
+            return makeError(fmt::format("{}: the options are {} bytes, from a later header than this library's ({} "
+                                         "bytes, version {}): build the host against this library's header",
+                                         function, given->size, sizeof(psys_options), kVersion));
+        std::memcpy(&o, given, given->size);
+    }
     out.backend = o.backend ? o.backend : "llvm";
     out.math = o.math ? o.math : "fast";
     if (o.capacity == 0 || o.capacity > 4294967295u)  // the language's own limit (@capacity)
@@ -73,6 +88,13 @@ psys_error* readOptions(const char* function, const psys_options* given, Options
     out.system.capacity = o.capacity;
     out.system.threads = o.threads;
     out.optimize = o.optimize != 0;
+    if (o.jit_cache) out.jitCache = o.jit_cache;
+    if (o.library_path)
+        for (std::string_view rest = o.library_path; !rest.empty();) {
+            size_t colon = std::min(rest.find(':'), rest.size());
+            if (colon > 0) out.libraryPath.emplace_back(rest.substr(0, colon));
+            rest.remove_prefix(std::min(colon + 1, rest.size()));
+        }
     return nullptr;
 }
 
@@ -85,7 +107,22 @@ const char* psys_version(void) { return kVersion; }
 void psys_options_init(psys_options* options) {
     if (!options) return;
     rt::SystemOptions defaults;
-    *options = psys_options{"llvm", "fast", defaults.seed, defaults.capacity, defaults.threads, 1};
+    *options = psys_options{sizeof(psys_options), "llvm", "fast", defaults.seed, defaults.capacity, defaults.threads, 1,
+                            nullptr, nullptr};
+}
+
+void psys_set_log(psys_log_function log, void* user) {
+    if (!log) {
+        psys::core::setLogSink({});
+        return;
+    }
+    psys::core::setLogSink([log, user](psys::core::LogLevel level, std::string_view message) {
+        psys_severity severity = level == psys::core::LogLevel::Error     ? PSYS_SEVERITY_ERROR
+                                 : level == psys::core::LogLevel::Warning ? PSYS_SEVERITY_WARNING
+                                                                          : PSYS_SEVERITY_NOTE;
+        std::string text(message);
+        log(user, severity, text.c_str());
+    });
 }
 
 void psys_system_free(psys_system* system) { delete system; }

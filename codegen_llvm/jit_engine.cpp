@@ -19,6 +19,7 @@
 #include <llvm/ExecutionEngine/Orc/JITTargetMachineBuilder.h>
 #include <unistd.h>
 
+#include "core/log.h"
 #include "jit_build_id.h"  // PSYS_JIT_BUILD_ID (generated: codegen_llvm/CMakeLists.txt)
 
 #include <llvm/Config/llvm-config.h>
@@ -79,6 +80,15 @@ struct RemarkCollector : llvm::DiagnosticHandler {
 // is simply not cached.
 class ObjectCache {
 public:
+    // The folder `chosen` names ("" : none), else the environment's.
+    static std::optional<ObjectCache> from(const std::optional<std::string>& chosen) {
+        if (!chosen) return fromEnvironment();
+        if (chosen->empty()) return std::nullopt;
+        ObjectCache cache;
+        cache.folder_ = *chosen;
+        cache.prune();
+        return cache;
+    }
     static std::optional<ObjectCache> fromEnvironment() {
         const char* setting = std::getenv("PSYS_JIT_CACHE");
         std::filesystem::path folder;
@@ -152,7 +162,12 @@ public:
         if (key.size() != 32) return;  // not a module keyed for the cache
         std::error_code error;
         std::filesystem::create_directories(folder_, error);
-        if (error) return;
+        if (error) {  // said once a cache: the run goes on, compiling what it cannot keep
+            if (!warned_->exchange(true))
+                core::log(core::LogLevel::Warning, "the JIT's cache `" + folder_.string() + "` cannot be made (" +
+                                                       error.message() + "): compiled kernels are not kept");
+            return;
+        }
         write(key + ".remarks", remarks.data(), remarks.size());  // first: an object never lacks its remarks
         write(key + ".o", object.getBufferStart(), object.getBufferSize());
     }
@@ -178,6 +193,8 @@ private:
         if (error) std::filesystem::remove(partial, error);
     }
     std::filesystem::path folder_;
+    // Whether store said it cannot make the folder (once: compile threads store at once).
+    std::shared_ptr<std::atomic<bool>> warned_ = std::make_shared<std::atomic<bool>>(false);
 };
 
 // Machine code for a module, with compile time linear in its size (optimize.h, "Code
@@ -274,10 +291,10 @@ struct JitEngine::Impl {
     }
 };
 
-JitEngine::JitEngine(MathMode mode) : impl_(std::make_unique<Impl>()) {
+JitEngine::JitEngine(MathMode mode, std::optional<std::string> cache) : impl_(std::make_unique<Impl>()) {
     impl_->mode = mode;
     impl_->avx512 = llvm::sys::getHostCPUFeatures().lookup("avx512f");
-    impl_->cache = ObjectCache::fromEnvironment();
+    impl_->cache = ObjectCache::from(cache);
     llvm::InitializeNativeTarget();
     llvm::InitializeNativeTargetAsmPrinter();
     auto host = llvm::orc::JITTargetMachineBuilder::detectHost();
@@ -308,8 +325,13 @@ JitEngine::JitEngine(MathMode mode) : impl_(std::make_unique<Impl>()) {
         linker->addPlugin(std::make_unique<CallRecorder>(&impl_->calls, &impl_->callsMutex));
     if (perfMapRequested()) {
         std::string error;
-        if (!addPerfMap(*impl_->jit, error)) std::fprintf(stderr, "psys: PSYS_PERF_MAP: %s\n", error.c_str());
+        if (!addPerfMap(*impl_->jit, error)) core::log(core::LogLevel::Warning, "PSYS_PERF_MAP: " + error);
     }
+    // The session's errors (LLVM prints "JIT session error: …" on standard error) through
+    // the library's log (core/log.h): a host's sink gets them.
+    impl_->jit->getExecutionSession().setErrorReporter([](llvm::Error error) {
+        core::log(core::LogLevel::Error, "JIT session error: " + llvm::toString(std::move(error)));
+    });
     impl_->jit->getIRTransformLayer().setTransform(
         [impl = impl_.get()](llvm::orc::ThreadSafeModule module, llvm::orc::MaterializationResponsibility&)
             -> llvm::Expected<llvm::orc::ThreadSafeModule> {

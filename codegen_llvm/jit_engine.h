@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,7 +20,9 @@ namespace psys::codegen_llvm {
 
 class JitEngine {
 public:
-    explicit JitEngine(MathMode mode);
+    // cache: the folder of compiled objects ("": none); unset: PSYS_JIT_CACHE, else
+    // $XDG_CACHE_HOME/psys/jit or ~/.cache/psys/jit (ObjectCache).
+    explicit JitEngine(MathMode mode, std::optional<std::string> cache = std::nullopt);
     ~JitEngine();
 
     // A context and an empty module with the JIT's target and data layout.

@@ -23,11 +23,11 @@ struct LlvmBackend::Impl {
     int counter = 0;
     unsigned lanes;
 
-    explicit Impl(MathMode m) : mode(m), engine(m), lanes(engine.floatLanes()) {}
+    Impl(MathMode m, std::optional<std::string> cache) : mode(m), engine(m, std::move(cache)), lanes(engine.floatLanes()) {}
 };
 
-LlvmBackend::LlvmBackend(MathMode mode)
-    : native::CompiledBackend(mode == MathMode::Exact), impl_(std::make_unique<Impl>(mode)) {}
+LlvmBackend::LlvmBackend(MathMode mode, std::optional<std::string> cache)
+    : native::CompiledBackend(mode == MathMode::Exact), impl_(std::make_unique<Impl>(mode, std::move(cache))) {}
 LlvmBackend::~LlvmBackend() = default;
 
 unsigned LlvmBackend::lanes() const { return impl_->lanes; }

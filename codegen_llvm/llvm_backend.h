@@ -14,6 +14,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,7 +25,8 @@ namespace psys::codegen_llvm {
 
 class LlvmBackend : public native::CompiledBackend {
 public:
-    explicit LlvmBackend(MathMode mode = MathMode::Fast);
+    // cache: the folder of compiled objects ("": none; unset: JitEngine's default).
+    explicit LlvmBackend(MathMode mode = MathMode::Fast, std::optional<std::string> cache = std::nullopt);
     ~LlvmBackend() override;
     std::string name() const override { return "llvm"; }
     // Floats per vector register the loops over pools use (16 with AVX-512, 8 with AVX, else 4).

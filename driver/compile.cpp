@@ -77,12 +77,14 @@ SourceRange sourceRange(const SourceManager& sources, ir::Loc loc) {
 
 std::optional<ir::Module> compileFile(const std::string& path, SourceManager& sources, DiagnosticEngine& diags,
                                       const CompileOptions& options) {
+    sources.setLibraryPath({options.libraryPath.begin(), options.libraryPath.end()});
     auto program = checkFile(path, sources, diags);
     return compileProgram(program.get(), sources, diags, options);
 }
 
 std::optional<ir::Module> compileText(const std::string& displayPath, std::string text, SourceManager& sources,
                                       DiagnosticEngine& diags, const CompileOptions& options) {
+    sources.setLibraryPath({options.libraryPath.begin(), options.libraryPath.end()});
     auto program = checkText(displayPath, std::move(text), sources, diags);
     return compileProgram(program.get(), sources, diags, options);
 }

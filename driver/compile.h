@@ -20,6 +20,8 @@ struct CompileOptions {
     // Called with the lowered module before the passes, and their messages: where the
     // chooser of integrators and steps under @tolerance (tune/tolerance.h) sets them.
     std::function<void(ir::Module&, opt::PassErrors&)> beforePasses;
+    // Directories `import "std/…"` looks in first (SourceManager::libraryPath).
+    std::vector<std::string> libraryPath;
 };
 
 // Returns the compiled module, or nullopt with the errors in `diags`. The passes' errors

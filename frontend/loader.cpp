@@ -48,10 +48,13 @@ namespace fs = std::filesystem;
 
 // The file an import names: the library's for `std/…` (the first directory that has
 // it; else empty, with where it looked in `looked`), else beside its importer.
-fs::path importTarget(const std::string& path, const fs::path& importer, std::string& looked) {
+fs::path importTarget(const std::string& path, const fs::path& importer, const SourceManager& sources,
+                      std::string& looked) {
     if (!path.starts_with("std/")) return (importer.parent_path() / path).lexically_normal();
     std::error_code ec;
-    for (const fs::path& dir : libraryDirectories()) {
+    std::vector<fs::path> dirs = sources.libraryPath();  // (the host's first)
+    for (fs::path& dir : libraryDirectories()) dirs.push_back(std::move(dir));
+    for (const fs::path& dir : dirs) {
         fs::path file = (dir / path).lexically_normal();
         // Named by where it really is (a build tree links share/psys/std to library/std).
         if (fs::exists(file, ec)) return fs::weakly_canonical(file, ec);
@@ -101,7 +104,7 @@ private:
             return false;
         }
         std::string looked;
-        fs::path target = importTarget(import.path, importer, looked);
+        fs::path target = importTarget(import.path, importer, sources_, looked);
         if (target.empty()) {
             diags_.error(import.pathRange,
                          fmt::format("there is no `{}` in the standard library (looked in {})", import.path,

@@ -71,10 +71,15 @@ public:
     // for the main file. Editors show an imported file's errors at the importer's line.
     SourceRange importedAt(int id) const { return importedAt_.at(static_cast<size_t>(id)); }
     void setImportedAt(int id, SourceRange where) { importedAt_.at(static_cast<size_t>(id)) = where; }
+    // Directories `import "std/…"` looks in before libraryDirectories()'s: a host's own
+    // (psys_options.library_path). Each holds `std/`.
+    const std::vector<std::filesystem::path>& libraryPath() const { return libraryPath_; }
+    void setLibraryPath(std::vector<std::filesystem::path> dirs) { libraryPath_ = std::move(dirs); }
 
 private:
     std::vector<std::unique_ptr<SourceFile>> files_;
     std::vector<SourceRange> importedAt_;
+    std::vector<std::filesystem::path> libraryPath_;
 };
 
 // A file a program names (`@texture("flame.png")`), found beside the program that names

@@ -3,10 +3,11 @@
 #include <atomic>
 #include <cstdlib>
 #include <cstring>
-#include <iostream>
 #include <mutex>
 
 #include <epoxy/gl.h>
+
+#include "core/log.h"
 
 namespace psys::gpu {
 
@@ -43,7 +44,7 @@ void GLAPIENTRY onMessage(GLenum, GLenum type, GLuint id, GLenum severity, GLsiz
         last = std::string(typeName(type)) + " (id " + std::to_string(id) + "): " + text;
     }
     if (environment() && (bad || severity != GL_DEBUG_SEVERITY_NOTIFICATION))
-        std::cerr << "GL " << typeName(type) << ": " << text << "\n";
+        core::log(bad ? core::LogLevel::Error : core::LogLevel::Warning, "GL " + std::string(typeName(type)) + ": " + text);
 }
 
 }  // namespace

@@ -14,7 +14,7 @@ Parsed<std::shared_ptr<rt::Backend>> makeBackend(const BackendChoice& choice) {
         return Result::fail("the maths is fast or exact, not `" + choice.math + "`");
     if (choice.name == "llvm") {
         auto mode = choice.math == "exact" ? codegen_llvm::MathMode::Exact : codegen_llvm::MathMode::Fast;
-        return {std::make_shared<codegen_llvm::LlvmBackend>(mode), {}};
+        return {std::make_shared<codegen_llvm::LlvmBackend>(mode, choice.jitCache), {}};
     }
     if (choice.name == "interp") return {std::make_shared<interp::Interpreter>(), {}};
     if (choice.name == "glsl") {

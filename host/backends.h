@@ -5,6 +5,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,9 @@ struct BackendChoice {
     // it gives up bit-exactness for speed anyway. A session decides this when it opens
     // and keeps it through reloads and backend switches, so one session runs one program.
     bool relaxesMaths() const { return name == "llvm" && math == "fast"; }
+    // llvm: the folder of the JIT's cache of compiled kernels ("": none); unset: as
+    // PSYS_JIT_CACHE says, else $XDG_CACHE_HOME/psys/jit or ~/.cache/psys/jit.
+    std::optional<std::string> jitCache = std::nullopt;
 };
 
 // The backends this build has, the default first.

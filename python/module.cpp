@@ -138,7 +138,8 @@ public:
 
     static std::unique_ptr<System> compile(const std::string& what, bool isSource, const std::string& name,
                                            const std::string& backend, const std::string& math, uint32_t seed,
-                                           size_t capacity, unsigned threads, bool optimize) {
+                                           size_t capacity, unsigned threads, bool optimize,
+                                           std::optional<std::string> jitCache, std::optional<std::string> libraryPath) {
         psys_options o;
         psys_options_init(&o);
         o.backend = backend.c_str();
@@ -147,6 +148,8 @@ public:
         if (capacity) o.capacity = capacity;
         o.threads = threads;
         o.optimize = optimize;
+        if (jitCache) o.jit_cache = jitCache->c_str();
+        if (libraryPath) o.library_path = libraryPath->c_str();
         if (isSource) refuseNul(what, name);
         psys_system* s = nullptr;
         psys_error* e = nullptr;
@@ -423,7 +426,8 @@ PYBIND11_MODULE(_psys, m) {
         valueTypeType() = std::move(valueType);
     });
     m.def("_compile", &System::compile, py::arg("what"), py::arg("is_source"), py::arg("name"), py::arg("backend"),
-          py::arg("math"), py::arg("seed"), py::arg("capacity"), py::arg("threads"), py::arg("optimize"));
+          py::arg("math"), py::arg("seed"), py::arg("capacity"), py::arg("threads"), py::arg("optimize"),
+          py::arg("jit_cache"), py::arg("library_path"));
     py::class_<System>(m, "System")
         .def("step", &System::step, py::arg("dt") = 1.0 / 60, py::arg("steps") = 1,
              "Advances every object by dt seconds, `steps` times.")

@@ -18,8 +18,11 @@
  * frees it. Nothing is changed by a call that fails, and no call aborts the host on bad
  * input: a null handle, an unknown name, the wrong number of values, a NaN.
  *
- * Structures. The structs below change only with the major version (libpsys.so.MAJOR):
- * a host built against this header runs with any library of the same major version.
+ * Structures. psys_options starts with its size, which psys_options_init sets: a later
+ * library reads an earlier header's options (the fields it lacks take their defaults), and
+ * refuses a later header's. The other structs change only with the soname's version
+ * (libpsys.so.0.MINOR before 1.0, libpsys.so.MAJOR after): a host built against this
+ * header runs with any library of the same soname.
  *
  * Threads. A system is used by one thread at a time (any thread on the CPU backends; the
  * thread whose GL context it was made in on the glsl backend). Systems are independent.
@@ -47,7 +50,7 @@ extern "C" {
 #endif
 
 #define PSYS_VERSION_MAJOR 0
-#define PSYS_VERSION_MINOR 1
+#define PSYS_VERSION_MINOR 2
 #define PSYS_VERSION_PATCH 0
 
 /* The library's version as "MAJOR.MINOR.PATCH" (the header's may differ: a host built
@@ -92,6 +95,9 @@ PSYS_API void psys_error_free(psys_error* error);
 typedef struct psys_system psys_system;
 
 typedef struct psys_options {
+    /* sizeof(psys_options) in the header the host was built with: psys_options_init sets
+     * it (0 is refused: the options were not initialised). */
+    uint32_t size;
     /* "llvm" (the JIT: the default), "interp" (the reference interpreter) or "glsl"
      * (compute shaders on OpenGL 4.5: the GL context current on the calling thread, or a
      * headless one of its own when none is). */
@@ -103,10 +109,25 @@ typedef struct psys_options {
     size_t capacity;    /* objects per type, unless its @capacity says otherwise */
     unsigned threads;   /* for the CPU backends: 0 for every core; results do not depend on it */
     int optimize;       /* nonzero (the default): the optimizer's passes */
+    /* The folder where the JIT keeps compiled kernels, so that a program's second start
+     * compiles nothing: NULL (the default) for $PSYS_JIT_CACHE, else $XDG_CACHE_HOME/psys/jit
+     * or ~/.cache/psys/jit; "" for none. */
+    const char* jit_cache;
+    /* Folders, ':'-separated, where `import "std/…"` looks first (each holds std/), before
+     * $PSYS_LIBRARY and the installed share/psys: NULL (the default) for none. */
+    const char* library_path;
 } psys_options;
 
-/* The defaults above: llvm, fast, seed 1, 2^20 objects a type, every core, optimized. */
+/* The defaults above: llvm, fast, seed 1, 2^20 objects a type, every core, optimized, the
+ * default cache, no library folders of the host's; and `size`. */
 PSYS_API void psys_options_init(psys_options* options);
+
+/* What the library has to say outside a call's result — a JIT session's error, a GL debug
+ * message (PSYS_GL_DEBUG), a setting it could not honour — one line a call, without a
+ * newline: to `log` from now on (any thread, one call at a time), or to standard error
+ * (NULL: the default). Process-wide. */
+typedef void (*psys_log_function)(void* user, psys_severity severity, const char* message);
+PSYS_API void psys_set_log(psys_log_function log, void* user);
 
 /* Compiles a program and starts a system (nothing is created before the first step or
  * trigger). On error *out is left NULL and the error has the diagnostics. `options` may

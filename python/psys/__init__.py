@@ -48,10 +48,18 @@ version = _psys.version
 
 
 def compile(path=None, *, source=None, name="<string>", backend="llvm", math="fast", seed=1,
-            capacity=0, threads=0, optimize=True):
+            capacity=0, threads=0, optimize=True, jit_cache=None, library_path=None):
     """Compiles a .psys file (or `source`, standing for a file called `name`) and starts a
     system on `backend`: "llvm" (the JIT), "interp" or "glsl" (a GPU, through OpenGL 4.5).
-    capacity: objects per type (0: the default, 2^20); threads: 0 for every core."""
+    capacity: objects per type (0: the default, 2^20); threads: 0 for every core;
+    jit_cache: the folder of the JIT's compiled kernels ("" none; None: the default);
+    library_path: folders (a list, or ':'-separated) where `import "std/…"` looks first."""
+    if jit_cache is not None:
+        jit_cache = os.fsdecode(jit_cache)
+    if library_path is not None and not isinstance(library_path, (str, bytes, os.PathLike)):
+        library_path = ":".join(os.fsdecode(p) for p in library_path)
+    elif library_path is not None:
+        library_path = os.fsdecode(library_path)
     if (path is None) == (source is None):
         raise TypeError("psys.compile takes a path or source=, one of them")
     for what, value, least, most in (("seed", seed, 0, 2**32 - 1), ("capacity", capacity, 0, 4294967295),
@@ -65,7 +73,8 @@ def compile(path=None, *, source=None, name="<string>", backend="llvm", math="fa
             source = source.decode("utf-8")
         if not isinstance(source, str):
             raise TypeError(f"psys.compile: source is text, not {type(source).__name__}")
-        return _psys._compile(source, True, name, backend, math, seed, capacity, threads, optimize)
+        return _psys._compile(source, True, name, backend, math, seed, capacity, threads, optimize, jit_cache,
+                              library_path)
     if not isinstance(path, (str, bytes, os.PathLike)):
         raise TypeError(f"psys.compile: a path is text or os.PathLike, not {type(path).__name__}")
     path = os.fsdecode(path)
@@ -73,7 +82,7 @@ def compile(path=None, *, source=None, name="<string>", backend="llvm", math="fa
         raise ValueError("psys.compile: a path has no NUL character")
     with open(path, "rb"):  # a missing or unreadable file: the OSError Python gives (FileNotFoundError, …)
         pass
-    return _psys._compile(path, False, "", backend, math, seed, capacity, threads, optimize)
+    return _psys._compile(path, False, "", backend, math, seed, capacity, threads, optimize, jit_cache, library_path)
 
 
 

@@ -276,3 +276,16 @@ def test_reserve_takes_room_ahead_and_changes_nothing_else():
         b.reserve("part", 2**21)
     with pytest.raises(KeyError):
         b.reserve("nothing", 1)
+
+
+def test_the_library_path_and_the_jit_cache_are_options(tmp_path):
+    (tmp_path / "lib" / "std").mkdir(parents=True)
+    (tmp_path / "lib" / "std" / "mine.psys").write_text("const far = 40;\n")
+    source = 'import "std/mine.psys";\nobject a { point(vec3(far), white, 1); }\nspawn a;\n'
+    s = psys.compile(source=source, library_path=[tmp_path / "nothing", tmp_path / "lib"],
+                     jit_cache=tmp_path / "cache")
+    s.step(1 / 60)
+    assert s.points("a")["position"].tolist() == [[40, 40, 40]]
+    assert any(p.suffix == ".o" for p in (tmp_path / "cache").iterdir())
+    with pytest.raises(psys.CompileError, match="std/mine.psys"):
+        psys.compile(source=source)

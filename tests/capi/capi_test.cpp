@@ -5,7 +5,9 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstddef>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -14,6 +16,8 @@
 #include "driver/compile.h"
 #include "ir/printer.h"
 #include "psys/psys.h"
+
+#include <unistd.h>
 
 namespace {
 
@@ -397,4 +401,73 @@ TEST_CASE("reserve takes room ahead, refuses more than the capacity or an unknow
     std::vector<psys_point> pa = points(a.s, 0), pb = points(b.s, 0);
     REQUIRE(pa.size() == pb.size());
     CHECK(std::memcmp(pa.data(), pb.data(), pa.size() * sizeof(psys_point)) == 0);
+}
+
+TEST_CASE("options carry their size: unset, a later header's refused in words; an earlier header's read with defaults") {
+    System s;
+    psys_options o = options("interp");
+    o.size = 0;
+    CHECK(take(psys_compile_string(kDots, nullptr, &o, &s.s)) ==
+          "psys_compile_string: psys_options.size is 0: psys_options_init(&options) sets it before the fields are changed");
+    o.size = sizeof(psys_options) + 8;
+    CHECK(take(psys_compile_string(kDots, nullptr, &o, &s.s)).find("from a later header than this library's") !=
+          std::string::npos);
+    CHECK(s.s == nullptr);
+    // A header that ended before jit_cache: those fields are the defaults, whatever follows.
+    o = options("interp");
+    o.size = offsetof(psys_options, jit_cache);
+    o.jit_cache = "/proc/not/a/folder";
+    o.library_path = reinterpret_cast<const char*>(1);  // past the host's struct: never read
+    CHECK(take(psys_compile_string(kDots, nullptr, &o, &s.s)).empty());
+    CHECK(s.s != nullptr);
+}
+
+namespace {
+std::vector<std::string> logged;
+void keepLog(void* user, psys_severity severity, const char* message) {
+    static_cast<std::vector<std::string>*>(user)->push_back(std::to_string(severity) + " " + message);
+}
+}  // namespace
+
+TEST_CASE("the JIT's cache folder and the library's folders are options; what the library says goes to the host's log") {
+    namespace fs = std::filesystem;
+    fs::path dir = fs::temp_directory_path() / ("psys-capi-options-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir / "lib" / "std");
+    std::ofstream(dir / "lib" / "std" / "mine.psys") << "const far = 40;\n";
+    const std::string source = "import \"std/mine.psys\";\nobject a { point(vec3(far), white, 1); }\nspawn a;\n";
+    const std::string libs = "/nonexistent:" + (dir / "lib").string();
+    {
+        System s;
+        psys_options o = options("llvm");
+        std::string cache = (dir / "cache").string();
+        o.jit_cache = cache.c_str();
+        o.library_path = libs.c_str();
+        REQUIRE(take(psys_compile_string(source.c_str(), "mine_user.psys", &o, &s.s)).empty());
+        REQUIRE(take(psys_step(s.s, 1.0 / 60)).empty());
+        std::vector<psys_point> p = points(s.s, 0);
+        REQUIRE(p.size() == 1);
+        CHECK(p[0].position[0] == 40);
+        size_t objects = 0;
+        for (const auto& e : fs::directory_iterator(dir / "cache")) objects += e.path().extension() == ".o";
+        CHECK(objects > 0);  // the kernels kept where the host said
+    }
+    {
+        System s;  // without the folder, the import is not found
+        psys_options o = options("interp");
+        CHECK(take(psys_compile_string(source.c_str(), "mine_user.psys", &o, &s.s)).find("std/mine.psys") !=
+              std::string::npos);
+    }
+    {
+        psys_set_log(keepLog, &logged);
+        System s;
+        psys_options o = options("llvm");
+        o.jit_cache = "/proc/psys-cannot-be-made";
+        REQUIRE(take(psys_compile_string(kDots, nullptr, &o, &s.s)).empty());
+        REQUIRE(take(psys_step(s.s, 1.0 / 60)).empty());
+        psys_set_log(nullptr, nullptr);
+        REQUIRE(logged.size() == 1);  // said once, as a warning, to the host's log and not to stderr
+        CHECK(logged[0].find("1 the JIT's cache `/proc/psys-cannot-be-made` cannot be made") == 0);
+    }
+    fs::remove_all(dir);
 }

@@ -19,7 +19,7 @@ exported() { nm -D --defined-only "$1" | awk '$2 != "A" && $2 ~ /^[A-Zu]$/ {prin
 for name in psys psys_runtime; do
   real=$(readlink -f "$prefix/lib/lib$name.so")
   soname=$(objdump -p "$real" | awk '/SONAME/ {print $2}')
-  [ "$soname" = "lib$name.so.0" ] || { echo "soname: $soname, not lib$name.so.0"; exit 1; }
+  [ "$soname" = "lib$name.so.0.2" ] || { echo "soname: $soname, not lib$name.so.0.2"; exit 1; }
   others=$(exported "$real" | grep -v '^psys_' || true)
   if [ -n "$others" ]; then
     echo "lib$name.so exports more than the C API:"; echo "$others" | head -20; exit 1
