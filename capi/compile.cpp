@@ -43,10 +43,13 @@ std::vector<OwnedDiagnostic> diagnosticsOf(const DiagnosticEngine& engine, bool 
         o.message = d.message;
         if (d.range.valid() && d.range.file < engine.sources().count()) {
             const SourceFile& f = engine.sources().file(d.range.file);
-            LineColumn begin = f.lineColumn(d.range.begin), end = f.lineColumn(d.range.end);
+            // line and column are where the message's `line:column` and caret point (the
+            // focus: a binary operator whose operands disagree), the range around it.
+            LineColumn end = f.lineColumn(d.range.end);
+            LineColumn at = f.lineColumn(d.focus.value_or(d.range.begin));
             o.file = f.path();
-            o.line = begin.line;
-            o.column = begin.column;
+            o.line = at.line;
+            o.column = at.column;
             o.endLine = end.line;
             o.endColumn = end.column;
         }

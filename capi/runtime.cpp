@@ -54,7 +54,7 @@ void psys_system::describe() {
     triggerTypes.clear();
     for (const psys::ir::Trigger& t : m.triggers) {
         std::string types;
-        for (const psys::ir::Param& p : t.params) types += (types.empty() ? "" : ", ") + rt::languageName(p.type);
+        for (const psys::ir::Param& p : t.params) types += (types.empty() ? "" : ", ") + rt::languageName(p);
         triggerTypes.push_back(types);
     }
 }
@@ -149,6 +149,19 @@ psys_error* psys_reserve(psys_system* s, size_t type, size_t rows) {
     if (!s) return nullArgument("psys_reserve", "the system");
     if (type >= s->system().typeCount()) return badType("psys_reserve", s, type);
     return guarded("psys_reserve", [&] { return orError("psys_reserve", s->system().reserve(type, rows)); });
+}
+
+psys_error* psys_prewarm(psys_system* s, double seconds, double longest_step) {
+    if (!s) return nullArgument("psys_prewarm", "the system");
+    return guarded("psys_prewarm", [&] { return orError("psys_prewarm", s->system().prewarm(seconds, longest_step)); });
+}
+
+psys_error* psys_reset(psys_system* s) {
+    if (!s) return nullArgument("psys_reset", "the system");
+    return guarded("psys_reset", [&]() -> psys_error* {
+        s->system().reset();
+        return nullptr;
+    });
 }
 
 double psys_time(const psys_system* s) { return s ? s->system().time() : 0; }

@@ -249,6 +249,8 @@ struct Param {
     std::string name;
     Type type;
     bool kept = true;  // false: read only at creation, so the pool does not store it
+    // Its type as declared where that says more (`color`, `point`): a trigger's, for hosts.
+    std::string spelling = std::string();
 };
 
 enum class StateInit {

@@ -62,7 +62,12 @@ std::vector<Param> params(const std::string& header) {
         std::string typeText = trim(item.substr(colon + 1));
         bool once = typeText.ends_with(" once");
         if (once) typeText = trim(typeText.substr(0, typeText.size() - 5));
-        out.push_back({trim(item.substr(0, colon)), type(typeText), !once});
+        std::string spelling;  // `vec3 as point`
+        if (auto as = typeText.find(" as "); as != std::string::npos) {
+            spelling = trim(typeText.substr(as + 4));
+            typeText = trim(typeText.substr(0, as));
+        }
+        out.push_back({trim(item.substr(0, colon)), type(typeText), !once, spelling});
     }
     return out;
 }

@@ -19,7 +19,9 @@ std::string constantText(const Inst& inst) {
 
 std::string params(const std::vector<Param>& ps) {
     std::string s;
-    for (auto& p : ps) s += (s.empty() ? "" : ", ") + p.name + ": " + p.type.str() + (p.kept ? "" : " once");
+    for (auto& p : ps)
+        s += (s.empty() ? "" : ", ") + p.name + ": " + p.type.str() + (p.spelling.empty() ? "" : " as " + p.spelling) +
+             (p.kept ? "" : " once");
     return s;
 }
 

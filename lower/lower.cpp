@@ -285,7 +285,10 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
                 auto& t = static_cast<const TriggerDecl&>(*d);
                 Trigger trigger;
                 trigger.name = t.name;
-                for (auto& p : t.params) trigger.params.push_back({p.name, irType(p.type.type)});
+                for (auto& p : t.params) {
+                    trigger.params.push_back({p.name, irType(p.type.type)});
+                    if (p.type.spelling == "color" || p.type.spelling == "point") trigger.params.back().spelling = p.type.spelling;
+                }
                 trigger.kernel.kind = KernelKind::Trigger;
                 int sites = 0;
                 ObjectLowering lowering(m, locate, trigger.kernel, nullptr, nullptr, &t, sites);

@@ -208,6 +208,16 @@ public:
         check(psys_fire(s_, trigger.c_str(), all.data(), all.size()));
     }
     void reserve(const py::object& type, size_t rows) { check(psys_reserve(open(), typeOf(type), rows)); }
+    void prewarm(double seconds, double longest) {
+        psys_system* s = open();
+        psys_error* e = nullptr;
+        {
+            py::gil_scoped_release unlocked;
+            e = psys_prewarm(s, seconds, longest);
+        }
+        check(e);
+    }
+    void reset() { check(psys_reset(open())); }
     void reload(std::optional<std::string> source) {
         if (source) refuseNul(*source, "<string>");
         psys_system* s = open();
@@ -443,6 +453,9 @@ PYBIND11_MODULE(_psys, m) {
         .def("stats", &System::stats)
         .def("reserve", &System::reserve, py::arg("type"), py::arg("rows"),
              "Room for `rows` objects of `type` made now: steps up to that many take nothing more.")
+        .def("prewarm", &System::prewarm, py::arg("seconds"), py::arg("longest_step") = 0.1,
+             "Runs `seconds` ahead at once in equal steps of at most `longest_step`, drawing nothing.")
+        .def("reset", &System::reset, "Back to the start, with the same seed and the externs as set.")
         .def("close", &System::close, "Frees the system now; any later call raises ValueError.")
         .def_property_readonly("closed", &System::closed)
         .def("__enter__", [](py::object self) { return self; })

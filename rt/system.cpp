@@ -88,6 +88,41 @@ System::~System() {
     state_->backend.forget(state_->module);
 }
 
+void System::reset() {
+    finish();
+    detail::State& old = *state_;
+    Backend& backend = old.backend;
+    SystemOptions options = old.options;
+    std::vector<Value> externs = old.externs;  // (the host's values stay)
+    // The module moves over whole: its kernels stay where they are, and the backend's
+    // compiled functions for them with them — nothing is compiled again.
+    ir::Module module = std::move(old.module);
+    drawing_.reset();
+    creation_.reset();
+    state_.reset();
+    state_ = std::make_unique<detail::State>(std::move(module), backend, options);
+    creation_ = std::make_unique<detail::Creation>(*state_);
+    drawing_ = std::make_unique<detail::Drawing>(*state_);
+    state_->schedule = detail::stepSchedule(*state_);
+    state_->externs = std::move(externs);
+    ++state_->externsVersion;
+}
+
+std::optional<std::string> System::prewarm(double seconds, double longest) {
+    if (!std::isfinite(seconds) || seconds < 0)
+        return fmt::format("prewarm: the time to run ahead is a finite, non-negative number of seconds, not {}", seconds);
+    if (!std::isfinite(longest) || longest <= 0)
+        return fmt::format("prewarm: the longest step is a finite, positive number of seconds, not {}", longest);
+    if (seconds == 0) return std::nullopt;
+    // Equal steps, as few as `longest` allows (no sliver of a last step).
+    const double steps = std::ceil(seconds / longest);
+    if (steps > 1e7) return fmt::format("prewarm: {} s in steps of {} s is {} steps: more than 10^7", seconds, longest, steps);
+    const double dt = seconds / steps;
+    for (double k = 0; k < steps; ++k)
+        if (auto error = step(dt)) return "prewarm: " + *error;
+    return std::nullopt;
+}
+
 void System::setThreads(unsigned threads) {
     state_->options.threads = threads;
     state_->parallel = std::make_unique<detail::Parallel>(threads);
@@ -246,6 +281,7 @@ std::string languageName(const ir::Type& t) {
 }
 
 std::string languageName(const ir::Extern& e) { return e.spelling.empty() ? languageName(e.type) : e.spelling; }
+std::string languageName(const ir::Param& p) { return p.spelling.empty() ? languageName(p.type) : p.spelling; }
 
 std::optional<std::string> System::reserve(size_t type, size_t rows) {
     detail::State& s = *state_;

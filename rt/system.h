@@ -169,8 +169,10 @@ class Drawing;
 
 // An extern's type as the program spells it (`float`, `vec3`, `bool`, `color`): for messages.
 std::string languageName(const ir::Extern& e);
-// A value's type as the language spells it without more to go on (a trigger's parameter).
+// A value's type as the language spells it without more to go on.
 std::string languageName(const ir::Type& t);
+// A parameter's type as the program spells it (a trigger's `point`, `color`).
+std::string languageName(const ir::Param& p);
 
 class System {
 public:
@@ -195,6 +197,14 @@ public:
     // machine's memory at the pool's bytes a row: nullopt, or an error that names the bytes.
     static std::optional<std::string> checkCapacity(const ir::Module& module, const SystemOptions& options);
     std::optional<std::string> step(double dt);
+    // Runs `seconds` ahead at once in equal steps of at most `longest` (a warm-up: what a
+    // host shows from its first frame has been running a while). Nothing is drawn in them
+    // unless the host draws between (it does not: one call). Errors: a bad time.
+    std::optional<std::string> prewarm(double seconds, double longest);
+    // Back to the start — time 0, nothing created, the counters at 0 — with the same seed
+    // (the same run again), the externs as the host last set them, and nothing compiled
+    // again.
+    void reset();
     // The latest time a step may reach: 2^32 s, where a double still counts microseconds.
     static constexpr double kLatestTime = 4294967296.0;
     // Room for `rows` objects of `type` made now (at most its capacity), so that steps with

@@ -69,8 +69,9 @@ typedef enum psys_severity {
 } psys_severity;
 
 /* One diagnostic of a compilation. Its strings live as long as the error (or the system,
- * for psys_warning). line and column count from 1 (column in bytes); 0 where the
- * diagnostic has no place in a file (a limit, the command line). */
+ * for psys_warning). line and column count from 1 (column in bytes): where the message's
+ * `file:line:column` and caret point; 0 where the diagnostic has no place in a file (a
+ * limit, the command line). */
 typedef struct psys_diagnostic {
     psys_severity severity;
     const char* file;
@@ -187,6 +188,17 @@ PSYS_API psys_error* psys_step(psys_system* system, double dt);
  * nothing and faults no page however the pool's population wanders. Results do not
  * change. */
 PSYS_API psys_error* psys_reserve(psys_system* system, size_t type, size_t rows);
+/* Runs `seconds` ahead at once (a warm-up, as a game shows a fire already burning), in
+ * equal steps of at most `longest_step` seconds (0.1 makes it cheap; the effect's own
+ * accuracy decides how long a step it bears), drawing nothing. Errors: a negative or
+ * non-finite time, a step not positive. */
+PSYS_API psys_error* psys_prewarm(psys_system* system, double seconds, double longest_step);
+/* Back to the start: time 0, no object, the counters at 0, the same seed (so the same run
+ * again), the externs as last set; nothing is compiled again. On the glsl backend, with
+ * the system's GL context current. */
+PSYS_API psys_error* psys_reset(psys_system* system);
+/* Pause and speed are the host's: a paused system is one not stepped, and a system at
+ * speed k is stepped by k·dt (a step of 0 moves nothing). */
 /* Seconds since the start, and steps taken. */
 PSYS_API double psys_time(const psys_system* system);
 PSYS_API uint64_t psys_step_count(const psys_system* system);

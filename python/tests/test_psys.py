@@ -289,3 +289,17 @@ def test_the_library_path_and_the_jit_cache_are_options(tmp_path):
     assert any(p.suffix == ".o" for p in (tmp_path / "cache").iterdir())
     with pytest.raises(psys.CompileError, match="std/mine.psys"):
         psys.compile(source=source)
+
+
+def test_prewarm_and_reset():
+    s = psys.compile(SAMPLES / "fountain.psys", math="exact")
+    s.prewarm(3.0)
+    assert s.step_count == 30 and abs(s.time - 3.0) < 1e-9
+    warm = s.points("drop")["position"]
+    assert len(warm) > 1000
+    s.reset()
+    assert s.time == 0 and s.step_count == 0 and len(s.points("drop")["id"]) == 0
+    s.prewarm(3.0, longest_step=0.1)
+    assert np.array_equal(s.points("drop")["position"], warm)  # the same seed: the same run
+    with pytest.raises(psys.Error, match="non-negative"):
+        s.prewarm(-1)

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -470,4 +471,70 @@ TEST_CASE("the JIT's cache folder and the library's folders are options; what th
         CHECK(logged[0].find("1 the JIT's cache `/proc/psys-cannot-be-made` cannot be made") == 0);
     }
     fs::remove_all(dir);
+}
+
+TEST_CASE("a trigger's parameters are described as the program declares them: a point is a point, not a vec3") {
+    System s;
+    psys_options o = options("interp");
+    REQUIRE(take(psys_compile_file((kSamples + "/swamp.psys").c_str(), &o, &s.s)).empty());
+    std::map<std::string, std::string> types;
+    psys_input in;
+    for (size_t i = 0; psys_trigger_info(s.s, i, &in) == 0; ++i) types[in.name] = in.type;
+    CHECK(types["fireball"] == "point, vec3");
+    CHECK(types["swarm"] == "point");
+}
+
+TEST_CASE("a diagnostic's line and column are where its message's caret points") {
+    System s;
+    psys_options o = options("interp");
+    // The operands of `+` disagree: the message and caret point at the `+`, not at `vec3`.
+    psys_error* e = psys_compile_string("object a { point(vec3(1) + vec4(1), white, 1); }\nspawn a;\n", "caret.psys", &o, &s.s);
+    REQUIRE(e != nullptr);
+    psys_diagnostic d;
+    REQUIRE(psys_error_diagnostic(e, 0, &d) == 0);
+    std::string message = psys_error_message(e);
+    CHECK(message.find("caret.psys:1:" + std::to_string(d.column) + ":") != std::string::npos);
+    CHECK(d.column == 26);  // the `+`
+    CHECK(d.end_column > d.column);
+    psys_error_free(e);
+}
+
+TEST_CASE("reset goes back to the start and runs the same again; prewarm runs ahead in equal steps, drawing nothing") {
+    for (const char* backend : {"interp", "llvm"}) {
+        CAPTURE(backend);
+        psys_options o = options(backend, "exact");
+        System s, fresh;
+        REQUIRE(take(psys_compile_file((kSamples + "/fire.psys").c_str(), &o, &s.s)).empty());
+        REQUIRE(take(psys_compile_file((kSamples + "/fire.psys").c_str(), &o, &fresh.s)).empty());
+        const float rate = 2000;
+        REQUIRE(take(psys_set_extern(s.s, "rate", &rate, 1)).empty());
+        REQUIRE(take(psys_set_extern(fresh.s, "rate", &rate, 1)).empty());
+        for (int i = 0; i < 40; ++i) REQUIRE(take(psys_step(s.s, 1.0 / 60)).empty());
+        REQUIRE(take(psys_reset(s.s)).empty());
+        CHECK(psys_time(s.s) == 0);
+        CHECK(psys_step_count(s.s) == 0);
+        CHECK(points(s.s, 0).empty());
+        float kept[4];
+        CHECK(psys_get_extern(s.s, "rate", kept) == 1);
+        CHECK(kept[0] == rate);  // the host's value stays
+        for (psys_system* each : {s.s, fresh.s})
+            for (int i = 0; i < 30; ++i) REQUIRE(take(psys_step(each, 1.0 / 60)).empty());
+        std::vector<psys_point> a = points(s.s, 0), b = points(fresh.s, 0);
+        REQUIRE(a.size() == b.size());
+        REQUIRE(!a.empty());
+        CHECK(std::memcmp(a.data(), b.data(), a.size() * sizeof(psys_point)) == 0);
+
+        REQUIRE(take(psys_reset(s.s)).empty());
+        REQUIRE(take(psys_prewarm(s.s, 2.05, 0.1)).empty());
+        CHECK(psys_time(s.s) == doctest::Approx(2.05));
+        CHECK(psys_step_count(s.s) == 21);  // 2.05 s in 21 equal steps, none longer than 0.1 s
+        psys_type_stats st;
+        REQUIRE(take(psys_get_type_stats(s.s, 0, &st)).empty());
+        CHECK(st.live > 1000);
+        CHECK(take(psys_prewarm(s.s, -1, 0.1)).find("a finite, non-negative number of seconds, not -1") !=
+              std::string::npos);
+        CHECK(take(psys_prewarm(s.s, 1, 0)).find("a finite, positive number of seconds, not 0") != std::string::npos);
+        CHECK(psys_step_count(s.s) == 21);  // refused: nothing moved
+        CHECK(take(psys_reset(nullptr)).find("psys_reset") == 0);
+    }
 }

@@ -117,7 +117,7 @@ std::string header(const ir::Module& m, const BuildOptions& o, const std::string
         std::set<std::string> used = {"system", "v"};
         for (const ir::Param& p : t.params) {
             parameters(p.type, p.name, list, values, used);
-            types += (types.empty() ? "" : ", ") + p.name + ": " + rt::languageName(p.type);
+            types += (types.empty() ? "" : ", ") + p.name + ": " + rt::languageName(p);
         }
         if (values.empty())
             h += fmt::format("\n/* trigger {}() */\nstatic inline psys_error* {}_fire_{}(psys_system* system) {{\n"
