@@ -189,20 +189,32 @@ int memoryTable(const std::vector<std::string>& effects, const std::vector<doubl
 // worst ÷ the median, the worst step ÷ the median of the 21 steps around it (a hitch, apart
 // from the population's growth: the last steps update twice the median's objects), and
 // the frames of the five worst.
-int hitchTable(const std::vector<std::string>& effects, double value, int frames, size_t capacity, const std::string& json) {
+// With `reserve` rows, each effect runs twice: as it is, then with its particles' rows
+// reserved before the first step (rt::System::reserve, at most the capacity).
+int hitchTable(const std::vector<std::string>& effects, double value, int frames, size_t capacity, size_t reserve,
+               const std::string& json) {
     nlohmann::json rows = nlohmann::json::array();
     codegen_llvm::LlvmBackend jit;
     std::cout << fmt::format("Steps from the first, {} of 1/60 s each, on {} cores (extern at {:g}{}):\n\n", frames,
                              std::max(1u, std::thread::hardware_concurrency()), value,
                              capacity ? fmt::format(", capacity {}", capacity) : std::string(", the default capacity"))
-              << "| effect | live at the end | median (ms) | 99th percentile (ms) | worst (ms) | worst ÷ median | "
-                 "worst ÷ the median around it | the five worst (frame: ms) |\n|---|---:|---:|---:|---:|---:|---:|---|\n";
-    for (const std::string& name : effects) {
-        const Effect* effect = bench::findEffect(name);
-        if (!effect) return 2;
-        rt::SystemOptions options;
-        if (capacity) options.capacity = capacity;
-        rt::System system(bench::compileEffect(name, true), jit, options);
+              << "| effect | reserved | live at the end | median (ms) | 99th percentile (ms) | worst (ms) | worst ÷ median | "
+                 "worst ÷ the median around it | the five worst (frame: ms) |\n|---|---:|---:|---:|---:|---:|---:|---:|---|\n";
+    for (const std::string& name : effects)
+        for (size_t reserved : reserve ? std::vector<size_t>{0, reserve} : std::vector<size_t>{0}) {
+            const Effect* effect = bench::findEffect(name);
+            if (!effect) return 2;
+            rt::SystemOptions options;
+            if (capacity) options.capacity = capacity;
+            rt::System system(bench::compileEffect(name, true), jit, options);
+            const auto particles = static_cast<size_t>(system.typeIndex(effect->particles));
+            if (reserved) {
+                reserved = std::min(reserved, system.pool(particles).capacity());
+                if (auto error = system.reserve(particles, reserved)) {
+                    std::cerr << *error << "\n";
+                    return 1;
+                }
+        }
         float v = static_cast<float>(value);
         system.setExtern(effect->knob, {&v, 1});
         std::vector<double> times;
@@ -210,8 +222,8 @@ int hitchTable(const std::vector<std::string>& effects, double value, int frames
             auto start = Clock::now();
             system.step(1.0 / 60);
             times.push_back(seconds(start, Clock::now()) * 1e3);
-            rows.push_back({{"effect", name}, {"frame", f}, {"ms", times.back()},
-                            {"live", system.pool(static_cast<size_t>(system.typeIndex(effect->particles))).live()}});
+            rows.push_back({{"effect", name}, {"reserved", reserved}, {"frame", f}, {"ms", times.back()},
+                            {"live", system.pool(particles).live()}});
         }
         std::vector<size_t> order(times.size());
         for (size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -227,12 +239,50 @@ int hitchTable(const std::vector<std::string>& effects, double value, int frames
             local = std::max(local, times[f] / median({times.begin() + static_cast<std::ptrdiff_t>(from),
                                                          times.begin() + static_cast<std::ptrdiff_t>(to)}));
         }
-        std::cout << fmt::format("| {} | {} | {:.2f} | {:.2f} | {:.2f} | {:.1f} | {:.1f} | {} |\n", name,
-                                 system.pool(static_cast<size_t>(system.typeIndex(effect->particles))).live(), med,
-                                 sorted[sorted.size() * 99 / 100], sorted.back(), sorted.back() / med, local, worst);
+        std::cout << fmt::format("| {} | {} | {} | {:.2f} | {:.2f} | {:.2f} | {:.1f} | {:.1f} | {} |\n", name, reserved,
+                                 system.pool(particles).live(), med, sorted[sorted.size() * 99 / 100], sorted.back(),
+                                 sorted.back() / med, local, worst);
         std::cout.flush();
-    }
+      }
     if (!json.empty() && !bench::writeJson(json, rows.dump(1), "psys_bench")) return 1;
+    return 0;
+}
+
+// Prewarm: `seconds` of each effect at its knob `value` run ahead at once
+// (rt::System::prewarm, steps of at most `longest`) against the same seconds stepped frame
+// by frame at 1/60 s: the time each takes and the live particles after.
+int prewarmTable(const std::vector<std::string>& effects, double value, double ahead, double longest) {
+    codegen_llvm::LlvmBackend jit;
+    std::cout << fmt::format("Prewarm: {:g} s at once in steps of at most {:g} s, against frames of 1/60 s (extern at "
+                             "{:g}, {} cores):\n\n",
+                             ahead, longest, value, std::max(1u, std::thread::hardware_concurrency()))
+              << "| effect | prewarm (ms) | live after it | frames (ms) | live after them | frames ÷ prewarm |\n"
+                 "|---|---:|---:|---:|---:|---:|\n";
+    for (const std::string& name : effects) {
+        const Effect* effect = bench::findEffect(name);
+        if (!effect) return 2;
+        double ms[2];
+        size_t live[2];
+        for (int way = 0; way < 2; ++way) {
+            rt::System system(bench::compileEffect(name, true), jit);
+            float v = static_cast<float>(value);
+            system.setExtern(effect->knob, {&v, 1});
+            system.step(0);  // (started: the first step's own work is not the prewarm's)
+            auto start = Clock::now();
+            if (way == 0) {
+                if (auto error = system.prewarm(ahead, longest)) {
+                    std::cerr << *error << "\n";
+                    return 1;
+                }
+            } else {
+                for (int f = 0; f < static_cast<int>(std::lround(ahead * 60)); ++f) system.step(1.0 / 60);
+            }
+            ms[way] = seconds(start, Clock::now()) * 1e3;
+            live[way] = system.pool(static_cast<size_t>(system.typeIndex(effect->particles))).live();
+        }
+        std::cout << fmt::format("| {} | {:.1f} | {} | {:.1f} | {} | {:.1f} |\n", name, ms[0], live[0], ms[1], live[1],
+                                 ms[1] / ms[0]);
+    }
     return 0;
 }
 
@@ -267,9 +317,16 @@ int main(int argc, char** argv) {
                  "Only the steps of each effect from its first, the pools growing as it runs: median, worst, worst ÷ median");
     app.add_option("--hitch-value", hitchValue, "--hitches: the effects' extern (1e5: the fire's rate per second)");
     app.add_option("--hitch-capacity", hitchCapacity, "--hitches: the pools' capacity (0: the default)");
+    double prewarm = 0, prewarmStep = 0.1;
+    app.add_option("--prewarm", prewarm, "time this many seconds of each effect run ahead at once (at --hitch-value)");
+    app.add_option("--prewarm-step", prewarmStep, "--prewarm: the longest step");
+    size_t hitchReserve = 0;
+    app.add_option("--hitch-reserve", hitchReserve,
+                   "--hitches: also run each effect with this many particle rows reserved before its first step");
     CLI11_PARSE(app, argc, argv);
     if (memory) return memoryTable(effects, sizes, frames);
-    if (hitches) return hitchTable(effects, hitchValue, frames, hitchCapacity, json);
+    if (hitches) return hitchTable(effects, hitchValue, frames, hitchCapacity, hitchReserve, json);
+    if (prewarm > 0) return prewarmTable(effects, hitchValue, prewarm, prewarmStep);
 
     unsigned cores = std::max(1u, std::thread::hardware_concurrency());
     codegen_llvm::LlvmBackend jit;

@@ -404,7 +404,7 @@ TEST_CASE("reserve takes room ahead, refuses more than the capacity or an unknow
     CHECK(std::memcmp(pa.data(), pb.data(), pa.size() * sizeof(psys_point)) == 0);
 }
 
-TEST_CASE("options carry their size: unset, a later header's refused in words; an earlier header's read with defaults") {
+TEST_CASE("options carry their size: unset or a later header's refused in words, an earlier header's read with defaults") {
     System s;
     psys_options o = options("interp");
     o.size = 0;
@@ -430,7 +430,7 @@ void keepLog(void* user, psys_severity severity, const char* message) {
 }
 }  // namespace
 
-TEST_CASE("the JIT's cache folder and the library's folders are options; what the library says goes to the host's log") {
+TEST_CASE("the JIT's cache folder and the library's folders are options, and what the library says goes to the host's log") {
     namespace fs = std::filesystem;
     fs::path dir = fs::temp_directory_path() / ("psys-capi-options-" + std::to_string(::getpid()));
     fs::remove_all(dir);
@@ -499,7 +499,7 @@ TEST_CASE("a diagnostic's line and column are where its message's caret points")
     psys_error_free(e);
 }
 
-TEST_CASE("reset goes back to the start and runs the same again; prewarm runs ahead in equal steps, drawing nothing") {
+TEST_CASE("reset goes back to the start and runs the same again, and prewarm runs ahead in equal steps, drawing nothing") {
     for (const char* backend : {"interp", "llvm"}) {
         CAPTURE(backend);
         psys_options o = options(backend, "exact");
