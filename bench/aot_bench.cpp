@@ -69,7 +69,8 @@ int main(int argc, char** argv) {
     }
     psys_type_stats drops;
     check(psys_get_type_stats(aot, fountain_type_drop, &drops));
-    std::printf("fountain, %zu drops, %d frames (a step and a draw each), %s\n\n", drops.live, frames, fountain_aot.target);
+    std::printf("fountain, %zu drops, %d frames (a step and a draw each), %s\n\n", drops.live, frames,
+                psys_aot_choose_cpu(&fountain_aot)->name);
     std::printf("| | start | frame (ms) |\n|---|---:|---:|\n");
     std::printf("| JIT (compile from source, LLVM) | %.1f ms | %.2f |\n", (t1 - t0) * 1e3, jitSeconds * 1e3 / frames);
     std::printf("| AOT (psys_open_aot, no LLVM) | %.2f ms | %.2f |\n", (t2 - t1) * 1e3, aotSeconds * 1e3 / frames);

@@ -1,5 +1,6 @@
 #include "codegen_llvm/aot_object.h"
 
+#include <algorithm>
 #include <set>
 
 #include <fmt/format.h>
@@ -28,6 +29,7 @@ namespace psys::codegen_llvm {
 namespace {
 
 std::unique_ptr<llvm::TargetMachine> targetMachine(const AotTarget& target, std::string& triple, std::string& cpu) {
+    const std::string wanted = target.cpus.empty() ? std::string() : target.cpus.front();
     llvm::InitializeAllTargetInfos();
     llvm::InitializeAllTargets();
     llvm::InitializeAllTargetMCs();
@@ -35,11 +37,11 @@ std::unique_ptr<llvm::TargetMachine> targetMachine(const AotTarget& target, std:
     std::string host = llvm::sys::getProcessTriple();  // as the JIT's (JITTargetMachineBuilder::detectHost)
     triple = target.triple.empty() ? host : target.triple;
     std::string features;
-    bool native = target.cpu == "native";  // as compilers spell the host's CPU (-march=native)
+    bool native = wanted == "native";  // as compilers spell the host's CPU (-march=native)
     if (native && llvm::Triple::normalize(triple) != llvm::Triple::normalize(host))
         throw std::runtime_error("`native` is this machine's CPU, and `" + triple + "` is not this machine (" + host + ")");
-    if (!target.cpu.empty() && !native) {
-        cpu = target.cpu;
+    if (!wanted.empty() && !native) {
+        cpu = wanted;
     } else if (triple == host) {  // the host's CPU and every feature it has
         cpu = llvm::sys::getHostCPUName().str();
         for (const auto& [name, on] : llvm::sys::getHostCPUFeatures())
@@ -115,65 +117,117 @@ void undefinedSymbols(const std::string& bytes, std::set<std::string>& out) {
 
 }  // namespace
 
+const char* const kCheckedFeatures[] = {
+    "sse3",     "ssse3",      "sse4.1",     "sse4.2",     "popcnt",       "avx",          "avx2",       "fma",
+    "bmi",      "bmi2",       "aes",        "pclmul",     "gfni",         "vpclmulqdq",   "avx512f",    "avx512dq",
+    "avx512cd", "avx512bw",   "avx512vl",   "avx512vnni", "avx512bf16",   "avx512vbmi",   "avx512vbmi2",
+    "avx512ifma", "avx512bitalg", "avx512vpopcntdq", nullptr};
+
+namespace {
+
+// One CPU of a build: its target machines (the large functions' without optimization, as
+// the JIT's), the features its code may use, and its kernels' rows of the table. Each
+// launch shape's code, once per key, is in a module of its own as the JIT compiles it (the
+// same code, bit for bit), hidden (two builds link into one host side by side).
+struct CpuKernels {
+    std::string name, features;
+    std::unique_ptr<llvm::TargetMachine> machine, large;
+    std::vector<llvm::Constant*> rows;
+};
+
+CpuKernels machinesFor(const AotTarget& target, const std::string& cpu, std::string& triple) {
+    CpuKernels out;
+    AotTarget one{target.triple, {cpu}};
+    out.machine = targetMachine(one, triple, out.name);
+    out.large = targetMachine(one, triple, out.name);
+    out.large->setOptLevel(llvm::CodeGenOptLevel::None);
+    const llvm::MCSubtargetInfo& subtarget = *out.machine->getMCSubtargetInfo();
+    if (out.machine->getTargetTriple().isX86())
+        for (const char* const* f = kCheckedFeatures; *f; ++f)
+            if (subtarget.checkFeatures(std::string("+") + *f)) out.features += (out.features.empty() ? "" : ",") + std::string(*f);
+    return out;
+}
+
+}  // namespace
+
 AotObject buildAotObject(const ir::Module& module, const std::string& irText, const std::string& glsl, MathMode mode,
                          const AotTarget& target, const std::string& symbol) {
     AotObject out;
-    std::unique_ptr<llvm::TargetMachine> machine = targetMachine(target, out.triple, out.cpu);
-    std::unique_ptr<llvm::TargetMachine> large = targetMachine(target, out.triple, out.cpu);
-    large->setOptLevel(llvm::CodeGenOptLevel::None);
-    // Floats a vector register holds, as the JIT's floatLanes() says for the host.
-    const llvm::MCSubtargetInfo& subtarget = *machine->getMCSubtargetInfo();
-    bool x86 = machine->getTargetTriple().isX86();
-    bool avx512 = x86 && subtarget.checkFeatures("+avx512f");
-    unsigned lanes = avx512 ? 16 : x86 && subtarget.checkFeatures("+avx") ? 8 : 4;
+    std::vector<CpuKernels> cpus;
+    for (const std::string& cpu : target.cpus.empty() ? std::vector<std::string>{""} : target.cpus)
+        cpus.push_back(machinesFor(target, cpu, out.triple));
+    // The most capable first (the most features; else as given): psys_open_aot runs the
+    // first the machine can.
+    std::stable_sort(cpus.begin(), cpus.end(), [](const CpuKernels& a, const CpuKernels& b) {
+        return std::count(a.features.begin(), a.features.end(), ',') + !a.features.empty() >
+               std::count(b.features.begin(), b.features.end(), ',') + !b.features.empty();
+    });
     llvm::LLVMContext context;
+    llvm::TargetMachine& first = *cpus.front().machine;
     auto newModule = [&](const std::string& name) {
         auto m = std::make_unique<llvm::Module>(name, context);
-        m->setDataLayout(machine->createDataLayout());
+        m->setDataLayout(first.createDataLayout());
         m->setTargetTriple(out.triple);
         return m;
     };
-
-    // Every launch shape's code, once per key, in a module of its own as the JIT compiles
-    // it (the same code, bit for bit); hidden (two builds link into one host side by side).
     auto table = newModule(symbol);
     llvm::Type* i32 = llvm::Type::getInt32Ty(context);
     llvm::Type* i64 = llvm::Type::getInt64Ty(context);
     llvm::Type* ptr = llvm::PointerType::get(context, 0);
     auto* kernelType = llvm::StructType::get(context, {i64, i64, ptr});
-    std::vector<llvm::Constant*> rows;
+    auto* cpuType = llvm::StructType::get(context, {ptr, ptr, i64, ptr});
     std::vector<std::pair<std::string, std::string>> objects;  // member name, bytes
-    std::set<std::pair<uint64_t, uint64_t>> seen;
     std::set<std::string> calls;
-    for (const native::Request& r : native::requests(mode == MathMode::Exact, module)) {
-        if (!seen.insert({r.key.low, r.key.high}).second) continue;
-        std::string name = symbol + "." + functionName(r, static_cast<int>(rows.size()));
-        auto kernel = newModule(name);
-        buildFunction(*kernel, mode, lanes, r, name);
-        llvm::Function* f = kernel->getFunction(name);
-        f->setVisibility(llvm::GlobalValue::HiddenVisibility);
-        verify(*kernel);
-        optimizeModule(*kernel, *machine, mode, avx512);
-        objects.push_back({fmt::format("k{}.o", rows.size()), emitObject(*kernel, *machine, *large)});
-        undefinedSymbols(objects.back().second, calls);
-        auto* declared = llvm::Function::Create(f->getFunctionType(), llvm::GlobalValue::ExternalLinkage, name, *table);
-        declared->setVisibility(llvm::GlobalValue::HiddenVisibility);
-        rows.push_back(llvm::ConstantStruct::get(
-            kernelType, {llvm::ConstantInt::get(i64, r.key.low), llvm::ConstantInt::get(i64, r.key.high), declared}));
+    std::vector<llvm::Constant*> cpuRows;
+    for (size_t c = 0; c < cpus.size(); ++c) {
+        CpuKernels& cpu = cpus[c];
+        llvm::TargetMachine& machine = *cpu.machine;
+        // Floats a vector register holds, as the JIT's floatLanes() says for the host.
+        const llvm::MCSubtargetInfo& subtarget = *machine.getMCSubtargetInfo();
+        bool x86 = machine.getTargetTriple().isX86();
+        bool avx512 = x86 && subtarget.checkFeatures("+avx512f");
+        unsigned lanes = avx512 ? 16 : x86 && subtarget.checkFeatures("+avx") ? 8 : 4;
+        std::set<std::pair<uint64_t, uint64_t>> seen;
+        const std::string prefix = cpus.size() == 1 ? symbol : fmt::format("{}.cpu{}", symbol, c);
+        for (const native::Request& r : native::requests(mode == MathMode::Exact, module)) {
+            if (!seen.insert({r.key.low, r.key.high}).second) continue;
+            std::string name = prefix + "." + functionName(r, static_cast<int>(cpu.rows.size()));
+            auto kernel = newModule(name);
+            buildFunction(*kernel, mode, lanes, r, name);
+            llvm::Function* f = kernel->getFunction(name);
+            f->setVisibility(llvm::GlobalValue::HiddenVisibility);
+            verify(*kernel);
+            optimizeModule(*kernel, machine, mode, avx512);
+            objects.push_back({fmt::format("k{}.o", objects.size()), emitObject(*kernel, machine, *cpu.large)});
+            undefinedSymbols(objects.back().second, calls);
+            auto* declared = llvm::Function::Create(f->getFunctionType(), llvm::GlobalValue::ExternalLinkage, name, *table);
+            declared->setVisibility(llvm::GlobalValue::HiddenVisibility);
+            cpu.rows.push_back(llvm::ConstantStruct::get(
+                kernelType, {llvm::ConstantInt::get(i64, r.key.low), llvm::ConstantInt::get(i64, r.key.high), declared}));
+        }
+        auto* tableType = llvm::ArrayType::get(kernelType, cpu.rows.size());
+        llvm::GlobalVariable* kernels = global(*table, llvm::ConstantArray::get(tableType, cpu.rows),
+                                               llvm::GlobalValue::PrivateLinkage, prefix + ".kernels");
+        cpuRows.push_back(llvm::ConstantStruct::get(
+            cpuType, {text(*table, cpu.name, prefix + ".cpu"), text(*table, cpu.features, prefix + ".features"),
+                      llvm::ConstantInt::get(i64, cpu.rows.size()), kernels}));
+        out.cpus.push_back(cpu.name);
+        out.kernels += cpu.rows.size();
     }
-    auto* tableType = llvm::ArrayType::get(kernelType, rows.size());
-    llvm::GlobalVariable* kernels =
-        global(*table, llvm::ConstantArray::get(tableType, rows), llvm::GlobalValue::PrivateLinkage, symbol + ".kernels");
-    // psys_aot: abi, exact, name, ir, kernel_count, kernels, glsl, target.
+    llvm::GlobalVariable* cpuTable = global(*table, llvm::ConstantArray::get(llvm::ArrayType::get(cpuType, cpuRows.size()), cpuRows),
+                                            llvm::GlobalValue::PrivateLinkage, symbol + ".cpus");
+    // psys_aot: abi, exact, name, ir, cpu_count, cpus, glsl, target.
     auto* aotType = llvm::StructType::get(context, {i32, i32, ptr, ptr, i64, ptr, ptr, ptr});
+    llvm::Constant* shaders = glsl.empty() ? llvm::ConstantPointerNull::get(llvm::PointerType::get(context, 0))
+                                           : text(*table, glsl, symbol + ".glsl");
     llvm::Constant* aot = llvm::ConstantStruct::get(
-        aotType, {llvm::ConstantInt::get(i32, 1), llvm::ConstantInt::get(i32, mode == MathMode::Exact ? 1 : 0),
+        aotType, {llvm::ConstantInt::get(i32, 2), llvm::ConstantInt::get(i32, mode == MathMode::Exact ? 1 : 0),
                   text(*table, symbol, symbol + ".name"), text(*table, irText, symbol + ".ir"),
-                  llvm::ConstantInt::get(i64, rows.size()), kernels, text(*table, glsl, symbol + ".glsl"),
-                  text(*table, out.cpu, symbol + ".target")});
+                  llvm::ConstantInt::get(i64, cpuRows.size()), cpuTable, shaders,
+                  text(*table, out.triple, symbol + ".target")});
     global(*table, aot, llvm::GlobalValue::ExternalLinkage, symbol);
     verify(*table);
-    objects.insert(objects.begin(), {"system.o", emitObject(*table, *machine, *large)});
+    objects.insert(objects.begin(), {"system.o", emitObject(*table, first, *cpus.front().large)});
     for (const std::string& c : calls)
         if (!c.starts_with(symbol + ".")) out.calls.push_back(c);
 
@@ -191,7 +245,6 @@ AotObject buildAotObject(const ir::Module& module, const std::string& irText, co
         throw std::runtime_error(llvm::toString(std::move(e)));
     stream.flush();
     out.bytes = std::move(archive);
-    out.kernels = rows.size();
     return out;
 }
 

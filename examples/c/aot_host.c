@@ -26,8 +26,8 @@ int main(int argc, char** argv) {
     for (frame = 0; frame < 240; ++frame)
         if (failed(psys_step(sys, 1.0 / 60))) return 1;
     if (failed(psys_get_type_stats(sys, fountain_type_drop, &drops))) return 1;
-    printf("fountain (ahead of time, %s): %zu drops alive after 4 s, %llu created\n", fountain_aot.target, drops.live,
-           (unsigned long long)drops.created);
+    printf("fountain (ahead of time, %s's kernels): %zu drops alive after 4 s, %llu created\n",
+           psys_aot_choose_cpu(&fountain_aot)->name, drops.live, (unsigned long long)drops.created);
     psys_system_free(sys);
     return 0;
 }

@@ -154,27 +154,42 @@ PSYS_API int psys_warning(const psys_system* system, size_t index, psys_diagnost
 /* ---- Ahead of time ------------------------------------------------------------------ */
 
 /* What `psysc build FILE -o NAME` writes into NAME.a, declared by NAME.h as NAME_aot: the
- * system's IR and its kernels' machine code for one CPU, found by key. A host links the
- * archive with libpsys_runtime (no compiler, no LLVM) or with libpsys. */
-#define PSYS_AOT_ABI 1
+ * system's IR and its kernels' machine code for one CPU or several (`--cpu
+ * x86-64-v3,znver4`), found by key. A host links the archive with libpsys_runtime (no
+ * compiler, no LLVM) or with libpsys. */
+#define PSYS_AOT_ABI 2
 typedef struct psys_aot_kernel {
     uint64_t key_low, key_high;
     void* code;
 } psys_aot_kernel;
+/* The kernels compiled for one CPU. */
+typedef struct psys_aot_cpu {
+    const char* name;     /* as LLVM names it: "x86-64-v3", "znver4", "sapphirerapids" */
+    const char* features; /* what its code may use that not every CPU of the triple has,
+                             comma-separated ("avx,avx2,fma,…"): a CPU lacking one cannot run it */
+    size_t kernel_count;
+    const psys_aot_kernel* kernels;
+} psys_aot_cpu;
 typedef struct psys_aot {
     uint32_t abi;   /* PSYS_AOT_ABI when it was built */
     uint32_t exact; /* 1: exact maths (the interpreter's bits), 0: fast */
     const char* name;
-    const char* ir;     /* the system (psysc --emit=ir) */
-    size_t kernel_count;
-    const psys_aot_kernel* kernels;
-    const char* glsl;   /* its compute shaders (psysc --emit=glsl), for a host's own GL pipeline */
-    const char* target; /* the CPU the kernels were compiled for */
+    const char* ir; /* the system (psysc --emit=ir) */
+    size_t cpu_count;
+    const psys_aot_cpu* cpus; /* the most capable first: psys_open_aot runs the first this CPU can */
+    const char* glsl;   /* its compute shaders (psysc --emit=glsl), for a host's own GL
+                           pipeline; NULL when built with --no-glsl */
+    const char* target; /* the triple the kernels were compiled for */
 } psys_aot;
 
+/* The CPU of `aot->cpus` whose kernels this machine runs (the first it can), or NULL when
+ * it can run none (psys_open_aot then refuses, saying what each lacks). */
+PSYS_API const psys_aot_cpu* psys_aot_choose_cpu(const psys_aot* aot);
+
 /* Starts an ahead-of-time compiled system. options->backend: "llvm" (the default) or "aot"
- * run its compiled kernels; "interp" and "glsl" run its IR there. Its maths is the build's
- * (options->math is not read). It does not reload: psys_reload says so. */
+ * run its compiled kernels (for the CPU psys_aot_choose_cpu chooses: none is an error that
+ * names what this CPU lacks); "interp" and "glsl" run its IR there. Its maths is the
+ * build's (options->math is not read). It does not reload: psys_reload says so. */
 PSYS_API psys_error* psys_open_aot(const psys_aot* aot, const psys_options* options, psys_system** out);
 
 /* ---- Running it --------------------------------------------------------------------- */

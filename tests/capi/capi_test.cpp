@@ -353,7 +353,8 @@ std::string irOf(const char* source) {
 
 TEST_CASE("an ahead-of-time build's IR runs on the interpreter, and a build that cannot run says why") {
     std::string ir = irOf(kDots);
-    psys_aot aot{PSYS_AOT_ABI, 1, "dots", ir.c_str(), 0, nullptr, "", "none"};
+    psys_aot_cpu any{"x86-64", "", 0, nullptr};  // a CPU every machine of the triple is: no kernels
+    psys_aot aot{PSYS_AOT_ABI, 1, "dots", ir.c_str(), 1, &any, nullptr, "none"};
     System fromAot, compiled;
     psys_options o = options("interp");
     REQUIRE(take(psys_open_aot(&aot, &o, &fromAot.s)) == "");
@@ -372,6 +373,21 @@ TEST_CASE("an ahead-of-time build's IR runs on the interpreter, and a build that
     // No code for its kernels: the compiled backend refuses it, naming what is missing.
     CHECK(take(psys_open_aot(&aot, nullptr, &out)).find("has no code for a kernel of `") != std::string::npos);
     CHECK(out == nullptr);
+    // Built for CPUs this one is not: refused, saying what each needs that it lacks.
+    psys_aot_cpu future[] = {{"future", "avx512fp16,avx10.2", 0, nullptr}, {"later", "sse4.2,avx10.2", 0, nullptr}};
+    psys_aot elsewhere = aot;
+    elsewhere.cpus = future;
+    elsewhere.cpu_count = 2;
+    CHECK(psys_aot_choose_cpu(&elsewhere) == nullptr);
+    CHECK(psys_aot_choose_cpu(&aot) == &any);
+    CHECK(take(psys_open_aot(&elsewhere, nullptr, &out)) ==
+          "psys_open_aot: this CPU runs none of the build's kernels: it was built for future (lacking avx512fp16 "
+          "avx10.2), later (lacking avx10.2); build it again with psysc build --cpu naming this machine's CPU (or a "
+          "generic one: x86-64-v2), or run its IR with options.backend = \"interp\"");
+    CHECK(out == nullptr);
+    CHECK(take(psys_open_aot(&elsewhere, &o, &out)).empty());  // its IR still runs on the interpreter
+    psys_system_free(out);
+    out = nullptr;
     psys_aot old = aot;
     old.abi = 99;
     CHECK(take(psys_open_aot(&old, &o, &out)).find("format is 99") != std::string::npos);

@@ -6,6 +6,8 @@
 #include <fstream>
 #include <iostream>
 #include <set>
+#include <string_view>
+#include <vector>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -97,7 +99,8 @@ std::string header(const ir::Module& m, const BuildOptions& o, const std::string
         "static inline psys_error* {name}_open(const psys_options* options, psys_system** out) {{\n"
         "    return psys_open_aot(&{name}_aot, options, out);\n}}\n\n",
         fmt::arg("name", name), fmt::arg("file", std::filesystem::path(o.file).filename().string()),
-        fmt::arg("math", o.math), fmt::arg("cpu", object.cpu), fmt::arg("triple", object.triple),
+        fmt::arg("math", o.math), fmt::arg("cpu", fmt::format("{}", fmt::join(object.cpus, ", "))),
+        fmt::arg("triple", object.triple),
         fmt::arg("libs", o.math == "fast" ? " and -lmvec -lm" : " and -lm"), fmt::arg("guard", guard));
     h += "/* Object types: the `type` of psys_get_draw, psys_read_points, psys_get_type_stats. */\nenum {\n";
     for (size_t t = 0; t < m.objects.size(); ++t) h += fmt::format("    {}_type_{} = {},\n", name, identifier(m.objects[t].name), t);
@@ -180,20 +183,27 @@ int buildSystem(const BuildOptions& o) {
         return 1;
     }
     std::string glsl;
-    for (const auto& shader : codegen_glsl::moduleShaders(rt::launchPlan(*module)))
-        glsl += "//// " + shader.name + "\n" + shader.source + "\n";
+    if (o.glsl)
+        for (const auto& shader : codegen_glsl::moduleShaders(rt::launchPlan(*module)))
+            glsl += "//// " + shader.name + "\n" + shader.source + "\n";
+    std::vector<std::string> cpus;
+    for (std::string_view rest = o.cpu; !rest.empty();) {
+        size_t comma = std::min(rest.find(','), rest.size());
+        if (comma > 0) cpus.emplace_back(rest.substr(0, comma));
+        rest.remove_prefix(std::min(comma + 1, rest.size()));
+    }
     std::string name = identifier(std::filesystem::path(o.output).filename().string());
     codegen_llvm::AotObject object;
     try {
         auto mode = o.math == "exact" ? codegen_llvm::MathMode::Exact : codegen_llvm::MathMode::Fast;
-        object = codegen_llvm::buildAotObject(*module, irText, glsl, mode, {o.target, o.cpu}, name + "_aot");
+        object = codegen_llvm::buildAotObject(*module, irText, glsl, mode, {o.target, cpus}, name + "_aot");
     } catch (const std::exception& e) {
         std::cerr << "psysc: error: " << e.what() << "\n";
         return 1;
     }
     if (!write(o.output + ".a", object.bytes) || !write(o.output + ".h", header(*module, o, name, object))) return 1;
-    std::cout << fmt::format("wrote {0}.a ({1} kernels for {2} {3}, {4} bytes) and {0}.h\n", o.output, object.kernels,
-                             object.cpu, object.triple, object.bytes.size());
+    std::cout << fmt::format("wrote {0}.a ({1} kernels for {2} {3}, {4} bytes{5}) and {0}.h\n", o.output, object.kernels,
+                             fmt::join(object.cpus, ", "), object.triple, object.bytes.size(), o.glsl ? "" : ", no shaders");
     if (!object.calls.empty()) std::cout << fmt::format("it calls: {}\n", fmt::join(object.calls, " "));
     return 0;
 }

@@ -15,7 +15,9 @@ struct BuildOptions {
     std::string file;
     std::string output;          // NAME: NAME.a and NAME.h are written
     std::string math = "fast";   // or "exact": the interpreter's bits
-    std::string target, cpu;     // empty: the host's
+    std::string target;          // empty: the host's
+    std::string cpu;             // CPUs, comma-separated (empty: the host's): a set of kernels each
+    bool glsl = true;            // false (--no-glsl): the archive holds no shaders
     bool optimize = true;
     bool relaxed = false;
     std::optional<core::Integrator> integrator;

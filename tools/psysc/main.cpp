@@ -262,8 +262,10 @@ int realMain(int argc, char** argv) {
     build->add_option("--math", buildOptions.math, "fast (the default) or exact (the interpreter's results bit for bit)")
         ->check(CLI::IsMember({"fast", "exact"}));
     build->add_option("--target", buildOptions.target, "The target triple (the host's by default)")->type_name("TRIPLE");
-    build->add_option("--cpu", buildOptions.cpu, "The CPU to compile for: a name LLVM knows, or native (this machine's, the default; generic for another "
-                      "triple)")->type_name("CPU");
+    build->add_option("--cpu", buildOptions.cpu, "The CPUs to compile for, comma-separated (x86-64-v2,x86-64-v3,znver4): names LLVM "
+                      "knows, or native (this machine's, the default; generic for another triple). The archive holds "
+                      "each one's kernels and runs the most capable the running machine has")->type_name("CPU[,CPU…]");
+    build->add_flag("!--no-glsl", buildOptions.glsl, "Leave the compute shaders out of the archive (psys_aot.glsl is NULL)");
     build->fallthrough();
 
     auto* lsp = app.add_subcommand("lsp", "Serve the Language Server Protocol on stdin and stdout (for editors)");
