@@ -4,14 +4,16 @@
 # compared); the host needs no LLVM (ldd), and the object refers to no LLVM symbol (nm).
 # With BACKEND glsl, the build's IR runs on the GPU (llvmpipe in CI) and draws what
 # `psysc run --backend glsl` draws.
-#   aot_test.sh PSYSC BUILD_DIR SOURCE_DIR SAMPLE.psys MATH [BACKEND]
+# FLAGS: more for psysc build (`--cpu x86-64-v2,native --no-glsl`).
+#   aot_test.sh PSYSC BUILD_DIR SOURCE_DIR SAMPLE.psys MATH [BACKEND [FLAGS]]
 set -euo pipefail
-psysc=$1 build=$2 src=$3 sample=$4 math=$5 backend=${6:-llvm}
+psysc=$1 build=$2 src=$3 sample=$4 math=$5 backend=${6:-llvm} flags=${7:-}
 work=$(mktemp -d /tmp/psys-aot.XXXXXX)
 trap 'status=$?; if [ $status = 0 ]; then rm -rf "$work"; else echo "(kept: $work)"; fi' EXIT
 name=$(basename "$sample" .psys)
 
-"$psysc" build "$sample" -o "$work/$name" --math "$math"
+# shellcheck disable=SC2086 # (FLAGS are words)
+"$psysc" build "$sample" -o "$work/$name" --math "$math" $flags
 cc -std=c99 -Wall -Wextra -Wpedantic -Werror -I"$src/include" -include "$work/$name.h" -DAOT_SYMBOL="${name}_aot" \
    -o "$work/host" "$src/tests/aot/aot_dump.c" "$work/$name.a" -L"$build/capi" -lpsys_runtime -lmvec -lm \
    -Wl,-rpath,"$build/capi"
