@@ -1,9 +1,11 @@
 // The C API (include/psys/psys.h) on a running system, however it was made (capi/handle.h):
 // stepped, set, fired, drawn and read by a C host. Every entry point checks its arguments
 // and turns what the layers below throw into an error value.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <iterator>
 #include <limits>
 #include <optional>
 #include <string>
@@ -63,18 +65,25 @@ namespace psys::capi {
 
 psys_error* readOptions(const char* function, const psys_options* given, Options& out) {
     psys_options o;
-    psys_options_init(&o);
+    psys_options_init_size(&o, sizeof o);
     if (given) {
         // An earlier header's options are a prefix of these (the rest keep the defaults);
         // a later header's are not this library's to read.
-        if (given->size < offsetof(psys_options, backend))
-            return makeError(fmt::format("{}: psys_options.size is {}: psys_options_init(&options) sets it before the "
+        // The sizes headers have had: 0.2's, the first with a size (a later one adds fields
+        // at the end, and this list its size).
+        static constexpr uint32_t kPublished[] = {sizeof(psys_options)};
+        if (given->size == 0)
+            return makeError(fmt::format("{}: psys_options.size is 0: psys_options_init(&options) sets it before the "
                                          "fields are changed",
-                                         function, given->size));
+                                         function));
         if (given->size > sizeof(psys_options))
             return makeError(fmt::format("{}: the options are {} bytes, from a later header than this library's ({} "
                                          "bytes, version {}): build the host against this library's header",
                                          function, given->size, sizeof(psys_options), kVersion));
+        if (std::find(std::begin(kPublished), std::end(kPublished), given->size) == std::end(kPublished))
+            return makeError(fmt::format("{}: psys_options.size is {}, the size of no header's options: "
+                                         "psys_options_init(&options) sets it",
+                                         function, given->size));
         std::memcpy(&o, given, given->size);
     }
     out.backend = o.backend ? o.backend : "llvm";
@@ -104,11 +113,16 @@ extern "C" {
 
 const char* psys_version(void) { return kVersion; }
 
-void psys_options_init(psys_options* options) {
-    if (!options) return;
+void psys_options_init_size(psys_options* given, size_t size) {
+    if (!given || size < sizeof(uint32_t)) return;
     rt::SystemOptions defaults;
-    *options = psys_options{sizeof(psys_options), "llvm", "fast", defaults.seed, defaults.capacity, defaults.threads, 1,
-                            nullptr, nullptr};
+    psys_options o{sizeof(psys_options), "llvm", "fast", defaults.seed, defaults.capacity, defaults.threads, 1,
+                   nullptr, nullptr};
+    // The host's struct: what this library knows of it (an earlier header's is a prefix),
+    // the rest (a later header's fields) zero; `size` the host's, which says which it is.
+    std::memset(static_cast<void*>(given), 0, size);
+    std::memcpy(static_cast<void*>(given), &o, std::min(size, sizeof o));
+    given->size = static_cast<uint32_t>(size);
 }
 
 void psys_set_log(psys_log_function log, void* user) {

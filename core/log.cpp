@@ -8,8 +8,9 @@ namespace psys::core {
 
 namespace {
 
-std::mutex& sinkMutex() {
-    static std::mutex m;
+// Recursive: a host's sink that logs again, or sets another sink, from inside a call.
+std::recursive_mutex& sinkMutex() {
+    static std::recursive_mutex m;
     return m;
 }
 std::function<void(LogLevel, std::string_view)>& sink() {
@@ -31,7 +32,8 @@ const char* levelName(LogLevel level) {
 void log(LogLevel level, std::string_view message) {
     std::lock_guard lock(sinkMutex());  // (one message at a time: a host's sink need not be thread-safe)
     if (sink()) {
-        sink()(level, message);
+        auto call = sink();  // (a copy: the sink may replace itself while it runs)
+        call(level, message);
         return;
     }
     std::string line = "psys: " + std::string(levelName(level)) + ": " + std::string(message) + "\n";

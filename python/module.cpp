@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cstring>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -129,6 +130,7 @@ public:
     ~System() { psys_system_free(s_); }
     // Frees the system now (a second close does nothing); every later call raises.
     void close() {
+        auto held = hold();
         psys_system_free(s_);
         s_ = nullptr;
     }
@@ -164,6 +166,7 @@ public:
 
     // Steps without the GIL: other Python threads run meanwhile (another system's steps too).
     void step(double dt, int steps) {
+        auto held = hold();
         if (steps < 0) raise(PyExc_ValueError, "step: steps is 0 or more, not " + std::to_string(steps));
         psys_system* s = open();
         psys_error* e = nullptr;
@@ -174,6 +177,7 @@ public:
         check(e);
     }
     void set(const std::string& name, const py::object& values) {
+        auto held = hold();
         std::vector<float> v = floats(values, "set");
         float current[4];
         int width = psys_get_extern(open(), name.c_str(), current);
@@ -185,6 +189,7 @@ public:
         check(psys_set_extern(s_, name.c_str(), v.data(), v.size()));
     }
     py::object get(const std::string& name) const {
+        auto held = hold();
         float v[4];
         int width = psys_get_extern(open(), name.c_str(), v);
         if (width < 0) raiseAs(unknownNameType(), "there is no extern `" + name + "`" + known(externs()));
@@ -192,6 +197,7 @@ public:
         return py::tuple(py::cast(std::vector<float>(v, v + width)));
     }
     void fire(const std::string& trigger, py::args args) {
+        auto held = hold();
         std::vector<float> all;
         for (py::handle a : args) {
             std::vector<float> v = floats(py::reinterpret_borrow<py::object>(a), "fire");
@@ -207,8 +213,12 @@ public:
                                          " in " + reprOf(args));
         check(psys_fire(s_, trigger.c_str(), all.data(), all.size()));
     }
-    void reserve(const py::object& type, size_t rows) { check(psys_reserve(open(), typeOf(type), rows)); }
+    void reserve(const py::object& type, size_t rows) {
+        auto held = hold();
+        check(psys_reserve(open(), typeOf(type), rows));
+    }
     void prewarm(double seconds, double longest) {
+        auto held = hold();
         psys_system* s = open();
         psys_error* e = nullptr;
         {
@@ -217,8 +227,12 @@ public:
         }
         check(e);
     }
-    void reset() { check(psys_reset(open())); }
+    void reset() {
+        auto held = hold();
+        check(psys_reset(open()));
+    }
     void reload(std::optional<std::string> source) {
+        auto held = hold();
         if (source) refuseNul(*source, "<string>");
         psys_system* s = open();
         psys_error* e = nullptr;
@@ -230,24 +244,28 @@ public:
     }
 
     std::vector<std::string> types() const {
+        auto held = hold();
         std::vector<std::string> out;
         psys_system* s = open();
         for (size_t t = 0; t < psys_type_count(s); ++t) out.push_back(psys_type_name(s, t));
         return out;
     }
     py::dict externs() const {
+        auto held = hold();
         py::dict out;
         psys_input in;
         for (size_t i = 0; psys_extern_info(open(), i, &in) == 0; ++i) out[in.name] = in.type;
         return out;
     }
     py::dict triggers() const {
+        auto held = hold();
         py::dict out;
         psys_input in;
         for (size_t i = 0; psys_trigger_info(open(), i, &in) == 0; ++i) out[in.name] = in.type;
         return out;
     }
     py::list warnings() const {
+        auto held = hold();
         py::list out;
         psys_diagnostic d;
         for (size_t i = 0; psys_warning(open(), i, &d) == 0; ++i) out.append(diagnostic(d));
@@ -255,6 +273,7 @@ public:
     }
 
     size_t typeOf(const py::object& type) const {
+        auto held = hold();
         if (py::isinstance<py::str>(type)) {
             int t = psys_type_index(open(), type.cast<std::string>().c_str());
             if (t < 0) {
@@ -284,6 +303,7 @@ public:
     // read freed memory (a crash on a large pool, old values or NaN on a small one).
     // A copy is a memcpy a column (about 3 ms for 13 columns of 262k rows).
     py::dict columns(const py::object& type) {
+        auto held = hold();
         psys_draw d;
         check(psys_get_draw(s_, typeOf(type), &d));
         py::dict out;
@@ -323,6 +343,7 @@ public:
     // The drawn points copied out (any backend): id (n), position (n×3), color (n×4), size (n),
     // written through raw pointers (what a NumPy copy of the columns costs, about).
     py::dict points(const py::object& type) {
+        auto held = hold();
         size_t t = typeOf(type), n = 0;
         check(psys_read_points(s_, t, nullptr, 0, &n));
         std::vector<psys_point> p(n);
@@ -350,6 +371,7 @@ public:
     // The drawn points' positions as an n×3 array (a copy: the columns are one a
     // component), in row order; on the glsl backend read back as points() reads them.
     py::array_t<float> positions(const py::object& type) {
+        auto held = hold();
         size_t t = typeOf(type);
         psys_draw d;
         check(psys_get_draw(s_, t, &d));
@@ -371,6 +393,7 @@ public:
     }
 
     py::dict stats() const {
+        auto held = hold();
         psys_stats st;
         check(psys_get_stats(open(), &st));
         py::dict out, types;
@@ -399,11 +422,31 @@ public:
         return out;
     }
 
-    double time() const { return psys_time(open()); }
-    uint64_t stepCount() const { return psys_step_count(open()); }
-    bool finished() const { return psys_finished(open()) != 0; }
+    double time() const {
+        auto held = hold();
+        return psys_time(open());
+    }
+    uint64_t stepCount() const {
+        auto held = hold();
+        return psys_step_count(open());
+    }
+    bool finished() const {
+        auto held = hold();
+        return psys_finished(open()) != 0;
+    }
 
 private:
+    // The system held for a call: one call at a time on a system (the C API's rule), now
+    // that step, prewarm and reload run without the GIL — a close() or a set() from another
+    // Python thread waits for the step to end. Waiting, this thread lets the GIL go.
+    std::unique_lock<std::recursive_mutex> hold() const {
+        std::unique_lock<std::recursive_mutex> held(mutex_, std::try_to_lock);
+        if (!held.owns_lock()) {
+            py::gil_scoped_release unlocked;
+            held.lock();
+        }
+        return held;
+    }
     // The system, or the error of a call after close().
     psys_system* open() const {
         if (!s_) raise(PyExc_ValueError, "the system is closed");
@@ -422,6 +465,7 @@ private:
     }
 
     psys_system* s_;
+    mutable std::recursive_mutex mutex_;
 };
 
 }  // namespace

@@ -91,7 +91,13 @@ void Ledger::resizeParts(LateKills& l, size_t parts) {
 }
 
 void Ledger::recycle(std::vector<LateKills>& lates) {
-    for (LateKills& l : lates) spares(l.type).lates.push_back(std::move(l));
+    for (LateKills& l : lates) {
+        // (A husk whose vectors were moved on — take keeps some, free takes one out — has
+        // nothing to give; past kMostSpares a type's spares are more than a step takes.)
+        bool husk = l.parts.capacity() == 0 && l.poolRows.capacity() == 0 && l.spans.capacity() == 0;
+        std::vector<LateKills>& kept = spares(l.type).lates;
+        if (!husk && kept.size() < kMostSpares) kept.push_back(std::move(l));
+    }
     lates.clear();
 }
 
@@ -418,7 +424,8 @@ void Ledger::free(Deaths& deaths, std::vector<LateKills>& lates) {
         if (!simple(l)) {  // its kills frozen in its place, as take would
             // A list of its own each time: take leaves the list it settles holding only what
             // it keeps (nothing here: the type's rows are not in the memory).
-            Deaths its;
+            Deaths& its = lists_.its;
+            its.clear();
             std::vector<LateKills>& single = lists_.single;
             single.clear();
             single.push_back(std::move(l));

@@ -179,8 +179,9 @@ private:
     };
     std::vector<Spares> spares_;
     Spares& spares(size_t type);
+    static constexpr size_t kMostSpares = 8;  // LateKills kept a type (a step takes one or two)
     struct Lists {
-        Deaths merged, kept;
+        Deaths merged, kept, its;
         std::vector<LateKills> keptLates, single;
         std::vector<std::vector<uint32_t>> own, waited, copies;
         std::vector<std::span<const uint32_t>> spans;

@@ -96,11 +96,12 @@ void System::reset() {
     std::vector<Value> externs = old.externs;  // (the host's values stay)
     // The module moves over whole: its kernels stay where they are, and the backend's
     // compiled functions for them with them — nothing is compiled again.
-    ir::Module module = std::move(old.module);
+    // The new state is made before the old goes (what holds the old, drawing and creation,
+    // goes first): a failure leaves a system that has no module, never a dangling one.
+    auto fresh = std::make_unique<detail::State>(std::move(old.module), backend, options);
     drawing_.reset();
     creation_.reset();
-    state_.reset();
-    state_ = std::make_unique<detail::State>(std::move(module), backend, options);
+    state_ = std::move(fresh);
     creation_ = std::make_unique<detail::Creation>(*state_);
     drawing_ = std::make_unique<detail::Drawing>(*state_);
     state_->schedule = detail::stepSchedule(*state_);

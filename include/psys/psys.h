@@ -120,8 +120,11 @@ typedef struct psys_options {
 } psys_options;
 
 /* The defaults above: llvm, fast, seed 1, 2^20 objects a type, every core, optimized, the
- * default cache, no library folders of the host's; and `size`. */
-PSYS_API void psys_options_init(psys_options* options);
+ * default cache, no library folders of the host's; and `size`, the host's sizeof (an
+ * inline function, so that it is the host's header's: the library writes no more than
+ * that, and reads what it knows of it). */
+PSYS_API void psys_options_init_size(psys_options* options, size_t size);
+static inline void psys_options_init(psys_options* options) { psys_options_init_size(options, sizeof *options); }
 
 /* What the library has to say outside a call's result — a JIT session's error, a GL debug
  * message (PSYS_GL_DEBUG), a setting it could not honour — one line a call, without a

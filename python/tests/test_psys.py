@@ -303,3 +303,22 @@ def test_prewarm_and_reset():
     assert np.array_equal(s.points("drop")["position"], warm)  # the same seed: the same run
     with pytest.raises(psys.Error, match="non-negative"):
         s.prewarm(-1)
+
+
+def test_a_close_from_another_thread_waits_for_the_step_it_would_cut_short():
+    import threading
+    s = psys.compile(SAMPLES / "fire.psys", threads=1)
+    s.set("rate", 100000)
+    s.step(1 / 60, steps=30)
+    started = threading.Event()
+
+    def stepping():
+        started.set()
+        s.step(1 / 60, steps=40)
+
+    worker = threading.Thread(target=stepping)
+    worker.start()
+    started.wait()
+    s.close()  # waits for the 40 steps (freed under them, the step would read freed memory)
+    worker.join()
+    assert s.closed

@@ -420,7 +420,7 @@ TEST_CASE("reserve takes room ahead, refuses more than the capacity or an unknow
     CHECK(std::memcmp(pa.data(), pb.data(), pa.size() * sizeof(psys_point)) == 0);
 }
 
-TEST_CASE("options carry their size: unset or a later header's refused in words, an earlier header's read with defaults") {
+TEST_CASE("options carry their size: unset, unknown or a later header's refused in words") {
     System s;
     psys_options o = options("interp");
     o.size = 0;
@@ -430,11 +430,22 @@ TEST_CASE("options carry their size: unset or a later header's refused in words,
     CHECK(take(psys_compile_string(kDots, nullptr, &o, &s.s)).find("from a later header than this library's") !=
           std::string::npos);
     CHECK(s.s == nullptr);
-    // A header that ended before jit_cache: those fields are the defaults, whatever follows.
+    // A size no header's options have (half a field: an uninitialised size) is refused.
+    o.size = offsetof(psys_options, jit_cache) + 4;
+    CHECK(take(psys_compile_string(kDots, nullptr, &o, &s.s)).find("the size of no header's options") !=
+          std::string::npos);
+    CHECK(s.s == nullptr);
+    // Init writes no more than the host's struct (here: a later header's, 8 bytes longer,
+    // zeroed past what this library knows), and says its size, which is then refused.
+    unsigned char later[sizeof(psys_options) + 8];
+    std::memset(later, 0xab, sizeof later);
+    psys_options_init_size(reinterpret_cast<psys_options*>(later), sizeof later);
+    CHECK(later[sizeof(psys_options)] == 0);
+    psys_options known;
+    std::memcpy(&known, later, sizeof known);
+    CHECK(known.size == sizeof later);
+    CHECK(std::string(known.backend) == "llvm");
     o = options("interp");
-    o.size = offsetof(psys_options, jit_cache);
-    o.jit_cache = "/proc/not/a/folder";
-    o.library_path = reinterpret_cast<const char*>(1);  // past the host's struct: never read
     CHECK(take(psys_compile_string(kDots, nullptr, &o, &s.s)).empty());
     CHECK(s.s != nullptr);
 }
