@@ -195,6 +195,36 @@ TEST_CASE("a steady-state step makes no heap allocation on the JIT, on one threa
     }
 }
 
+TEST_CASE("late kills of a nested type and of a top-level one in the same step recycle what they took") {
+    // A comet (nested tails that die, read by nothing) beside sparks that only die: the
+    // ledger frees both kinds each step (Ledger::free: a type read or nested, and a simple
+    // one), and neither keeps what it took.
+    const std::string source = R"(
+object comet {
+    pos = vec3(cos(age) * 5, 3, sin(age) * 5);
+    point(pos, white, 1);
+    emit tail(nrand3()) at 300 per second;
+    emit spark(pos) at 500 per second;
+    object tail(offset: vec3) {
+        point(comet.pos + offset * age, white, 1);
+        kill when age > 1;
+    }
+}
+object spark(p: vec3) {
+    point(p + vec3(0, age, 0), white, 1);
+    kill when age > 0.5;
+}
+spawn comet;
+)";
+    for (const char* backend : {"llvm", "interp"}) {
+        CAPTURE(std::string(backend));
+        psys_options o = options(backend, "exact", 2);
+        Opened s;
+        REQUIRE(take(psys_compile_string(source.c_str(), "comet_and_sparks.psys", &o, &s.sys)) == "");
+        CHECK(allocationsOfSteadySteps(s.sys, nullptr, 0, 180, 300) == 0);
+    }
+}
+
 TEST_CASE("a steady-state step makes no heap allocation on an ahead-of-time build") {
     for (unsigned threads : {1u, 2u}) {
         CAPTURE(threads);
