@@ -340,25 +340,51 @@ public:
         return out;
     }
 
-    // The drawn points copied out (any backend): id (n), position (n×3), color (n×4), size (n),
-    // written through raw pointers (what a NumPy copy of the columns costs, about).
+    // The drawn points copied out (any backend): id (n), position (n×3), color (n×4), size (n).
+    // On the CPU backends straight from the draw columns (what a NumPy copy of them costs,
+    // about); on the glsl backend read back through psys_read_points.
     py::dict points(const py::object& type) {
         auto held = hold();
         size_t t = typeOf(type), n = 0;
-        check(psys_read_points(s_, t, nullptr, 0, &n));
-        std::vector<psys_point> p(n);
-        check(psys_read_points(s_, t, p.data(), p.size(), &n));
+        psys_draw d;
+        check(psys_get_draw(open(), t, &d));
+        bool onGpu = d.visible.gl_buffer || d.ids.gl_buffer || d.size.gl_buffer;
+        for (const psys_column& c : d.position) onGpu |= c.gl_buffer != 0;
+        for (const psys_column& c : d.color) onGpu |= c.gl_buffer != 0;
+        auto value = [](const psys_column& c, size_t row) {
+            return c.data ? static_cast<const float*>(c.data)[row] : c.constant;
+        };
+        std::vector<psys_point> read;
+        if (onGpu) {
+            check(psys_read_points(s_, t, nullptr, 0, &n));
+            read.resize(n);
+            check(psys_read_points(s_, t, read.data(), read.size(), &n));
+        } else {
+            for (size_t row = 0; row < d.rows; ++row) n += value(d.visible, row) == 1.0f;
+        }
         auto rows = static_cast<py::ssize_t>(n);
         py::array_t<uint32_t> id(rows);
         py::array_t<float> position({rows, py::ssize_t{3}}), color({rows, py::ssize_t{4}}), size(rows);
         uint32_t* ids = id.mutable_data();
         float *xyz = position.mutable_data(), *rgba = color.mutable_data(), *sizes = size.mutable_data();
-        for (size_t i = 0; i < n; ++i) {
-            const psys_point& q = p[i];
-            ids[i] = q.id;
-            std::memcpy(xyz + 3 * i, q.position, sizeof q.position);
-            std::memcpy(rgba + 4 * i, q.color, sizeof q.color);
-            sizes[i] = q.size;
+        if (onGpu) {
+            for (size_t i = 0; i < n; ++i) {
+                const psys_point& q = read[i];
+                ids[i] = q.id;
+                std::memcpy(xyz + 3 * i, q.position, sizeof q.position);
+                std::memcpy(rgba + 4 * i, q.color, sizeof q.color);
+                sizes[i] = q.size;
+            }
+        } else {
+            const auto* idColumn = static_cast<const uint32_t*>(d.ids.data);
+            for (size_t row = 0, i = 0; row < d.rows; ++row) {
+                if (value(d.visible, row) != 1.0f) continue;
+                ids[i] = idColumn ? idColumn[row] : static_cast<uint32_t>(d.ids.constant);
+                for (int k = 0; k < 3; ++k) xyz[3 * i + static_cast<size_t>(k)] = value(d.position[k], row);
+                for (int k = 0; k < 4; ++k) rgba[4 * i + static_cast<size_t>(k)] = value(d.color[k], row);
+                sizes[i] = value(d.size, row);
+                ++i;
+            }
         }
         py::dict out;
         out["id"] = id;
