@@ -126,18 +126,21 @@ Pool::Pool(const ir::Object& object, size_t capacity, Memory& memory)
 // a pool growing inside a step (a rate filling it) moves and copies nothing: growing a
 // 500,000-row pool's arrays by doubling took 5.6 ms of a 0.2 ms step (`psys_bench
 // --hitches`, docs/performance.md).
-void Pool::reserveRows() {
-    room_ = reservableRows(capacity_, rowBytes(*object_));
-    auto reserve = [&](Buffer b) {
-        if (b.valid()) memory_->reserve(b, room_);
-    };
+void Pool::forEachRowColumn(core::FunctionRef<void(Buffer)> f) const {
     for (Buffer b : {created, ids, updatable.column, alive.column, rows_.stack, rows_.generation, rows_.readers,
                      rows_.waiting, parentRows, frozenAt})
-        reserve(b);
-    for (Buffer b : emitted) reserve(b);
+        if (b.valid()) f(b);
+    for (Buffer b : emitted)
+        if (b.valid()) f(b);
     for (const ValueColumns* v : {&state, &params, &exports})
         for (size_t i = 0; i < v->count(); ++i)
-            for (int c = 0; c < v->type(i).width; ++c) reserve(v->column(i, static_cast<size_t>(c)));
+            for (int c = 0; c < v->type(i).width; ++c)
+                if (Buffer b = v->column(i, static_cast<size_t>(c)); b.valid()) f(b);
+}
+
+void Pool::reserveRows() {
+    room_ = reservableRows(capacity_, rowBytes(*object_));
+    forEachRowColumn([&](Buffer b) { memory_->reserve(b, room_); });
     updatable.reserved(*memory_);
     alive.reserved(*memory_);
     if (inMemory_) return;  // (its host arrays are copies, read back when asked)
@@ -151,16 +154,7 @@ void Pool::reserveRows() {
 
 void Pool::populate(size_t rows) {
     rows = std::min(rows, room_);
-    auto populate = [&](Buffer b) {
-        if (b.valid()) memory_->populate(b, rows);
-    };
-    for (Buffer b : {created, ids, updatable.column, alive.column, rows_.stack, rows_.generation, rows_.readers,
-                     rows_.waiting, parentRows, frozenAt})
-        populate(b);
-    for (Buffer b : emitted) populate(b);
-    for (const ValueColumns* v : {&state, &params, &exports})
-        for (size_t i = 0; i < v->count(); ++i)
-            for (int c = 0; c < v->type(i).width; ++c) populate(v->column(i, static_cast<size_t>(c)));
+    forEachRowColumn([&](Buffer b) { memory_->populate(b, rows); });
     if (inMemory_) return;
     populateRoom(status_, rows);
     populateRoom(generation_, rows);

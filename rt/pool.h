@@ -291,6 +291,9 @@ private:
     mutable std::vector<uint8_t> mask_;
     void fetch() const;  // the host copies of the rows in the memory, where they are stale
     void reserveRows();
+    // f(column) for each valid column a row has (bookkeeping, emitters' accumulators, state,
+    // parameters, exports): what reserveRows and populate take room for.
+    void forEachRowColumn(core::FunctionRef<void(Buffer)> f) const;
     PieceRunner runPieces_;
     // fn(begin, end) over pieces of [0, n): on every thread where runPieces_ is set and the
     // masks are the host's (SyncedMask::direct), else in order.
