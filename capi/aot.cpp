@@ -144,6 +144,8 @@ extern "C" psys_error* psys_open_aot(const psys_aot* aot, const psys_options* gi
         auto s = std::make_unique<AotSystem>();
         s->backend = makeBackend(*aot, o.backend, error);
         if (!s->backend) return makeError(fmt::format("{}: {}", function, error));
+        if (auto refused = rt::System::checkBackend(*module, *s->backend))
+            return makeError(fmt::format("{}: {}", function, *refused));
         s->running = std::make_unique<rt::System>(std::move(*module), *s->backend, o.system);
         s->describe();
         *out = s.release();

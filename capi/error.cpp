@@ -15,6 +15,10 @@ psys_error* nullArgument(const char* function, const char* what) {
     return makeError(std::string(function) + ": " + what + " is NULL");
 }
 
+psys_error* orError(const char* function, const std::optional<std::string>& error) {
+    return error ? makeError(std::string(function) + ": " + *error) : nullptr;
+}
+
 }  // namespace psys::capi
 
 using psys::capi::OwnedDiagnostic;

@@ -2,6 +2,7 @@
 // diagnostics as plain data (file, line, column, text) that outlive the compiler's own.
 #pragma once
 
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -23,6 +24,9 @@ psys_error* makeError(std::string message, std::vector<OwnedDiagnostic> diagnost
 
 // "psys_step: the system is NULL": the message of a null argument.
 psys_error* nullArgument(const char* function, const char* what);
+
+// "psys_step: …" where a call of the run-time said why it refused, else no error.
+psys_error* orError(const char* function, const std::optional<std::string>& error);
 
 // Runs `body` and turns what it throws into an error: no exception crosses into C.
 template <typename Body>

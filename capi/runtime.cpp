@@ -20,6 +20,7 @@
 using psys::capi::guarded;
 using psys::capi::makeError;
 using psys::capi::nullArgument;
+using psys::capi::orError;
 namespace rt = psys::rt;
 
 
@@ -31,10 +32,6 @@ static_assert(PSYS_VERSION_MAJOR == PSYS_LIBRARY_MAJOR && PSYS_VERSION_MINOR == 
                   PSYS_VERSION_PATCH == PSYS_LIBRARY_PATCH,
               "include/psys/psys.h's version is the project's (CMakeLists.txt)");
 
-
-psys_error* orError(const char* function, const std::optional<std::string>& error) {
-    return error ? makeError(fmt::format("{}: {}", function, *error)) : nullptr;
-}
 
 psys_error* badType(const char* function, const psys_system* s, size_t type) {
     return makeError(fmt::format("{}: there is no object type {} (the system has {})", function, type,
@@ -56,7 +53,7 @@ void psys_system::describe() {
     triggerTypes.clear();
     for (const psys::ir::Trigger& t : m.triggers) {
         std::string types;
-        for (const psys::ir::Param& p : t.params) types += (types.empty() ? "" : ", ") + rt::languageName(p);
+        for (const psys::ir::Param& p : t.hostParams()) types += (types.empty() ? "" : ", ") + rt::languageName(p);
         triggerTypes.push_back(types);
     }
 }
@@ -244,7 +241,7 @@ int psys_trigger_info(const psys_system* s, size_t index, psys_input* out) {
     if (!s || !out || index >= psys_trigger_count(s)) return -1;
     const psys::ir::Trigger& t = s->system().module().triggers[index];
     size_t values = 0;
-    for (const psys::ir::Param& p : t.params) values += static_cast<size_t>(p.type.width);
+    for (const psys::ir::Param& p : t.hostParams()) values += static_cast<size_t>(p.type.width);
     *out = {t.name.c_str(), s->triggerTypes[index].c_str(), values};
     return 0;
 }
@@ -261,6 +258,7 @@ psys_error* psys_get_draw(psys_system* s, size_t type, psys_draw* out) {
         d.drawn = c.counted ? c.drawn : std::numeric_limits<size_t>::max();
         d.visible = column(m, c.visible, 0);
         d.ids = column(m, c.ids, 0);
+        d.instance = column(m, c.instance, 0);
         const auto values = c.values();
         psys_column* into[rt::DrawColumns::kValues] = {&d.position[0], &d.position[1], &d.position[2], &d.color[0],
                                                        &d.color[1],    &d.color[2],    &d.color[3],    &d.size,

@@ -204,6 +204,7 @@ private:
                     s = fmt::format("({} + {} * {})", s, component(a(0), w, l), component(a(1), w, l));
                 return s;
             }
+            case Op::Instance: throw std::runtime_error(std::string(core::kNoInstances));
             default: throw std::runtime_error(unexpectedOp(inst, "the GLSL backend"));
         }
     }

@@ -224,10 +224,10 @@ private:
             }
         };
         if (uniformKernel_) {  // this row's uniform values, at its own clock
-            auto values = emitKernelBody(b_, module_, *uniformKernel_, mode_, seed, leaf);
+            auto values = emitKernelBody(b_, module_, *uniformKernel_, mode_, seed, loop_->getArg(kExterns), leaf);
             for (const Yield& y : uniformKernel_->yields) uniforms[y.index] = values[y.value];
         }
-        auto values = emitKernelBody(b_, module_, kernel, mode_, seed, leaf);
+        auto values = emitKernelBody(b_, module_, kernel, mode_, seed, loop_->getArg(kExterns), leaf);
 
         auto [killedNow, unstableNow] = storeYields(kernel, layout, argOf, values, killedSoFar, unstableSoFar);
         llvm::Value* next = b_.CreateAdd(row_, b_.getInt64(1), "", true, true);
@@ -399,7 +399,7 @@ public:
             if (i.op == Op::DrawIndex && i.attr == 1) return {childDraw};
             return emitter.at(&i);
         };
-        auto values = emitKernelBody(b_, module_, spawn, mode_, fn_->getArg(kSeed), leaf);
+        auto values = emitKernelBody(b_, module_, spawn, mode_, fn_->getArg(kSeed), fn_->getArg(kExterns), leaf);
         llvm::Value* target = b_.CreateAdd(fn_->getArg(kArgsFirst), k);
         // The argument columns are distinct arrays: each store in a scope of its own,
         // declared not to alias the others', so the stores need no run-time overlap checks.

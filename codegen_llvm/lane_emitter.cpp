@@ -7,6 +7,7 @@
 #include <llvm/IR/Intrinsics.h>
 
 #include "core/hash.h"
+#include "core/instances.h"
 
 namespace psys::codegen_llvm {
 
@@ -22,8 +23,9 @@ namespace {
 
 class BodyEmitter {
 public:
-    BodyEmitter(llvm::IRBuilder<>& b, llvm::Module& m, const Kernel& k, MathMode mode, llvm::Value* seed)
-        : b_(b), module_(m), kernel_(k), mode_(mode), seed_(seed) {}
+    BodyEmitter(llvm::IRBuilder<>& b, llvm::Module& m, const Kernel& k, MathMode mode, llvm::Value* seed,
+                llvm::Value* externs)
+        : b_(b), module_(m), kernel_(k), mode_(mode), seed_(seed), externs_(externs) {}
 
     std::vector<Lanes> run(const LeafReader& leaf) {
         llvm::FastMathFlags flags;
@@ -36,6 +38,8 @@ public:
             if (isInput(i.op)) {
                 values_[v] = leaf(i, parentOrdinal);
                 if (isGathered(i.op)) ++parentOrdinal;
+            } else if (i.op == Op::Instance) {
+                values_[v] = instance(i);
             } else {
                 values_[v] = emit(i);
             }
@@ -46,6 +50,30 @@ public:
 
 private:
     llvm::Value* f(float x) { return llvm::ConstantFP::get(b_.getFloatTy(), x); }
+
+    // A record of the instance table after the externs (core/instances.h): its place
+    // clamped as core::instanceSlot clamps it (NaN and negatives to the first, past the
+    // count to the last), then four loads.
+    Lanes instance(const Inst& i) {
+        if (!externs_) throw std::runtime_error(unexpectedOp(i, "the JIT (here)"));
+        llvm::Type* value = llvm::StructType::get(b_.getContext(), {llvm::ArrayType::get(b_.getFloatTy(), 4), b_.getInt32Ty()});
+        auto at = [&](llvm::Value* slot, unsigned lane) {
+            return b_.CreateGEP(value, externs_, {slot, b_.getInt32(0), b_.getInt32(lane)});
+        };
+        llvm::Value* start = b_.getInt32(static_cast<uint32_t>(i.attr2));
+        llvm::Value* count = b_.CreateAlignedLoad(b_.getFloatTy(), at(start, 0), llvm::Align(4));
+        llvm::Value* last = b_.CreateFPToUI(b_.CreateMaxNum(b_.CreateFSub(count, f(1)), f(0)), b_.getInt32Ty());
+        llvm::Value* x = values_[i.operands[0]][0];
+        llvm::Value* positive = b_.CreateFCmpOGT(x, f(0));  // false for NaN
+        llvm::Value* beyond = b_.CreateFCmpOGE(x, b_.CreateUIToFP(b_.CreateAdd(last, b_.getInt32(1)), b_.getFloatTy()));
+        llvm::Value* whole = b_.CreateFPToUI(b_.CreateSelect(positive, b_.CreateSelect(beyond, f(0), x), f(0)), b_.getInt32Ty());
+        llvm::Value* index = b_.CreateSelect(beyond, last, whole);
+        llvm::Value* slot = b_.CreateAdd(start, b_.CreateAdd(b_.getInt32(1 + static_cast<uint32_t>(i.attr)),
+                                                             b_.CreateMul(index, b_.getInt32(core::kInstanceRecordValues))));
+        Lanes out;
+        for (unsigned l = 0; l < 4; ++l) out.push_back(b_.CreateAlignedLoad(b_.getFloatTy(), at(slot, l), llvm::Align(4)));
+        return out;
+    }
 
     // One lane through a libm function: a plain call in exact mode (the interpreter's
     // function), an intrinsic the vectorizer can map onto libmvec in fast mode.
@@ -225,14 +253,15 @@ private:
     const Kernel& kernel_;
     MathMode mode_;
     llvm::Value* seed_;
+    llvm::Value* externs_;
     std::vector<Lanes> values_;
 };
 
 }  // namespace
 
 std::vector<Lanes> emitKernelBody(llvm::IRBuilder<>& builder, llvm::Module& module, const Kernel& kernel,
-                                  MathMode mode, llvm::Value* seed, const LeafReader& leaf) {
-    return BodyEmitter(builder, module, kernel, mode, seed).run(leaf);
+                                  MathMode mode, llvm::Value* seed, llvm::Value* externs, const LeafReader& leaf) {
+    return BodyEmitter(builder, module, kernel, mode, seed, externs).run(leaf);
 }
 
 }  // namespace psys::codegen_llvm

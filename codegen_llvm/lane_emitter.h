@@ -26,9 +26,10 @@ using Lanes = llvm::SmallVector<llvm::Value*, 4>;
 using LeafReader = std::function<Lanes(const ir::Inst& inst, int parentOrdinal)>;
 
 // Emits `kernel` at the builder's insertion point; returns the lanes of every value.
-// `seed` (i32) keys the random numbers.
+// `seed` (i32) keys the random numbers; `externs` points at the externs' Values, the
+// instance table after them (core/instances.h; null where the kernel can read none).
 std::vector<Lanes> emitKernelBody(llvm::IRBuilder<>& builder, llvm::Module& module, const ir::Kernel& kernel,
-                                  MathMode mode, llvm::Value* seed, const LeafReader& leaf);
+                                  MathMode mode, llvm::Value* seed, llvm::Value* externs, const LeafReader& leaf);
 
 // The LLVM type of one lane of an IR type.
 llvm::Type* laneType(llvm::IRBuilder<>& builder, ir::Type type);

@@ -92,7 +92,7 @@ void buildPairFunction(llvm::Module& module, MathMode mode, const Object& object
         }
         throw std::runtime_error(unexpectedOp(i, "the JIT's pair kernels"));
     };
-    std::vector<Lanes> values = emitKernelBody(b, module, pair, mode, b.getInt32(0), leaf);
+    std::vector<Lanes> values = emitKernelBody(b, module, pair, mode, b.getInt32(0), nullptr, leaf);
     std::vector<llvm::Value*> next(sums.begin(), sums.end());
     for (size_t y = 0; y < pair.yields.size(); ++y) {
         const Lanes& term = values[pair.yields[y].value];

@@ -27,6 +27,7 @@ enum class OpKind : uint8_t {
     Pure,      // a function of its operands only
     Random,    // a counter-based random draw; attr is its call site
     Temporal,  // the thesis's constructs over an object's history (lowered by opt/)
+    Lookup,    // reads a table of the run-time's at the place its operand names (the instances')
 };
 
 // Properties.
@@ -88,6 +89,7 @@ struct OpSpelling {
     X(NeighbourRead, "neighbour.read", 0, Input, 0, 0, PSYS_NONE) /* pair kernels: attr: index into Object::neighbourReads */                                 \
     X(NeighbourExport, "neighbour.export", 0, Input, 0, 0, PSYS_NONE) /* pair kernels: attr: export; attr2: 0 this object, 1 the other */                     \
     X(Fold, "fold", 0, Input, 0, 0, PSYS_NONE)                 /* attr: fold (Object::folds): over the neighbours, this step */                               \
+    X(Instance, "instance", 1, Lookup, 0, 0, PSYS_NONE)        /* operand: the instance (f32); attr: value k of its record; attr2: where the table starts among the externs (core/instances.h) */ \
     X(Add, "add", 2, Pure, kCommutative | kComponentwise, 0, PSYS_NONE)                                                                                       \
     X(Sub, "sub", 2, Pure, kComponentwise, 0, PSYS_NONE)                                                                                                      \
     X(Mul, "mul", 2, Pure, kCommutative | kComponentwise, 0, PSYS_NONE)                                                                                       \
@@ -171,6 +173,7 @@ inline bool isPure(Op op) { return kindOf(op) == OpKind::Pure; }
 inline bool jumps(Op op) { return (opInfo(op).flags & kJumps) != 0; }
 inline bool isRandom(Op op) { return kindOf(op) == OpKind::Random; }
 inline bool isTemporal(Op op) { return kindOf(op) == OpKind::Temporal; }
+inline bool isLookup(Op op) { return kindOf(op) == OpKind::Lookup; }
 inline bool isCommutative(Op op) { return opInfo(op).flags & kCommutative; }
 inline bool isComponentwise(Op op) { return opInfo(op).flags & kComponentwise; }
 inline bool hasOwnSite(Op op) { return opInfo(op).flags & kOwnSite; }

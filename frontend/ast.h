@@ -121,6 +121,7 @@ struct MemberExpr : Expr {
     int parentDepth = 0;                   // 1: the direct parent, 2: its parent, …
     Ref parentRef;                         // what is read in the parent
     bool neighbour = false;                // `other.vel` in a fold's term: `parent` is the other's type
+    int instance = -1;                     // `instance.pos`: its member (builtins.h, instanceMembers)
 };
 
 enum class UnaryOp { Neg, Not, Plus };
@@ -322,6 +323,9 @@ struct Module {
 // The main file and everything it imports, each file once.
 struct Program {
     std::vector<std::unique_ptr<Module>> modules;  // imported files before their importers; the main file last
+    // Some expression reads `instance` (set by the checker): the program is played as
+    // instances (core/instances.h).
+    bool instanced = false;
     const Module& main() const { return *modules.back(); }
 };
 

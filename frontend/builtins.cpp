@@ -1,5 +1,6 @@
 #include "frontend/builtins.h"
 
+#include "core/instances.h"
 #include "core/integrators.h"
 
 #include <array>
@@ -147,6 +148,22 @@ std::span<const BuiltinConstant> builtinConstants() { return kConstants; }
 int findBuiltinConstant(std::string_view name) {
     for (size_t i = 0; i < std::size(kConstants); ++i)
         if (kConstants[i].name == name) return static_cast<int>(i);
+    return -1;
+}
+
+constexpr InstanceMember kInstanceMembers[] = {
+    {"pos", core::kInstancePosition, 0, 3, "where the instance is: its transform's translation"},
+    {"x", core::kInstanceAxisX, 0, 3, "the instance's x axis: its transform's first column (its length the scale)"},
+    {"y", core::kInstanceAxisY, 0, 3, "the instance's y axis: its transform's second column"},
+    {"z", core::kInstanceAxisZ, 0, 3, "the instance's z axis: its transform's third column"},
+    {"index", core::kInstanceIndex, 3, 1, "the instance's index (0 for the system's own)"},
+};
+
+std::span<const InstanceMember> instanceMembers() { return kInstanceMembers; }
+
+int findInstanceMember(std::string_view name) {
+    for (size_t i = 0; i < std::size(kInstanceMembers); ++i)
+        if (kInstanceMembers[i].name == name) return static_cast<int>(i);
     return -1;
 }
 

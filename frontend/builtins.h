@@ -57,6 +57,20 @@ struct BuiltinConstant {
 std::span<const BuiltinConstant> builtinConstants();
 int findBuiltinConstant(std::string_view name);  // -1 when none
 
+// `instance.pos`, `instance.x`, …: what a program reads of the instance an object belongs
+// to (core/instances.h): lanes [first, first + width) of record value `record`.
+struct InstanceMember {
+    std::string_view name;
+    int record;
+    int first;
+    int width;
+    std::string_view meaning;  // for hovers and notes
+};
+std::span<const InstanceMember> instanceMembers();
+int findInstanceMember(std::string_view name);  // -1 when none
+// The name of the built-in value whose members those are.
+constexpr std::string_view kInstanceName = "instance";
+
 // `age`, `time`, `dt`: names that always mean the same thing inside an object.
 std::span<const std::string_view> builtinVariables();
 bool isBuiltinVariable(std::string_view name);

@@ -246,6 +246,36 @@ std::optional<Ref> Checker::memberOf(const ObjectDecl& object, const MemberExpr&
     return it->second;
 }
 
+// `instance.pos`: the instance the object belongs to (core/instances.h), read live in an
+// object, at the start of the instance in a spawn, where fired in a trigger.
+Type Checker::checkInstanceMember(MemberExpr& member, const Context& ctx) {
+    member.base->type = Type::error();  // `instance` is not a value of its own
+    if (ctx.fold || ctx.fn || (ctx.where != Where::Object && ctx.where != Where::Spawn && ctx.where != Where::Trigger)) {
+        const char* place = ctx.fold ? "the term of a fold: it reads this object's equations and `other.NAME`"
+                            : ctx.where == Where::Fn || ctx.fn ? "a function: functions are pure; pass it as a parameter"
+                                                               : "a constant expression";
+        diags_.error(member.range, fmt::format("`instance` cannot be read in {}", place));
+        return Type::error();
+    }
+    int found = findInstanceMember(member.member);
+    if (found < 0) {
+        std::vector<std::string> names;
+        for (const InstanceMember& m : instanceMembers()) names.emplace_back(m.name);
+        std::string suggestion = closestName(member.member, names);
+        std::string all;
+        for (const std::string& n : names) all += fmt::format("{}`{}`", all.empty() ? "" : ", ", n);
+        Diagnostic& d = diags_.error(member.memberRange,
+                                     fmt::format("`instance` has no member `{}`{}; it has {}", member.member,
+                                                 suggestion.empty() ? "" : fmt::format(" (did you mean `{}`?)", suggestion),
+                                                 all));
+        if (!suggestion.empty()) d.fixes.push_back({fmt::format("Change to `{}`", suggestion), member.memberRange, suggestion});
+        return Type::error();
+    }
+    member.instance = found;
+    program_.instanced = true;
+    return instanceMembers()[static_cast<size_t>(found)].width == 1 ? Type::scalar() : Type::vec(3);
+}
+
 Type Checker::checkMember(MemberExpr& member, const Context& ctx) {
     if (member.base->kind == ExprKind::Name && static_cast<NameExpr&>(*member.base).name == "other") {
         if (ctx.fold) return checkNeighbourMember(member, ctx);
@@ -257,6 +287,8 @@ Type Checker::checkMember(MemberExpr& member, const Context& ctx) {
             return Type::error();
         }
     }
+    if (member.base->kind == ExprKind::Name && static_cast<NameExpr&>(*member.base).name == kInstanceName)
+        return checkInstanceMember(member, ctx);
     // `rocket.pos`: a live read of an enclosing object.
     if (member.base->kind == ExprKind::Name) {
         auto& base = static_cast<NameExpr&>(*member.base);

@@ -69,6 +69,7 @@ private:
     Type checkBuiltinCall(ast::CallExpr& call, const std::vector<Type>& args, const Context& ctx);
     Type checkUserCall(ast::CallExpr& call, const ast::FnDecl& fn, const std::vector<Type>& args);
     Type checkMember(ast::MemberExpr& member, const Context& ctx);
+    Type checkInstanceMember(ast::MemberExpr& member, const Context& ctx);
     // `object`'s equation or parameter `member.member` (marked used), or an error naming
     // the closest of its names and `alsoNamed`.
     std::optional<ast::Ref> memberOf(const ast::ObjectDecl& object, const ast::MemberExpr& member,

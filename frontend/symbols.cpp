@@ -67,6 +67,11 @@ std::string closestName(const std::string& name, const std::vector<std::string>&
 
 // A user's name may not redefine what the language defines.
 bool Checker::checkDeclarableName(const std::string& name, SourceRange range, const char* what) {
+    if (name == kInstanceName) {
+        diags_.error(range, fmt::format("cannot declare {} named `instance`: `instance` is a built-in value (the "
+                                        "instance an object belongs to: `instance.pos`, …)", what));
+        return false;
+    }
     if (isBuiltinVariable(name)) {
         diags_.error(range, fmt::format("cannot declare {} named `{}`: `{}` is a built-in variable", what, name, name));
         return false;
@@ -227,6 +232,12 @@ Ref Checker::lookupName(const std::string& name, SourceRange range, const Contex
                 return ref;
             }
         }
+    }
+    if (name == kInstanceName) {
+        std::string members;
+        for (const InstanceMember& m : instanceMembers()) members += fmt::format("{}`instance.{}`", members.empty() ? "" : ", ", m.name);
+        diags_.error(range, fmt::format("`instance` is read by its members: {}", members));
+        return ref;
     }
     if (isBuiltinVariable(name)) {
         bool allowed = ctx.where == Where::Object || (name == "time" && (ctx.where == Where::Trigger || ctx.where == Where::Spawn));

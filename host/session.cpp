@@ -81,6 +81,10 @@ std::unique_ptr<Session> Session::start(const std::string& path, const SessionOp
         error = *tooLarge;
         return nullptr;
     }
+    if (auto refused = rt::System::checkBackend(module, **backend)) {
+        error = *refused;
+        return nullptr;
+    }
     std::unique_ptr<Session> s(new Session());
     s->path_ = path;
     s->options_ = options;
@@ -126,6 +130,12 @@ Session::Candidate Session::compileCandidate(const std::string* text) const {
     Candidate c;
     c.compile = compile(path_, options_.compile, c.module, text);
     c.backend = backend_;
+    if (c.module)
+        if (auto refused = rt::System::checkBackend(*c.module, *c.backend)) {  // the running system goes on
+            c.compile.diagnostics->error({}, *refused);
+            c.compile.ok = false;
+            c.module.reset();
+        }
     if (c.module) {
         auto start = std::chrono::steady_clock::now();
         c.backend->prepare(rt::launchPlan(*c.module));
@@ -151,6 +161,7 @@ Session::Reload Session::reload(const std::string* text) { return adopt(compileC
 std::optional<std::string> Session::switchBackend(const BackendChoice& choice) {
     auto backend = makeBackend(choice);
     if (!backend) return backend.error;
+    if (auto refused = rt::System::checkBackend(system_->module(), **backend)) return refused;
     auto next = std::make_unique<rt::System>(system_->module(), **backend, system_->options());
     next->carryOver(*system_);
     system_ = std::move(next);  // the old system goes before its backend

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "core/hash.h"
+#include "core/instances.h"
 #include "core/lanes.h"
 
 namespace psys::ir {
@@ -154,6 +155,14 @@ void Evaluator::run(const Kernel& kernel, std::span<const KernelInputs> rows, st
             case Op::NeighbourExport:
                 each([&](const KernelInputs& in, size_t) { return (inst.attr2 ? in.other : in.self)[inst.attr]; });
                 break;
+            case Op::Instance: {  // core/instances.h
+                const Value* instance = r + inst.operands[0] * n;
+                each([&](const KernelInputs& in, size_t row) {
+                    const Value* table = in.externs + inst.attr2;
+                    return table[core::instanceSlot(instance[row].f[0], static_cast<uint32_t>(table[0].f[0]), inst.attr)];
+                });
+                break;
+            }
             case Op::ObjectId:
                 each([](const KernelInputs& in, size_t) { Value x; x.u = in.objectId; return x; });
                 break;
@@ -194,7 +203,7 @@ bool evaluates(Op op) {
         case Op::Const: case Op::Param: case Op::TriggerParam: case Op::StateRead: case Op::Extern:
         case Op::Uniform: case Op::Age: case Op::Dt: case Op::Time: case Op::First: case Op::ParentExport:
         case Op::ParentAlive: case Op::ParentAge: case Op::ObjectId: case Op::DrawIndex: case Op::Rand:
-        case Op::NRand: case Op::Fold: case Op::NeighbourExport:
+        case Op::NRand: case Op::Fold: case Op::NeighbourExport: case Op::Instance:
             return true;
         default: return isPure(op);
     }

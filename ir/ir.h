@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <unordered_map>
@@ -28,6 +29,7 @@
 
 #include "core/draw.h"
 #include "core/fold.h"
+#include "core/instances.h"
 #include "core/integrators.h"
 #include "ir/ops.h"
 #include "ir/types.h"
@@ -389,6 +391,13 @@ struct Trigger {
     std::vector<Param> params;
     std::vector<EmitSite> emits;
     Kernel kernel;
+    // The parameters a host gives: all but an instanced program's hidden `instance`, which
+    // the run-time fills in (core/instances.h).
+    std::span<const Param> hostParams() const {
+        size_t n = params.size();
+        if (n > 0 && params.back().name == core::kInstanceParam) --n;
+        return {params.data(), n};
+    }
 };
 
 struct Module {
@@ -400,6 +409,9 @@ struct Module {
 
     const Object* object(const std::string& name) const;
     int objectIndex(const std::string& name) const;
+    // Whether it is played as instances (core/instances.h): every object, trigger and the
+    // start then have the hidden parameter `instance`, last.
+    bool instanced() const { return !start.params.empty(); }
     int externIndex(const std::string& name) const;
 };
 

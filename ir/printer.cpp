@@ -106,6 +106,7 @@ std::string print(const Kernel& kernel, int indent, PrintOptions options) {
                         inst.op == Op::TriggerParam || inst.op == Op::ParentRead || inst.op == Op::ParentExport ||
                         inst.op == Op::Extract || inst.op == Op::DrawIndex || inst.op == Op::Uniform ||
                         inst.op == Op::NeighbourRead || inst.op == Op::NeighbourExport || inst.op == Op::Fold ||
+                        inst.op == Op::Instance ||
                         hasOwnSite(inst.op);
         if (showAttr) line += fmt::format(" #{}", inst.attr);
         if (inst.attr2 != 0) line += fmt::format(" ^{}", inst.attr2);

@@ -1,5 +1,7 @@
 #include "ir/verifier.h"
 
+#include "core/instances.h"
+
 #include <fmt/format.h>
 
 namespace psys::ir {
@@ -136,6 +138,12 @@ private:
                            static_cast<size_t>(i.attr) < object_->folds.size() &&
                            object_->folds[static_cast<size_t>(i.attr)].type == i.type,
                        "no fold of this index and type (outside a pair kernel)");
+                break;
+            case Op::Instance:
+                expect(i.type == Type::vec(4) && t(0).isScalarFloat() && i.attr >= 0 &&
+                           i.attr < core::kInstanceRecordValues &&
+                           static_cast<size_t>(i.attr2) == module_.externs.size(),
+                       "a vec4: value #0…#3 of the record of the instance an f32 names, the table after the externs (^count)");
                 break;
             case Op::ParentAlive: expect(i.type.isBool() && i.attr2 >= 1, "a bool, at least one level up"); break;
             case Op::ParentAge: expect(i.type.isScalarFloat() && i.attr2 >= 1, "an f32, at least one level up"); break;

@@ -26,6 +26,7 @@
 #include <functional>
 #include <map>
 
+#include "core/instances.h"
 #include "lower/object_lowering.h"
 
 namespace psys::lower {
@@ -150,6 +151,10 @@ struct CommandLowering {
                     for (size_t i = 0; i < cmd->args.size(); ++i)
                         k.yields.push_back({YieldKind::EmitArg, site, static_cast<int>(i), lowering.lowerOne(*cmd->args[i])});
                     lowering.perChild_ = false;
+                    if (program.instanced) {  // a child belongs to its emitter's instance
+                        k.yields.push_back({YieldKind::EmitArg, site, static_cast<int>(cmd->args.size()), lowering.instance()});
+                        if (object) instanceEmission(site);
+                    }
                     break;
                 }
                 case CommandKind::When: {
@@ -159,6 +164,20 @@ struct CommandLowering {
                     break;
                 }
                 case CommandKind::On: deaths_.push_back(cmd.get()); break;  // (the checker allows `death` only)
+            }
+        }
+    }
+
+    // An instance that is stopped emits no more at a rate; one that is killed creates
+    // nothing at all (its objects die in their next update: instanceKill).
+    void instanceEmission(int site) {
+        for (Yield& y : k.yields) {
+            if (y.index != site) continue;
+            if (y.kind == YieldKind::EmitRate)
+                y.value = k.op(Op::Mul, Type::f32(), {y.value, lowering.instanceFlag(core::kInstanceEmitting)});
+            if (y.kind == YieldKind::EmitCount && !emits[static_cast<size_t>(site)].rate()) {
+                ValueId killed = k.op(Op::Gt, Type::boolean(), {lowering.instanceFlag(core::kInstanceKilled), k.scalar(0)});
+                y.value = k.op(Op::Select, Type::f32(), {killed, k.scalar(0), y.value});
             }
         }
     }
@@ -257,6 +276,7 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
         o.parent = qualified(decl->parent);
         o.attributes = attributes;
         for (auto& p : decl->params) o.params.push_back({p.name, irType(p.type.type)});
+        if (program.instanced) o.params.push_back({std::string(core::kInstanceParam), Type::f32()});
         m.objects.push_back(std::move(o));
     }
     for (size_t i = 0; i < decls.size(); ++i) {
@@ -274,6 +294,11 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
         o.draw = commands.draw;
         o.trail = commands.trail;
         lowering.flushDeferred();
+        if (program.instanced) {  // an instance killed by the host takes its objects with it
+            LocScope at(k, locate(decl->nameRange));
+            ValueId killed = k.op(Op::Gt, Type::boolean(), {lowering.instanceFlag(core::kInstanceKilled), k.scalar(0)});
+            kill = k.op(Op::Or, Type::boolean(), {kill, killed});
+        }
         k.yields.push_back({YieldKind::Kill, 0, 0, kill});
         o.kernels.push_back(std::move(k));
     }
@@ -289,6 +314,7 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
                     trigger.params.push_back({p.name, irType(p.type.type)});
                     if (p.type.spelling == "color" || p.type.spelling == "point") trigger.params.back().spelling = p.type.spelling;
                 }
+                if (program.instanced) trigger.params.push_back({std::string(core::kInstanceParam), Type::f32()});
                 trigger.kernel.kind = KernelKind::Trigger;
                 int sites = 0;
                 ObjectLowering lowering(m, locate, trigger.kernel, nullptr, nullptr, &t, sites);
@@ -300,6 +326,7 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
         }
     m.start.name = "start";
     m.start.kernel.kind = KernelKind::Start;
+    if (program.instanced) m.start.params.push_back({std::string(core::kInstanceParam), Type::f32()});
     int startSites = 0;
     ObjectLowering startLowering(m, locate, m.start.kernel, nullptr, nullptr, nullptr, startSites);
     for (auto& module : program.modules)
@@ -312,6 +339,9 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
                 for (size_t i = 0; i < s.args.size(); ++i)
                     m.start.kernel.yields.push_back(
                         {YieldKind::EmitArg, site, static_cast<int>(i), startLowering.lowerOne(*s.args[i])});
+                if (program.instanced)
+                    m.start.kernel.yields.push_back(
+                        {YieldKind::EmitArg, site, static_cast<int>(s.args.size()), startLowering.instance()});
             }
     return m;
 }

@@ -161,6 +161,15 @@ ValueId ObjectLowering::lowerNear(const CallExpr& c) {
     return input(Op::Fold, t, fold);
 }
 
+ValueId ObjectLowering::instanceMember(int member) {
+    const InstanceMember& m = instanceMembers()[static_cast<size_t>(member)];
+    ValueId record = instanceRecord(m.record);
+    if (m.width == 1) return extract(record, m.first);
+    std::vector<uint8_t> lanes;
+    for (int l = 0; l < m.width; ++l) lanes.push_back(static_cast<uint8_t>(m.first + l));
+    return shuffle(record, lanes);
+}
+
 Values ObjectLowering::lower(const Expr& e) {
     LocScope at(k_, locate_(e.range));
     switch (e.kind) {
@@ -171,6 +180,7 @@ Values ObjectLowering::lower(const Expr& e) {
         case ExprKind::Member: {
             auto& m = static_cast<const MemberExpr&>(e);
             if (m.neighbour) return {neighbourRead(true, m.member, irType(m.type))};
+            if (m.instance >= 0) return {instanceMember(m.instance)};
             if (m.parent) return {parentRead(m)};
             ValueId base = lowerOne(*m.base);
             if (m.swizzle.size() == 1) return {extract(base, m.swizzle[0])};

@@ -156,6 +156,21 @@ private:
     ValueId neighbourRead(bool other, const std::string& member, Type t);
 
 public:
+    // The instance this object (or trigger, or start) belongs to, in an instanced program:
+    // its hidden last parameter (core/instances.h).
+    ValueId instance() {
+        if (object_) return input(Op::Param, Type::f32(), static_cast<int>(object_->params.size()) - 1);
+        return input(Op::TriggerParam, Type::f32(), trigger_ ? static_cast<int>(trigger_->params.size()) : 0);
+    }
+    // Value `value` of that instance's record.
+    ValueId instanceRecord(int value) {
+        return k_.add(Inst::make(Op::Instance, Type::vec(4), {instance()}, value, static_cast<int>(module_.externs.size())));
+    }
+    // A flag of the record's (core/instances.h: kInstanceEmitting, …): the w lane of value `flag`.
+    ValueId instanceFlag(int flag) { return extract(instanceRecord(flag), 3); }
+    // `instance.pos`, … (frontend/builtins.h, instanceMembers).
+    ValueId instanceMember(int member);
+
     // Object types' names in the IR (nested ones qualified): what a fold names its type by.
     std::function<std::string(const ObjectDecl*)> qualify;
     // Lowering a fold's term into a pair kernel: the object's names read its exports.

@@ -105,7 +105,15 @@ void System::reset() {
     creation_ = std::make_unique<detail::Creation>(*state_);
     drawing_ = std::make_unique<detail::Drawing>(*state_);
     state_->schedule = detail::stepSchedule(*state_);
+    // (Of the instances only the system's own is left, playing, where it was.)
+    const size_t own = state_->module.externs.size() + (state_->module.instanced() ? 1 + core::kInstanceRecordValues : 0);
+    externs.resize(own);
     state_->externs = std::move(externs);
+    if (state_->module.instanced()) {
+        state_->externs[state_->module.externs.size()].f[0] = 1;
+        state_->instanceRecords()[core::kInstanceEmitting].f[3] = 1;
+        state_->instanceRecords()[core::kInstanceKilled].f[3] = 0;
+    }
     ++state_->externsVersion;
 }
 
@@ -146,7 +154,10 @@ void System::start() {
     if (s.started && s.reloadSpawns.empty()) return;
     if (!s.started) {
         s.started = true;
-        creation_->emitFromKernel(s.module.start, {}, kStartObject);
+        // (An instanced program's: the system's own instance, unless the host killed it first.)
+        if (!s.module.instanced()) creation_->emitFromKernel(s.module.start, {}, kStartObject);
+        else if (s.instances[0].life == InstanceLife::Playing)
+            creation_->emitFromKernel(s.module.start, std::vector<Value>{Value::scalar(0)}, kStartObject);
     } else {  // a reload's added spawns: the start with the others' counts left out
         ir::Trigger added = s.module.start;
         std::erase_if(added.kernel.yields, [&](const ir::Yield& y) {
@@ -155,7 +166,9 @@ void System::start() {
                        s.reloadSpawns.end();
         });
         s.reloadSpawns.clear();
-        creation_->emitFromKernel(added, {}, kStartObject);
+        std::vector<Value> own;
+        if (s.module.instanced()) own.push_back(Value::scalar(0));
+        creation_->emitFromKernel(added, own, kStartObject);
     }
     creation_->drain(s.now);
     s.ledger.settle(Wait::No);
@@ -258,6 +271,7 @@ std::optional<std::string> System::step(double dt) {
     }
     drawing_->invalidate(true);
     ++s.stats.steps;
+    s.finishInstances();
     if (s.options.onFinished) {
         bool now = finished();
         if (now && !s.saidFinished) s.options.onFinished(*this);
@@ -373,7 +387,7 @@ std::optional<std::string> System::checkFiring(std::string_view name, size_t val
         return fmt::format("there is no trigger `{}`{}", name,
                            names.empty() ? " (the system has none)" : " (the triggers are " + names + ")");
     size_t width = 0;
-    for (auto& p : trigger->params) width += static_cast<size_t>(p.type.width);
+    for (auto& p : trigger->hostParams()) width += static_cast<size_t>(p.type.width);
     if (values != width)
         return fmt::format("trigger `{}` takes {} number{}, not {}", name, width, width == 1 ? "" : "s", values);
     return std::nullopt;
@@ -388,18 +402,30 @@ std::optional<std::string> System::checkFiring(std::string_view name, std::span<
 }
 
 std::optional<std::string> System::fire(std::string_view name, std::span<const float> args) {
-    detail::State& s = *state_;
     if (auto error = checkFiring(name, args)) return error;
+    detail::State& s = *state_;
+    if (s.module.instanced() && s.instances[0].life == InstanceLife::Finished) {  // the system's own, again
+        s.instances[0].life = InstanceLife::Playing;
+        s.instanceRecords()[core::kInstanceEmitting].f[3] = 1;
+        s.instanceRecords()[core::kInstanceKilled].f[3] = 0;
+    }
+    return fireOn(name, args, 0);
+}
+
+// A checked firing, on instance `slot` where the program is instanced.
+std::optional<std::string> System::fireOn(std::string_view name, std::span<const float> args, uint32_t slot) {
+    detail::State& s = *state_;
     const ir::Trigger* trigger = nullptr;
     for (const ir::Trigger& t : s.module.triggers)
         if (t.name == name) trigger = &t;
     std::vector<Value> params;
     size_t at = 0;
-    for (auto& p : trigger->params) {
+    for (auto& p : trigger->hostParams()) {
         Value v;
         for (int c = 0; c < p.type.width; ++c) v.f[static_cast<size_t>(c)] = args[at++];
         params.push_back(v);
     }
+    if (s.module.instanced()) params.push_back(Value::scalar(static_cast<float>(slot)));
     start();
     s.ledger.settle(Wait::Yes);  // the rows the last step freed, before these objects take rows
     creation_->emitFromKernel(*trigger, params, kTriggerObject);

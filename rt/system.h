@@ -68,6 +68,16 @@ struct SystemOptions {
     std::function<void(const System&)> onFinished;
 };
 
+// An instance of an instanced program (docs/embedding.md, "Instances"): its slot in the
+// low 32 bits, the slot's generation in the high ones. 0 is the system's own.
+using InstanceHandle = uint64_t;
+enum class InstanceLife : uint8_t {
+    Playing,   // its `spawn`s ran; it emits
+    Stopped,   // its emitters emit no more at a rate; what it made lives out its life
+    Killed,    // its objects die at the next step, creating nothing
+    Finished,  // nothing of it is left (or it never was)
+};
+
 struct TypeStats {
     std::string name;
     size_t live = 0;
@@ -128,6 +138,7 @@ struct DrawColumns {
     Buffer rotation, frame; // f32: a sprite's
     Buffer end[3];          // f32: a streak's other end
     Buffer ids;             // u32
+    Buffer instance;        // f32: each row's instance (an instanced program's slot; else none)
     // The drawn values in render-column order past `visible` (ColumnLayout::kPosition …):
     // position x y z, colour r g b a, size, rotation, frame, end x y z.
     static constexpr int kValues = 13;
@@ -188,6 +199,7 @@ public:
     std::optional<std::string> setExtern(int handle, std::span<const float> value);
     // The current value of an extern (its default until set).
     std::optional<Value> externValue(std::string_view name) const;
+    // (On an instanced program, on the system's own instance: played again if it finished.)
     std::optional<std::string> fire(std::string_view trigger, std::span<const float> args);
     // Whether fire(trigger, `values` numbers) would be accepted: nullopt, or why not.
     std::optional<std::string> checkFiring(std::string_view trigger, size_t values) const;
@@ -196,6 +208,9 @@ public:
     // Whether every type's capacity (its @capacity, else the options') fits in this
     // machine's memory at the pool's bytes a row: nullopt, or an error that names the bytes.
     static std::optional<std::string> checkCapacity(const ir::Module& module, const SystemOptions& options);
+    // Whether `backend` runs `module`: nullopt, or why not (the glsl backend does not play
+    // instances yet). The constructor throws that.
+    static std::optional<std::string> checkBackend(const ir::Module& module, Backend& backend);
     std::optional<std::string> step(double dt);
     // Runs `seconds` ahead at once in equal steps of at most `longest` (a warm-up: what a
     // host shows from its first frame has been running a while). Nothing is drawn in them
@@ -214,6 +229,25 @@ public:
     std::optional<std::string> reserve(size_t type, size_t rows);
     // Threads for launches over pools from now on: 0 for every core. Results do not change.
     void setThreads(unsigned threads);
+
+    // Instances (docs/embedding.md, "Instances"), for an instanced program — one that reads
+    // `instance` (ir::Module::instanced); the others refuse them. Each plays the `spawn`s
+    // again, its objects (and theirs) reading its transform as `instance.pos`, … . The
+    // system's own instance, handle 0, plays when the system starts (kill it before the
+    // first step for a system of the host's plays alone). `transform`: 16 floats, a 4×4
+    // affine matrix in columns (OpenGL's, GLM's order; its last row 0 0 0 1), empty for the
+    // identity. Starting one compiles nothing: its objects join the effect's pools.
+    std::optional<std::string> play(std::span<const float> transform, InstanceHandle& out);
+    std::optional<std::string> setTransform(InstanceHandle instance, std::span<const float> transform);
+    std::optional<std::string> stop(InstanceHandle instance);  // no more emission at a rate
+    std::optional<std::string> kill(InstanceHandle instance);  // its objects die at the next step
+    // A trigger fired on one instance: what it creates belongs to it.
+    std::optional<std::string> fire(std::string_view trigger, std::span<const float> args, InstanceHandle instance);
+    InstanceLife life(InstanceHandle instance) const;  // Finished also for a handle never given
+    size_t instanceCount() const;                      // not finished, the system's own included
+    // The instances that finished in the latest step, in slot order: a host learns of them
+    // without asking each.
+    std::span<const InstanceHandle> finishedInstances() const;
 
     // Whether the system can produce nothing more of its own accord: it has started,
     // nothing is alive and nothing waits to be created. A trigger fired later still
@@ -260,6 +294,9 @@ public:
 
 private:
     void start();
+    // The instance a handle names, or why it names none that may change.
+    std::optional<std::string> liveInstance(InstanceHandle instance, uint32_t& slot) const;
+    std::optional<std::string> fireOn(std::string_view trigger, std::span<const float> args, uint32_t slot);
     void runPhases(size_t first, size_t end, double dt, double t1, bool last, double stepEnd);
     void initNewSlots(const ReloadReport& report);
 

@@ -164,6 +164,8 @@ const DrawColumns& Drawing::draw(size_t type) {
     out = {};
     out.rows = rows;
     out.ids = pool.ids;
+    if (s_.module.instanced() && !pool.paramColumn.empty() && pool.paramColumn.back() >= 0)
+        out.instance = pool.params.column(static_cast<size_t>(pool.paramColumn.back()), 0);
     if (!info.render || !info.drawn[0] || rows == 0) {
         out.rows = 0;
         return out;

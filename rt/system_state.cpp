@@ -261,6 +261,7 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
       options(o),
       ancestors(b.memory()),
       parallel(std::make_unique<Parallel>(o.threads)) {
+    if (module.instanced() && !memory.hostResident()) throw std::runtime_error(std::string(core::kNoInstances));
     for (const ir::Object& obj : module.objects) {
         size_t capacity = obj.attributes.capacity ? static_cast<size_t>(*obj.attributes.capacity) : options.capacity;
         pools.emplace_back(obj, capacity, memory);
@@ -300,6 +301,13 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
         }
     }
     for (const ir::Extern& e : module.externs) externs.push_back({e.defaultValue, 0});
+    if (module.instanced()) {  // the system's own instance, playing where the host has not moved it
+        externs.push_back(Value::scalar(0));
+        growInstances(1);
+        instances[0].life = InstanceLife::Playing;
+        instanceRecords()[core::kInstanceEmitting].f[3] = 1;
+        instanceRecords()[core::kInstanceKilled].f[3] = 0;
+    }
     uniformCache.resize(pools.size());
 }
 

@@ -139,6 +139,14 @@ struct UniformCache {
     std::vector<Value> values;
 };
 
+// An instance's slot in the table (core/instances.h, rt/system_instances.cpp): where it is
+// in its life, and its generation — it changes when the instance finishes, so a handle
+// of an earlier play reads "finished" however often the slot is played again.
+struct InstanceSlot {
+    InstanceLife life = InstanceLife::Finished;  // Finished: free
+    uint32_t generation = 0;
+};
+
 struct State {
     State(ir::Module module, Backend& backend, SystemOptions options);
     ~State();
@@ -156,8 +164,18 @@ struct State {
     // time: the chunks of a pool's launch gather on several threads.
     Scratch ancestors;
     std::mutex ancestorsInUse;
-    std::vector<Value> externs;
+    std::vector<Value> externs;  // the module's, then the instance table where it has one
     uint64_t externsVersion = 0;
+    // Instances, by slot (slot 0: the system's own, played at the start), with the
+    // instances that finished in the last step and a step's counts (kept for their vectors).
+    std::vector<InstanceSlot> instances;
+    std::vector<InstanceHandle> finishedInstances;
+    std::vector<uint32_t> instanceLive;
+    Value* instanceRecords() { return externs.data() + module.externs.size() + 1; }  // slot 0's first value
+    // The table with room for `slots` slots (new ones free, their records the identity).
+    void growInstances(size_t slots);
+    // The instances whose objects are all gone, after a step: finished (the CPU's pools).
+    void finishInstances();
     std::vector<std::array<UniformCache, 3>> uniformCache;
     std::vector<Value> uniformValues;  // (uniforms': kept from step to step)
     std::vector<TypeStats> typeStats;

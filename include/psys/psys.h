@@ -50,7 +50,7 @@ extern "C" {
 #endif
 
 #define PSYS_VERSION_MAJOR 0
-#define PSYS_VERSION_MINOR 2
+#define PSYS_VERSION_MINOR 3
 #define PSYS_VERSION_PATCH 0
 
 /* The library's version as "MAJOR.MINOR.PATCH" (the header's may differ: a host built
@@ -233,6 +233,43 @@ PSYS_API int psys_get_extern(const psys_system* system, const char* name, float 
 /* Fires a trigger with its arguments (`count` numbers: the widths of its parameters). */
 PSYS_API psys_error* psys_fire(psys_system* system, const char* trigger, const float* args, size_t count);
 
+/* ---- Instances ---------------------------------------------------------------------- */
+
+/* An instanced program — one that reads `instance` (instance.pos, instance.x, …: docs/
+ * language.md) — is an effect played many times at once: each play runs its `spawn`s
+ * again, and what they create (and what that creates) belongs to that instance and reads
+ * its transform. All instances share the effect's pools and one update a step; starting
+ * one compiles nothing. The system's own instance (handle 0) plays when the system starts,
+ * as a program that is not instanced does; kill it before the first step for a system
+ * whose instances the host plays alone. Other programs refuse these calls (their
+ * instances could not be told apart). Not on the glsl backend yet. docs/embedding.md,
+ * "Instances". */
+typedef uint64_t psys_instance;
+typedef enum psys_life {
+    PSYS_PLAYING = 0,  /* it emits */
+    PSYS_STOPPED = 1,  /* psys_instance_stop: no more emission at a rate; what it made lives on */
+    PSYS_KILLED = 2,   /* psys_instance_kill: its objects die at the next step, creating nothing */
+    PSYS_FINISHED = 3  /* nothing of it is left (also a handle never given) */
+} psys_life;
+
+/* Plays the effect again: `transform` is a 4×4 affine matrix, 16 floats in columns
+ * (OpenGL's and GLM's order, its last row 0 0 0 1), NULL for the identity. *out gets its
+ * handle. Its `spawn`s run now, at the system's time. */
+PSYS_API psys_error* psys_play(psys_system* system, const float* transform, psys_instance* out);
+/* Moves an instance (the host may call it every frame): read from the next step on. */
+PSYS_API psys_error* psys_instance_transform(psys_system* system, psys_instance instance, const float* transform);
+PSYS_API psys_error* psys_instance_stop(psys_system* system, psys_instance instance);
+PSYS_API psys_error* psys_instance_kill(psys_system* system, psys_instance instance);
+/* psys_fire on one instance: what the trigger creates belongs to it. */
+PSYS_API psys_error* psys_instance_fire(psys_system* system, psys_instance instance, const char* trigger,
+                                        const float* args, size_t count);
+PSYS_API psys_life psys_instance_life(const psys_system* system, psys_instance instance);
+/* Instances not finished, the system's own included while it lives. */
+PSYS_API size_t psys_instance_count(const psys_system* system);
+/* The instances that finished in the latest step (without asking each): up to `max` into
+ * out; returns how many there are. */
+PSYS_API size_t psys_finished_instances(const psys_system* system, psys_instance* out, size_t max);
+
 /* ---- What it is made of ------------------------------------------------------------- */
 
 /* Object types, in the program's order (parents before children): index 0 .. count-1. */
@@ -278,6 +315,8 @@ typedef struct psys_draw {
     psys_column size;
     psys_column rotation, frame; /* a sprite's */
     psys_column end[3];          /* a streak's other end */
+    psys_column instance;        /* float: the instance a row belongs to (its slot, the
+                                    handle's low 32 bits); the constant 0 unless instanced */
 } psys_draw;
 
 PSYS_API psys_error* psys_get_draw(psys_system* system, size_t type, psys_draw* out);

@@ -1,0 +1,81 @@
+// The C API's instances (include/psys/psys.h, "Instances"): rt::System's, checked for
+// null arguments and with its refusals as errors.
+#include <span>
+
+#include "capi/error.h"
+#include "capi/handle.h"
+
+using psys::capi::guarded;
+using psys::capi::nullArgument;
+using psys::capi::orError;
+namespace rt = psys::rt;
+
+namespace {
+
+std::span<const float> transformOf(const float* transform) {
+    return transform ? std::span<const float>(transform, 16) : std::span<const float>();
+}
+
+}  // namespace
+
+extern "C" {
+
+psys_error* psys_play(psys_system* s, const float* transform, psys_instance* out) {
+    if (!s) return nullArgument("psys_play", "the system");
+    if (!out) return nullArgument("psys_play", "the place for the instance (out)");
+    return guarded("psys_play", [&] {
+        rt::InstanceHandle h = 0;
+        psys_error* e = orError("psys_play", s->system().play(transformOf(transform), h));
+        if (!e) *out = h;
+        return e;
+    });
+}
+
+psys_error* psys_instance_transform(psys_system* s, psys_instance instance, const float* transform) {
+    if (!s) return nullArgument("psys_instance_transform", "the system");
+    return guarded("psys_instance_transform", [&] {
+        return orError("psys_instance_transform", s->system().setTransform(instance, transformOf(transform)));
+    });
+}
+
+psys_error* psys_instance_stop(psys_system* s, psys_instance instance) {
+    if (!s) return nullArgument("psys_instance_stop", "the system");
+    return guarded("psys_instance_stop", [&] { return orError("psys_instance_stop", s->system().stop(instance)); });
+}
+
+psys_error* psys_instance_kill(psys_system* s, psys_instance instance) {
+    if (!s) return nullArgument("psys_instance_kill", "the system");
+    return guarded("psys_instance_kill", [&] { return orError("psys_instance_kill", s->system().kill(instance)); });
+}
+
+psys_error* psys_instance_fire(psys_system* s, psys_instance instance, const char* trigger, const float* args,
+                               size_t count) {
+    if (!s) return nullArgument("psys_instance_fire", "the system");
+    if (!trigger) return nullArgument("psys_instance_fire", "the trigger's name");
+    if (!args && count) return nullArgument("psys_instance_fire", "the arguments");
+    return guarded("psys_instance_fire", [&] {
+        return orError("psys_instance_fire", s->system().fire(trigger, std::span<const float>(args, count), instance));
+    });
+}
+
+psys_life psys_instance_life(const psys_system* s, psys_instance instance) {
+    if (!s) return PSYS_FINISHED;
+    switch (s->system().life(instance)) {
+        case rt::InstanceLife::Playing: return PSYS_PLAYING;
+        case rt::InstanceLife::Stopped: return PSYS_STOPPED;
+        case rt::InstanceLife::Killed: return PSYS_KILLED;
+        case rt::InstanceLife::Finished: break;
+    }
+    return PSYS_FINISHED;
+}
+
+size_t psys_instance_count(const psys_system* s) { return s ? s->system().instanceCount() : 0; }
+
+size_t psys_finished_instances(const psys_system* s, psys_instance* out, size_t max) {
+    if (!s) return 0;
+    std::span<const rt::InstanceHandle> finished = s->system().finishedInstances();
+    for (size_t i = 0; i < finished.size() && i < max && out; ++i) out[i] = finished[i];
+    return finished.size();
+}
+
+}  // extern "C"

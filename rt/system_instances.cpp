@@ -1,0 +1,195 @@
+// Instances (core/instances.h, docs/embedding.md "Instances"): an instanced program's
+// `spawn`s played once per instance, all of them in the effect's pools and one update.
+// The run-time keeps the table the kernels read — each slot's transform and flags — and
+// each slot's life; an instance finishes after the step that leaves none of its objects.
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "rt/rng.h"
+#include "rt/system.h"
+#include "rt/system_create.h"
+#include "rt/system_draw.h"
+#include "rt/system_support.h"
+
+namespace psys::rt {
+namespace {
+
+using Wait = detail::Ledger::Wait;
+
+uint32_t slotOf(InstanceHandle h) { return static_cast<uint32_t>(h & 0xffffffffu); }
+uint32_t generationOf(InstanceHandle h) { return static_cast<uint32_t>(h >> 32); }
+InstanceHandle handle(uint32_t slot, uint32_t generation) { return static_cast<InstanceHandle>(generation) << 32 | slot; }
+
+// A transform as the host gives it: 16 finite floats in columns, affine.
+std::optional<std::string> checkTransform(std::span<const float> m) {
+    if (m.empty()) return std::nullopt;
+    if (m.size() != 16)
+        return fmt::format("an instance's transform is a 4×4 matrix: 16 numbers in columns, not {}", m.size());
+    for (float x : m)
+        if (!std::isfinite(x)) return fmt::format("an instance's transform takes finite numbers, not {}", x);
+    if (m[3] != 0 || m[7] != 0 || m[11] != 0 || m[15] != 1)
+        return fmt::format("an instance's transform is affine: its last row is 0 0 0 1, not {} {} {} {} (the "
+                           "matrix in columns, as OpenGL and GLM keep it)",
+                           m[3], m[7], m[11], m[15]);
+    return std::nullopt;
+}
+
+// Writes the transform (the identity where empty) into a slot's records, flags kept.
+void writeTransform(Value* records, std::span<const float> m) {
+    for (int column = 0; column < 4; ++column)
+        for (int row = 0; row < 3; ++row)
+            records[column].f[static_cast<size_t>(row)] =
+                m.empty() ? (row == column ? 1.0f : 0.0f) : m[static_cast<size_t>(4 * column + row)];
+}
+
+}  // namespace
+
+namespace detail {
+
+void State::growInstances(size_t slots) {
+    const size_t before = instances.size();
+    if (slots <= before) return;
+    instances.resize(slots);
+    externs.resize(module.externs.size() + 1 + core::kInstanceRecordValues * slots);
+    externs[module.externs.size()].f[0] = static_cast<float>(slots);
+    for (size_t slot = before; slot < slots; ++slot) {
+        Value* records = instanceRecords() + core::kInstanceRecordValues * slot;
+        writeTransform(records, {});
+        records[core::kInstanceEmitting].f[3] = 0;
+        records[core::kInstanceKilled].f[3] = 1;  // (a free slot: nothing of it may live)
+        records[core::kInstanceIndex].f[3] = static_cast<float>(slot);
+        records[core::kInstancePosition].f[3] = 1;
+    }
+}
+
+// Counts each slot's live objects in the pools' hidden `instance` columns; a slot still
+// playing, stopped or killed with none finishes. Only where the host addresses the pools
+// (the CPU's memory: the glsl backend refuses instanced programs).
+void State::finishInstances() {
+    finishedInstances.clear();
+    if (!module.instanced() || !memory.hostResident()) return;
+    ledger.settle(Wait::No);  // what is ready: else a step late
+    instanceLive.assign(instances.size(), 0);
+    const float last = static_cast<float>(instances.size() - 1);
+    for (Pool& pool : pools) {
+        const int column = pool.paramColumn.empty() ? -1 : pool.paramColumn.back();
+        if (column < 0 || pool.live() == 0) continue;
+        const float* instance = view<float>(pool.params.column(static_cast<size_t>(column), 0));
+        const uint8_t* alive = view<uint8_t>(pool.alive.column);
+        for (size_t r = 0, rows = pool.rows(); r < rows; ++r)
+            if (alive[r]) ++instanceLive[static_cast<size_t>(std::clamp(instance[r], 0.0f, last))];
+    }
+    for (uint32_t slot = 0; slot < instances.size(); ++slot) {
+        InstanceSlot& i = instances[slot];
+        if (i.life == InstanceLife::Finished || instanceLive[slot] > 0) continue;
+        finishedInstances.push_back(handle(slot, i.generation));
+        i.life = InstanceLife::Finished;
+        ++i.generation;
+        Value* records = instanceRecords() + core::kInstanceRecordValues * slot;
+        records[core::kInstanceEmitting].f[3] = 0;
+        records[core::kInstanceKilled].f[3] = 1;
+    }
+}
+
+}  // namespace detail
+
+std::optional<std::string> System::checkBackend(const ir::Module& module, Backend& backend) {
+    if (module.instanced() && !backend.memory().hostResident()) return std::string(core::kNoInstances);
+    return std::nullopt;
+}
+
+std::optional<std::string> System::liveInstance(InstanceHandle instance, uint32_t& slot) const {
+    const detail::State& s = *state_;
+    if (!s.module.instanced())
+        return std::string("the program is not instanced: it reads no `instance` (instance.pos, …), so its "
+                           "instances could not be told apart (docs/embedding.md, \"Instances\")");
+    slot = slotOf(instance);
+    if (slot >= s.instances.size() || generationOf(instance) > s.instances[slot].generation)
+        return fmt::format("there is no instance {:#x}", instance);
+    if (generationOf(instance) < s.instances[slot].generation || s.instances[slot].life == InstanceLife::Finished)
+        return fmt::format("instance {:#x} has finished", instance);
+    return std::nullopt;
+}
+
+std::optional<std::string> System::play(std::span<const float> transform, InstanceHandle& out) {
+    detail::State& s = *state_;
+    uint32_t slot = 0;
+    if (!s.module.instanced()) return liveInstance(0, slot);
+    if (auto error = checkTransform(transform)) return error;
+    // The lowest free slot past the system's own (it is the system's, played by fire()).
+    slot = 1;
+    while (slot < s.instances.size() && s.instances[slot].life != InstanceLife::Finished) ++slot;
+    if (slot >= (1u << 24))  // (an instance's index is a float: whole numbers are exact below 2^24)
+        return std::string("a system plays at most 2^24 instances at once");
+    if (slot >= s.instances.size()) s.growInstances(std::max<size_t>(slot + 1, s.instances.size() * 2));
+    Value* records = s.instanceRecords() + core::kInstanceRecordValues * slot;
+    writeTransform(records, transform);
+    records[core::kInstanceEmitting].f[3] = 1;
+    records[core::kInstanceKilled].f[3] = 0;
+    s.instances[slot].life = InstanceLife::Playing;
+    ++s.externsVersion;
+    out = handle(slot, s.instances[slot].generation);
+    start();
+    s.ledger.settle(Wait::Yes);  // the rows the last step freed, before these objects take rows
+    creation_->emitFromKernel(s.module.start, std::vector<Value>{Value::scalar(static_cast<float>(slot))}, kStartObject);
+    creation_->drain(s.now);
+    s.ledger.settle(Wait::No);
+    drawing_->invalidate();
+    return std::nullopt;
+}
+
+std::optional<std::string> System::setTransform(InstanceHandle instance, std::span<const float> transform) {
+    uint32_t slot = 0;
+    if (auto error = liveInstance(instance, slot)) return error;
+    if (auto error = checkTransform(transform)) return error;
+    writeTransform(state_->instanceRecords() + core::kInstanceRecordValues * slot, transform);
+    ++state_->externsVersion;
+    return std::nullopt;
+}
+
+std::optional<std::string> System::stop(InstanceHandle instance) {
+    uint32_t slot = 0;
+    if (auto error = liveInstance(instance, slot)) return error;
+    detail::InstanceSlot& i = state_->instances[slot];
+    if (i.life == InstanceLife::Playing) i.life = InstanceLife::Stopped;
+    state_->instanceRecords()[core::kInstanceRecordValues * slot + core::kInstanceEmitting].f[3] = 0;
+    ++state_->externsVersion;
+    return std::nullopt;
+}
+
+std::optional<std::string> System::kill(InstanceHandle instance) {
+    uint32_t slot = 0;
+    if (auto error = liveInstance(instance, slot)) return error;
+    state_->instances[slot].life = InstanceLife::Killed;
+    Value* records = state_->instanceRecords() + core::kInstanceRecordValues * slot;
+    records[core::kInstanceEmitting].f[3] = 0;
+    records[core::kInstanceKilled].f[3] = 1;
+    ++state_->externsVersion;
+    return std::nullopt;
+}
+
+std::optional<std::string> System::fire(std::string_view trigger, std::span<const float> args, InstanceHandle instance) {
+    uint32_t slot = 0;
+    if (auto error = liveInstance(instance, slot)) return error;
+    if (state_->instances[slot].life == InstanceLife::Killed)
+        return fmt::format("instance {:#x} is killed: it creates nothing more", instance);
+    if (auto error = checkFiring(trigger, args)) return error;
+    return fireOn(trigger, args, slot);
+}
+
+InstanceLife System::life(InstanceHandle instance) const {
+    uint32_t slot = 0;
+    if (liveInstance(instance, slot)) return InstanceLife::Finished;
+    return state_->instances[slot].life;
+}
+
+size_t System::instanceCount() const {
+    size_t n = 0;
+    for (const detail::InstanceSlot& i : state_->instances) n += i.life != InstanceLife::Finished;
+    return n;
+}
+
+std::span<const InstanceHandle> System::finishedInstances() const { return state_->finishedInstances; }
+
+}  // namespace psys::rt
