@@ -126,8 +126,9 @@ public:
                 t.params = params(line);
                 triggerBody(t);
                 m.triggers.push_back(std::move(t));
-            } else if (w[0] == "start") {
+            } else if (w[0] == "start" || w[0].starts_with("start(")) {
                 m.start.name = "start";
+                if (line.find('(') != std::string::npos) m.start.params = params(line);
                 triggerBody(m.start);
             } else {
                 throw ParseError("expected extern, object, trigger or start, found `" + w[0] + "`");

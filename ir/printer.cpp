@@ -186,7 +186,9 @@ std::string print(const Module& m, PrintOptions options) {
         out += "end\n";
     };
     for (auto& t : m.triggers) trigger(t, fmt::format("trigger {}({})", t.name, params(t.params)));
-    if (!m.start.emits.empty() || m.start.kernel.size() > 0) trigger(m.start, "start");
+    // (An instanced program's start has its hidden parameter: `start(instance: f32)`.)
+    if (!m.start.emits.empty() || m.start.kernel.size() > 0 || !m.start.params.empty())
+        trigger(m.start, m.start.params.empty() ? std::string("start") : fmt::format("start({})", params(m.start.params)));
     return out;
 }
 

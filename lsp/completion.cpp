@@ -1,7 +1,8 @@
 // Completion: what may be written at the cursor. After `name.`, what an enclosing object
 // offers to be read live, or a vector's components; after `@`, the attributes; inside
 // `@integrator(`, the methods; elsewhere the names in scope (the object's, fn's or
-// trigger's own, then the file's), the built-ins and the keywords — in a fn's body only
+// trigger's own, then the file's), the built-ins (`instance` and, after `instance.`, its
+// members) and the keywords — in a fn's body only
 // what a fn may read (no age, time or dt, no externs, objects or triggers, no history).
 #include <cctype>
 #include <set>
@@ -32,6 +33,8 @@ std::vector<Name> builtinNames() {
         names.push_back({std::string(c.name), c.type.str(), "built-in constant", CompletionKind::Constant});
     for (std::string_view v : builtinVariables())
         names.push_back({std::string(v), "float", "built-in variable", CompletionKind::Variable});
+    names.push_back({std::string(kInstanceName), "instance", "the instance the object belongs to: instance.pos, …",
+                     CompletionKind::Variable});
     for (std::string_view t : Type::names()) names.push_back({std::string(t), "type", "", CompletionKind::TypeParameter});
     return names;
 }
@@ -40,6 +43,7 @@ std::vector<Name> builtinNames() {
 bool impure(const Name& n) {
     if (n.kind == CompletionKind::Class || n.kind == CompletionKind::Event) return true;
     if (n.detail.starts_with("extern ")) return true;
+    if (n.label == kInstanceName && n.detail == "instance") return true;
     if (n.kind == CompletionKind::Variable && isBuiltinVariable(n.label) && n.documentation == "built-in variable") return true;
     int f = n.kind == CompletionKind::Function ? findBuiltinFunction(n.label) : -1;
     return f >= 0 && n.documentation == "built-in function" && isTemporal(builtinFunction(f).rule);
@@ -115,6 +119,10 @@ nlohmann::json completion(const Analysis& a, const std::string& text, uint32_t o
         std::string base = text.substr(baseStart, start - 1 - baseStart);
         for (const auto& [object, members] : a.members)
             if (object == base) names = members;
+        if (names.empty() && base == kInstanceName)  // the instance an object belongs to
+            for (const InstanceMember& m : instanceMembers())
+                names.push_back({std::string(m.name), m.width == 1 ? "float" : "vec3", std::string(m.meaning),
+                                 CompletionKind::Field});
         if (names.empty())
             if (int width = a.parsed ? vectorWidth(a, base, offset) : 0) names = swizzles(width);
     } else if (start > 0 && text[start - 1] == '@') {

@@ -196,8 +196,14 @@ public:
         if (width == 1) return py::float_(v[0]);
         return py::tuple(py::cast(std::vector<float>(v, v + width)));
     }
-    void fire(const std::string& trigger, py::args args) {
+    void fire(const std::string& trigger, py::args args, py::kwargs kwargs) {
         auto held = hold();
+        std::optional<uint64_t> instance;
+        for (auto [key, value] : kwargs) {
+            if (key.cast<std::string>() != "instance")
+                raise(PyExc_TypeError, "fire() takes the trigger's arguments and instance=, not " + key.cast<std::string>() + "=");
+            instance = value.cast<uint64_t>();
+        }
         std::vector<float> all;
         for (py::handle a : args) {
             std::vector<float> v = floats(py::reinterpret_borrow<py::object>(a), "fire");
@@ -211,7 +217,59 @@ public:
             raiseAs(valueTypeType(), "fire: trigger `" + trigger + "` takes (" + in.type + "): " +
                                          std::to_string(in.values) + " numbers, not " + std::to_string(all.size()) +
                                          " in " + reprOf(args));
-        check(psys_fire(s_, trigger.c_str(), all.data(), all.size()));
+        if (instance) check(psys_instance_fire(s_, *instance, trigger.c_str(), all.data(), all.size()));
+        else check(psys_fire(s_, trigger.c_str(), all.data(), all.size()));
+    }
+    // Instances (docs/embedding.md, "Instances"): handles are ints.
+    static std::vector<float> transformOf(const py::object& transform) {
+        if (transform.is_none()) return {};
+        std::vector<float> m = floats(py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(transform)
+                                          .attr("T").attr("ravel")(),
+                                      "transform");
+        if (m.size() != 16)
+            raiseAs(valueTypeType(), "a transform is a 4×4 matrix (rows of columns, as NumPy prints it), not " +
+                                         reprOf(transform));
+        return m;
+    }
+    uint64_t play(const py::object& transform) {
+        auto held = hold();
+        std::vector<float> m = transformOf(transform);
+        psys_instance h = 0;
+        check(psys_play(open(), m.empty() ? nullptr : m.data(), &h));
+        return h;
+    }
+    void move(uint64_t instance, const py::object& transform) {
+        auto held = hold();
+        std::vector<float> m = transformOf(transform);
+        check(psys_instance_transform(open(), instance, m.empty() ? nullptr : m.data()));
+    }
+    void stop(uint64_t instance) {
+        auto held = hold();
+        check(psys_instance_stop(open(), instance));
+    }
+    void kill(uint64_t instance) {
+        auto held = hold();
+        check(psys_instance_kill(open(), instance));
+    }
+    std::string life(uint64_t instance) const {
+        auto held = hold();
+        switch (psys_instance_life(open(), instance)) {
+            case PSYS_PLAYING: return "playing";
+            case PSYS_STOPPED: return "stopped";
+            case PSYS_KILLED: return "killed";
+            case PSYS_FINISHED: break;
+        }
+        return "finished";
+    }
+    size_t instanceCount() const {
+        auto held = hold();
+        return psys_instance_count(open());
+    }
+    std::vector<uint64_t> finishedInstances() const {
+        auto held = hold();
+        std::vector<uint64_t> out(psys_finished_instances(open(), nullptr, 0));
+        psys_finished_instances(s_, out.data(), out.size());
+        return out;
     }
     void reserve(const py::object& type, size_t rows) {
         auto held = hold();
@@ -337,6 +395,7 @@ public:
         for (int k = 0; k < 3; ++k) add(xyz[k], d.position[k], false);
         for (int k = 0; k < 4; ++k) add(rgba[k], d.color[k], false);
         add("size", d.size, false);
+        add("instance", d.instance, false);
         return out;
     }
 
@@ -365,6 +424,7 @@ public:
         auto rows = static_cast<py::ssize_t>(n);
         py::array_t<uint32_t> id(rows);
         py::array_t<float> position({rows, py::ssize_t{3}}), color({rows, py::ssize_t{4}}), size(rows);
+        py::dict out;
         uint32_t* ids = id.mutable_data();
         float *xyz = position.mutable_data(), *rgba = color.mutable_data(), *sizes = size.mutable_data();
         if (onGpu) {
@@ -386,7 +446,17 @@ public:
                 ++i;
             }
         }
-        py::dict out;
+        // Each point's instance (0 where the program is not instanced, and on the glsl
+        // backend, which plays none).
+        py::array_t<float> instance(rows);
+        float* slots = instance.mutable_data();
+        if (!onGpu && d.instance.data) {
+            for (size_t row = 0, i = 0; row < d.rows; ++row)
+                if (value(d.visible, row) == 1.0f) slots[i++] = value(d.instance, row);
+        } else {
+            std::fill(slots, slots + n, 0.0f);
+        }
+        out["instance"] = instance;
         out["id"] = id;
         out["position"] = position;
         out["color"] = color;
@@ -513,7 +583,8 @@ PYBIND11_MODULE(_psys, m) {
              "Advances every object by dt seconds, `steps` times.")
         .def("set", &System::set, py::arg("extern"), py::arg("value"), "Sets an extern: a number or a sequence.")
         .def("get", &System::get, py::arg("extern"), "An extern's value (a float or a tuple).")
-        .def("fire", &System::fire, py::arg("trigger"), "Fires a trigger with its arguments (numbers or sequences).")
+        .def("fire", &System::fire, py::arg("trigger"),
+             "Fires a trigger with its arguments (numbers or sequences); instance=H fires it on one instance.")
         .def("reload", &System::reload, py::arg("source") = py::none(),
              "Compiles the file again (or `source`); the running objects carry over.")
         .def("columns", &System::columns, py::arg("type"),
@@ -521,6 +592,15 @@ PYBIND11_MODULE(_psys, m) {
         .def("points", &System::points, py::arg("type"), "The drawn points, copied: id, position, color, size.")
         .def("positions", &System::positions, py::arg("type"), "The drawn points' positions, copied: an n×3 array.")
         .def("stats", &System::stats)
+        .def("play", &System::play, py::arg("transform") = py::none(),
+             "Plays the effect again (an instanced program): a 4×4 affine transform (None: the identity); "
+             "returns the instance's handle.")
+        .def("move", &System::move, py::arg("instance"), py::arg("transform"), "Sets an instance's transform.")
+        .def("stop", &System::stop, py::arg("instance"), "The instance emits no more; what it made lives on.")
+        .def("kill", &System::kill, py::arg("instance"), "The instance's objects die at the next step.")
+        .def("life", &System::life, py::arg("instance"), "'playing', 'stopped', 'killed' or 'finished'.")
+        .def_property_readonly("instance_count", &System::instanceCount)
+        .def("finished_instances", &System::finishedInstances, "The instances that finished in the latest step.")
         .def("reserve", &System::reserve, py::arg("type"), py::arg("rows"),
              "Room for `rows` objects of `type` made now: steps up to that many take nothing more.")
         .def("prewarm", &System::prewarm, py::arg("seconds"), py::arg("longest_step") = 0.1,

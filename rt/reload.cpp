@@ -142,6 +142,12 @@ ReloadReport System::carryOver(const System& oldSystem) {
         if (j >= 0 && old.module.externs[static_cast<size_t>(j)].type == s.module.externs[e].type)
             s.externs[e] = old.externs[static_cast<size_t>(j)];
     }
+    if (s.module.instanced() && old.module.instanced()) {  // the instances play on: slots, lives, transforms
+        s.growInstances(old.instances.size());
+        s.instances = old.instances;
+        const Value* records = old.externs.data() + old.module.externs.size() + 1;
+        std::copy(records, records + core::kInstanceRecordValues * old.instances.size(), s.instanceRecords());
+    }
     ++s.externsVersion;
     std::vector<int> oldTypeOf(s.pools.size(), -1);
     std::vector<bool> kept(old.pools.size(), false);

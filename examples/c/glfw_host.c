@@ -1,12 +1,14 @@
-/* A host that embeds a system and draws it with OpenGL in a GLFW window: the draw columns
+/* A host that embeds systems and draws them with OpenGL in a GLFW window: the draw columns
  * become vertex attributes — uploaded from the system's arrays on the CPU backends, bound
  * as they are on the glsl backend (the system computes in the window's GL context, and
  * nothing is read back).
  *
- *   glfw_host FILE [--backend llvm|interp|glsl] [--frames N] [--png OUT.png]
+ *   glfw_host FILE... [--backend llvm|interp|glsl] [--frames N] [--png OUT.png] [--play N]
  *
- * Space fires the program's first trigger (with zeros); Escape quits. --frames stops after
- * N frames (and --png saves the last one).
+ * Each FILE is a system of its own (up to 4). --play N plays N instances of each (an
+ * instanced program: docs/embedding.md, "Instances") on a turning ring, moved every frame,
+ * each played again where it is when it finishes. Space fires each program's first trigger
+ * (with zeros); Escape quits. --frames stops after N frames (and --png saves the last one).
  */
 #include <math.h>
 #include <stdio.h>
@@ -148,13 +150,42 @@ static void savePng(const char* path, int width, int height) {
 
 static void parseVec3(const char* text, float out[3]) { sscanf(text, "%f,%f,%f", &out[0], &out[1], &out[2]); }
 
+enum { kMostFiles = 4, kMostInstances = 1024 };
+
+/* Where instance j of the `n` of system k is at time t: on a ring of its own for each
+ * system, turning, tilted a little (a rotation about z: a transform in columns). */
+static void placement(int k, int j, int n, double t, float out[16]) {
+    float ring = 3.0f + 2.0f * (float)k, a = 6.2831853f * (float)j / (float)n + (float)t * (k % 2 ? -0.3f : 0.4f);
+    float tilt = 0.3f * sinf(a * 2.0f), c = cosf(tilt), s = sinf(tilt);
+    float m[16] = {c, s, 0, 0, -s, c, 0, 0, 0, 0, 1, 0, ring * cosf(a), 2.0f + 1.5f * (float)k, ring * sinf(a), 1};
+    memcpy(out, m, sizeof m);
+}
+
+/* The instances of system k, moved to where they are at time t; those that finished in
+ * the last step played again. */
+static int playInstances(psys_system* sys, int k, psys_instance* played, int n, double t) {
+    psys_instance done[kMostInstances];
+    size_t finished = psys_finished_instances(sys, done, kMostInstances), f;
+    float m[16];
+    int j;
+    for (j = 0; j < n; ++j) {
+        int again = played[j] == 0;
+        for (f = 0; f < finished && !again; ++f) again = done[f] == played[j];
+        placement(k, j, n, t, m);
+        if (again ? failed(psys_play(sys, m, &played[j])) : failed(psys_instance_transform(sys, played[j], m)))
+            return 1;
+    }
+    return 0;
+}
+
 int main(int argc, char** argv) {
-    const char *file = NULL, *png = NULL;
+    const char *files[kMostFiles], *png = NULL;
     long frames = -1, frame;
     float eye[3] = {0, 4, 13}, at[3] = {0, 3.5f, 0}, viewProjection[16];
-    int i, width = 960, height = 540, status = 0;
+    int i, k, width = 960, height = 540, status = 0, count = 0, instances = 0;
     psys_options options;
-    psys_system* sys = NULL;
+    psys_system* sys[kMostFiles] = {NULL};
+    static psys_instance played[kMostFiles][kMostInstances];
     GLFWwindow* window;
     GLuint shaders, vao, staging[kAttributes];
 
@@ -165,11 +196,12 @@ int main(int argc, char** argv) {
         else if (!strcmp(argv[i], "--png") && i + 1 < argc) png = argv[++i];
         else if (!strcmp(argv[i], "--eye") && i + 1 < argc) parseVec3(argv[++i], eye);
         else if (!strcmp(argv[i], "--at") && i + 1 < argc) parseVec3(argv[++i], at);
-        else file = argv[i];
+        else if (!strcmp(argv[i], "--play") && i + 1 < argc) instances = atoi(argv[++i]);
+        else if (count < kMostFiles) files[count++] = argv[i];
     }
-    if (!file) {
-        fprintf(stderr, "usage: glfw_host FILE [--backend llvm|interp|glsl] [--frames N] [--png OUT.png] "
-                        "[--eye X,Y,Z] [--at X,Y,Z]\n");
+    if (count == 0 || instances < 0 || instances > kMostInstances) {
+        fprintf(stderr, "usage: glfw_host FILE... [--backend llvm|interp|glsl] [--frames N] [--png OUT.png] "
+                        "[--eye X,Y,Z] [--at X,Y,Z] [--play N (at most %d)]\n", kMostInstances);
         return 2;
     }
     if (!glfwInit()) {
@@ -191,9 +223,14 @@ int main(int argc, char** argv) {
     glfwMakeContextCurrent(window);
     glfwSwapInterval(1);
 
-    if (failed(psys_compile_file(file, &options, &sys))) {
-        glfwTerminate();
-        return 1;
+    for (k = 0; k < count; ++k) {
+        if (failed(psys_compile_file(files[k], &options, &sys[k]))) {
+            status = 1;
+            break;
+        }
+        /* The host plays them all: the system's own instance goes before it starts. */
+        if (instances > 0 && (failed(psys_instance_kill(sys[k], 0)) || playInstances(sys[k], k, played[k], instances, 0)))
+            status = 1;
     }
     shaders = program();
     glCreateVertexArrays(1, &vao);
@@ -202,36 +239,40 @@ int main(int argc, char** argv) {
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
 
-    for (frame = 0; !glfwWindowShouldClose(window) && (frames < 0 || frame < frames); ++frame) {
+    for (frame = 0; !status && !glfwWindowShouldClose(window) && (frames < 0 || frame < frames); ++frame) {
         glfwPollEvents();
         if (glfwGetKey(window, GLFW_KEY_ESCAPE) == GLFW_PRESS) break;
-        if (glfwGetKey(window, GLFW_KEY_SPACE) == GLFW_PRESS && psys_trigger_count(sys) > 0) {
-            psys_input trigger;
-            float zeros[16] = {0};
-            psys_trigger_info(sys, 0, &trigger);
-            if (trigger.values <= 16) failed(psys_fire(sys, trigger.name, zeros, trigger.values));
-        }
-        if (failed(psys_step(sys, 1.0 / 60))) {
-            status = 1;
-            break;
-        }
         glfwGetFramebufferSize(window, &width, &height);
         glViewport(0, 0, width, height);
         glClearColor(0.02f, 0.02f, 0.04f, 1);
         glClear(GL_COLOR_BUFFER_BIT);
-        glUseProgram(shaders);
         camera((float)width / (float)(height > 0 ? height : 1), eye, at, viewProjection);
-        glUniformMatrix4fv(glGetUniformLocation(shaders, "view_projection"), 1, GL_FALSE, viewProjection);
-        glUniform1f(glGetUniformLocation(shaders, "pixels"), (float)height);
-        if (draw(sys, shaders, vao, staging)) {
-            status = 1;
-            break;
+        for (k = 0; k < count && !status; ++k) {
+            if (glfwGetKey(window, GLFW_KEY_SPACE) == GLFW_PRESS && psys_trigger_count(sys[k]) > 0) {
+                psys_input trigger;
+                float zeros[16] = {0};
+                psys_trigger_info(sys[k], 0, &trigger);
+                if (trigger.values <= 16) failed(psys_fire(sys[k], trigger.name, zeros, trigger.values));
+            }
+            if (failed(psys_step(sys[k], 1.0 / 60)) ||
+                (instances > 0 && playInstances(sys[k], k, played[k], instances, psys_time(sys[k])))) {
+                status = 1;
+                break;
+            }
+            glUseProgram(shaders);
+            glUniformMatrix4fv(glGetUniformLocation(shaders, "view_projection"), 1, GL_FALSE, viewProjection);
+            glUniform1f(glGetUniformLocation(shaders, "pixels"), (float)height);
+            if (draw(sys[k], shaders, vao, staging)) status = 1;
         }
         if (png && frames >= 0 && frame == frames - 1) savePng(png, width, height);
         glfwSwapBuffers(window);
     }
-    printf("glfw_host: %ld frames of %s on %s\n", frame, file, options.backend);
-    psys_system_free(sys); /* with its context current: its GL objects go with it */
+    for (k = 0; k < count; ++k) {
+        printf("glfw_host: %ld frames of %s on %s", frame, files[k], options.backend);
+        if (instances > 0 && sys[k]) printf(", %zu instances playing", psys_instance_count(sys[k]));
+        printf("\n");
+        psys_system_free(sys[k]); /* with its context current: its GL objects go with it */
+    }
     glDeleteBuffers(kAttributes, staging);
     glDeleteVertexArrays(1, &vao);
     glDeleteProgram(shaders);

@@ -6,6 +6,11 @@
     drops = fountain.points("drop")                           # id, position (n×3), color, size
     cols = fountain.columns("drop")                           # visible, id, x y z, r g b a, size (copies)
 
+An instanced program (one that reads `instance`) plays many times in one system:
+`h = s.play(m)` with a 4×4 transform, `s.move(h, m)`, `s.stop(h)`, `s.kill(h)`,
+`s.life(h)`, `s.fire(name, *args, instance=h)`, `s.finished_instances()` after a step;
+`points()` and `columns()` give each row's instance.
+
 Errors are exceptions: psys.CompileError carries the compiler's diagnostics (a list of
 dicts: severity, file, line, column, end_line, end_column, message); an unknown extern,
 trigger or type is psys.UnknownNameError (a KeyError), a value of the wrong size

@@ -322,3 +322,63 @@ def test_a_close_from_another_thread_waits_for_the_step_it_would_cut_short():
     s.close()  # waits for the 40 steps (freed under them, the step would read freed memory)
     worker.join()
     assert s.closed
+
+
+HIT = """
+object spark(v: vec3) {
+    pos = snapshot(instance.pos) + integrate(v);
+    point(pos, white, 2);
+    kill when age > 0.5;
+}
+object hit {
+    emit spark(nrand3()) at 120 per second;
+    kill when age > 0.3;
+}
+trigger burst(n: float) { emit hit count n; }
+spawn hit;
+"""
+
+
+def test_instances_play_at_their_transforms_and_finish():
+    s = psys.compile(source=HIT)
+    s.kill(0)  # the system's own: the host plays them all
+    places = {}
+    for k in range(4):
+        m = np.eye(4, dtype=np.float32)
+        m[:3, 3] = (10 * k, 0, 0)  # NumPy's rows and columns: the translation is the last column
+        places[s.play(m)] = 10 * k
+    s.step(1 / 60, steps=6)
+    assert s.instance_count == 4
+    p = s.points("spark")
+    assert set(np.unique(p["instance"]).astype(int)) == {h & 0xFFFFFFFF for h in places}
+    for h, x in places.items():
+        mine = p["position"][p["instance"] == (h & 0xFFFFFFFF)]
+        assert len(mine) > 5 and np.abs(mine[:, 0] - x).max() < 1
+    first = next(iter(places))
+    s.fire("burst", 2, instance=first)
+    s.stop(first)
+    assert s.life(first) == "stopped"
+    finished = []
+    for _ in range(120):
+        s.step(1 / 60)
+        finished += s.finished_instances()
+    assert sorted(finished) == sorted(places)
+    assert s.life(first) == "finished" and s.instance_count == 0
+    with pytest.raises(psys.Error, match="has finished"):
+        s.move(first, np.eye(4))
+    with pytest.raises(psys.Error, match="affine"):
+        s.play(np.ones((4, 4)))
+    with pytest.raises(psys.ValueTypeError, match="4×4"):
+        s.play([1, 2, 3])
+    with pytest.raises(psys.Error, match="not instanced"):
+        psys.compile(source=DOTS).play()
+
+
+def test_the_instances_example_plays_two_effects_and_plots_them(tmp_path):
+    out = tmp_path / "instances.png"
+    r = subprocess.run([sys.executable, EXAMPLES / "python" / "instances.py", EXAMPLES / "effects" / "burst.psys",
+                        EXAMPLES / "effects" / "halo.psys", out, "--play", "20", "--seconds", "1.5"],
+                       capture_output=True, text=True, check=True)
+    assert "[20, 20] instances playing" in r.stdout
+    assert int(r.stdout.split("instances playing, ")[1].split()[0]) >= 20  # the bursts, again
+    assert out.stat().st_size > 10_000

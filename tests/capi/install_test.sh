@@ -19,7 +19,7 @@ exported() { nm -D --defined-only "$1" | awk '$2 != "A" && $2 ~ /^[A-Zu]$/ {prin
 for name in psys psys_runtime; do
   real=$(readlink -f "$prefix/lib/lib$name.so")
   soname=$(objdump -p "$real" | awk '/SONAME/ {print $2}')
-  [ "$soname" = "lib$name.so.0.2" ] || { echo "soname: $soname, not lib$name.so.0.2"; exit 1; }
+  [ "$soname" = "lib$name.so.0.3" ] || { echo "soname: $soname, not lib$name.so.0.3"; exit 1; }
   others=$(exported "$real" | grep -v '^psys_' || true)
   if [ -n "$others" ]; then
     echo "lib$name.so exports more than the C API:"; echo "$others" | head -20; exit 1
@@ -82,5 +82,14 @@ if command -v xvfb-run > /dev/null; then
     echo "glfw_host on $backend: $lit pixels lit"
     [ "$lit" -gt 1000 ] || { echo "glfw_host drew too little on $backend"; exit 1; }
   done
+  # 200 instances of two effects on turning rings, each played again as it finishes.
+  xvfb-run -a -s "-screen 0 1280x720x24" "$work/examples/glfw_host" "$src/examples/effects/burst.psys" \
+    "$src/examples/effects/halo.psys" --play 100 --frames 150 --eye 0,6,10 --at 0,2.5,0 --png "$work/instances.png" \
+    | tee "$work/instances.out"
+  [ "$(grep -c ', 100 instances playing' "$work/instances.out")" = 2 ] || { echo "glfw_host --play: not 2 × 100"; exit 1; }
+  lit=$(/usr/bin/python3 -c "import matplotlib.image as m, sys; p = m.imread(sys.argv[1]); print(int((p[:, :, :3].max(axis=2) > 0.3).sum()))" \
+        "$work/instances.png")
+  echo "glfw_host --play 100: $lit pixels lit"
+  [ "$lit" -gt 2000 ] || { echo "glfw_host --play drew too little"; exit 1; }
 fi
 echo "installed package: ok"

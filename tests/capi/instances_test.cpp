@@ -171,7 +171,7 @@ TEST_CASE("instances: kill takes its objects at the next step and creates nothin
     CHECK(psys_instance_life(e.s, a) == PSYS_FINISHED);
 }
 
-TEST_CASE("instances: a trigger fired on an instance creates for it; hosts see the trigger's own parameters") {
+TEST_CASE("instances: a trigger fired on an instance creates for it, and hosts see the trigger's own parameters") {
     Effect e(kHit, "llvm");
     psys_input in;
     REQUIRE(psys_trigger_info(e.s, 0, &in) == 0);
@@ -253,4 +253,26 @@ TEST_CASE("instances: the glsl backend refuses an instanced program with a worde
     CHECK(m.find("internal error") == std::string::npos);
     CHECK(s == nullptr);
     psys_system_free(s);
+}
+
+TEST_CASE("instances: a hot reload keeps the instances playing where they were") {
+    Effect e(kHit, "llvm");
+    auto far = translation(30, 0, 0);
+    psys_instance a = 0;
+    REQUIRE(message(psys_play(e.s, far.data(), &a)) == "");
+    e.step(5);
+    std::string edited = kHit;
+    edited.replace(edited.find("point(pos, red, 1)"), std::string("point(pos, red, 1)").size(), "point(pos, blue, 1)");
+    REQUIRE(message(psys_reload(e.s, edited.c_str())) == "");
+    CHECK(psys_instance_life(e.s, a) == PSYS_PLAYING);
+    CHECK(psys_instance_count(e.s) == 2);
+    e.step();
+    auto rings = rowsBySlot(e.s, 1);
+    REQUIRE(rings.count(static_cast<int>(a & 0xffffffffu)) == 1);
+    for (auto& p : rings[static_cast<int>(a & 0xffffffffu)]) CHECK(std::abs(p[0] - 30) <= 1.0001f);
+    auto moved = translation(-30, 0, 0);
+    REQUIRE(message(psys_instance_transform(e.s, a, moved.data())) == "");
+    e.step();
+    rings = rowsBySlot(e.s, 1);
+    for (auto& p : rings[static_cast<int>(a & 0xffffffffu)]) CHECK(std::abs(p[0] + 30) <= 1.0001f);
 }

@@ -57,7 +57,13 @@ TEST_CASE("hash-consing merges equal instructions and orders commutative operand
 
 TEST_CASE("every sample's IR prints, parses back and prints the same, before and after the passes") {
     int count = 0;
-    for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
+    // (The examples' effects too: instanced programs, their hidden parameters and lookups.)
+    std::vector<std::filesystem::directory_entry> files;
+    for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) files.push_back(entry);
+    for (auto& entry :
+         std::filesystem::directory_iterator(std::filesystem::path(PSYS_SAMPLES_DIR).parent_path() / "examples" / "effects"))
+        files.push_back(entry);
+    for (auto& entry : files) {
         if (entry.path().extension() != ".psys") continue;
         ++count;
         auto c = test::check(test::readFile(entry.path().string()), entry.path().string());

@@ -118,7 +118,7 @@ std::string header(const ir::Module& m, const BuildOptions& o, const std::string
         std::string list, types;
         std::vector<std::string> values;
         std::set<std::string> used = {"system", "v"};
-        for (const ir::Param& p : t.params) {
+        for (const ir::Param& p : t.hostParams()) {
             parameters(p.type, p.name, list, values, used);
             types += (types.empty() ? "" : ", ") + p.name + ": " + rt::languageName(p);
         }
@@ -183,7 +183,8 @@ int buildSystem(const BuildOptions& o) {
         return 1;
     }
     std::string glsl;
-    if (o.glsl)
+    const bool shaders = o.glsl && !module->instanced();  // (the glsl backend plays no instances yet)
+    if (shaders)
         for (const auto& shader : codegen_glsl::moduleShaders(rt::launchPlan(*module)))
             glsl += "//// " + shader.name + "\n" + shader.source + "\n";
     std::vector<std::string> cpus;
@@ -203,7 +204,8 @@ int buildSystem(const BuildOptions& o) {
     }
     if (!write(o.output + ".a", object.bytes) || !write(o.output + ".h", header(*module, o, name, object))) return 1;
     std::cout << fmt::format("wrote {0}.a ({1} kernels for {2} {3}, {4} bytes{5}) and {0}.h\n", o.output, object.kernels,
-                             fmt::join(object.cpus, ", "), object.triple, object.bytes.size(), o.glsl ? "" : ", no shaders");
+                             fmt::join(object.cpus, ", "), object.triple, object.bytes.size(),
+                             shaders ? "" : o.glsl ? ", no shaders: the glsl backend does not play instances yet" : ", no shaders");
     if (!object.calls.empty()) std::cout << fmt::format("it calls: {}\n", fmt::join(object.calls, " "));
     return 0;
 }

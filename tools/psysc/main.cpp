@@ -185,6 +185,10 @@ int printGlsl(const std::string& file, const psys::CompileOptions& options, bool
     auto module = psys::compileFile(file, sources, diags, options);
     diags.print(std::cerr, colour);
     if (!module) return 1;
+    if (module->instanced()) {
+        std::cerr << "psysc: error: " << psys::core::kNoInstances << "\n";
+        return 1;
+    }
     for (const auto& shader : psys::codegen_glsl::moduleShaders(psys::rt::launchPlan(*module)))
         std::cout << "//// " << shader.name << "\n" << shader.source << "\n";
     return 0;

@@ -199,10 +199,10 @@ void Panel::triggers() {
         ImGui::PushID(t.name.c_str());
         std::vector<float>& args = args_[t.name];
         size_t width = 0;
-        for (const ir::Param& p : t.params) width += static_cast<size_t>(p.type.width);
+        for (const ir::Param& p : t.hostParams()) width += static_cast<size_t>(p.type.width);
         args.resize(width, 0);
         size_t at = 0;
-        for (const ir::Param& p : t.params) {
+        for (const ir::Param& p : t.hostParams()) {
             float* x = args.data() + at;
             switch (p.type.width) {
                 case 1: ImGui::DragFloat(p.name.c_str(), x, 0.05f); break;

@@ -287,7 +287,7 @@ void Viewer::key(int key, bool shift) {
                 if (index < triggers.size()) {
                     std::vector<float> args = panel_ ? panel_->triggerArgs(index) : std::vector<float>{};
                     if (args.empty())
-                        for (const ir::Param& p : triggers[index].params) args.resize(args.size() + static_cast<size_t>(p.type.width), 0);
+                        for (const ir::Param& p : triggers[index].hostParams()) args.resize(args.size() + static_cast<size_t>(p.type.width), 0);
                     fire(triggers[index].name, args);
                 }
             }
