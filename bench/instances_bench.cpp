@@ -36,6 +36,15 @@ std::string plainProgram() {  // the same without `instance`: one system as it w
     return s;
 }
 
+// The plain program with `n` emitters made by a root at the start: what 1,000 emitters
+// cost without instances (the emission per emitter is the same).
+std::string manyEmitters(int n) {
+    std::string s = plainProgram();
+    s.replace(s.find("spawn emitter;"), std::strlen("spawn emitter;"),
+              "object root { emit emitter count " + std::to_string(n) + "; }\nspawn root;");
+    return s;
+}
+
 double seconds() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -58,11 +67,14 @@ psys_system* compile(const std::string& source, unsigned threads) {
 struct Run {
     double median = 0;  // seconds a step
     size_t live = 0;
+    double update = 0, emit = 0, create = 0;  // of the measured steps, a step's (the stats')
 };
 
 // Runs 90 frames to fill the pools, then measures `frames`.
 Run measure(psys_system* s, int frames) {
     for (int f = 0; f < 90; ++f) check(psys_step(s, 1.0 / 60));
+    psys_stats before, after;
+    check(psys_get_stats(s, &before));
     std::vector<double> t;
     for (int f = 0; f < frames; ++f) {
         double a = seconds();
@@ -72,7 +84,9 @@ Run measure(psys_system* s, int frames) {
     std::sort(t.begin(), t.end());
     psys_type_stats st;
     check(psys_get_type_stats(s, 0, &st));
-    return {t[t.size() / 2], st.live};
+    check(psys_get_stats(s, &after));
+    return {t[t.size() / 2], st.live, (after.update_seconds - before.update_seconds) / frames,
+            (after.emit_seconds - before.emit_seconds) / frames, (after.create_seconds - before.create_seconds) / frames};
 }
 
 }  // namespace
@@ -101,6 +115,11 @@ int main(int argc, char** argv) {
     Run p = measure(plain, frames);
     psys_system_free(plain);
 
+    psys_system* emitters = compile(manyEmitters(instances), threads);
+    check(psys_set_extern(emitters, "rate", &per, 1));
+    Run e = measure(emitters, frames);
+    psys_system_free(emitters);
+
     psys_system* one = compile(kInstanced, threads);
     check(psys_set_extern(one, "rate", &total, 1));
     Run o = measure(one, frames);
@@ -124,11 +143,21 @@ int main(int argc, char** argv) {
     const double compileOne = seconds() - start;
     psys_system_free(fresh);
 
+    auto parts = [](const Run& r) {
+        std::printf("      update %.3f, emit %.3f, create %.3f ms a step (means)\n", r.update * 1e3, r.emit * 1e3,
+                    r.create * 1e3);
+    };
     std::printf("  one system, no `instance`     %8.3f ms a step  (%zu sparks)\n", p.median * 1e3, p.live);
+    parts(p);
+    std::printf("  %d emitters, no `instance`  %8.3f ms a step  (%zu sparks)  %.2f× the first\n", instances,
+                e.median * 1e3, e.live, e.median / p.median);
+    parts(e);
     std::printf("  one system, instanced         %8.3f ms a step  (%zu sparks)  %.2f× the first\n", o.median * 1e3,
                 o.live, o.median / p.median);
-    std::printf("  %d instances                %8.3f ms a step  (%zu sparks)  %.2f× the first\n", instances,
-                m.median * 1e3, m.live, m.median / p.median);
+    parts(o);
+    std::printf("  %d instances                %8.3f ms a step  (%zu sparks)  %.2f× the first, %.2f× the emitters\n",
+                instances, m.median * 1e3, m.live, m.median / p.median, m.median / e.median);
+    parts(m);
     std::printf("  starting an instance          %8.2f µs (a system compiled for it: %.1f ms, %.0f×)\n", play * 1e6,
                 compileOne * 1e3, compileOne / play);
     return 0;

@@ -63,26 +63,41 @@ void State::growInstances(size_t slots) {
     }
 }
 
-// Counts each slot's live objects in the pools' hidden `instance` columns; a slot still
-// playing, stopped or killed with none finishes. Only where the host addresses the pools
-// (the CPU's memory: the glsl backend refuses instanced programs).
+// Marks the slots that still have a live object in the pools' hidden `instance` columns;
+// a slot playing, stopped or killed with none finishes. The scan stops once every slot
+// that may finish is marked — in a steady state after a few rows a slot, not the pools'
+// every row; it reads them all only in a step where some instance has none left. Only
+// where the host addresses the pools (the CPU's memory: the glsl backend refuses
+// instanced programs).
 void State::finishInstances() {
     finishedInstances.clear();
     if (!module.instanced() || !memory.hostResident()) return;
     ledger.settle(Wait::No);  // what is ready: else a step late
-    instanceLive.assign(instances.size(), 0);
-    const float last = static_cast<float>(instances.size() - 1);
-    for (Pool& pool : pools) {
+    const auto slots = static_cast<uint32_t>(instances.size());
+    instanceLive.assign(slots, 0);
+    uint32_t* seen = instanceLive.data();
+    size_t unseen = 0;
+    for (uint32_t slot = 0; slot < slots; ++slot) {
+        if (instances[slot].life == InstanceLife::Finished) seen[slot] = 1;
+        else ++unseen;
+    }
+    const float last = static_cast<float>(slots - 1);
+    for (size_t t = 0; t < pools.size() && unseen > 0; ++t) {
+        Pool& pool = pools[t];
         const int column = pool.paramColumn.empty() ? -1 : pool.paramColumn.back();
         if (column < 0 || pool.live() == 0) continue;
         const float* instance = view<float>(pool.params.column(static_cast<size_t>(column), 0));
         const uint8_t* alive = view<uint8_t>(pool.alive.column);
-        for (size_t r = 0, rows = pool.rows(); r < rows; ++r)
-            if (alive[r]) ++instanceLive[static_cast<size_t>(std::clamp(instance[r], 0.0f, last))];
+        for (size_t r = 0, rows = pool.rows(); r < rows && unseen > 0; ++r) {
+            if (!alive[r]) continue;
+            // (A NaN fails every comparison: it marks slot 0, as core::instanceSlot reads it.)
+            auto slot = static_cast<uint32_t>(instance[r] >= 0 ? std::min(instance[r], last) : 0.0f);
+            if (!seen[slot]) seen[slot] = 1, --unseen;
+        }
     }
-    for (uint32_t slot = 0; slot < instances.size(); ++slot) {
+    for (uint32_t slot = 0; slot < slots; ++slot) {
         InstanceSlot& i = instances[slot];
-        if (i.life == InstanceLife::Finished || instanceLive[slot] > 0) continue;
+        if (i.life == InstanceLife::Finished || seen[slot]) continue;
         finishedInstances.push_back(handle(slot, i.generation));
         i.life = InstanceLife::Finished;
         ++i.generation;

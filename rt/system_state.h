@@ -170,7 +170,7 @@ struct State {
     // instances that finished in the last step and a step's counts (kept for their vectors).
     std::vector<InstanceSlot> instances;
     std::vector<InstanceHandle> finishedInstances;
-    std::vector<uint32_t> instanceLive;
+    std::vector<uint32_t> instanceLive;  // finishInstances: per slot, whether a live row was seen
     Value* instanceRecords() { return externs.data() + module.externs.size() + 1; }  // slot 0's first value
     // The table with room for `slots` slots (new ones free, their records the identity).
     void growInstances(size_t slots);
