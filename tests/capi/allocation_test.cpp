@@ -236,3 +236,39 @@ TEST_CASE("a steady-state step makes no heap allocation on an ahead-of-time buil
         CHECK(allocationsOfSteadySteps(s.sys, "population", 20000, 60, 300) == 0);
     }
 }
+
+TEST_CASE("a steady-state step of 50 instances moved every frame makes no heap allocation") {
+    for (const char* backend : {"llvm", "interp"}) {
+        CAPTURE(backend);
+        psys_options o = options(backend, "fast", 2);
+        Opened s;
+        const std::string halo = std::string(PSYS_EXAMPLES_DIR) + "/effects/halo.psys";
+        REQUIRE(take(psys_compile_file(halo.c_str(), &o, &s.sys)) == "");
+        REQUIRE(take(psys_instance_kill(s.sys, 0)) == "");
+        psys_instance played[50];
+        float m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        for (psys_instance& h : played) REQUIRE(take(psys_play(s.sys, m, &h)) == "");
+        int frame = 0;
+        auto run = [&](int frames) {
+            for (int f = 0; f < frames; ++f, ++frame) {
+                for (int i = 0; i < 50; ++i) {
+                    m[12] = static_cast<float>(i) + 0.01f * static_cast<float>(frame);
+                    REQUIRE(take(psys_instance_transform(s.sys, played[i], m)) == "");
+                }
+                REQUIRE(take(psys_step(s.sys, 1.0 / 60)) == "");
+                psys_draw draw;
+                for (size_t t = 0; t < psys_type_count(s.sys); ++t) REQUIRE(take(psys_get_draw(s.sys, t, &draw)) == "");
+                psys_instance done[4];  // (the system's own, killed, at the first step: no other)
+                CHECK(psys_finished_instances(s.sys, done, 4) == (frame == 0 ? 1u : 0u));
+            }
+        };
+        run(300);
+        reserveTwiceLive(s.sys);
+        run(60);
+        allocations = 0;
+        counting = true;
+        run(300);
+        counting = false;
+        CHECK(allocations.load() == 0);
+    }
+}
