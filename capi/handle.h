@@ -20,6 +20,8 @@ struct psys_system {
     std::vector<psys::capi::OwnedDiagnostic> warnings;  // of the latest compilation that took
     // The spelled types of externs and triggers (psys_input::type), made at each compilation.
     std::vector<std::string> externTypes, triggerTypes;
+    std::vector<std::string> eventNames;  // psys_event_name's
+    std::vector<float> events;             // psys_read_events': kept, so that reading them allocates nothing
     // The stats read last (psys_get_stats, psys_get_type_stats): kept, so that reading them
     // every frame allocates nothing.
     mutable psys::rt::Stats stats;

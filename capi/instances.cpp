@@ -1,5 +1,6 @@
-// The C API's instances (include/psys/psys.h, "Instances"): rt::System's, checked for
-// null arguments and with its refusals as errors.
+// The C API's instances and events (include/psys/psys.h, "Instances", "Events"):
+// rt::System's, checked for null arguments and with its refusals as errors.
+#include <algorithm>
 #include <span>
 
 #include "capi/error.h"
@@ -76,6 +77,27 @@ size_t psys_finished_instances(const psys_system* s, psys_instance* out, size_t 
     std::span<const rt::InstanceHandle> finished = s->system().finishedInstances();
     for (size_t i = 0; i < finished.size() && i < max && out; ++i) out[i] = finished[i];
     return finished.size();
+}
+
+size_t psys_event_count(const psys_system* s) { return s ? s->eventNames.size() : 0; }
+
+const char* psys_event_name(const psys_system* s, size_t index) {
+    return s && index < s->eventNames.size() ? s->eventNames[index].c_str() : nullptr;
+}
+
+psys_error* psys_read_events(psys_system* s, const char* name, float* out, size_t max, size_t* count, size_t* width) {
+    if (!s) return nullArgument("psys_read_events", "the system");
+    if (!name) return nullArgument("psys_read_events", "the event's name");
+    if (!out && max) return nullArgument("psys_read_events", "the events (out)");
+    return guarded("psys_read_events", [&]() -> psys_error* {
+        size_t w = 0;
+        if (psys_error* e = orError("psys_read_events", s->system().events(name, s->events, w))) return e;
+        const size_t n = w ? s->events.size() / w : 0;
+        if (count) *count = n;
+        if (width) *width = w;
+        if (out) std::copy_n(s->events.begin(), std::min(n, max) * w, out);
+        return nullptr;
+    });
 }
 
 }  // extern "C"

@@ -50,6 +50,7 @@ void psys_system::describe() {
     const psys::ir::Module& m = system().module();
     externTypes.clear();
     for (const psys::ir::Extern& e : m.externs) externTypes.push_back(rt::languageName(e));
+    eventNames = system().eventNames();
     triggerTypes.clear();
     for (const psys::ir::Trigger& t : m.triggers) {
         std::string types;

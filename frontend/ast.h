@@ -192,13 +192,14 @@ struct Attribute {
 
 // ---------------------------------------------------------------- commands
 
-enum class CommandKind { Draw, Kill, Emit, When, On };
+enum class CommandKind { Draw, Kill, Emit, When, On, Notify };
 
 struct Command {
     CommandKind kind;
     SourceRange range;
     SourceRange keywordRange;
-    std::vector<ExprPtr> args;   // a draw command's (point: pos, colour, size); emit: the child's arguments
+    std::vector<ExprPtr> args;   // a draw command's (point: pos, colour, size); emit: the child's arguments;
+                                 // notify: the event's values
     core::DrawKind draw = core::DrawKind::Point;  // a draw command's: point, sprite, streak or trail
     int trailPoints = 0;         // a trail's length, set by the checker where it is valid
     ExprPtr cond;                // kill when / when; null for a bare `kill;`
@@ -210,7 +211,7 @@ struct Command {
     ExprPtr count;  // `count N`; null means 1
     // when, on: the commands it guards
     std::vector<std::unique_ptr<Command>> body;
-    // on: the event (`death`)
+    // on: the event (`death`); notify: the event's name (the string's text)
     std::string event;
     SourceRange eventRange;
 };
@@ -326,6 +327,14 @@ struct Program {
     // Some expression reads `instance` (set by the checker): the program is played as
     // instances (core/instances.h).
     bool instanced = false;
+    // The events `notify` names, in the order they are first notified, with their values'
+    // types (set by the checker).
+    struct Event {
+        std::string name;
+        std::vector<Type> types;
+        SourceRange range;
+    };
+    std::vector<Event> events;
     const Module& main() const { return *modules.back(); }
 };
 

@@ -115,6 +115,12 @@ private:
                 line(depth, "on " + c.event, c.range);
                 for (auto& inner : c.body) command(*inner, depth + 1);
                 break;
+            case CommandKind::Notify: {
+                std::string s = "notify \"" + c.event + "\"(";
+                for (size_t i = 0; i < c.args.size(); ++i) s += (i ? ", " : "") + expr(*c.args[i]);
+                line(depth, s + ")", c.range);
+                break;
+            }
         }
     }
 

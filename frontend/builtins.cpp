@@ -99,7 +99,7 @@ constexpr BuiltinAttribute kAttributes[] = {
 };
 
 constexpr std::string_view kKeywords[] = {"import", "const", "fn", "let", "extern", "range", "trigger", "object",
-                                          "spawn", "point", "sprite", "streak", "trail", "kill", "when", "on", "emit", "at", "per", "second", "count",
+                                          "spawn", "point", "sprite", "streak", "trail", "kill", "when", "on", "emit", "notify", "at", "per", "second", "count",
                                           "if", "then", "else", "true", "false"};
 
 }  // namespace

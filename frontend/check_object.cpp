@@ -5,6 +5,7 @@
 // from the annotations, re-check all equations until no type changes (diagnostics held
 // back), then check once more with diagnostics on. A recursive equation whose width
 // nothing fixes defaults to float.
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <span>
@@ -333,8 +334,54 @@ void Checker::checkCommands(std::vector<CommandPtr>& commands, const Context& ct
                 break;
             }
             case CommandKind::On: checkOn(*cmd, ctx, point); break;
+            case CommandKind::Notify: checkNotify(*cmd, ctx); break;
         }
     }
+}
+
+// `notify "hit"(pos, speed)`: an event the host reads after the step, with its values
+// (docs/language.md, "Events"). Every `notify` of a name gives the same types.
+void Checker::checkNotify(Command& cmd, const Context& ctx) {
+    if (ctx.where != Where::Object && ctx.where != Where::Trigger) {
+        diags_.error(cmd.keywordRange, "`notify` belongs in an object or a trigger");
+        return;
+    }
+    bool named = !cmd.event.empty() && cmd.event.size() <= 64 && !std::isdigit(static_cast<unsigned char>(cmd.event[0]));
+    for (char c : cmd.event) named &= std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+    if (!named) {
+        diags_.error(cmd.eventRange, fmt::format("an event's name is letters, digits and `_` (up to 64, not starting "
+                                                 "with a digit), as a host spells it: not \"{}\"", cmd.event));
+        return;
+    }
+    std::vector<Type> types;
+    bool ok = true;
+    for (auto& a : cmd.args) {
+        Type t = check(*a, ctx);
+        if (t.isVague()) {
+            ok = false;
+        } else if (!t.isNumeric()) {
+            diags_.error(a->range, fmt::format("an event's values are numbers (float or vecN), not {}", t.str()));
+            ok = false;
+        }
+        types.push_back(t);
+    }
+    if (!ok) return;
+    for (ast::Program::Event& e : program_.events) {
+        if (e.name != cmd.event) continue;
+        if (e.types != types) {
+            auto list = [](const std::vector<Type>& ts) {
+                std::string out;
+                for (const Type& t : ts) out += (out.empty() ? "" : ", ") + t.str();
+                return "(" + out + ")";
+            };
+            diags_.error(cmd.range, fmt::format("event \"{}\" gives {} here and {} where it is first notified: a "
+                                                "host reads one layout an event",
+                                                cmd.event, list(types), list(e.types)))
+                .notes.push_back({e.range, "first notified here"});
+        }
+        return;
+    }
+    program_.events.push_back({cmd.event, types, cmd.range});
 }
 
 void Checker::checkAttributes(const std::vector<Attribute*>& attributes) {

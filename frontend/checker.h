@@ -94,6 +94,7 @@ private:
     void checkCommands(std::vector<ast::CommandPtr>& commands, const Context& ctx, const ast::Command** point);
     void checkEmit(ast::Command& emit, const Context& ctx);
     void checkOn(ast::Command& on, const Context& ctx, const ast::Command** point);
+    void checkNotify(ast::Command& cmd, const Context& ctx);
     void checkDraw(ast::Command& draw, const Context& ctx, const ast::Command** point);
     void checkTrailLength(ast::Command& trail, const ast::Expr& length);
     void checkTexture(ast::Attribute& texture, const Context& ctx);

@@ -107,7 +107,8 @@ bool endsOperand(const Atom& token) {
 
 // Keywords that a `(` follows without a space, as a call's name does.
 bool takesArguments(const Atom& token) {
-    return token.type == PsysLexer::IDENT || token.text == "point" || token.text == "sprite" ||
+    // (A string before `(` is an event's name: `notify "hit"(pos)`.)
+    return token.type == PsysLexer::IDENT || token.type == PsysLexer::STRING || token.text == "point" || token.text == "sprite" ||
            token.text == "streak" || token.text == "trail" || token.text == "range";
 }
 

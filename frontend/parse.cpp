@@ -236,6 +236,12 @@ private:
             if (e->argList()) c->args = args(e->argList());
             if (e->emitRate()) c->rate = expr(e->emitRate()->expr());
             if (e->emitCount()) c->count = expr(e->emitCount()->expr());
+        } else if (auto* n = dynamic_cast<PsysParser::NotifyCmdContext*>(ctx)) {
+            c->kind = CommandKind::Notify;
+            std::string quoted = n->STRING()->getText();
+            c->event = quoted.size() >= 2 ? quoted.substr(1, quoted.size() - 2) : quoted;
+            c->eventRange = range(n->STRING());
+            if (n->argList()) c->args = args(n->argList());
         } else if (auto* on = dynamic_cast<PsysParser::OnCmdContext*>(ctx)) {
             c->kind = CommandKind::On;
             c->event = on->IDENT()->getText();

@@ -53,6 +53,7 @@ std::string ruleWords(antlr4::ParserRuleContext* ctx) {
                 if (auto* d = dynamic_cast<PsysParser::DrawCmdContext*>(c)) return d->drawing->getText() + " command";
                 if (dynamic_cast<PsysParser::KillCmdContext*>(c)) return "kill command";
                 if (dynamic_cast<PsysParser::EmitCmdContext*>(c)) return "emit command";
+                if (dynamic_cast<PsysParser::NotifyCmdContext*>(c)) return "notify command";
                 if (dynamic_cast<PsysParser::WhenCmdContext*>(c)) return "when command";
                 if (dynamic_cast<PsysParser::OnCmdContext*>(c)) return "`on` block";
                 return "command";
@@ -85,7 +86,7 @@ std::string describeExpected(antlr4::Parser* parser, const antlr4::misc::Interva
 
     std::vector<std::string> words;
     bool exprStart = types.count(PsysParser::NUMBER) && types.count(PsysParser::IDENT) && has({"("});
-    bool objectBody = has({"point", "kill", "emit", "when", "on", "object"});
+    bool objectBody = has({"point", "kill", "emit", "notify", "when", "on", "object"});
     bool topLevel = has({"import", "const", "fn", "extern", "trigger", "object", "spawn"});
     if (topLevel) {
         words.push_back("a declaration (object, const, fn, extern, trigger, spawn or import)");
@@ -93,7 +94,7 @@ std::string describeExpected(antlr4::Parser* parser, const antlr4::misc::Interva
         types.erase(static_cast<size_t>(antlr4::Token::EOF));
     } else if (objectBody) {
         words.push_back("an equation, a command, a nested object");
-        drop({"point", "sprite", "streak", "trail", "kill", "emit", "when", "on", "object", "@", "("});
+        drop({"point", "sprite", "streak", "trail", "kill", "emit", "notify", "when", "on", "object", "@", "("});
         types.erase(PsysParser::IDENT);
     } else if (exprStart) {
         words.push_back("an expression");

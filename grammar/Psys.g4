@@ -65,6 +65,7 @@ equation    : IDENT ( ':' typeRef )? '=' expr ';'                  # singleEquat
 command     : drawing=( 'point' | 'sprite' | 'streak' | 'trail' ) '(' argList? ')' ';'      # drawCmd
             | 'kill' ( 'when' expr )? ';'                                       # killCmd
             | 'emit' IDENT ( '(' argList? ')' )? emitRate? emitCount? ';'        # emitCmd
+            | 'notify' STRING ( '(' argList? ')' )? ';'                         # notifyCmd
             | 'when' expr '{' command* '}'                                      # whenCmd
             | 'on' IDENT '{' command* '}'                                       # onCmd
             ;

@@ -376,6 +376,12 @@ struct Object {
 // behind its head.
 inline int renderColumns(const Object& o) { return kDrawnColumns + 3 * std::max(o.trail - 1, 0); }
 
+// The object type an event makes (`notify "hit"(…)`: docs/language.md, "Events"): one
+// object a notification, living until the end of the next step's update, its values its
+// parameters. `notify` is a keyword, so no type of a program is named so.
+inline std::string eventType(std::string_view event) { return "notify." + std::string(event); }
+inline bool isEventType(std::string_view type) { return type.starts_with("notify."); }
+
 struct Extern {
     std::string name;
     Type type;

@@ -111,6 +111,42 @@ struct CommandLowering {
         }
     }
 
+    // `emit` (or `notify`, a burst of one object of its event's type) at a new site.
+    void emit(const Command& cmd, const std::string& target, const std::vector<ValueId>& conditions) {
+        int site = static_cast<int>(emits.size());
+        EmitSite::When when = cmd.rate              ? EmitSite::When::Rate
+                              : dying_              ? EmitSite::When::Death
+                              : object && !conditions.empty() ? EmitSite::When::Edge
+                                                    : EmitSite::When::Creation;
+        emits.push_back({target, when});
+        ValueId on = lowering.guard(conditions);
+        // A burst in a `when` fires where the condition becomes true: it was
+        // false at the previous update (`prev` is false at creation). Each
+        // burst's `prev` is a call site of its own, so its state slot has a
+        // name of its own (`prev#SITE`): hot reload carries state by name.
+        if (when == EmitSite::When::Edge) {
+            ValueId before = lowering.temporal(Op::Prev, Type::boolean(), {on});
+            on = k.op(Op::And, Type::boolean(), {on, k.op(Op::Not, Type::boolean(), {before})});
+        }
+        ValueId zero = k.scalar(0);
+        ValueId count = cmd.count ? lowering.lowerOne(*cmd.count) : k.scalar(1);
+        if (cmd.rate) {
+            ValueId rate = lowering.lowerOne(*cmd.rate);
+            k.yields.push_back({YieldKind::EmitRate, site, 0, k.op(Op::Select, Type::f32(), {on, rate, zero})});
+            k.yields.push_back({YieldKind::EmitCount, site, 0, count});
+        } else {
+            k.yields.push_back({YieldKind::EmitCount, site, 0, k.op(Op::Select, Type::f32(), {on, count, zero})});
+        }
+        lowering.perChild_ = true;
+        for (size_t i = 0; i < cmd.args.size(); ++i)
+            k.yields.push_back({YieldKind::EmitArg, site, static_cast<int>(i), lowering.lowerOne(*cmd.args[i])});
+        lowering.perChild_ = false;
+        if (program.instanced) {  // a child belongs to its emitter's instance
+            k.yields.push_back({YieldKind::EmitArg, site, static_cast<int>(cmd.args.size()), lowering.instance()});
+            if (object) instanceEmission(site);
+        }
+    }
+
     void run(const std::vector<CommandPtr>& commands, std::vector<ValueId> conditions, ValueId& kill) {
         for (auto& cmd : commands) {
             LocScope at(k, lowering.locate(cmd->range));
@@ -122,41 +158,8 @@ struct CommandLowering {
                     kill = k.op(Op::Or, Type::boolean(), {kill, guarded});
                     break;
                 }
-                case CommandKind::Emit: {
-                    int site = static_cast<int>(emits.size());
-                    EmitSite::When when = cmd->rate              ? EmitSite::When::Rate
-                                          : dying_               ? EmitSite::When::Death
-                                          : object && !conditions.empty() ? EmitSite::When::Edge
-                                                                 : EmitSite::When::Creation;
-                    emits.push_back({qualified(cmd->targetDecl), when});
-                    ValueId on = lowering.guard(conditions);
-                    // A burst in a `when` fires where the condition becomes true: it was
-                    // false at the previous update (`prev` is false at creation). Each
-                    // burst's `prev` is a call site of its own, so its state slot has a
-                    // name of its own (`prev#SITE`): hot reload carries state by name.
-                    if (when == EmitSite::When::Edge) {
-                        ValueId before = lowering.temporal(Op::Prev, Type::boolean(), {on});
-                        on = k.op(Op::And, Type::boolean(), {on, k.op(Op::Not, Type::boolean(), {before})});
-                    }
-                    ValueId zero = k.scalar(0);
-                    ValueId count = cmd->count ? lowering.lowerOne(*cmd->count) : k.scalar(1);
-                    if (cmd->rate) {
-                        ValueId rate = lowering.lowerOne(*cmd->rate);
-                        k.yields.push_back({YieldKind::EmitRate, site, 0, k.op(Op::Select, Type::f32(), {on, rate, zero})});
-                        k.yields.push_back({YieldKind::EmitCount, site, 0, count});
-                    } else {
-                        k.yields.push_back({YieldKind::EmitCount, site, 0, k.op(Op::Select, Type::f32(), {on, count, zero})});
-                    }
-                    lowering.perChild_ = true;
-                    for (size_t i = 0; i < cmd->args.size(); ++i)
-                        k.yields.push_back({YieldKind::EmitArg, site, static_cast<int>(i), lowering.lowerOne(*cmd->args[i])});
-                    lowering.perChild_ = false;
-                    if (program.instanced) {  // a child belongs to its emitter's instance
-                        k.yields.push_back({YieldKind::EmitArg, site, static_cast<int>(cmd->args.size()), lowering.instance()});
-                        if (object) instanceEmission(site);
-                    }
-                    break;
-                }
+                case CommandKind::Emit: emit(*cmd, qualified(cmd->targetDecl), conditions); break;
+                case CommandKind::Notify: emit(*cmd, ir::eventType(cmd->event), conditions); break;
                 case CommandKind::When: {
                     auto inner = conditions;
                     inner.push_back(lowering.lowerOne(*cmd->cond));
@@ -277,6 +280,25 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
         o.attributes = attributes;
         for (auto& p : decl->params) o.params.push_back({p.name, irType(p.type.type)});
         if (program.instanced) o.params.push_back({std::string(core::kInstanceParam), Type::f32()});
+        m.objects.push_back(std::move(o));
+    }
+    // Events (`notify "hit"(…)`): a type each, after the program's, whose objects live
+    // until the end of the next step's update — `seen = false -> true; kill when
+    // prev(seen)` — so a host finds a step's events alive after it, and only them.
+    for (const ast::Program::Event& e : program.events) {
+        Object o;
+        o.name = ir::eventType(e.name);
+        o.loc = locate(e.range);
+        for (size_t v = 0; v < e.types.size(); ++v) o.params.push_back({fmt::format("value{}", v), irType(e.types[v])});
+        if (program.instanced) o.params.push_back({std::string(core::kInstanceParam), Type::f32()});
+        Kernel k;
+        k.kind = KernelKind::Behaviour;
+        LocScope at(k, o.loc);
+        int sites = 0;
+        ObjectLowering lowering(m, locate, k, &o, nullptr, nullptr, sites);
+        ValueId seen = lowering.temporal(Op::FollowedBy, Type::boolean(), {k.boolean(false), k.boolean(true)});
+        k.yields.push_back({YieldKind::Kill, 0, 0, lowering.temporal(Op::Prev, Type::boolean(), {seen})});
+        o.kernels.push_back(std::move(k));
         m.objects.push_back(std::move(o));
     }
     for (size_t i = 0; i < decls.size(); ++i) {

@@ -157,7 +157,8 @@ void eliminate(Object& o, bool reloadable) {
     clean.kind = KernelKind::Update;
     *update = std::move(clean);
 
-    // Parameters: kept only if a kernel after creation reads them.
+    // Parameters: kept only if a kernel after creation reads them — or the host does (an
+    // event's values: ir::eventType).
     std::set<int> slotsUnused, params;
     for (const Kernel& k : o.kernels) {
         if (k.kind == KernelKind::Init) continue;
@@ -165,7 +166,9 @@ void eliminate(Object& o, bool reloadable) {
         for (const Yield& y : k.yields) roots.push_back(y.value);
         reads(k, roots, slotsUnused, &params);
     }
-    for (size_t p = 0; p < o.params.size(); ++p) o.params[p].kept = keepParams || params.count(static_cast<int>(p)) > 0;
+    const bool hostReads = isEventType(o.name);
+    for (size_t p = 0; p < o.params.size(); ++p)
+        o.params[p].kept = keepParams || hostReads || params.count(static_cast<int>(p)) > 0;
 }
 
 }  // namespace

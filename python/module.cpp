@@ -271,6 +271,27 @@ public:
         psys_finished_instances(s_, out.data(), out.size());
         return out;
     }
+    // Events (`notify "hit"(…)`): a step's notifications of one, n × width floats.
+    py::array_t<float> events(const std::string& name) {
+        auto held = hold();
+        size_t n = 0, width = 0;
+        psys_error* e = psys_read_events(open(), name.c_str(), nullptr, 0, &n, &width);
+        if (e && std::string(psys_error_message(e)).find("there is no event") != std::string::npos) {
+            std::string m = psys_error_message(e);
+            psys_error_free(e);
+            raiseAs(unknownNameType(), m);
+        }
+        check(e);
+        py::array_t<float> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(width)});
+        check(psys_read_events(s_, name.c_str(), out.mutable_data(), n, &n, &width));
+        return out;
+    }
+    std::vector<std::string> eventNames() const {
+        auto held = hold();
+        std::vector<std::string> out;
+        for (size_t i = 0; const char* name = psys_event_name(open(), i); ++i) out.emplace_back(name);
+        return out;
+    }
     void reserve(const py::object& type, size_t rows) {
         auto held = hold();
         check(psys_reserve(open(), typeOf(type), rows));
@@ -601,6 +622,10 @@ PYBIND11_MODULE(_psys, m) {
         .def("life", &System::life, py::arg("instance"), "'playing', 'stopped', 'killed' or 'finished'.")
         .def_property_readonly("instance_count", &System::instanceCount)
         .def("finished_instances", &System::finishedInstances, "The instances that finished in the latest step.")
+        .def("events", &System::events, py::arg("name"),
+             "A step's notifications of an event (`notify`): an n × width array, its values in order (and, "
+             "instanced, the instance's slot last).")
+        .def_property_readonly("event_names", &System::eventNames)
         .def("reserve", &System::reserve, py::arg("type"), py::arg("rows"),
              "Room for `rows` objects of `type` made now: steps up to that many take nothing more.")
         .def("prewarm", &System::prewarm, py::arg("seconds"), py::arg("longest_step") = 0.1,

@@ -249,6 +249,14 @@ public:
     // without asking each.
     std::span<const InstanceHandle> finishedInstances() const;
 
+    // Events (`notify "hit"(pos, speed)`: docs/language.md, "Events"): the names the program
+    // notifies, and one's notifications of the latest step (and of triggers fired since),
+    // in row order, `width` floats each — its values' components in order, then, in an
+    // instanced program, the instance's slot — into `out` (reused). Any backend (a device's
+    // are read back).
+    std::vector<std::string> eventNames() const;
+    std::optional<std::string> events(std::string_view name, std::vector<float>& out, size_t& width);
+
     // Whether the system can produce nothing more of its own accord: it has started,
     // nothing is alive and nothing waits to be created. A trigger fired later still
     // creates objects (and the system is no longer finished). On a device whose kills come

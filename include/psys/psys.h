@@ -270,6 +270,22 @@ PSYS_API size_t psys_instance_count(const psys_system* system);
  * out; returns how many there are. */
 PSYS_API size_t psys_finished_instances(const psys_system* system, psys_instance* out, size_t max);
 
+/* ---- Events ------------------------------------------------------------------------- */
+
+/* What a program tells the host (`notify "hit"(pos, speed);` in an object — in its body,
+ * a `when` or `on death` — or a trigger: docs/language.md, "Events"), read after a step
+ * as a list, without polling any type: each notification of the latest step (and of
+ * triggers fired since) once, in a stable order, its values' components in order (`width`
+ * floats an event; in an instanced program the instance's slot last). Any backend. */
+PSYS_API size_t psys_event_count(const psys_system* system);
+/* The name of event `index` (as the program spells it), NULL past the end. */
+PSYS_API const char* psys_event_name(const psys_system* system, size_t index);
+/* Up to `max` events into out (max × width floats); *count gets how many there are and
+ * *width the floats of one (either may be NULL; out NULL with max 0 to ask). An unknown
+ * name is an error that lists the program's events. */
+PSYS_API psys_error* psys_read_events(psys_system* system, const char* name, float* out, size_t max, size_t* count,
+                                      size_t* width);
+
 /* ---- What it is made of ------------------------------------------------------------- */
 
 /* Object types, in the program's order (parents before children): index 0 .. count-1. */

@@ -382,3 +382,27 @@ def test_the_instances_example_plays_two_effects_and_plots_them(tmp_path):
     assert "[20, 20] instances playing" in r.stdout
     assert int(r.stdout.split("instances playing, ")[1].split()[0]) >= 20  # the bursts, again
     assert out.stat().st_size > 10_000
+
+
+def test_events_come_once_a_step_as_an_array():
+    s = psys.compile(source="""
+object shell(v: vec3) {
+    pos = integrate(v + integrate(vec3(0, -9.8, 0)));
+    point(pos, white, 3);
+    kill when age > 1;
+    on death { notify "pop"(pos, age); }
+}
+object launcher { emit shell(vec3(nrand(), 8, nrand())) at 5 per second; }
+spawn launcher;
+""")
+    assert s.event_names == ["pop"]
+    total = 0
+    for _ in range(180):
+        s.step(1 / 60)
+        e = s.events("pop")
+        assert e.shape[1] == 4 and e.dtype == np.float32
+        assert (e[:, 3] > 1).all()
+        total += len(e)
+    assert total == s.stats()["types"]["shell"]["killed"]
+    with pytest.raises(psys.UnknownNameError, match='its events are "pop"'):
+        s.events("boom")

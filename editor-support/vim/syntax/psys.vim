@@ -6,7 +6,7 @@ endif
 
 
 syn keyword psysStorage object fn trigger extern const let
-syn keyword psysKeyword import spawn emit kill when on at per second count range sprite streak trail
+syn keyword psysKeyword import spawn emit notify kill when on at per second count range sprite streak trail
 syn keyword psysConditional if then else
 syn keyword psysBoolean true false
 " `point` and `vec3` are types, unless called: then a command and a constructor.
