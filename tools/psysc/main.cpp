@@ -124,6 +124,8 @@ void addRunOptions(CLI::App& run, psys::tools::RunOptions& o) {
     run.add_option("--dump", o.dump, "Write every drawn point per frame to FILE.csv or FILE.json");
     run.add_option("--dump-every", o.dumpEvery, "Dump every Nth frame (1)")->check(CLI::Range(1, 1000000000));
     run.add_flag("--quiet", o.quiet, "No line per frame, only the summary");
+    run.add_flag("--events", o.events,
+                 "Print each frame's notifications (`notify \"NAME\"(…)`): a line each, `event NAME at frame F: values`");
     run.add_flag("--until-finished", o.untilFinished,
                  "Stop after the frame that leaves the system finished: nothing alive, nothing to create (--frames is "
                  "the most frames, and no --fire is left)");

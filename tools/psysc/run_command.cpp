@@ -206,6 +206,17 @@ int runSystem(const RunOptions& options) {
             for (auto& t : system.stats().types) line += fmt::format("  {} {}", t.name, t.live);
             std::cout << line << "\n";
         }
+        if (options.events) {
+            std::vector<float> values;
+            size_t width = 0;
+            for (const std::string& name : system.eventNames()) {
+                if (auto e = system.events(name, values, width)) return failed(*e);
+                for (size_t k = 0; width > 0 && k < values.size(); k += width)
+                    std::cout << fmt::format("event {} at frame {}: {}\n", name, frame,
+                                             fmt::join(values.begin() + static_cast<std::ptrdiff_t>(k),
+                                                       values.begin() + static_cast<std::ptrdiff_t>(k + width), " "));
+            }
+        }
         // Every frame is drawn (as a host would), so points with NaN or infinite values
         // are counted even when nothing is dumped.
         auto start = std::chrono::steady_clock::now();

@@ -21,6 +21,7 @@ struct RunOptions {
     std::string dump;                // FILE.csv or FILE.json
     int dumpEvery = 1;
     bool quiet = false;
+    bool events = false;             // print each frame's notifications (rt::System::events)
     bool untilFinished = false;      // stop after the frame that leaves nothing alive (rt::System::finished)
     bool optimize = true;
     bool relaxed = false;
