@@ -202,6 +202,28 @@ std::array<float, 4> externLanes(const std::optional<ConstValue>& v, Type t) {
     return out;
 }
 
+// Events (`notify "hit"(…)`): a type each, after the program's, whose objects live until
+// the end of the next step's update — `seen = false -> true; kill when prev(seen)` — so a
+// host finds a step's events alive after it, and only them.
+void lowerEvents(Module& m, const ast::Program& program, const Locator& locate) {
+    for (const ast::Program::Event& e : program.events) {
+        Object o;
+        o.name = ir::eventType(e.name);
+        o.loc = locate(e.range);
+        for (size_t v = 0; v < e.types.size(); ++v) o.params.push_back({fmt::format("value{}", v), irType(e.types[v])});
+        if (program.instanced) o.params.push_back({std::string(core::kInstanceParam), Type::f32()});
+        Kernel k;
+        k.kind = KernelKind::Behaviour;
+        LocScope at(k, o.loc);
+        int sites = 0;
+        ObjectLowering lowering(m, locate, k, &o, nullptr, nullptr, sites);
+        ValueId seen = lowering.temporal(Op::FollowedBy, Type::boolean(), {k.boolean(false), k.boolean(true)});
+        k.yields.push_back({YieldKind::Kill, 0, 0, lowering.temporal(Op::Prev, Type::boolean(), {seen})});
+        o.kernels.push_back(std::move(k));
+        m.objects.push_back(std::move(o));
+    }
+}
+
 }  // namespace
 
 ir::Module lowerProgram(const ast::Program& program, const SourceManager& sources) {
@@ -282,25 +304,7 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
         if (program.instanced) o.params.push_back({std::string(core::kInstanceParam), Type::f32()});
         m.objects.push_back(std::move(o));
     }
-    // Events (`notify "hit"(…)`): a type each, after the program's, whose objects live
-    // until the end of the next step's update — `seen = false -> true; kill when
-    // prev(seen)` — so a host finds a step's events alive after it, and only them.
-    for (const ast::Program::Event& e : program.events) {
-        Object o;
-        o.name = ir::eventType(e.name);
-        o.loc = locate(e.range);
-        for (size_t v = 0; v < e.types.size(); ++v) o.params.push_back({fmt::format("value{}", v), irType(e.types[v])});
-        if (program.instanced) o.params.push_back({std::string(core::kInstanceParam), Type::f32()});
-        Kernel k;
-        k.kind = KernelKind::Behaviour;
-        LocScope at(k, o.loc);
-        int sites = 0;
-        ObjectLowering lowering(m, locate, k, &o, nullptr, nullptr, sites);
-        ValueId seen = lowering.temporal(Op::FollowedBy, Type::boolean(), {k.boolean(false), k.boolean(true)});
-        k.yields.push_back({YieldKind::Kill, 0, 0, lowering.temporal(Op::Prev, Type::boolean(), {seen})});
-        o.kernels.push_back(std::move(k));
-        m.objects.push_back(std::move(o));
-    }
+    lowerEvents(m, program, locate);
     for (size_t i = 0; i < decls.size(); ++i) {
         const ObjectDecl* decl = decls[i].first;
         Object& o = m.objects[i];
