@@ -1,5 +1,9 @@
 #include "native/compiled_backend.h"
 
+#include <array>
+#include <span>
+#include <vector>
+
 #include "rt/system.h"
 
 namespace psys::native {
@@ -73,21 +77,32 @@ void* CompiledBackend::function(const Object& o, const Kernel& k, bool children,
     return functions_.at(shape);
 }
 
-void CompiledBackend::addresses(std::span<const rt::Buffer> columns, std::vector<void*>& out) {
-    out.assign(columns.size(), nullptr);
-    for (size_t i = 0; i < columns.size(); ++i)
-        if (columns[i].valid()) out[i] = memory_.host(columns[i]);
-}
-
 namespace {
-// Each thread's addresses of a launch's columns and arguments (launches run on every thread).
-thread_local std::vector<void*> launchColumns, launchArgs;
+// The host addresses of a launch's columns (null for an invalid buffer): on the stack
+// where they fit, so that a launch allocates nothing on whatever thread runs it (a
+// thread's own vector did, the first time a thread pool's worker ran a launch); past 96
+// columns on the heap.
+class Addresses {
+public:
+    Addresses(rt::HostMemory& memory, std::span<const rt::Buffer> columns) {
+        if (columns.size() > few_.size()) {
+            many_.resize(columns.size());
+            data_ = many_.data();
+        }
+        for (size_t i = 0; i < columns.size(); ++i) data_[i] = columns[i].valid() ? memory.host(columns[i]) : nullptr;
+    }
+    void** data() { return data_; }
+
+private:
+    std::array<void*, 96> few_;
+    std::vector<void*> many_;
+    void** data_ = few_.data();
+};
 }  // namespace
 
 rt::RowsResult CompiledBackend::run(const rt::RowsLaunch& l) {
     auto fn = reinterpret_cast<RowsFn>(function(*l.object, *l.kernel, false, l.clock.now, l.clock.dt));
-    std::vector<void*>& columns = launchColumns;
-    addresses(l.columns, columns);
+    Addresses columns(memory_, l.columns);
     const auto* mask = static_cast<const uint8_t*>(memory_.host(l.mask));
     RowCounts counts = fn(columns.data(), mask, static_cast<int64_t>(l.begin), static_cast<int64_t>(l.end), l.externs,
                           l.uniforms, l.clock.nowValue, l.clock.dtValue, l.clock.first ? 1u : 0u, l.seed, l.draw);
@@ -106,9 +121,7 @@ rt::PairFunction CompiledBackend::pairFunction(const Object& object, const Kerne
 
 void CompiledBackend::run(const rt::ChildrenLaunch& l) {
     auto fn = reinterpret_cast<ChildrenFn>(function(*l.object, *l.spawn, true, Clock::Source::Uniform, Clock::Source::Uniform));
-    std::vector<void*>&columns = launchColumns, &args = launchArgs;
-    addresses(l.columns, columns);
-    addresses(l.args, args);
+    Addresses columns(memory_, l.columns), args(memory_, l.args);
     fn(columns.data(), static_cast<int64_t>(l.row), l.parents, l.externs, l.clock.nowValue, l.clock.dtValue,
        l.clock.first ? 1u : 0u, l.seed, l.draw, l.firstChild, static_cast<int64_t>(l.count),
        reinterpret_cast<float* const*>(args.data()), static_cast<int64_t>(l.argsFirst));

@@ -87,9 +87,6 @@ private:
     // The code for a launch shape (provided now if `prepare` did not list it).
     void* function(const ir::Object& o, const ir::Kernel& k, bool children, rt::Clock::Source now,
                    rt::Clock::Source dt);
-    // The host addresses of `columns` (null for an invalid buffer) in `out`, a thread's own
-    // vector kept from launch to launch: a launch allocates nothing.
-    void addresses(std::span<const rt::Buffer> columns, std::vector<void*>& out);
 
     bool exact_;
     std::mutex mutex_;  // functions_: launches may come from several threads
