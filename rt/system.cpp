@@ -111,8 +111,7 @@ void System::reset() {
     state_->externs = std::move(externs);
     if (state_->module.instanced()) {
         state_->externs[state_->module.externs.size()].f[0] = 1;
-        state_->instanceRecords()[core::kInstanceEmitting].f[3] = 1;
-        state_->instanceRecords()[core::kInstanceKilled].f[3] = 0;
+        state_->setLife(0, InstanceLife::Playing);
     }
     ++state_->externsVersion;
 }
@@ -404,11 +403,8 @@ std::optional<std::string> System::checkFiring(std::string_view name, std::span<
 std::optional<std::string> System::fire(std::string_view name, std::span<const float> args) {
     if (auto error = checkFiring(name, args)) return error;
     detail::State& s = *state_;
-    if (s.module.instanced() && s.instances[0].life == InstanceLife::Finished) {  // the system's own, again
-        s.instances[0].life = InstanceLife::Playing;
-        s.instanceRecords()[core::kInstanceEmitting].f[3] = 1;
-        s.instanceRecords()[core::kInstanceKilled].f[3] = 0;
-    }
+    if (s.module.instanced() && s.instances[0].life == InstanceLife::Finished)  // the system's own, again
+        s.setLife(0, InstanceLife::Playing);
     return fireOn(name, args, 0);
 }
 

@@ -56,11 +56,18 @@ void State::growInstances(size_t slots) {
     for (size_t slot = before; slot < slots; ++slot) {
         Value* records = instanceRecords() + core::kInstanceRecordValues * slot;
         writeTransform(records, {});
-        records[core::kInstanceEmitting].f[3] = 0;
-        records[core::kInstanceKilled].f[3] = 1;  // (a free slot: nothing of it may live)
         records[core::kInstanceIndex].f[3] = static_cast<float>(slot);
         records[core::kInstancePosition].f[3] = 1;
+        setLife(slot, InstanceLife::Finished);
     }
+}
+
+void State::setLife(size_t slot, InstanceLife life) {
+    instances[slot].life = life;
+    Value* records = instanceRecords() + core::kInstanceRecordValues * slot;
+    records[core::kInstanceEmitting].f[3] = life == InstanceLife::Playing ? 1.0f : 0.0f;
+    records[core::kInstanceKilled].f[3] = life == InstanceLife::Killed || life == InstanceLife::Finished ? 1.0f : 0.0f;
+    ++externsVersion;
 }
 
 // Marks the slots that still have a live object in the pools' hidden `instance` columns;
@@ -99,11 +106,8 @@ void State::finishInstances() {
         InstanceSlot& i = instances[slot];
         if (i.life == InstanceLife::Finished || seen[slot]) continue;
         finishedInstances.push_back(handle(slot, i.generation));
-        i.life = InstanceLife::Finished;
         ++i.generation;
-        Value* records = instanceRecords() + core::kInstanceRecordValues * slot;
-        records[core::kInstanceEmitting].f[3] = 0;
-        records[core::kInstanceKilled].f[3] = 1;
+        setLife(slot, InstanceLife::Finished);
     }
 }
 
@@ -138,12 +142,8 @@ std::optional<std::string> System::play(std::span<const float> transform, Instan
     if (slot >= (1u << 24))  // (an instance's index is a float: whole numbers are exact below 2^24)
         return std::string("a system plays at most 2^24 instances at once");
     if (slot >= s.instances.size()) s.growInstances(std::max<size_t>(slot + 1, s.instances.size() * 2));
-    Value* records = s.instanceRecords() + core::kInstanceRecordValues * slot;
-    writeTransform(records, transform);
-    records[core::kInstanceEmitting].f[3] = 1;
-    records[core::kInstanceKilled].f[3] = 0;
-    s.instances[slot].life = InstanceLife::Playing;
-    ++s.externsVersion;
+    writeTransform(s.instanceRecords() + core::kInstanceRecordValues * slot, transform);
+    s.setLife(slot, InstanceLife::Playing);
     out = handle(slot, s.instances[slot].generation);
     start();
     s.ledger.settle(Wait::Yes);  // the rows the last step freed, before these objects take rows
@@ -166,21 +166,14 @@ std::optional<std::string> System::setTransform(InstanceHandle instance, std::sp
 std::optional<std::string> System::stop(InstanceHandle instance) {
     uint32_t slot = 0;
     if (auto error = liveInstance(instance, slot)) return error;
-    detail::InstanceSlot& i = state_->instances[slot];
-    if (i.life == InstanceLife::Playing) i.life = InstanceLife::Stopped;
-    state_->instanceRecords()[core::kInstanceRecordValues * slot + core::kInstanceEmitting].f[3] = 0;
-    ++state_->externsVersion;
+    if (state_->instances[slot].life == InstanceLife::Playing) state_->setLife(slot, InstanceLife::Stopped);
     return std::nullopt;
 }
 
 std::optional<std::string> System::kill(InstanceHandle instance) {
     uint32_t slot = 0;
     if (auto error = liveInstance(instance, slot)) return error;
-    state_->instances[slot].life = InstanceLife::Killed;
-    Value* records = state_->instanceRecords() + core::kInstanceRecordValues * slot;
-    records[core::kInstanceEmitting].f[3] = 0;
-    records[core::kInstanceKilled].f[3] = 1;
-    ++state_->externsVersion;
+    state_->setLife(slot, InstanceLife::Killed);
     return std::nullopt;
 }
 

@@ -304,9 +304,7 @@ State::State(ir::Module m, Backend& b, SystemOptions o)
     if (module.instanced()) {  // the system's own instance, playing where the host has not moved it
         externs.push_back(Value::scalar(0));
         growInstances(1);
-        instances[0].life = InstanceLife::Playing;
-        instanceRecords()[core::kInstanceEmitting].f[3] = 1;
-        instanceRecords()[core::kInstanceKilled].f[3] = 0;
+        setLife(0, InstanceLife::Playing);
     }
     uniformCache.resize(pools.size());
 }

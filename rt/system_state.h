@@ -174,6 +174,9 @@ struct State {
     Value* instanceRecords() { return externs.data() + module.externs.size() + 1; }  // slot 0's first value
     // The table with room for `slots` slots (new ones free, their records the identity).
     void growInstances(size_t slots);
+    // Where slot `slot` is in its life, and its record's flags, which follow from it
+    // (emitting while playing; killed once killed or finished: nothing of it may live).
+    void setLife(size_t slot, InstanceLife life);
     // The instances whose objects are all gone, after a step: finished (the CPU's pools).
     void finishInstances();
     std::vector<std::array<UniformCache, 3>> uniformCache;
