@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "psys/psys.h"
+#include "rt/host_allocator.h"
 
 namespace psys::capi {
 
@@ -33,6 +34,8 @@ template <typename Body>
 psys_error* guarded(const char* function, Body&& body) {
     try {
         return body();
+    } catch (const rt::HostOutOfMemory& e) {  // (the host's allocator said no: not the library's fault)
+        return makeError(std::string(function) + ": " + e.what());
     } catch (const std::exception& e) {
         return makeError(std::string(function) + ": internal error: " + e.what());
     } catch (...) {

@@ -67,9 +67,9 @@ psys_error* readOptions(const char* function, const psys_options* given, Options
     if (given) {
         // An earlier header's options are a prefix of these (the rest keep the defaults);
         // a later header's are not this library's to read.
-        // The sizes headers have had: 0.2's, the first with a size (a later one adds fields
-        // at the end, and this list its size).
-        static constexpr uint32_t kPublished[] = {sizeof(psys_options)};
+        // The sizes headers have had: 0.2's, the first with a size, then 0.3's with the
+        // allocator (a later one adds fields at the end, and this list its size).
+        static constexpr uint32_t kPublished[] = {offsetof(psys_options, allocator), sizeof(psys_options)};
         if (given->size == 0)
             return makeError(fmt::format("{}: psys_options.size is 0: psys_options_init(&options) sets it before the "
                                          "fields are changed",
@@ -94,6 +94,11 @@ psys_error* readOptions(const char* function, const psys_options* given, Options
     out.system.seed = o.seed;
     out.system.capacity = o.capacity;
     out.system.threads = o.threads;
+    if (!o.allocator.allocate != !o.allocator.release)
+        return makeError(fmt::format("{}: psys_options.allocator needs both allocate and release (or neither, for the "
+                                     "library's own)",
+                                     function));
+    out.system.allocator = {o.allocator.allocate, o.allocator.release, o.allocator.user};
     out.optimize = o.optimize != 0;
     if (o.jit_cache) out.jitCache = o.jit_cache;
     if (o.library_path)
@@ -115,7 +120,7 @@ void psys_options_init_size(psys_options* given, size_t size) {
     if (!given || size < sizeof(uint32_t)) return;
     rt::SystemOptions defaults;
     psys_options o{sizeof(psys_options), "llvm", "fast", defaults.seed, defaults.capacity, defaults.threads, 1,
-                   nullptr, nullptr};
+                   nullptr, nullptr, {}};
     // The host's struct: what this library knows of it (an earlier header's is a prefix),
     // the rest (a later header's fields) zero; `size` the host's, which says which it is.
     std::memset(static_cast<void*>(given), 0, size);

@@ -9,6 +9,7 @@
 #include <new>
 #include <stdexcept>
 
+#include <fmt/format.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -29,11 +30,19 @@ struct HostMemory::Column {
     Elem elem;
     size_t rows = 0, capacity = 0;
     std::byte* data = nullptr;
-    size_t mappedBytes = 0;  // 0: data is from aligned_alloc
+    size_t mappedBytes = 0;  // 0: data is from aligned_alloc or the host's allocator
+    HostAllocator host;      // set: data is the host's, hostBytes of it
+    size_t hostBytes = 0;
 
-    ~Column() {
-        if (mappedBytes) ::munmap(data, mappedBytes);
-        else std::free(data);
+    ~Column() { drop(); }
+    void drop() {
+        if (host) {
+            if (data) host.give(data, hostBytes);
+        } else if (mappedBytes) {
+            ::munmap(data, mappedBytes);
+        } else {
+            std::free(data);
+        }
     }
     size_t size() const { return elemSize(elem); }
     // Room for `wanted` rows; `exactly`: that many (a pool's capacity), else doubled.
@@ -41,6 +50,16 @@ struct HostMemory::Column {
         if (wanted <= capacity) return;
         size_t grown = exactly ? wanted : std::max(wanted, capacity * 2);
         size_t bytes = (grown * size() + 63) / 64 * 64;
+        if (host) {
+            // (The host's memory cannot be remapped: a larger block and a copy.)
+            auto* fresh = static_cast<std::byte*>(host.take(std::max<size_t>(bytes, 64), 64));
+            if (data) std::memcpy(fresh, data, rows * size());
+            drop();
+            data = fresh;
+            hostBytes = std::max<size_t>(bytes, 64);
+            capacity = hostBytes / size();
+            return;
+        }
         if (bytes >= kMapped) {
             const size_t page = static_cast<size_t>(::sysconf(_SC_PAGESIZE));
             bytes = (bytes + page - 1) / page * page;
@@ -76,6 +95,7 @@ HostMemory::~HostMemory() = default;
 Buffer HostMemory::create(Elem elem, size_t rows) {
     auto column = std::make_unique<Column>();
     column->elem = elem;
+    column->host = allocator();
     column->resize(rows);
     if (!free_.empty()) {
         uint32_t id = free_.back();
@@ -90,8 +110,10 @@ Buffer HostMemory::create(Elem elem, size_t rows) {
 void HostMemory::resize(Buffer b, size_t rows) { columns_.at(b.id)->resize(rows); }
 
 void HostMemory::reserve(Buffer b, size_t rows) {
+    Column& c = *columns_.at(b.id);
+    if (c.host) return c.reserve(rows, true);  // (memory, not address space: the host hears of a failure)
     try {
-        columns_.at(b.id)->reserve(rows, true);
+        c.reserve(rows, true);
     } catch (const std::bad_alloc&) {  // (no address space for it: it grows when it must)
     }
 }
@@ -99,6 +121,17 @@ void HostMemory::reserve(Buffer b, size_t rows) {
 void HostMemory::populate(Buffer b, size_t rows) {
     Column& c = *columns_.at(b.id);
     populatePages(c.data, std::min(rows, c.capacity) * c.size());
+}
+
+void* HostAllocator::take(size_t bytes, size_t alignment) const {
+    void* p = allocate(user, bytes, alignment);
+    if (!p) throw HostOutOfMemory(fmt::format("the host's allocator gave no memory for {} bytes", bytes));
+    if (reinterpret_cast<uintptr_t>(p) % alignment != 0) {
+        release(user, p, bytes);
+        throw HostOutOfMemory(fmt::format("the host's allocator gave {} bytes at {}, not aligned to {} bytes as asked",
+                                          bytes, fmt::ptr(p), alignment));
+    }
+    return p;
 }
 
 void populatePages(void* data, size_t bytes) {

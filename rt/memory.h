@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "rt/allocation.h"
+#include "rt/host_allocator.h"
 
 namespace psys::rt {
 
@@ -148,6 +149,11 @@ constexpr size_t runsWords(size_t rows, size_t sites) {
 class Memory {
 public:
     virtual ~Memory() = default;
+    // Where the host's memory comes from from now on (SystemOptions::allocator): the host
+    // memory's columns made after it, and the host arrays of pools made after it
+    // (Pool::Pool). What was made before goes back where it came from.
+    void useAllocator(const HostAllocator& allocator) { allocator_ = allocator; }
+    const HostAllocator& allocator() const { return allocator_; }
     // A column of `rows` elements, zero-filled.
     virtual Buffer create(Elem elem, size_t rows) = 0;
     // Keeps the first min(old, rows) elements; new ones are zero.
@@ -327,6 +333,9 @@ public:
     // where the columns are (GlMemory: a dispatch, 24 bytes back).
     virtual Bounds bounds(Buffer visible, const std::array<Buffer, 3>& position, const std::array<float, 3>& constant,
                           size_t rows) const;
+
+private:
+    HostAllocator allocator_;
 };
 
 // Host RAM: buffers are arrays the host addresses directly (aligned to 64 bytes).

@@ -94,6 +94,14 @@ void SyncedMask::restore(Memory& memory, std::vector<uint8_t> values) {
 
 Pool::Pool(const ir::Object& object, size_t capacity, Memory& memory)
     : object_(&object), capacity_(capacity), memory_(&memory) {
+    if (const HostAllocator& host = memory.allocator()) {  // (its host arrays are the host's memory too)
+        parent = HostArray<Handle>(MappedAllocator<Handle>(host));
+        readers = HostArray<uint32_t>(MappedAllocator<uint32_t>(host));
+        diedAt = HostArray<double>(MappedAllocator<double>(host));
+        status_ = HostArray<Status>(MappedAllocator<Status>(host));
+        generation_ = HostArray<uint32_t>(MappedAllocator<uint32_t>(host));
+        freeRows_ = HostArray<uint32_t>(MappedAllocator<uint32_t>(host));
+    }
     created = memory.create(Elem::F64, 0);
     ids = memory.create(Elem::U32, 0);
     updatable.create(memory);
@@ -139,6 +147,9 @@ void Pool::forEachRowColumn(core::FunctionRef<void(Buffer)> f) const {
 }
 
 void Pool::reserveRows() {
+    // (The host's allocator gives memory, not address space: its pools take room only
+    // when the host reserves rows — populate.)
+    if (memory_->allocator()) return;
     room_ = reservableRows(capacity_, rowBytes(*object_));
     forEachRowColumn([&](Buffer b) { memory_->reserve(b, room_); });
     updatable.reserved(*memory_);
@@ -153,6 +164,19 @@ void Pool::reserveRows() {
 }
 
 void Pool::populate(size_t rows) {
+    if (memory_->allocator()) {  // room for them from the host's allocator, whose memory is the host's to page
+        rows = std::min(rows, capacity_);
+        forEachRowColumn([&](Buffer b) { memory_->reserve(b, rows); });
+        updatable.reserved(*memory_);
+        alive.reserved(*memory_);
+        room_ = std::max(room_, rows);
+        if (inMemory_) return;
+        for (auto* v : {&generation_, &freeRows_, &readers}) v->reserve(rows);
+        status_.reserve(rows);
+        parent.reserve(rows);
+        diedAt.reserve(rows);
+        return;
+    }
     rows = std::min(rows, room_);
     forEachRowColumn([&](Buffer b) { memory_->populate(b, rows); });
     if (inMemory_) return;

@@ -63,6 +63,9 @@ struct SystemOptions {
     // deaths (Memory::emitAtRate: rt/system_state.cpp, TypeInfo::rowsInMemory).
     // Results are the same, rows included (tests compare them).
     enum class Rows : uint8_t { AsBackend, InMemory, OnHost } rows = Rows::AsBackend;
+    // Where the system's particle memory comes from (rt/host_allocator.h): unset, the
+    // library's own. It outlives the system.
+    HostAllocator allocator;
     // Called at the end of the step after which the system is finished (System::finished),
     // once each time it becomes so: a host may recycle the system there.
     std::function<void(const System&)> onFinished;

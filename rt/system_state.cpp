@@ -252,12 +252,19 @@ void decideRows(std::vector<TypeInfo>& types, const ir::Module& module, const Sy
     decideEmitters(types, module, options, inMemory, backend);
 }
 
+// The backend's memory, taking its memory from the host's allocator where the options
+// give one (before anything of the state is made in it).
+Memory& allocatingFrom(Memory& memory, const HostAllocator& allocator) {
+    memory.useAllocator(allocator);
+    return memory;
+}
+
 }  // namespace
 
 State::State(ir::Module m, Backend& b, SystemOptions o)
     : module(std::move(m)),
       backend(b),
-      memory(b.memory()),
+      memory(allocatingFrom(b.memory(), o.allocator)),
       options(o),
       ancestors(b.memory()),
       parallel(std::make_unique<Parallel>(o.threads)) {

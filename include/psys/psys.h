@@ -95,6 +95,22 @@ PSYS_API void psys_error_free(psys_error* error);
 
 typedef struct psys_system psys_system;
 
+/* Where a system's particle memory comes from: its columns and its pools' arrays — what
+ * grows with its objects (docs/embedding.md, "Allocator"). `allocate` returns `bytes`
+ * aligned to `alignment` (a power of two, at most 64), or NULL when it has none (the call
+ * that asked then fails with an error that says so); `release` takes back a block with
+ * the size it was asked for. Both NULL (the default): the library's own, which takes
+ * address space for each type's capacity at the start; with the host's, a pool takes
+ * memory only as its objects need it (doubling, with a copy), or up front as
+ * psys_reserve asks. It may be called from any of the threads a system's work runs on,
+ * several at once (it is thread-safe), and it outlives the system.
+ * A compilation's memory and a system's small bookkeeping come from the C++ heap. */
+typedef struct psys_allocator {
+    void* (*allocate)(void* user, size_t bytes, size_t alignment);
+    void (*release)(void* user, void* memory, size_t bytes);
+    void* user;
+} psys_allocator;
+
 typedef struct psys_options {
     /* sizeof(psys_options) in the header the host was built with: psys_options_init sets
      * it (0 is refused: the options were not initialised). */
@@ -117,6 +133,8 @@ typedef struct psys_options {
     /* Folders, ':'-separated, where `import "std/…"` looks first (each holds std/), before
      * $PSYS_LIBRARY and the installed share/psys: NULL (the default) for none. */
     const char* library_path;
+    /* The host's allocator for particle memory: zero (the default) for the library's own. */
+    psys_allocator allocator;
 } psys_options;
 
 /* The defaults above: llvm, fast, seed 1, 2^20 objects a type, every core, optimized, the
