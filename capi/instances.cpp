@@ -1,7 +1,10 @@
 // The C API's instances and events (include/psys/psys.h, "Instances", "Events"):
 // rt::System's, checked for null arguments and with its refusals as errors.
 #include <algorithm>
+#include <optional>
 #include <span>
+
+#include <fmt/format.h>
 
 #include "capi/error.h"
 #include "capi/handle.h"
@@ -57,6 +60,29 @@ psys_error* psys_instance_fire(psys_system* s, psys_instance instance, const cha
     return guarded("psys_instance_fire", [&] {
         return orError("psys_instance_fire", s->system().fire(trigger, std::span<const float>(args, count), instance));
     });
+}
+
+psys_error* psys_instance_set_extern(psys_system* s, psys_instance instance, const char* name, const float* values,
+                                     size_t count) {
+    if (!s) return nullArgument("psys_instance_set_extern", "the system");
+    if (!name) return nullArgument("psys_instance_set_extern", "the extern's name");
+    if (!values && count) return nullArgument("psys_instance_set_extern", "the values");
+    return guarded("psys_instance_set_extern", [&] {
+        int handle = s->system().externHandle(name);
+        if (handle < 0) return orError("psys_instance_set_extern", fmt::format("there is no extern `{}`", name));
+        return orError("psys_instance_set_extern",
+                       s->system().setInstanceExtern(instance, handle, std::span<const float>(values, count)));
+    });
+}
+
+int psys_instance_get_extern(const psys_system* s, psys_instance instance, const char* name, float values[4]) {
+    if (!s || !name) return -1;
+    int handle = s->system().externHandle(name);
+    std::optional<rt::Value> v = s->system().instanceExtern(instance, handle);
+    if (!v) return -1;
+    int width = s->system().module().externs[static_cast<size_t>(handle)].type.width;
+    for (int c = 0; values && c < width; ++c) values[c] = v->f[static_cast<size_t>(c)];
+    return width;
 }
 
 psys_life psys_instance_life(const psys_system* s, psys_instance instance) {

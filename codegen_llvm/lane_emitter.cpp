@@ -53,7 +53,7 @@ private:
 
     // A record of the instance table after the externs (core/instances.h): its place
     // clamped as core::instanceSlot clamps it (NaN and negatives to the first, past the
-    // count to the last), then four loads.
+    // count to the last), then a load a lane.
     Lanes instance(const Inst& i) {
         if (!externs_) throw std::runtime_error(unexpectedOp(i, "the JIT (here)"));
         llvm::Type* value = llvm::StructType::get(b_.getContext(), {llvm::ArrayType::get(b_.getFloatTy(), 4), b_.getInt32Ty()});
@@ -68,10 +68,14 @@ private:
         llvm::Value* beyond = b_.CreateFCmpOGE(x, b_.CreateUIToFP(b_.CreateAdd(last, b_.getInt32(1)), b_.getFloatTy()));
         llvm::Value* whole = b_.CreateFPToUI(b_.CreateSelect(positive, b_.CreateSelect(beyond, f(0), x), f(0)), b_.getInt32Ty());
         llvm::Value* index = b_.CreateSelect(beyond, last, whole);
-        llvm::Value* slot = b_.CreateAdd(start, b_.CreateAdd(b_.getInt32(1 + static_cast<uint32_t>(i.attr)),
-                                                             b_.CreateMul(index, b_.getInt32(core::kInstanceRecordValues))));
-        Lanes out;
-        for (unsigned l = 0; l < 4; ++l) out.push_back(b_.CreateAlignedLoad(b_.getFloatTy(), at(slot, l), llvm::Align(4)));
+        llvm::Value* stride = b_.getInt32(core::instanceRecordValues(static_cast<size_t>(i.attr2)));
+        llvm::Value* slot =
+            b_.CreateAdd(start, b_.CreateAdd(b_.getInt32(1 + static_cast<uint32_t>(i.attr)), b_.CreateMul(index, stride)));
+        Lanes out;  // (as an extern's value: its type's lanes, a bool 0 or 1)
+        for (unsigned l = 0; l < static_cast<unsigned>(i.type.width); ++l) {
+            llvm::Value* lane = b_.CreateAlignedLoad(b_.getFloatTy(), at(slot, l), llvm::Align(4));
+            out.push_back(i.type.isBool() ? b_.CreateFCmpUNE(lane, f(0)) : lane);
+        }
         return out;
     }
 

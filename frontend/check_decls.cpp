@@ -279,6 +279,7 @@ void Checker::run() {
             if (decl->kind == DeclKind::Trigger) checkTrigger(static_cast<TriggerDecl&>(*decl));
             if (decl->kind == DeclKind::Spawn) checkSpawn(static_cast<SpawnDecl&>(*decl));
         }
+    reportInstancedFoldExterns();
     if (diags_.errorCount() == 0) checkInlinedSize();
     if (diags_.errorCount() == 0) reportUnused();
 }

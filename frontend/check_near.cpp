@@ -174,7 +174,8 @@ void Checker::checkFoldCall(const CallExpr& call, const Context& ctx) {
 // What a fold's term may read by name.
 bool Checker::checkFoldTermRef(const NameExpr& name, const Context& ctx) {
     switch (name.ref.kind) {
-        case Ref::Kind::Param: case Ref::Kind::Equation: case Ref::Kind::Const: case Ref::Kind::Extern:
+        case Ref::Kind::Extern: foldExternReads_.emplace_back(&name, ctx.fold->callee); return true;
+        case Ref::Kind::Param: case Ref::Kind::Equation: case Ref::Kind::Const:
         case Ref::Kind::BuiltinConst: case Ref::Kind::Unresolved:
             return true;
         default: break;
@@ -182,6 +183,21 @@ bool Checker::checkFoldTermRef(const NameExpr& name, const Context& ctx) {
     diags_.error(name.range, fmt::format("the term of `{}` cannot read `{}`: it may read this object's equations and "
                                          "parameters, `other.NAME`, constants and externs", ctx.fold->callee, name.name));
     return false;
+}
+
+// In an instanced program each instance has its own value of an extern, and a term is of
+// two objects that may be of different instances: it reads one through an equation of
+// this object (core/instances.h; the lowering keeps a term's extern reads effect-wide).
+void Checker::reportInstancedFoldExterns() {
+    if (!program_.instanced) return;
+    std::set<const NameExpr*> said;  // (a term is checked more than once as types settle)
+    for (const auto& [name, fold] : foldExternReads_)
+        if (said.insert(name).second)
+            diags_.error(name->range, fmt::format("the term of `{}` cannot read extern `{}` in an instanced program: each "
+                                              "instance has its own, and the two objects of a term may be of two "
+                                              "instances; read it through an equation of this object (`{}_here = {};`) "
+                                              "and name that",
+                                              fold, name->name, name->name, name->name));
 }
 
 }  // namespace psys::detail

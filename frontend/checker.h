@@ -131,6 +131,10 @@ private:
 
     std::set<const ast::Equation*> usedEquations_;
     std::set<const ast::ObjectDecl*> createdObjects_;
+    // Externs a fold's term reads (the name, the fold's callee): an error once the program
+    // turns out instanced, where each instance has its own (reportInstancedFoldExterns).
+    std::vector<std::pair<const ast::NameExpr*, std::string>> foldExternReads_;
+    void reportInstancedFoldExterns();
 };
 
 // Levenshtein-nearest candidate within a small distance, for "did you mean …?".

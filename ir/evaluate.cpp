@@ -159,7 +159,8 @@ void Evaluator::run(const Kernel& kernel, std::span<const KernelInputs> rows, st
                 const Value* instance = r + inst.operands[0] * n;
                 each([&](const KernelInputs& in, size_t row) {
                     const Value* table = in.externs + inst.attr2;
-                    return table[core::instanceSlot(instance[row].f[0], static_cast<uint32_t>(table[0].f[0]), inst.attr)];
+                    return table[core::instanceSlot(instance[row].f[0], static_cast<uint32_t>(table[0].f[0]), inst.attr,
+                                                    core::instanceRecordValues(static_cast<size_t>(inst.attr2)))];
                 });
                 break;
             }

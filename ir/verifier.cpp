@@ -140,10 +140,13 @@ private:
                        "no fold of this index and type (outside a pair kernel)");
                 break;
             case Op::Instance:
-                expect(i.type == Type::vec(4) && t(0).isScalarFloat() && i.attr >= 0 &&
-                           i.attr < core::kInstanceRecordValues &&
-                           static_cast<size_t>(i.attr2) == module_.externs.size(),
-                       "a vec4: value #0…#3 of the record of the instance an f32 names, the table after the externs (^count)");
+                expect(t(0).isScalarFloat() && i.attr >= 0 && static_cast<size_t>(i.attr2) == module_.externs.size() &&
+                           (i.attr < core::kInstanceOwnValues
+                                ? i.type == Type::vec(4)
+                                : static_cast<uint32_t>(i.attr) < core::instanceRecordValues(module_.externs.size()) &&
+                                      i.type == module_.externs[static_cast<size_t>(i.attr - core::kInstanceOwnValues)].type),
+                       "value #k of the record of the instance an f32 names, the table after the externs (^count): a "
+                       "vec4 for #0…#3, extern #k−4's type past them");
                 break;
             case Op::ParentAlive: expect(i.type.isBool() && i.attr2 >= 1, "a bool, at least one level up"); break;
             case Op::ParentAge: expect(i.type.isScalarFloat() && i.attr2 >= 1, "an f32, at least one level up"); break;

@@ -243,6 +243,9 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
                 }
                 m.externs.push_back(x);
             }
+    // An instanced program's start takes the instance it plays (and kernels read their
+    // externs from its record: Module::instanced, from here on).
+    if (program.instanced) m.start.params.push_back({std::string(core::kInstanceParam), Type::f32()});
 
     // Objects, parents before children; nested objects get qualified names.
     std::map<const ObjectDecl*, std::string> names;
@@ -352,7 +355,6 @@ ir::Module lowerProgram(const ast::Program& program, const SourceManager& source
         }
     m.start.name = "start";
     m.start.kernel.kind = KernelKind::Start;
-    if (program.instanced) m.start.params.push_back({std::string(core::kInstanceParam), Type::f32()});
     int startSites = 0;
     ObjectLowering startLowering(m, locate, m.start.kernel, nullptr, nullptr, nullptr, startSites);
     for (auto& module : program.modules)

@@ -95,7 +95,15 @@ Values ObjectLowering::lowerName(const NameExpr& n) {
             if (t.isBool()) return {k_.boolean(v->isTrue())};
             return {k_.constant(t, t.width == 1 ? std::array<float, 4>{v->v[0], 0, 0, 0} : v->v)};
         }
-        case Ref::Kind::Extern: return {input(Op::Extern, t, module_.externIndex(r.externVar->name))};
+        case Ref::Kind::Extern: {
+            int index = module_.externIndex(r.externVar->name);
+            // An instanced program's externs are each instance's (core/instances.h): read
+            // from its record, but in a fold's term, which the checker keeps from them.
+            if (module_.instanced() && !pair_)
+                return {k_.add(Inst::make(Op::Instance, t, {instance()}, core::kInstanceOwnValues + index,
+                                          static_cast<int>(module_.externs.size())))};
+            return {input(Op::Extern, t, index)};
+        }
         case Ref::Kind::FnParam: return frames_.back().params.at(static_cast<size_t>(r.index));
         case Ref::Kind::Let: return frames_.back().lets.at(r.let);
         case Ref::Kind::Age: return {input(Op::Age, Type::f32())};

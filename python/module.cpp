@@ -176,7 +176,8 @@ public:
         }
         check(e);
     }
-    void set(const std::string& name, const py::object& values) {
+    // (instance: None for the effect's value, which sets every instance's; a handle for one's.)
+    void set(const std::string& name, const py::object& values, const py::object& instance) {
         auto held = hold();
         std::vector<float> v = floats(values, "set");
         float current[4];
@@ -186,13 +187,16 @@ public:
             raiseAs(valueTypeType(), "set: extern `" + name + "` is a " + externs()[name.c_str()].cast<std::string>() +
                                          " (" + std::to_string(width) + (width == 1 ? " number" : " numbers") +
                                          "), not " + reprOf(values));
-        check(psys_set_extern(s_, name.c_str(), v.data(), v.size()));
+        if (instance.is_none()) return check(psys_set_extern(s_, name.c_str(), v.data(), v.size()));
+        check(psys_instance_set_extern(s_, instance.cast<psys_instance>(), name.c_str(), v.data(), v.size()));
     }
-    py::object get(const std::string& name) const {
+    py::object get(const std::string& name, const py::object& instance) const {
         auto held = hold();
         float v[4];
         int width = psys_get_extern(open(), name.c_str(), v);
         if (width < 0) raiseAs(unknownNameType(), "there is no extern `" + name + "`" + known(externs()));
+        if (!instance.is_none() && psys_instance_get_extern(s_, instance.cast<psys_instance>(), name.c_str(), v) < 0)
+            raise(PyExc_ValueError, "get: no instance " + py::repr(instance).cast<std::string>() + " is playing");
         if (width == 1) return py::float_(v[0]);
         return py::tuple(py::cast(std::vector<float>(v, v + width)));
     }
@@ -602,8 +606,10 @@ PYBIND11_MODULE(_psys, m) {
     py::class_<System>(m, "System")
         .def("step", &System::step, py::arg("dt") = 1.0 / 60, py::arg("steps") = 1,
              "Advances every object by dt seconds, `steps` times.")
-        .def("set", &System::set, py::arg("extern"), py::arg("value"), "Sets an extern: a number or a sequence.")
-        .def("get", &System::get, py::arg("extern"), "An extern's value (a float or a tuple).")
+        .def("set", &System::set, py::arg("extern"), py::arg("value"), py::kw_only(), py::arg("instance") = py::none(),
+             "Sets an extern: a number or a sequence; instance=H sets one instance's (else every instance's).")
+        .def("get", &System::get, py::arg("extern"), py::kw_only(), py::arg("instance") = py::none(),
+             "An extern's value (a float or a tuple); instance=H one instance's.")
         .def("fire", &System::fire, py::arg("trigger"),
              "Fires a trigger with its arguments (numbers or sequences); instance=H fires it on one instance.")
         .def("reload", &System::reload, py::arg("source") = py::none(),

@@ -137,16 +137,30 @@ ReloadReport System::carryOver(const System& oldSystem) {
     s.nextId = old.nextId;
     s.started = old.started;
     s.stats = old.stats;
+    // Externs still there with their types keep the host's values (a new one: its default).
+    std::vector<int> oldExtern(s.module.externs.size(), -1);
     for (size_t e = 0; e < s.module.externs.size(); ++e) {
         int j = old.module.externIndex(s.module.externs[e].name);
-        if (j >= 0 && old.module.externs[static_cast<size_t>(j)].type == s.module.externs[e].type)
-            s.externs[e] = old.externs[static_cast<size_t>(j)];
+        if (j < 0 || old.module.externs[static_cast<size_t>(j)].type != s.module.externs[e].type) continue;
+        oldExtern[e] = j;
+        s.externs[e] = old.externs[static_cast<size_t>(j)];
     }
-    if (s.module.instanced() && old.module.instanced()) {  // the instances play on: slots, lives, transforms
-        s.growInstances(old.instances.size());
-        s.instances = old.instances;
-        const Value* records = old.externs.data() + old.module.externs.size() + 1;
-        std::copy(records, records + core::kInstanceRecordValues * old.instances.size(), s.instanceRecords());
+    if (s.module.instanced()) {  // the instances play on: slots, lives, transforms, their externs
+        const bool carried = old.module.instanced();
+        if (carried) {
+            s.growInstances(old.instances.size());
+            s.instances = old.instances;
+        }
+        const size_t oldValues = core::instanceRecordValues(old.module.externs.size());
+        for (size_t slot = 0; slot < s.instances.size(); ++slot) {
+            const Value* from = carried ? old.externs.data() + old.module.externs.size() + 1 + oldValues * slot : nullptr;
+            Value* to = s.instanceRecord(slot);
+            if (carried) std::copy(from, from + core::kInstanceOwnValues, to);
+            for (size_t e = 0; e < oldExtern.size(); ++e)
+                to[core::kInstanceOwnValues + e] = carried && oldExtern[e] >= 0
+                                                       ? from[core::kInstanceOwnValues + static_cast<size_t>(oldExtern[e])]
+                                                       : s.externs[e];
+        }
     }
     ++s.externsVersion;
     std::vector<int> oldTypeOf(s.pools.size(), -1);

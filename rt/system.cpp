@@ -106,7 +106,7 @@ void System::reset() {
     drawing_ = std::make_unique<detail::Drawing>(*state_);
     state_->schedule = detail::stepSchedule(*state_);
     // (Of the instances only the system's own is left, playing, where it was.)
-    const size_t own = state_->module.externs.size() + (state_->module.instanced() ? 1 + core::kInstanceRecordValues : 0);
+    const size_t own = state_->module.externs.size() + (state_->module.instanced() ? 1 + state_->instanceValues() : 0);
     externs.resize(own);
     state_->externs = std::move(externs);
     if (state_->module.instanced()) {
@@ -322,7 +322,7 @@ std::optional<std::string> System::setExtern(std::string_view name, std::span<co
     return setExtern(index, value);
 }
 
-std::optional<std::string> System::setExtern(int index, std::span<const float> value) {
+std::optional<std::string> System::checkExtern(int index, std::span<const float> value, Value& out) {
     detail::State& s = *state_;
     if (index < 0 || static_cast<size_t>(index) >= s.module.externs.size())
         return fmt::format("there is no extern with handle {}", index);
@@ -350,7 +350,19 @@ std::optional<std::string> System::setExtern(int index, std::span<const float> v
                                e.low ? (*e.low)[i] : -INFINITY, e.high ? (*e.high)[i] : INFINITY);
         }
     }
+    out = v;
+    return std::nullopt;
+}
+
+std::optional<std::string> System::setExtern(int index, std::span<const float> value) {
+    detail::State& s = *state_;
+    Value v;
+    if (auto error = checkExtern(index, value, v)) return error;
     s.externs[static_cast<size_t>(index)] = v;
+    // An instanced program reads its externs per instance: every instance takes this one.
+    if (s.module.instanced())
+        for (size_t slot = 0; slot < s.instances.size(); ++slot)
+            s.instanceRecord(slot)[core::kInstanceOwnValues + static_cast<size_t>(index)] = v;
     ++s.externsVersion;
     // A render kernel may read it: what the step drew as it went is drawn again.
     for (detail::TypeWork& w : s.work) w.inStep.fresh = false;

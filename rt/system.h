@@ -199,6 +199,7 @@ public:
     std::optional<std::string> setExtern(std::string_view name, std::span<const float> value);
     // The same by handle, for hosts that set an extern every frame: -1 for an unknown name.
     int externHandle(std::string_view name) const;
+    // (On an instanced program, every instance's value: each reads its own.)
     std::optional<std::string> setExtern(int handle, std::span<const float> value);
     // The current value of an extern (its default until set).
     std::optional<Value> externValue(std::string_view name) const;
@@ -246,6 +247,11 @@ public:
     std::optional<std::string> kill(InstanceHandle instance);  // its objects die at the next step
     // A trigger fired on one instance: what it creates belongs to it.
     std::optional<std::string> fire(std::string_view trigger, std::span<const float> args, InstanceHandle instance);
+    // An extern's value for one instance (its objects, triggers and `spawn`s read it),
+    // checked as setExtern checks it; until set, and once setExtern sets every instance's,
+    // the effect's.
+    std::optional<std::string> setInstanceExtern(InstanceHandle instance, int handle, std::span<const float> value);
+    std::optional<Value> instanceExtern(InstanceHandle instance, int handle) const;
     InstanceLife life(InstanceHandle instance) const;  // Finished also for a handle never given
     size_t instanceCount() const;                      // not finished, the system's own included
     // The instances that finished in the latest step, in slot order: a host learns of them
@@ -308,6 +314,9 @@ private:
     // The instance a handle names, or why it names none that may change.
     std::optional<std::string> liveInstance(InstanceHandle instance, uint32_t& slot) const;
     std::optional<std::string> fireOn(std::string_view trigger, std::span<const float> args, uint32_t slot);
+    // An extern's value as the host gives it, checked (its width, a bool's 0 or 1, finite,
+    // its range: counted in the stats where not): into `out`, or why not.
+    std::optional<std::string> checkExtern(int handle, std::span<const float> value, Value& out);
     void runPhases(size_t first, size_t end, double dt, double t1, bool last, double stepEnd);
     void initNewSlots(const ReloadReport& report);
 

@@ -2,7 +2,9 @@
 // `spawn`s played once per instance, all of them in the effect's pools and one update.
 // The run-time keeps the table the kernels read — each slot's transform and flags — and
 // each slot's life; an instance finishes after the step that leaves none of its objects.
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 #include <fmt/format.h>
 
@@ -51,11 +53,13 @@ void State::growInstances(size_t slots) {
     const size_t before = instances.size();
     if (slots <= before) return;
     instances.resize(slots);
-    externs.resize(module.externs.size() + 1 + core::kInstanceRecordValues * slots);
+    externs.resize(module.externs.size() + 1 + instanceValues() * slots);
     externs[module.externs.size()].f[0] = static_cast<float>(slots);
     for (size_t slot = before; slot < slots; ++slot) {
-        Value* records = instanceRecords() + core::kInstanceRecordValues * slot;
+        Value* records = instanceRecord(slot);
         writeTransform(records, {});
+        std::copy(externs.begin(), externs.begin() + static_cast<std::ptrdiff_t>(module.externs.size()),
+                  records + core::kInstanceOwnValues);
         records[core::kInstanceIndex].f[3] = static_cast<float>(slot);
         records[core::kInstancePosition].f[3] = 1;
         setLife(slot, InstanceLife::Finished);
@@ -64,7 +68,7 @@ void State::growInstances(size_t slots) {
 
 void State::setLife(size_t slot, InstanceLife life) {
     instances[slot].life = life;
-    Value* records = instanceRecords() + core::kInstanceRecordValues * slot;
+    Value* records = instanceRecord(slot);
     records[core::kInstanceEmitting].f[3] = life == InstanceLife::Playing ? 1.0f : 0.0f;
     records[core::kInstanceKilled].f[3] = life == InstanceLife::Killed || life == InstanceLife::Finished ? 1.0f : 0.0f;
     ++externsVersion;
@@ -142,7 +146,11 @@ std::optional<std::string> System::play(std::span<const float> transform, Instan
     if (slot >= (1u << 24))  // (an instance's index is a float: whole numbers are exact below 2^24)
         return std::string("a system plays at most 2^24 instances at once");
     if (slot >= s.instances.size()) s.growInstances(std::max<size_t>(slot + 1, s.instances.size() * 2));
-    writeTransform(s.instanceRecords() + core::kInstanceRecordValues * slot, transform);
+    Value* records = s.instanceRecord(slot);
+    writeTransform(records, transform);
+    // (Its externs the effect's: what the host set for all, not what a slot's last instance had.)
+    std::copy(s.externs.begin(), s.externs.begin() + static_cast<std::ptrdiff_t>(s.module.externs.size()),
+              records + core::kInstanceOwnValues);
     s.setLife(slot, InstanceLife::Playing);
     out = handle(slot, s.instances[slot].generation);
     start();
@@ -158,7 +166,7 @@ std::optional<std::string> System::setTransform(InstanceHandle instance, std::sp
     uint32_t slot = 0;
     if (auto error = liveInstance(instance, slot)) return error;
     if (auto error = checkTransform(transform)) return error;
-    writeTransform(state_->instanceRecords() + core::kInstanceRecordValues * slot, transform);
+    writeTransform(state_->instanceRecord(slot), transform);
     ++state_->externsVersion;
     return std::nullopt;
 }
@@ -184,6 +192,24 @@ std::optional<std::string> System::fire(std::string_view trigger, std::span<cons
         return fmt::format("instance {:#x} is killed: it creates nothing more", instance);
     if (auto error = checkFiring(trigger, args)) return error;
     return fireOn(trigger, args, slot);
+}
+
+std::optional<std::string> System::setInstanceExtern(InstanceHandle instance, int handle, std::span<const float> value) {
+    uint32_t slot = 0;
+    if (auto error = liveInstance(instance, slot)) return error;
+    Value v;
+    if (auto error = checkExtern(handle, value, v)) return error;
+    state_->instanceRecord(slot)[core::kInstanceOwnValues + static_cast<size_t>(handle)] = v;
+    ++state_->externsVersion;
+    for (detail::TypeWork& w : state_->work) w.inStep.fresh = false;  // (a render kernel may read it)
+    return std::nullopt;
+}
+
+std::optional<Value> System::instanceExtern(InstanceHandle instance, int handle) const {
+    uint32_t slot = 0;
+    if (liveInstance(instance, slot) || handle < 0 || static_cast<size_t>(handle) >= state_->module.externs.size())
+        return std::nullopt;
+    return state_->instanceRecord(slot)[core::kInstanceOwnValues + static_cast<size_t>(handle)];
 }
 
 InstanceLife System::life(InstanceHandle instance) const {

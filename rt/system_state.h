@@ -171,7 +171,10 @@ struct State {
     std::vector<InstanceSlot> instances;
     std::vector<InstanceHandle> finishedInstances;
     std::vector<uint32_t> instanceLive;  // finishInstances: per slot, whether a live row was seen
-    Value* instanceRecords() { return externs.data() + module.externs.size() + 1; }  // slot 0's first value
+    // A slot's record (core/instances.h): its transform, then its values of the externs.
+    size_t instanceValues() const { return core::instanceRecordValues(module.externs.size()); }
+    Value* instanceRecord(size_t slot) { return externs.data() + module.externs.size() + 1 + instanceValues() * slot; }
+    const Value* instanceRecord(size_t slot) const { return const_cast<State*>(this)->instanceRecord(slot); }
     // The table with room for `slots` slots (new ones free, their records the identity).
     void growInstances(size_t slots);
     // Where slot `slot` is in its life, and its record's flags, which follow from it

@@ -281,6 +281,15 @@ PSYS_API psys_error* psys_instance_kill(psys_system* system, psys_instance insta
 /* psys_fire on one instance: what the trigger creates belongs to it. */
 PSYS_API psys_error* psys_instance_fire(psys_system* system, psys_instance instance, const char* trigger,
                                         const float* args, size_t count);
+/* An extern's value for one instance: in an instanced program each instance reads its
+ * own, the effect's (psys_set_extern, which sets every instance's) until this sets it —
+ * a played instance starts with the effect's. Checked as psys_set_extern checks it. */
+PSYS_API psys_error* psys_instance_set_extern(psys_system* system, psys_instance instance, const char* name,
+                                              const float* values, size_t count);
+/* Its value for that instance into values[0 .. width); its width, or -1 when there is no
+ * such extern or no such instance playing. */
+PSYS_API int psys_instance_get_extern(const psys_system* system, psys_instance instance, const char* name,
+                                      float values[4]);
 PSYS_API psys_life psys_instance_life(const psys_system* system, psys_instance instance);
 /* Instances not finished, the system's own included while it lives. */
 PSYS_API size_t psys_instance_count(const psys_system* system);

@@ -374,6 +374,37 @@ def test_instances_play_at_their_transforms_and_finish():
         psys.compile(source=DOTS).play()
 
 
+def test_each_instance_reads_its_own_externs():
+    s = psys.compile(source="""
+extern spread: float = 1;
+object spark(v: vec3) {
+    pos = instance.pos + v * spread;
+    point(pos, white, 1);
+}
+object hit { emit spark(normalize(nrand3())) count 16; }
+spawn hit;
+""")
+    s.kill(0)
+    a, b = s.play(), s.play()
+    s.set("spread", 4, instance=a)
+    assert s.get("spread", instance=a) == 4 and s.get("spread", instance=b) == 1 and s.get("spread") == 1
+    s.step()
+    p = s.points("spark")
+    r = np.linalg.norm(p["position"], axis=1)
+    assert np.allclose(r[p["instance"] == (a & 0xFFFFFFFF)], 4, rtol=1e-5)
+    assert np.allclose(r[p["instance"] == (b & 0xFFFFFFFF)], 1, rtol=1e-5)
+    s.set("spread", 2)  # the effect's: every instance's
+    assert s.get("spread", instance=a) == 2
+    with pytest.raises(psys.UnknownNameError):
+        s.set("nope", 1, instance=a)
+    s.kill(b)
+    s.step()
+    with pytest.raises(psys.Error, match="has finished"):
+        s.set("spread", 3, instance=b)
+    with pytest.raises(ValueError, match="no instance"):
+        s.get("spread", instance=b)
+
+
 def test_the_instances_example_plays_two_effects_and_plots_them(tmp_path):
     out = tmp_path / "instances.png"
     r = subprocess.run([sys.executable, EXAMPLES / "python" / "instances.py", EXAMPLES / "effects" / "burst.psys",

@@ -396,3 +396,100 @@ TEST_CASE("events: an instanced program's end with the instance") {
     CHECK(seen0 > 0);
     CHECK(seenA > 0);
 }
+
+TEST_CASE("instances: each reads its own externs — the effect's until the host sets one's") {
+    const char* const source = R"(
+extern radius: float = 1 range(0, 10);
+extern lift: float = 0;
+extern lit: bool = true;
+object ring(k: float) {
+    pos = instance.pos + vec3(cos(k), 0, sin(k)) * radius + vec3(0, lift, 0);
+    point(pos, red, 1);
+    kill when age > 1 || !lit;
+}
+object hit {
+    emit ring(rand() * tau) count 8;
+    kill when age > 1;
+}
+trigger more(k: float) { emit ring(k) count radius; }
+spawn hit;
+)";
+    std::map<std::string, std::vector<float>> drawn;  // per backend: every row's y and distance
+    for (const char* backend : {"llvm", "interp"}) {
+        CAPTURE(backend);
+        Effect e(source, backend, "exact");
+        REQUIRE(message(psys_instance_kill(e.s, 0)) == "");
+        auto at0 = translation(0, 0, 0), at50 = translation(50, 0, 0);
+        psys_instance a = 0, b = 0;
+        REQUIRE(message(psys_play(e.s, at0.data(), &a)) == "");
+        REQUIRE(message(psys_play(e.s, at50.data(), &b)) == "");
+        const float two = 2, three = 3, five = 5, no = 0;
+        REQUIRE(message(psys_instance_set_extern(e.s, a, "radius", &two, 1)) == "");
+        float got[4] = {};
+        CHECK(psys_instance_get_extern(e.s, a, "radius", got) == 1);
+        CHECK(got[0] == 2);
+        CHECK(psys_instance_get_extern(e.s, b, "radius", got) == 1);
+        CHECK(got[0] == 1);
+        CHECK(psys_get_extern(e.s, "radius", got) == 1);
+        CHECK(got[0] == 1);  // (the effect's)
+        REQUIRE(message(psys_set_extern(e.s, "lift", &three, 1)) == "");  // every instance's
+        e.step();
+        auto distances = [&](int slot, float cx) {
+            std::vector<float> out;
+            auto rows = rowsBySlot(e.s, 0);
+            for (auto& p : rows[slot]) {
+                CHECK(p[1] == doctest::Approx(3));
+                out.push_back(std::hypot(p[0] - cx, p[2]));
+            }
+            return out;
+        };
+        const int sa = static_cast<int>(a & 0xffffffffu), sb = static_cast<int>(b & 0xffffffffu);
+        auto da = distances(sa, 0), db = distances(sb, 50);
+        CHECK(da.size() == 8);
+        CHECK(db.size() == 8);
+        for (float d : da) CHECK(d == doctest::Approx(2).epsilon(1e-5));
+        for (float d : db) CHECK(d == doctest::Approx(1).epsilon(1e-5));
+        // A trigger on one instance reads its values: `count radius`.
+        REQUIRE(message(psys_instance_fire(e.s, a, "more", &no, 1)) == "");
+        REQUIRE(message(psys_instance_fire(e.s, b, "more", &no, 1)) == "");
+        e.step();
+        CHECK(rowsBySlot(e.s, 0)[sa].size() == 10);
+        CHECK(rowsBySlot(e.s, 0)[sb].size() == 9);
+        // A hot reload keeps each instance's values.
+        REQUIRE(message(psys_reload(e.s, source)) == "");
+        CHECK(psys_instance_get_extern(e.s, a, "radius", got) == 1);
+        CHECK(got[0] == 2);
+        // A bool of one instance's: b's rings die, a's live on.
+        REQUIRE(message(psys_instance_set_extern(e.s, b, "lit", &no, 1)) == "");
+        e.step();
+        CHECK(rowsBySlot(e.s, 0)[sa].size() == 10);
+        CHECK(rowsBySlot(e.s, 0).count(sb) == 0);
+        for (float d : distances(sa, 0)) drawn[backend].push_back(d);
+        // The effect's value sets every instance's; a new one starts with the effect's.
+        REQUIRE(message(psys_set_extern(e.s, "radius", &five, 1)) == "");
+        CHECK(psys_instance_get_extern(e.s, a, "radius", got) == 1);
+        CHECK(got[0] == 5);
+        psys_instance c = 0;
+        REQUIRE(message(psys_play(e.s, nullptr, &c)) == "");
+        CHECK(psys_instance_get_extern(e.s, c, "lit", got) == 1);
+        CHECK(got[0] == 1);
+        // Refusals, in words, changing nothing.
+        CHECK(message(psys_instance_set_extern(e.s, a, "nope", &two, 1)) ==
+              "psys_instance_set_extern: there is no extern `nope`");
+        const float eleven = 11, half = 0.5f;
+        CHECK(message(psys_instance_set_extern(e.s, a, "radius", &eleven, 1)) ==
+              "psys_instance_set_extern: extern `radius`: 11 is outside its range [0, 10]; it keeps its value");
+        CHECK(message(psys_instance_set_extern(e.s, a, "lit", &half, 1)).find("is a bool") != std::string::npos);
+        CHECK(message(psys_instance_set_extern(e.s, a, "radius", got, 2)).find("takes 1 value, not 2") != std::string::npos);
+        CHECK(message(psys_instance_set_extern(e.s, a, "radius", nullptr, 1)) ==
+              "psys_instance_set_extern: the values is NULL");
+        REQUIRE(message(psys_instance_kill(e.s, b)) == "");
+        e.step();
+        CHECK(message(psys_instance_set_extern(e.s, b, "radius", &two, 1)).find("has finished") != std::string::npos);
+        CHECK(psys_instance_get_extern(e.s, b, "radius", got) == -1);
+        CHECK(psys_instance_get_extern(e.s, a, "nope", got) == -1);
+        CHECK(psys_instance_get_extern(e.s, a, "radius", got) == 1);
+        CHECK(got[0] == 5);
+    }
+    CHECK(drawn["llvm"] == drawn["interp"]);  // (exact maths: the same bits)
+}
