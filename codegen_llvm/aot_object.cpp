@@ -10,6 +10,7 @@
 #include <llvm/IR/Constants.h>
 #include <llvm/IR/LegacyPassManager.h>
 #include <llvm/IR/Verifier.h>
+#include <llvm/Linker/Linker.h>
 #include <llvm/MC/MCSubtargetInfo.h>
 #include <llvm/MC/TargetRegistry.h>
 #include <llvm/TargetParser/Triple.h>
@@ -176,7 +177,6 @@ AotObject buildAotObject(const ir::Module& module, const std::string& irText, co
     llvm::Type* ptr = llvm::PointerType::get(context, 0);
     auto* kernelType = llvm::StructType::get(context, {i64, i64, ptr});
     auto* cpuType = llvm::StructType::get(context, {ptr, ptr, i64, ptr});
-    std::vector<std::pair<std::string, std::string>> objects;  // member name, bytes
     std::set<std::string> calls;
     std::vector<llvm::Constant*> cpuRows;
     for (size_t c = 0; c < cpus.size(); ++c) {
@@ -194,14 +194,24 @@ AotObject buildAotObject(const ir::Module& module, const std::string& irText, co
             std::string name = prefix + "." + functionName(r, static_cast<int>(cpu.rows.size()));
             auto kernel = newModule(name);
             buildFunction(*kernel, mode, lanes, r, name);
-            llvm::Function* f = kernel->getFunction(name);
-            f->setVisibility(llvm::GlobalValue::HiddenVisibility);
             verify(*kernel);
             optimizeModule(*kernel, machine, mode, avx512);
-            objects.push_back({fmt::format("k{}.o", objects.size()), emitObject(*kernel, machine, *cpu.large)});
-            undefinedSymbols(objects.back().second, calls);
-            auto* declared = llvm::Function::Create(f->getFunctionType(), llvm::GlobalValue::ExternalLinkage, name, *table);
-            declared->setVisibility(llvm::GlobalValue::HiddenVisibility);
+            // Into the table's module, local to it: each function compiled for its CPU
+            // (its attributes), a large one at the least optimization (what the JIT does).
+            const bool large = prepareForCodegen(*kernel);
+            for (llvm::Function& f : *kernel) {
+                if (f.isDeclaration()) continue;
+                f.addFnAttr("target-cpu", machine.getTargetCPU());
+                f.addFnAttr("target-features", machine.getTargetFeatureString());
+                if (large) {
+                    f.addFnAttr(llvm::Attribute::OptimizeNone);
+                    f.addFnAttr(llvm::Attribute::NoInline);
+                }
+            }
+            if (llvm::Linker::linkModules(*table, std::move(kernel)))
+                throw std::runtime_error("LLVM could not link kernel " + name + " into the build's object");
+            llvm::Function* declared = table->getFunction(name);
+            declared->setLinkage(llvm::GlobalValue::InternalLinkage);
             cpu.rows.push_back(llvm::ConstantStruct::get(
                 kernelType, {llvm::ConstantInt::get(i64, r.key.low), llvm::ConstantInt::get(i64, r.key.high), declared}));
         }
@@ -226,18 +236,21 @@ AotObject buildAotObject(const ir::Module& module, const std::string& irText, co
                   llvm::ConstantInt::get(i64, cpuRows.size()), cpuTable, shaders,
                   text(*table, out.triple, symbol + ".target")});
     global(*table, aot, llvm::GlobalValue::ExternalLinkage, symbol);
+    // (Every function's own machine: its attributes. Its blocks were split with it.)
+    for (llvm::Function& f : *table)
+        if (!f.isDeclaration() && f.getLinkage() != llvm::GlobalValue::InternalLinkage)
+            f.setLinkage(llvm::GlobalValue::InternalLinkage);
     verify(*table);
-    objects.insert(objects.begin(), {"system.o", emitObject(*table, first, *cpus.front().large)});
-    for (const std::string& c : calls)
-        if (!c.starts_with(symbol + ".")) out.calls.push_back(c);
+    const std::string object = emitObject(*table, first, first);
+    undefinedSymbols(object, calls);
+    out.calls.assign(calls.begin(), calls.end());
 
-    // One archive: the table's member defines the psys_aot and pulls in every kernel's.
+    // One archive of one object, whose one global symbol is the psys_aot (kernels and
+    // tables are local to it: two builds linked into one host share no name).
     std::vector<llvm::NewArchiveMember> members;
-    for (auto& [name, bytes] : objects) {
-        llvm::NewArchiveMember member(llvm::MemoryBufferRef(bytes, name));
-        member.MemberName = name;
-        members.push_back(std::move(member));
-    }
+    llvm::NewArchiveMember member(llvm::MemoryBufferRef(object, "system.o"));
+    member.MemberName = "system.o";
+    members.push_back(std::move(member));
     std::string archive;
     llvm::raw_string_ostream stream(archive);
     if (llvm::Error e = llvm::writeArchiveToStream(stream, members, llvm::SymtabWritingMode::NormalSymtab,
