@@ -28,7 +28,7 @@ for name in psys psys_runtime; do
 done
 if ldd "$prefix/lib/libpsys_runtime.so" | grep -i llvm; then echo "libpsys_runtime loads LLVM"; exit 1; fi
 for f in include/psys/psys.h lib/cmake/psys/psysConfig.cmake lib/pkgconfig/psys.pc lib/pkgconfig/psys-runtime.pc \
-         share/psys/std bin/psysc; do
+         lib/pkgconfig/psys-runtime-static.pc lib/libpsys_runtime.a share/psys/std bin/psysc; do
   [ -e "$prefix/$f" ] || { echo "not installed: $f"; exit 1; }
 done
 
@@ -43,6 +43,18 @@ grep -q "drops drawn: [1-9]" "$work/minimal.out"
 "$work/examples/aot_host" 6000 | tee "$work/aot.out"
 grep -q "drops alive after 4 s" "$work/aot.out"
 if ldd "$work/examples/aot_host" | grep -i "llvm\|libpsys.so"; then echo "the AOT host loads the compiler"; exit 1; fi
+# … and linked statically (psys::runtime_static, and pkg-config's psys-runtime-static):
+# no libpsys library at run time.
+"$work/examples/aot_host_static" 6000 | tee "$work/aot-static.out"
+cmp "$work/aot.out" "$work/aot-static.out"
+"$prefix/bin/psysc" build "$src/samples/fountain.psys" -o "$work/fountain" > /dev/null
+static=$(PKG_CONFIG_PATH="$prefix/lib/pkgconfig" pkg-config --cflags --libs psys-runtime-static)
+cc -std=c99 -Wall -Wextra -Wpedantic -Werror -I"$work" -o "$work/aot-pc-static" \
+  "$src/examples/c/aot_host.c" "$work/fountain.a" $static
+for host in "$work/examples/aot_host_static" "$work/aot-pc-static"; do
+  if ldd "$host" | grep -i "llvm\|libpsys"; then echo "$host loads a psys library: not static"; exit 1; fi
+done
+"$work/aot-pc-static" 6000 | grep -q "drops alive after 4 s"
 
 # pkg-config as docs/embedding.md says it (the .pc file is relocatable: the prefix is where
 # it lies; it carries an rpath, so the binary finds the library with no LD_LIBRARY_PATH)
