@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "core/few.h"
 #include "rt/clock.h"
 
 namespace psys::interp {
@@ -11,18 +12,13 @@ using namespace ir;
 using rt::Buffer;
 using rt::ColumnLayout;
 
-// Each thread's addresses of the launch it runs, kept from launch to launch (a step
-// allocates nothing); one launch at a time on a thread.
-thread_local std::vector<void*> launchAddresses;
-
 // The columns of a launch's table on host memory, their addresses looked up once.
+// (On the stack up to 96: core/few.h, a launch allocates nothing on whatever thread runs it.)
 struct Columns {
-    std::vector<void*>& address = launchAddresses;
+    core::Few<void*, 96> address;
 
-    Columns(rt::Memory& memory, std::span<const Buffer> table) {
-        address.assign(table.size(), nullptr);
-        for (size_t i = 0; i < table.size(); ++i)
-            if (table[i].valid()) address[i] = memory.host(table[i]);
+    Columns(rt::Memory& memory, std::span<const Buffer> table) : address(table.size()) {
+        for (size_t i = 0; i < table.size(); ++i) address[i] = table[i].valid() ? memory.host(table[i]) : nullptr;
     }
     float* floats(int column) const { return static_cast<float*>(address[static_cast<size_t>(column)]); }
     Value gather(int column, int width, size_t row) const {
@@ -187,9 +183,8 @@ void Interpreter::run(const rt::ChildrenLaunch& launch) {
     columns.inputs(*launch.object, *launch.layout, launch.row, params_.data(), state_.data());
     const auto* created = rt::hostData<double>(*memory_, launch.columns[ColumnLayout::kCreated]);
     const auto* ids = rt::hostData<uint32_t>(*memory_, launch.columns[ColumnLayout::kIds]);
-    thread_local rt::ArgumentColumns arguments;  // (kept from launch to launch)
-    rt::argumentColumns(spawn, arguments);
-    const std::vector<size_t>& firstColumn = arguments.first;
+    rt::argumentColumns(spawn, arguments_);
+    const std::vector<size_t>& firstColumn = arguments_.first;
     KernelInputs in;
     in.params = params_.data();
     in.state = state_.data();

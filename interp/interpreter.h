@@ -41,6 +41,7 @@ private:
     std::vector<rt::Value> params_, state_, parents_, uniforms_, yields_;
     std::vector<ir::KernelInputs> inputs_, uniformInputs_;
     std::vector<size_t> batchRows_;
+    rt::ArgumentColumns arguments_;  // a children launch's (kept, as the vectors above, from launch to launch)
 };
 
 }  // namespace psys::interp

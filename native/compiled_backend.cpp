@@ -4,6 +4,7 @@
 #include <span>
 #include <vector>
 
+#include "core/few.h"
 #include "rt/system.h"
 
 namespace psys::native {
@@ -78,25 +79,17 @@ void* CompiledBackend::function(const Object& o, const Kernel& k, bool children,
 }
 
 namespace {
-// The host addresses of a launch's columns (null for an invalid buffer): on the stack
-// where they fit, so that a launch allocates nothing on whatever thread runs it (a
-// thread's own vector did, the first time a thread pool's worker ran a launch); past 96
-// columns on the heap.
+// The host addresses of a launch's columns (null for an invalid buffer), on the stack up
+// to 96 (core/few.h: a launch allocates nothing on whatever thread runs it).
 class Addresses {
 public:
-    Addresses(rt::HostMemory& memory, std::span<const rt::Buffer> columns) {
-        if (columns.size() > few_.size()) {
-            many_.resize(columns.size());
-            data_ = many_.data();
-        }
+    Addresses(rt::HostMemory& memory, std::span<const rt::Buffer> columns) : data_(columns.size()) {
         for (size_t i = 0; i < columns.size(); ++i) data_[i] = columns[i].valid() ? memory.host(columns[i]) : nullptr;
     }
-    void** data() { return data_; }
+    void** data() { return data_.data(); }
 
 private:
-    std::array<void*, 96> few_;
-    std::vector<void*> many_;
-    void** data_ = few_.data();
+    core::Few<void*, 96> data_;
 };
 }  // namespace
 

@@ -1,8 +1,10 @@
 #include "rt/system_draw.h"
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <mutex>
+#include <span>
 
 #include "rt/system_support.h"
 
@@ -16,15 +18,16 @@ void markDrawn(Memory& memory, const RowsLaunch& launch, const uint8_t* mask, si
     const ColumnLayout& layout = *launch.layout;
     auto column = [&](int c) { return launch.columns[static_cast<size_t>(layout.drawnFrom(c))]; };
     float* visible = hostData<float>(memory, column(ColumnLayout::kVisible));
-    // Every drawn value's column: position … a trail's last point (each thread's vector,
-    // kept from launch to launch).
-    thread_local std::vector<const float*> values;
-    values.clear();
+    // Every drawn value's column: position … a trail's last point (on the stack: a launch
+    // allocates nothing on whatever thread runs it).
+    std::array<const float*, ColumnLayout::kRenderColumns> columns{};
+    size_t count = 0;
     bool constantsFinite = true;       // the constant components: the same for every row
     for (int c = ColumnLayout::kPosition; c < layout.renderColumns; ++c) {
         if (auto k = layout.constant(c)) constantsFinite &= std::isfinite(*k);
-        else values.push_back(viewData<float>(memory, column(c)));
+        else columns[count++] = viewData<float>(memory, column(c));
     }
+    const std::span<const float* const> values(columns.data(), count);
     for (size_t row = begin; row < end; ++row) {
         if (!mask[row] || visible[row] == 0) {
             visible[row] = 0;

@@ -6,6 +6,7 @@
 #include <bit>
 #include <stdexcept>
 
+#include "core/few.h"
 #include "core/fold.h"
 #include "rt/system_support.h"
 
@@ -389,11 +390,10 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
     if (pools[type].parentRows.valid() && !poolRows)
         gatherThrough(type, layout, table, pools[type].parentRows, begin, begin, end, at,
                       atRows ? pools[type].created : Buffer{});
-    // (Each thread's, kept from launch to launch: chunks gather on every thread, and a
-    // step allocates nothing.)
-    thread_local std::vector<uint32_t> rows;
-    thread_local std::vector<float> values;
-    rows.resize(end - begin);
+    // (On the stack up to a chunk: chunks gather on every thread, and a launch allocates
+    // nothing on whatever thread runs it — core/few.h.)
+    core::Few<uint32_t, kRowsPerChunk> rows(end - begin);
+    core::Few<float, kRowsPerChunk> values(end - begin);
     int rowsDepth = -1;
     for (const auto& p : layout.parentColumns) {
         // A pool's launch: its folds copied row for row (on a device, no list sent; no mask
@@ -421,10 +421,10 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
         }
         if (p.op == ir::Op::Fold) {  // this object's own folds (rows: its own)
             const Pool& pool = pools[type];
-            foldRowsOf(type, rows);
+            foldRowsOf(type, rows.span());
             for (int c = 0; c < p.width; ++c)
                 memory.gather(pool.folds.column(static_cast<size_t>(p.exportIndex), static_cast<size_t>(c)),
-                              table[static_cast<size_t>(p.offset + c)], begin, rows);
+                              table[static_cast<size_t>(p.offset + c)], begin, rows.span());
             rowsDepth = -1;
             continue;
         }
@@ -437,11 +437,11 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
                 }
                 const Pool& parent = pools[static_cast<size_t>(parentType)];
                 memory.gather(parent.exports.column(static_cast<size_t>(p.exportIndex), static_cast<size_t>(c)), to, begin,
-                              rows);
+                              rows.span());
             }
             continue;
         }
-        values.assign(end - begin, 0.0f);
+        std::fill_n(values.data(), values.size(), 0.0f);
         for (size_t i = begin; i < end; ++i) {
             if (rows[i - begin] == kSkipRow) continue;
             const Pool& parent = pools[static_cast<size_t>(parentType)];
