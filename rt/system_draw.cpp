@@ -6,6 +6,7 @@
 #include <mutex>
 #include <span>
 
+#include "core/few.h"
 #include "rt/system_support.h"
 
 namespace psys::rt {
@@ -18,9 +19,10 @@ void markDrawn(Memory& memory, const RowsLaunch& launch, const uint8_t* mask, si
     const ColumnLayout& layout = *launch.layout;
     auto column = [&](int c) { return launch.columns[static_cast<size_t>(layout.drawnFrom(c))]; };
     float* visible = hostData<float>(memory, column(ColumnLayout::kVisible));
-    // Every drawn value's column: position … a trail's last point (on the stack: a launch
-    // allocates nothing on whatever thread runs it).
-    std::array<const float*, ColumnLayout::kRenderColumns> columns{};
+    // Every drawn value's column: position … a trail's last point (a trail's points are
+    // columns past kRenderColumns; on the stack: a launch allocates nothing on whatever
+    // thread runs it, core/few.h).
+    core::Few<const float*, 64> columns(static_cast<size_t>(std::max(layout.renderColumns - ColumnLayout::kPosition, 0)));
     size_t count = 0;
     bool constantsFinite = true;       // the constant components: the same for every row
     for (int c = ColumnLayout::kPosition; c < layout.renderColumns; ++c) {

@@ -43,6 +43,9 @@ std::string caseText(const Case& c) {
             case Event::Kind::Fire: out += fmt::format("{}fire {}", kMark, e.name); break;
             case Event::Kind::Set: out += fmt::format("{}set {}", kMark, e.name); break;
             case Event::Kind::Reload: out += fmt::format("{}reload", kMark); break;
+            case Event::Kind::Play: out += fmt::format("{}play", kMark); break;
+            case Event::Kind::Stop: out += fmt::format("{}stop", kMark); break;
+            case Event::Kind::Kill: out += fmt::format("{}kill", kMark); break;
         }
         for (float v : e.values) out += fmt::format(" {}", v);
         out += fmt::format(" @{}\n", e.frame);
@@ -88,10 +91,16 @@ std::optional<Case> parseCase(const std::string& text, const std::string& edit, 
             std::string what;
             if (!(words >> what) || what != "fast") return fail("`compare fast`");
             c.compareFast = true;
-        } else if (word == "fire" || word == "set" || word == "reload") {
+        } else if (word == "fire" || word == "set" || word == "reload" || word == "play" || word == "stop" ||
+                   word == "kill") {
             Event e;
-            e.kind = word == "fire" ? Event::Kind::Fire : word == "set" ? Event::Kind::Set : Event::Kind::Reload;
-            if (e.kind != Event::Kind::Reload) words >> e.name;
+            e.kind = word == "fire"   ? Event::Kind::Fire
+                     : word == "set"  ? Event::Kind::Set
+                     : word == "play" ? Event::Kind::Play
+                     : word == "stop" ? Event::Kind::Stop
+                     : word == "kill" ? Event::Kind::Kill
+                                      : Event::Kind::Reload;
+            if (e.kind == Event::Kind::Fire || e.kind == Event::Kind::Set) words >> e.name;
             std::string w;
             bool at = false;
             while (words >> w) {
@@ -112,6 +121,9 @@ std::optional<Case> parseCase(const std::string& text, const std::string& edit, 
             }
             if (!at) return fail("an event needs its frame, @N");
             if (e.kind == Event::Kind::Reload && edit.empty()) return fail("a reload needs the case's .edit.psys");
+            if (e.kind == Event::Kind::Play && e.values.size() != 3) return fail("a play takes a translation, X Y Z");
+            if ((e.kind == Event::Kind::Stop || e.kind == Event::Kind::Kill) && e.values.size() != 1)
+                return fail("which instance the case played, from 0");
             c.events.push_back(e);
         } else {
             return fail("unknown directive");

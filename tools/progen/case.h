@@ -9,6 +9,8 @@
 //   //! set wind 1 0 0 @30
 //   //! reload @60                 (NAME.edit.psys, before the step of frame 60)
 //   //! compare fast               (fast maths must decide as exact maths: generator.h)
+//   //! play 2 0 -1 @5             (an instance of an instanced program, translated so)
+//   //! stop 0 @50                 (the first instance the case played; `kill 0` kills it)
 #pragma once
 
 #include <cstdint>
@@ -19,10 +21,10 @@
 namespace psys::progen {
 
 struct Event {
-    enum class Kind { Fire, Set, Reload } kind = Kind::Fire;
+    enum class Kind { Fire, Set, Reload, Play, Stop, Kill } kind = Kind::Fire;
     int frame = 0;
     std::string name;           // the trigger or extern
-    std::vector<float> values;  // its arguments or value
+    std::vector<float> values;  // its arguments or value; a play's translation; which played instance
 };
 
 struct Case {

@@ -46,7 +46,8 @@ private:
 
 class Builder {
 public:
-    Builder(uint64_t seed, bool ageControlled) : r_(seed), more_(seed ^ 0x5eed5eed5eed5eedull), age_(ageControlled) {}
+    Builder(uint64_t seed, bool ageControlled)
+        : r_(seed), more_(seed ^ 0x5eed5eed5eed5eedull), events_(seed ^ 0xe7e27e27e27e27e2ull), age_(ageControlled) {}
 
     Model build() {
         int externs = r_.between(0, 2);
@@ -70,6 +71,7 @@ public:
         for (int i = 0; i < triggers; ++i) addTrigger(i);
         addSpawns();
         capPopulations();
+        notifications();
         if (r_.chance(0.1)) m_.fileAttr = r_.pick(std::vector<std::string>{"@integrator(rk4);", "@integrator(midpoint);", "@integrator(euler);"});
         return m_;
     }
@@ -86,6 +88,7 @@ public:
 
 private:
     Rng r_, more_;
+    Rng events_;  // notifications and instances: a stream of their own (every seed's program is otherwise what it was)
     bool age_, flat_ = false;
     Model m_;
 
@@ -306,6 +309,28 @@ private:
         for (const std::string& a : attributes(t)) t.attrs.push_back(a);
     }
 
+    // Some types tell the host what happens (`notify`: in the body, in a `when`, `on death`),
+    // and some programs are instanced (their draws at `instance.pos`): the case then plays
+    // instances, stops and kills them (generate()).
+    void notifications() {
+        Rng& r = events_;
+        for (size_t i = 0; i < m_.types.size(); ++i) {
+            Type& t = m_.types[i];
+            if (!r.chance(0.25)) continue;
+            switch (r.below(3)) {
+                case 0: t.notifies.push_back(fmt::format("notify \"seen{}\"(pos, age);", i)); break;
+                case 1:
+                    t.notifies.push_back(fmt::format("when age > {} {{ notify \"old{}\"(age); }}", num(r.real(0.05, 1)), i));
+                    break;
+                default: t.deathNotifies.push_back(fmt::format("notify \"gone{}\"(pos.y);", i)); break;
+            }
+        }
+        if (!r.chance(0.2)) return;
+        m_.instanced = true;
+        for (Type& t : m_.types)
+            if (!t.draw.empty()) t.draw = std::regex_replace(t.draw, std::regex("^(\\w+)\\(pos"), "$1(instance.pos + pos");
+    }
+
     std::vector<std::string> attributes(const Type& t) {
         std::vector<std::string> out;
         if (r_.chance(0.15)) out.push_back(r_.chance(0.5) ? "@step(1 / 240)" : "@step(0.007)");
@@ -510,6 +535,22 @@ Case generate(uint64_t seed) {
         e.frame = r.between(1, c.frames - 1);
         for (int c = 0; c < (x.ty == Ty::Vec3 ? 3 : 1); ++c) e.values.push_back(static_cast<float>(r.real(x.lo, x.hi)));
         c.events.push_back(e);
+    }
+    if (m.instanced) {  // (its own draws: a stream of its own, so the other events are what they were)
+        Rng plays(seed ^ 0x91a7591a7591a75ull);
+        int played = plays.between(1, 3);
+        for (int i = 0; i < played; ++i) {
+            Event e;
+            e.kind = Event::Kind::Play;
+            e.frame = plays.between(0, c.frames / 2);
+            for (int k = 0; k < 3; ++k) e.values.push_back(static_cast<float>(plays.real(-4, 4)));
+            c.events.push_back(e);
+        }
+        Event end;
+        end.kind = plays.chance(0.5) ? Event::Kind::Stop : Event::Kind::Kill;
+        end.frame = plays.between(c.frames / 2, c.frames - 1);
+        end.values.push_back(static_cast<float>(plays.below(static_cast<size_t>(played))));
+        c.events.push_back(end);
     }
     if (r.chance(0.6)) {
         Model edited = m;

@@ -59,6 +59,9 @@ void printType(const Model& m, int index, int indent, std::string& out) {
     if (!t.whenKill.empty()) out += fmt::format("{}when {} {{ kill; }}\n", in, t.whenKill);
     for (const Emit& e : t.emits)
         if (e.kind != Emit::Death) out += in + emitText(e, m.types) + "\n";
+    for (const std::string& n : t.notifies) out += in + n + "\n";
+    if (dies)
+        for (const std::string& n : t.deathNotifies) out += fmt::format("{}on death {{ {} }}\n", in, n);
     for (int c : t.children) printType(m, c, indent + 4, out);
     out += pad + "}\n";
 }

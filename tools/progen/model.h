@@ -36,6 +36,9 @@ struct Type {
     std::vector<std::string> kills;  // conditions
     std::string whenKill;           // a `when C { kill; }` condition, or empty
     std::vector<Emit> emits;
+    // Notifications (`notify "NAME"(…)`, docs/language.md "Events"): whole statements, those
+    // `on death` printed only where the type dies (as its death emits are).
+    std::vector<std::string> notifies, deathNotifies;
     std::vector<int> children;
     bool hasVel = false, removed = false;
     int foldOver = -1;  // the type its `crowd` fold reads
@@ -59,6 +62,7 @@ struct Model {
     std::vector<Trigger> triggers;
     std::vector<std::pair<int, std::vector<std::string>>> spawns;
     std::string fileAttr;
+    bool instanced = false;  // its draws read `instance.pos`: the case plays instances
 };
 
 // The program's text.

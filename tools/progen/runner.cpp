@@ -1,9 +1,11 @@
 #include "tools/progen/runner.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <span>
 
 #include <fmt/format.h>
 
@@ -41,6 +43,7 @@ struct Side {
     Config config;
     std::shared_ptr<rt::Backend> backend;
     std::unique_ptr<rt::System> system;
+    std::vector<rt::InstanceHandle> played;  // the case's plays, in order
 };
 
 // A case with an edit reloads: its systems are compiled as a host that reloads compiles
@@ -101,12 +104,13 @@ public:
     std::optional<Finding> go() {
         for (const Config& config : options_.configs) {
             if (config.backend == "llvm" && !config.exact && !options_.compareFast) continue;
-            Side side{config, nullptr, nullptr};
+            Side side{config, nullptr, nullptr, {}};
             std::string error;
             side.backend = makeBackend(config, error);
             if (!side.backend) return Finding{config.label, "error", -1, "the backend cannot start: " + error};
             auto module = compile(c_.source, config.backend == "llvm" && !config.exact, !c_.edit.empty(), error);
             if (!module) return Finding{config.label, "compile", -1, error};
+            if (rt::System::checkBackend(*module, *side.backend)) continue;  // (the glsl backend plays no instances yet)
             rt::SystemOptions systemOptions;
             if (config.rowsInMemory) {  // (drawn after the step, as the GPU draws: a type drawn as the
                 systemOptions.rows = rt::SystemOptions::Rows::InMemory;  // step goes keeps its rows on the host)
@@ -125,6 +129,7 @@ public:
                 if (auto found = event(c_.events[next], f)) return found;
             if (auto found = each(f, "step", [&](rt::System& s) { return s.step(c_.stepAt(f)); })) return found;
             if (auto found = compareDrawn(f)) return found;
+            if (auto found = compareEvents(f)) return found;
             if ((f + 1) % kRowsEvery == 0 || f + 1 == c_.frames)
                 if (auto found = compareRows(f)) return found;
         }
@@ -156,6 +161,30 @@ private:
                 return each(f, "fire", [&](rt::System& s) { return s.fire(e.name, e.values); });
             case Event::Kind::Set:
                 return each(f, "set", [&](rt::System& s) { return s.setExtern(e.name, e.values); });
+            case Event::Kind::Play: {
+                std::array<float, 16> m = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, e.values.at(0), e.values.at(1), e.values.at(2), 1};
+                if (auto found = each(f, "play", [&](rt::System& s) {
+                        rt::InstanceHandle h = 0;
+                        auto error = s.play(m, h);
+                        for (Side& side : sides_)
+                            if (side.system.get() == &s && !error) side.played.push_back(h);
+                        return error;
+                    }))
+                    return found;
+                for (size_t i = 1; i < sides_.size(); ++i)
+                    if (sides_[i].played != sides_[0].played)
+                        return Finding{sides_[i].config.label, "instances", f, "a play's handle is not the interpreter's"};
+                return std::nullopt;
+            }
+            case Event::Kind::Stop: case Event::Kind::Kill: {
+                auto k = static_cast<size_t>(e.values.at(0));
+                if (k >= sides_[0].played.size()) return std::nullopt;  // (not played yet: a shrunk case)
+                size_t side = 0;
+                return each(f, e.kind == Event::Kind::Stop ? "stop" : "kill", [&](rt::System& s) {
+                    rt::InstanceHandle h = sides_[side++].played[k];
+                    return e.kind == Event::Kind::Stop ? s.stop(h) : s.kill(h);
+                });
+            }
             case Event::Kind::Reload:
                 for (Side& side : sides_) {
                     std::string error;
@@ -199,6 +228,42 @@ private:
                     }
                 }
             }
+        }
+        return std::nullopt;
+    }
+
+    // The step's notifications, name by name, in the same order with the same values; the
+    // instances that finished in it.
+    std::optional<Finding> compareEvents(int f) {
+        rt::System& a = *sides_[0].system;
+        std::vector<float> va, vb;
+        size_t wa = 0, wb = 0;
+        for (const std::string& name : a.eventNames()) {
+            if (auto error = a.events(name, va, wa)) return Finding{sides_[0].config.label, "error", f, *error};
+            for (size_t i = 1; i < sides_.size(); ++i) {
+                const Side& side = sides_[i];
+                if (auto error = side.system->events(name, vb, wb)) return Finding{side.config.label, "error", f, *error};
+                if (va.size() != vb.size() || wa != wb)
+                    return Finding{side.config.label, "events", f,
+                                   fmt::format("`{}`: {} notified, the interpreter {}", name, wb ? vb.size() / wb : 0,
+                                               wa ? va.size() / wa : 0)};
+                for (size_t k = 0; k < va.size(); ++k) {
+                    bool same = side.config.bitwise() ? std::memcmp(&va[k], &vb[k], sizeof(float)) == 0
+                                                      : std::fabs(double(va[k]) - double(vb[k])) /
+                                                                std::max(1.0, std::fabs(double(va[k]))) <=
+                                                            options_.tolerance;
+                    if (!same && (side.config.bitwise() || !folds_ || f < kCrowdFrames))
+                        return Finding{side.config.label, "events", f,
+                                       fmt::format("`{}`: value {} is {}, the interpreter's {}", name, k, vb[k], va[k])};
+                }
+            }
+        }
+        std::span<const rt::InstanceHandle> done = a.finishedInstances();
+        for (size_t i = 1; i < sides_.size(); ++i) {
+            std::span<const rt::InstanceHandle> other = sides_[i].system->finishedInstances();
+            if (!std::equal(done.begin(), done.end(), other.begin(), other.end()))
+                return Finding{sides_[i].config.label, "instances", f,
+                               fmt::format("{} instances finished, the interpreter's {}", other.size(), done.size())};
         }
         return std::nullopt;
     }

@@ -34,7 +34,8 @@ std::vector<std::string> configNames();
 struct Finding {
     std::string config;  // the backend that differs from the interpreter (or failed)
     // compile (the program does not compile: a generator's or compiler's fault), error (a
-    // step, fire or set failed on one side only), ids, values, rows, counts, crash, timeout
+    // step, fire, set or play failed on one side only), ids, values, rows, counts, events
+    // (notifications or finished instances), instances (handles), crash, timeout
     std::string kind;
     int frame = -1;
     std::string detail;
