@@ -21,6 +21,8 @@
 using psys::capi::guarded;
 using psys::capi::makeError;
 using psys::capi::nullArgument;
+static_assert(PSYS_AOT_ABI == psys::native::kAotAbi, "the header's AOT ABI is the one psysc build writes");
+
 namespace rt = psys::rt;
 
 namespace {

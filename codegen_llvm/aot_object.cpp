@@ -179,6 +179,7 @@ AotObject buildAotObject(const ir::Module& module, const std::string& irText, co
     auto* cpuType = llvm::StructType::get(context, {ptr, ptr, i64, ptr});
     std::set<std::string> calls;
     std::vector<llvm::Constant*> cpuRows;
+    std::unique_ptr<llvm::Module> largeKernels;  // (none, mostly)
     for (size_t c = 0; c < cpus.size(); ++c) {
         CpuKernels& cpu = cpus[c];
         llvm::TargetMachine& machine = *cpu.machine;
@@ -196,22 +197,29 @@ AotObject buildAotObject(const ir::Module& module, const std::string& irText, co
             buildFunction(*kernel, mode, lanes, r, name);
             verify(*kernel);
             optimizeModule(*kernel, machine, mode, avx512);
-            // Into the table's module, local to it: each function compiled for its CPU
-            // (its attributes), a large one at the least optimization (what the JIT does).
+            // Into the table's module, local to it, each function compiled for its CPU (its
+            // attributes) — but a kernel too large for the optimizing code generator, which
+            // goes into an object of its own made as the JIT makes it (CodeGenOptLevel::
+            // None: the register allocator is the machine's, not a function's), its symbol
+            // hidden.
             const bool large = prepareForCodegen(*kernel);
             for (llvm::Function& f : *kernel) {
                 if (f.isDeclaration()) continue;
                 f.addFnAttr("target-cpu", machine.getTargetCPU());
                 f.addFnAttr("target-features", machine.getTargetFeatureString());
-                if (large) {
-                    f.addFnAttr(llvm::Attribute::OptimizeNone);
-                    f.addFnAttr(llvm::Attribute::NoInline);
-                }
             }
-            if (llvm::Linker::linkModules(*table, std::move(kernel)))
+            llvm::Module& into = large ? (largeKernels ? *largeKernels : *(largeKernels = newModule(symbol + ".large"))) : *table;
+            llvm::FunctionType* type = kernel->getFunction(name)->getFunctionType();
+            if (llvm::Linker::linkModules(into, std::move(kernel)))
                 throw std::runtime_error("LLVM could not link kernel " + name + " into the build's object");
             llvm::Function* declared = table->getFunction(name);
-            declared->setLinkage(llvm::GlobalValue::InternalLinkage);
+            if (large) {
+                into.getFunction(name)->setVisibility(llvm::GlobalValue::HiddenVisibility);
+                declared = llvm::Function::Create(type, llvm::GlobalValue::ExternalLinkage, name, *table);
+                declared->setVisibility(llvm::GlobalValue::HiddenVisibility);
+            } else {
+                declared->setLinkage(llvm::GlobalValue::InternalLinkage);
+            }
             cpu.rows.push_back(llvm::ConstantStruct::get(
                 kernelType, {llvm::ConstantInt::get(i64, r.key.low), llvm::ConstantInt::get(i64, r.key.high), declared}));
         }
@@ -231,7 +239,7 @@ AotObject buildAotObject(const ir::Module& module, const std::string& irText, co
     llvm::Constant* shaders = glsl.empty() ? llvm::ConstantPointerNull::get(llvm::PointerType::get(context, 0))
                                            : text(*table, glsl, symbol + ".glsl");
     llvm::Constant* aot = llvm::ConstantStruct::get(
-        aotType, {llvm::ConstantInt::get(i32, 2), llvm::ConstantInt::get(i32, mode == MathMode::Exact ? 1 : 0),
+        aotType, {llvm::ConstantInt::get(i32, native::kAotAbi), llvm::ConstantInt::get(i32, mode == MathMode::Exact ? 1 : 0),
                   text(*table, symbol, symbol + ".name"), text(*table, irText, symbol + ".ir"),
                   llvm::ConstantInt::get(i64, cpuRows.size()), cpuTable, shaders,
                   text(*table, out.triple, symbol + ".target")});
@@ -241,16 +249,25 @@ AotObject buildAotObject(const ir::Module& module, const std::string& irText, co
         if (!f.isDeclaration() && f.getLinkage() != llvm::GlobalValue::InternalLinkage)
             f.setLinkage(llvm::GlobalValue::InternalLinkage);
     verify(*table);
-    const std::string object = emitObject(*table, first, first);
-    undefinedSymbols(object, calls);
-    out.calls.assign(calls.begin(), calls.end());
+    std::vector<std::pair<std::string, std::string>> objects;  // member name, bytes
+    objects.push_back({"system.o", emitObject(*table, first, first)});
+    if (largeKernels) {
+        verify(*largeKernels);
+        objects.push_back({"large.o", emitObject(*largeKernels, first, *cpus.front().large)});
+    }
+    for (const auto& [name, bytes] : objects) undefinedSymbols(bytes, calls);
+    for (const std::string& c : calls)
+        if (!c.starts_with(symbol + ".")) out.calls.push_back(c);
 
-    // One archive of one object, whose one global symbol is the psys_aot (kernels and
-    // tables are local to it: two builds linked into one host share no name).
+    // One archive: system.o's one global symbol is the psys_aot (kernels and tables are
+    // local to it: two builds linked into one host share no name), and large.o, where a
+    // build has one, holds the kernels too large for it, hidden.
     std::vector<llvm::NewArchiveMember> members;
-    llvm::NewArchiveMember member(llvm::MemoryBufferRef(object, "system.o"));
-    member.MemberName = "system.o";
-    members.push_back(std::move(member));
+    for (auto& [name, bytes] : objects) {
+        llvm::NewArchiveMember member(llvm::MemoryBufferRef(bytes, name));
+        member.MemberName = name;
+        members.push_back(std::move(member));
+    }
     std::string archive;
     llvm::raw_string_ostream stream(archive);
     if (llvm::Error e = llvm::writeArchiveToStream(stream, members, llvm::SymtabWritingMode::NormalSymtab,

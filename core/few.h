@@ -1,7 +1,9 @@
 // Few<T, N>: a call's scratch of n elements, on the stack up to N and on the heap past
 // it, so that a launch allocates nothing on whatever thread runs it — a thread's own
 // vector (thread_local) did, the first time a thread pool's worker ran a launch, which a
-// steady state may meet at any step (tests/capi/allocation_test.cpp). Its elements start
+// steady state may meet at any step (tests/capi/allocation_test.cpp). Past N it takes a
+// vector of its own, or the caller's (`spill`, kept from call to call: it grows once).
+// N stays small (a host's thread may have a small stack). Its elements start
 // uninitialized; it is neither copied nor moved (its data may be its own array).
 #pragma once
 
@@ -19,6 +21,12 @@ public:
         if (n > N) {
             many_.resize(n);
             data_ = many_.data();
+        }
+    }
+    Few(size_t n, std::vector<T>& spill) : size_(n) {
+        if (n > N) {
+            if (spill.size() < n) spill.resize(n);
+            data_ = spill.data();
         }
     }
     Few(const Few&) = delete;

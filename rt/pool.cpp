@@ -166,7 +166,13 @@ void Pool::reserveRows() {
 void Pool::populate(size_t rows) {
     if (memory_->allocator()) {  // room for them from the host's allocator, whose memory is the host's to page
         rows = std::min(rows, capacity_);
-        forEachRowColumn([&](Buffer b) { memory_->reserve(b, rows); });
+        try {
+            forEachRowColumn([&](Buffer b) { memory_->reserve(b, rows); });
+        } catch (...) {
+            updatable.reserved(*memory_);  // (a mask column that moved before the failure)
+            alive.reserved(*memory_);
+            throw;
+        }
         updatable.reserved(*memory_);
         alive.reserved(*memory_);
         room_ = std::max(room_, rows);
@@ -240,6 +246,10 @@ Pool::~Pool() {
 }
 
 void Pool::grow(size_t n) {
+    // Room for n rows in everything first, which may fail (the host's allocator: std::
+    // bad_alloc) and changes no row count; then the resizes, which cannot. A failed growth
+    // leaves the pool as it was, no column shorter than its rows.
+    roomFor(n);
     if (inMemory_) {
         highWater_ = n;
         for (Buffer b : {rows_.stack, rows_.generation, rows_.readers, rows_.waiting, parentRows, frozenAt})
@@ -258,6 +268,29 @@ void Pool::grow(size_t n) {
     state.resize(*memory_, n);
     params.resize(*memory_, n);
     exports.resize(*memory_, n);
+}
+
+void Pool::roomFor(size_t n) {
+    if (n <= rows()) return;
+    try {
+        // (Doubled, as a resize would — growth stays amortized — up to the capacity, the
+        // most a pool holds: what reserveRows took room for is never exceeded.)
+        const size_t room = std::max(n, std::min(2 * rows(), capacity_));
+        forEachRowColumn([&](Buffer b) { memory_->reserve(b, room); });
+        updatable.reserved(*memory_);
+        alive.reserved(*memory_);
+        if (!inMemory_) {
+            if (status_.capacity() < n) status_.reserve(room);
+            if (generation_.capacity() < n) generation_.reserve(room);
+        }
+        if (parent.capacity() < n) parent.reserve(room);
+        if (readers.capacity() < n) readers.reserve(room);
+        if (diedAt.capacity() < n) diedAt.reserve(room);
+    } catch (...) {
+        updatable.reserved(*memory_);  // (a mask column that moved before the failure)
+        alive.reserved(*memory_);
+        throw;
+    }
 }
 
 void Pool::countsDownParent(Buffer parentReaders) {

@@ -291,6 +291,9 @@ private:
     mutable std::vector<uint8_t> mask_;
     void fetch() const;  // the host copies of the rows in the memory, where they are stale
     void reserveRows();
+    // Room for n rows in every column and host array (grow's first half: it may fail and
+    // changes no row count).
+    void roomFor(size_t n);
     // f(column) for each valid column a row has (bookkeeping, emitters' accumulators, state,
     // parameters, exports): what reserveRows and populate take room for.
     void forEachRowColumn(core::FunctionRef<void(Buffer)> f) const;

@@ -143,8 +143,10 @@ std::optional<std::string> System::play(std::span<const float> transform, Instan
     // The lowest free slot past the system's own (it is the system's, played by fire()).
     slot = 1;
     while (slot < s.instances.size() && s.instances[slot].life != InstanceLife::Finished) ++slot;
-    if (slot >= (1u << 24))  // (an instance's index is a float: whole numbers are exact below 2^24)
-        return std::string("a system plays at most 2^24 instances at once");
+    // (An instance's index is a float: whole numbers are exact below 2^24; and a record's
+    // place in the table is a 32-bit index.)
+    const size_t most = std::min<size_t>(size_t{1} << 24, (size_t{1} << 31) / s.instanceValues());
+    if (slot >= most) return fmt::format("a system of this program plays at most {} instances at once", most);
     if (slot >= s.instances.size()) s.growInstances(std::max<size_t>(slot + 1, s.instances.size() * 2));
     Value* records = s.instanceRecord(slot);
     writeTransform(records, transform);

@@ -23,8 +23,9 @@ Buffer Scratch::at(size_t index, Elem elem, size_t rows, size_t room) {
     while (buffers_.size() <= index) buffers_.push_back({});
     Buffer& b = buffers_[index];
     if (!b.valid() || memory_->elem(b) != elem) {
+        Buffer made = memory_->create(elem, rows);  // (first: a failure leaves b as it was)
         if (b.valid()) memory_->release(b);
-        b = memory_->create(elem, rows);
+        b = made;
     } else if (memory_->rows(b) < rows) {
         memory_->resize(b, rows);
     }
@@ -390,10 +391,13 @@ void State::gatherParents(size_t type, const ColumnLayout& layout, std::span<con
     if (pools[type].parentRows.valid() && !poolRows)
         gatherThrough(type, layout, table, pools[type].parentRows, begin, begin, end, at,
                       atRows ? pools[type].created : Buffer{});
-    // (On the stack up to a chunk: chunks gather on every thread, and a launch allocates
-    // nothing on whatever thread runs it — core/few.h.)
-    core::Few<uint32_t, kRowsPerChunk> rows(end - begin);
-    core::Few<float, kRowsPerChunk> values(end - begin);
+    // (On the stack up to 1,024 rows — chunks gather on every thread, and a launch
+    // allocates nothing on whatever thread runs it: core/few.h — past them in the
+    // thread's own vectors, kept from launch to launch.)
+    thread_local std::vector<uint32_t> manyRows;
+    thread_local std::vector<float> manyValues;
+    core::Few<uint32_t, 1024> rows(end - begin, manyRows);
+    core::Few<float, 1024> values(end - begin, manyValues);
     int rowsDepth = -1;
     for (const auto& p : layout.parentColumns) {
         // A pool's launch: its folds copied row for row (on a device, no list sent; no mask

@@ -110,7 +110,8 @@ public:
             if (!side.backend) return Finding{config.label, "error", -1, "the backend cannot start: " + error};
             auto module = compile(c_.source, config.backend == "llvm" && !config.exact, !c_.edit.empty(), error);
             if (!module) return Finding{config.label, "compile", -1, error};
-            if (rt::System::checkBackend(*module, *side.backend)) continue;  // (the glsl backend plays no instances yet)
+            if (module->instanced() && rt::System::checkBackend(*module, *side.backend))
+                continue;  // (the glsl backend plays no instances yet)
             rt::SystemOptions systemOptions;
             if (config.rowsInMemory) {  // (drawn after the step, as the GPU draws: a type drawn as the
                 systemOptions.rows = rt::SystemOptions::Rows::InMemory;  // step goes keeps its rows on the host)
