@@ -208,7 +208,8 @@ AotObject buildAotObject(const ir::Module& module, const std::string& irText, co
                 f.addFnAttr("target-cpu", machine.getTargetCPU());
                 f.addFnAttr("target-features", machine.getTargetFeatureString());
             }
-            llvm::Module& into = large ? (largeKernels ? *largeKernels : *(largeKernels = newModule(symbol + ".large"))) : *table;
+            if (large && !largeKernels) largeKernels = newModule(symbol + ".large");
+            llvm::Module& into = large ? *largeKernels : *table;
             llvm::FunctionType* type = kernel->getFunction(name)->getFunctionType();
             if (llvm::Linker::linkModules(into, std::move(kernel)))
                 throw std::runtime_error("LLVM could not link kernel " + name + " into the build's object");
