@@ -112,12 +112,39 @@ rt::PairFunction CompiledBackend::pairFunction(const Object& object, const Kerne
     return reinterpret_cast<rt::PairFunction>(function(object, pair, false, Clock::Source::Uniform, Clock::Source::Uniform));
 }
 
-void CompiledBackend::run(const rt::ChildrenLaunch& l) {
-    auto fn = reinterpret_cast<ChildrenFn>(function(*l.object, *l.spawn, true, Clock::Source::Uniform, Clock::Source::Uniform));
-    Addresses columns(memory_, l.columns), args(memory_, l.args);
-    fn(columns.data(), static_cast<int64_t>(l.row), l.parents, l.externs, l.clock.nowValue, l.clock.dtValue,
-       l.clock.first ? 1u : 0u, l.seed, l.draw, l.firstChild, static_cast<int64_t>(l.count),
-       reinterpret_cast<float* const*>(args.data()), static_cast<int64_t>(l.argsFirst));
+void CompiledBackend::run(const rt::ChildrenLaunch& l) { runChildren({&l, 1}); }
+
+namespace {
+// Whether two launches run one kernel on the same columns: an emit site's emitters'.
+bool sameSite(const rt::ChildrenLaunch& a, const rt::ChildrenLaunch& b) {
+    return a.spawn == b.spawn && a.object == b.object && a.columns.data() == b.columns.data() &&
+           a.columns.size() == b.columns.size() && a.args.data() == b.args.data() && a.args.size() == b.args.size();
+}
+}  // namespace
+
+// A step's launches come an emitter at a time, and an effect played many times has many
+// emitters of one site in a row (docs/embedding.md, "Instances"): such a run of launches
+// finds its code and its columns' addresses once.
+void CompiledBackend::runChildren(std::span<const rt::ChildrenLaunch> launches) {
+    for (size_t i = 0; i < launches.size();) {
+        const rt::ChildrenLaunch& first = launches[i];
+        if (first.records.valid()) {  // one launch an emitter, read from the records
+            rt::Backend::runChildren(launches.subspan(i, 1));
+            ++i;
+            continue;
+        }
+        size_t end = i + 1;
+        while (end < launches.size() && !launches[end].records.valid() && sameSite(first, launches[end])) ++end;
+        auto fn = reinterpret_cast<ChildrenFn>(
+            function(*first.object, *first.spawn, true, Clock::Source::Uniform, Clock::Source::Uniform));
+        Addresses columns(memory_, first.columns), args(memory_, first.args);
+        for (; i < end; ++i) {
+            const rt::ChildrenLaunch& l = launches[i];
+            fn(columns.data(), static_cast<int64_t>(l.row), l.parents, l.externs, l.clock.nowValue, l.clock.dtValue,
+               l.clock.first ? 1u : 0u, l.seed, l.draw, l.firstChild, static_cast<int64_t>(l.count),
+               reinterpret_cast<float* const*>(args.data()), static_cast<int64_t>(l.argsFirst));
+        }
+    }
 }
 
 }  // namespace psys::native

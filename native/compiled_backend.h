@@ -78,6 +78,7 @@ public:
     void forget(const ir::Module& module) override;
     rt::RowsResult run(const rt::RowsLaunch& launch) override;
     void run(const rt::ChildrenLaunch& launch) override;
+    void runChildren(std::span<const rt::ChildrenLaunch> launches) override;
     rt::PairFunction pairFunction(const ir::Object& object, const ir::Kernel& pair) override;
     bool concurrent() const override { return true; }
     bool marksDrawn() const override { return true; }  // render loops mark and count what they draw

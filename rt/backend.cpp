@@ -55,7 +55,7 @@ void Backend::runChildren(std::span<const ChildrenLaunch> launches) {
             continue;
         }
         std::vector<Value> parents;
-        for (const ChildrenLaunch& one : eachEmitter(memory(), l, parents)) run(one);
+        runChildren(eachEmitter(memory(), l, parents));  // (none of them from records)
     }
 }
 

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "core/few.h"
 #include "rt/rng.h"
 #include "rt/system.h"
 #include "rt/system_create.h"
@@ -93,8 +94,16 @@ void State::finishInstances() {
         else ++unseen;
     }
     const float last = static_cast<float>(slots - 1);
-    for (size_t t = 0; t < pools.size() && unseen > 0; ++t) {
-        Pool& pool = pools[t];
+    // The smallest pools first: an effect's emitters are few, one or so an instance, and
+    // mark every playing slot before the scan reaches their particles.
+    core::Few<size_t, 32> order(pools.size(), poolOrder);
+    for (size_t t = 0; t < pools.size(); ++t) {  // (an insertion sort: std::stable_sort may allocate)
+        size_t k = t;
+        for (; k > 0 && pools[order[k - 1]].live() > pools[t].live(); --k) order[k] = order[k - 1];
+        order[k] = t;
+    }
+    for (size_t k = 0; k < order.size() && unseen > 0; ++k) {
+        Pool& pool = pools[order[k]];
         const int column = pool.paramColumn.empty() ? -1 : pool.paramColumn.back();
         if (column < 0 || pool.live() == 0) continue;
         const float* instance = view<float>(pool.params.column(static_cast<size_t>(column), 0));

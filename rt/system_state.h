@@ -171,6 +171,7 @@ struct State {
     std::vector<InstanceSlot> instances;
     std::vector<InstanceHandle> finishedInstances;
     std::vector<uint32_t> instanceLive;  // finishInstances: per slot, whether a live row was seen
+    std::vector<size_t> poolOrder;       // finishInstances: the pools by size, where they are many
     // A slot's record (core/instances.h): its transform, then its values of the externs.
     size_t instanceValues() const { return core::instanceRecordValues(module.externs.size()); }
     Value* instanceRecord(size_t slot) { return externs.data() + module.externs.size() + 1 + instanceValues() * slot; }
