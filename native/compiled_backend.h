@@ -19,8 +19,9 @@ namespace psys::native {
 
 // The version of an ahead-of-time build's table and of what its kernels read (psys_aot.abi,
 // PSYS_AOT_ABI in include/psys/psys.h, which capi/aot.cpp checks is this): a build made
-// under another is refused at open, never run. 3: an instance's record holds its externs.
-constexpr uint32_t kAotAbi = 3;
+// under another is refused at open, never run. 3: an instance's record holds its externs;
+// 4: an instanced program's updates also at per-row dt (instance speeds).
+constexpr uint32_t kAotAbi = 4;
 
 // RowCounts rows(void* const* columns, const uint8_t* mask, int64_t begin, int64_t end,
 //                const Value* externs, const Value* uniforms, double now, float dt,

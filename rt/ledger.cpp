@@ -370,6 +370,8 @@ void Ledger::take(Deaths& dying, std::vector<LateKills>& late) {
                     size_t r = launchRow - l.first;
                     row = l.poolRows[r];
                     at = l.t1 - l.spans[r];
+                } else if (l.scaled) {  // (a pool update's launch: its rows are the pool's)
+                    at = l.t1 - l.dt * s_.rowSpeed(l.type, row);
                 }
                 ++s_.typeStats[l.type].killed;
                 pool.freeze(row, at);

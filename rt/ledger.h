@@ -59,6 +59,7 @@ struct LateKills {
     bool released = false;
     Buffer map;
     double t1 = 0, dt = 0;  // a pool's update: killed at t1 − dt
+    bool scaled = false;    // a scaled step's: at t1 − dt · its instance's speed (State::rowSpeed)
     // A creation batch's first update: launch row first + r is pool row poolRows[r],
     // killed at t1 − spans[r].
     size_t first = 0;

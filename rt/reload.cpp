@@ -150,6 +150,10 @@ ReloadReport System::carryOver(const System& oldSystem) {
         if (carried) {
             s.growInstances(old.instances.size());
             s.instances = old.instances;
+            // (speeds and pause need the rows on the host: where the new program keeps
+            // some in the backend's memory, every instance plays on at 1)
+            if (checkSpeeds())
+                for (detail::InstanceSlot& i : s.instances) i.speed = 1, i.paused = false;
         }
         const size_t oldValues = core::instanceRecordValues(old.module.externs.size());
         for (size_t slot = 0; slot < s.instances.size(); ++slot) {

@@ -38,6 +38,9 @@ Plan launchPlan(const ir::Module& module) {
     for (const ir::Object& o : module.objects)
         for (const ir::EmitSite& e : o.emits)
             if (e.rate()) streams.insert(e.target);
+    // An instanced program's updates run at each instance's speed (per-row dt) in a step
+    // where one is not 1 (rt/system_speeds.cpp).
+    const bool instanced = module.instanced();
     Plan plan;
     for (const ir::Object& o : module.objects) {
         bool stream = streams.count(o.name) > 0;
@@ -52,11 +55,13 @@ Plan launchPlan(const ir::Module& module) {
                     break;
                 case KernelKind::Update:
                     plan.rows.push_back({&o, &k, S::Uniform, S::Uniform});
+                    if (instanced) plan.rows.push_back({&o, &k, S::Uniform, S::PerRow});  // (instance speeds)
                     plan.rows.push_back({&o, &k, S::Uniform, S::SinceCreated, stream});
                     if (subSteps) plan.rows.push_back({&o, &k, S::PerRow, S::PerRow, stream});
                     break;
                 case KernelKind::Exports:  // also at creation, at each object's creation time
                     plan.rows.push_back({&o, &k, S::Uniform, S::Uniform});
+                    if (instanced) plan.rows.push_back({&o, &k, S::Uniform, S::PerRow});
                     plan.rows.push_back({&o, &k, S::PerRow, S::PerRow, stream});
                     plan.rows.push_back({&o, &k, S::Uniform, S::SinceCreated, stream});
                     break;
@@ -201,7 +206,9 @@ void System::runPhases(size_t first, size_t end, double dt, double t1, bool last
             case PhaseKind::SubSteps: {
                 // Sub-steps of equal length, each a pass over the pool: an object killed in one
                 // takes no more, and what it emits in each is queued in (sub-step, row) order.
-                uint32_t n = subStepCount(dt, p.stepLimit, s.typeStats[type].cappedSubSteps);
+                // (At the fastest instance's speed: none of its sub-steps is longer than the limit.)
+                const double span = s.scaledStep ? dt * s.fastest : dt;
+                uint32_t n = subStepCount(span, p.stepLimit, s.typeStats[type].cappedSubSteps);
                 for (uint32_t k = 1; k <= n; ++k)
                     runPhases(i + 1, i + 1 + p.span, dt / n, subStepEnd(t1, dt, k, n), last && k == n, stepEnd);
                 i += p.span;
@@ -254,6 +261,7 @@ std::optional<std::string> System::step(double dt) {
     }
     ++s.step;
     s.lastDt = dt;
+    s.takeSpeeds();  // (after the last step's deaths are settled: they read its speeds)
     double t1 = s.now + dt;
     // The host drew after the last step: this one draws as it goes.
     bool drawing = s.options.drawInStep && drawing_->drewSinceStep() && s.backend.rendersInStep();
@@ -312,6 +320,7 @@ std::optional<std::string> System::reserve(size_t type, size_t rows) {
     detail::TypeWork& work = s.work[type];
     if (work.killed.size() < chunks) work.killed.resize(chunks);
     for (size_t c = 0; c < chunks; ++c) work.killed[c].rows.reserve(std::min(per, rows - c * per));
+    work.killTimes.reserve(rows);  // (a scaled step's: rt/system_speeds.cpp)
     s.ledger.reserve(type, chunks, per, 1);
     return std::nullopt;
 }

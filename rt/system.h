@@ -252,6 +252,14 @@ public:
     // the effect's.
     std::optional<std::string> setInstanceExtern(InstanceHandle instance, int handle, std::span<const float> value);
     std::optional<Value> instanceExtern(InstanceHandle instance, int handle) const;
+    // Its speed: seconds of its own a second of the system's (1 at play; 0 to 100), and
+    // pause, which keeps the speed for its resumption: its ages, motion and emissions at
+    // its own pace, in the effect's one update (rt/system_speeds.cpp). Read from the next
+    // step on; the objects' rows must be the host's (not SystemOptions::Rows::InMemory).
+    std::optional<std::string> setSpeed(InstanceHandle instance, double speed);
+    std::optional<std::string> pause(InstanceHandle instance, bool paused);
+    std::optional<float> speed(InstanceHandle instance) const;  // none for a handle of none
+    std::optional<bool> paused(InstanceHandle instance) const;
     InstanceLife life(InstanceHandle instance) const;  // Finished also for a handle never given
     size_t instanceCount() const;                      // not finished, the system's own included
     // The instances that finished in the latest step, in slot order: a host learns of them
@@ -313,6 +321,7 @@ private:
     void start();
     // The instance a handle names, or why it names none that may change.
     std::optional<std::string> liveInstance(InstanceHandle instance, uint32_t& slot) const;
+    std::optional<std::string> checkSpeeds() const;  // why speeds cannot be set, if they cannot
     std::optional<std::string> fireOn(std::string_view trigger, std::span<const float> args, uint32_t slot);
     // An extern's value as the host gives it, checked (its width, a bool's 0 or 1, finite,
     // its range: counted in the stats where not): into `out`, or why not.

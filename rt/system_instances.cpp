@@ -120,6 +120,10 @@ void State::finishInstances() {
         if (i.life == InstanceLife::Finished || seen[slot]) continue;
         finishedInstances.push_back(handle(slot, i.generation));
         ++i.generation;
+        // (its speed and pause are the handle's: a slot played again, or the system's own
+        // restarted by a trigger, starts at 1 and playing)
+        i.speed = 1;
+        i.paused = false;
         setLife(slot, InstanceLife::Finished);
     }
 }
@@ -163,6 +167,8 @@ std::optional<std::string> System::play(std::span<const float> transform, Instan
     std::copy(s.externs.begin(), s.externs.begin() + static_cast<std::ptrdiff_t>(s.module.externs.size()),
               records + core::kInstanceOwnValues);
     s.setLife(slot, InstanceLife::Playing);
+    s.instances[slot].speed = 1;  // (not the slot's last instance's)
+    s.instances[slot].paused = false;
     out = handle(slot, s.instances[slot].generation);
     start();
     s.ledger.settle(Wait::Yes);  // the rows the last step freed, before these objects take rows

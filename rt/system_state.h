@@ -128,6 +128,7 @@ struct TypeWork {
     // ledger, kept from step to step.
     std::vector<std::vector<uint32_t>> killPieces;
     std::vector<std::span<const uint32_t>> killLists;
+    std::vector<double> killTimes;  // a scaled step's: each killed row's time, in the lists' order
 };
 
 // Per type and served kernel (update, render, exports): the uniform values and the
@@ -145,6 +146,8 @@ struct UniformCache {
 struct InstanceSlot {
     InstanceLife life = InstanceLife::Finished;  // Finished: free
     uint32_t generation = 0;
+    float speed = 1;      // System::setSpeed: seconds of its own a second of the system's
+    bool paused = false;  // System::pause: a speed of 0 until resumed, its speed kept
 };
 
 struct State {
@@ -183,6 +186,28 @@ struct State {
     void setLife(size_t slot, InstanceLife life);
     // The instances whose objects are all gone, after a step: finished (the CPU's pools).
     void finishInstances();
+    // Instance speeds (rt/system_speeds.cpp): each slot's speed in the step being run (0
+    // while paused), taken at its start, after the last step's deaths are settled —
+    // whose times they give (Ledger) — and whether some slot runs at another speed than
+    // 1 (a scaled step: each row's update gets its own dt); the fastest of them.
+    std::vector<float> stepSpeeds;
+    bool scaledStep = false;
+    float fastest = 1;
+    void takeSpeeds();
+    // A row's speed, its instance's in this step: the instance column found once a call.
+    struct RowSpeeds {
+        const float* instance = nullptr;  // (none: every row at 1)
+        const float* speeds = nullptr;
+        uint32_t slots = 0;
+        float operator()(uint32_t row) const;
+    };
+    RowSpeeds rowSpeeds(size_t type) const;
+    float rowSpeed(size_t type, uint32_t row) const { return rowSpeeds(type)(row); }
+    // A scaled step's update of `type` over (t1 − dt, t1], rows [begin, end) of its
+    // updatable ones: each row's dt (its instance's speed times dt) into `dts`, and its
+    // creation time moved on by (1 − speed) · dt, so that its age at t1 has grown by its
+    // own dt (rt/system_speeds.cpp says why).
+    void scaleRows(size_t type, double dt, float* dts, const uint8_t* updatable, size_t begin, size_t end);
     std::vector<std::array<UniformCache, 3>> uniformCache;
     std::vector<Value> uniformValues;  // (uniforms': kept from step to step)
     std::vector<TypeStats> typeStats;

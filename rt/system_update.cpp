@@ -101,6 +101,7 @@ void runEmissions(State& s, Creation& creation, size_t type, double dt, double t
         piece.rate = w.rate;
         piece.count = w.count;
         piece.row.resize(sites);
+        const State::RowSpeeds speedOf = s.rowSpeeds(type);
         auto dying = std::lower_bound(died.begin(), died.end(), begin);
         for (size_t row = begin; row < end; ++row) {
             bool dies = dying != died.end() && *dying == row;
@@ -110,7 +111,8 @@ void runEmissions(State& s, Creation& creation, size_t type, double dt, double t
                 if (w.rates[site]) piece.rate[site] = w.rates[site][row];
                 if (w.counts[site]) piece.count[site] = w.counts[site][row];
             }
-            Creation::emissionsOf(o, w.accumulated.data(), static_cast<uint32_t>(row), piece.rate, piece.count, dt, t1,
+            const double own = s.scaledStep ? dt * speedOf(static_cast<uint32_t>(row)) : dt;  // (its instance's)
+            Creation::emissionsOf(o, w.accumulated.data(), static_cast<uint32_t>(row), piece.rate, piece.count, own, t1,
                                   dies, piece.row.data());
             if (std::none_of(piece.row.begin(), piece.row.end(),
                              [](const RateEmission& x) { return x.children || x.invalid || x.clamped; }))
@@ -132,6 +134,26 @@ void runEmissions(State& s, Creation& creation, size_t type, double dt, double t
 // taken now, or, for late launches, their kills (listed or ticketed) and unstable counts
 // kept for the end of the step (or the next settle: rt/ledger.h), in their place
 // (LateKills); else read from the kill flags in row order.
+namespace {
+
+// The times of the deaths in a type's kill lists: `at` (t1 − dt) for all, or in a scaled
+// step each row's, t1 − its own dt (rt/system_speeds.cpp).
+std::span<const double> killTimes(State& s, size_t type, double dt, double t1, const double& at) {
+    if (!s.scaledStep) return {&at, 1};
+    std::vector<double>& times = s.work[type].killTimes;  // (kept from step to step; System::reserve)
+    times.clear();
+    size_t killed = 0;
+    for (std::span<const uint32_t> rows : s.work[type].killLists) killed += rows.size();
+    if (times.capacity() < killed) times.reserve(2 * killed);  // (headroom: growing is rare)
+    const State::RowSpeeds speedOf = s.rowSpeeds(type);
+    for (std::span<const uint32_t> rows : s.work[type].killLists)
+        for (uint32_t row : rows) times.push_back(t1 - dt * speedOf(row));
+    if (times.empty()) return {&at, 1};
+    return times;
+}
+
+}  // namespace
+
 void runKills(State& s, size_t type, double dt, double t1) {
     TypeWork& work = s.work[type];
     const TypeInfo& info = s.types[type];
@@ -141,6 +163,7 @@ void runKills(State& s, size_t type, double dt, double t1) {
         LateKills l = s.ledger.fresh(type, chunks);
         l.t1 = t1;
         l.dt = dt;
+        l.scaled = s.scaledStep;
         for (size_t c = 0; c < chunks; ++c) std::swap(l.parts[c], work.killed[c]);  // (each keeps a vector)
         if (info.read && info.rowsInMemory) s.ledger.listNow(l);  // its dead are dead to its children at once
         if (work.pass.takeOut && info.updateEmits) {  // (after its emissions: takeOutKills)
@@ -155,7 +178,7 @@ void runKills(State& s, size_t type, double dt, double t1) {
         const double at = t1 - dt;
         work.killLists.clear();  // (taken at once: on every thread)
         for (size_t c = 0; c < chunks; ++c) work.killLists.push_back(work.killed[c].rows);
-        s.ledger.kill(type, work.killLists, {&at, 1});
+        s.ledger.kill(type, work.killLists, killTimes(s, type, dt, t1, at));
         return;
     }
     if (!info.kills) return;
@@ -177,7 +200,7 @@ void runKills(State& s, size_t type, double dt, double t1) {
         for (size_t p = 0; p < pieces; ++p)
             work.pass.dying.insert(work.pass.dying.end(), work.killPieces[p].begin(), work.killPieces[p].end());
     const double at = t1 - dt;
-    s.ledger.kill(type, work.killLists, {&at, 1});
+    s.ledger.kill(type, work.killLists, killTimes(s, type, dt, t1, at));
 }
 
 namespace {
@@ -198,6 +221,13 @@ RowsLaunch poolUpdate(State& s, size_t type, double dt, double t1) {
     update.uniforms = s.uniforms(type, *info.update, static_cast<float>(dt), static_cast<float>(t1));
     update.seed = s.options.seed;
     update.draw = static_cast<uint32_t>(s.step);
+    if (s.scaledStep) {  // each row's dt its instance's (rt/system_speeds.cpp), in a column past the scratch's others
+        const ColumnLayout& l = info.updateLayout;
+        work.updateTable[ColumnLayout::kDt] =
+            work.update.at(static_cast<size_t>(1 + l.total - l.emits), Elem::F32, s.pools[type].rows(), s.pools[type].room());
+        update.clock.dt = Clock::Source::PerRow;
+        update.uniformKernel = s.uniformKernel(type, *info.update);
+    }
     return update;
 }
 
@@ -250,6 +280,10 @@ void runUpdate(State& s, const Phase& phase, double dt, double t1, bool last) {
         exports.columns = work.exportsTable;
         exports.mask = exportMask;
         exports.uniforms = s.uniforms(type, *info.exports, static_cast<float>(dt), static_cast<float>(t1));
+        if (s.scaledStep) {  // (the update's dt column)
+            work.exportsTable[ColumnLayout::kDt] = work.updateTable[ColumnLayout::kDt];
+            exports.uniformKernel = s.uniformKernel(type, *info.exports);
+        }
     }
     // (Where the rows are in the memory the flags stay there: nothing here reads them.)
     const uint8_t* kill = phase.inMemory ? nullptr : s.view<uint8_t>(work.updateTable[ColumnLayout::kKill]);
@@ -269,7 +303,9 @@ void runUpdate(State& s, const Phase& phase, double dt, double t1, bool last) {
         for (size_t c = 0; c < chunks; ++c)
             work.killed[c].killList = pool.scratchRows(std::min(s.backend.chunkRows(), rows - c * s.backend.chunkRows()) + 1);
     std::atomic<uint64_t> unstable = 0;
+    float* dts = s.scaledStep ? s.host<float>(work.updateTable[ColumnLayout::kDt]) : nullptr;
     auto chunk = [&](size_t c, size_t begin, size_t end) {
+        if (dts) s.scaleRows(type, dt, dts, pool.mask(), begin, end);
         RowsLaunch part = update;
         part.begin = begin;
         part.end = end;
