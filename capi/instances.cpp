@@ -85,6 +85,28 @@ int psys_instance_get_extern(const psys_system* s, psys_instance instance, const
     return width;
 }
 
+psys_error* psys_instance_set_speed(psys_system* s, psys_instance instance, float speed) {
+    if (!s) return nullArgument("psys_instance_set_speed", "the system");
+    return guarded("psys_instance_set_speed",
+                   [&] { return orError("psys_instance_set_speed", s->system().setSpeed(instance, speed)); });
+}
+
+float psys_instance_speed(const psys_system* s, psys_instance instance) {
+    std::optional<float> v = s ? s->system().speed(instance) : std::nullopt;
+    return v ? *v : -1.0f;
+}
+
+psys_error* psys_instance_pause(psys_system* s, psys_instance instance, int paused) {
+    if (!s) return nullArgument("psys_instance_pause", "the system");
+    return guarded("psys_instance_pause",
+                   [&] { return orError("psys_instance_pause", s->system().pause(instance, paused != 0)); });
+}
+
+int psys_instance_paused(const psys_system* s, psys_instance instance) {
+    std::optional<bool> v = s ? s->system().paused(instance) : std::nullopt;
+    return v ? static_cast<int>(*v) : -1;
+}
+
 psys_life psys_instance_life(const psys_system* s, psys_instance instance) {
     if (!s) return PSYS_FINISHED;
     switch (s->system().life(instance)) {

@@ -154,6 +154,29 @@ public:
         auto held = hold();
         check(psys_instance_kill(open(), instance));
     }
+    // (speed=None reads it; a number sets it.)
+    py::object speed(uint64_t instance, const py::object& value) {
+        auto held = hold();
+        if (value.is_none()) {
+            float v = psys_instance_speed(open(), instance);
+            if (v < 0) raise(PyExc_ValueError, "speed: no instance " + std::to_string(instance) + " is playing");
+            return py::float_(v);
+        }
+        std::vector<float> v = floats(value, "speed");
+        if (v.size() != 1) raise(PyExc_TypeError, "speed takes one number, not " + std::to_string(v.size()));
+        check(psys_instance_set_speed(open(), instance, v[0]));
+        return py::none();
+    }
+    void pause(uint64_t instance, bool paused) {
+        auto held = hold();
+        check(psys_instance_pause(open(), instance, paused ? 1 : 0));
+    }
+    bool paused(uint64_t instance) const {
+        auto held = hold();
+        int v = psys_instance_paused(open(), instance);
+        if (v < 0) raise(PyExc_ValueError, "paused: no instance " + std::to_string(instance) + " is playing");
+        return v == 1;
+    }
     std::string life(uint64_t instance) const {
         auto held = hold();
         switch (psys_instance_life(open(), instance)) {
@@ -406,6 +429,11 @@ PYBIND11_MODULE(_psys, m) {
         .def("move", &System::move, py::arg("instance"), py::arg("transform"), "Sets an instance's transform.")
         .def("stop", &System::stop, py::arg("instance"), "The instance emits no more; what it made lives on.")
         .def("kill", &System::kill, py::arg("instance"), "The instance's objects die at the next step.")
+        .def("speed", &System::speed, py::arg("instance"), py::arg("value") = py::none(),
+             "The instance's speed (seconds of its own a second of the system's, 0 to 100); with a value, sets it.")
+        .def("pause", &System::pause, py::arg("instance"), py::arg("paused") = true,
+             "Pauses the instance (paused=False resumes it): its objects stand still, its speed is kept.")
+        .def("paused", &System::paused, py::arg("instance"), "Whether the instance is paused.")
         .def("life", &System::life, py::arg("instance"), "'playing', 'stopped', 'killed' or 'finished'.")
         .def_property_readonly("instance_count", &System::instanceCount)
         .def("finished_instances", &System::finishedInstances, "The instances that finished in the latest step.")

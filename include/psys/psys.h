@@ -178,7 +178,7 @@ PSYS_API int psys_warning(const psys_system* system, size_t index, psys_diagnost
  * system's IR and its kernels' machine code for one CPU or several (`--cpu
  * x86-64-v3,znver4`), found by key. A host links the archive with libpsys_runtime (no
  * compiler, no LLVM) or with libpsys. */
-#define PSYS_AOT_ABI 3 /* 3: an instance's record holds its externs (core/instances.h) */
+#define PSYS_AOT_ABI 4 /* 4: an instanced program's updates at each instance's speed */
 typedef struct psys_aot_kernel {
     uint64_t key_low, key_high;
     void* code;
@@ -290,6 +290,20 @@ PSYS_API psys_error* psys_instance_set_extern(psys_system* system, psys_instance
  * such extern or no such instance playing. */
 PSYS_API int psys_instance_get_extern(const psys_system* system, psys_instance instance, const char* name,
                                       float values[4]);
+/* An instance's speed: seconds of its own a second of the system's, from 0 to 100 (1 when
+ * played). Its objects age, move and emit at its pace in the effect's one update; `time`
+ * in equations stays the system's. Read from the next step on. */
+PSYS_API psys_error* psys_instance_set_speed(psys_system* system, psys_instance instance, float speed);
+/* Its speed, or -1 when no such instance is playing. */
+PSYS_API float psys_instance_speed(const psys_system* system, psys_instance instance);
+/* Pauses (paused != 0) or resumes an instance: paused, no time passes for its objects —
+ * their updates run with dt 0: nothing ages, moves by an integral or emits at a rate (what
+ * counts updates, as `prev`, still counts them; what reads `time` or the instance's
+ * transform still follows them) — and what is fired at it (psys_instance_fire) is made
+ * paused too; its speed is kept for its resumption. */
+PSYS_API psys_error* psys_instance_pause(psys_system* system, psys_instance instance, int paused);
+/* 1 while paused, 0 if not, -1 when no such instance is playing. */
+PSYS_API int psys_instance_paused(const psys_system* system, psys_instance instance);
 PSYS_API psys_life psys_instance_life(const psys_system* system, psys_instance instance);
 /* Instances not finished, the system's own included while it lives. */
 PSYS_API size_t psys_instance_count(const psys_system* system);

@@ -405,6 +405,40 @@ spawn hit;
         s.get("spread", instance=b)
 
 
+def test_instances_run_at_their_own_speed_and_pause():
+    src = """
+object spark(v: vec3) {
+    pos = instance.pos + integrate(v);
+    point(pos, white, age);
+}
+object hit { emit spark(vec3(1, 0, 0)) count 1; }
+spawn hit;
+"""
+    s = psys.compile(source=src, backend="interp")
+    s.kill(0)
+    slow, still, full = s.play(), s.play(), s.play()
+    s.speed(slow, 0.25)
+    s.pause(still)
+    assert s.speed(slow) == 0.25 and s.speed(full) == 1
+    assert s.paused(still) and not s.paused(slow)
+    s.step(1 / 32, steps=32)  # 1 s of the system's
+    p = s.points("spark")
+    age = {int(i): a for i, a in zip(p["instance"], p["size"])}
+    assert age == {slow & 0xFFFFFFFF: 0.25, still & 0xFFFFFFFF: 0, full & 0xFFFFFFFF: 1}
+    s.pause(still, False)
+    assert s.speed(still) == 1 and not s.paused(still)
+    with pytest.raises(psys.Error, match="from 0 to 100"):
+        s.speed(slow, -1)
+    with pytest.raises(TypeError, match="not str"):
+        s.speed(slow, "fast")
+    s.kill(slow)
+    s.step()
+    with pytest.raises(ValueError, match="no instance"):
+        s.speed(slow)
+    with pytest.raises(psys.Error, match="has finished"):
+        s.pause(slow)
+
+
 def test_the_instances_example_plays_two_effects_and_plots_them(tmp_path):
     out = tmp_path / "instances.png"
     r = subprocess.run([sys.executable, EXAMPLES / "python" / "instances.py", EXAMPLES / "effects" / "burst.psys",
