@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstring>
 
+#include "core/instances.h"
 #include "ir/evaluate.h"
 #include "run.h"
 
@@ -30,6 +31,7 @@ struct RowInputs {
             v.u = next();
             return v;
         };
+        std::vector<int> tables;  // where instance tables start among the externs
         auto fill = [&](std::vector<ir::Value>& to, int index) {
             if (to.size() <= static_cast<size_t>(index)) to.resize(static_cast<size_t>(index) + 1);
         };
@@ -40,12 +42,17 @@ struct RowInputs {
                 case ir::Op::Extern: fill(externs, i.attr); break;
                 case ir::Op::Uniform: fill(uniforms, i.attr); break;
                 case ir::Op::NeighbourExport: fill(i.attr2 ? other : self, i.attr); break;
+                case ir::Op::Instance:  // (its table among the externs: a count, then 3 records)
+                    tables.push_back(i.attr2);
+                    fill(externs, i.attr2 + 3 * static_cast<int>(core::instanceRecordValues(static_cast<size_t>(i.attr2))));
+                    break;
                 default: break;
             }
         }
         parents.resize(ir::parentReads(kernel).size());
         for (auto* v : {&params, &state, &externs, &uniforms, &parents, &self, &other})
             for (ir::Value& each : *v) each = value();
+        for (int t : tables) externs[static_cast<size_t>(t)].f[0] = 3;
         in.params = params.data();
         in.state = state.data();
         in.externs = externs.data();
