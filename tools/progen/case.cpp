@@ -1,5 +1,7 @@
 #include "tools/progen/case.h"
 
+#include <algorithm>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -33,6 +35,11 @@ double variedStep(uint64_t seed, int frame) {
 
 double Case::stepAt(int f) const { return dt > 0 ? dt : variedStep(seed, f); }
 
+bool Case::paces() const {
+    return std::any_of(events.begin(), events.end(),
+                       [](const Event& e) { return e.kind == Event::Kind::Speed || e.kind == Event::Kind::Pause; });
+}
+
 std::string caseText(const Case& c) {
     std::string out = fmt::format("{}frames {}\n", kMark, c.frames);
     if (c.dt > 0) out += fmt::format("{}dt {}\n", kMark, c.dt);
@@ -46,6 +53,8 @@ std::string caseText(const Case& c) {
             case Event::Kind::Play: out += fmt::format("{}play", kMark); break;
             case Event::Kind::Stop: out += fmt::format("{}stop", kMark); break;
             case Event::Kind::Kill: out += fmt::format("{}kill", kMark); break;
+            case Event::Kind::Speed: out += fmt::format("{}speed", kMark); break;
+            case Event::Kind::Pause: out += fmt::format("{}pause", kMark); break;
         }
         for (float v : e.values) out += fmt::format(" {}", v);
         out += fmt::format(" @{}\n", e.frame);
@@ -92,14 +101,16 @@ std::optional<Case> parseCase(const std::string& text, const std::string& edit, 
             if (!(words >> what) || what != "fast") return fail("`compare fast`");
             c.compareFast = true;
         } else if (word == "fire" || word == "set" || word == "reload" || word == "play" || word == "stop" ||
-                   word == "kill") {
+                   word == "kill" || word == "speed" || word == "pause") {
             Event e;
-            e.kind = word == "fire"   ? Event::Kind::Fire
-                     : word == "set"  ? Event::Kind::Set
-                     : word == "play" ? Event::Kind::Play
-                     : word == "stop" ? Event::Kind::Stop
-                     : word == "kill" ? Event::Kind::Kill
-                                      : Event::Kind::Reload;
+            e.kind = word == "fire"    ? Event::Kind::Fire
+                     : word == "set"   ? Event::Kind::Set
+                     : word == "play"  ? Event::Kind::Play
+                     : word == "stop"  ? Event::Kind::Stop
+                     : word == "kill"  ? Event::Kind::Kill
+                     : word == "speed" ? Event::Kind::Speed
+                     : word == "pause" ? Event::Kind::Pause
+                                       : Event::Kind::Reload;
             if (e.kind == Event::Kind::Fire || e.kind == Event::Kind::Set) words >> e.name;
             std::string w;
             bool at = false;
@@ -124,6 +135,8 @@ std::optional<Case> parseCase(const std::string& text, const std::string& edit, 
             if (e.kind == Event::Kind::Play && e.values.size() != 3) return fail("a play takes a translation, X Y Z");
             if ((e.kind == Event::Kind::Stop || e.kind == Event::Kind::Kill) && e.values.size() != 1)
                 return fail("which instance the case played, from 0");
+            if ((e.kind == Event::Kind::Speed || e.kind == Event::Kind::Pause) && e.values.size() != 2)
+                return fail("which instance the case played, from 0, and its speed (pause: 1 or 0)");
             c.events.push_back(e);
         } else {
             return fail("unknown directive");

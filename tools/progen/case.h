@@ -11,6 +11,7 @@
 //   //! compare fast               (fast maths must decide as exact maths: generator.h)
 //   //! play 2 0 -1 @5             (an instance of an instanced program, translated so)
 //   //! stop 0 @50                 (the first instance the case played; `kill 0` kills it)
+//   //! speed 0 0.5 @20            (that instance's speed; `pause 0 1` pauses it, `pause 0 0` resumes)
 #pragma once
 
 #include <cstdint>
@@ -21,7 +22,7 @@
 namespace psys::progen {
 
 struct Event {
-    enum class Kind { Fire, Set, Reload, Play, Stop, Kill } kind = Kind::Fire;
+    enum class Kind { Fire, Set, Reload, Play, Stop, Kill, Speed, Pause } kind = Kind::Fire;
     int frame = 0;
     std::string name;           // the trigger or extern
     std::vector<float> values;  // its arguments or value; a play's translation; which played instance
@@ -35,6 +36,8 @@ struct Case {
     uint64_t seed = 0;
     std::vector<Event> events;  // in frame order
     bool compareFast = false;   // fast maths creates and kills what exact maths does
+    // Whether it sets an instance's speed or pauses one (rows kept in the memory cannot).
+    bool paces() const;
 
     // The step of frame `f`.
     double stepAt(int f) const;

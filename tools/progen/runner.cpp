@@ -112,6 +112,7 @@ public:
             if (!module) return Finding{config.label, "compile", -1, error};
             if (module->instanced() && rt::System::checkBackend(*module, *side.backend))
                 continue;  // (the glsl backend plays no instances yet)
+            if (config.rowsInMemory && c_.paces()) continue;  // (instance speeds need the rows on the host)
             rt::SystemOptions systemOptions;
             if (config.rowsInMemory) {  // (drawn after the step, as the GPU draws: a type drawn as the
                 systemOptions.rows = rt::SystemOptions::Rows::InMemory;  // step goes keeps its rows on the host)
@@ -184,6 +185,15 @@ private:
                 return each(f, e.kind == Event::Kind::Stop ? "stop" : "kill", [&](rt::System& s) {
                     rt::InstanceHandle h = sides_[side++].played[k];
                     return e.kind == Event::Kind::Stop ? s.stop(h) : s.kill(h);
+                });
+            }
+            case Event::Kind::Speed: case Event::Kind::Pause: {
+                auto k = static_cast<size_t>(e.values.at(0));
+                if (k >= sides_[0].played.size()) return std::nullopt;  // (not played yet: a shrunk case)
+                size_t side = 0;
+                return each(f, e.kind == Event::Kind::Speed ? "speed" : "pause", [&](rt::System& s) {
+                    rt::InstanceHandle h = sides_[side++].played[k];
+                    return e.kind == Event::Kind::Speed ? s.setSpeed(h, e.values.at(1)) : s.pause(h, e.values.at(1) != 0);
                 });
             }
             case Event::Kind::Reload:
