@@ -1,7 +1,8 @@
 // Instances against one system (docs/embedding.md, "Instances"): the same spark effect as
 // one system of N·k sparks, as N instances of k sparks each in one system, and as the
 // program without `instance` (what instancing itself costs); then what starting an
-// instance costs against compiling a system of its own. Steady-state steps, the median of
+// instance costs against compiling a system of its own, and what instances at their own
+// speeds cost (rt/system_speeds.cpp). Steady-state steps, the median of
 // the frames measured; ratios from one run (docs/performance.md).
 #include <algorithm>
 #include <chrono>
@@ -136,6 +137,9 @@ int main(int argc, char** argv) {
     }
     const double play = (seconds() - start) / instances;
     Run m = measure(many, frames);
+    // Half of them at half speed: each row's dt a column, its creation time moved on.
+    for (int i = 0; i < instances; i += 2) check(psys_instance_set_speed(many, played[static_cast<size_t>(i)], 0.5f));
+    Run paced = measure(many, frames);
     psys_system_free(many);
 
     start = seconds();
@@ -158,6 +162,9 @@ int main(int argc, char** argv) {
     std::printf("  %d instances                %8.3f ms a step  (%zu sparks)  %.2f× the first, %.2f× the emitters\n",
                 instances, m.median * 1e3, m.live, m.median / p.median, m.median / e.median);
     parts(m);
+    std::printf("  the same, half at speed 0.5     %8.3f ms a step  (%zu sparks)  %.2f× the instances at 1\n",
+                paced.median * 1e3, paced.live, paced.median / m.median);
+    parts(paced);
     std::printf("  starting an instance          %8.2f µs (a system compiled for it: %.1f ms, %.0f×)\n", play * 1e6,
                 compileOne * 1e3, compileOne / play);
     return 0;
