@@ -273,6 +273,7 @@ void Checker::run() {
         }
         checkAttributes(fileAttributes);
     }
+    inferObjects();
     for (auto& module : program_.modules)
         for (auto& decl : module->decls) {
             if (decl->kind == DeclKind::Object) checkObject(static_cast<ObjectDecl&>(*decl));

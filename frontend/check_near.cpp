@@ -55,14 +55,18 @@ Type Checker::checkNear(CallExpr& call, const Context& ctx) {
     const ObjectDecl* target = nullptr;
     if (typeArg.kind == ExprKind::Name) target = findObjectType(static_cast<const NameExpr&>(typeArg).name);
     if (!target) {
-        diags_.error(typeArg.range, fmt::format("the first argument of `{}` must name an object type (the objects it "
-                                                "folds over): {}", call.callee, usage));
-        return Type::error();
-    }
-    if (target != ctx.object && !objectScopes_.count(target)) {
-        diags_.error(typeArg.range, fmt::format("`{}` is declared after `{}`: a fold reads the equations of its own "
-                                                "type or of one declared before it", target->name, ctx.object->name))
-            .notes.push_back({target->nameRange, fmt::format("`{}` declared here", target->name)});
+        std::string suggestion;
+        if (typeArg.kind == ExprKind::Name) {
+            std::vector<std::string> types;
+            for (const auto& [name, decl] : globals_)
+                if (decl->kind == DeclKind::Object) types.push_back(name);
+            for (const auto& [name, object] : nestedObjects_) types.push_back(name);
+            suggestion = closestName(static_cast<const NameExpr&>(typeArg).name, types);
+        }
+        Diagnostic& d = diags_.error(typeArg.range, fmt::format("the first argument of `{}` must name an object type (the "
+                                                                "objects it folds over): {}{}", call.callee, usage,
+                                                                suggestion.empty() ? "" : fmt::format("; did you mean `{}`?", suggestion)));
+        if (!suggestion.empty()) d.fixes.push_back({fmt::format("Change to `{}`", suggestion), typeArg.range, suggestion});
         return Type::error();
     }
     call.neighbours = target;

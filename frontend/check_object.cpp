@@ -1,13 +1,15 @@
 // Checking objects: their names, equations, commands and nested objects.
 //
 // Equations are a set: each may refer to any other, and recursion through `integrate`,
-// `prev` or `->` is legal (thesis §3.1.5). So their types are inferred together: start
-// from the annotations, re-check all equations until no type changes (diagnostics held
-// back), then check once more with diagnostics on. A recursive equation whose width
-// nothing fixes defaults to float.
+// `prev` or `->` is legal (thesis §3.1.5), and a fold's term reads another type's (any
+// type's, declared before or after). So the types of every object's equations are
+// inferred together: start from the annotations, re-check all equations until no type
+// changes (diagnostics held back), then check each object once more with diagnostics on.
+// A recursive equation whose width nothing fixes defaults to float.
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <span>
 
 #include <fmt/format.h>
@@ -34,8 +36,10 @@ std::string attributeList() {
 
 }  // namespace
 
+// Into a fresh scope: inferObjects declares every object's names (diagnostics held back),
+// checkObject again with them on; both give the same scope.
 void Checker::declareObjectNames(ObjectDecl& object) {
-    ObjectScope& scope = objectScopes_[&object];
+    ObjectScope scope;
     auto declare = [&](const std::string& name, SourceRange range, Ref ref, const char* what) {
         if (!checkDeclarableName(name, range, what)) return;
         if (auto it = scope.declaredAt.find(name); it != scope.declaredAt.end()) {
@@ -63,8 +67,6 @@ void Checker::declareObjectNames(ObjectDecl& object) {
         declare(object.params[i].name, object.params[i].nameRange, ref, "a parameter");
     }
     for (auto& eq : object.equations) {
-        eq->types.assign(eq->names.size(), Type::unknown());
-        if (eq->annotation) eq->types[0] = eq->annotation->type;
         for (size_t i = 0; i < eq->names.size(); ++i) {
             Ref ref;
             ref.kind = Ref::Kind::Equation;
@@ -74,6 +76,7 @@ void Checker::declareObjectNames(ObjectDecl& object) {
             declare(eq->names[i], eq->nameRanges[i], ref, "an equation");
         }
     }
+    objectScopes_[&object] = std::move(scope);
 }
 
 // Checks one equation's value and records the types of the names it defines. On the final
@@ -122,31 +125,55 @@ void Checker::checkEquation(Equation& eq, const Context& ctx, bool final) {
     eq.types = t.elements();
 }
 
-void Checker::inferEquations(ObjectDecl& object) {
-    Context ctx;
-    ctx.where = Where::Object;
-    ctx.object = &object;
+// Every object's equations at once: a fold's term reads another type's equations
+// (`other.vel`), of a type declared before or after, and a nested object its parents'.
+void Checker::inferObjects() {
+    std::vector<ObjectDecl*> objects;
+    std::function<void(ObjectDecl&)> collect = [&](ObjectDecl& o) {
+        objects.push_back(&o);
+        for (auto& child : o.children) collect(*child);
+    };
+    for (auto& module : program_.modules)
+        for (auto& decl : module->decls)
+            if (decl->kind == DeclKind::Object) collect(static_cast<ObjectDecl&>(*decl));
     bool wasSuppressed = diags_.suppressed();
     diags_.setSuppressed(true);
+    for (ObjectDecl* o : objects) {
+        for (auto& eq : o->equations) {
+            eq->types.assign(eq->names.size(), Type::unknown());
+            if (eq->annotation) eq->types[0] = eq->annotation->type;
+        }
+        declareObjectNames(*o);
+    }
+    auto contextOf = [](const ObjectDecl& o) {
+        Context ctx;
+        ctx.where = Where::Object;
+        ctx.object = &o;
+        return ctx;
+    };
     for (int round = 0; round < 16; ++round) {
         std::vector<std::vector<Type>> before;
-        for (auto& eq : object.equations) before.push_back(eq->types);
-        for (auto& eq : object.equations) checkEquation(*eq, ctx, false);
+        for (ObjectDecl* o : objects)
+            for (auto& eq : o->equations) before.push_back(eq->types);
+        for (ObjectDecl* o : objects)
+            for (auto& eq : o->equations) checkEquation(*eq, contextOf(*o), false);
         bool changed = false;
-        for (size_t i = 0; i < object.equations.size(); ++i) changed |= before[i] != object.equations[i]->types;
+        size_t i = 0;
+        for (ObjectDecl* o : objects)
+            for (auto& eq : o->equations) changed |= before[i++] != eq->types;
         if (changed) continue;
         // Stable: give any still-unknown recursive equation the default type float and go on.
         bool defaulted = false;
-        for (auto& eq : object.equations)
-            for (auto& t : eq->types)
-                if (t.isUnknown()) {
-                    t = Type::scalar();
-                    defaulted = true;
-                }
+        for (ObjectDecl* o : objects)
+            for (auto& eq : o->equations)
+                for (auto& t : eq->types)
+                    if (t.isUnknown()) {
+                        t = Type::scalar();
+                        defaulted = true;
+                    }
         if (!defaulted) break;
     }
     diags_.setSuppressed(wasSuppressed);
-    for (auto& eq : object.equations) checkEquation(*eq, ctx, true);
 }
 
 void Checker::checkArguments(std::vector<ExprPtr>& args, const ObjectDecl& target, SourceRange callRange,
@@ -540,11 +567,11 @@ void Checker::checkObject(ObjectDecl& object) {
     for (auto& a : object.attributes) attributes.push_back(&a);
     checkAttributes(attributes);
     declareObjectNames(object);
-    inferEquations(object);
-    checkAlgebraicLoops(object);
     Context ctx;
     ctx.where = Where::Object;
     ctx.object = &object;
+    for (auto& eq : object.equations) checkEquation(*eq, ctx, true);
+    checkAlgebraicLoops(object);
     const Command* point = nullptr;
     checkCommands(object.commands, ctx, &point);
     const Attribute* shape = nullptr;
@@ -562,7 +589,7 @@ void Checker::checkObject(ObjectDecl& object) {
                 .notes.push_back({point ? point->keywordRange : object.nameRange,
                                   point ? "draw it with `sprite(position, colour, size)`" : "the object"});
     }
-    // Parents before children: a child reads its parent's equations, whose types are now known.
+    // (every object's equation types are inferred before any is checked: inferObjects)
     for (auto& child : object.children) checkObject(*child);
 }
 

@@ -89,7 +89,7 @@ private:
     // check_object.cpp
     void checkObject(ast::ObjectDecl& object);
     void declareObjectNames(ast::ObjectDecl& object);
-    void inferEquations(ast::ObjectDecl& object);
+    void inferObjects();
     void checkEquation(ast::Equation& eq, const Context& ctx, bool final);
     void checkCommands(std::vector<ast::CommandPtr>& commands, const Context& ctx, const ast::Command** point);
     void checkEmit(ast::Command& emit, const Context& ctx);
