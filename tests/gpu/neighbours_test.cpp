@@ -1,7 +1,8 @@
 // Neighbour folds on the GPU (gpu/gl_fold.cpp): the grid built and walked there, the
 // results where the update reads them — no wait for the GPU, nothing read back — and the
 // interpreter's folds within tolerance; every fold, over its own type and another, with
-// deaths that free rows new objects take (tests/programs/neighbours.psys).
+// deaths that free rows new objects take (tests/programs/neighbours.psys); two types that
+// fold over each other (tests/programs/mutual_folds.psys).
 #include <doctest/doctest.h>
 
 #include "gpu_support.h"
@@ -30,6 +31,19 @@ TEST_CASE("every fold on the GPU, over its own type and another, with deaths and
     CHECK(p.compare() <= kSamplesTolerance);
     p.steps(240, 1.0 / 60);  // deaths (at 3 s) and rows taken again: then the same objects, in the same rows
     p.compare();
+}
+
+TEST_CASE("two types folding over each other on the GPU, each reading the other's folds, give the interpreter's") {
+    // tests/programs/mutual_folds.psys: mice that flee the cats declared after them, cats
+    // that chase them and read their fold (`other.fear`). A crowd: compared over its first
+    // frames (test::kCrowdRun), its folds on the GPU once past the host side's few rows.
+    Pair p(readFile(programsDir() + "/mutual_folds.psys"));
+    for (int frame = 0; frame < test::kCrowdRun; ++frame) {
+        p.steps(1, 1.0 / 60);
+        CHECK(p.compare() <= kSamplesTolerance);
+    }
+    CHECK(p.stats("mouse").live > 40);
+    CHECK(p.stats("cat").live == 3);
 }
 
 TEST_CASE("a fold's grid on the GPU is the same every run: its buckets' rows sorted after the atomics scatter them") {

@@ -1,7 +1,8 @@
 // Neighbour folds (docs/language.md, "Neighbours"): what near_count, near_sum, near_min and
 // near_max give against what a row of objects one apart makes obvious; who counts as a
 // neighbour (within the radius, its edge included; never itself; only the type named);
-// when (the last step's values; a new object's first update sees none); and that the
+// when (the last step's values; a new object's first update sees none), over a type
+// declared before or after, both ways at once; and that the
 // order of a fold's terms is the grid's whatever the threads.
 #include <doctest/doctest.h>
 
@@ -78,6 +79,42 @@ TEST_CASE("a fold sees the others as the last step left them, and a new object n
     REQUIRE(w.size() == 1);
     CHECK(w[0].color[0] == 1);      // the mover at x = -0.25 when the step began
     CHECK(w[0].color[1] == 0.25f);  // (its value then, not this step's 0)
+}
+
+TEST_CASE("two types fold over each other, declared in either order, each seeing the other as the last step left it") {
+    // Cats at x = 0 and 0.5, mice at 1 and 5. A cat counts the mice within 1 and sums their
+    // own count of cats — as the last step left it: 0 after the spawns' first update (a
+    // new object sees none), the mouse at 1's two cats from the second step on.
+    const std::string cat = R"(
+        object cat(p: vec3) {
+            mice = near_count(mouse, 1);
+            fear = near_sum(mouse, 1, other.cats);
+            point(p, vec4(mice, fear, 0, 1), 1);
+        })";
+    const std::string mouse = R"(
+        object mouse(p: vec3) {
+            cats = near_count(cat, 1);
+            point(p, vec4(cats, 0, 0, 1), 1);
+        })";
+    const std::string spawns = R"(
+        spawn cat(vec3(0, 0, 0)); spawn cat(vec3(0.5, 0, 0)); spawn mouse(vec3(1, 0, 0)); spawn mouse(vec3(5, 0, 0));)";
+    for (const std::string& text : {cat + mouse + spawns, mouse + cat + spawns}) {
+        INFO(text);
+        Run run(text);
+        run.steps(1, 1.0 / 60);
+        auto cats = run.points("cat"), mice = run.points("mouse");
+        REQUIRE(cats.size() == 2);
+        REQUIRE(mice.size() == 2);
+        CHECK(at(cats, 0).color[0] == 1);
+        CHECK(at(cats, 0.5f).color[0] == 1);
+        CHECK(at(cats, 0).color[1] == 0);
+        CHECK(at(mice, 1).color[0] == 2);
+        CHECK(at(mice, 5).color[0] == 0);
+        run.steps(1, 1.0 / 60);
+        cats = run.points("cat");
+        CHECK(at(cats, 0).color[1] == 2);
+        CHECK(at(cats, 0.5f).color[1] == 2);
+    }
 }
 
 TEST_CASE("an object is not its own neighbour, and another type's objects are folded over only where named") {
