@@ -228,7 +228,8 @@ TEST_CASE("every sample is drawn: frame 600, fitted, lights its share of the fra
         {"follow_parent", 0.004}, {"fountain", 0.004}, {"galaxy", 0.01},   {"grinder", 0.004},
         {"rain", 0.002},        {"random", 0.02},    {"smoke", 0.05},     {"swamp", 0.002},
         {"triggered_explosion", 0.01}, {"two_streams", 0.01}, {"wand", 0.1}, {"wind", 0.02},
-        {"shapes", 0.03}, {"tornado", 0.1}, {"marbles", 0.03}, {"boids", 0.005}, {"repel", 0.4}, {"fluid", 0.2}};
+        {"shapes", 0.03}, {"tornado", 0.1}, {"marbles", 0.03}, {"boids", 0.005}, {"repel", 0.4}, {"fluid", 0.2},
+        {"predators", 0.005}};
     size_t samples = 0;
     for (auto& entry : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
         if (entry.path().extension() != ".psys") continue;
