@@ -47,7 +47,8 @@ private:
 class Builder {
 public:
     Builder(uint64_t seed, bool ageControlled)
-        : r_(seed), more_(seed ^ 0x5eed5eed5eed5eedull), events_(seed ^ 0xe7e27e27e27e27e2ull), age_(ageControlled) {}
+        : r_(seed), more_(seed ^ 0x5eed5eed5eed5eedull), events_(seed ^ 0xe7e27e27e27e27e2ull),
+          folds_(seed ^ 0xf01df01df01df01dull), age_(ageControlled) {}
 
     Model build() {
         int externs = r_.between(0, 2);
@@ -67,6 +68,7 @@ public:
         int tops = r_.between(flat_ ? 2 : 1, 4);
         for (int i = 0; i < tops; ++i) addType(-1);
         for (size_t t = 0; t < m_.types.size(); ++t) fillType(static_cast<int>(t));
+        foldsOverLaterTypes();
         int triggers = r_.between(0, 2);
         for (int i = 0; i < triggers; ++i) addTrigger(i);
         addSpawns();
@@ -89,6 +91,7 @@ public:
 private:
     Rng r_, more_;
     Rng events_;  // notifications and instances: a stream of their own (every seed's program is otherwise what it was)
+    Rng folds_;   // folds over types declared later: the same
     bool age_, flat_ = false;
     Model m_;
 
@@ -265,11 +268,37 @@ private:
         return e;
     }
 
+    // Half the folds retargeted at a top-level type declared after theirs (once every
+    // type's draw is known: both must draw), and where that one folds too, it sometimes
+    // back at this one: predators and prey.
+    void foldsOverLaterTypes() {
+        auto retarget = [&](int index, int over) {
+            Type& t = m_.types[static_cast<size_t>(index)];
+            const std::string& from = m_.types[static_cast<size_t>(t.foldOver)].name;
+            for (std::string& e : t.equations)
+                if (e.rfind("crowd = near_count(" + from + ",", 0) == 0)
+                    e = "crowd = near_count(" + m_.types[static_cast<size_t>(over)].name + e.substr(19 + from.size());
+            t.foldOver = over;
+        };
+        for (int index : tops()) {
+            Type& t = m_.types[static_cast<size_t>(index)];
+            if (t.foldOver < 0 || !folds_.chance(0.5)) continue;
+            std::vector<int> later;
+            for (int o : tops())
+                if (o > index && !m_.types[static_cast<size_t>(o)].draw.empty()) later.push_back(o);
+            if (later.empty()) continue;
+            int over = folds_.pick(later);
+            retarget(index, over);
+            if (m_.types[static_cast<size_t>(over)].foldOver >= 0 && folds_.chance(0.5)) retarget(over, index);
+        }
+    }
+
     void fillType(int index) {
         Type& t = m_.types[static_cast<size_t>(index)];
         equations(t);
         // A fold over its own type or one declared before it (fewer in a flat program: what
-        // is folded over exports, and an emitter that dies and exports is the host's).
+        // is folded over exports, and an emitter that dies and exports is the host's);
+        // foldsOverLaterTypes turns some to types declared after.
         if (t.parent < 0 && r_.chance(flat_ ? 0.05 : 0.15)) {
             std::vector<int> over;
             for (int o : tops())  // both must draw: near is measured between drawn positions
@@ -499,6 +528,29 @@ private:
     }
 };
 
+// Some cases play an instance at another speed, or pause one and resume it (a stream of
+// their own: the other events are what they were).
+void paces(Case& c, int played, uint64_t seed) {
+    Rng r(seed ^ 0x5bd1e9955bd1e995ull);
+    if (!r.chance(0.5)) return;
+    Event speed;
+    speed.kind = Event::Kind::Speed;
+    speed.frame = r.between(0, c.frames - 1);
+    speed.values = {static_cast<float>(r.below(static_cast<size_t>(played))),
+                    r.pick(std::vector<float>{0, 0.25f, 0.5f, 2, 3.5f})};
+    c.events.push_back(speed);
+    if (!r.chance(0.5)) return;
+    Event pause;
+    pause.kind = Event::Kind::Pause;
+    pause.frame = r.between(0, c.frames - 1);
+    pause.values = {static_cast<float>(r.below(static_cast<size_t>(played))), 1};
+    c.events.push_back(pause);
+    Event resume = pause;
+    resume.frame = r.between(pause.frame, c.frames);
+    resume.values[1] = 0;
+    c.events.push_back(resume);
+}
+
 }  // namespace
 
 Case generate(uint64_t seed) {
@@ -551,6 +603,7 @@ Case generate(uint64_t seed) {
         end.frame = plays.between(c.frames / 2, c.frames - 1);
         end.values.push_back(static_cast<float>(plays.below(static_cast<size_t>(played))));
         c.events.push_back(end);
+        paces(c, played, seed);
     }
     if (r.chance(0.6)) {
         Model edited = m;
