@@ -178,3 +178,31 @@ TEST_CASE("a fold over a crowd spread over many cells finds every neighbour a br
     }
     CHECK(pairs > 1000);  // (most dots have neighbours: the walk is tested)
 }
+
+TEST_CASE("under @step a fold is the step's: taken once before the first sub-step, the same in every one") {
+    // Two walkers 10 apart, moving 1 unit a second, each summing the other's x and
+    // integrating that sum in 4 sub-steps of a 1 s step: each step the integral grows by
+    // exactly the fold times 1 (4 × its quarter), the fold being the other's x as the
+    // last step left it.
+    Run run(R"(
+        @step(0.25)
+        object walker(x0: float) {
+            pos = vec3(x0 + age, 0, 0);
+            seen = near_sum(walker, 100, other.pos.x);
+            total = integrate(seen);
+            point(pos, vec4(seen, total, 0, 1), 1);
+        }
+        spawn walker(0); spawn walker(10);)");
+    float lastTotal = 0;
+    for (int step = 1; step <= 4; ++step) {
+        run.steps(1, 1.0);
+        auto w = run.points("walker");
+        REQUIRE(w.size() == 2);
+        const auto& near = *std::min_element(w.begin(), w.end(), [](auto& a, auto& b) { return a.position[0] < b.position[0]; });
+        INFO("step " << step);
+        CHECK(near.position[0] == static_cast<float>(step));
+        CHECK(near.color[0] == static_cast<float>(10 + step - 1));  // the other at the step's start
+        CHECK(near.color[1] - lastTotal == near.color[0]);         // the same fold in each sub-step
+        lastTotal = near.color[1];
+    }
+}
