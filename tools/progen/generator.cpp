@@ -530,20 +530,25 @@ private:
 
 // Some cases play an instance at another speed, or pause one and resume it (a stream of
 // their own: the other events are what they were).
-void paces(Case& c, int played, uint64_t seed) {
+// Speed and pause events, each at or after the frame its instance (the k-th to play, in
+// the order the plays run) plays.
+void paces(Case& c, std::vector<int> playFrames, uint64_t seed) {
+    std::stable_sort(playFrames.begin(), playFrames.end());
     Rng r(seed ^ 0x5bd1e9955bd1e995ull);
     if (!r.chance(0.5)) return;
+    auto instance = [&] { return static_cast<size_t>(r.below(playFrames.size())); };
     Event speed;
     speed.kind = Event::Kind::Speed;
-    speed.frame = r.between(0, c.frames - 1);
-    speed.values = {static_cast<float>(r.below(static_cast<size_t>(played))),
-                    r.pick(std::vector<float>{0, 0.25f, 0.5f, 2, 3.5f})};
+    size_t k = instance();
+    speed.frame = r.between(playFrames[k], c.frames - 1);
+    speed.values = {static_cast<float>(k), r.pick(std::vector<float>{0, 0.25f, 0.5f, 2, 3.5f})};
     c.events.push_back(speed);
     if (!r.chance(0.5)) return;
     Event pause;
     pause.kind = Event::Kind::Pause;
-    pause.frame = r.between(0, c.frames - 1);
-    pause.values = {static_cast<float>(r.below(static_cast<size_t>(played))), 1};
+    k = instance();
+    pause.frame = r.between(playFrames[k], c.frames - 1);
+    pause.values = {static_cast<float>(k), 1};
     c.events.push_back(pause);
     Event resume = pause;
     resume.frame = r.between(pause.frame, c.frames);
@@ -591,10 +596,12 @@ Case generate(uint64_t seed) {
     if (m.instanced) {  // (its own draws: a stream of its own, so the other events are what they were)
         Rng plays(seed ^ 0x91a7591a7591a75ull);
         int played = plays.between(1, 3);
+        std::vector<int> playFrames;
         for (int i = 0; i < played; ++i) {
             Event e;
             e.kind = Event::Kind::Play;
             e.frame = plays.between(0, c.frames / 2);
+            playFrames.push_back(e.frame);
             for (int k = 0; k < 3; ++k) e.values.push_back(static_cast<float>(plays.real(-4, 4)));
             c.events.push_back(e);
         }
@@ -603,7 +610,7 @@ Case generate(uint64_t seed) {
         end.frame = plays.between(c.frames / 2, c.frames - 1);
         end.values.push_back(static_cast<float>(plays.below(static_cast<size_t>(played))));
         c.events.push_back(end);
-        paces(c, played, seed);
+        paces(c, playFrames, seed);
     }
     if (r.chance(0.6)) {
         Model edited = m;
