@@ -20,8 +20,9 @@ namespace psys::native {
 // The version of an ahead-of-time build's table and of what its kernels read (psys_aot.abi,
 // PSYS_AOT_ABI in include/psys/psys.h, which capi/aot.cpp checks is this): a build made
 // under another is refused at open, never run. 3: an instance's record holds its externs;
-// 4: an instanced program's updates also at per-row dt (instance speeds).
-constexpr uint32_t kAotAbi = 4;
+// 4: an instanced program's updates also at per-row dt (instance speeds); 5: a fold's pair
+// function walks its grid's buckets (rt::PairWalk).
+constexpr uint32_t kAotAbi = 5;
 
 // RowCounts rows(void* const* columns, const uint8_t* mask, int64_t begin, int64_t end,
 //                const Value* externs, const Value* uniforms, double now, float dt,

@@ -155,13 +155,33 @@ struct FoldLaunch {
     size_t externCount = 0;
 };
 
-// A group's terms for one object and its neighbours, compiled: `self` points at this
-// side's export columns (export e's component c at 4e + c; `selfRow` its row), `other` at
-// the other side's (the ones the terms read, in the grid's order: `others` are places
-// there), `acc` at the group's folds' components (in fold order), each combined with
-// every neighbour's terms in order (core/fold.h combine).
+// One object's walk of a fold's grid: the buckets of the 27 cells around it (ascending,
+// each once), the grid's bucket starts, its places' positions and rows, this object's
+// position, the radius squared and the row that is not its own neighbour (kSkipRow: none);
+// `scratch` has room for every place of the buckets. The layout compiled walks read
+// (codegen_llvm/pair_function.cpp).
+struct PairWalk {
+    const uint32_t* buckets;
+    const uint32_t* start;
+    const float* x;
+    const float* y;
+    const float* z;
+    const uint32_t* rows;
+    uint32_t* scratch;
+    uint32_t count;  // buckets
+    uint32_t skip;
+    float px, py, pz, radius2;
+};
+
+// A group's walk and terms for one object, compiled: every place of the walk's buckets, in
+// order, whose position lies within the radius (dx² + dy² + dz² ≤ r², in that order of
+// operations, as the run-time's walk tests it) and whose row is not `skip`, is a
+// neighbour. `self` points at this side's export columns (export e's component c at 4e +
+// c; `selfRow` its row), `other` at the other side's (the ones the terms read, in the
+// grid's order: by place), `acc` at the group's folds' components (in fold order), each
+// combined with every neighbour's terms in order (core/fold.h combine).
 using PairFunction = void (*)(const float* const* self, const float* const* other, uint32_t selfRow,
-                              const uint32_t* others, uint32_t count, const Value* externs, float* acc);
+                              const PairWalk* walk, const Value* externs, float* acc);
 
 // Every launch shape a system will use, listed before its first step.
 struct Plan {

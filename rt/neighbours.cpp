@@ -230,22 +230,27 @@ void State::foldOnHost(const FoldLaunch& launch) {
                     for (uint32_t dx = 0; dx < 3; ++dx) buckets[n++] = grid.bucket(cx + dx - 1, cy + dy - 1, cz + dz - 1);
             std::sort(buckets, buckets + n);
             n = static_cast<int>(std::unique(buckets, buckets + n) - buckets);
-            // Each bucket's places kept where within the radius, without a branch per place
-            // (a third of the candidates are kept: a branch would be mispredicted often).
+            const auto self = launch.same ? static_cast<uint32_t>(i) : kSkipRow;
+            float* acc = results.data() + i * width;
             size_t room = 0;
             for (int b = 0; b < n; ++b) room += grid.start[buckets[b] + 1] - grid.start[buckets[b]];
             if (candidates.size() < room) candidates.resize(room);
+            if (compiled) {  // the walk compiled with the terms
+                PairWalk walk{buckets, grid.start.data(), grid.x.data(), grid.y.data(), grid.z.data(), grid.rows.data(),
+                              candidates.data(), static_cast<uint32_t>(n), self, px, py, pz, radius2};
+                compiled(sx, ox, static_cast<uint32_t>(i), &walk, launch.externs, acc);
+                continue;
+            }
+            // Each bucket's places kept where within the radius, without a branch per place
+            // (a third of the candidates are kept: a branch would be mispredicted often).
             uint32_t count = 0;
-            const auto self = launch.same ? static_cast<uint32_t>(i) : kSkipRow;
             for (int b = 0; b < n; ++b)
                 for (uint32_t j = grid.start[buckets[b]]; j < grid.start[buckets[b] + 1]; ++j) {
                     float dx = grid.x[j] - px, dy = grid.y[j] - py, dz = grid.z[j] - pz;
                     candidates[count] = j;
                     count += (dx * dx + dy * dy + dz * dz <= radius2) & (grid.rows[j] != self);
                 }
-            float* acc = results.data() + i * width;
-            if (compiled) compiled(sx, ox, static_cast<uint32_t>(i), candidates.data(), count, launch.externs, acc);
-            else (*evaluated)(sx, ox, static_cast<uint32_t>(i), candidates.data(), count, acc);
+            (*evaluated)(sx, ox, static_cast<uint32_t>(i), candidates.data(), count, acc);
         }
     });
     // Into the fold columns, component by component.

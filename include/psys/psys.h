@@ -178,7 +178,7 @@ PSYS_API int psys_warning(const psys_system* system, size_t index, psys_diagnost
  * system's IR and its kernels' machine code for one CPU or several (`--cpu
  * x86-64-v3,znver4`), found by key. A host links the archive with libpsys_runtime (no
  * compiler, no LLVM) or with libpsys. */
-#define PSYS_AOT_ABI 4 /* 4: an instanced program's updates at each instance's speed */
+#define PSYS_AOT_ABI 5 /* 5: a fold's walk of its grid compiled with its terms */
 typedef struct psys_aot_kernel {
     uint64_t key_low, key_high;
     void* code;
