@@ -26,7 +26,7 @@ void buildRowsFunction(llvm::Module& module, MathMode mode, unsigned lanes, cons
                        rt::Clock::Source dt, const std::string& name);
 void buildChildrenFunction(llvm::Module& module, MathMode mode, const ir::Object& object, const ir::Kernel& spawn,
                            const std::string& name);
-// A neighbour group's pair kernel as an rt::PairFunction (pair_function.cpp).
+// A neighbour group's walk and pair kernel as an rt::PairFunction (pair_function.cpp).
 void buildPairFunction(llvm::Module& module, MathMode mode, const ir::Object& object, const ir::Kernel& pair,
                        const std::string& name);
 
