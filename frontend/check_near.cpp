@@ -57,11 +57,21 @@ Type Checker::checkNear(CallExpr& call, const Context& ctx) {
     if (!target) {
         std::string suggestion;
         if (typeArg.kind == ExprKind::Name) {
+            const std::string& named = static_cast<const NameExpr&>(typeArg).name;
+            if (nestedObjects_.count(named) > 1) {
+                Diagnostic& d = diags_.error(typeArg.range, fmt::format("`{}` names {} nested object types: a fold "
+                                                                        "folds over one (rename one of them)",
+                                                                        named, nestedObjects_.count(named)));
+                auto [first, last] = nestedObjects_.equal_range(named);
+                for (auto it = first; it != last; ++it) d.notes.push_back({it->second->nameRange, "declared here"});
+                return Type::error();
+            }
             std::vector<std::string> types;
             for (const auto& [name, decl] : globals_)
-                if (decl->kind == DeclKind::Object) types.push_back(name);
-            for (const auto& [name, object] : nestedObjects_) types.push_back(name);
-            suggestion = closestName(static_cast<const NameExpr&>(typeArg).name, types);
+                if (decl->kind == DeclKind::Object && name != named) types.push_back(name);
+            for (const auto& [name, object] : nestedObjects_)
+                if (name != named) types.push_back(name);
+            suggestion = closestName(named, types);
         }
         Diagnostic& d = diags_.error(typeArg.range, fmt::format("the first argument of `{}` must name an object type (the "
                                                                 "objects it folds over): {}{}", call.callee, usage,

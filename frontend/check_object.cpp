@@ -151,7 +151,10 @@ void Checker::inferObjects() {
         ctx.object = &o;
         return ctx;
     };
-    for (int round = 0; round < 16; ++round) {
+    // (A read of a type checked later in the round takes a round a link: folds over
+    // types declared after, chained, need as many rounds as types.)
+    const size_t rounds = 16 + objects.size();
+    for (size_t round = 0; round < rounds; ++round) {
         std::vector<std::vector<Type>> before;
         for (ObjectDecl* o : objects)
             for (auto& eq : o->equations) before.push_back(eq->types);
@@ -173,6 +176,12 @@ void Checker::inferObjects() {
                     }
         if (!defaulted) break;
     }
+    // Still changing after every round (an unbounded widening): float, as a recursive
+    // equation nothing fixes, so that the final check reports what does not fit.
+    for (ObjectDecl* o : objects)
+        for (auto& eq : o->equations)
+            for (auto& t : eq->types)
+                if (t.isUnknown()) t = Type::scalar();
     diags_.setSuppressed(wasSuppressed);
 }
 
