@@ -14,6 +14,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <span>
 #include <string>
 #include <vector>
@@ -182,6 +183,7 @@ struct PairWalk {
 // combined with every neighbour's terms in order (core/fold.h combine).
 using PairFunction = void (*)(const float* const* self, const float* const* other, uint32_t selfRow,
                               const PairWalk* walk, const Value* externs, float* acc);
+static_assert(sizeof(PairWalk) == 80 && offsetof(PairWalk, px) == 64, "the layout compiled walks read");
 
 // Every launch shape a system will use, listed before its first step.
 struct Plan {
@@ -287,9 +289,10 @@ public:
     // host's memory; a GPU gains nothing from it and pays a dispatch per chunk.
     virtual bool rendersInStep() const { return true; }
     // A neighbour group's folds, all on the backend's side; false: the run-time folds on
-    // the host (its grid and loop), asking pairFunction for the terms.
+    // the host (its grid), asking pairFunction for each object's walk and terms.
     virtual bool fold(const FoldLaunch&) { return false; }
-    // A group's terms compiled (PairFunction); null: the run-time evaluates the pair kernel.
+    // A group's walk and terms compiled (PairFunction); null: the run-time walks the grid
+    // and evaluates the pair kernel.
     virtual PairFunction pairFunction(const ir::Object&, const ir::Kernel&) { return nullptr; }
     virtual BackendReport report() const { return {}; }
 };

@@ -7,8 +7,9 @@
 // little) wide, hashed into buckets (core/hash.h cellBucket), its rows counting-sorted by
 // bucket in row order — then, for each object, the buckets of the 27 cells around its
 // own in bucket order, each bucket's rows in row order. That is the order terms are
-// combined in, so the folds do not depend on the number of threads. The terms are the
-// backend's compiled pair kernel (Backend::pairFunction) or the IR evaluated.
+// combined in, so the folds do not depend on the number of threads. The walk of those
+// buckets and the terms are the backend's compiled function (Backend::pairFunction), or
+// the run-time's walk and the IR evaluated.
 #include <algorithm>
 #include <cmath>
 
