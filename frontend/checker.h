@@ -3,7 +3,8 @@
 // One Checker walks the whole program once: it fills in every NameExpr's Ref, every
 // Expr's Type, every emit's target and every equation's types, and reports what is wrong.
 // Split over files by concern: symbols.cpp (scopes and lookup), check_expr.cpp
-// (expressions), check_object.cpp (objects, equations, commands), check_decls.cpp
+// (expressions), check_infer.cpp (every object's equation types, together),
+// check_object.cpp (objects, equations, commands), check_decls.cpp
 // (constants, functions, externs, triggers, spawns, attributes), check_cycles.cpp
 // (algebraic loops among an object's equations), check_size.cpp (functions' size once inlined).
 #pragma once
@@ -89,6 +90,7 @@ private:
     // check_object.cpp
     void checkObject(ast::ObjectDecl& object);
     void declareObjectNames(ast::ObjectDecl& object);
+    // check_infer.cpp
     void inferObjects();
     void checkEquation(ast::Equation& eq, const Context& ctx, bool final);
     void checkCommands(std::vector<ast::CommandPtr>& commands, const Context& ctx, const ast::Command** point);
