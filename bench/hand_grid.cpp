@@ -4,6 +4,10 @@
 // copied in bucket order, so the inner loop reads them in a row), the 27 cells around
 // each particle, the push and the count in one pass over every thread. Compiled like
 // hand_written.cpp (-O3 -march=native -ffast-math).
+//
+// Two walks: the particles in their own order (what one writes first), or in the grid's
+// order with the 27 cells found once for the particles of a cell (what the run-time does:
+// a cell's neighbours are read from memory once for all of them).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -28,8 +32,8 @@ uint32_t mix(uint32_t v) {  // an integer hash (PCG's output step)
 
 class Grid final : public HandGrid {
 public:
-    Grid(size_t n, float side, unsigned threads, unsigned seed)
-        : n_(n), arena_(threads ? static_cast<int>(threads) : tbb::task_arena::automatic) {
+    Grid(size_t n, float side, unsigned threads, unsigned seed, HandWalk walk)
+        : n_(n), walk_(walk), arena_(threads ? static_cast<int>(threads) : tbb::task_arena::automatic) {
         std::mt19937 random(seed);
         std::uniform_real_distribution<float> u(0, side);
         for (auto* a : {&x_, &y_, &z_}) a->resize(n);
@@ -58,28 +62,36 @@ public:
         sx_.resize(n_);
         sy_.resize(n_);
         sz_.resize(n_);
+        sorted_.resize(n_);
         std::vector<uint32_t> next(start_.begin(), start_.end() - 1);
         for (size_t i = 0; i < n_; ++i) {
             uint32_t at = next[of[i]]++;
             sx_[at] = x_[i];
             sy_[at] = y_[i];
             sz_[at] = z_[i];
+            sorted_[at] = static_cast<uint32_t>(i);
         }
         constexpr size_t kChunk = 1024;
         std::vector<size_t> pairs((n_ + kChunk - 1) / kChunk, 0);
         arena_.execute([&] {
             tbb::parallel_for(size_t{0}, pairs.size(), [&](size_t c) {
                 size_t found = 0;
-                for (size_t i = c * kChunk; i < std::min(n_, (c + 1) * kChunk); ++i) {
+                uint32_t seen[27];
+                int m = 0;
+                uint32_t at[3] = {0, 0, 0};
+                for (size_t k = c * kChunk; k < std::min(n_, (c + 1) * kChunk); ++k) {
+                    size_t i = walk_ == HandWalk::cells ? sorted_[k] : k;
                     float px = x_[i], py = y_[i], pz = z_[i];
                     uint32_t cx = cell(px), cy = cell(py), cz = cell(pz);
-                    uint32_t seen[27];
-                    int m = 0;
-                    for (uint32_t dz = 0; dz < 3; ++dz)
-                        for (uint32_t dy = 0; dy < 3; ++dy)
-                            for (uint32_t dx = 0; dx < 3; ++dx) seen[m++] = bucket(cx + dx - 1, cy + dy - 1, cz + dz - 1);
-                    std::sort(seen, seen + 27);
-                    m = static_cast<int>(std::unique(seen, seen + 27) - seen);
+                    if (walk_ == HandWalk::rows || m == 0 || cx != at[0] || cy != at[1] || cz != at[2]) {
+                        at[0] = cx, at[1] = cy, at[2] = cz;
+                        m = 0;
+                        for (uint32_t dz = 0; dz < 3; ++dz)
+                            for (uint32_t dy = 0; dy < 3; ++dy)
+                                for (uint32_t dx = 0; dx < 3; ++dx) seen[m++] = bucket(cx + dx - 1, cy + dy - 1, cz + dz - 1);
+                        std::sort(seen, seen + 27);
+                        m = static_cast<int>(std::unique(seen, seen + 27) - seen);
+                    }
                     float ax = 0, ay = 0, az = 0, count = 0;
                     for (int k = 0; k < m; ++k)
                         for (uint32_t j = start_[seen[k]]; j < start_[seen[k] + 1]; ++j) {
@@ -120,17 +132,18 @@ public:
 
 private:
     size_t n_;
+    HandWalk walk_;
     tbb::task_arena arena_;
     uint32_t buckets_ = 64;
     std::vector<float> x_, y_, z_, vx_, vy_, vz_, px_, py_, pz_, crowd_, sx_, sy_, sz_;
-    std::vector<uint32_t> of_, start_;
+    std::vector<uint32_t> of_, start_, sorted_;
     size_t pairs_ = 0;
 };
 
 }  // namespace
 
-std::unique_ptr<HandGrid> makeHandGrid(size_t n, float side, unsigned threads, unsigned seed) {
-    return std::make_unique<Grid>(n, side, threads, seed);
+std::unique_ptr<HandGrid> makeHandGrid(size_t n, float side, unsigned threads, unsigned seed, HandWalk walk) {
+    return std::make_unique<Grid>(n, side, threads, seed, walk);
 }
 
 }  // namespace psys::bench

@@ -40,7 +40,8 @@ int crowdFigures(std::ostream& out, gpu::GlslBackend& gpu, const std::vector<dou
 // The same crowd written by hand: SoA arrays, a grid rebuilt each step by a counting sort
 // of hashed cells, then per particle the 27 cells around it — the push and the count in
 // one pass (threads: the particles split into chunks). fold() runs that pass and the
-// grid; step() the fold and the update.
+// grid; step() the fold and the update. `walk`: the particles walked in their own order,
+// or in the grid's with a cell's 27 buckets found once for its particles.
 class HandGrid {
 public:
     virtual ~HandGrid() = default;
@@ -48,6 +49,7 @@ public:
     virtual void update(float dt) = 0;
     virtual size_t pairs() const = 0;  // of the last fold
 };
-std::unique_ptr<HandGrid> makeHandGrid(size_t n, float side, unsigned threads, unsigned seed);
+enum class HandWalk { rows, cells };
+std::unique_ptr<HandGrid> makeHandGrid(size_t n, float side, unsigned threads, unsigned seed, HandWalk walk);
 
 }  // namespace psys::bench

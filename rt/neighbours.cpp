@@ -10,6 +10,12 @@
 // combined in, so the folds do not depend on the number of threads. The walk of those
 // buckets and the terms are the backend's compiled function (Backend::pairFunction), or
 // the run-time's walk and the IR evaluated.
+//
+// The objects are walked in their own grid's order, not row order: the objects of one cell
+// read the same 27 buckets (found once for them) one after another, so a bucket is read
+// from memory once for a cell rather than once for each object in it — at 10⁶ objects
+// walking by row waited on memory for most of its time. An object's folds are its own,
+// whoever computes them when, so the order of the walk changes no bit of them.
 #include <algorithm>
 #include <cmath>
 
@@ -56,6 +62,16 @@ struct Grid {
     std::vector<std::vector<float>> sorted;
     std::vector<const float*> columns;
 
+    // Its arrays back to `buffers`, for the next step's grid.
+    void keep(FoldBuffers& buffers) {
+        buffers.start = std::move(start);
+        buffers.rows = std::move(rows);
+        buffers.x = std::move(x);
+        buffers.y = std::move(y);
+        buffers.z = std::move(z);
+        buffers.sorted = std::move(sorted);
+    }
+
     uint32_t cell(float p) const { return core::HostAlgebra::wholeToInt(std::floor(p * inverse)); }
     uint32_t bucket(uint32_t cx, uint32_t cy, uint32_t cz) const {
         core::HostAlgebra a;
@@ -63,43 +79,69 @@ struct Grid {
     }
 };
 
-Grid buildGrid(const HostSide& other, size_t rows, int position, float radius, const ir::Kernel& pair) {
+// A side's live rows counting-sorted by the bucket of their position (row order within
+// one) into `sorted`, with where each bucket starts when `start` is given.
+void rowsByBucket(const Grid& g, const HostSide& side, size_t rows, int position, std::vector<uint32_t>& sorted,
+                  std::vector<uint32_t>& bucketOf, std::vector<uint32_t>* start) {
+    const float* px = side.columns[static_cast<size_t>(4 * position)];
+    const float* py = side.columns[static_cast<size_t>(4 * position + 1)];
+    const float* pz = side.columns[static_cast<size_t>(4 * position + 2)];
+    bucketOf.resize(rows);
+    std::vector<uint32_t> local, &count = start ? *start : local;
+    count.assign(size_t{g.mask} + 2, 0);
+    for (size_t r = 0; r < rows; ++r) {
+        if (!side.mask[r]) continue;
+        bucketOf[r] = g.bucket(g.cell(px[r]), g.cell(py[r]), g.cell(pz[r]));
+        ++count[bucketOf[r] + 1];
+    }
+    for (uint32_t b = 0; b <= g.mask; ++b) count[b + 1] += count[b];
+    sorted.resize(count.back());
+    for (size_t r = 0; r < rows; ++r)
+        if (side.mask[r]) sorted[count[bucketOf[r]]++] = static_cast<uint32_t>(r);
+    // (count[b] is now where bucket b ends: where b + 1 starts)
+    for (size_t b = count.size() - 1; b > 0; --b) count[b] = count[b - 1];
+    count[0] = 0;
+}
+
+// The grid, its arrays `buffers`' (given back by keep()).
+Grid buildGrid(const HostSide& other, size_t rows, int position, float radius, const ir::Kernel& pair,
+               FoldBuffers& buffers) {
     Grid g;
     g.inverse = 1.0f / (radius * core::kCellMargin);
-    uint32_t buckets = core::gridBuckets(rows);
-    g.mask = buckets - 1;
+    g.mask = core::gridBuckets(rows) - 1;
+    g.start = std::move(buffers.start);
+    g.rows = std::move(buffers.rows);
+    g.x = std::move(buffers.x);
+    g.y = std::move(buffers.y);
+    g.z = std::move(buffers.z);
+    g.sorted = std::move(buffers.sorted);
+    rowsByBucket(g, other, rows, position, g.rows, buffers.bucketOf, &g.start);
+    size_t n = g.rows.size();
     const float* px = other.columns[static_cast<size_t>(4 * position)];
     const float* py = other.columns[static_cast<size_t>(4 * position + 1)];
     const float* pz = other.columns[static_cast<size_t>(4 * position + 2)];
-    std::vector<uint32_t> bucketOf(rows);
-    g.start.assign(buckets + 1, 0);
-    for (size_t r = 0; r < rows; ++r) {
-        if (!other.mask[r]) continue;
-        bucketOf[r] = g.bucket(g.cell(px[r]), g.cell(py[r]), g.cell(pz[r]));
-        ++g.start[bucketOf[r] + 1];
-    }
-    for (uint32_t b = 0; b < buckets; ++b) g.start[b + 1] += g.start[b];
-    size_t n = g.start[buckets];
-    g.rows.resize(n);
     g.x.resize(n);
     g.y.resize(n);
     g.z.resize(n);
-    std::vector<uint32_t> next(g.start.begin(), g.start.end() - 1);
-    for (size_t r = 0; r < rows; ++r) {
-        if (!other.mask[r]) continue;
-        uint32_t at = next[bucketOf[r]]++;
-        g.rows[at] = static_cast<uint32_t>(r);
-        g.x[at] = px[r];
-        g.y[at] = py[r];
-        g.z[at] = pz[r];
+    for (size_t j = 0; j < n; ++j) {
+        g.x[j] = px[g.rows[j]];
+        g.y[j] = py[g.rows[j]];
+        g.z[j] = pz[g.rows[j]];
     }
     g.columns.assign(other.columns.size(), nullptr);
+    size_t used = 0;  // of g.sorted
     for (const ir::Inst& i : pair.insts()) {
         if (i.op != ir::Op::NeighbourExport || i.attr2 != 1) continue;
         for (int c = 0; c < i.type.width; ++c) {
             auto column = static_cast<size_t>(4 * i.attr + c);
             if (g.columns[column]) continue;
-            std::vector<float>& to = g.sorted.emplace_back(n);
+            if (i.attr == position) {  // the positions: sorted already
+                g.columns[column] = (c == 0 ? g.x : c == 1 ? g.y : g.z).data();
+                continue;
+            }
+            if (used == g.sorted.size()) g.sorted.emplace_back();
+            std::vector<float>& to = g.sorted[used++];
+            to.resize(n);
             const float* from = other.columns[column];
             for (size_t j = 0; j < n; ++j) to[j] = from[g.rows[j]];
             g.columns[column] = to.data();
@@ -192,7 +234,8 @@ void State::foldOnHost(const FoldLaunch& launch) {
     const ir::Object& object = *launch.object;
     const ir::NeighbourGroup& group = *launch.group;
     HostSide self(memory, launch.self), other(memory, launch.other);
-    Grid grid = buildGrid(other, launch.other.rows, group.otherPosition, group.radius, *launch.pair);
+    FoldBuffers& buffers = foldBuffers;
+    Grid grid = buildGrid(other, launch.other.rows, group.otherPosition, group.radius, *launch.pair, buffers);
     const float radius2 = group.radius * group.radius;
 
     // The group's folds: their components, in fold order, and where each fold's are.
@@ -208,38 +251,47 @@ void State::foldOnHost(const FoldLaunch& launch) {
     std::vector<float> empty;
     for (const ir::Fold* f : folds) empty.insert(empty.end(), static_cast<size_t>(f->type.width), core::emptyFold(f->reduce));
     const size_t rows = launch.self.rows;
-    std::vector<float> results((rows + 1) * width);  // row by row
+    std::vector<float>& results = buffers.results;  // row by row
+    results.resize((rows + 1) * width);
     for (size_t r = 0; r <= rows; ++r) std::copy(empty.begin(), empty.end(), results.begin() + static_cast<std::ptrdiff_t>(r * width));
 
     PairFunction compiled = backend.pairFunction(object, *launch.pair);
     const float* const* sx = self.columns.data();
     const float* const* ox = grid.columns.data();  // (by place in the grid, not by row)
     const size_t sp = static_cast<size_t>(4 * group.selfPosition);
-    size_t chunks = (rows + kFoldRows - 1) / kFoldRows;
+    // The objects in their grid's order (the other side's grid where it is their own).
+    if (!launch.same) rowsByBucket(grid, self, rows, group.selfPosition, buffers.order, buffers.bucketOf, nullptr);
+    const std::vector<uint32_t>& order = launch.same ? grid.rows : buffers.order;
+    size_t chunks = (order.size() + kFoldRows - 1) / kFoldRows;
     parallel->forEach(chunks, true, [&](size_t c) {
         std::optional<EvaluatedTerms> evaluated;
         if (!compiled) evaluated.emplace(object, *launch.pair, launch.externs);
         std::vector<uint32_t> candidates;
         uint32_t buckets[27];
-        for (size_t i = c * kFoldRows; i < std::min(rows, (c + 1) * kFoldRows); ++i) {
-            if (!self.mask[i]) continue;
+        uint32_t cell[3] = {0, 0, 0};
+        int n = 0;  // the buckets around `cell`; 0: none found yet
+        for (size_t k = c * kFoldRows; k < std::min(order.size(), (c + 1) * kFoldRows); ++k) {
+            const uint32_t i = order[k];
             float px = sx[sp][i], py = sx[sp + 1][i], pz = sx[sp + 2][i];
             uint32_t cx = grid.cell(px), cy = grid.cell(py), cz = grid.cell(pz);
-            int n = 0;
-            for (uint32_t dz = 0; dz < 3; ++dz)
-                for (uint32_t dy = 0; dy < 3; ++dy)
-                    for (uint32_t dx = 0; dx < 3; ++dx) buckets[n++] = grid.bucket(cx + dx - 1, cy + dy - 1, cz + dz - 1);
-            std::sort(buckets, buckets + n);
-            n = static_cast<int>(std::unique(buckets, buckets + n) - buckets);
-            const auto self = launch.same ? static_cast<uint32_t>(i) : kSkipRow;
-            float* acc = results.data() + i * width;
-            size_t room = 0;
-            for (int b = 0; b < n; ++b) room += grid.start[buckets[b] + 1] - grid.start[buckets[b]];
-            if (candidates.size() < room) candidates.resize(room);
+            if (n == 0 || cx != cell[0] || cy != cell[1] || cz != cell[2]) {
+                cell[0] = cx, cell[1] = cy, cell[2] = cz;
+                n = 0;
+                for (uint32_t dz = 0; dz < 3; ++dz)
+                    for (uint32_t dy = 0; dy < 3; ++dy)
+                        for (uint32_t dx = 0; dx < 3; ++dx) buckets[n++] = grid.bucket(cx + dx - 1, cy + dy - 1, cz + dz - 1);
+                std::sort(buckets, buckets + n);
+                n = static_cast<int>(std::unique(buckets, buckets + n) - buckets);
+                size_t room = 0;
+                for (int b = 0; b < n; ++b) room += grid.start[buckets[b] + 1] - grid.start[buckets[b]];
+                if (candidates.size() < room) candidates.resize(room);
+            }
+            const auto self = launch.same ? i : kSkipRow;
+            float* acc = results.data() + size_t{i} * width;
             if (compiled) {  // the walk compiled with the terms
                 PairWalk walk{buckets, grid.start.data(), grid.x.data(), grid.y.data(), grid.z.data(), grid.rows.data(),
                               candidates.data(), static_cast<uint32_t>(n), self, px, py, pz, radius2};
-                compiled(sx, ox, static_cast<uint32_t>(i), &walk, launch.externs, acc);
+                compiled(sx, ox, i, &walk, launch.externs, acc);
                 continue;
             }
             // Each bucket's places kept where within the radius, without a branch per place
@@ -251,11 +303,12 @@ void State::foldOnHost(const FoldLaunch& launch) {
                     candidates[count] = j;
                     count += (dx * dx + dy * dy + dz * dz <= radius2) & (grid.rows[j] != self);
                 }
-            (*evaluated)(sx, ox, static_cast<uint32_t>(i), candidates.data(), count, acc);
+            (*evaluated)(sx, ox, i, candidates.data(), count, acc);
         }
     });
     // Into the fold columns, component by component.
-    std::vector<float> column(rows + 1);
+    std::vector<float>& column = buffers.column;
+    column.resize(rows + 1);
     for (size_t k = 0; k < folds.size(); ++k) {
         auto index = static_cast<size_t>(folds[k] - object.folds.data());
         for (int comp = 0; comp < folds[k]->type.width; ++comp) {
@@ -263,6 +316,7 @@ void State::foldOnHost(const FoldLaunch& launch) {
             memory.write(launch.results[index][static_cast<size_t>(comp)], 0, rows + 1, column.data());
         }
     }
+    grid.keep(buffers);
 }
 
 // Every group of a type's folds, over its objects alive before this step.

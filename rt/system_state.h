@@ -150,6 +150,14 @@ struct InstanceSlot {
     bool paused = false;  // System::pause: a speed of 0 until resumed, its speed kept
 };
 
+// The host's neighbour fold's arrays (rt/neighbours.cpp), kept from step to step: fresh
+// ones each step cost a page fault every 4 KiB of them.
+struct FoldBuffers {
+    std::vector<uint32_t> start, rows, order, bucketOf;
+    std::vector<float> x, y, z, results, column;
+    std::vector<std::vector<float>> sorted;
+};
+
 struct State {
     State(ir::Module module, Backend& backend, SystemOptions options);
     ~State();
@@ -261,6 +269,7 @@ struct State {
     // The neighbour folds of a type's objects, for this step (rt/neighbours.cpp).
     void foldNeighbours(size_t type);
     void foldOnHost(const FoldLaunch& launch);
+    FoldBuffers foldBuffers;
     // Rows [first, first + count) of a fold's launch columns (`p`, in `table`) set to a fold
     // over nothing: what an object created since the folds reads.
     void emptyFold(size_t type, const ColumnLayout::ParentColumn& p, std::span<const Buffer> table, size_t first,
