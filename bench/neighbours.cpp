@@ -95,8 +95,11 @@ int crowdFigures(std::ostream& out, gpu::GlslBackend& gpu, const std::vector<dou
             passes += fmt::format("{}{} {:.2f}", passes.empty() ? "" : ", ", pass, ms);
             if (pass == "fold") foldMs = ms;
         }
-        out << fmt::format("| {:.0e} | {:.2f} | {} | {:.1f} | {:.0f} | {:.1f} | {:.1f} |\n", n, f.stepSeconds * 1e3, passes,
-                           foldMs * 1e6 / f.live, f.pairs / (foldMs * 1e-3) / 1e6, waited, kb);
+        // (a device without timer queries or pass times, llvmpipe: no fold figures)
+        bool timed = foldMs > 0;
+        out << fmt::format("| {:.0e} | {:.2f} | {} | {} | {} | {:.1f} | {:.1f} |\n", n, f.stepSeconds * 1e3, passes,
+                           timed ? fmt::format("{:.1f}", foldMs * 1e6 / f.live) : "—",
+                           timed ? fmt::format("{:.0f}", f.pairs / (foldMs * 1e-3) / 1e6) : "—", waited, kb);
     }
     return 0;
 }

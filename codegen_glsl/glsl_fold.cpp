@@ -92,10 +92,22 @@ uint lw(uint k) {{ return w[k]; }}
 float sv(uint s, uint i) {{ return uintBitsToFloat(sw[s * lw(0u) + i]); }}
 float ov(uint s, uint j) {{ return uintBitsToFloat(ow[s * lw(1u) + j]); }}  // (by place in the grid)
 {5}void main() {{
-    uint i = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
+    uint k = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
     uint rows = lw(0u);
-    if (i > rows) return;
-{6}    if (i < rows && sw[i] != 0u) {{
+    if (k > rows) return;
+    if (k == rows || sw[k] == 0u) {{  // a row no walk writes: the row of empty folds, or a dead one
+        uint i = k;
+{6}{8}    }}
+    // The object invocation k walks: where the sides are one type, the grid's k-th (the
+    // objects of a cell walk side by side, reading the same buckets), else row k.
+    uint i = k;
+    if (lw(5u) != 0u) {{
+        if (k >= start[lw(2u) + 1u]) return;
+        i = sorted[k];
+    }} else if (k == rows || sw[k] == 0u) {{
+        return;
+    }}
+{6}    {{
         precise float px = sv(1u, i), py = sv(2u, i), pz = sv(3u, i);
         uint cx = psys_cell(px), cy = psys_cell(py), cz = psys_cell(pz);
         uint b[27];

@@ -1,5 +1,6 @@
 // A neighbour group's folds as a GLSL compute shader (gpu/gl_fold.cpp runs it, after
-// building the grid on the GPU): one invocation per object of the folding type, walking
+// building the grid on the GPU): one invocation per object of the folding type (in the
+// grid's order where it folds over itself: a cell's objects side by side), walking
 // the 27 cells around it in the order the run-time's host fold walks them
 // (rt/neighbours.cpp) — buckets ascending, rows ascending within one — and combining each
 // term as core/fold.h does.

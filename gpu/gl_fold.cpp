@@ -8,8 +8,8 @@
 // (prefix sums, as the compactor's); the rows scattered to their places (atomics: in no
 // set order) and each bucket's rows sorted by row — so the grid is the host's, the same
 // every run; the other side's columns copied in that order (a bucket's read in a row);
-// then one invocation per object walks the 27 cells around it
-// (codegen_glsl::foldShader), and the results are adopted as the fold columns.
+// then one invocation per object (in the grid's order where a type folds over itself)
+// walks the 27 cells around it (codegen_glsl::foldShader), and the results are adopted as the fold columns.
 #include <epoxy/gl.h>
 
 #include <bit>
