@@ -65,7 +65,8 @@ fs::path importTarget(const std::string& path, const fs::path& importer, const S
 
 class Loader {
 public:
-    Loader(SourceManager& sources, DiagnosticEngine& diags) : sources_(sources), diags_(diags) {}
+    Loader(SourceManager& sources, DiagnosticEngine& diags, const SourceOverrides* overrides)
+        : sources_(sources), diags_(diags), overrides_(overrides) {}
 
     std::unique_ptr<ast::Program> run(const std::string& displayPath, std::string text) {
         program_ = std::make_unique<ast::Program>();
@@ -92,11 +93,7 @@ public:
     }
 
 private:
-    static std::string canonicalKey(const fs::path& path) {
-        std::error_code ec;
-        fs::path canonical = fs::weakly_canonical(path, ec);
-        return (ec ? path.lexically_normal() : canonical).string();
-    }
+    static std::string canonicalKey(const fs::path& path) { return sourceKey(path); }
 
     bool loadImport(ast::ImportDecl& import, const fs::path& importer) {
         if (import.path.empty()) {
@@ -126,7 +123,12 @@ private:
             return true;
         }
         std::string error;
-        auto text = readSourceFile(target, error);
+        std::optional<std::string> text;
+        if (auto open = overrides_ ? overrides_->find(key) : SourceOverrides::const_iterator();
+            overrides_ && open != overrides_->end())
+            text = open->second;
+        else
+            text = readSourceFile(target, error);
         if (!text) {
             diags_.error(import.pathRange, fmt::format("cannot open imported file `{}`: {}", target.string(), error));
             return false;
@@ -138,6 +140,7 @@ private:
 
     SourceManager& sources_;
     DiagnosticEngine& diags_;
+    const SourceOverrides* overrides_;
     std::unique_ptr<ast::Program> program_;
     std::map<std::string, int> loaded_;
     std::vector<std::pair<std::string, std::string>> stack_;  // (canonical, display) of files being loaded
@@ -221,8 +224,15 @@ std::unique_ptr<ast::Program> loadProgram(const std::string& mainPath, SourceMan
 }
 
 std::unique_ptr<ast::Program> loadProgramFromText(const std::string& displayPath, std::string text,
-                                                  SourceManager& sources, DiagnosticEngine& diags) {
-    return Loader(sources, diags).run(displayPath, std::move(text));
+                                                  SourceManager& sources, DiagnosticEngine& diags,
+                                                  const SourceOverrides* overrides) {
+    return Loader(sources, diags, overrides).run(displayPath, std::move(text));
+}
+
+std::string sourceKey(const std::filesystem::path& path) {
+    std::error_code ec;
+    fs::path canonical = fs::weakly_canonical(path, ec);
+    return (ec ? path.lexically_normal() : canonical).string();
 }
 
 }  // namespace psys

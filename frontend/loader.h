@@ -7,6 +7,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -33,12 +34,20 @@ std::optional<std::string> readSourceFile(const std::filesystem::path& path, std
 // empty: for the quick fix that imports it. The library is read once per process.
 std::string libraryFileDeclaring(const std::string& name);
 
+// Texts that stand for files, by the files' keys (sourceKey): an editor's open, unsaved
+// documents, which an import reads rather than what is on disk.
+using SourceOverrides = std::map<std::string, std::string>;
+// The key a file is loaded once by: its canonical path where it has one.
+std::string sourceKey(const std::filesystem::path& path);
+
 // Returns null when the main file cannot be read or any file has syntax errors.
 std::unique_ptr<ast::Program> loadProgram(const std::string& mainPath, SourceManager& sources, DiagnosticEngine& diags);
 
 // The same for a main file given as text (tests, the viewer's editor buffer); imports are
-// resolved relative to the directory of `displayPath`.
+// resolved relative to the directory of `displayPath`, and read from `overrides` where
+// it holds their text.
 std::unique_ptr<ast::Program> loadProgramFromText(const std::string& displayPath, std::string text,
-                                                  SourceManager& sources, DiagnosticEngine& diags);
+                                                  SourceManager& sources, DiagnosticEngine& diags,
+                                                  const SourceOverrides* overrides = nullptr);
 
 }  // namespace psys

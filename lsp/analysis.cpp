@@ -56,13 +56,14 @@ void methodHints(const ir::Module& module, Analysis& a) {
 
 }  // namespace
 
-Analysis analyze(const std::string& path, std::string text, const std::atomic<bool>* cancelled) {
+Analysis analyze(const std::string& path, std::string text, const std::atomic<bool>* cancelled,
+                 const SourceOverrides* open) {
     auto stop = [&] { return cancelled && cancelled->load(std::memory_order_relaxed); };
     Analysis a;
     a.sources = std::make_unique<SourceManager>();
     DiagnosticEngine diags(*a.sources);
     try {
-        std::unique_ptr<ast::Program> program = loadProgramFromText(path, std::move(text), *a.sources, diags);
+        std::unique_ptr<ast::Program> program = loadProgramFromText(path, std::move(text), *a.sources, diags, open);
         if (program && stop()) return a;  // a newer text is on its way: this one is not wanted
         if (program) {
             checkProgram(*program, diags);
@@ -97,6 +98,8 @@ Analysis analyze(const std::string& path, std::string text, const std::atomic<bo
     if (a.mainFile < 0)
         for (int f = 0; f < a.sources->count(); ++f)
             if (a.sources->file(f).path() == path) a.mainFile = f;
+    for (int f = 0; f < a.sources->count(); ++f)
+        if (f != a.mainFile) a.imported.insert(sourceKey(a.sources->file(f).path()));
     a.diagnostics = diags.all();
     return a;
 }

@@ -8,10 +8,12 @@
 #include <atomic>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "frontend/diagnostics.h"
+#include "frontend/loader.h"
 #include "frontend/source.h"
 
 namespace psys::lsp {
@@ -88,15 +90,20 @@ struct Analysis {
     std::vector<Hint> hints;              // the main file's
     std::vector<SourceRange> integrating;  // the main file's objects that integrate (name ranges)
     std::vector<std::pair<std::string, std::vector<Name>>> members;  // per object: what `object.` reads
+    // The files the main file imports, directly or not (their sourceKey): an edit to one of
+    // them, open in the editor, calls for this document to be analysed again.
+    std::set<std::string> imported;
 
     // The innermost occurrence at `offset` of `file` (its end counts: the cursor just after a name).
     const Occurrence* at(int file, uint32_t offset) const;
 };
 
-// Runs the front end over `text` as the file `path` (imports are read from disk, relative
-// to it), and the compiler's passes when it is clean, for their warnings.
+// Runs the front end over `text` as the file `path` (imports are read relative to it,
+// from `open` where it has their text — the editor's documents — else from disk), and the
+// compiler's passes when it is clean, for their warnings.
 // `cancelled`, when given and set (from another thread) while it runs, stops it early
 // between its phases; what it returns then is incomplete and only to be thrown away.
-Analysis analyze(const std::string& path, std::string text, const std::atomic<bool>* cancelled = nullptr);
+Analysis analyze(const std::string& path, std::string text, const std::atomic<bool>* cancelled = nullptr,
+                 const SourceOverrides* open = nullptr);
 
 }  // namespace psys::lsp

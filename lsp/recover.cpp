@@ -92,6 +92,8 @@ Analysis recover(const Analysis& good, const Analysis& current, const std::strin
         if (auto at = move.strict(h.at)) out.hints.push_back({*at, h.label, h.kind});
     out.globals = good.globals;
     out.members = good.members;
+    out.imported = good.imported;  // (the current text's imports, as far as it parsed, too)
+    out.imported.insert(current.imported.begin(), current.imported.end());
     return out;
 }
 

@@ -211,6 +211,7 @@ void Server::didOpen(const json& params) {
     doc.edits = old == docs_.end() ? 0 : old->second.edits + 1;
     auto [it, _] = docs_.insert_or_assign(doc.uri, std::move(doc));
     analyse(it->second);
+    touchImporters(it->second);
 }
 
 void Server::didChange(const json& params) {
@@ -234,6 +235,28 @@ void Server::didChange(const json& params) {
     doc.changedAt = Clock::now();
     ++doc.edits;
     cancelPending(uri);
+    touchImporters(doc);
+}
+
+void Server::touchImporters(const Document& changed) {
+    std::string key = sourceKey(changed.path);
+    for (auto& [uri, doc] : docs_) {
+        if (&doc == &changed) continue;
+        bool imports = (doc.analysis && doc.analysis->imported.count(key)) ||
+                       (doc.lastParsed && doc.lastParsed->imported.count(key));
+        if (!imports) continue;
+        doc.dirty = true;
+        doc.changedAt = Clock::now();
+        ++doc.edits;  // (what it read is not the text now)
+        cancelPending(uri);
+    }
+}
+
+SourceOverrides Server::openTexts(const Document& doc) const {
+    SourceOverrides open;
+    for (const auto& [uri, other] : docs_)
+        if (&other != &doc) open[sourceKey(other.path)] = other.text;
+    return open;
 }
 
 void Server::cancelPending(const std::string& uri) {
@@ -246,7 +269,9 @@ void Server::didClose(const json& params) {
     cancelPending(it->first);
     for (const std::string& uri : it->second.publishedTo)
         notify("textDocument/publishDiagnostics", {{"uri", uri}, {"diagnostics", json::array()}});
+    Document closed = std::move(it->second);
     docs_.erase(it);
+    touchImporters(closed);  // (they read it from disk now)
 }
 
 std::vector<const Analysis*> Server::analyses() {
@@ -299,7 +324,10 @@ Server::Document& Server::document(const json& params) {
     return it->second;
 }
 
-void Server::analyse(Document& doc) { install(doc, analyze(doc.path, doc.text)); }
+void Server::analyse(Document& doc) {
+    SourceOverrides open = openTexts(doc);
+    install(doc, analyze(doc.path, doc.text, nullptr, &open));
+}
 
 void Server::install(Document& doc, Analysis analysis) {
     auto fresh = std::make_shared<const Analysis>(std::move(analysis));
@@ -350,9 +378,10 @@ void Server::idle() {
         if (!doc.dirty || now - doc.changedAt < options_.debounce) continue;
         auto cancelled = std::make_shared<std::atomic<bool>>(false);
         pending_ = Pending{uri, doc.edits, cancelled,
-                           std::async(std::launch::async, [path = doc.path, text = doc.text, cancelled] {
-                               return analyze(path, text, cancelled.get());
-                           })};
+                           std::async(std::launch::async,
+                                      [path = doc.path, text = doc.text, open = openTexts(doc), cancelled] {
+                                          return analyze(path, text, cancelled.get(), &open);
+                                      })};
         return;
     }
 }

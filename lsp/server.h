@@ -1,6 +1,8 @@
 // `psysc lsp`: the language server. Documents the editor has open are kept as text; each is
 // analysed when opened and again once edits have paused for the debounce interval, and
-// its diagnostics are published then. Requests about a document analyse it first if it
+// its diagnostics are published then. The open documents are the truth: a file imported
+// by another is read from the editor's text where it is open, saved or not, and an edit to
+// it analyses its importers again. Requests about a document analyse it first if it
 // has changed since, so an answer always matches the text it is asked about.
 //
 // A debounced analysis runs on a thread of its own, one at a time, so the server goes on
@@ -85,6 +87,11 @@ private:
     std::vector<const Analysis*> analyses();  // every open document's, analysed
     nlohmann::json withUris(nlohmann::json answer) const;
     void analyse(Document& doc);
+    // The open documents' texts but `doc`'s, for an analysis of `doc` to import.
+    SourceOverrides openTexts(const Document& doc) const;
+    // `changed`'s text is not what the documents importing it last read: each is analysed
+    // again (once edits pause), an analysis of theirs that is running thrown away.
+    void touchImporters(const Document& changed);
     void install(Document& doc, Analysis fresh);
     void cancelPending(const std::string& uri);
     void publish(Document& doc);

@@ -158,6 +158,43 @@ local formatted = vim.api.nvim_buf_get_lines(0, 9, 10, false)[1]
 check(formatted == "spawn rocket(vec3(0, 15, 0));", "formatted: " .. formatted)
 ok("formatting")
 
+-- Two files, neither saved after a rename across them: main.psys imports lib.psys and
+-- calls its `lift`; renamed to `rise` from main (both buffers edited as the client applies
+-- the edit), main is checked against lib's text in the editor, not the one on disk.
+vim.o.hidden = true
+local libFile, mainFile = dir .. "/lib.psys", dir .. "/main.psys"
+vim.fn.writefile({ "fn lift(h: float) -> vec3 = vec3(0, h, 0);" }, libFile)
+vim.fn.writefile({ 'import "lib.psys";', "object o {", "    pos = origin + lift(2);", "    point(pos, white, 1);",
+  "    kill when age > 1;", "}", "spawn o;" }, mainFile)
+vim.cmd("edit " .. libFile)
+local libBuf = vim.api.nvim_get_current_buf()
+vim.bo.filetype = "psys"
+vim.lsp.buf_attach_client(0, id)
+vim.cmd("edit " .. mainFile)
+local mainBuf = vim.api.nvim_get_current_buf()
+vim.bo.filetype = "psys"
+vim.lsp.buf_attach_client(0, id)
+local before = at(3, 20, "textDocument/hover")
+check(before and before.contents.value:find("fn lift", 1, true), "hover before the rename: " .. vim.inspect(before))
+local across = at(3, 20, "textDocument/rename", { newName = "rise" })
+vim.lsp.util.apply_workspace_edit(across, "utf-16")
+check(vim.api.nvim_buf_get_lines(libBuf, 0, 1, false)[1] == "fn rise(h: float) -> vec3 = vec3(0, h, 0);", "lib renamed")
+check(vim.api.nvim_buf_get_lines(mainBuf, 2, 3, false)[1] == "    pos = origin + rise(2);", "main renamed")
+check(vim.bo[libBuf].modified and vim.bo[mainBuf].modified, "neither saved")
+-- (the client sends its changes after a pause: asked until they have come)
+local riseHover
+vim.wait(5000, function()
+  riseHover = at(3, 20, "textDocument/hover")
+  return riseHover and riseHover.contents.value:find("fn rise", 1, true)
+end, 50)
+check(riseHover and riseHover.contents.value:find("fn rise", 1, true), "hover on the renamed call: " .. vim.inspect(riseHover))
+local riseDef = at(3, 20, "textDocument/definition")
+riseDef = riseDef[1] or riseDef
+check(riseDef.uri == vim.uri_from_fname(libFile) and riseDef.range.start.line == 0, "definition in lib: " .. vim.inspect(riseDef))
+check(vim.wait(5000, function() return #vim.diagnostic.get(mainBuf) == 0 end, 20),
+  "main's diagnostics: " .. vim.inspect(vim.diagnostic.get(mainBuf)))
+ok("unsaved imports")
+
 out:write("done\n")
 out:close()
 vim.lsp.stop_client(id)

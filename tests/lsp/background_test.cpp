@@ -85,3 +85,84 @@ TEST_CASE("background analysis: requests are answered while it runs, and a stale
     }();
     CHECK(hover["result"]["contents"]["value"].get<std::string>().find("green") != std::string::npos);
 }
+
+TEST_CASE("an open, unsaved file is what its importers read: an edit to it checks them again, and definitions point into its text") {
+    // main.psys imports lib.psys and calls `lift`; lib renames it to `rise` without saving.
+    TempDir dir;
+    std::string lib = "fn lift(h: float) -> vec3 = vec3(0, h, 0);\n";
+    std::string main = "import \"lib.psys\";\nobject o {\n    pos = origin + lift(2);\n    point(pos, white, 1);\n"
+                       "    kill when age > 1;\n}\nspawn o;\n";
+    std::string libPath = dir.write("lib.psys", lib), mainPath = dir.write("main.psys", main);
+    std::string libUri = uriFromPath(libPath), mainUri = uriFromPath(mainPath);
+    std::vector<json> out;
+    ServerOptions options;
+    options.debounce = std::chrono::milliseconds(0);
+    Server server(options, [&](const json& m) { out.push_back(m); });
+    server.handle({{"jsonrpc", "2.0"}, {"id", 1}, {"method", "initialize"}, {"params", json::object()}});
+    auto open = [&](const std::string& uri, const std::string& text) {
+        server.handle(message("textDocument/didOpen", {{"textDocument", {{"uri", uri}, {"version", 1}, {"text", text}}}}));
+    };
+    auto change = [&](const std::string& uri, int version, const std::string& text) {
+        server.handle(message("textDocument/didChange", {{"textDocument", {{"uri", uri}, {"version", version}}},
+                                                         {"contentChanges", {{{"text", text}}}}}));
+    };
+    auto settle = [&] {
+        for (int i = 0; i < 100000 && (server.busy() || server.nextDeadline()); ++i) {
+            server.idle();
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+    };
+    // The diagnostics last published for main.psys.
+    auto mainErrors = [&] {
+        std::vector<std::string> messages;
+        bool seen = false;
+        for (const json& m : out)
+            if (m.value("method", "") == "textDocument/publishDiagnostics" && m["params"]["uri"] == mainUri) {
+                seen = true;
+                messages.clear();
+                for (const json& d : m["params"]["diagnostics"]) messages.push_back(d["message"]);
+            }
+        REQUIRE(seen);
+        return messages;
+    };
+    open(mainUri, main);
+    open(libUri, lib);
+    settle();
+    CHECK(mainErrors().empty());
+
+    // lib renames `lift` (unsaved): main is checked again, against lib's text in the editor.
+    out.clear();
+    std::string renamed = "fn rise(h: float) -> vec3 = vec3(0, h, 0);\n";
+    change(libUri, 2, renamed);
+    settle();
+    auto errors = mainErrors();
+    REQUIRE(errors.size() == 1);
+    CHECK(errors[0].find("unknown function `lift`") != std::string::npos);
+
+    // main follows (as a rename across both buffers does): clean, and `rise` is defined in
+    // lib's unsaved text.
+    out.clear();
+    std::string follows = main;
+    follows.replace(follows.find("lift"), 4, "rise");
+    change(mainUri, 2, follows);
+    settle();
+    CHECK(mainErrors().empty());
+    SourceFile now(mainPath, follows);
+    json definition = [&] {
+        out.clear();
+        server.handle({{"jsonrpc", "2.0"}, {"id", 5}, {"method", "textDocument/definition"},
+                       {"params", {{"textDocument", {{"uri", mainUri}}}, {"position", position(now, at(follows, "rise", 1, 1))}}}});
+        return out.back();
+    }();
+    REQUIRE(definition["result"].is_object());
+    CHECK(definition["result"]["uri"] == libUri);
+    CHECK(definition["result"]["range"]["start"] == json({{"line", 0}, {"character", 3}}));
+
+    // lib closed unsaved: the disk's `lift` is what main reads again.
+    out.clear();
+    server.handle(message("textDocument/didClose", {{"textDocument", {{"uri", libUri}}}}));
+    settle();
+    errors = mainErrors();
+    REQUIRE(errors.size() == 1);
+    CHECK(errors[0].find("unknown function `rise`") != std::string::npos);
+}
