@@ -80,14 +80,13 @@ struct Grid {
 };
 
 // A side's live rows counting-sorted by the bucket of their position (row order within
-// one) into `sorted`, with where each bucket starts when `start` is given.
+// one) into `sorted`, with where each bucket starts into `start`.
 void rowsByBucket(const Grid& g, const HostSide& side, size_t rows, int position, std::vector<uint32_t>& sorted,
-                  std::vector<uint32_t>& bucketOf, std::vector<uint32_t>* start) {
+                  std::vector<uint32_t>& bucketOf, std::vector<uint32_t>& count) {
     const float* px = side.columns[static_cast<size_t>(4 * position)];
     const float* py = side.columns[static_cast<size_t>(4 * position + 1)];
     const float* pz = side.columns[static_cast<size_t>(4 * position + 2)];
     bucketOf.resize(rows);
-    std::vector<uint32_t> local, &count = start ? *start : local;
     count.assign(size_t{g.mask} + 2, 0);
     for (size_t r = 0; r < rows; ++r) {
         if (!side.mask[r]) continue;
@@ -115,7 +114,7 @@ Grid buildGrid(const HostSide& other, size_t rows, int position, float radius, c
     g.y = std::move(buffers.y);
     g.z = std::move(buffers.z);
     g.sorted = std::move(buffers.sorted);
-    rowsByBucket(g, other, rows, position, g.rows, buffers.bucketOf, &g.start);
+    rowsByBucket(g, other, rows, position, g.rows, buffers.bucketOf, g.start);
     size_t n = g.rows.size();
     const float* px = other.columns[static_cast<size_t>(4 * position)];
     const float* py = other.columns[static_cast<size_t>(4 * position + 1)];
@@ -260,7 +259,7 @@ void State::foldOnHost(const FoldLaunch& launch) {
     const float* const* ox = grid.columns.data();  // (by place in the grid, not by row)
     const size_t sp = static_cast<size_t>(4 * group.selfPosition);
     // The objects in their grid's order (the other side's grid where it is their own).
-    if (!launch.same) rowsByBucket(grid, self, rows, group.selfPosition, buffers.order, buffers.bucketOf, nullptr);
+    if (!launch.same) rowsByBucket(grid, self, rows, group.selfPosition, buffers.order, buffers.bucketOf, buffers.orderStart);
     const std::vector<uint32_t>& order = launch.same ? grid.rows : buffers.order;
     size_t chunks = (order.size() + kFoldRows - 1) / kFoldRows;
     parallel->forEach(chunks, true, [&](size_t c) {

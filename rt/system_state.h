@@ -153,7 +153,7 @@ struct InstanceSlot {
 // The host's neighbour fold's arrays (rt/neighbours.cpp), kept from step to step: fresh
 // ones each step cost a page fault every 4 KiB of them.
 struct FoldBuffers {
-    std::vector<uint32_t> start, rows, order, bucketOf;
+    std::vector<uint32_t> start, rows, order, orderStart, bucketOf;
     std::vector<float> x, y, z, results, column;
     std::vector<std::vector<float>> sorted;
 };
