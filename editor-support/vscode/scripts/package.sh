@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Packages the extension as a .vsix through the manifest's own `npm run package` (vsce, its
 # client bundled by esbuild into dist/extension.js; both installed by scripts/setup.sh from
-# package-lock.json) and checks that it holds what VS Code needs and nothing else.
+# package-lock.json) and checks that it holds what VS Code needs and nothing else (an
+# allow-list: a new file in the folder fails here until it is needed or in .vscodeignore).
 #   bash editor-support/vscode/scripts/package.sh [OUT.vsix]   (default: editor-support/vscode/psys.vsix)
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
@@ -30,9 +31,11 @@ need = ["extension/language-configuration.json", "extension/syntaxes/psys.tmLang
         "extension/images/preview.png", "extension/readme.md",
         "extension/dist/extension.js"]
 missing = [n for n in need if n not in names and n.replace("readme", "README") not in names]
-# The client is bundled: no node_modules, no sources beside the bundle, no tests.
-dev = [n for n in names if "/node_modules/" in n or "/test/" in n or n == "extension/extension.js"]
-if missing or dev:
-    sys.exit(f"{sys.argv[1]}: missing {missing}; development files packaged: {dev[:5]}")
+# Nothing else: the client is bundled (no node_modules, no sources beside the bundle), and
+# no tests, scripts or the repository's dotfiles.
+package = {"[Content_Types].xml", "extension.vsixmanifest", "extension/package.json"}
+extra = sorted(n for n in names if n not in package and n not in need and n.replace("README", "readme") not in need)
+if missing or extra:
+    sys.exit(f"{sys.argv[1]}: missing {missing}; files VS Code does not need: {extra[:8]}")
 print(f"{sys.argv[1]}: {len(names)} files, {manifest['name']} {manifest['version']}, everything VS Code needs")
 PY
