@@ -160,7 +160,7 @@ Diagnostic& DiagnosticEngine::add(Severity severity, SourceRange range, std::str
     ++count;
     // Past the limit they are counted, not kept: 50,000 errors of a broken generated file
     // would bury the first, which is the one to fix.
-    if (count > kMaxShown) {
+    if (count > limit_) {
         discarded_ = {};
         return discarded_;
     }
@@ -186,10 +186,9 @@ void DiagnosticEngine::print(std::ostream& out, bool colour) const {
         for (const DiagnosticNote& n : d.notes)
             printOne(out, sources_, Severity::Note, n.range, std::nullopt, n.message, colour, program_);
     }
-    int hiddenErrors = std::max(0, errors_ - kMaxShown), hiddenWarnings = std::max(0, warnings_ - kMaxShown);
-    if (hiddenErrors > 0 || hiddenWarnings > 0)
+    if (hiddenErrors() > 0 || hiddenWarnings() > 0)
         out << fmt::format("(the first {} errors and {} warnings are shown; {} more errors and {} more warnings are not)\n",
-                           std::min(errors_, kMaxShown), std::min(warnings_, kMaxShown), hiddenErrors, hiddenWarnings);
+                           std::min(errors_, limit_), std::min(warnings_, limit_), hiddenErrors(), hiddenWarnings());
     if (errors_ > 0 || warnings_ > 0) {
         std::vector<std::string> parts;
         if (errors_ > 0) parts.push_back(fmt::format("{} error{}", errors_, errors_ == 1 ? "" : "s"));

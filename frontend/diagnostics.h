@@ -8,6 +8,7 @@
 // Several errors per run; colour only when asked (the driver asks on a terminal).
 #pragma once
 
+#include <algorithm>
 #include <iosfwd>
 #include <optional>
 #include <string>
@@ -53,8 +54,14 @@ public:
     Diagnostic& warning(SourceRange range, std::string message);
     Diagnostic& remark(SourceRange range, std::string message);
 
-    // At most this many errors and this many warnings are kept and printed; the rest are counted.
+    // At most `limit()` errors and as many warnings are kept and printed; the rest are
+    // counted. A terminal shows 50 (the first is the one to fix); an editor lists more.
     static constexpr int kMaxShown = 50;
+    void setLimit(int limit) { limit_ = limit; }
+    int limit() const { return limit_; }
+    // How many were counted but not kept.
+    int hiddenErrors() const { return std::max(0, errors_ - limit_); }
+    int hiddenWarnings() const { return std::max(0, warnings_ - limit_); }
 
     int errorCount() const { return errors_; }
     int warningCount() const { return warnings_; }
@@ -81,6 +88,7 @@ private:
     int errors_ = 0;
     int warnings_ = 0;
     int remarks_ = 0;
+    int limit_ = kMaxShown;
     bool suppressed_ = false;
 };
 

@@ -167,7 +167,7 @@ std::vector<std::string> Checker::namesInScope(const Context& ctx) const {
 void Checker::reportUnknown(const std::string& what, const std::string& name, SourceRange range,
                             const std::function<std::vector<std::string>()>& candidates) {
     // A suggestion costs a search of the names in scope: none for errors no one will see.
-    bool shown = diags_.errorCount() < DiagnosticEngine::kMaxShown && !diags_.suppressed();
+    bool shown = diags_.errorCount() < diags_.limit() && !diags_.suppressed();
     if (!shown) {
         diags_.error(range, fmt::format("unknown {} `{}`", what, name));
         return;

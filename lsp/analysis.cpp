@@ -62,6 +62,7 @@ Analysis analyze(const std::string& path, std::string text, const std::atomic<bo
     Analysis a;
     a.sources = std::make_unique<SourceManager>();
     DiagnosticEngine diags(*a.sources);
+    diags.setLimit(kMaxPublished);
     try {
         std::unique_ptr<ast::Program> program = loadProgramFromText(path, std::move(text), *a.sources, diags, open);
         if (program && stop()) return a;  // a newer text is on its way: this one is not wanted
@@ -101,6 +102,8 @@ Analysis analyze(const std::string& path, std::string text, const std::atomic<bo
     for (int f = 0; f < a.sources->count(); ++f)
         if (f != a.mainFile) a.imported.insert(sourceKey(a.sources->file(f).path()));
     a.diagnostics = diags.all();
+    a.hiddenErrors = diags.hiddenErrors();
+    a.hiddenWarnings = diags.hiddenWarnings();
     return a;
 }
 

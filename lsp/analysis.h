@@ -75,6 +75,11 @@ struct Scope {
     bool pure = false;  // a fn's body: no history, no age or time, no externs or objects
 };
 
+// An editor lists every error a file has, up to this many (and as many warnings); past
+// that, a note at the top of the file says how many more there are. 50,000 errors of a
+// broken generated file would be megabytes of JSON on every keystroke.
+constexpr int kMaxPublished = 1000;
+
 struct Analysis {
     std::unique_ptr<SourceManager> sources;
     int mainFile = -1;
@@ -82,7 +87,8 @@ struct Analysis {
     // The index of an older text that parsed, moved into this one around the edit since
     // (lsp/recover.h): this text has syntax errors, `diagnostics` are its own.
     bool recovered = false;
-    std::vector<Diagnostic> diagnostics;
+    std::vector<Diagnostic> diagnostics;  // at most kMaxPublished errors and as many warnings
+    int hiddenErrors = 0, hiddenWarnings = 0;  // counted past that, not kept
     std::vector<Occurrence> occurrences;  // every file's, in the order found
     std::vector<Symbol> symbols;          // the main file's declarations
     std::vector<Name> globals;            // the file scope: every module's declarations

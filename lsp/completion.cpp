@@ -1,9 +1,11 @@
 // Completion: what may be written at the cursor. After `name.`, what an enclosing object
-// offers to be read live, or a vector's components; after `@`, the attributes; inside
-// `@integrator(`, the methods; elsewhere the names in scope (the object's, fn's or
-// trigger's own, then the file's), the built-ins (`instance` and, after `instance.`, its
-// members) and the keywords — in a fn's body only
-// what a fn may read (no age, time or dt, no externs, objects or triggers, no history).
+// offers to be read live (only an enclosing one: elsewhere `rocket.` offers nothing), or a
+// vector's components; after `@`, the attributes; inside `@integrator(`, the methods;
+// elsewhere the names in scope (the object's, fn's or trigger's own, then the file's), the
+// built-ins (`instance` and, after `instance.`, its members) and the keywords that can be
+// written there — in a fn's body only what a fn may read (no age, time or dt, no externs,
+// objects or triggers, no history).
+#include <algorithm>
 #include <cctype>
 #include <set>
 
@@ -80,6 +82,32 @@ int vectorWidth(const Analysis& a, const std::string& name, uint32_t offset) {
     return 0;
 }
 
+// The main file's objects whose declaration holds `offset`, outermost first (the last is
+// the one the cursor is in).
+std::vector<std::string> objectsAround(const Analysis& a, uint32_t offset) {
+    std::vector<std::string> path;
+    const std::vector<Symbol>* level = &a.symbols;
+    for (bool deeper = true; deeper;) {
+        deeper = false;
+        for (const Symbol& s : *level)
+            if (s.kind == SymbolKind::Class && s.range.begin < offset && offset < s.range.end) {
+                path.push_back(s.name);
+                level = &s.children;
+                deeper = true;
+                break;
+            }
+    }
+    return path;
+}
+
+// Keywords that begin a declaration of the file: not written inside an object or a fn.
+bool topLevelOnly(std::string_view k) {
+    return k == "import" || k == "const" || k == "fn" || k == "extern" || k == "range" || k == "trigger" || k == "spawn";
+}
+
+// What a fn's body is made of: lets and one expression.
+bool inFnBody(std::string_view k) { return k == "let" || k == "if" || k == "then" || k == "else" || k == "true" || k == "false"; }
+
 // The text before `offset` without trailing blanks.
 std::string_view before(const std::string& text, size_t offset) {
     while (offset > 0 && (text[offset - 1] == ' ' || text[offset - 1] == '\t')) --offset;
@@ -117,8 +145,13 @@ nlohmann::json completion(const Analysis& a, const std::string& text, uint32_t o
         size_t baseStart = start - 1;
         while (baseStart > 0 && identChar(text[baseStart - 1])) --baseStart;
         std::string base = text.substr(baseStart, start - 1 - baseStart);
-        for (const auto& [object, members] : a.members)
-            if (object == base) names = members;
+        // An object's members are read live only from inside its children: `rocket.`
+        // offers rocket's where the cursor is in an object rocket encloses.
+        std::vector<std::string> around = objectsAround(a, offset);
+        if (!around.empty()) around.pop_back();  // (the object the cursor is in is not its own parent)
+        if (std::find(around.begin(), around.end(), base) != around.end())
+            for (const auto& [object, members] : a.members)
+                if (object == base) names = members;
         if (names.empty() && base == kInstanceName)  // the instance an object belongs to
             for (const InstanceMember& m : instanceMembers())
                 names.push_back({std::string(m.name), m.width == 1 ? "float" : "vec3", std::string(m.meaning),
@@ -145,6 +178,14 @@ nlohmann::json completion(const Analysis& a, const std::string& text, uint32_t o
         std::vector<Name> builtins = builtinNames();
         names.insert(names.end(), builtins.begin(), builtins.end());
         if (pure) std::erase_if(names, impure);
+        // Keywords where they can be written: a declaration's only at the top of the file,
+        // a fn's body only lets and conditionals, an object's no `let`.
+        bool inObject = a.parsed && !objectsAround(a, offset).empty();
+        std::erase_if(names, [&](const Name& n) {
+            if (n.kind != CompletionKind::Keyword) return false;
+            if (pure) return !inFnBody(n.label);
+            return inObject && (topLevelOnly(n.label) || n.label == "let");
+        });
     }
     nlohmann::json items = nlohmann::json::array();
     std::set<std::string> seen;  // the innermost declaration of a name wins

@@ -57,6 +57,15 @@ std::map<std::string, nlohmann::json> diagnosticsByUri(const Analysis& a) {
             out[uriFromPath(main.path())].push_back(shown);
         }
     }
+    if ((a.hiddenErrors > 0 || a.hiddenWarnings > 0) && a.mainFile >= 0) {
+        const SourceFile& main = a.sources->file(a.mainFile);
+        out[uriFromPath(main.path())].push_back(
+            {{"range", range(main, 0, 0)},
+             {"severity", a.hiddenErrors > 0 ? 1 : 2},
+             {"source", "psysc"},
+             {"message", fmt::format("{} more errors and {} more warnings are not listed (the first {} of each are)",
+                                     a.hiddenErrors, a.hiddenWarnings, kMaxPublished)}});
+    }
     return out;
 }
 

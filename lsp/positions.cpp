@@ -8,13 +8,13 @@ namespace {
 
 // A position's field as a count: a JSON integer, or a number past any file's lines or
 // columns (1e300, 2^64) clamped to the largest; a negative or non-numeric one is an error.
-uint64_t count(const nlohmann::json& at, const char* field) {
-    const nlohmann::json& v = at.at(field);
+uint64_t count(const Field& at, const char* field) {
+    Field f = at[field];
+    const nlohmann::json& v = f.json();
     if (v.is_number_unsigned()) return v.get<uint64_t>();
     if (v.is_number_integer() && v.get<int64_t>() >= 0) return static_cast<uint64_t>(v.get<int64_t>());
     if (v.is_number_float() && v.get<double>() >= 0) return v.get<double>() >= 1e18 ? UINT64_MAX : static_cast<uint64_t>(v.get<double>());
-    throw nlohmann::json::other_error::create(501, std::string("a position's ") + field + " is a count from 0, not " + v.dump(),
-                                              nullptr);
+    f.refuse("a count from 0");
 }
 
 }  // namespace
@@ -31,7 +31,9 @@ nlohmann::json range(const SourceFile& file, uint32_t begin, uint32_t end) {
     return {{"start", position(file, begin)}, {"end", position(file, end)}};
 }
 
-uint32_t offsetOf(const SourceFile& file, const nlohmann::json& at) {
+uint32_t offsetOf(const SourceFile& file, const nlohmann::json& at) { return offsetOf(file, Field(at, "position")); }
+
+uint32_t offsetOf(const SourceFile& file, const Field& at) {
     uint64_t line = count(at, "line"), character = count(at, "character");
     auto lineNo = static_cast<uint32_t>(std::min<uint64_t>(line + 1, UINT32_MAX));
     if (line >= UINT32_MAX) lineNo = UINT32_MAX;

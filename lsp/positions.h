@@ -9,12 +9,15 @@
 #include <nlohmann/json.hpp>
 
 #include "frontend/source.h"
+#include "lsp/params.h"
 
 namespace psys::lsp {
 
 nlohmann::json position(const SourceFile& file, uint32_t offset);
 nlohmann::json range(const SourceFile& file, uint32_t begin, uint32_t end);
 // The byte offset of a protocol position (clamped to the line and the text).
+// A position that is not two counts is refused (InvalidParams, naming the field).
+uint32_t offsetOf(const SourceFile& file, const Field& position);
 uint32_t offsetOf(const SourceFile& file, const nlohmann::json& position);
 
 // `file:///a%20b/c.psys` ↔ `/a b/c.psys`. A URI of another scheme is returned as it is.

@@ -72,6 +72,8 @@ Analysis recover(const Analysis& good, const Analysis& current, const std::strin
     out.parsed = true;
     out.recovered = true;
     out.diagnostics = current.diagnostics;
+    out.hiddenErrors = current.hiddenErrors;
+    out.hiddenWarnings = current.hiddenWarnings;
     EditMap edit(good.sources->file(good.mainFile).text(), text);
     Mover move{edit, good.mainFile};
     for (const Occurrence& o : good.occurrences) {

@@ -24,6 +24,19 @@ struct RequestError {
 
 bool isNotification(const json& m) { return !m.contains("id"); }
 
+std::string query(const Field& params) {
+    auto q = params.get("query");
+    return q ? q->string() : std::string();
+}
+
+// A document's version: a whole number where given.
+int64_t version(const Field& textDocument, int64_t otherwise) {
+    auto v = textDocument.get("version");
+    if (!v) return otherwise;
+    if (!v->json().is_number_integer()) v->refuse("a whole number");
+    return v->json().get<int64_t>();
+}
+
 }  // namespace
 
 void Server::notify(const std::string& method, json params) {
@@ -40,7 +53,7 @@ void Server::handle(const json& m) {
     }
     if (!m.contains("method")) return;  // a response to something the server never asks
     std::string method = m["method"];
-    json params = m.value("params", json::object());
+    json params = m.contains("params") ? m["params"] : json::object();
     bool notification = isNotification(m);
     json id = notification ? json() : m["id"];
     if (method == "exit") {
@@ -52,7 +65,7 @@ void Server::handle(const json& m) {
             throw RequestError{error::kServerNotInitialized, "the server has not been initialised"};
         if (shutdown_) throw RequestError{error::kInvalidRequest, "the server is shutting down: only `exit` is accepted"};
         bool found = false;
-        json result = dispatch(method, params, &found);
+        json result = dispatch(method, Field(params, ""), &found);
         if (!found) {
             if (notification) return;  // notifications the server does not know are ignored, as the protocol says
             throw RequestError{error::kMethodNotFound, "no method `" + method + "`"};
@@ -60,14 +73,14 @@ void Server::handle(const json& m) {
         if (!notification) send_({{"jsonrpc", "2.0"}, {"id", id}, {"result", result}});
     } catch (const RequestError& e) {
         if (!notification) send_(errorResponse(id, e.code, e.message));
-    } catch (const json::exception& e) {
+    } catch (const InvalidParams& e) {
         if (!notification) send_(errorResponse(id, error::kInvalidParams, std::string("invalid params: ") + e.what()));
     } catch (const std::exception& e) {
         if (!notification) send_(errorResponse(id, error::kInternalError, e.what()));
     }
 }
 
-json Server::dispatch(const std::string& method, const json& params, bool* found) {
+json Server::dispatch(const std::string& method, const Field& params, bool* found) {
     *found = true;
     if (method == "initialize") return initialize(params);
     if (method == "initialized") return nullptr;
@@ -93,7 +106,7 @@ json Server::dispatch(const std::string& method, const json& params, bool* found
         for (auto& [uri, doc] : docs_) doc.dirty = true, doc.changedAt = Clock::now() - options_.debounce;
         return nullptr;
     }
-    auto offset = [&](Document& doc) { return offsetOf(doc.analysis->sources->file(doc.analysis->mainFile), params.at("position")); };
+    auto offset = [&](Document& doc) { return offsetOf(doc.analysis->sources->file(doc.analysis->mainFile), params["position"]); };
     if (method == "textDocument/hover") {
         Document& doc = document(params);
         return hover(*doc.analysis, offset(doc));
@@ -105,27 +118,29 @@ json Server::dispatch(const std::string& method, const json& params, bool* found
     if (method == "textDocument/documentSymbol") return documentSymbols(*document(params).analysis);
     if (method == "textDocument/semanticTokens/full") return semanticTokens(*document(params).analysis);
     if (method == "textDocument/foldingRange") return foldingRanges(*document(params).analysis);
-    if (method == "workspace/symbol") return withUris(workspaceSymbols(analyses(), params.value("query", std::string())));
+    if (method == "workspace/symbol") return withUris(workspaceSymbols(analyses(), query(params)));
     // Completion and signature help read names from the last text that parsed and the
     // cursor in the text as it is now: they need not wait for an analysis.
     auto typing = [&](auto answer) -> json {
         Document* doc = &openDocument(params);
         if (!doc->lastParsed && !doc->analysis) doc = &document(params);
         const Analysis& names = doc->lastParsed ? *doc->lastParsed : *doc->analysis;
-        return answer(names, doc->text, offsetOf(SourceFile(doc->path, doc->text), params.at("position")));
+        return answer(names, doc->text, offsetOf(SourceFile(doc->path, doc->text), params["position"]));
     };
     if (method == "textDocument/signatureHelp")
         return typing([](const Analysis& a, const std::string& text, uint32_t at) { return signatureHelp(a, text, at); });
     if (method == "textDocument/inlayHint") {
         Document& doc = document(params);
         const SourceFile& f = doc.analysis->sources->file(doc.analysis->mainFile);
-        return inlayHints(*doc.analysis, offsetOf(f, params.at("range").at("start")), offsetOf(f, params.at("range").at("end")));
+        return inlayHints(*doc.analysis, offsetOf(f, params["range"]["start"]), offsetOf(f, params["range"]["end"]));
     }
     if (method == "textDocument/references") {
         Document& doc = document(params);
         auto d = declarationAt(*doc.analysis, offset(doc));
         if (!d) return nullptr;
-        bool withDeclaration = params.value("context", json::object()).value("includeDeclaration", true);
+        auto context = params.get("context");
+        auto include = context ? context->get("includeDeclaration") : std::nullopt;
+        bool withDeclaration = include ? include->boolean() : true;
         return withUris(references(analyses(), *d, withDeclaration));
     }
     if (method == "textDocument/documentHighlight") {
@@ -134,19 +149,22 @@ json Server::dispatch(const std::string& method, const json& params, bool* found
     }
     if (method == "textDocument/rename") {
         Document& doc = document(params);
-        auto edit = rename(analyses(), *doc.analysis, offset(doc), params.at("newName").get<std::string>());
+        auto edit = rename(analyses(), *doc.analysis, offset(doc), params["newName"].string());
         if (auto* why = std::get_if<std::string>(&edit)) throw RequestError{error::kRequestFailed, *why};
         return withUris(std::get<json>(std::move(edit)));
     }
     if (method == "textDocument/codeAction") {
         Document& doc = document(params);
         const SourceFile& f = doc.analysis->sources->file(doc.analysis->mainFile);
-        uint32_t begin = offsetOf(f, params.at("range").at("start")), end = offsetOf(f, params.at("range").at("end"));
+        uint32_t begin = offsetOf(f, params["range"]["start"]), end = offsetOf(f, params["range"]["end"]);
         // The diagnostics the client shows where the cursor is (its whole line, for some)
         // count too, though the cursor is not on them.
-        for (const json& d : params.value("context", json::object()).value("diagnostics", json::array())) {
-            begin = std::min(begin, offsetOf(f, d.at("range").at("start")));
-            end = std::max(end, offsetOf(f, d.at("range").at("end")));
+        auto context = params.get("context");
+        auto shown = context ? context->get("diagnostics") : std::nullopt;
+        for (size_t i = 0; shown && i < shown->array().size(); ++i) {
+            Field d(shown->json()[i], shown->path() + "[" + std::to_string(i) + "]");
+            begin = std::min(begin, offsetOf(f, d["range"]["start"]));
+            end = std::max(end, offsetOf(f, d["range"]["end"]));
         }
         json actions = codeActions(*doc.analysis, begin, end);
         for (json& action : actions) action["edit"] = withUris(action["edit"]);
@@ -164,7 +182,8 @@ json Server::dispatch(const std::string& method, const json& params, bool* found
     return nullptr;
 }
 
-json Server::initialize(const json& params) {
+json Server::initialize(const Field& field) {
+    const json& params = field.object();
     if (initialized_) throw RequestError{error::kInvalidRequest, "the server is already initialised"};
     // The options are checked first: an initialize that fails leaves the server as it was.
     if (params.contains("initializationOptions") && params["initializationOptions"].is_object()) {
@@ -199,13 +218,13 @@ json Server::initialize(const json& params) {
             {"serverInfo", {{"name", "psysc"}, {"version", options_.version}}}};
 }
 
-void Server::didOpen(const json& params) {
-    const json& td = params.at("textDocument");
+void Server::didOpen(const Field& params) {
+    Field td = params["textDocument"];
     Document doc;
-    doc.uri = td.at("uri").get<std::string>();
+    doc.uri = td["uri"].string();
     doc.path = pathFromUri(doc.uri);
-    doc.text = td.at("text").get<std::string>();
-    doc.version = td.value("version", 0);
+    doc.text = td["text"].string();
+    doc.version = version(td, 0);
     cancelPending(doc.uri);
     auto old = docs_.find(doc.uri);
     doc.edits = old == docs_.end() ? 0 : old->second.edits + 1;
@@ -214,23 +233,29 @@ void Server::didOpen(const json& params) {
     touchImporters(it->second);
 }
 
-void Server::didChange(const json& params) {
-    std::string uri = params.at("textDocument").at("uri");
+void Server::didChange(const Field& params) {
+    std::string uri = params["textDocument"]["uri"].string();
     auto it = docs_.find(uri);
     if (it == docs_.end()) throw RequestError{error::kInvalidParams, uri + " is not open"};
     Document& doc = it->second;
-    for (const json& change : params.at("contentChanges")) {
-        if (!change.contains("range")) {
-            doc.text = change.at("text").get<std::string>();
+    // Every change is read before any is applied: a bad one leaves the text as it was.
+    Field changes = params["contentChanges"];
+    std::string text = doc.text;
+    for (size_t i = 0; i < changes.array().size(); ++i) {
+        Field change(changes.json()[i], "contentChanges[" + std::to_string(i) + "]");
+        auto range = change.get("range");
+        if (!range) {
+            text = change["text"].string();
             continue;
         }
         // An incremental change: positions are in the text as it stands before this change.
-        SourceFile current(doc.path, doc.text);
-        uint32_t begin = offsetOf(current, change["range"].at("start"));
-        uint32_t end = std::max(begin, offsetOf(current, change["range"].at("end")));
-        doc.text.replace(begin, end - begin, change.at("text").get<std::string>());
+        SourceFile current(doc.path, text);
+        uint32_t begin = offsetOf(current, (*range)["start"]);
+        uint32_t end = std::max(begin, offsetOf(current, (*range)["end"]));
+        text.replace(begin, end - begin, change["text"].string());
     }
-    doc.version = params["textDocument"].value("version", doc.version);
+    doc.text = std::move(text);
+    doc.version = version(params["textDocument"], doc.version);
     doc.dirty = true;
     doc.changedAt = Clock::now();
     ++doc.edits;
@@ -263,8 +288,8 @@ void Server::cancelPending(const std::string& uri) {
     if (pending_ && pending_->uri == uri) pending_->cancelled->store(true);
 }
 
-void Server::didClose(const json& params) {
-    auto it = docs_.find(params.at("textDocument").at("uri").get<std::string>());
+void Server::didClose(const Field& params) {
+    auto it = docs_.find(params["textDocument"]["uri"].string());
     if (it == docs_.end()) return;
     cancelPending(it->first);
     for (const std::string& uri : it->second.publishedTo)
@@ -305,15 +330,15 @@ json Server::withUris(json answer) const {
     return answer;
 }
 
-Server::Document& Server::openDocument(const json& params) {
-    std::string uri = params.at("textDocument").at("uri");
+Server::Document& Server::openDocument(const Field& params) {
+    std::string uri = params["textDocument"]["uri"].string();
     auto it = docs_.find(uri);
     if (it == docs_.end()) throw RequestError{error::kInvalidParams, uri + " is not open"};
     return it->second;
 }
 
-Server::Document& Server::document(const json& params) {
-    std::string uri = params.at("textDocument").at("uri");
+Server::Document& Server::document(const Field& params) {
+    std::string uri = params["textDocument"]["uri"].string();
     auto it = docs_.find(uri);
     if (it == docs_.end()) throw RequestError{error::kInvalidParams, uri + " is not open"};
     if (pending_ && pending_->uri == uri) settle();

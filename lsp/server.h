@@ -26,6 +26,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lsp/analysis.h"
+#include "lsp/params.h"
 
 namespace psys::lsp {
 
@@ -77,13 +78,13 @@ private:
         std::future<Analysis> result;
     };
 
-    nlohmann::json dispatch(const std::string& method, const nlohmann::json& params, bool* found);
-    nlohmann::json initialize(const nlohmann::json& params);
-    void didOpen(const nlohmann::json& params);
-    void didChange(const nlohmann::json& params);
-    void didClose(const nlohmann::json& params);
-    Document& document(const nlohmann::json& params);  // the open document a request names, analysed
-    Document& openDocument(const nlohmann::json& params);  // the same, as it is
+    nlohmann::json dispatch(const std::string& method, const Field& params, bool* found);
+    nlohmann::json initialize(const Field& params);
+    void didOpen(const Field& params);
+    void didChange(const Field& params);
+    void didClose(const Field& params);
+    Document& document(const Field& params);  // the open document a request names, analysed
+    Document& openDocument(const Field& params);  // the same, as it is
     std::vector<const Analysis*> analyses();  // every open document's, analysed
     nlohmann::json withUris(nlohmann::json answer) const;
     void analyse(Document& doc);

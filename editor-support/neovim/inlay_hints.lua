@@ -1,13 +1,26 @@
 -- Inlay hints for Neovim before 0.10 (which shows them itself: vim.lsp.inlay_hint.enable()):
--- asks the server for the buffer's hints after each change and shows them at the end of
--- their lines. In init.lua: require("psys_inlay_hints").attach(bufnr, client_id), with this
+-- asks the server for the buffer's hints once it has opened the buffer, and after each
+-- change, and shows them at the end of their lines. In init.lua: require("psys_inlay_hints").attach(bufnr, client_id), with this
 -- file on the runtimepath as lua/psys_inlay_hints.lua (editor-support/README.md).
 local M = {}
 local ns = vim.api.nvim_create_namespace("psys_inlay_hints")
 
-function M.refresh(bufnr, client_id)
+-- Whether the client has told the server the buffer is open: until then a request about it
+-- is refused (the client sends `didOpen` once the server has answered `initialize`, which
+-- is after a FileType callback has attached the buffer and called attach()).
+local function opened(client, bufnr)
+  return client.initialized and client.attached_buffers and client.attached_buffers[bufnr]
+end
+
+function M.refresh(bufnr, client_id, tries)
   local client = vim.lsp.get_client_by_id(client_id)
-  if not client then return end
+  if not client or not vim.api.nvim_buf_is_valid(bufnr) then return end
+  if not opened(client, bufnr) then
+    -- Asked again every 20 ms for as long as ten seconds (a server's start).
+    tries = (tries or 0) + 1
+    if tries <= 500 then vim.defer_fn(function() M.refresh(bufnr, client_id, tries) end, 20) end
+    return
+  end
   local last = vim.api.nvim_buf_line_count(bufnr)
   local params = {
     textDocument = { uri = vim.uri_from_bufnr(bufnr) },
@@ -34,6 +47,7 @@ function M.refresh(bufnr, client_id)
 end
 
 function M.attach(bufnr, client_id)
+  if bufnr == 0 then bufnr = vim.api.nvim_get_current_buf() end  -- (the client keys buffers by number)
   M.refresh(bufnr, client_id)
   vim.api.nvim_create_autocmd({ "InsertLeave", "TextChanged", "BufWritePost" }, {
     buffer = bufnr,

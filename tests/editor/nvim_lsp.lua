@@ -33,6 +33,10 @@ vim.bo.filetype = "psys"
 local id = vim.lsp.start_client({ name = "psysc", cmd = { psysc, "lsp", "--debounce", "0" }, root_dir = dir })
 check(id, "the client starts")
 vim.lsp.buf_attach_client(0, id)
+-- editor-support/neovim/inlay_hints.lua attached as the README says, before the server has
+-- answered `initialize`: the hints show when the file opens, with no edit.
+local inlay = dofile("editor-support/neovim/inlay_hints.lua")
+inlay.attach(0, id)
 check(vim.wait(10000, function()
   local c = vim.lsp.get_client_by_id(id)
   return c ~= nil and c.initialized
@@ -95,6 +99,17 @@ for _, a in pairs(hints) do for _, h in ipairs(a.result or {}) do labels[#labels
 check(vim.tbl_contains(labels, ": vec3") and vim.tbl_contains(labels, "rk4, a step per update"),
   "inlay hints: " .. vim.inspect(labels))
 ok("inlayHint")
+local shown = {}
+check(vim.wait(5000, function()
+  shown = {}
+  local ns = vim.api.nvim_create_namespace("psys_inlay_hints")
+  for _, m in ipairs(vim.api.nvim_buf_get_extmarks(0, ns, 0, -1, { details = true })) do
+    for _, chunk in ipairs(m[4].virt_text or {}) do shown[#shown + 1] = chunk[1] end
+  end
+  return #shown > 0
+end, 20), "inlay_hints.lua shows hints on open, before any edit")
+check(table.concat(shown, "|"):find("vel: vec3", 1, true), "inlay_hints.lua's text: " .. vim.inspect(shown))
+ok("inlay_hints.lua on open")
 
 local help = at(6, 46, "textDocument/signatureHelp")
 check(help and help.signatures[1].label:find("fn gravity", 1, true) and help.activeParameter == 0, "signature help")
