@@ -219,4 +219,75 @@ std::string integratorDoc(std::string_view name) {
     return what + "; " + order + "; " + stable + ".";
 }
 
+namespace {
+
+struct Word {
+    std::string_view name, doc;
+};
+
+constexpr Word kCommandDocs[] = {
+    {"point", "draws the object as a round dot `size` pixels across at the reference distance"},
+    {"sprite", "draws the object as a camera-facing square `size` world units across, turned by `rotation` radians, "
+               "of the type's @shape or @texture (`frame` picks a flip-book's frame); rotation and frame may be left out"},
+    {"streak", "draws a band `width` world units wide from `start` to `end`"},
+    {"trail", "draws a ribbon through the object's positions at its last `length` updates (this one first), `width` "
+              "world units wide at its head, narrowing and fading to nothing at its tail"},
+    {"kill", "the object dies: at once (`kill;`), or at the first update the condition holds (`kill when c;`)"},
+    {"emit", "creates objects of a type: once at creation, `at R per second` while alive, `count N` at a time; the "
+             "arguments are the new objects' parameters"},
+    {"notify", "sends an event the host receives, with values (`notify \"hit\"(pos);`)"},
+    {"when", "the commands inside run at the updates where the condition holds"},
+    {"on", "the commands inside run when the event happens (`on death { … }`: as the object dies)"},
+    {"spawn", "creates an object of a type when the system starts"},
+};
+
+constexpr Word kShapeDocs[] = {
+    {"soft", "a disc with a soft edge (the default)"},
+    {"disc", "a disc with a hard edge"},
+    {"ring", "a ring"},
+    {"star", "a four-pointed flare"},
+    {"smoke", "a puff of value noise"},
+};
+
+constexpr Word kBlendDocs[] = {
+    {"add", "colours are added to what is behind (light: sparks, fire, glows; order does not matter); the default"},
+    {"alpha", "colours are blended over what is behind by their alpha (matter: smoke, dust; drawn back to front)"},
+};
+
+constexpr Word kTypeDocs[] = {
+    {"bool", "true or false"},
+    {"float", "a number (32-bit floating point)"},
+    {"scalar", "a number: another name of float"},
+    {"vec2", "two floats (x, y)"},
+    {"vec3", "three floats (x, y, z)"},
+    {"point", "a place: three floats, another name of vec3"},
+    {"vector", "a direction and length: three floats, another name of vec3"},
+    {"vec4", "four floats (x, y, z, w)"},
+    {"color", "a colour: red, green, blue, alpha; another name of vec4"},
+};
+
+template <size_t N>
+std::string_view lookup(const Word (&words)[N], std::string_view name) {
+    for (const Word& w : words)
+        if (w.name == name) return w.doc;
+    return {};
+}
+
+}  // namespace
+
+std::string_view commandDoc(std::string_view keyword) { return lookup(kCommandDocs, keyword); }
+std::string_view shapeDoc(std::string_view shape) { return lookup(kShapeDocs, shape); }
+std::string_view blendDoc(std::string_view blend) { return lookup(kBlendDocs, blend); }
+std::string_view typeDoc(std::string_view type) { return lookup(kTypeDocs, type); }
+
+Type drawParamType(const core::DrawParam& p) { return p.width == 1 ? Type::scalar() : Type::vec(p.width); }
+
+std::string drawCallSignature(core::DrawKind kind) {
+    core::DrawSignature signature = core::drawSignature(kind);
+    std::string out = std::string(core::drawKindName(kind)) + "(";
+    for (size_t i = 0; i < signature.count; ++i)
+        out += (i ? ", " : "") + std::string(signature.params[i].name) + ": " + drawParamType(signature.params[i]).str();
+    return out + ")";
+}
+
 }  // namespace psys

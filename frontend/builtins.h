@@ -8,8 +8,10 @@
 
 #include <optional>
 #include <span>
+#include <string>
 #include <string_view>
 
+#include "core/draw.h"
 #include "core/ops.h"
 #include "frontend/types.h"
 
@@ -91,5 +93,16 @@ std::span<const std::string_view> keywords();
 // table in a sentence, with its order and its stability limit): "" for an unknown name.
 std::span<const std::string_view> integratorNames();
 std::string integratorDoc(std::string_view name);
+
+// What the commands, a sprite's shapes, the blends and the named types are, in a sentence
+// each: what an editor shows on hover and in signature help ("" for a word that is none).
+std::string_view commandDoc(std::string_view keyword);  // point, sprite, streak, trail, kill, emit, notify, when, on, spawn
+std::string_view shapeDoc(std::string_view shape);
+std::string_view blendDoc(std::string_view blend);
+std::string_view typeDoc(std::string_view type);
+// A draw command's parameters as a call: "point(position: vec3, colour: vec4, size: float)"
+// (the optional ones last: `required` in core::drawSignature says how many must be given).
+Type drawParamType(const core::DrawParam& p);
+std::string drawCallSignature(core::DrawKind kind);
 
 }  // namespace psys

@@ -211,10 +211,6 @@ void Checker::checkOn(Command& on, const Context& ctx, const Command** point) {
     checkCommands(on.body, inner, point);
 }
 
-namespace {
-Type drawParamType(const core::DrawParam& p) { return p.width == 1 ? Type::scalar() : Type::vec(p.width); }
-}  // namespace
-
 // `point`, `sprite`, `streak`: how the object is drawn, at most one per object.
 void Checker::checkDraw(Command& cmd, const Context& ctx, const Command** point) {
     std::string_view name = core::drawKindName(cmd.draw);

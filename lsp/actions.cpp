@@ -1,6 +1,9 @@
 // Edits the server offers: quick fixes (the fix-its the front end and the passes attach to
 // their diagnostics: a did-you-mean, a missing standard-library import, an integrator or a
 // step that keeps a decay stable) and formatting (frontend/format.h).
+#include <optional>
+#include <string_view>
+
 #include <fmt/format.h>
 
 #include "frontend/format.h"
@@ -28,17 +31,61 @@ nlohmann::json codeActions(const Analysis& a, uint32_t begin, uint32_t end) {
     return actions;
 }
 
-std::variant<nlohmann::json, std::string> formatting(const std::string& path, const std::string& text) {
+namespace {
+
+// The text laid out canonically, or why it cannot be.
+std::optional<std::string> formatted(const std::string& path, const std::string& text, std::string& why) {
     SourceManager sources;
     DiagnosticEngine diags(sources);
     int file = sources.add(path, text);
     auto out = formatSource(file, sources, diags);
     if (!out) {
-        if (diags.all().empty()) return std::string("the file cannot be formatted");
-        const Diagnostic& first = diags.all().front();
-        LineColumn at = sources.file(file).lineColumn(first.range.begin);
-        return fmt::format("not formatted: fix the syntax first (line {}: {})", at.line, first.message);
+        if (diags.all().empty()) why = "the file cannot be formatted";
+        else {
+            const Diagnostic& first = diags.all().front();
+            LineColumn at = sources.file(file).lineColumn(first.range.begin);
+            why = fmt::format("not formatted: fix the syntax first (line {}: {})", at.line, first.message);
+        }
     }
+    return out;
+}
+
+bool blank(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
+
+}  // namespace
+
+std::variant<nlohmann::json, std::string> rangeFormatting(const std::string& path, const std::string& text, uint32_t begin,
+                                                          uint32_t end) {
+    std::string why;
+    auto out = formatted(path, text, why);
+    if (!out) return why;
+    // The layout changes only white space (frontend/format.h: the same tokens, comments
+    // kept), so the two texts' other characters pair up one to one, and each run of white
+    // space in the text is replaced by its partner in the layout: the runs that touch the
+    // range are its edits, whatever the layout does elsewhere.
+    SourceFile f(path, text);
+    nlohmann::json edits = nlohmann::json::array();
+    size_t i = 0, j = 0;
+    for (;;) {
+        size_t runStart = i, outStart = j;
+        while (i < text.size() && blank(text[i])) ++i;
+        while (j < out->size() && blank((*out)[j])) ++j;
+        std::string_view was(text.data() + runStart, i - runStart), now(out->data() + outStart, j - outStart);
+        if (was != now && runStart <= end && i >= begin)
+            edits.push_back({{"range", range(f, static_cast<uint32_t>(runStart), static_cast<uint32_t>(i))},
+                             {"newText", std::string(now)}});
+        if (i == text.size() || j == out->size()) break;
+        if (text[i] != (*out)[j]) return std::string("the layout changed more than white space: not formatted");
+        ++i, ++j;
+    }
+    if (i != text.size() || j != out->size()) return std::string("the layout changed more than white space: not formatted");
+    return edits;
+}
+
+std::variant<nlohmann::json, std::string> formatting(const std::string& path, const std::string& text) {
+    std::string why;
+    auto out = formatted(path, text, why);
+    if (!out) return why;
     // One edit over what differs, not the whole text, so the editor keeps its cursor and marks.
     size_t prefix = 0, suffix = 0;
     while (prefix < text.size() && prefix < out->size() && text[prefix] == (*out)[prefix]) ++prefix;
@@ -49,7 +96,7 @@ std::variant<nlohmann::json, std::string> formatting(const std::string& path, co
     while (suffix > 0 && (static_cast<unsigned char>(text[text.size() - suffix]) & 0xC0) == 0x80) --suffix;
     nlohmann::json edits = nlohmann::json::array();
     if (prefix == text.size() && prefix == out->size()) return edits;
-    const SourceFile& f = sources.file(file);
+    SourceFile f(path, text);
     edits.push_back({{"range", range(f, static_cast<uint32_t>(prefix), static_cast<uint32_t>(text.size() - suffix))},
                      {"newText", out->substr(prefix, out->size() - suffix - prefix)}});
     return edits;

@@ -10,6 +10,7 @@
 #include "frontend/frontend.h"
 #include "frontend/loader.h"
 #include "lsp/index_builder.h"
+#include "lsp/salvage.h"
 #include "opt/passes.h"
 #include "tune/tolerance.h"
 
@@ -57,7 +58,7 @@ void methodHints(const ir::Module& module, Analysis& a) {
 }  // namespace
 
 Analysis analyze(const std::string& path, std::string text, const std::atomic<bool>* cancelled,
-                 const SourceOverrides* open) {
+                 const SourceOverrides* open, bool salvage) {
     auto stop = [&] { return cancelled && cancelled->load(std::memory_order_relaxed); };
     Analysis a;
     a.sources = std::make_unique<SourceManager>();
@@ -104,7 +105,40 @@ Analysis analyze(const std::string& path, std::string text, const std::atomic<bo
     a.diagnostics = diags.all();
     a.hiddenErrors = diags.hiddenErrors();
     a.hiddenWarnings = diags.hiddenWarnings();
+    if (salvage && !a.parsed && !stop())
+        if (auto s = salvaged(path, a, cancelled, open)) return std::move(*s);
     return a;
+}
+
+std::optional<Analysis> salvaged(const std::string& path, const Analysis& broken, const std::atomic<bool>* cancelled,
+                                 const SourceOverrides* open) {
+    // Only where every error is the main file's own (an import's would be numbered apart).
+    std::vector<uint32_t> errors;
+    for (const Diagnostic& d : broken.diagnostics) {
+        if (d.severity != Severity::Error) continue;
+        if (d.range.file != broken.mainFile || broken.mainFile < 0) return std::nullopt;
+        errors.push_back(d.range.begin);
+    }
+    const std::string& text = broken.sources->file(broken.mainFile).text();
+    auto blanked = blankBroken(text, errors);
+    if (!blanked) return std::nullopt;
+    Analysis s = analyze(path, *blanked, cancelled, open);
+    if (!s.parsed || s.mainFile < 0) return std::nullopt;
+    // The index over the text as it is (the blanked one has spaces where the broken
+    // declarations are, so every offset is the same); the diagnostics the text's own.
+    auto sources = std::make_unique<SourceManager>();
+    for (int f = 0; f < s.sources->count(); ++f) {
+        const SourceFile& file = s.sources->file(f);
+        sources->add(file.path(), f == s.mainFile ? text : file.text());
+        sources->setImportedAt(f, s.sources->importedAt(f));
+    }
+    s.sources = std::move(sources);
+    s.diagnostics = broken.diagnostics;
+    s.hiddenErrors = broken.hiddenErrors;
+    s.hiddenWarnings = broken.hiddenWarnings;
+    s.recovered = true;
+    s.imported.insert(broken.imported.begin(), broken.imported.end());
+    return s;
 }
 
 }  // namespace psys::lsp

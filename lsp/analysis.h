@@ -109,7 +109,13 @@ struct Analysis {
 // compiler's passes when it is clean, for their warnings.
 // `cancelled`, when given and set (from another thread) while it runs, stops it early
 // between its phases; what it returns then is incomplete and only to be thrown away.
+// `salvage`: where the text has syntax errors, the index is that of the text with its broken
+// top-level declarations blanked (lsp/salvage.h), marked `recovered` (a second analysis:
+// for a file with no earlier text that parsed to recover from).
 Analysis analyze(const std::string& path, std::string text, const std::atomic<bool>* cancelled = nullptr,
-                 const SourceOverrides* open = nullptr);
+                 const SourceOverrides* open = nullptr, bool salvage = false);
+// That second analysis of `broken`, nullopt where it cannot help.
+std::optional<Analysis> salvaged(const std::string& path, const Analysis& broken, const std::atomic<bool>* cancelled,
+                                 const SourceOverrides* open);
 
 }  // namespace psys::lsp

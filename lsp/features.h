@@ -3,6 +3,7 @@
 // position, so tests call them without a transport.
 #pragma once
 
+#include <cstdint>
 #include <map>
 #include <string>
 #include <variant>
@@ -42,9 +43,26 @@ nlohmann::json completion(const Analysis& scopes, const std::string& text, uint3
 nlohmann::json foldingRanges(const Analysis& a);
 nlohmann::json workspaceSymbols(const std::vector<const Analysis*>& analyses, const std::string& query);
 nlohmann::json signatureHelp(const Analysis& a, const std::string& text, uint32_t offset);
-// The main file's names as semantic tokens (SemanticTokens), and the legend that reads them.
-nlohmann::json semanticTokens(const Analysis& a);
+// The main file's names that begin in bytes [begin, end) as semantic tokens
+// (SemanticTokens), and the legend that reads them; the edits that turn one token list's
+// numbers into another's (SemanticTokensEdit[], for semanticTokens/full/delta).
+nlohmann::json semanticTokens(const Analysis& a, uint32_t begin = 0, uint32_t end = UINT32_MAX);
+nlohmann::json semanticTokensEdits(const nlohmann::json& before, const nlohmann::json& after);
 nlohmann::json semanticTokensLegend();
+
+// lsp/navigation.cpp: the main file's imports as links to their files (DocumentLink[]);
+// the ranges around `offset`, innermost first (SelectionRange, each with its parent); the
+// main file's diagnostics as a pull answers them (a full DocumentDiagnosticReport); a
+// completion item with the documentation of a built-in word added.
+nlohmann::json documentLinks(const Analysis& a);
+nlohmann::json selectionRange(const Analysis& a, uint32_t offset);
+nlohmann::json documentDiagnostics(const Analysis& a);
+nlohmann::json resolveCompletion(nlohmann::json item);
+
+// lsp/actions.cpp: the formatting edits that fall in bytes [begin, end] of `text` (each
+// run of white space between two tokens is its own edit).
+std::variant<nlohmann::json, std::string> rangeFormatting(const std::string& path, const std::string& text, uint32_t begin,
+                                                          uint32_t end);
 
 // The language's own words by category (keywords, functions, constants, variables,
 // types, attributes, integrators): `psysc builtins`, which the editor grammars' tests read.

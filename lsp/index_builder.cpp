@@ -155,8 +155,29 @@ private:
             if (e) expr(*e);
     }
 
+    // A type as written (`ivel: vec3`): what the type is.
+    void annotation(const TypeAnnotation& t) {
+        std::string name = t.spelling.empty() ? t.type.str() : t.spelling;
+        if (std::string_view doc = typeDoc(name); !doc.empty() && t.range.valid())
+            add(t.range, code(name) + "\n\n" + std::string(doc), std::nullopt, {TokenType::None});
+    }
+    void annotation(const std::optional<TypeAnnotation>& t) {
+        if (t) annotation(*t);
+    }
+
+    // A command's keyword: what the command does (a drawing: its parameters too).
+    void keyword(const Command& c) {
+        static constexpr std::string_view kWords[] = {"", "kill", "emit", "when", "on", "notify"};
+        std::string_view word = c.kind == CommandKind::Draw ? core::drawKindName(c.draw) : kWords[static_cast<int>(c.kind)];
+        std::string_view doc = commandDoc(word);
+        if (doc.empty() || !c.keywordRange.valid()) return;
+        std::string head = c.kind == CommandKind::Draw ? drawCallSignature(c.draw) : std::string(word);
+        add(c.keywordRange, code(head) + "\n\n" + std::string(doc), std::nullopt, {TokenType::None});
+    }
+
     void commands(const std::vector<CommandPtr>& list) {
         for (const CommandPtr& c : list) {
+            keyword(*c);
             exprs(c->args);
             if (c->cond) expr(*c->cond);
             if (c->rate) expr(*c->rate);
@@ -171,18 +192,22 @@ private:
         add(a.nameRange, code("@" + a.name) + "\n\n" + std::string(attributeDoc(a.name)), std::nullopt,
             {TokenType::Decorator});
         exprs(a.args);
-        // A method's name is no expression: its hover says what the method computes.
-        if (a.name == "integrator" && a.args.size() == 1 && a.args[0]->kind == ExprKind::Name) {
-            const std::string& method = static_cast<const NameExpr&>(*a.args[0]).name;
-            if (std::string doc = integratorDoc(method); !doc.empty())
-                add(a.args[0]->range, code("@integrator(" + method + ")") + "\n\n" + doc, std::nullopt,
-                    {TokenType::EnumMember, kDefaultLibrary});
-        }
+        // A method's, a shape's or a blend's name is no expression: its hover says what it is.
+        if (a.args.size() != 1 || a.args[0]->kind != ExprKind::Name) return;
+        const std::string& word = static_cast<const NameExpr&>(*a.args[0]).name;
+        std::string doc = a.name == "integrator" ? integratorDoc(word)
+                          : a.name == "shape"    ? std::string(shapeDoc(word))
+                          : a.name == "blend"    ? std::string(blendDoc(word))
+                                                 : std::string();
+        if (!doc.empty())
+            add(a.args[0]->range, code("@" + a.name + "(" + word + ")") + "\n\n" + doc, std::nullopt,
+                {TokenType::EnumMember, kDefaultLibrary});
     }
 
     std::vector<Name> paramNames(const std::vector<Param>& params, const std::string& owner) {
         std::vector<Name> names;
         for (const Param& p : params) {
+            annotation(p.type);
             names.push_back({p.name, paramText(p), "parameter of " + owner, CompletionKind::Variable});
             add(p.nameRange, code(paramText(p)) + "\n\nparameter of " + owner, p.nameRange,
                 {TokenType::Parameter, kDeclaration});
@@ -203,6 +228,7 @@ private:
         }
         integrates_ = false;
         for (const EquationPtr& eq : o.equations) {
+            annotation(eq->annotation);
             for (size_t i = 0; i < eq->names.size(); ++i) {
                 std::string t = eq->names[i] + ": " + (i < eq->types.size() ? typeText(eq->types[i]) : "?");
                 if (main_ && i < eq->types.size() && !eq->types[i].isVague())
@@ -248,6 +274,7 @@ private:
             case DeclKind::Attribute: attribute(static_cast<const FileAttributeDecl&>(d).attribute); return;
             case DeclKind::Const: {
                 auto& c = static_cast<const ConstDecl&>(d);
+                annotation(c.annotation);
                 std::string t = "const " + c.name + ": " + typeText(c.type);
                 add(c.nameRange, code(t), c.nameRange, {TokenType::Variable, kDeclaration | kReadonly});
                 expr(*c.value);
@@ -259,7 +286,9 @@ private:
                 auto& f = static_cast<const FnDecl&>(d);
                 add(f.nameRange, code(signature(f)), f.nameRange, {TokenType::Function, kDeclaration});
                 Scope scope{f.range, paramNames(f.params, "`" + f.name + "`"), true};
+                annotation(f.returnType);
                 for (const auto& let : f.lets) {
+                    annotation(let->annotation);
                     std::string t = "let " + let->name + ": " + typeText(let->type);
                     if (main && !let->type.isVague()) out_.hints.push_back({let->nameRange, ": " + let->type.str(), 1});
                     add(let->nameRange, code(t), let->nameRange, {TokenType::Variable, kDeclaration});
@@ -274,6 +303,7 @@ private:
             }
             case DeclKind::Extern: {
                 auto& x = static_cast<const ExternDecl&>(d);
+                annotation(x.type);
                 std::string t = "extern " + x.name + ": " + (x.type.spelling.empty() ? typeText(x.type.type) : x.type.spelling);
                 add(x.nameRange, code(t) + "\n\nset by the host", x.nameRange, {TokenType::Macro, kDeclaration});
                 for (const Expr* e : {x.defaultValue.get(), x.rangeLow.get(), x.rangeHigh.get()})

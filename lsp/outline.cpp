@@ -140,9 +140,26 @@ json signatureHelp(const Analysis& a, const std::string& text, uint32_t offset) 
     while (start > 0 && (std::isalnum(static_cast<unsigned char>(text[start - 1])) || text[start - 1] == '_')) --start;
     std::string name = text.substr(start, end - start);
     if (name.empty()) return nullptr;
+    // The word before the name: `emit spark(` and `spawn rocket(` give an object's parameters.
+    size_t wordEnd = start;
+    while (wordEnd > 0 && std::isspace(static_cast<unsigned char>(text[wordEnd - 1]))) --wordEnd;
+    size_t wordStart = wordEnd;
+    while (wordStart > 0 && std::isalpha(static_cast<unsigned char>(text[wordStart - 1]))) --wordStart;
+    std::string before = text.substr(wordStart, wordEnd - wordStart);
     std::string label, doc;
+    if (before == "emit" || before == "spawn") {
+        auto object = [&](const std::vector<Name>& names) {
+            for (const Name& n : names)
+                if (n.label == name && n.kind == CompletionKind::Class) label = n.detail, doc = n.documentation;
+        };
+        object(a.globals);
+        for (const Scope& s : a.scopes)  // a nested object, named where the cursor is
+            if (s.range.file == a.mainFile && s.range.begin <= offset && offset <= s.range.end) object(s.names);
+    } else if (auto draw = core::fromName<core::DrawKind>(name, core::kDrawKindNames)) {
+        label = drawCallSignature(*draw), doc = std::string(commandDoc(name));
+    }
     for (const Name& n : a.globals)
-        if (n.label == name && n.kind == CompletionKind::Function) label = n.detail, doc = n.documentation;
+        if (label.empty() && n.label == name && n.kind == CompletionKind::Function) label = n.detail, doc = n.documentation;
     if (label.empty())
         if (int b = findBuiltinFunction(name); b >= 0) label = std::string(builtinFunction(b).signature), doc = "built-in function";
     if (label.empty()) return nullptr;
@@ -154,10 +171,11 @@ json signatureHelp(const Analysis& a, const std::string& text, uint32_t offset) 
     return {{"signatures", {signature}}, {"activeSignature", 0}, {"activeParameter", active}};
 }
 
-nlohmann::json semanticTokens(const Analysis& a) {
+nlohmann::json semanticTokens(const Analysis& a, uint32_t begin, uint32_t stop) {
     std::vector<const Occurrence*> names;
     for (const Occurrence& o : a.occurrences)
-        if (o.token.type != TokenType::None && o.range.file == a.mainFile && o.range.end > o.range.begin)
+        if (o.token.type != TokenType::None && o.range.file == a.mainFile && o.range.end > o.range.begin &&
+            o.range.begin >= begin && o.range.begin < stop)
             names.push_back(&o);
     std::stable_sort(names.begin(), names.end(),
                      [](const Occurrence* x, const Occurrence* y) { return x->range.begin < y->range.begin; });
@@ -178,6 +196,23 @@ nlohmann::json semanticTokens(const Analysis& a) {
         line = l, character = c, end = o->range.end;
     }
     return {{"data", data}};
+}
+
+nlohmann::json semanticTokensEdits(const nlohmann::json& before, const nlohmann::json& after) {
+    // One edit: the numbers between the common start and the common end. An edit inside
+    // one declaration leaves the numbers before it as they were, and those after it too
+    // (each token's place is relative to the one before).
+    size_t prefix = 0, suffix = 0;
+    while (prefix < before.size() && prefix < after.size() && before[prefix] == after[prefix]) ++prefix;
+    while (suffix < before.size() - prefix && suffix < after.size() - prefix &&
+           before[before.size() - 1 - suffix] == after[after.size() - 1 - suffix])
+        ++suffix;
+    nlohmann::json edits = nlohmann::json::array();
+    if (prefix == before.size() && prefix == after.size()) return edits;
+    nlohmann::json data = nlohmann::json::array();
+    for (size_t i = prefix; i < after.size() - suffix; ++i) data.push_back(after[i]);
+    edits.push_back({{"start", prefix}, {"deleteCount", before.size() - suffix - prefix}, {"data", data}});
+    return edits;
 }
 
 nlohmann::json semanticTokensLegend() {

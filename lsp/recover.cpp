@@ -1,27 +1,86 @@
 #include "lsp/recover.h"
 
 #include <algorithm>
+#include <string_view>
+
+#include <dtl/dtl.hpp>
 
 namespace psys::lsp {
 
-EditMap::EditMap(const std::string& older, const std::string& current)
-    : olderSize_(static_cast<uint32_t>(older.size())), currentSize_(static_cast<uint32_t>(current.size())) {
-    uint32_t shorter = std::min(olderSize_, currentSize_);
-    while (prefix_ < shorter && older[prefix_] == current[prefix_]) ++prefix_;
-    while (suffix_ < shorter - prefix_ && older[olderSize_ - 1 - suffix_] == current[currentSize_ - 1 - suffix_])
-        ++suffix_;
+namespace {
+
+// Where each line of `text` starts, and its end (the text's size) last.
+std::vector<uint32_t> lineStarts(const std::string& text) {
+    std::vector<uint32_t> starts = {0};
+    for (uint32_t i = 0; i < text.size(); ++i)
+        if (text[i] == '\n') starts.push_back(i + 1);
+    if (starts.back() != text.size()) starts.push_back(static_cast<uint32_t>(text.size()));
+    return starts;
 }
 
-std::optional<uint32_t> EditMap::toOlder(uint32_t current) const {
-    if (current <= prefix_) return current;
-    if (current >= currentSize_ - suffix_) return current - currentSize_ + olderSize_;
-    return std::nullopt;
+std::vector<std::string_view> lines(const std::string& text, const std::vector<uint32_t>& starts) {
+    std::vector<std::string_view> out;
+    for (size_t i = 0; i + 1 < starts.size(); ++i) out.push_back(std::string_view(text).substr(starts[i], starts[i + 1] - starts[i]));
+    return out;
 }
 
-std::optional<uint32_t> EditMap::toCurrent(uint32_t older) const {
-    if (older <= prefix_) return older;
-    if (older >= olderSize_ - suffix_) return older - olderSize_ + currentSize_;
-    return std::nullopt;
+}  // namespace
+
+EditMap::EditMap(const std::string& older, const std::string& current) {
+    // The lines the texts share, by a shortest edit script over lines (dtl: Myers's
+    // algorithm, O((N+M)·D) for D differing lines), then each run of differing lines
+    // narrowed to the characters that differ (an edit inside a line keeps the names
+    // before and after it on that line).
+    std::vector<uint32_t> olderStarts = lineStarts(older), currentStarts = lineStarts(current);
+    std::vector<std::string_view> a = lines(older, olderStarts), b = lines(current, currentStarts);
+    dtl::Diff<std::string_view, std::vector<std::string_view>> diff(a, b);
+    diff.onHuge();
+    diff.compose();
+    uint32_t i = 0, j = 0;  // lines of each
+    auto flush = [&](uint32_t i0, uint32_t j0) {
+        if (i0 == i && j0 == j) return;
+        uint32_t ob = olderStarts[i0], oe = olderStarts[i], cb = currentStarts[j0], ce = currentStarts[j];
+        while (ob < oe && cb < ce && older[ob] == current[cb]) ++ob, ++cb;
+        while (oe > ob && ce > cb && older[oe - 1] == current[ce - 1]) --oe, --ce;
+        hunks_.push_back({ob, oe, cb, ce});
+    };
+    uint32_t i0 = 0, j0 = 0;
+    for (const auto& [line, info] : diff.getSes().getSequence()) {
+        if (info.type == dtl::SES_COMMON) {
+            flush(i0, j0);
+            ++i, ++j;
+            i0 = i, j0 = j;
+        } else if (info.type == dtl::SES_DELETE) {
+            ++i;
+        } else {
+            ++j;
+        }
+    }
+    flush(i0, j0);
+}
+
+std::optional<uint32_t> EditMap::toCurrent(uint32_t older, bool after) const {
+    int64_t shift = 0;
+    for (const Hunk& h : hunks_) {
+        if (older < h.olderBegin) break;
+        if (older == h.olderBegin && older == h.olderEnd) return after ? h.currentEnd : h.currentBegin;
+        if (older == h.olderBegin) return h.currentBegin;
+        if (older < h.olderEnd) return std::nullopt;
+        shift = int64_t(h.currentEnd) - int64_t(h.olderEnd);
+    }
+    return static_cast<uint32_t>(int64_t(older) + shift);
+}
+
+std::optional<uint32_t> EditMap::toOlder(uint32_t current, bool after) const {
+    int64_t shift = 0;
+    for (const Hunk& h : hunks_) {
+        if (current < h.currentBegin) break;
+        if (current == h.currentBegin && current == h.currentEnd) return after ? h.olderEnd : h.olderBegin;
+        if (current == h.currentBegin) return h.olderBegin;
+        if (current < h.currentEnd) return std::nullopt;
+        shift = int64_t(h.olderEnd) - int64_t(h.currentEnd);
+    }
+    return static_cast<uint32_t>(int64_t(current) + shift);
 }
 
 namespace {
@@ -33,14 +92,14 @@ struct Mover {
     // A place in the main file moved, or nullopt where the edit touched it; other files' as they are.
     std::optional<SourceRange> strict(SourceRange r) const {
         if (r.file != main) return r;
-        auto b = edit.toCurrent(r.begin), e = edit.toCurrent(r.end);
-        if (!b || !e) return std::nullopt;
+        auto b = edit.toCurrent(r.begin, true), e = edit.toCurrent(r.end);
+        if (!b || !e || *e < *b) return std::nullopt;
         return SourceRange{r.file, *b, *e};
     }
     // A declaration's whole range: where the edit is inside it, it still spans the edit.
     std::optional<SourceRange> spanning(SourceRange r) const {
         if (r.file != main) return r;
-        auto b = edit.toCurrent(r.begin), e = edit.toCurrent(r.end);
+        auto b = edit.toCurrent(r.begin, true), e = edit.toCurrent(r.end);
         if (!b || !e) return std::nullopt;
         return SourceRange{r.file, *b, std::max(*b, *e)};
     }

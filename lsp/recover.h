@@ -1,26 +1,34 @@
 // What a file with a syntax error still answers: the last analysis that parsed, its
-// places moved into the text as it is now. The edit since is the span between the two
-// texts' common prefix and common suffix; what lies outside it is where it was (shifted
-// by the edit's length after it), what lies inside it is not known and is left out. So
-// one unfinished line costs hover, definition and symbols only on that line.
+// places moved into the text as it is now. The edits since are the runs of lines that
+// differ between the two texts (a line diff), each narrowed to the characters that differ;
+// what lies outside them is where it was (shifted by the edits before it), what lies
+// inside one is not known and is left out. So one unfinished line costs hover, definition
+// and symbols only on that line, however many other places changed since.
 #pragma once
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "lsp/analysis.h"
 
 namespace psys::lsp {
 
-// Offsets between an older text and the current one, through the edit between them.
+// Offsets between an older text and the current one, through the edits between them.
 class EditMap {
 public:
     EditMap(const std::string& older, const std::string& current);
-    std::optional<uint32_t> toOlder(uint32_t current) const;  // nullopt: inside the edit
-    std::optional<uint32_t> toCurrent(uint32_t older) const;  // nullopt: inside what the edit replaced
+    // nullopt: inside an edit. At an insertion's place, an offset maps before what was
+    // inserted, or after it where `after` (the start of a range that follows the insertion).
+    std::optional<uint32_t> toOlder(uint32_t current, bool after = false) const;
+    std::optional<uint32_t> toCurrent(uint32_t older, bool after = false) const;
+    size_t edits() const { return hunks_.size(); }
 
 private:
-    uint32_t prefix_ = 0, suffix_ = 0, olderSize_ = 0, currentSize_ = 0;
+    struct Hunk {
+        uint32_t olderBegin, olderEnd, currentBegin, currentEnd;  // [begin, end) in each text
+    };
+    std::vector<Hunk> hunks_;  // in order, apart
 };
 
 // `good`'s index (occurrences, symbols, scopes) over `text`, the main file's current text,

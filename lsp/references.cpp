@@ -108,6 +108,16 @@ json highlights(const Analysis& a, uint32_t offset) {
     return out;
 }
 
+std::variant<json, std::string> prepareRename(const Analysis& a, uint32_t offset) {
+    auto d = declarationAt(a, offset);
+    if (!d) return std::string("there is no name to rename here (a built-in's name cannot be renamed)");
+    if (d->path.find("/std/") != std::string::npos)
+        return fmt::format("`{}` is declared in the standard library ({})", d->name, d->path);
+    const Occurrence* o = a.at(a.mainFile, offset);
+    const SourceFile& f = a.sources->file(a.mainFile);
+    return json{{"range", range(f, o->range.begin, o->range.end)}, {"placeholder", d->name}};
+}
+
 std::variant<json, std::string> rename(const std::vector<const Analysis*>& analyses, const Analysis& a, uint32_t offset,
                                        const std::string& newName) {
     auto d = declarationAt(a, offset);

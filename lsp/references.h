@@ -34,6 +34,10 @@ nlohmann::json references(const std::vector<const Analysis*>& analyses, const De
 // as a write, the rest as reads).
 nlohmann::json highlights(const Analysis& a, uint32_t offset);
 
+// What textDocument/prepareRename answers: the range of the name at `offset` and the name,
+// or why it cannot be renamed (as rename would say).
+std::variant<nlohmann::json, std::string> prepareRename(const Analysis& a, uint32_t offset);
+
 // A rename's WorkspaceEdit, or why it is refused: not a name, a keyword, a built-in's
 // name, a name already declared where one of the uses is, a declaration in the standard
 // library, or no name at `offset`.

@@ -16,18 +16,7 @@ using nlohmann::json;
 
 namespace {
 
-// A request's failure the client is told about (the protocol's error code and message).
-struct RequestError {
-    int code;
-    std::string message;
-};
-
 bool isNotification(const json& m) { return !m.contains("id"); }
-
-std::string query(const Field& params) {
-    auto q = params.get("query");
-    return q ? q->string() : std::string();
-}
 
 // A document's version: a whole number where given.
 int64_t version(const Field& textDocument, int64_t otherwise) {
@@ -106,78 +95,8 @@ json Server::dispatch(const std::string& method, const Field& params, bool* foun
         for (auto& [uri, doc] : docs_) doc.dirty = true, doc.changedAt = Clock::now() - options_.debounce;
         return nullptr;
     }
-    auto offset = [&](Document& doc) { return offsetOf(doc.analysis->sources->file(doc.analysis->mainFile), params["position"]); };
-    if (method == "textDocument/hover") {
-        Document& doc = document(params);
-        return hover(*doc.analysis, offset(doc));
-    }
-    if (method == "textDocument/definition") {
-        Document& doc = document(params);
-        return definition(*doc.analysis, offset(doc));
-    }
-    if (method == "textDocument/documentSymbol") return documentSymbols(*document(params).analysis);
-    if (method == "textDocument/semanticTokens/full") return semanticTokens(*document(params).analysis);
-    if (method == "textDocument/foldingRange") return foldingRanges(*document(params).analysis);
-    if (method == "workspace/symbol") return withUris(workspaceSymbols(analyses(), query(params)));
-    // Completion and signature help read names from the last text that parsed and the
-    // cursor in the text as it is now: they need not wait for an analysis.
-    auto typing = [&](auto answer) -> json {
-        Document* doc = &openDocument(params);
-        if (!doc->lastParsed && !doc->analysis) doc = &document(params);
-        const Analysis& names = doc->lastParsed ? *doc->lastParsed : *doc->analysis;
-        return answer(names, doc->text, offsetOf(SourceFile(doc->path, doc->text), params["position"]));
-    };
-    if (method == "textDocument/signatureHelp")
-        return typing([](const Analysis& a, const std::string& text, uint32_t at) { return signatureHelp(a, text, at); });
-    if (method == "textDocument/inlayHint") {
-        Document& doc = document(params);
-        const SourceFile& f = doc.analysis->sources->file(doc.analysis->mainFile);
-        return inlayHints(*doc.analysis, offsetOf(f, params["range"]["start"]), offsetOf(f, params["range"]["end"]));
-    }
-    if (method == "textDocument/references") {
-        Document& doc = document(params);
-        auto d = declarationAt(*doc.analysis, offset(doc));
-        if (!d) return nullptr;
-        auto context = params.get("context");
-        auto include = context ? context->get("includeDeclaration") : std::nullopt;
-        bool withDeclaration = include ? include->boolean() : true;
-        return withUris(references(analyses(), *d, withDeclaration));
-    }
-    if (method == "textDocument/documentHighlight") {
-        Document& doc = document(params);
-        return highlights(*doc.analysis, offset(doc));
-    }
-    if (method == "textDocument/rename") {
-        Document& doc = document(params);
-        auto edit = rename(analyses(), *doc.analysis, offset(doc), params["newName"].string());
-        if (auto* why = std::get_if<std::string>(&edit)) throw RequestError{error::kRequestFailed, *why};
-        return withUris(std::get<json>(std::move(edit)));
-    }
-    if (method == "textDocument/codeAction") {
-        Document& doc = document(params);
-        const SourceFile& f = doc.analysis->sources->file(doc.analysis->mainFile);
-        uint32_t begin = offsetOf(f, params["range"]["start"]), end = offsetOf(f, params["range"]["end"]);
-        // The diagnostics the client shows where the cursor is (its whole line, for some)
-        // count too, though the cursor is not on them.
-        auto context = params.get("context");
-        auto shown = context ? context->get("diagnostics") : std::nullopt;
-        for (size_t i = 0; shown && i < shown->array().size(); ++i) {
-            Field d(shown->json()[i], shown->path() + "[" + std::to_string(i) + "]");
-            begin = std::min(begin, offsetOf(f, d["range"]["start"]));
-            end = std::max(end, offsetOf(f, d["range"]["end"]));
-        }
-        json actions = codeActions(*doc.analysis, begin, end);
-        for (json& action : actions) action["edit"] = withUris(action["edit"]);
-        return actions;
-    }
-    if (method == "textDocument/formatting") {
-        Document& doc = document(params);
-        auto edits = formatting(doc.path, doc.text);
-        if (auto* why = std::get_if<std::string>(&edits)) throw RequestError{error::kRequestFailed, *why};
-        return std::get<json>(std::move(edits));
-    }
-    if (method == "textDocument/completion")
-        return typing([](const Analysis& a, const std::string& text, uint32_t at) { return completion(a, text, at); });
+    if (method.starts_with("textDocument/") || method.starts_with("workspace/") || method.starts_with("completionItem/"))
+        return request(method, params, found);
     *found = false;
     return nullptr;
 }
@@ -206,15 +125,20 @@ json Server::initialize(const Field& field) {
               {"documentSymbolProvider", true},
               {"referencesProvider", true},
               {"documentHighlightProvider", true},
-              {"renameProvider", true},
+              {"renameProvider", {{"prepareProvider", true}}},
+              {"declarationProvider", true},
+              {"documentLinkProvider", {{"resolveProvider", false}}},
+              {"selectionRangeProvider", true},
+              {"documentRangeFormattingProvider", true},
+              {"diagnosticProvider", {{"interFileDependencies", true}, {"workspaceDiagnostics", false}}},
               {"inlayHintProvider", true},
               {"codeActionProvider", {{"codeActionKinds", {"quickfix"}}}},
               {"documentFormattingProvider", true},
-              {"semanticTokensProvider", {{"legend", semanticTokensLegend()}, {"full", true}}},
+              {"semanticTokensProvider", {{"legend", semanticTokensLegend()}, {"full", {{"delta", true}}}, {"range", true}}},
               {"foldingRangeProvider", true},
               {"workspaceSymbolProvider", true},
               {"signatureHelpProvider", {{"triggerCharacters", {"(", ","}}}},
-              {"completionProvider", {{"triggerCharacters", {".", "@"}}}}}},
+              {"completionProvider", {{"triggerCharacters", {".", "@"}}, {"resolveProvider", true}}}}},
             {"serverInfo", {{"name", "psysc"}, {"version", options_.version}}}};
 }
 
@@ -318,7 +242,11 @@ json Server::withUris(json answer) const {
         return it == spelling.end() ? uri : it->second;
     };
     if (answer.is_array()) {
-        for (json& entry : answer) {  // locations, or symbols with one
+        for (json& entry : answer) {  // locations, symbols with one, or links
+            if (entry.contains("target")) {
+                entry["target"] = respell(entry["target"]);
+                continue;
+            }
             json& location = entry.contains("location") ? entry["location"] : entry;
             location["uri"] = respell(location["uri"]);
         }
@@ -351,14 +279,15 @@ Server::Document& Server::document(const Field& params) {
 
 void Server::analyse(Document& doc) {
     SourceOverrides open = openTexts(doc);
-    install(doc, analyze(doc.path, doc.text, nullptr, &open));
+    install(doc, analyze(doc.path, doc.text, nullptr, &open, !doc.lastParsed));
 }
 
 void Server::install(Document& doc, Analysis analysis) {
     auto fresh = std::make_shared<const Analysis>(std::move(analysis));
-    if (fresh->parsed) doc.lastParsed = fresh;
+    if (fresh->parsed && !fresh->recovered) doc.lastParsed = fresh;
     // A syntax error: hover, definition and symbols answer from the last text that parsed,
-    // everywhere the edit since has not touched.
+    // everywhere the edits since have not touched; with none, from the text's declarations
+    // that parse (analyze's salvage).
     if (!fresh->parsed && doc.lastParsed && doc.lastParsed->mainFile >= 0)
         doc.analysis = std::make_shared<const Analysis>(recover(*doc.lastParsed, *fresh, doc.text));
     else
@@ -404,8 +333,9 @@ void Server::idle() {
         auto cancelled = std::make_shared<std::atomic<bool>>(false);
         pending_ = Pending{uri, doc.edits, cancelled,
                            std::async(std::launch::async,
-                                      [path = doc.path, text = doc.text, open = openTexts(doc), cancelled] {
-                                          return analyze(path, text, cancelled.get(), &open);
+                                      [path = doc.path, text = doc.text, open = openTexts(doc), cancelled,
+                                       salvage = !doc.lastParsed] {
+                                          return analyze(path, text, cancelled.get(), &open, salvage);
                                       })};
         return;
     }

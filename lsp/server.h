@@ -38,6 +38,12 @@ struct ServerOptions {
     std::string version = "0";
 };
 
+// A request's failure the client is told about (the protocol's error code and message).
+struct RequestError {
+    int code;
+    std::string message;
+};
+
 class Server {
 public:
     using Send = std::function<void(const nlohmann::json&)>;
@@ -70,6 +76,8 @@ private:
         std::shared_ptr<const Analysis> analysis, lastParsed;
         std::set<std::string> publishedTo;  // URIs this document's diagnostics went to
         uint64_t edits = 0;                 // counts changes: an analysis of an older text is stale
+        std::string tokensId;               // the last semantic tokens sent (for a delta from them)
+        nlohmann::json tokens;
     };
     struct Pending {
         std::string uri;
@@ -79,6 +87,9 @@ private:
     };
 
     nlohmann::json dispatch(const std::string& method, const Field& params, bool* found);
+    // lsp/server_requests.cpp: the requests about documents: reads, then edits.
+    nlohmann::json request(const std::string& method, const Field& params, bool* found);
+    nlohmann::json editRequest(const std::string& method, const Field& params, bool* found);
     nlohmann::json initialize(const Field& params);
     void didOpen(const Field& params);
     void didChange(const Field& params);
@@ -103,6 +114,7 @@ private:
     std::map<std::string, Document> docs_;  // by URI
     std::optional<Pending> pending_;        // the analysis running in the background
     bool initialized_ = false, shutdown_ = false;
+    uint64_t tokenResults_ = 0;  // numbers the semantic tokens' result ids
     std::optional<int> exitCode_;
 };
 

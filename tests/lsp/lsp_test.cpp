@@ -514,7 +514,7 @@ TEST_CASE("a syntax error does not blank the file: hover, definition and symbols
     CHECK(rocket["children"].size() >= 4);        // its parameter and equations
     // On the unfinished line itself: nothing known.
     json none = s.request(5, "textDocument/hover", {{"textDocument", {{"uri", uri}}}, {"position", position(broken, at(broken, "x = ", 1, 1))}});
-    CHECK(none["result"].is_null());
+    CHECK_MESSAGE(none["result"].is_null(), none.dump());
 }
 
 TEST_CASE("edit map: offsets around one edit, both ways") {

@@ -87,7 +87,8 @@ TEST_CASE("semantic tokens: an equation, a parameter, a parent read, an extern, 
 TEST_CASE("semantic tokens: the server announces them with their legend and answers for an open document") {
     Session s;
     json caps = s.request(1, "initialize")["result"]["capabilities"];
-    CHECK(caps["semanticTokensProvider"]["full"] == true);
+    CHECK(caps["semanticTokensProvider"]["full"]["delta"] == true);
+    CHECK(caps["semanticTokensProvider"]["range"] == true);
     CHECK(caps["semanticTokensProvider"]["legend"]["tokenTypes"][0] == "variable");
     s.server.handle({{"jsonrpc", "2.0"},
                      {"method", "textDocument/didOpen"},
