@@ -57,15 +57,15 @@ void methodHints(const ir::Module& module, Analysis& a) {
 
 }  // namespace
 
-Analysis analyze(const std::string& path, std::string text, const std::atomic<bool>* cancelled,
-                 const SourceOverrides* open, bool salvage) {
+Analysis analyze(const std::string& path, std::string text, const AnalyzeOptions& options) {
+    const std::atomic<bool>* cancelled = options.cancelled;
     auto stop = [&] { return cancelled && cancelled->load(std::memory_order_relaxed); };
     Analysis a;
     a.sources = std::make_unique<SourceManager>();
     DiagnosticEngine diags(*a.sources);
     diags.setLimit(kMaxPublished);
     try {
-        std::unique_ptr<ast::Program> program = loadProgramFromText(path, std::move(text), *a.sources, diags, open);
+        std::unique_ptr<ast::Program> program = loadProgramFromText(path, std::move(text), *a.sources, diags, options.open);
         if (program && stop()) return a;  // a newer text is on its way: this one is not wanted
         if (program) {
             checkProgram(*program, diags);
@@ -80,16 +80,16 @@ Analysis analyze(const std::string& path, std::string text, const std::atomic<bo
             // An editor never waits long on them: a fortieth of `psysc check`'s budget of
             // steps (about 2 s on the interpreter at most: didOpen and a request on an edited
             // text analyse at once), and a newer text stops the ones in the background.
-            CompileOptions options;
+            CompileOptions compile;
             interp::Interpreter trials;
             tune::TuneOptions tune;
             tune.budget /= 40;
             tune.cancelled = cancelled;
-            options.beforePasses = [&](ir::Module& module, opt::PassErrors& messages) {
+            compile.beforePasses = [&](ir::Module& module, opt::PassErrors& messages) {
                 if (!stop()) tune::chooseMethods(module, trials, tune, messages);
             };
-            if (diags.errorCount() == 0 && !stop())
-                if (auto module = compileProgram(program.get(), *a.sources, diags, options)) methodHints(*module, a);
+            if (options.passes && diags.errorCount() == 0 && !stop())
+                if (auto module = compileProgram(program.get(), *a.sources, diags, compile)) methodHints(*module, a);
         }
     } catch (const std::exception& e) {
         // The front end's own failure must not end the editing session: it is reported
@@ -105,13 +105,12 @@ Analysis analyze(const std::string& path, std::string text, const std::atomic<bo
     a.diagnostics = diags.all();
     a.hiddenErrors = diags.hiddenErrors();
     a.hiddenWarnings = diags.hiddenWarnings();
-    if (salvage && !a.parsed && !stop())
-        if (auto s = salvaged(path, a, cancelled, open)) return std::move(*s);
+    if (options.salvage && !a.parsed && !stop())
+        if (auto s = salvaged(path, a, options)) return std::move(*s);
     return a;
 }
 
-std::optional<Analysis> salvaged(const std::string& path, const Analysis& broken, const std::atomic<bool>* cancelled,
-                                 const SourceOverrides* open) {
+std::optional<Analysis> salvaged(const std::string& path, const Analysis& broken, const AnalyzeOptions& options) {
     // Only where every error is the main file's own (an import's would be numbered apart).
     std::vector<uint32_t> errors;
     for (const Diagnostic& d : broken.diagnostics) {
@@ -122,7 +121,9 @@ std::optional<Analysis> salvaged(const std::string& path, const Analysis& broken
     const std::string& text = broken.sources->file(broken.mainFile).text();
     auto blanked = blankBroken(text, errors);
     if (!blanked) return std::nullopt;
-    Analysis s = analyze(path, *blanked, cancelled, open);
+    AnalyzeOptions again = options;
+    again.salvage = false;
+    Analysis s = analyze(path, *blanked, again);
     if (!s.parsed || s.mainFile < 0) return std::nullopt;
     // The index over the text as it is (the blanked one has spaces where the broken
     // declarations are, so every offset is the same); the diagnostics the text's own.

@@ -104,18 +104,25 @@ struct Analysis {
     const Occurrence* at(int file, uint32_t offset) const;
 };
 
-// Runs the front end over `text` as the file `path` (imports are read relative to it,
-// from `open` where it has their text — the editor's documents — else from disk), and the
-// compiler's passes when it is clean, for their warnings.
-// `cancelled`, when given and set (from another thread) while it runs, stops it early
-// between its phases; what it returns then is incomplete and only to be thrown away.
-// `salvage`: where the text has syntax errors, the index is that of the text with its broken
-// top-level declarations blanked (lsp/salvage.h), marked `recovered` (a second analysis:
-// for a file with no earlier text that parsed to recover from).
-Analysis analyze(const std::string& path, std::string text, const std::atomic<bool>* cancelled = nullptr,
-                 const SourceOverrides* open = nullptr, bool salvage = false);
-// That second analysis of `broken`, nullopt where it cannot help.
-std::optional<Analysis> salvaged(const std::string& path, const Analysis& broken, const std::atomic<bool>* cancelled,
-                                 const SourceOverrides* open);
+struct AnalyzeOptions {
+    // When given and set (from another thread) while it runs, the analysis stops early
+    // between its phases; what it returns then is incomplete and only to be thrown away.
+    const std::atomic<bool>* cancelled = nullptr;
+    // Imports are read from here where it has their text (the editor's documents), else from disk.
+    const SourceOverrides* open = nullptr;
+    // Where the text has syntax errors, the index is that of the text with its broken
+    // top-level declarations blanked (lsp/salvage.h), marked `recovered` (a second
+    // analysis: for a file with no earlier text that parsed to recover from).
+    bool salvage = false;
+    // The compiler's passes (their warnings, the methods' hints) after a clean front end:
+    // not for the workspace index, which needs names and places only.
+    bool passes = true;
+};
+
+// Runs the front end over `text` as the file `path` (imports are read relative to it),
+// and the compiler's passes when it is clean, for their warnings.
+Analysis analyze(const std::string& path, std::string text, const AnalyzeOptions& options = {});
+// The salvage of `broken` (AnalyzeOptions::salvage), nullopt where it cannot help.
+std::optional<Analysis> salvaged(const std::string& path, const Analysis& broken, const AnalyzeOptions& options);
 
 }  // namespace psys::lsp

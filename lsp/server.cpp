@@ -18,6 +18,20 @@ namespace {
 
 bool isNotification(const json& m) { return !m.contains("id"); }
 
+// The folders of the workspace, as paths: `workspaceFolders`, else `rootUri`, else `rootPath`.
+std::vector<std::string> workspaceFolders(const Field& params) {
+    std::vector<std::string> out;
+    if (auto folders = params.get("workspaceFolders")) {
+        for (size_t i = 0; i < folders->array().size(); ++i)
+            out.push_back(pathFromUri(Field(folders->json()[i], "workspaceFolders[" + std::to_string(i) + "]")["uri"].string()));
+    } else if (auto root = params.get("rootUri")) {
+        out.push_back(pathFromUri(root->string()));
+    } else if (auto path = params.get("rootPath")) {
+        out.push_back(path->string());
+    }
+    return out;
+}
+
 // A document's version: a whole number where given.
 int64_t version(const Field& textDocument, int64_t otherwise) {
     auto v = textDocument.get("version");
@@ -91,8 +105,17 @@ json Server::dispatch(const std::string& method, const Field& params, bool* foun
     }
     if (method == "textDocument/didSave" || method == "workspace/didChangeWatchedFiles") {
         // A saved file, or one changed on disk, may be imported by the open ones: they
-        // are analysed again.
+        // are analysed again; the index reads it again.
         for (auto& [uri, doc] : docs_) doc.dirty = true, doc.changedAt = Clock::now() - options_.debounce;
+        if (method == "textDocument/didSave") index_.changed(pathFromUri(params["textDocument"]["uri"].string()));
+        auto changes = params.get("changes");
+        for (size_t i = 0; changes && i < changes->array().size(); ++i) {
+            Field change(changes->json()[i], "changes[" + std::to_string(i) + "]");
+            std::string path = pathFromUri(change["uri"].string());
+            if (!path.ends_with(".psys")) continue;
+            if (change["type"].json() == 3) index_.removed(path);  // FileChangeType: 1 created, 2 changed, 3 deleted
+            else index_.changed(path);
+        }
         return nullptr;
     }
     if (method.starts_with("textDocument/") || method.starts_with("workspace/") || method.starts_with("completionItem/"))
@@ -117,7 +140,9 @@ json Server::initialize(const Field& field) {
             options_.debounce = std::chrono::milliseconds(d.get<int64_t>());
         }
     }
+    std::vector<std::string> folders = workspaceFolders(field);
     initialized_ = true;
+    index_.setFolders(folders);
     return {{"capabilities",
              {{"textDocumentSync", {{"openClose", true}, {"change", 2}, {"save", true}}},
               {"hoverProvider", true},
@@ -189,6 +214,7 @@ void Server::didChange(const Field& params) {
 
 void Server::touchImporters(const Document& changed) {
     std::string key = sourceKey(changed.path);
+    index_.importChanged(key);
     for (auto& [uri, doc] : docs_) {
         if (&doc == &changed) continue;
         bool imports = (doc.analysis && doc.analysis->imported.count(key)) ||
@@ -201,10 +227,10 @@ void Server::touchImporters(const Document& changed) {
     }
 }
 
-SourceOverrides Server::openTexts(const Document& doc) const {
+SourceOverrides Server::openTexts(const Document* except) const {
     SourceOverrides open;
     for (const auto& [uri, other] : docs_)
-        if (&other != &doc) open[sourceKey(other.path)] = other.text;
+        if (&other != except) open[sourceKey(other.path)] = other.text;
     return open;
 }
 
@@ -226,10 +252,14 @@ void Server::didClose(const Field& params) {
 std::vector<const Analysis*> Server::analyses() {
     std::vector<const Analysis*> out;
     settle();
+    std::set<std::string> open;
     for (auto& [uri, doc] : docs_) {
         if (doc.dirty) analyse(doc);
         out.push_back(doc.analysis.get());
+        open.insert(sourceKey(doc.path));
     }
+    std::vector<const Analysis*> indexed = index_.all(openTexts(nullptr), open);
+    out.insert(out.end(), indexed.begin(), indexed.end());
     return out;
 }
 
@@ -278,8 +308,8 @@ Server::Document& Server::document(const Field& params) {
 }
 
 void Server::analyse(Document& doc) {
-    SourceOverrides open = openTexts(doc);
-    install(doc, analyze(doc.path, doc.text, nullptr, &open, !doc.lastParsed));
+    SourceOverrides open = openTexts(&doc);
+    install(doc, analyze(doc.path, doc.text, {.open = &open, .salvage = !doc.lastParsed}));
 }
 
 void Server::install(Document& doc, Analysis analysis) {
@@ -326,6 +356,7 @@ void Server::settle() {
 
 void Server::idle() {
     if (pending_ && pending_->result.wait_for(std::chrono::seconds(0)) == std::future_status::ready) settle();
+    indexing_ = index_.step(openTexts(nullptr));
     if (pending_) return;
     auto now = Clock::now();
     for (auto& [uri, doc] : docs_) {
@@ -333,9 +364,9 @@ void Server::idle() {
         auto cancelled = std::make_shared<std::atomic<bool>>(false);
         pending_ = Pending{uri, doc.edits, cancelled,
                            std::async(std::launch::async,
-                                      [path = doc.path, text = doc.text, open = openTexts(doc), cancelled,
+                                      [path = doc.path, text = doc.text, open = openTexts(&doc), cancelled,
                                        salvage = !doc.lastParsed] {
-                                          return analyze(path, text, cancelled.get(), &open, salvage);
+                                          return analyze(path, text, {.cancelled = cancelled.get(), .open = &open, .salvage = salvage});
                                       })};
         return;
     }
@@ -344,6 +375,7 @@ void Server::idle() {
 std::optional<std::chrono::milliseconds> Server::nextDeadline() const {
     // While an analysis runs in the background, the loop looks in on it every few milliseconds.
     if (pending_) return std::chrono::milliseconds(2);
+    if (indexing_) return std::chrono::milliseconds(10);
     std::optional<std::chrono::milliseconds> next;
     auto now = Clock::now();
     for (const auto& [uri, doc] : docs_) {

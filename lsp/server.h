@@ -27,6 +27,7 @@
 
 #include "lsp/analysis.h"
 #include "lsp/params.h"
+#include "lsp/workspace.h"
 
 namespace psys::lsp {
 
@@ -57,8 +58,8 @@ public:
     // Publishes the analysis that has finished in the background, if any, and starts the
     // next of the documents whose debounce has run out.
     void idle();
-    // An analysis is running in the background.
-    bool busy() const { return pending_.has_value(); }
+    // An analysis is running in the background (a document's or the workspace index's).
+    bool busy() const { return pending_.has_value() || indexing_; }
     // Waits for the background analysis and publishes it (if its text is still current).
     void settle();
     // How long until idle() has work (nullopt: none pending).
@@ -96,11 +97,12 @@ private:
     void didClose(const Field& params);
     Document& document(const Field& params);  // the open document a request names, analysed
     Document& openDocument(const Field& params);  // the same, as it is
-    std::vector<const Analysis*> analyses();  // every open document's, analysed
+    // Every open document's analysis, and every other file's of the workspace index.
+    std::vector<const Analysis*> analyses();
     nlohmann::json withUris(nlohmann::json answer) const;
     void analyse(Document& doc);
     // The open documents' texts but `doc`'s, for an analysis of `doc` to import.
-    SourceOverrides openTexts(const Document& doc) const;
+    SourceOverrides openTexts(const Document* except) const;
     // `changed`'s text is not what the documents importing it last read: each is analysed
     // again (once edits pause), an analysis of theirs that is running thrown away.
     void touchImporters(const Document& changed);
@@ -113,8 +115,10 @@ private:
     Send send_;
     std::map<std::string, Document> docs_;  // by URI
     std::optional<Pending> pending_;        // the analysis running in the background
+    WorkspaceIndex index_;                  // the workspace folders' files
     bool initialized_ = false, shutdown_ = false;
     uint64_t tokenResults_ = 0;  // numbers the semantic tokens' result ids
+    bool indexing_ = false;      // the workspace index is analysing in the background
     std::optional<int> exitCode_;
 };
 

@@ -28,6 +28,10 @@ local text = {
 }
 local file = dir .. "/fireworks.psys"
 vim.fn.writefile(text, file)
+-- In the workspace from the start, never opened until a rename edits it (the workspace index).
+local bouncyFile, marblesFile = dir .. "/bouncy.psys", dir .. "/marbles.psys"
+vim.fn.writefile({ "fn bounce(v: float) -> float = -v * 0.8;" }, bouncyFile)
+vim.fn.writefile({ 'import "bouncy.psys";', "const k = bounce(1);" }, marblesFile)
 vim.cmd("edit " .. file)
 vim.bo.filetype = "psys"
 local id = vim.lsp.start_client({ name = "psysc", cmd = { psysc, "lsp", "--debounce", "0" }, root_dir = dir })
@@ -209,6 +213,40 @@ check(riseDef.uri == vim.uri_from_fname(libFile) and riseDef.range.start.line ==
 check(vim.wait(5000, function() return #vim.diagnostic.get(mainBuf) == 0 end, 20),
   "main's diagnostics: " .. vim.inspect(vim.diagnostic.get(mainBuf)))
 ok("unsaved imports")
+
+-- The workspace index: references to bounce from bouncy.psys find marbles.psys, which no
+-- one opened, and a rename edits it.
+vim.cmd("edit " .. bouncyFile)
+vim.bo.filetype = "psys"
+vim.lsp.buf_attach_client(0, id)
+local uses = at(1, 4, "textDocument/references", { context = { includeDeclaration = true } })
+local inMarbles = false
+for _, r in ipairs(uses or {}) do inMarbles = inMarbles or r.uri == vim.uri_from_fname(marblesFile) end
+check(#uses == 2 and inMarbles, "references across the workspace: " .. vim.inspect(uses))
+check(vim.fn.bufloaded(marblesFile) == 0, "marbles.psys not opened")
+local wide = at(1, 4, "textDocument/rename", { newName = "rebound" })
+vim.lsp.util.apply_workspace_edit(wide, "utf-16")
+local marblesBuf = vim.fn.bufnr(marblesFile)
+check(marblesBuf > 0 and vim.api.nvim_buf_get_lines(marblesBuf, 1, 2, false)[1] == "const k = rebound(1);",
+  "marbles.psys renamed: " .. vim.inspect(marblesBuf > 0 and vim.api.nvim_buf_get_lines(marblesBuf, 0, -1, false)))
+ok("workspace index")
+
+-- A file opened with a syntax error in it: the outline and hover answer outside the
+-- broken declaration.
+local brokenFile = dir .. "/broken.psys"
+vim.fn.writefile({ "fn up(h: float) -> vec3 = vec3(0, h, 0);", "object o {", "    pos = origin + up(", "}",
+  "object p {", "    pos = origin + up(1);", "    point(pos, white, 1);", "}", "spawn p;" }, brokenFile)
+vim.cmd("edit " .. brokenFile)
+vim.bo.filetype = "psys"
+vim.lsp.buf_attach_client(0, id)
+local outline = at(1, 0, "textDocument/documentSymbol")
+local shown = {}
+for _, sym in ipairs(outline or {}) do shown[#shown + 1] = sym.name end
+check(vim.tbl_contains(shown, "up") and vim.tbl_contains(shown, "p") and not vim.tbl_contains(shown, "o"),
+  "outline of a file opened broken: " .. vim.inspect(shown))
+local upHover = at(6, 20, "textDocument/hover")
+check(upHover and upHover.contents.value:find("fn up", 1, true), "hover in a file opened broken: " .. vim.inspect(upHover))
+ok("opened with a syntax error")
 
 out:write("done\n")
 out:close()

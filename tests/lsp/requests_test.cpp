@@ -6,6 +6,7 @@
 #include <doctest/doctest.h>
 
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "lsp/positions.h"
@@ -293,4 +294,54 @@ TEST_CASE("top-level declarations: by brackets and semicolons; a missing } ends 
     CHECK(blanked->size() == text.size());
     CHECK(blanked->find("object o") == std::string::npos);
     CHECK(blanked->find("fn f(x: float)") == text.find("fn f(x: float)"));
+}
+
+TEST_CASE("workspace index: references, rename and symbols reach files no one opened, kept current from file events") {
+    TempDir dir;
+    std::string lib = "fn bounce(v: float) -> float = -v * 0.8;\n";
+    std::string marbles = "import \"lib.psys\";\nobject m {\n    vel = snapshot(bounce(1));\n    pos = origin + "
+                          "integrate(vec3(0, vel, 0));\n    point(pos, white, 2);\n}\nspawn m;\n";
+    std::string libPath = dir.write("lib.psys", lib);
+    dir.write("marbles.psys", marbles);
+    std::filesystem::create_directories(dir.path / ".hidden");
+    dir.write(".hidden/skip.psys", "import \"../lib.psys\";\nconst k = bounce(2);\n");
+    Session s;
+    s.request(1, "initialize", {{"initializationOptions", {{"debounceMs", 0}}},
+                                {"workspaceFolders", {{{"uri", uriFromPath(dir.path.string())}, {"name", "w"}}}}});
+    std::string uri = uriFromPath(libPath);
+    s.server.handle({{"jsonrpc", "2.0"}, {"method", "textDocument/didOpen"},
+                     {"params", {{"textDocument", {{"uri", uri}, {"version", 1}, {"text", lib}}}}}});
+    while (s.server.busy()) s.server.idle();  // the index is built in the background
+    json at = {{"textDocument", {{"uri", uri}}}, {"position", {{"line", 0}, {"character", 4}}}};
+    json refs = s.request(2, "textDocument/references", at)["result"];
+    std::set<std::string> files;
+    for (const json& r : refs) files.insert(r["uri"]);
+    CHECK(files == std::set<std::string>{uri, uriFromPath((dir.path / "marbles.psys").string())});
+    json renamed = at;
+    renamed["newName"] = "rebound";
+    json edit = s.request(3, "textDocument/rename", renamed)["result"];
+    CHECK(edit["changes"].size() == 2);
+    CHECK(edit["changes"][uriFromPath((dir.path / "marbles.psys").string())].size() == 1);
+    json symbols = s.request(4, "workspace/symbol", {{"query", "m"}})["result"];
+    bool m = false;
+    for (const json& sym : symbols) m |= sym["name"] == "m";
+    CHECK(m);  // marbles' object, never opened
+    // A file created on disk (didChangeWatchedFiles): its use is found; deleted: gone.
+    std::string more = dir.write("more.psys", "import \"lib.psys\";\nconst k = bounce(3);\n");
+    s.server.handle({{"jsonrpc", "2.0"}, {"method", "workspace/didChangeWatchedFiles"},
+                     {"params", {{"changes", {{{"uri", uriFromPath(more)}, {"type", 1}}}}}}});
+    CHECK(s.request(5, "textDocument/references", at)["result"].size() == refs.size() + 1);
+    std::filesystem::remove(more);
+    s.server.handle({{"jsonrpc", "2.0"}, {"method", "workspace/didChangeWatchedFiles"},
+                     {"params", {{"changes", {{{"uri", uriFromPath(more)}, {"type", 3}}}}}}});
+    CHECK(s.request(6, "textDocument/references", at)["result"].size() == refs.size());
+    // An unsaved edit to lib (a line added above bounce): marbles' uses are still found,
+    // and the declaration's place is the one in the editor's text.
+    s.server.handle({{"jsonrpc", "2.0"}, {"method", "textDocument/didChange"},
+                     {"params", {{"textDocument", {{"uri", uri}, {"version", 2}}}, {"contentChanges", {{{"text", "\n" + lib}}}}}}});
+    json moved = {{"textDocument", {{"uri", uri}}}, {"position", {{"line", 1}, {"character", 4}}}};
+    json after = s.request(7, "textDocument/references", moved)["result"];
+    CHECK(after.size() == refs.size());
+    for (const json& r : after)
+        if (r["uri"] == uri) CHECK(r["range"]["start"]["line"] == 1);
 }
