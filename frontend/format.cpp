@@ -253,8 +253,8 @@ bool sameAtoms(const std::vector<Atom>& a, const std::vector<Atom>& b) {
 
 }  // namespace
 
-std::optional<std::string> formatSource(int file, const SourceManager& sources, DiagnosticEngine& diags) {
-    if (!parseModule(file, sources, diags)) return std::nullopt;
+std::optional<std::string> formatSource(int file, const SourceManager& sources, DiagnosticEngine& diags, bool parses) {
+    if (!parses && !parseModule(file, sources, diags)) return std::nullopt;
     // A UTF-8 byte order mark stays where the file had it, outside the layout (as a token
     // it came out of the layout elsewhere, and formatting refused the file).
     static const std::string kByteOrderMark = "\xEF\xBB\xBF";

@@ -13,6 +13,9 @@ namespace psys {
 // syntax errors (reported to `diags`: a file is formatted only when its every token is
 // known). The result has the same tokens in the same order, so the same meaning; the
 // formatter checks that before it answers, and formatting it again changes nothing.
-std::optional<std::string> formatSource(int file, const SourceManager& sources, DiagnosticEngine& diags);
+// `parses`: the caller knows the text parses (an editor that has just analysed it), so it is
+// not parsed again here (it is still lexed, twice: the check of the tokens stays).
+std::optional<std::string> formatSource(int file, const SourceManager& sources, DiagnosticEngine& diags,
+                                        bool parses = false);
 
 }  // namespace psys

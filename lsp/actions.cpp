@@ -34,11 +34,11 @@ nlohmann::json codeActions(const Analysis& a, uint32_t begin, uint32_t end) {
 namespace {
 
 // The text laid out canonically, or why it cannot be.
-std::optional<std::string> formatted(const std::string& path, const std::string& text, std::string& why) {
+std::optional<std::string> formatted(const std::string& path, const std::string& text, bool parses, std::string& why) {
     SourceManager sources;
     DiagnosticEngine diags(sources);
     int file = sources.add(path, text);
-    auto out = formatSource(file, sources, diags);
+    auto out = formatSource(file, sources, diags, parses);
     if (!out) {
         if (diags.all().empty()) why = "the file cannot be formatted";
         else {
@@ -55,9 +55,9 @@ bool blank(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
 }  // namespace
 
 std::variant<nlohmann::json, std::string> rangeFormatting(const std::string& path, const std::string& text, uint32_t begin,
-                                                          uint32_t end) {
+                                                          uint32_t end, bool parses) {
     std::string why;
-    auto out = formatted(path, text, why);
+    auto out = formatted(path, text, parses, why);
     if (!out) return why;
     // The layout changes only white space (frontend/format.h: the same tokens, comments
     // kept), so the two texts' other characters pair up one to one, and each run of white
@@ -82,9 +82,9 @@ std::variant<nlohmann::json, std::string> rangeFormatting(const std::string& pat
     return edits;
 }
 
-std::variant<nlohmann::json, std::string> formatting(const std::string& path, const std::string& text) {
+std::variant<nlohmann::json, std::string> formatting(const std::string& path, const std::string& text, bool parses) {
     std::string why;
-    auto out = formatted(path, text, why);
+    auto out = formatted(path, text, parses, why);
     if (!out) return why;
     // One edit over what differs, not the whole text, so the editor keeps its cursor and marks.
     size_t prefix = 0, suffix = 0;

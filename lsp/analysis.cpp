@@ -1,5 +1,6 @@
 #include "lsp/analysis.h"
 
+#include <chrono>
 #include <cmath>
 #include <exception>
 
@@ -58,6 +59,7 @@ void methodHints(const ir::Module& module, Analysis& a) {
 }  // namespace
 
 Analysis analyze(const std::string& path, std::string text, const AnalyzeOptions& options) {
+    auto started = std::chrono::steady_clock::now();
     const std::atomic<bool>* cancelled = options.cancelled;
     auto stop = [&] { return cancelled && cancelled->load(std::memory_order_relaxed); };
     Analysis a;
@@ -106,7 +108,8 @@ Analysis analyze(const std::string& path, std::string text, const AnalyzeOptions
     a.hiddenErrors = diags.hiddenErrors();
     a.hiddenWarnings = diags.hiddenWarnings();
     if (options.salvage && !a.parsed && !stop())
-        if (auto s = salvaged(path, a, options)) return std::move(*s);
+        if (auto s = salvaged(path, a, options)) a = std::move(*s);
+    a.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
     return a;
 }
 

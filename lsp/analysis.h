@@ -41,7 +41,8 @@ struct Token {
 // name) what kind of name it is.
 struct Occurrence {
     SourceRange range;
-    std::string hover;  // Markdown
+    // Markdown (shared: an analysis moved through an edit copies 100,000 occurrences)
+    std::shared_ptr<const std::string> hover;
     std::optional<SourceRange> definition;
     Token token;
 };
@@ -87,6 +88,7 @@ struct Analysis {
     // The index of an older text that parsed, moved into this one around the edit since
     // (lsp/recover.h): this text has syntax errors, `diagnostics` are its own.
     bool recovered = false;
+    double milliseconds = 0;  // how long the analysis took
     std::vector<Diagnostic> diagnostics;  // at most kMaxPublished errors and as many warnings
     int hiddenErrors = 0, hiddenWarnings = 0;  // counted past that, not kept
     std::vector<Occurrence> occurrences;  // every file's, in the order found

@@ -45,7 +45,8 @@ public:
 private:
     void add(SourceRange range, std::string hover, std::optional<SourceRange> definition = std::nullopt,
              Token token = {}) {
-        if (range.valid()) out_.occurrences.push_back({range, std::move(hover), definition, token});
+        if (range.valid())
+            out_.occurrences.push_back({range, std::make_shared<const std::string>(std::move(hover)), definition, token});
     }
 
     struct Described {

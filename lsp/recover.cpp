@@ -119,7 +119,7 @@ struct Mover {
 
 }  // namespace
 
-Analysis recover(const Analysis& good, const Analysis& current, const std::string& text) {
+Analysis recover(const Analysis& good, const Analysis& current, const std::string& text, bool readsOnly) {
     Analysis out;
     out.sources = std::make_unique<SourceManager>();
     for (int f = 0; f < good.sources->count(); ++f) {
@@ -129,12 +129,14 @@ Analysis recover(const Analysis& good, const Analysis& current, const std::strin
     }
     out.mainFile = good.mainFile;
     out.parsed = true;
+    out.milliseconds = current.milliseconds;
     out.recovered = true;
     out.diagnostics = current.diagnostics;
     out.hiddenErrors = current.hiddenErrors;
     out.hiddenWarnings = current.hiddenWarnings;
     EditMap edit(good.sources->file(good.mainFile).text(), text);
     Mover move{edit, good.mainFile};
+    out.occurrences.reserve(good.occurrences.size());
     for (const Occurrence& o : good.occurrences) {
         auto range = move.strict(o.range);
         if (!range) continue;
@@ -147,10 +149,11 @@ Analysis recover(const Analysis& good, const Analysis& current, const std::strin
     }
     for (Symbol s : good.symbols)
         if (move.symbol(s)) out.symbols.push_back(std::move(s));
-    for (Scope s : good.scopes)
-        if (auto range = move.spanning(s.range)) out.scopes.push_back({*range, std::move(s.names), s.pure});
     for (const Hint& h : good.hints)
         if (auto at = move.strict(h.at)) out.hints.push_back({*at, h.label, h.kind});
+    if (readsOnly) return out;
+    for (const Scope& s : good.scopes)
+        if (auto range = move.spanning(s.range)) out.scopes.push_back({*range, s.names, s.pure});
     out.globals = good.globals;
     out.members = good.members;
     out.imported = good.imported;  // (the current text's imports, as far as it parsed, too)

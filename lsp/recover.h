@@ -32,7 +32,8 @@ private:
 };
 
 // `good`'s index (occurrences, symbols, scopes) over `text`, the main file's current text,
-// with `current`'s diagnostics; Analysis::recovered is set.
-Analysis recover(const Analysis& good, const Analysis& current, const std::string& text);
+// with `current`'s diagnostics; Analysis::recovered is set. `readsOnly`: what the reads
+// need (occurrences, symbols, hints), not the names completion and rename look up.
+Analysis recover(const Analysis& good, const Analysis& current, const std::string& text, bool readsOnly = false);
 
 }  // namespace psys::lsp

@@ -73,7 +73,11 @@ void Server::handle(const json& m) {
             if (notification) return;  // notifications the server does not know are ignored, as the protocol says
             throw RequestError{error::kMethodNotFound, "no method `" + method + "`"};
         }
-        if (!notification) send_({{"jsonrpc", "2.0"}, {"id", id}, {"result", result}});
+        if (!notification) {
+            json answer = {{"jsonrpc", "2.0"}, {"id", id}};
+            answer["result"] = std::move(result);  // (not copied: an outline can be 15,000 symbols)
+            send_(answer);
+        }
     } catch (const RequestError& e) {
         if (!notification) send_(errorResponse(id, e.code, e.message));
     } catch (const InvalidParams& e) {
@@ -305,6 +309,18 @@ Server::Document& Server::document(const Field& params) {
         analyse(it->second);
     }
     return it->second;
+}
+
+const Analysis& Server::readable(const Field& params) {
+    Document& doc = openDocument(params);
+    bool running = pending_ && pending_->uri == doc.uri;
+    if (!doc.analysis || (!doc.dirty && !running)) return *document(params).analysis;
+    if (doc.analysis->milliseconds < options_.quickAnalysisMs) return *document(params).analysis;
+    if (doc.movedAt != doc.edits) {
+        doc.moved = std::make_shared<const Analysis>(recover(*doc.analysis, *doc.analysis, doc.text, true));
+        doc.movedAt = doc.edits;
+    }
+    return *doc.moved;
 }
 
 void Server::analyse(Document& doc) {

@@ -27,15 +27,21 @@
 
 #include "lsp/analysis.h"
 #include "lsp/params.h"
+#include "lsp/recover.h"
 #include "lsp/workspace.h"
 
 namespace psys::lsp {
+
+// A read waits for an analysis of the text it is asked about when the last one took
+// less than this; otherwise it answers from the last analysis at once.
+constexpr double kQuickAnalysisMs = 20;
 
 // The longest debounce a client may ask for (initializationOptions.debounceMs): ten minutes.
 constexpr uint64_t kMaxDebounceMs = 600000;
 
 struct ServerOptions {
     std::chrono::milliseconds debounce{150};
+    double quickAnalysisMs = kQuickAnalysisMs;
     std::string version = "0";
 };
 
@@ -77,6 +83,10 @@ private:
         std::shared_ptr<const Analysis> analysis, lastParsed;
         std::set<std::string> publishedTo;  // URIs this document's diagnostics went to
         uint64_t edits = 0;                 // counts changes: an analysis of an older text is stale
+        std::shared_ptr<const Analysis> moved;  // `analysis` moved to the text of `movedAt` edits
+        uint64_t movedAt = UINT64_MAX;
+        std::shared_ptr<const EditMap> map;     // from `analysis`'s text to the text of `mapAt` edits
+        uint64_t mapAt = UINT64_MAX;
         std::string tokensId;               // the last semantic tokens sent (for a delta from them)
         nlohmann::json tokens;
     };
@@ -97,6 +107,15 @@ private:
     void didClose(const Field& params);
     Document& document(const Field& params);  // the open document a request names, analysed
     Document& openDocument(const Field& params);  // the same, as it is
+    // What reads answer from: the analysis of the text as it is where it is current, or
+    // will be soon (the last one took under kQuickAnalysis); else, at once, the last
+    // analysis moved through the edits since (lsp/recover.h), which knows nothing of what
+    // they changed until the new analysis is in.
+    const Analysis& readable(const Field& params);
+    // Hover and definition where readable() would move the last analysis: the place asked
+    // about mapped back into its text, the answer mapped forward (no copy of the index).
+    // Nullopt where readable() is what answers.
+    std::optional<nlohmann::json> throughEdits(const Field& params, bool definition);
     // Every open document's analysis, and every other file's of the workspace index.
     std::vector<const Analysis*> analyses();
     nlohmann::json withUris(nlohmann::json answer) const;

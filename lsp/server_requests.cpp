@@ -1,10 +1,14 @@
-// The requests about documents and the workspace: each reads the analysis of the text it
-// is asked about (Server::document analyses a changed text first), or, for completion and
-// signature help, the last text that parsed with the cursor in the text as it is now.
+// The requests about documents and the workspace. Reads (hover, definition, symbols,
+// tokens, …) answer from Server::readable: the analysis of the text as it is, or, while
+// that would take long, the last one moved through the edits since. Completion and
+// signature help read the last text that parsed with the cursor in the text as it is now.
+// What edits the text (rename, quick fixes), references and pulled diagnostics wait for
+// the analysis of the text they are asked about.
 #include <algorithm>
 
 #include "lsp/features.h"
 #include "lsp/positions.h"
+#include "lsp/recover.h"
 #include "lsp/references.h"
 #include "lsp/server.h"
 #include "lsp/transport.h"
@@ -29,21 +33,24 @@ T orRefuse(std::variant<T, std::string> answer) {
 }  // namespace
 
 json Server::request(const std::string& method, const Field& params, bool* found) {
-    auto mainFile = [](Document& doc) -> const SourceFile& { return doc.analysis->sources->file(doc.analysis->mainFile); };
-    auto offset = [&](Document& doc) { return offsetOf(mainFile(doc), params["position"]); };
+    // Reads answer from readable(): never behind an analysis that takes long.
+    auto main = [](const Analysis& a) -> const SourceFile& { return a.sources->file(a.mainFile); };
+    auto offset = [&](const Analysis& a) { return offsetOf(main(a), params["position"]); };
     if (method == "textDocument/hover") {
-        Document& doc = document(params);
-        return hover(*doc.analysis, offset(doc));
+        if (auto answer = throughEdits(params, false)) return *answer;
+        const Analysis& a = readable(params);
+        return hover(a, offset(a));
     }
     // A name's declaration is where it is defined: the language has no declarations apart.
     if (method == "textDocument/definition" || method == "textDocument/declaration") {
-        Document& doc = document(params);
-        return definition(*doc.analysis, offset(doc));
+        if (auto answer = throughEdits(params, true)) return *answer;
+        const Analysis& a = readable(params);
+        return definition(a, offset(a));
     }
-    if (method == "textDocument/documentSymbol") return documentSymbols(*document(params).analysis);
+    if (method == "textDocument/documentSymbol") return documentSymbols(readable(params));
     if (method == "textDocument/semanticTokens/full" || method == "textDocument/semanticTokens/full/delta") {
-        Document& doc = document(params);
-        json tokens = semanticTokens(*doc.analysis);
+        json tokens = semanticTokens(readable(params));
+        Document& doc = openDocument(params);
         auto previous = params.get("previousResultId");
         bool delta = previous && previous->string() == doc.tokensId && !doc.tokensId.empty();
         json answer = {{"resultId", std::to_string(++tokenResults_)}};
@@ -54,21 +61,28 @@ json Server::request(const std::string& method, const Field& params, bool* found
         return answer;
     }
     if (method == "textDocument/semanticTokens/range") {
-        Document& doc = document(params);
-        return semanticTokens(*doc.analysis, offsetOf(mainFile(doc), params["range"]["start"]),
-                              offsetOf(mainFile(doc), params["range"]["end"]));
+        const Analysis& a = readable(params);
+        return semanticTokens(a, offsetOf(main(a), params["range"]["start"]), offsetOf(main(a), params["range"]["end"]));
     }
-    if (method == "textDocument/foldingRange") return foldingRanges(*document(params).analysis);
-    if (method == "textDocument/documentLink") return withUris(documentLinks(*document(params).analysis));
+    if (method == "textDocument/foldingRange") return foldingRanges(readable(params));
+    if (method == "textDocument/documentLink") return withUris(documentLinks(readable(params)));
     if (method == "textDocument/selectionRange") {
-        Document& doc = document(params);
+        const Analysis& a = readable(params);
         Field positions = params["positions"];
         json answer = json::array();
         for (size_t i = 0; i < positions.array().size(); ++i)
-            answer.push_back(selectionRange(
-                *doc.analysis, offsetOf(mainFile(doc), Field(positions.json()[i], "positions[" + std::to_string(i) + "]"))));
+            answer.push_back(selectionRange(a, offsetOf(main(a), Field(positions.json()[i], "positions[" + std::to_string(i) + "]"))));
         return answer;
     }
+    if (method == "textDocument/inlayHint") {
+        const Analysis& a = readable(params);
+        return inlayHints(a, offsetOf(main(a), params["range"]["start"]), offsetOf(main(a), params["range"]["end"]));
+    }
+    if (method == "textDocument/documentHighlight") {
+        const Analysis& a = readable(params);
+        return highlights(a, offset(a));
+    }
+    // The diagnostics the editor pulls are the text's own: they wait for its analysis.
     if (method == "textDocument/diagnostic") return documentDiagnostics(*document(params).analysis);
     if (method == "workspace/symbol") return withUris(workspaceSymbols(analyses(), query(params)));
     if (method == "completionItem/resolve") return resolveCompletion(params.object());
@@ -84,25 +98,51 @@ json Server::request(const std::string& method, const Field& params, bool* found
         return typing([](const Analysis& a, const std::string& text, uint32_t at) { return signatureHelp(a, text, at); });
     if (method == "textDocument/completion")
         return typing([](const Analysis& a, const std::string& text, uint32_t at) { return completion(a, text, at); });
-    if (method == "textDocument/inlayHint") {
-        Document& doc = document(params);
-        return inlayHints(*doc.analysis, offsetOf(mainFile(doc), params["range"]["start"]),
-                          offsetOf(mainFile(doc), params["range"]["end"]));
-    }
     if (method == "textDocument/references") {
         Document& doc = document(params);
-        auto d = declarationAt(*doc.analysis, offset(doc));
+        auto d = declarationAt(*doc.analysis, offsetOf(main(*doc.analysis), params["position"]));
         if (!d) return nullptr;
         auto context = params.get("context");
         auto include = context ? context->get("includeDeclaration") : std::nullopt;
         bool withDeclaration = include ? include->boolean() : true;
         return withUris(references(analyses(), *d, withDeclaration));
     }
-    if (method == "textDocument/documentHighlight") {
-        Document& doc = document(params);
-        return highlights(*doc.analysis, offset(doc));
-    }
     return editRequest(method, params, found);
+}
+
+std::optional<json> Server::throughEdits(const Field& params, bool wantDefinition) {
+    Document& doc = openDocument(params);
+    bool running = pending_ && pending_->uri == doc.uri;
+    if (!doc.analysis || !doc.analysis->parsed || (!doc.dirty && !running)) return std::nullopt;
+    if (doc.analysis->milliseconds < options_.quickAnalysisMs || doc.movedAt == doc.edits) return std::nullopt;
+    // The place asked about, in the text the last analysis read; what is there, moved back
+    // into the text as it is (nothing where the edits since touched it).
+    const Analysis& a = *doc.analysis;
+    if (doc.mapAt != doc.edits) {
+        doc.map = std::make_shared<const EditMap>(a.sources->file(a.mainFile).text(), doc.text);
+        doc.mapAt = doc.edits;
+    }
+    SourceFile now(doc.path, doc.text);
+    auto older = doc.map->toOlder(offsetOf(now, params["position"]));
+    const Occurrence* o = older ? a.at(a.mainFile, *older) : nullptr;
+    auto moved = [&](SourceRange r) -> std::optional<SourceRange> {
+        if (r.file != a.mainFile) return r;
+        auto b = doc.map->toCurrent(r.begin, true), e = doc.map->toCurrent(r.end);
+        if (!b || !e || *e < *b) return std::nullopt;
+        return SourceRange{r.file, *b, *e};
+    };
+    auto at = o ? moved(o->range) : std::nullopt;
+    if (!at) return json(nullptr);
+    auto where = [&](SourceRange r) -> json {
+        const SourceFile& f = r.file == a.mainFile ? now : a.sources->file(r.file);
+        return {{"uri", uriFromPath(f.path())}, {"range", range(f, r.begin, r.end)}};
+    };
+    if (wantDefinition) {
+        auto d = o->definition && o->definition->valid() ? moved(*o->definition) : std::nullopt;
+        return d ? where(*d) : json(nullptr);
+    }
+    if (!o->hover || o->hover->empty()) return json(nullptr);
+    return json{{"contents", {{"kind", "markdown"}, {"value", *o->hover}}}, {"range", range(now, at->begin, at->end)}};
 }
 
 json Server::editRequest(const std::string& method, const Field& params, bool* found) {
@@ -133,16 +173,21 @@ json Server::editRequest(const std::string& method, const Field& params, bool* f
         for (json& action : actions) action["edit"] = withUris(action["edit"]);
         return actions;
     }
-    // Formatting reads the text as it is now: it needs no analysis.
+    // Formatting reads the text as it is now: it needs no analysis, but where the one it
+    // has is of this text and it parsed, the text is not parsed again.
+    auto parses = [this](const Document& doc) {
+        bool running = pending_ && pending_->uri == doc.uri;
+        return !doc.dirty && !running && doc.analysis && doc.analysis->parsed && !doc.analysis->recovered;
+    };
     if (method == "textDocument/formatting") {
         Document& doc = openDocument(params);
-        return orRefuse(formatting(doc.path, doc.text));
+        return orRefuse(formatting(doc.path, doc.text, parses(doc)));
     }
     if (method == "textDocument/rangeFormatting") {
         Document& doc = openDocument(params);
         SourceFile f(doc.path, doc.text);
         return orRefuse(rangeFormatting(doc.path, doc.text, offsetOf(f, params["range"]["start"]),
-                                        offsetOf(f, params["range"]["end"])));
+                                        offsetOf(f, params["range"]["end"]), parses(doc)));
     }
     *found = false;
     return nullptr;

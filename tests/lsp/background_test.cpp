@@ -166,3 +166,46 @@ TEST_CASE("an open, unsaved file is what its importers read: an edit to it check
     REQUIRE(errors.size() == 1);
     CHECK(errors[0].find("unknown function `rise`") != std::string::npos);
 }
+
+TEST_CASE("reads never wait on a slow analysis: they answer from the last one, moved through the edits since") {
+    std::vector<json> out;
+    ServerOptions options;
+    options.debounce = std::chrono::milliseconds(60000);
+    options.quickAnalysisMs = 0;  // every analysis counts as slow
+    Server server(options, [&](const json& m) { out.push_back(m); });
+    auto request = [&](int id, const std::string& method, json params) {
+        out.clear();
+        server.handle({{"jsonrpc", "2.0"}, {"id", id}, {"method", method}, {"params", std::move(params)}});
+        for (const json& m : out)
+            if (m.contains("id") && m["id"] == id) return m["result"];
+        return json();
+    };
+    request(1, "initialize", json::object());
+    std::string uri = "file:///tmp/never_waits.psys", text = kFireworks;
+    server.handle({{"jsonrpc", "2.0"}, {"method", "textDocument/didOpen"},
+                   {"params", {{"textDocument", {{"uri", uri}, {"version", 1}, {"text", text}}}}}});
+    // Two lines above everything, one of them a new constant: not analysed yet (debounce).
+    std::string edited = "const lift = 2;\n\n" + text;
+    server.handle({{"jsonrpc", "2.0"}, {"method", "textDocument/didChange"},
+                   {"params", {{"textDocument", {{"uri", uri}, {"version", 2}}}, {"contentChanges", {{{"text", edited}}}}}}});
+    auto pos = [&](uint32_t offset) { return position(SourceFile("x", edited), offset); };
+    json doc = {{"uri", uri}};
+    json h = request(2, "textDocument/hover", {{"textDocument", doc}, {"position", pos(at(edited, "gravity(0.3)", 1, 2))}});
+    REQUIRE(h.is_object());
+    CHECK(h["contents"]["value"].get<std::string>().find("fn gravity") != std::string::npos);
+    CHECK(h["range"]["start"]["line"] == 6);  // where the call is now
+    json d = request(3, "textDocument/definition", {{"textDocument", doc}, {"position", pos(at(edited, "gravity(0.3)", 1, 2))}});
+    CHECK(d["range"]["start"] == json{{"line", 3}, {"character", 3}});
+    CHECK(request(4, "textDocument/hover", {{"textDocument", doc}, {"position", pos(7)}}).is_null());  // `lift`: not known yet
+    json symbols = request(5, "textDocument/documentSymbol", {{"textDocument", doc}});
+    bool rocketMoved = false;
+    for (const json& sym : symbols) rocketMoved |= sym["name"] == "rocket" && sym["range"]["start"]["line"] == 4;
+    CHECK(rocketMoved);
+    for (const json& m : out) CHECK(m.value("method", "") != "textDocument/publishDiagnostics");  // nothing analysed
+    // Once the new analysis is in, the new constant is known.
+    CHECK(server.nextDeadline().has_value());
+    request(6, "textDocument/references", {{"textDocument", doc}, {"position", pos(7)}});  // (waits: analyses)
+    json fresh = request(7, "textDocument/hover", {{"textDocument", doc}, {"position", pos(7)}});
+    REQUIRE(fresh.is_object());
+    CHECK(fresh["contents"]["value"].get<std::string>().find("const lift") != std::string::npos);
+}
