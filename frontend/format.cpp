@@ -5,8 +5,10 @@
 // Structure fixes the line breaks (one statement a line, blocks opened at the end of a
 // line and closed on one of their own, each object attribute on a line); inside a
 // statement the author's line breaks stay, and the continuation lines are indented one
-// level past the line that opened the innermost bracket still open. Blank lines are kept
-// (at most one) between statements. Trailing comments on consecutive lines line up.
+// level past the line that opened the innermost bracket still open. A line longer than
+// the width (100) is broken after a comma or an operator, by the same rule. Blank lines are
+// kept (at most one) between statements. Trailing comments on consecutive lines line up; a
+// block comment over several lines moves with its code, its own layout kept.
 #include "frontend/format.h"
 
 #include <algorithm>
@@ -31,14 +33,21 @@ struct Atom {
     std::string text;
     int newlinesBefore = 0;  // in the source, between the previous atom and this one
     bool endsAttribute = false;
+    int column = 0;  // a block comment's: where it began on its line in the source
 };
 
 bool isToken(const Atom* atom, std::string_view text) {
     return atom && atom->kind == Kind::Token && atom->type != PsysLexer::STRING && atom->text == text;
 }
 
-// Newlines, `//` and `/* */` comments in the text between two tokens (the lexer skips them).
-void addGap(std::string_view gap, std::vector<Atom>& atoms, int& newlines) {
+size_t displayWidth(std::string_view text) {
+    return static_cast<size_t>(
+        std::count_if(text.begin(), text.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
+}
+
+// Newlines, `//` and `/* */` comments in the text between two tokens (the lexer skips them);
+// the gap starts at `from` in `whole`.
+void addGap(std::string_view whole, size_t from, std::string_view gap, std::vector<Atom>& atoms, int& newlines) {
     for (size_t i = 0; i < gap.size();) {
         if (gap.compare(i, 2, "//") == 0) {
             size_t end = gap.find('\n', i);
@@ -52,7 +61,10 @@ void addGap(std::string_view gap, std::vector<Atom>& atoms, int& newlines) {
         } else if (gap.compare(i, 2, "/*") == 0) {
             size_t end = gap.find("*/", i + 2);
             end = end == std::string_view::npos ? gap.size() : end + 2;
-            atoms.push_back({Kind::BlockComment, 0, std::string(gap.substr(i, end - i)), newlines, false});
+            size_t lineStart = whole.rfind('\n', from + i == 0 ? 0 : from + i - 1);
+            lineStart = lineStart == std::string_view::npos ? 0 : lineStart + 1;
+            int column = static_cast<int>(displayWidth(whole.substr(lineStart, from + i - lineStart)));
+            atoms.push_back({Kind::BlockComment, 0, std::string(gap.substr(i, end - i)), newlines, false, column});
             newlines = 0;
             i = end;
         } else {
@@ -75,13 +87,13 @@ std::optional<std::vector<Atom>> atomsOf(const std::string& text) {
     for (const auto& token : lexer.getAllTokens()) {
         if (token->getType() == PsysLexer::UNKNOWN_CHAR) return std::nullopt;
         uint32_t begin = offsets[token->getStartIndex()], end = offsets[token->getStopIndex() + 1];
-        addGap(std::string_view(text).substr(at, begin - at), atoms, newlines);
+        addGap(text, at, std::string_view(text).substr(at, begin - at), atoms, newlines);
         atoms.push_back({Kind::Token, static_cast<int>(token->getType()), text.substr(begin, end - begin), newlines,
                          false});
         newlines = 0;
         at = end;
     }
-    addGap(std::string_view(text).substr(at), atoms, newlines);
+    addGap(text, at, std::string_view(text).substr(at), atoms, newlines);
     // An attribute ends at its name or at the `)` that closes its arguments.
     for (size_t i = 0; i + 1 < atoms.size(); ++i) {
         if (!isToken(&atoms[i], "@")) continue;
@@ -100,6 +112,45 @@ std::optional<std::vector<Atom>> atomsOf(const std::string& text) {
     return atoms;
 }
 
+// A block comment over several lines moves with its code: its lines after the first are
+// shifted as far as its start moved (from its column in the source to `column`), so a
+// comment's own layout (a column of `*`, an indented example) stays as it was drawn.
+std::string reindented(const Atom& comment, int column) {
+    int shift = column - comment.column;
+    if (shift == 0 || comment.text.find('\n') == std::string::npos) return comment.text;
+    std::string out;
+    size_t start = 0;
+    for (bool first = true; start <= comment.text.size(); first = false) {
+        size_t end = comment.text.find('\n', start);
+        std::string_view line(comment.text.data() + start, (end == std::string::npos ? comment.text.size() : end) - start);
+        if (!first && shift > 0 && !line.empty()) out += std::string(static_cast<size_t>(shift), ' ');
+        if (!first && shift < 0) {
+            size_t drop = 0;
+            while (drop < line.size() && drop < static_cast<size_t>(-shift) && line[drop] == ' ') ++drop;
+            line.remove_prefix(drop);
+        }
+        out += line;
+        if (end == std::string::npos) break;
+        out += '\n';
+        start = end + 1;
+    }
+    return out;
+}
+
+// A block comment's text as the check of the layout compares it: its lines after the
+// first without their indentation (which the layout moves).
+std::string comparable(const Atom& atom) {
+    if (atom.kind != Kind::BlockComment) return atom.text;
+    std::string out;
+    bool lineStart = false;
+    for (char c : atom.text) {
+        if (lineStart && (c == ' ' || c == '\t')) continue;
+        lineStart = c == '\n';
+        out += c;
+    }
+    return out;
+}
+
 bool endsOperand(const Atom& token) {
     return token.type == PsysLexer::NUMBER || token.type == PsysLexer::STRING || token.type == PsysLexer::IDENT ||
            token.text == ")" || token.text == "true" || token.text == "false";
@@ -112,40 +163,74 @@ bool takesArguments(const Atom& token) {
            token.text == "streak" || token.text == "trail" || token.text == "range";
 }
 
-size_t displayWidth(std::string_view text) {
-    return static_cast<size_t>(
-        std::count_if(text.begin(), text.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
-}
+// A place a line may be broken: after a comma or a binary operator.
+struct Break {
+    size_t at;        // in Line::code, after the token
+    int depth;        // brackets open there
+    int rank;         // `=` 0, a comma 1, then the operators by precedence, loosest first
+    long open;        // in Line::code, the innermost bracket still open there (-1: opened on an earlier line)
+    int level;        // a continuation's level where that bracket opened on an earlier line
+};
 
 struct Line {
     int level = 0;
     std::string code;
     std::string comment;  // a trailing `//` comment
     bool blankBefore = false;
+    std::vector<Break> breaks;
+    std::vector<long> opens;  // in `code`, the brackets open (positions of their `(`)
 };
+
+// `line` as lines no longer than `width`, each with its start in the line's code.
+std::vector<std::pair<size_t, Line>> fitted(const Line& line, int width);
 
 class Layout {
 public:
+    explicit Layout(int width) : width_(width) {}
+
     void add(const Atom& atom) {
         int brk = lineBreak(atom);
-        if (brk > 0) startLine(atom, brk == 2);
+        if (brk > 0) {
+            fitLast();
+            startLine(atom, brk == 2);
+        }
         Line& line = lines_.back();
         if (atom.kind == Kind::LineComment && !line.code.empty()) {
             line.comment = atom.text;
         } else {
             if (!line.code.empty() && spaced(atom)) line.code += ' ';
-            line.code += atom.text;
+            if (atom.kind == Kind::BlockComment)
+                line.code += reindented(atom, 4 * line.level + static_cast<int>(displayWidth(line.code)));
+            else
+                line.code += atom.text;
         }
-        if (atom.kind == Kind::Token) track(atom);
+        if (atom.kind == Kind::Token) {
+            int rank = breaksAfter(atom);
+            track(atom);
+            if (isToken(&atom, "(")) {
+                line.opens.push_back(static_cast<long>(line.code.size()) - 1);
+                brackets_.back().at = line.opens.back();
+            }
+            else if (isToken(&atom, ")") && !line.opens.empty()) line.opens.pop_back();
+            if (rank >= 0 && !brackets_.empty() && !boundary_)
+                line.breaks.push_back({line.code.size(), static_cast<int>(brackets_.size()), rank,
+                                       line.opens.empty() ? -1 : line.opens.back(), brackets_.back().lineLevel + 1});
+            else if (rank >= 0 && !boundary_)
+                line.breaks.push_back({line.code.size(), 0, rank, -1, statementLevel_ + 1});
+        }
         previous_ = &atom;
     }
 
+    // Fits the last line (the others are fitted as the next begins).
+    void finish() { fitLast(); }
     std::string text() const;
 
 private:
     struct Open {
         int lineLevel;
         int questions = 0;  // `?` waiting for their `:`
+        size_t line = 0;    // where the `(` is: lines_'s index, and its place in the line's code
+        long at = -1;
     };
 
     // 0: on this line; 1: on the next; 2: after a blank line.
@@ -186,6 +271,24 @@ private:
 
     int questionsWaiting() const { return brackets_.empty() ? questions_ : brackets_.back().questions; }
 
+    // After a statement's `=`, a comma or a binary operator (not a sign, not `.`, not a
+    // fn's `->` before its result type) a line may be broken: its rank (`=` 0, a comma 1,
+    // then the operators from the loosest), or -1.
+    int breaksAfter(const Atom& token) const {
+        if (token.type == PsysLexer::STRING) return -1;
+        static constexpr std::string_view kRanked[][4] = {{"="}, {","}, {"->"}, {"?", ":"}, {"||"}, {"&&"}, {"==", "!="},
+                                                          {"<", "<=", ">", ">="}, {"+", "-"}, {"*", "/", "%"}};
+        int rank = -1;
+        for (int r = 0; r < static_cast<int>(std::size(kRanked)) && rank < 0; ++r)
+            for (std::string_view op : kRanked[r])
+                if (!op.empty() && op == token.text) rank = r;
+        if (rank < 0) return -1;
+        if (token.text == "-" || token.text == "+") return lastToken_ && endsOperand(*lastToken_) ? rank : -1;  // not a sign
+        if (token.text == ":") return questionsWaiting() > 0 ? rank : -1;  // a ternary's, not a type's
+        if (token.text == "->") return sawEquals_ ? rank : -1;  // `init -> next`, not `fn f() -> T`
+        return rank;
+    }
+
     void track(const Atom& token) {
         bool statementStart = boundary_ || (lastToken_ && lastToken_->endsAttribute);
         if (statementStart) statementLevel_ = level_;
@@ -195,12 +298,13 @@ private:
         int& questions = brackets_.empty() ? questions_ : brackets_.back().questions;
         if (isToken(&token, "?")) ++questions;
         else if (isToken(&token, ":") && questions > 0) --questions;
-        else if (isToken(&token, "(")) brackets_.push_back({lines_.back().level});
+        else if (isToken(&token, "(")) brackets_.push_back({lines_.back().level, 0, lines_.size() - 1, -1});
         else if (isToken(&token, ")") && !brackets_.empty()) brackets_.pop_back();
         else if (isToken(&token, "{")) ++level_, boundary_ = true;
         else if (isToken(&token, "}")) level_ = std::max(0, level_ - 1), boundary_ = true;
         else if (isToken(&token, ";")) boundary_ = true;
-        if (boundary_) brackets_.clear(), questions_ = 0;
+        else if (isToken(&token, "=")) sawEquals_ = true;
+        if (boundary_) brackets_.clear(), questions_ = 0, sawEquals_ = false;
         lastToken_ = &token;
     }
 
@@ -209,34 +313,118 @@ private:
     const Atom* lastToken_ = nullptr;
     bool boundary_ = true;  // the next token starts a statement
     bool prevUnary_ = false;
+    bool sawEquals_ = false;  // the statement's `=` is behind: an expression follows
+    int width_;
+
+    // The last line broken where it is too long; the brackets still open in it then belong
+    // to the piece that holds them: a continuation line after it is indented past that
+    // piece (as when the file is formatted again, with the pieces as its lines).
+    void fitLast() {
+        if (lines_.empty()) return;
+        size_t index = lines_.size() - 1;
+        std::vector<std::pair<size_t, Line>> pieces = fitted(lines_.back(), width_);
+        if (pieces.size() == 1) return;
+        for (Open& open : brackets_) {
+            if (open.line != index || open.at < 0) continue;
+            for (const auto& [start, piece] : pieces)
+                if (static_cast<size_t>(open.at) >= start) open.lineLevel = piece.level;
+        }
+        lines_.pop_back();
+        for (auto& [start, piece] : pieces) lines_.push_back(std::move(piece));
+        for (Open& open : brackets_)
+            if (open.line == index) open.line = SIZE_MAX;  // (its level is settled)
+    }
     int level_ = 0;
     int statementLevel_ = 0;
     int questions_ = 0;
     std::vector<Open> brackets_;
 };
 
+// `line` as lines no longer than `width` (where it can be broken): each break is one whose
+// first part fits, one whose rest fits too where there is one, then at the shallowest
+// bracket depth, a statement's `=` before a comma, a comma before an operator and a loose
+// operator before a tight one, the rightmost of those.
+std::vector<std::pair<size_t, Line>> fitted(const Line& line, int width) {
+    auto length = [](const Line& l) { return 4 * static_cast<size_t>(l.level) + displayWidth(l.code); };
+    if (width <= 0 || line.breaks.empty() || line.code.find('\n') != std::string::npos ||
+        length(line) + (line.comment.empty() ? 0 : line.comment.size() + 2) <= static_cast<size_t>(width))
+        return {{0, line}};
+    std::vector<std::pair<size_t, Line>> out;
+    std::vector<std::pair<size_t, int>> pieces;  // each piece's start in `code` and its level
+    pieces.push_back({0, line.level});
+    size_t start = 0;
+    auto levelAt = [&](const Break& b) {
+        if (b.open < 0) return b.level;
+        int level = line.level;  // the level of the piece that holds the bracket
+        for (auto [at, l] : pieces)
+            if (static_cast<size_t>(b.open) >= at) level = l;
+        return level + 1;
+    };
+    for (;;) {
+        int indent = 4 * pieces.back().second;
+        if (indent + displayWidth(std::string_view(line.code).substr(start)) <= static_cast<size_t>(width)) break;
+        // A break whose rest fits on the next line first (two lines, not three).
+        const Break* best = nullptr;
+        bool bestRestFits = false;
+        for (const Break& b : line.breaks) {
+            if (b.at <= start || b.at >= line.code.size()) continue;
+            bool fits = indent + displayWidth(std::string_view(line.code).substr(start, b.at - start)) <= static_cast<size_t>(width);
+            if (!fits) break;
+            bool restFits = 4 * static_cast<size_t>(levelAt(b)) + displayWidth(std::string_view(line.code).substr(b.at)) <=
+                            static_cast<size_t>(width) + 1;  // (+1: the space after the break goes)
+            auto key = [](const Break& x) { return std::pair(x.depth, x.rank); };
+            bool better = !best || (restFits && !bestRestFits) ||
+                          (restFits == bestRestFits && (key(b) < key(*best) || (key(b) == key(*best) && b.at > best->at)));
+            if (better) best = &b, bestRestFits = restFits;
+        }
+        if (!best)  // nothing fits: the first break after `start`, so the rest is shorter
+            for (const Break& b : line.breaks)
+                if (b.at > start && b.at < line.code.size()) {
+                    best = &b;
+                    break;
+                }
+        if (!best) break;
+        size_t next = best->at;
+        while (next < line.code.size() && line.code[next] == ' ') ++next;
+        pieces.push_back({next, levelAt(*best)});
+        start = next;
+    }
+    for (size_t i = 0; i < pieces.size(); ++i) {
+        Line piece;
+        piece.level = pieces[i].second;
+        size_t end = i + 1 < pieces.size() ? pieces[i + 1].first : line.code.size();
+        piece.code = line.code.substr(pieces[i].first, end - pieces[i].first);
+        while (!piece.code.empty() && piece.code.back() == ' ') piece.code.pop_back();
+        piece.blankBefore = i == 0 && line.blankBefore;
+        if (i + 1 == pieces.size()) piece.comment = line.comment;
+        out.push_back({pieces[i].first, std::move(piece)});
+    }
+    return out;
+}
+
 std::string Layout::text() const {
+    const std::vector<Line>& lines = lines_;
     // Trailing comments of consecutive lines start in one column.
-    std::vector<size_t> column(lines_.size(), 0);
-    for (size_t i = 0; i < lines_.size();) {
+    std::vector<size_t> column(lines.size(), 0);
+    for (size_t i = 0; i < lines.size();) {
         size_t j = i, widest = 0;
-        while (j < lines_.size() && !lines_[j].comment.empty() && lines_[j].code.find('\n') == std::string::npos &&
-               (j == i || !lines_[j].blankBefore)) {
-            widest = std::max(widest, 4 * static_cast<size_t>(lines_[j].level) + displayWidth(lines_[j].code));
+        while (j < lines.size() && !lines[j].comment.empty() && lines[j].code.find('\n') == std::string::npos &&
+               (j == i || !lines[j].blankBefore)) {
+            widest = std::max(widest, 4 * static_cast<size_t>(lines[j].level) + displayWidth(lines[j].code));
             ++j;
         }
         for (size_t k = i; k < j; ++k) column[k] = widest + 2;
         i = std::max(j, i + 1);
     }
     std::string out;
-    for (size_t i = 0; i < lines_.size(); ++i) {
-        const Line& line = lines_[i];
+    for (size_t i = 0; i < lines.size(); ++i) {
+        const Line& line = lines[i];
         if (line.blankBefore) out += '\n';
         std::string text(4 * static_cast<size_t>(line.level), ' ');
         text += line.code;
         if (!line.comment.empty()) {
-            size_t width = displayWidth(text);
-            text += std::string(column[i] > width ? column[i] - width : 2, ' ');
+            size_t used = displayWidth(text);
+            text += std::string(column[i] > used ? column[i] - used : 2, ' ');
             text += line.comment;
         }
         out += text;
@@ -247,14 +435,15 @@ std::string Layout::text() const {
 
 bool sameAtoms(const std::vector<Atom>& a, const std::vector<Atom>& b) {
     return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](const Atom& x, const Atom& y) {
-               return x.kind == y.kind && x.type == y.type && x.text == y.text;
+               return x.kind == y.kind && x.type == y.type && comparable(x) == comparable(y);
            });
 }
 
 }  // namespace
 
-std::optional<std::string> formatSource(int file, const SourceManager& sources, DiagnosticEngine& diags, bool parses) {
-    if (!parses && !parseModule(file, sources, diags)) return std::nullopt;
+std::optional<std::string> formatSource(int file, const SourceManager& sources, DiagnosticEngine& diags,
+                                        const LayoutOptions& options) {
+    if (!options.parses && !parseModule(file, sources, diags)) return std::nullopt;
     // A UTF-8 byte order mark stays where the file had it, outside the layout (as a token
     // it came out of the layout elsewhere, and formatting refused the file).
     static const std::string kByteOrderMark = "\xEF\xBB\xBF";
@@ -263,8 +452,9 @@ std::optional<std::string> formatSource(int file, const SourceManager& sources, 
     std::string text = marked ? whole.substr(kByteOrderMark.size()) : whole;
     auto atoms = atomsOf(text);
     if (!atoms) return std::nullopt;  // the parser has reported the character
-    Layout layout;
+    Layout layout(options.width);
     for (const Atom& atom : *atoms) layout.add(atom);
+    layout.finish();
     std::string out = layout.text();
     auto again = atomsOf(out);
     if (!again || !sameAtoms(*atoms, *again)) {

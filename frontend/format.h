@@ -13,9 +13,17 @@ namespace psys {
 // syntax errors (reported to `diags`: a file is formatted only when its every token is
 // known). The result has the same tokens in the same order, so the same meaning; the
 // formatter checks that before it answers, and formatting it again changes nothing.
-// `parses`: the caller knows the text parses (an editor that has just analysed it), so it is
-// not parsed again here (it is still lexed, twice: the check of the tokens stays).
+struct LayoutOptions {
+    // A line longer than this (its indentation counted) is broken after a comma or a binary
+    // operator, at the shallowest bracket depth that fits, the rest indented one level past
+    // the line of the innermost bracket still open; 0: lines are never broken.
+    int width = 100;
+    // The caller knows the text parses (an editor that has just analysed it), so it is not
+    // parsed again here (it is still lexed, twice: the check of the tokens stays).
+    bool parses = false;
+};
+
 std::optional<std::string> formatSource(int file, const SourceManager& sources, DiagnosticEngine& diags,
-                                        bool parses = false);
+                                        const LayoutOptions& options = {});
 
 }  // namespace psys

@@ -38,7 +38,9 @@ std::optional<std::string> formatted(const std::string& path, const std::string&
     SourceManager sources;
     DiagnosticEngine diags(sources);
     int file = sources.add(path, text);
-    auto out = formatSource(file, sources, diags, parses);
+    LayoutOptions layout;
+    layout.parses = parses;
+    auto out = formatSource(file, sources, diags, layout);
     if (!out) {
         if (diags.all().empty()) why = "the file cannot be formatted";
         else {

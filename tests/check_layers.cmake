@@ -19,7 +19,7 @@ set(allowed_host "core;frontend;lower;ir;opt;driver;tune;rt;interp;native;codege
 set(allowed_capi "core;frontend;lower;ir;opt;driver;tune;rt;interp;native;codegen_llvm;codegen_glsl;gpu;host;psys")
 set(allowed_python "psys")
 set(allowed_tools "core;frontend;lsp;lower;ir;opt;driver;tune;rt;interp;native;codegen_llvm;codegen_glsl;gpu;host")
-set(allowed_bench "core;frontend;lower;ir;opt;driver;tune;rt;interp;native;codegen_llvm;codegen_glsl;gpu;host;psys")
+set(allowed_bench "core;frontend;lsp;lower;ir;opt;driver;tune;rt;interp;native;codegen_llvm;codegen_glsl;gpu;host;psys")
 set(layers core frontend lower ir opt driver tune lsp rt interp native codegen_llvm codegen_glsl gpu host capi python tools bench)
 
 set(problems "")

@@ -78,7 +78,7 @@ TEST_CASE("capabilities: the server announces every request it answers") {
     CHECK(caps["completionProvider"]["resolveProvider"] == true);
 }
 
-TEST_CASE("prepareRename: the name's range and text, or why it cannot be renamed; declaration is the definition") {
+TEST_CASE("prepareRename: the name's range and text, or why it cannot be renamed, and declaration is the definition") {
     std::string text = kFireworks;
     Open s(text);
     json r = s.at("textDocument/prepareRename", text, at(text, "vel.y", 1, 1));
@@ -93,7 +93,7 @@ TEST_CASE("prepareRename: the name's range and text, or why it cannot be renamed
     CHECK(declaration["result"]["range"]["start"]["line"] == 1);
 }
 
-TEST_CASE("document links: an import's path links to the file it loads; std/ imports to the library's") {
+TEST_CASE("document links: an import's path links to the file it loads, a std/ import to the library's") {
     TempDir dir;
     dir.write("lib.psys", "fn lift(x: float) -> float = x * 2;\n");
     std::string text = "import \"lib.psys\";\nimport \"std/forces.psys\";\nconst k = lift(1);\n";
@@ -172,7 +172,7 @@ TEST_CASE("pull diagnostics: the document's report, the same diagnostics as publ
     CHECK(report["items"][0]["message"].get<std::string>().find("nope") != std::string::npos);
 }
 
-TEST_CASE("completionItem/resolve adds what a built-in word is; hover explains types, commands and @shape's names") {
+TEST_CASE("completionItem/resolve adds what a built-in word is, and hover explains types, commands and @shape's names") {
     Session s;
     s.request(1, "initialize");
     json sprite = s.request(2, "completionItem/resolve", {{"label", "sprite"}, {"kind", 14}})["result"];
@@ -281,7 +281,7 @@ TEST_CASE("a file opened with a syntax error: outline, hover and definition ever
     (void)reported;
 }
 
-TEST_CASE("top-level declarations: by brackets and semicolons; a missing } ends at the next declaration's keyword") {
+TEST_CASE("top-level declarations: by brackets and semicolons, a missing } ending at the next declaration's keyword") {
     std::string text = "const a = 1;\n@shape(star)\nobject o {\n    object p { x = \"}\"; }\n// }\nfn f(x: float) -> float = x;\nobject q {\n";
     auto d = topLevelDeclarations(text);
     REQUIRE(d.size() == 4);

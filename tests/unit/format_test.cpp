@@ -125,6 +125,58 @@ TEST_CASE("format: a statement keeps its line breaks, continuation lines indent 
     CHECK(formatted("object o {\n\n  x = 1 +\n\n 2;\n\n}\n") == "object o {\n    x = 1 +\n        2;\n}\n");
 }
 
+TEST_CASE("format: a line past the width breaks after a comma or operator, the shallowest that fits, its rest one level in") {
+    // An emit of 118 columns: after the comma between its two arguments, not inside them.
+    std::string emit = "object o {\n    emit p(vec3(nrand() * 0.3, 0.3, nrand() * 0.3), vec3(nrand() * 0.5, 1 + rand(), "
+                       "nrand() * 0.5)) at 10 per second;\n}\nobject p(a: vec3, b: vec3) { point(a, white, 1); }\n";
+    std::string out = formatted(emit);
+    CHECK(out.find("    emit p(vec3(nrand() * 0.3, 0.3, nrand() * 0.3),\n        vec3(nrand() * 0.5, 1 + rand(), "
+                   "nrand() * 0.5)) at 10 per second;\n") != std::string::npos);
+    // A fn: after its `=` (the body fits on the next line), never after the `->` of its type.
+    std::string fn = "fn ramp(t: float, t0: float, c0: vec4, t1: float, c1: vec4) -> vec4 = mix(c0, c1, clamp((t - t0) "
+                     "/ (t1 - t0)));\n";
+    CHECK(formatted(fn) == "fn ramp(t: float, t0: float, c0: vec4, t1: float, c1: vec4) -> vec4 =\n"
+                           "    mix(c0, c1, clamp((t - t0) / (t1 - t0)));\n");
+    // `init -> next` may break after its `->`; a line the author broke keeps its break, and
+    // its continuation indents past the piece that holds its open bracket.
+    std::string arrow = "object o(ipos: vec3) {\n    (pos, vel) = (ipos, vec3(0)) -> bounce(prev(pos), prev(vel) * "
+                        "exp(-1.5 * dt) + vec3(0, -9.8, 0) * dt,\n        vec3(0), dt, 0.5);\n    point(pos, white, "
+                        "1);\n}\nfn bounce(p: vec3, v: vec3, a: vec3, dt: float, k: float) -> (vec3, vec3) = (p + v * "
+                        "dt, v * k + a);\n";
+    std::string arrowOut = formatted(arrow);
+    CHECK(arrowOut.find("\n            vec3(0), dt, 0.5);\n") != std::string::npos);
+    for (size_t at = 0, end; at < arrowOut.size(); at = end + 1) {  // no line past 100
+        end = arrowOut.find('\n', at);
+        CHECK(end - at <= 100);
+    }
+    // Width 0: never broken; a long line with nowhere to break stays as it is.
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    LayoutOptions unlimited;
+    unlimited.width = 0;
+    CHECK(formatSource(sources.add("w.psys", emit), sources, diags, unlimited)->find("nrand() * 0.3),\n") ==
+          std::string::npos);
+    std::string word = "spawn " + std::string(120, 'a') + ";\n";
+    CHECK(formatted(word) == word);
+    // Where no break makes the first part fit, the first one is taken: the rest is shorter.
+    CHECK(formatted("const " + std::string(120, 'a') + " = 1;\n") == "const " + std::string(120, 'a') + " =\n    1;\n");
+}
+
+TEST_CASE("format: a block comment over several lines moves with its code, its own layout kept") {
+    // Written two levels in, at column 8; its object is at the top: it moves 4 left, its
+    // column of stars and its indented example with it.
+    std::string text = "object o {\n        /* A column of stars:\n         *   pos = 1;\n         */\n"
+                       "    pos = vec3(1);\n    point(pos, white, 1);\n}\n";
+    CHECK(formatted(text) == "object o {\n    /* A column of stars:\n     *   pos = 1;\n     */\n    pos = vec3(1);\n"
+                             "    point(pos, white, 1);\n}\n");
+    // Moved right: from column 0 into the object.
+    std::string right = "object o {\n/* two\n   lines */\n    point(vec3(0), white, 1);\n}\n";
+    CHECK(formatted(right) == "object o {\n    /* two\n       lines */\n    point(vec3(0), white, 1);\n}\n");
+    // After code on its line: its start is where the code ends.
+    std::string after = "const a = 1;    /* one\n                   two */\n";
+    CHECK(formatted(after) == "const a = 1; /* one\n" + std::string(16, ' ') + "two */\n");
+}
+
 TEST_CASE("format: the line endings and white space of any editor give the same layout") {
     CHECK(formatted("object a {\r\n\tx = 1;\r\n}\r\n") == "object a {\n    x = 1;\n}\n");
     CHECK(formatted("const a = 1;   \n\n\n\n   const b = 2;") == "const a = 1;\n\nconst b = 2;\n");

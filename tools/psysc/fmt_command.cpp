@@ -78,7 +78,9 @@ int formatFiles(const FormatOptions& options) {
         SourceManager sources;
         DiagnosticEngine diags(sources);
         int file = sources.add(path == "-" ? "<stdin>" : path, *text);
-        auto formatted = formatSource(file, sources, diags);
+        LayoutOptions layout;
+        layout.width = options.width;
+        auto formatted = formatSource(file, sources, diags, layout);
         diags.print(std::cerr, options.colour);
         if (!formatted) {
             std::cerr << "psysc: `" << (path == "-" ? "<stdin>" : path) << "` is not formatted: fix its syntax first\n";

@@ -12,6 +12,7 @@ struct FormatOptions {
     bool check = false;              // report the files that are not formatted; change nothing
     bool write = false;              // rewrite the files that are not formatted
     bool colour = false;
+    int width = 100;                 // lines longer are broken (0: never)
 };
 
 // Returns the process exit status: 0, or 1 when a file cannot be read, has syntax errors

@@ -284,6 +284,10 @@ int realMain(int argc, char** argv) {
     psys::tools::FormatOptions formatOptions;
     format->add_option("files", formatOptions.files, "Files to format (- reads standard input)")->required()
         ->type_name("FILE");
+    format->add_option("--width", formatOptions.width,
+                       "Break lines longer than this after a comma or an operator (0: never)")
+        ->check(CLI::Range(0, 10000))
+        ->capture_default_str();
     auto* checkFlag = format->add_flag("--check", formatOptions.check, "Change nothing; list the files that are not formatted and exit 1 "
                      "if there are any");
     checkFlag->excludes(format->add_flag("-w,--write", formatOptions.write,
