@@ -123,7 +123,8 @@ std::string reindented(const Atom& comment, int column) {
     for (bool first = true; start <= comment.text.size(); first = false) {
         size_t end = comment.text.find('\n', start);
         std::string_view line(comment.text.data() + start, (end == std::string::npos ? comment.text.size() : end) - start);
-        if (!first && shift > 0 && !line.empty()) out += std::string(static_cast<size_t>(shift), ' ');
+        bool blankLine = line.find_first_not_of(" \t\r") == std::string_view::npos;  // (no trailing spaces added)
+        if (!first && shift > 0 && !blankLine) out += std::string(static_cast<size_t>(shift), ' ');
         if (!first && shift < 0) {
             size_t drop = 0;
             while (drop < line.size() && drop < static_cast<size_t>(-shift) && line[drop] == ' ') ++drop;
@@ -199,8 +200,15 @@ public:
             line.comment = atom.text;
         } else {
             if (!line.code.empty() && spaced(atom)) line.code += ' ';
-            if (atom.kind == Kind::BlockComment)
-                line.code += reindented(atom, 4 * line.level + static_cast<int>(displayWidth(line.code)));
+            if (atom.kind == Kind::BlockComment) {
+                // Its column: after the code on its line (the last line of it, where an
+                // earlier comment spans several).
+                size_t lastBreak = line.code.rfind('\n');
+                int column = lastBreak == std::string::npos
+                                 ? 4 * line.level + static_cast<int>(displayWidth(line.code))
+                                 : static_cast<int>(displayWidth(std::string_view(line.code).substr(lastBreak + 1)));
+                line.code += reindented(atom, column);
+            }
             else
                 line.code += atom.text;
         }

@@ -79,13 +79,16 @@ json resolveCompletion(json item) {
     // to the one item the editor shows in full.
     if (!item.is_object() || !item.contains("label") || !item["label"].is_string() || item.contains("documentation"))
         return item;
+    // Which word it is, by the kind (and detail) completion gave it: a user's `const rk4`
+    // is not the integrator.
     std::string label = item["label"];
+    int kind = item.contains("kind") && item["kind"].is_number_integer() ? item["kind"].get<int>() : 0;
+    std::string detail = item.contains("detail") && item["detail"].is_string() ? item["detail"].get<std::string>() : "";
     std::string doc;
-    if (std::string_view c = commandDoc(label); !c.empty()) doc = std::string(c);
-    else if (std::string_view t = typeDoc(label); !t.empty()) doc = std::string(t);
-    else if (std::string_view at = attributeDoc(label); !at.empty() && item.value("kind", 0) == static_cast<int>(CompletionKind::Property))
-        doc = std::string(at);
-    else if (std::string m = integratorDoc(label); !m.empty()) doc = m;
+    if (kind == static_cast<int>(CompletionKind::Keyword)) doc = std::string(commandDoc(label));
+    else if (kind == static_cast<int>(CompletionKind::TypeParameter)) doc = std::string(typeDoc(label));
+    else if (kind == static_cast<int>(CompletionKind::Property) && detail.starts_with("@")) doc = std::string(attributeDoc(label));
+    else if (kind == static_cast<int>(CompletionKind::Constant) && detail == "integrator") doc = integratorDoc(label);
     if (!doc.empty()) item["documentation"] = {{"kind", "markdown"}, {"value", doc}};
     return item;
 }

@@ -26,6 +26,10 @@ std::vector<std::string_view> lines(const std::string& text, const std::vector<u
 
 }  // namespace
 
+// Past this many differing lines (a file re-indented, pasted over) the line script is not
+// worth its time: they are one edit.
+constexpr size_t kMaxDiffLines = 4000;
+
 EditMap::EditMap(const std::string& older, const std::string& current) {
     // The lines the texts share, by a shortest edit script over lines (dtl: Myers's
     // algorithm, O((N+M)·D) for D differing lines), then each run of differing lines
@@ -33,9 +37,24 @@ EditMap::EditMap(const std::string& older, const std::string& current) {
     // before and after it on that line).
     std::vector<uint32_t> olderStarts = lineStarts(older), currentStarts = lineStarts(current);
     std::vector<std::string_view> a = lines(older, olderStarts), b = lines(current, currentStarts);
-    dtl::Diff<std::string_view, std::vector<std::string_view>> diff(a, b);
-    diff.onHuge();
-    diff.compose();
+    // The lines both texts begin and end with are the same; between them, the script. Its
+    // cost grows with the lines that differ: past kMaxDiffLines they are one edit.
+    size_t head = 0, tail = 0;
+    while (head < a.size() && head < b.size() && a[head] == b[head]) ++head;
+    while (tail < a.size() - head && tail < b.size() - head && a[a.size() - 1 - tail] == b[b.size() - 1 - tail]) ++tail;
+    std::vector<std::string_view> midA(a.begin() + long(head), a.end() - long(tail)),
+        midB(b.begin() + long(head), b.end() - long(tail));
+    std::vector<dtl::edit_t> script(head, dtl::SES_COMMON);
+    if (midA.size() + midB.size() > kMaxDiffLines) {
+        script.insert(script.end(), midA.size(), dtl::SES_DELETE);
+        script.insert(script.end(), midB.size(), dtl::SES_ADD);
+    } else {
+        dtl::Diff<std::string_view, std::vector<std::string_view>> diff(midA, midB);
+        diff.onHuge();
+        diff.compose();
+        for (const auto& [line, info] : diff.getSes().getSequence()) script.push_back(info.type);
+    }
+    script.insert(script.end(), tail, dtl::SES_COMMON);
     uint32_t i = 0, j = 0;  // lines of each
     auto flush = [&](uint32_t i0, uint32_t j0) {
         if (i0 == i && j0 == j) return;
@@ -45,12 +64,12 @@ EditMap::EditMap(const std::string& older, const std::string& current) {
         hunks_.push_back({ob, oe, cb, ce});
     };
     uint32_t i0 = 0, j0 = 0;
-    for (const auto& [line, info] : diff.getSes().getSequence()) {
-        if (info.type == dtl::SES_COMMON) {
+    for (dtl::edit_t type : script) {
+        if (type == dtl::SES_COMMON) {
             flush(i0, j0);
             ++i, ++j;
             i0 = i, j0 = j;
-        } else if (info.type == dtl::SES_DELETE) {
+        } else if (type == dtl::SES_DELETE) {
             ++i;
         } else {
             ++j;
@@ -69,6 +88,16 @@ std::optional<uint32_t> EditMap::toCurrent(uint32_t older, bool after) const {
         shift = int64_t(h.currentEnd) - int64_t(h.olderEnd);
     }
     return static_cast<uint32_t>(int64_t(older) + shift);
+}
+
+bool EditMap::touches(uint32_t begin, uint32_t end) const {
+    for (const Hunk& h : hunks_) {
+        if (h.olderBegin >= end) break;
+        bool inside = h.olderBegin == h.olderEnd ? begin < h.olderBegin && h.olderBegin < end  // an insertion
+                                                 : h.olderBegin < end && h.olderEnd > begin;
+        if (inside) return true;
+    }
+    return false;
 }
 
 std::optional<uint32_t> EditMap::toOlder(uint32_t current, bool after) const {
@@ -92,6 +121,7 @@ struct Mover {
     // A place in the main file moved, or nullopt where the edit touched it; other files' as they are.
     std::optional<SourceRange> strict(SourceRange r) const {
         if (r.file != main) return r;
+        if (edit.touches(r.begin, r.end)) return std::nullopt;
         auto b = edit.toCurrent(r.begin, true), e = edit.toCurrent(r.end);
         if (!b || !e || *e < *b) return std::nullopt;
         return SourceRange{r.file, *b, *e};

@@ -23,6 +23,9 @@ public:
     std::optional<uint32_t> toOlder(uint32_t current, bool after = false) const;
     std::optional<uint32_t> toCurrent(uint32_t older, bool after = false) const;
     size_t edits() const { return hunks_.size(); }
+    // An edit lies inside [begin, end) of the older text (not at its ends): what the range
+    // held there is not what it holds now.
+    bool touches(uint32_t begin, uint32_t end) const;
 
 private:
     struct Hunk {

@@ -23,12 +23,13 @@ bool topKeyword(std::string_view text, size_t at) {
 
 }  // namespace
 
-std::vector<std::pair<uint32_t, uint32_t>> topLevelDeclarations(const std::string& text) {
-    std::vector<std::pair<uint32_t, uint32_t>> out;
+std::vector<TopDeclaration> topLevelDeclarations(const std::string& text) {
+    std::vector<TopDeclaration> out;
     size_t start = std::string::npos;
     int depth = 0;
-    auto close = [&](size_t end) {
-        if (start != std::string::npos) out.push_back({static_cast<uint32_t>(start), static_cast<uint32_t>(end)});
+    auto close = [&](size_t end, bool finished) {
+        if (start != std::string::npos)
+            out.push_back({static_cast<uint32_t>(start), static_cast<uint32_t>(end), !finished});
         start = std::string::npos;
         depth = 0;
     };
@@ -51,7 +52,7 @@ std::vector<std::pair<uint32_t, uint32_t>> topLevelDeclarations(const std::strin
         bool lineStart = i == 0 || text[i - 1] == '\n';
         if (lineStart && (c == '@' || topKeyword(text, i)) && start != std::string::npos &&
             (depth > 0 || text[start] != '@'))
-            close(i);
+            close(i, false);
         if (start == std::string::npos) start = i;
         if (c == '"') {
             for (++i; i < text.size() && text[i] != '"' && text[i] != '\n'; ++i)
@@ -60,21 +61,23 @@ std::vector<std::pair<uint32_t, uint32_t>> topLevelDeclarations(const std::strin
         }
         if (c == '{' || c == '(') ++depth;
         else if ((c == '}' || c == ')') && depth > 0) {
-            if (--depth == 0 && c == '}') close(i + 1);
+            if (--depth == 0 && c == '}') close(i + 1, true);
         } else if (c == ';' && depth == 0) {
-            close(i + 1);
+            close(i + 1, true);
         }
     }
-    close(text.size());
+    close(text.size(), false);
     return out;
 }
 
 std::optional<std::string> blankBroken(const std::string& text, const std::vector<uint32_t>& errors) {
     std::string out = text;
     bool blanked = false;
-    for (auto [begin, end] : topLevelDeclarations(text)) {
-        bool broken = false;
-        for (uint32_t e : errors) broken |= (begin <= e && e < end) || (e == end && end == text.size());
+    for (auto [begin, end, unfinished] : topLevelDeclarations(text)) {
+        // (A missing `}` is reported where the parser gave up, maybe in the next
+        // declaration: the one left open is blanked whatever the errors say.)
+        bool broken = unfinished;
+        for (uint32_t e : errors) broken |= begin <= e && e <= end;
         if (!broken) continue;
         for (uint32_t i = begin; i < end; ++i)
             if (out[i] != '\n') out[i] = ' ';

@@ -10,12 +10,18 @@
 
 namespace psys::lsp {
 
-// The top-level declarations of `text` as byte ranges [begin, end), found by brackets,
-// semicolons and declaration keywords at the start of a line (comments and strings skipped).
-std::vector<std::pair<uint32_t, uint32_t>> topLevelDeclarations(const std::string& text);
+struct TopDeclaration {
+    uint32_t begin, end;  // [begin, end) of the text
+    bool unfinished;      // cut off (by the next declaration's keyword, or the end) before its `;` or `}`
+};
 
-// `text` with every top-level declaration that holds one of the `errors` (byte offsets;
-// one at the end of the text counts for the last) blanked: spaces for all but line breaks.
+// The top-level declarations of `text`, found by brackets, semicolons and declaration
+// keywords at the start of a line (comments and strings skipped).
+std::vector<TopDeclaration> topLevelDeclarations(const std::string& text);
+
+// `text` with every top-level declaration that is unfinished or holds one of the `errors`
+// (byte offsets; one at a declaration's end counts for it) blanked: spaces for all but
+// line breaks.
 // Nullopt where none does.
 std::optional<std::string> blankBroken(const std::string& text, const std::vector<uint32_t>& errors);
 

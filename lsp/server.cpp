@@ -145,9 +145,13 @@ json Server::initialize(const Field& field) {
         }
     }
     std::vector<std::string> folders = workspaceFolders(field);
+    // A client that pulls diagnostics (textDocument/diagnostic) gets each document's own
+    // that way only: pushed too, it would list each twice.
+    if (auto capabilities = field.get("capabilities"))
+        if (auto text = capabilities->get("textDocument")) pulls_ = text->get("diagnostic").has_value();
     initialized_ = true;
     index_.setFolders(folders);
-    return {{"capabilities",
+    json answer = {{"capabilities",
              {{"textDocumentSync", {{"openClose", true}, {"change", 2}, {"save", true}}},
               {"hoverProvider", true},
               {"definitionProvider", true},
@@ -159,7 +163,6 @@ json Server::initialize(const Field& field) {
               {"documentLinkProvider", {{"resolveProvider", false}}},
               {"selectionRangeProvider", true},
               {"documentRangeFormattingProvider", true},
-              {"diagnosticProvider", {{"interFileDependencies", true}, {"workspaceDiagnostics", false}}},
               {"inlayHintProvider", true},
               {"codeActionProvider", {{"codeActionKinds", {"quickfix"}}}},
               {"documentFormattingProvider", true},
@@ -169,6 +172,9 @@ json Server::initialize(const Field& field) {
               {"signatureHelpProvider", {{"triggerCharacters", {"(", ","}}}},
               {"completionProvider", {{"triggerCharacters", {".", "@"}}, {"resolveProvider", true}}}}},
             {"serverInfo", {{"name", "psysc"}, {"version", options_.version}}}};
+    if (pulls_)
+        answer["capabilities"]["diagnosticProvider"] = {{"interFileDependencies", true}, {"workspaceDiagnostics", false}};
+    return answer;
 }
 
 void Server::didOpen(const Field& params) {
@@ -330,6 +336,8 @@ void Server::analyse(Document& doc) {
 
 void Server::install(Document& doc, Analysis analysis) {
     auto fresh = std::make_shared<const Analysis>(std::move(analysis));
+    doc.moved.reset(), doc.map.reset();  // (of the analysis this one replaces)
+    doc.movedAt = doc.mapAt = UINT64_MAX;
     if (fresh->parsed && !fresh->recovered) doc.lastParsed = fresh;
     // A syntax error: hover, definition and symbols answer from the last text that parsed,
     // everywhere the edits since have not touched; with none, from the text's declarations
@@ -353,6 +361,7 @@ void Server::publish(Document& doc) {
         if (!byUri.count(uri)) byUri[uri] = json::array();
     doc.publishedTo.clear();
     for (auto& [uri, diagnostics] : byUri) {
+        if (pulls_ && uri == doc.uri) continue;  // (the client pulls them)
         json params = {{"uri", uri}, {"diagnostics", diagnostics}};
         if (uri == doc.uri) params["version"] = doc.version;
         if (!diagnostics.empty() || uri == doc.uri) doc.publishedTo.insert(uri);
@@ -372,7 +381,7 @@ void Server::settle() {
 
 void Server::idle() {
     if (pending_ && pending_->result.wait_for(std::chrono::seconds(0)) == std::future_status::ready) settle();
-    indexing_ = index_.step(openTexts(nullptr));
+    indexing_ = index_.step([this] { return openTexts(nullptr); });
     if (pending_) return;
     auto now = Clock::now();
     for (auto& [uri, doc] : docs_) {

@@ -138,6 +138,7 @@ private:
     bool initialized_ = false, shutdown_ = false;
     uint64_t tokenResults_ = 0;  // numbers the semantic tokens' result ids
     bool indexing_ = false;      // the workspace index is analysing in the background
+    bool pulls_ = false;         // the client pulls diagnostics (it said so in initialize)
     std::optional<int> exitCode_;
 };
 

@@ -45,7 +45,8 @@ json Server::request(const std::string& method, const Field& params, bool* found
     if (method == "textDocument/definition" || method == "textDocument/declaration") {
         if (auto answer = throughEdits(params, true)) return *answer;
         const Analysis& a = readable(params);
-        return definition(a, offset(a));
+        json found = definition(a, offset(a));
+        return found.is_null() ? found : withUris(json::array({found}))[0];  // (the editor's spelling of its URIs)
     }
     if (method == "textDocument/documentSymbol") return documentSymbols(readable(params));
     if (method == "textDocument/semanticTokens/full" || method == "textDocument/semanticTokens/full/delta") {
@@ -123,23 +124,25 @@ std::optional<json> Server::throughEdits(const Field& params, bool wantDefinitio
         doc.mapAt = doc.edits;
     }
     SourceFile now(doc.path, doc.text);
-    auto older = doc.map->toOlder(offsetOf(now, params["position"]));
+    uint32_t cursor = offsetOf(now, params["position"]);
+    auto older = doc.map->toOlder(cursor);
     const Occurrence* o = older ? a.at(a.mainFile, *older) : nullptr;
     auto moved = [&](SourceRange r) -> std::optional<SourceRange> {
         if (r.file != a.mainFile) return r;
+        if (doc.map->touches(r.begin, r.end)) return std::nullopt;  // edited inside
         auto b = doc.map->toCurrent(r.begin, true), e = doc.map->toCurrent(r.end);
         if (!b || !e || *e < *b) return std::nullopt;
         return SourceRange{r.file, *b, *e};
     };
     auto at = o ? moved(o->range) : std::nullopt;
-    if (!at) return json(nullptr);
+    if (!at || cursor < at->begin || cursor > at->end) return json(nullptr);  // (typed onto its end: another name)
     auto where = [&](SourceRange r) -> json {
         const SourceFile& f = r.file == a.mainFile ? now : a.sources->file(r.file);
         return {{"uri", uriFromPath(f.path())}, {"range", range(f, r.begin, r.end)}};
     };
     if (wantDefinition) {
         auto d = o->definition && o->definition->valid() ? moved(*o->definition) : std::nullopt;
-        return d ? where(*d) : json(nullptr);
+        return d ? withUris(json::array({where(*d)}))[0] : json(nullptr);
     }
     if (!o->hover || o->hover->empty()) return json(nullptr);
     return json{{"contents", {{"kind", "markdown"}, {"value", *o->hover}}}, {"range", range(now, at->begin, at->end)}};

@@ -69,8 +69,10 @@ void WorkspaceIndex::removed(const std::string& path) {
 }
 
 void WorkspaceIndex::importChanged(const std::string& key) {
+    // An entry not analysed yet, or being analysed now, may import it too (what it reads
+    // of it may be the text before this change): it is analysed again.
     for (auto& [k, e] : entries_)
-        if (e.analysis && e.analysis->imported.count(key)) ++e.generation;
+        if (!e.analysis || e.analysed != e.generation || e.analysis->imported.count(key)) ++e.generation;
 }
 
 void WorkspaceIndex::collect() {
@@ -86,7 +88,7 @@ void WorkspaceIndex::collect() {
     }
 }
 
-bool WorkspaceIndex::step(const SourceOverrides& open) {
+bool WorkspaceIndex::step(const std::function<SourceOverrides()>& openTexts) {
     if (job_ && job_->result.wait_for(std::chrono::seconds(0)) == std::future_status::ready) collect();
     if (job_) return true;
     std::vector<std::pair<std::string, uint64_t>> stale;
@@ -94,6 +96,7 @@ bool WorkspaceIndex::step(const SourceOverrides& open) {
     for (const auto& [key, e] : entries_)
         if (e.analysed != e.generation) stale.push_back({key, e.generation}), paths.push_back(e.path);
     if (stale.empty()) return false;
+    SourceOverrides open = openTexts();
     auto cancelled = std::make_shared<std::atomic<bool>>(false);
     job_ = Job{stale, cancelled, std::async(std::launch::async, [paths, open, cancelled] {
                    std::vector<Analysis> out;

@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <future>
 #include <map>
 #include <memory>
@@ -34,8 +35,8 @@ public:
     void importChanged(const std::string& key);
 
     // Collects a finished background analysis, then starts one of what is stale (reading
-    // `open` for the files the editor has open). True while one runs.
-    bool step(const SourceOverrides& open);
+    // `openTexts()` for the files the editor has open: asked only then). True while one runs.
+    bool step(const std::function<SourceOverrides()>& openTexts);
     // Every indexed file's analysis but those whose key is in `skip` (the open documents:
     // their own analyses are the truth), stale ones analysed first; waits for the
     // background one.

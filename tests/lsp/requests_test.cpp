@@ -74,8 +74,21 @@ TEST_CASE("capabilities: the server announces every request it answers") {
     for (const char* p : {"declarationProvider", "selectionRangeProvider", "documentRangeFormattingProvider"})
         CHECK_MESSAGE(caps[p] == true, p);
     CHECK(caps["documentLinkProvider"].is_object());
-    CHECK(caps["diagnosticProvider"]["interFileDependencies"] == true);
+    CHECK_FALSE(caps.contains("diagnosticProvider"));  // (the client did not say it pulls)
     CHECK(caps["completionProvider"]["resolveProvider"] == true);
+}
+
+TEST_CASE("a client that pulls diagnostics gets a document's own only when it asks, not pushed as well") {
+    Session s;
+    json caps = s.request(1, "initialize", {{"capabilities", {{"textDocument", {{"diagnostic", json::object()}}}}}})["result"]["capabilities"];
+    CHECK(caps["diagnosticProvider"]["interFileDependencies"] == true);
+    std::string uri = "file:///tmp/pulled.psys";
+    s.out.clear();
+    s.server.handle({{"jsonrpc", "2.0"}, {"method", "textDocument/didOpen"},
+                     {"params", {{"textDocument", {{"uri", uri}, {"version", 1}, {"text", "const a = nope;\n"}}}}}});
+    for (const json& m : s.out) CHECK(m.value("method", "") != "textDocument/publishDiagnostics");
+    json report = s.request(2, "textDocument/diagnostic", {{"textDocument", {{"uri", uri}}}})["result"];
+    CHECK(report["items"].size() == 1);
 }
 
 TEST_CASE("prepareRename: the name's range and text, or why it cannot be renamed, and declaration is the definition") {
@@ -285,15 +298,69 @@ TEST_CASE("top-level declarations: by brackets and semicolons, a missing } endin
     std::string text = "const a = 1;\n@shape(star)\nobject o {\n    object p { x = \"}\"; }\n// }\nfn f(x: float) -> float = x;\nobject q {\n";
     auto d = topLevelDeclarations(text);
     REQUIRE(d.size() == 4);
-    CHECK(text.substr(d[0].first, d[0].second - d[0].first) == "const a = 1;");
-    CHECK(text.compare(d[1].first, 12, "@shape(star)") == 0);  // an object's attribute is its own
-    CHECK(text.compare(d[2].first, 5, "fn f(") == 0);          // o's `}` is missing: fn starts anew
-    CHECK(text.compare(d[3].first, 8, "object q") == 0);
-    auto blanked = blankBroken(text, {static_cast<uint32_t>(text.find("x = "))});
+    CHECK(text.substr(d[0].begin, d[0].end - d[0].begin) == "const a = 1;");
+    CHECK(text.compare(d[1].begin, 12, "@shape(star)") == 0);  // an object's attribute is its own
+    CHECK(d[1].unfinished);
+    CHECK(text.compare(d[2].begin, 5, "fn f(") == 0);          // o's `}` is missing: fn starts anew
+    CHECK_FALSE(d[2].unfinished);
+    CHECK(text.compare(d[3].begin, 8, "object q") == 0);
+    CHECK(d[3].unfinished);
+    auto blanked = blankBroken(text, {});  // the unfinished ones, whatever the errors say
     REQUIRE(blanked);
     CHECK(blanked->size() == text.size());
     CHECK(blanked->find("object o") == std::string::npos);
+    CHECK(blanked->find("object q") == std::string::npos);
     CHECK(blanked->find("fn f(x: float)") == text.find("fn f(x: float)"));
+    CHECK(blanked->find("const a = 1;") == 0);
+}
+
+TEST_CASE("a file opened with a missing } answers in the declarations after it") {
+    std::string text = "object a {\n    x = 1;\n\nobject b {\n    pos = vec3(1);\n    point(pos, white, 1);\n}\nspawn b;\n";
+    Open s(text);
+    json symbols = s.ask("textDocument/documentSymbol", json::object())["result"];
+    std::vector<std::string> names;
+    for (const json& sym : symbols) names.push_back(sym["name"]);
+    CHECK(has(names, "b"));
+    CHECK_FALSE(has(names, "a"));
+    CHECK(hoverOf(s.at("textDocument/hover", text, at(text, "pos = vec3", 1, 1))).find("pos: vec3") != std::string::npos);
+}
+
+TEST_CASE("an edit inside a name: what the last analysis said of it is not shown while the next runs") {
+    // Slow analyses (every one counted slow), a long debounce: reads answer from the last analysis.
+    std::vector<json> out;
+    ServerOptions options;
+    options.debounce = std::chrono::milliseconds(60000);
+    options.quickAnalysisMs = 0;
+    Server server(options, [&](const json& m) { out.push_back(m); });
+    auto request = [&](int id, const std::string& method, json params) {
+        out.clear();
+        server.handle({{"jsonrpc", "2.0"}, {"id", id}, {"method", method}, {"params", std::move(params)}});
+        for (const json& m : out)
+            if (m.contains("id") && m["id"] == id) return m["result"];
+        return json();
+    };
+    request(1, "initialize", json::object());
+    std::string uri = "file:///tmp/inside.psys", text = kFireworks;
+    server.handle({{"jsonrpc", "2.0"}, {"method", "textDocument/didOpen"},
+                   {"params", {{"textDocument", {{"uri", uri}, {"version", 1}, {"text", text}}}}}});
+    auto change = [&](const std::string& now, int version) {
+        server.handle({{"jsonrpc", "2.0"}, {"method", "textDocument/didChange"},
+                       {"params", {{"textDocument", {{"uri", uri}, {"version", version}}}, {"contentChanges", {{{"text", now}}}}}}});
+    };
+    auto hoverAt = [&](const std::string& now, uint32_t offset, int id) {
+        return request(id, "textDocument/hover", {{"textDocument", {{"uri", uri}}}, {"position", position(SourceFile("x", now), offset)}});
+    };
+    // `gravity` → `graXvity` (inside the name): no hover for it, nor tokens.
+    std::string inside = text;
+    inside.insert(at(text, "gravity(0.3)", 1, 3), "X");
+    change(inside, 2);
+    CHECK(hoverAt(inside, at(inside, "graXvity", 1, 1), 2).is_null());
+    // `gravity` → `gravityx` (typed onto its end): the cursor past the old name gets nothing.
+    std::string onto = text;
+    onto.insert(at(text, "gravity(0.3)", 1, 7), "x");
+    change(onto, 3);
+    CHECK(hoverAt(onto, at(onto, "gravityx", 1, 8), 3).is_null());
+    CHECK(hoverOf(json{{"result", hoverAt(onto, at(onto, "vel = snapshot"), 4)}}).find("vel: vec3") != std::string::npos);
 }
 
 TEST_CASE("workspace index: references, rename and symbols reach files no one opened, kept current from file events") {

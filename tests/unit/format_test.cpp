@@ -175,6 +175,10 @@ TEST_CASE("format: a block comment over several lines moves with its code, its o
     // After code on its line: its start is where the code ends.
     std::string after = "const a = 1;    /* one\n                   two */\n";
     CHECK(formatted(after) == "const a = 1; /* one\n" + std::string(16, ' ') + "two */\n");
+    // One after another on a line: each from where it starts (formatting again changes nothing).
+    formatted("/* a\n   b */ /* c\n   d */\nconst x = 1;\n");
+    // Blank lines (CRLF's too) get no trailing spaces.
+    CHECK(formatted("object o {\n/* a\r\n\r\n   b */\n    point(vec3(0), white, 1);\n}\n").find(" \r") == std::string::npos);
 }
 
 TEST_CASE("format: the line endings and white space of any editor give the same layout") {
