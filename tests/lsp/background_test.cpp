@@ -168,18 +168,10 @@ TEST_CASE("an open, unsaved file is what its importers read: an edit to it check
 }
 
 TEST_CASE("reads never wait on a slow analysis: they answer from the last one, moved through the edits since") {
-    std::vector<json> out;
-    ServerOptions options;
-    options.debounce = std::chrono::milliseconds(60000);
-    options.quickAnalysisMs = 0;  // every analysis counts as slow
-    Server server(options, [&](const json& m) { out.push_back(m); });
-    auto request = [&](int id, const std::string& method, json params) {
-        out.clear();
-        server.handle({{"jsonrpc", "2.0"}, {"id", id}, {"method", method}, {"params", std::move(params)}});
-        for (const json& m : out)
-            if (m.contains("id") && m["id"] == id) return m["result"];
-        return json();
-    };
+    SlowSession session;  // every analysis slow: reads answer from the last one
+    auto& server = session.server;
+    auto& out = session.out;
+    auto request = [&](int id, const std::string& method, json params) { return session.request(id, method, std::move(params)); };
     request(1, "initialize", json::object());
     std::string uri = "file:///tmp/never_waits.psys", text = kFireworks;
     server.handle({{"jsonrpc", "2.0"}, {"method", "textDocument/didOpen"},

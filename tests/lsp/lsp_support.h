@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -87,5 +88,25 @@ struct Session {
     }
 };
 
+
+// A server whose every analysis counts as slow and whose edits wait a minute to be
+// analysed: reads answer from the last analysis. `request` returns the result alone.
+struct SlowSession {
+    std::vector<json> out;
+    Server server{slow(), [this](const json& m) { out.push_back(m); }};
+    static ServerOptions slow() {
+        ServerOptions options;
+        options.debounce = std::chrono::milliseconds(60000);
+        options.quickAnalysisMs = 0;
+        return options;
+    }
+    json request(int id, const std::string& method, json params) {
+        out.clear();
+        server.handle({{"jsonrpc", "2.0"}, {"id", id}, {"method", method}, {"params", std::move(params)}});
+        for (const json& m : out)
+            if (m.contains("id") && m["id"] == id) return m["result"];
+        return json();
+    }
+};
 
 }  // namespace psys::lsp::test

@@ -326,19 +326,9 @@ TEST_CASE("a file opened with a missing } answers in the declarations after it")
 }
 
 TEST_CASE("an edit inside a name: what the last analysis said of it is not shown while the next runs") {
-    // Slow analyses (every one counted slow), a long debounce: reads answer from the last analysis.
-    std::vector<json> out;
-    ServerOptions options;
-    options.debounce = std::chrono::milliseconds(60000);
-    options.quickAnalysisMs = 0;
-    Server server(options, [&](const json& m) { out.push_back(m); });
-    auto request = [&](int id, const std::string& method, json params) {
-        out.clear();
-        server.handle({{"jsonrpc", "2.0"}, {"id", id}, {"method", method}, {"params", std::move(params)}});
-        for (const json& m : out)
-            if (m.contains("id") && m["id"] == id) return m["result"];
-        return json();
-    };
+    SlowSession session;  // every analysis slow: reads answer from the last one
+    auto& server = session.server;
+    auto request = [&](int id, const std::string& method, json params) { return session.request(id, method, std::move(params)); };
     request(1, "initialize", json::object());
     std::string uri = "file:///tmp/inside.psys", text = kFireworks;
     server.handle({{"jsonrpc", "2.0"}, {"method", "textDocument/didOpen"},
