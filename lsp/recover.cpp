@@ -1,9 +1,8 @@
 #include "lsp/recover.h"
 
 #include <algorithm>
+#include <optional>
 #include <string_view>
-
-#include <dtl/dtl.hpp>
 
 namespace psys::lsp {
 
@@ -18,6 +17,44 @@ std::vector<uint32_t> lineStarts(const std::string& text) {
     return starts;
 }
 
+enum class Step : uint8_t { Same, Delete, Insert };
+
+// The shortest edit script from the lines `a` to the lines `b` (Myers, "An O(ND)
+// difference algorithm", 1986: O((N+M)·D) time for D lines deleted or inserted), or nullopt
+// where it is longer than `maxEdits`. (Written here: Debian's dtl, the library at hand,
+// has a header clang refuses.)
+std::optional<std::vector<Step>> lineScript(const std::vector<std::string_view>& a, const std::vector<std::string_view>& b,
+                                            int maxEdits) {
+    const int n = static_cast<int>(a.size()), m = static_cast<int>(b.size()), mid = maxEdits + 1;
+    std::vector<int> v(static_cast<size_t>(2 * maxEdits + 3), 0);  // per diagonal k = x - y: the furthest x
+    std::vector<std::vector<int>> trace;                            // v as each round began
+    auto at = [&](std::vector<int>& w, int k) -> int& { return w[static_cast<size_t>(mid + k)]; };
+    for (int d = 0; d <= maxEdits; ++d) {
+        trace.push_back(v);
+        for (int k = -d; k <= d; k += 2) {
+            int x = (k == -d || (k != d && at(v, k - 1) < at(v, k + 1))) ? at(v, k + 1) : at(v, k - 1) + 1;
+            int y = x - k;
+            while (x < n && y < m && a[static_cast<size_t>(x)] == b[static_cast<size_t>(y)]) ++x, ++y;
+            at(v, k) = x;
+            if (x < n || y < m) continue;
+            // Back from the end, round by round: the snake, then the one step before it.
+            std::vector<Step> script;
+            for (int e = d; e >= 0; --e) {
+                std::vector<int>& w = trace[static_cast<size_t>(e)];
+                int kk = x - y;
+                int prevK = (kk == -e || (kk != e && at(w, kk - 1) < at(w, kk + 1))) ? kk + 1 : kk - 1;
+                int prevX = at(w, prevK), prevY = prevX - prevK;
+                while (x > prevX && y > prevY) script.push_back(Step::Same), --x, --y;
+                if (e > 0) script.push_back(x == prevX ? Step::Insert : Step::Delete);
+                x = prevX, y = prevY;
+            }
+            std::reverse(script.begin(), script.end());
+            return script;
+        }
+    }
+    return std::nullopt;
+}
+
 std::vector<std::string_view> lines(const std::string& text, const std::vector<uint32_t>& starts) {
     std::vector<std::string_view> out;
     for (size_t i = 0; i + 1 < starts.size(); ++i) out.push_back(std::string_view(text).substr(starts[i], starts[i + 1] - starts[i]));
@@ -26,35 +63,32 @@ std::vector<std::string_view> lines(const std::string& text, const std::vector<u
 
 }  // namespace
 
-// Past this many differing lines (a file re-indented, pasted over) the line script is not
-// worth its time: they are one edit.
-constexpr size_t kMaxDiffLines = 4000;
+// Past this many lines deleted and inserted (a file re-indented, pasted over) the line
+// script is not worth its time and memory: what lies between the common first and last
+// lines is one edit.
+constexpr int kMaxEdits = 500;
 
 EditMap::EditMap(const std::string& older, const std::string& current) {
-    // The lines the texts share, by a shortest edit script over lines (dtl: Myers's
-    // algorithm, O((N+M)·D) for D differing lines), then each run of differing lines
+    // The lines the texts share, by a shortest edit script over lines (Myers's algorithm,
+    // O((N+M)·D) for D differing lines), then each run of differing lines
     // narrowed to the characters that differ (an edit inside a line keeps the names
     // before and after it on that line).
     std::vector<uint32_t> olderStarts = lineStarts(older), currentStarts = lineStarts(current);
     std::vector<std::string_view> a = lines(older, olderStarts), b = lines(current, currentStarts);
-    // The lines both texts begin and end with are the same; between them, the script. Its
-    // cost grows with the lines that differ: past kMaxDiffLines they are one edit.
+    // The lines both texts begin and end with are the same; between them, the script.
     size_t head = 0, tail = 0;
     while (head < a.size() && head < b.size() && a[head] == b[head]) ++head;
     while (tail < a.size() - head && tail < b.size() - head && a[a.size() - 1 - tail] == b[b.size() - 1 - tail]) ++tail;
     std::vector<std::string_view> midA(a.begin() + long(head), a.end() - long(tail)),
         midB(b.begin() + long(head), b.end() - long(tail));
-    std::vector<dtl::edit_t> script(head, dtl::SES_COMMON);
-    if (midA.size() + midB.size() > kMaxDiffLines) {
-        script.insert(script.end(), midA.size(), dtl::SES_DELETE);
-        script.insert(script.end(), midB.size(), dtl::SES_ADD);
+    std::vector<Step> script(head, Step::Same);
+    if (auto middle = lineScript(midA, midB, kMaxEdits)) {
+        script.insert(script.end(), middle->begin(), middle->end());
     } else {
-        dtl::Diff<std::string_view, std::vector<std::string_view>> diff(midA, midB);
-        diff.onHuge();
-        diff.compose();
-        for (const auto& [line, info] : diff.getSes().getSequence()) script.push_back(info.type);
+        script.insert(script.end(), midA.size(), Step::Delete);
+        script.insert(script.end(), midB.size(), Step::Insert);
     }
-    script.insert(script.end(), tail, dtl::SES_COMMON);
+    script.insert(script.end(), tail, Step::Same);
     uint32_t i = 0, j = 0;  // lines of each
     auto flush = [&](uint32_t i0, uint32_t j0) {
         if (i0 == i && j0 == j) return;
@@ -64,12 +98,12 @@ EditMap::EditMap(const std::string& older, const std::string& current) {
         hunks_.push_back({ob, oe, cb, ce});
     };
     uint32_t i0 = 0, j0 = 0;
-    for (dtl::edit_t type : script) {
-        if (type == dtl::SES_COMMON) {
+    for (Step step : script) {
+        if (step == Step::Same) {
             flush(i0, j0);
             ++i, ++j;
             i0 = i, j0 = j;
-        } else if (type == dtl::SES_DELETE) {
+        } else if (step == Step::Delete) {
             ++i;
         } else {
             ++j;

@@ -20,7 +20,6 @@ run_packages=(
   llvm-19-dev libzstd-dev
   libglm-dev libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libimgui-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev libstb-dev libtbb-dev
-  libdtl-dev  # the language server: the edits between a text that parsed and the text now
   fonts-dejavu-core  # the viewer's panel font
 )
 # The editor extension's tests and package: Node.js 20 and npm come with the machine; where
