@@ -402,3 +402,33 @@ TEST_CASE("workspace index: references, rename and symbols reach files no one op
     for (const json& r : after)
         if (r["uri"] == uri) CHECK(r["range"]["start"]["line"] == 1);
 }
+
+TEST_CASE("edit map: random line edits, every line kept maps to itself and every line inserted to nothing") {
+    uint32_t seed = 12345;
+    auto next = [&] { return seed = seed * 1664525u + 1013904223u; };
+    for (int round = 0; round < 200; ++round) {
+        std::vector<std::string> older;
+        for (int i = 0; i < 40; ++i) older.push_back("line " + std::to_string(next() % 7));  // repeats on purpose
+        std::vector<std::string> current;
+        std::vector<int> from;  // per current line: its older line, or -1 (inserted)
+        for (int i = 0; i < 40; ++i) {
+            uint32_t r = next() % 10;
+            if (r == 0) continue;  // deleted
+            if (r == 1) current.push_back("new " + std::to_string(next())), from.push_back(-1);
+            current.push_back(older[static_cast<size_t>(i)]), from.push_back(i);
+        }
+        std::string a, b;
+        std::vector<uint32_t> aStart, bStart;
+        for (const std::string& l : older) aStart.push_back(static_cast<uint32_t>(a.size())), a += l + "\n";
+        for (const std::string& l : current) bStart.push_back(static_cast<uint32_t>(b.size())), b += l + "\n";
+        EditMap m(a, b);
+        for (size_t j = 0; j < current.size(); ++j) {
+            auto back = m.toOlder(bStart[j] + 1);  // a byte inside the line
+            if (!back) continue;                   // (inside an edit: not known, never wrong)
+            // Wherever it maps, the older text has the same line there; an inserted line's
+            // inside maps nowhere.
+            CHECK(a.compare(*back - 1, current[j].size() + 1, current[j] + "\n") == 0);
+            if (from[j] < 0) FAIL_CHECK("an inserted line maps into the older text: " << current[j]);
+        }
+    }
+}
