@@ -34,7 +34,7 @@ TEST_CASE("background analysis: requests are answered while it runs, and a stale
     std::vector<json> out;
     ServerOptions options;
     options.debounce = std::chrono::milliseconds(0);
-    Server server(options, [&](const json& m) { out.push_back(m); });
+    Server server(exactReads(options), [&](const json& m) { out.push_back(m); });
     server.handle({{"jsonrpc", "2.0"}, {"id", 1}, {"method", "initialize"}, {"params", json::object()}});
     std::string small = kFireworks;
     server.handle(message("textDocument/didOpen", {{"textDocument", {{"uri", "file:///tmp/small.psys"}, {"version", 1},
@@ -97,7 +97,7 @@ TEST_CASE("an open, unsaved file is what its importers read: an edit to it check
     std::vector<json> out;
     ServerOptions options;
     options.debounce = std::chrono::milliseconds(0);
-    Server server(options, [&](const json& m) { out.push_back(m); });
+    Server server(exactReads(options), [&](const json& m) { out.push_back(m); });
     server.handle({{"jsonrpc", "2.0"}, {"id", 1}, {"method", "initialize"}, {"params", json::object()}});
     auto open = [&](const std::string& uri, const std::string& text) {
         server.handle(message("textDocument/didOpen", {{"textDocument", {{"uri", uri}, {"version", 1}, {"text", text}}}}));

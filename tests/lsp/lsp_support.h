@@ -9,6 +9,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -76,9 +77,17 @@ struct TempDir {
 };
 
 
+// Options whose reads always wait for the analysis of the text they ask about: how fast an
+// analysis is (a sanitizer build, a loaded machine) decides nothing in a test. (The reads
+// that do not wait are tested with SlowSession.)
+inline ServerOptions exactReads(ServerOptions options = {}) {
+    options.quickAnalysisMs = std::numeric_limits<double>::infinity();
+    return options;
+}
+
 struct Session {
     std::vector<json> out;
-    Server server{ServerOptions{}, [this](const json& m) { out.push_back(m); }};
+    Server server{exactReads(), [this](const json& m) { out.push_back(m); }};
     json request(int id, const std::string& method, json params = json::object()) {
         out.clear();
         server.handle({{"jsonrpc", "2.0"}, {"id", id}, {"method", method}, {"params", params}});
