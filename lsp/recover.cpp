@@ -112,16 +112,23 @@ EditMap::EditMap(const std::string& older, const std::string& current) {
     flush(i0, j0);
 }
 
-std::optional<uint32_t> EditMap::toCurrent(uint32_t older, bool after) const {
+// One way through the hunks: `from` and `to` pick each hunk's two sides.
+std::optional<uint32_t> EditMap::through(uint32_t at, bool after, Side from, Side to) const {
     int64_t shift = 0;
     for (const Hunk& h : hunks_) {
-        if (older < h.olderBegin) break;
-        if (older == h.olderBegin && older == h.olderEnd) return after ? h.currentEnd : h.currentBegin;
-        if (older == h.olderBegin) return h.currentBegin;
-        if (older < h.olderEnd) return std::nullopt;
-        shift = int64_t(h.currentEnd) - int64_t(h.olderEnd);
+        auto [fromBegin, fromEnd] = side(h, from);
+        auto [toBegin, toEnd] = side(h, to);
+        if (at < fromBegin) break;
+        if (at == fromBegin && at == fromEnd) return after ? toEnd : toBegin;
+        if (at == fromBegin) return toBegin;
+        if (at < fromEnd) return std::nullopt;
+        shift = int64_t(toEnd) - int64_t(fromEnd);
     }
-    return static_cast<uint32_t>(int64_t(older) + shift);
+    return static_cast<uint32_t>(int64_t(at) + shift);
+}
+
+std::optional<uint32_t> EditMap::toCurrent(uint32_t older, bool after) const {
+    return through(older, after, Side::Older, Side::Current);
 }
 
 bool EditMap::touches(uint32_t begin, uint32_t end) const {
@@ -135,15 +142,7 @@ bool EditMap::touches(uint32_t begin, uint32_t end) const {
 }
 
 std::optional<uint32_t> EditMap::toOlder(uint32_t current, bool after) const {
-    int64_t shift = 0;
-    for (const Hunk& h : hunks_) {
-        if (current < h.currentBegin) break;
-        if (current == h.currentBegin && current == h.currentEnd) return after ? h.olderEnd : h.olderBegin;
-        if (current == h.currentBegin) return h.olderBegin;
-        if (current < h.currentEnd) return std::nullopt;
-        shift = int64_t(h.olderEnd) - int64_t(h.currentEnd);
-    }
-    return static_cast<uint32_t>(int64_t(current) + shift);
+    return through(current, after, Side::Current, Side::Older);
 }
 
 namespace {

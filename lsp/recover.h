@@ -8,6 +8,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lsp/analysis.h"
@@ -32,6 +33,11 @@ private:
         uint32_t olderBegin, olderEnd, currentBegin, currentEnd;  // [begin, end) in each text
     };
     std::vector<Hunk> hunks_;  // in order, apart
+    enum class Side { Older, Current };
+    static std::pair<uint32_t, uint32_t> side(const Hunk& h, Side s) {
+        return s == Side::Older ? std::pair(h.olderBegin, h.olderEnd) : std::pair(h.currentBegin, h.currentEnd);
+    }
+    std::optional<uint32_t> through(uint32_t at, bool after, Side from, Side to) const;
 };
 
 // `good`'s index (occurrences, symbols, scopes) over `text`, the main file's current text,

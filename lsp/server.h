@@ -2,8 +2,10 @@
 // analysed when opened and again once edits have paused for the debounce interval, and
 // its diagnostics are published then. The open documents are the truth: a file imported
 // by another is read from the editor's text where it is open, saved or not, and an edit to
-// it analyses its importers again. Requests about a document analyse it first if it
-// has changed since, so an answer always matches the text it is asked about.
+// it analyses its importers again. A request that edits (rename, quick fixes), references
+// and pulled diagnostics analyse a changed document first, so they match its text; reads
+// (hover, definition, symbols, tokens) do too where that is quick, and otherwise answer at
+// once from the last analysis moved through the edits since (Server::readable).
 //
 // A debounced analysis runs on a thread of its own, one at a time, so the server goes on
 // reading while it runs: edits, requests about the other documents, completion and
