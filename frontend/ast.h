@@ -338,4 +338,8 @@ struct Program {
     const Module& main() const { return *modules.back(); }
 };
 
+// A deep copy of a declaration as the parser built it (not yet checked), its ranges moved
+// by `shift` bytes into `file` (frontend/ast_clone.cpp).
+DeclPtr cloneParsed(const Decl& decl, int file, int64_t shift);
+
 }  // namespace psys::ast

@@ -43,11 +43,15 @@ std::string sourceKey(const std::filesystem::path& path);
 // Returns null when the main file cannot be read or any file has syntax errors.
 std::unique_ptr<ast::Program> loadProgram(const std::string& mainPath, SourceManager& sources, DiagnosticEngine& diags);
 
+class ParseCache;
+
 // The same for a main file given as text (tests, the viewer's editor buffer); imports are
 // resolved relative to the directory of `displayPath`, and read from `overrides` where
-// it holds their text.
+// it holds their text. Every file is parsed through `cache` where one is given
+// (frontend/parse_cache.h: an editor's document, analysed after each edit).
 std::unique_ptr<ast::Program> loadProgramFromText(const std::string& displayPath, std::string text,
                                                   SourceManager& sources, DiagnosticEngine& diags,
-                                                  const SourceOverrides* overrides = nullptr);
+                                                  const SourceOverrides* overrides = nullptr,
+                                                  ParseCache* cache = nullptr);
 
 }  // namespace psys

@@ -12,6 +12,7 @@
 
 #include "PsysLexer.h"
 #include "PsysParser.h"
+#include "frontend/parse_cache.h"
 #include "frontend/syntax_errors.h"
 
 namespace psys {
@@ -382,10 +383,10 @@ namespace {
 std::optional<uint32_t> unterminatedComment(std::string_view text) {
     for (size_t i = 0; i + 1 < text.size(); ++i) {
         if (text[i] == '"') {  // a string ends at its quote or the end of its line
-            for (++i; i < text.size() && text[i] != '"' && text[i] != '\n'; ++i)
+            for (++i; i < text.size() && text[i] != '"' && text[i] != '\n' && text[i] != '\r'; ++i)
                 if (text[i] == '\\') ++i;
         } else if (text[i] == '/' && text[i + 1] == '/') {
-            i = text.find('\n', i);
+            i = text.find_first_of("\r\n", i);  // (the lexer's line comment ends at either)
             if (i == std::string_view::npos) return std::nullopt;
         } else if (text[i] == '/' && text[i + 1] == '*') {
             size_t close = text.find("*/", i + 2);
@@ -406,13 +407,13 @@ std::optional<uint32_t> tooDeep(std::string_view text) {
     for (size_t i = 0; i < text.size(); ++i) {
         char c = text[i];
         if (c == '"') {
-            for (++i; i < text.size() && text[i] != '"' && text[i] != '\n'; ++i)
+            for (++i; i < text.size() && text[i] != '"' && text[i] != '\n' && text[i] != '\r'; ++i)
                 if (text[i] == '\\') ++i;
             operand = true;
             continue;
         }
         if (c == '/' && i + 1 < text.size() && (text[i + 1] == '/' || text[i + 1] == '*')) {
-            size_t end = text[i + 1] == '/' ? text.find('\n', i) : text.find("*/", i + 2);
+            size_t end = text[i + 1] == '/' ? text.find_first_of("\r\n", i) : text.find("*/", i + 2);
             if (end == std::string_view::npos) return std::nullopt;
             i = text[i + 1] == '/' ? end : end + 1;
             continue;
@@ -433,31 +434,41 @@ std::optional<uint32_t> tooDeep(std::string_view text) {
 
 }  // namespace
 
-std::unique_ptr<Module> parseModule(int file, const SourceManager& sources, DiagnosticEngine& diags) {
-    const std::string& text = sources.file(file).text();
+namespace {
+
+// Reports what keeps `text` from being parsed at all (its size, its encoding, an
+// unterminated comment, nesting too deep for the parser's recursion), if anything does.
+std::optional<SourceRange> unparsable(int file, const std::string& text, DiagnosticEngine& diags) {
     if (text.size() > kMaxSourceBytes) {
         diags.error({file, 0, 0}, fmt::format("this file is {} bytes, more than the {} a source file may be",
                                               text.size(), kMaxSourceBytes));
-        return nullptr;
+        return SourceRange{file, 0, 0};
     }
     // The lexer reads code points: a file must be UTF-8 (ASCII is), and one that is not is
     // reported at its first bad byte rather than read wrongly.
     if (auto bad = firstInvalidUtf8(text)) {
         diags.error({file, *bad, *bad + 1}, fmt::format("this file is not valid UTF-8: byte 0x{:02X} cannot be here; "
                                                         "save it as UTF-8", static_cast<unsigned char>(text[*bad])));
-        return nullptr;
+        return SourceRange{file, *bad, *bad + 1};
     }
     if (auto open = unterminatedComment(text)) {
         diags.error({file, *open, *open + 2}, "unterminated comment: this `/*` has no `*/`");
-        return nullptr;
+        return SourceRange{file, *open, *open + 2};
     }
     if (auto deep = tooDeep(text)) {
         diags.error({file, *deep, *deep + 1}, fmt::format("nesting exceeds the maximum of {} levels (brackets, or prefix "
                                                           "operators in a row); split the expression with a `let` or an "
                                                           "equation", kMaxNesting));
-        return nullptr;
+        return SourceRange{file, *deep, *deep + 1};
     }
-    antlr4::ANTLRInputStream input(text);
+    return std::nullopt;
+}
+
+}  // namespace
+
+std::unique_ptr<Module> parseText(int file, std::string_view text, uint32_t shift, DiagnosticEngine& diags,
+                                  bool report) {
+    antlr4::ANTLRInputStream input(text.data(), text.size());
     grammar::PsysLexer lexer(&input);
     lexer.removeErrorListeners();
     antlr4::CommonTokenStream tokens(&lexer);
@@ -465,7 +476,9 @@ std::unique_ptr<Module> parseModule(int file, const SourceManager& sources, Diag
     parser.removeErrorListeners();
     SilentListener silent;
     parser.addErrorListener(&silent);
-    std::vector<uint32_t> offsets = codePointOffsets(text);
+    std::vector<uint32_t> offsets = codePointOffsets(std::string(text));
+    if (shift)
+        for (uint32_t& o : offsets) o += shift;
 
     int errorsBefore = diags.errorCount();
     // Two-stage parsing: the fast SLL prediction parses every valid file of this grammar;
@@ -479,6 +492,7 @@ std::unique_ptr<Module> parseModule(int file, const SourceManager& sources, Diag
         tree = nullptr;
     }
     if (!tree) {
+        if (!report) return nullptr;
         tokens.seek(0);
         parser.reset();
         parser.getInterpreter<antlr4::atn::ParserATNSimulator>()->setPredictionMode(antlr4::atn::PredictionMode::LL);
@@ -487,8 +501,14 @@ std::unique_ptr<Module> parseModule(int file, const SourceManager& sources, Diag
     }
     if (diags.errorCount() > errorsBefore || parser.getNumberOfSyntaxErrors() > 0) return nullptr;
     AstBuilder builder(file, std::move(offsets), diags);
-    auto module = builder.build(tree);
-    module->path = sources.file(file).path();
+    return builder.build(tree);
+}
+
+std::unique_ptr<Module> parseModule(int file, const SourceManager& sources, DiagnosticEngine& diags, ParseCache* cache) {
+    const std::string& text = sources.file(file).text();
+    if (unparsable(file, text, diags)) return nullptr;
+    auto module = cache ? cache->parse(file, text, diags) : parseText(file, text, 0, diags, true);
+    if (module) module->path = sources.file(file).path();
     return module;
 }
 

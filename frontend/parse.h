@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "frontend/ast.h"
@@ -11,9 +12,20 @@
 
 namespace psys {
 
+class ParseCache;
+
 // Returns null when the file has syntax errors (they are reported to `diags`, several per
-// file: the parser recovers and goes on).
-std::unique_ptr<ast::Module> parseModule(int file, const SourceManager& sources, DiagnosticEngine& diags);
+// file: the parser recovers and goes on). With a cache, the file's top-level declarations
+// that an earlier parse through it saw are copied rather than parsed again (the same AST).
+std::unique_ptr<ast::Module> parseModule(int file, const SourceManager& sources, DiagnosticEngine& diags,
+                                         ParseCache* cache = nullptr);
+
+// Parses `text`, the bytes [shift, shift + text.size()) of `file` from a top-level
+// declaration's start on, as a sequence of declarations; ranges are the file's. Where it
+// does not parse: null, its syntax errors worded and reported when `report`, else at
+// once. (An unknown type name is reported by the AST's builder, which returns the module.)
+std::unique_ptr<ast::Module> parseText(int file, std::string_view text, uint32_t shift, DiagnosticEngine& diags,
+                                       bool report);
 
 // Character index (ANTLR decodes UTF-8 into code points) → byte offset, plus one past the end.
 std::vector<uint32_t> codePointOffsets(const std::string& text);

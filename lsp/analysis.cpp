@@ -67,7 +67,7 @@ Analysis analyze(const std::string& path, std::string text, const AnalyzeOptions
     DiagnosticEngine diags(*a.sources);
     diags.setLimit(kMaxPublished);
     try {
-        std::unique_ptr<ast::Program> program = loadProgramFromText(path, std::move(text), *a.sources, diags, options.open);
+        std::unique_ptr<ast::Program> program = loadProgramFromText(path, std::move(text), *a.sources, diags, options.open, options.cache);
         if (program && stop()) return a;  // a newer text is on its way: this one is not wanted
         if (program) {
             checkProgram(*program, diags);

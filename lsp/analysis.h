@@ -14,6 +14,7 @@
 
 #include "frontend/diagnostics.h"
 #include "frontend/loader.h"
+#include "frontend/parse_cache.h"
 #include "frontend/source.h"
 
 namespace psys::lsp {
@@ -119,6 +120,9 @@ struct AnalyzeOptions {
     // The compiler's passes (their warnings, the methods' hints) after a clean front end:
     // not for the workspace index, which needs names and places only.
     bool passes = true;
+    // Where given, the files are parsed through it (frontend/parse_cache.h): a document's
+    // analysis after an edit parses only the declarations the edit changed.
+    ParseCache* cache = nullptr;
 };
 
 // Runs the front end over `text` as the file `path` (imports are read relative to it),

@@ -10,14 +10,7 @@
 
 namespace psys::lsp {
 
-struct TopDeclaration {
-    uint32_t begin, end;  // [begin, end) of the text
-    bool unfinished;      // cut off (by the next declaration's keyword, or the end) before its `;` or `}`
-};
-
-// The top-level declarations of `text`, found by brackets, semicolons and declaration
-// keywords at the start of a line (comments and strings skipped).
-std::vector<TopDeclaration> topLevelDeclarations(const std::string& text);
+// (The declarations are frontend/parse_cache.h's topLevelDeclarations.)
 
 // `text` with every top-level declaration that is unfinished or holds one of the `errors`
 // (byte offsets; one at a declaration's end counts for it) blanked: spaces for all but

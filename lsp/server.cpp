@@ -331,7 +331,7 @@ const Analysis& Server::readable(const Field& params) {
 
 void Server::analyse(Document& doc) {
     SourceOverrides open = openTexts(&doc);
-    install(doc, analyze(doc.path, doc.text, {.open = &open, .salvage = !doc.lastParsed}));
+    install(doc, analyze(doc.path, doc.text, {.open = &open, .salvage = !doc.lastParsed, .cache = doc.parses.get()}));
 }
 
 void Server::install(Document& doc, Analysis analysis) {
@@ -347,6 +347,7 @@ void Server::install(Document& doc, Analysis analysis) {
     else
         doc.analysis = fresh;
     doc.dirty = false;
+    doc.parses->sweep();  // (what neither this text nor the one before used)
     publish(doc);
 }
 
@@ -390,8 +391,9 @@ void Server::idle() {
         pending_ = Pending{uri, doc.edits, cancelled,
                            std::async(std::launch::async,
                                       [path = doc.path, text = doc.text, open = openTexts(&doc), cancelled,
-                                       salvage = !doc.lastParsed] {
-                                          return analyze(path, text, {.cancelled = cancelled.get(), .open = &open, .salvage = salvage});
+                                       salvage = !doc.lastParsed, parses = doc.parses] {
+                                          return analyze(path, text, {.cancelled = cancelled.get(), .open = &open,
+                                                                      .salvage = salvage, .cache = parses.get()});
                                       })};
         return;
     }

@@ -91,6 +91,9 @@ private:
         uint64_t mapAt = UINT64_MAX;
         std::string tokensId;               // the last semantic tokens sent (for a delta from them)
         nlohmann::json tokens;
+        // Its declarations as last parsed: an analysis parses only what the edits changed
+        // (shared with the analysis running in the background).
+        std::shared_ptr<ParseCache> parses = std::make_shared<ParseCache>();
     };
     struct Pending {
         std::string uri;

@@ -3,6 +3,13 @@
 // again: the diagnostic it fixes is gone.
 #include <doctest/doctest.h>
 
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
+
+#include <fmt/format.h>
+
 #include "lsp/positions.h"
 #include "lsp/transport.h"
 #include "lsp_support.h"
@@ -157,4 +164,54 @@ TEST_CASE("diagnostics: a type error covers the operands that disagree, in UTF-1
     CHECK(d[0]["message"].get<std::string>().find("cannot add vec3 and vec4") != std::string::npos);
     // `/* é😀 */` is 9 UTF-16 units: `vec3(1)` starts at 18, `vec4(1)` ends at 35.
     CHECK(d[0]["range"] == json{{"start", {{"line", 1}, {"character", 18}}}, {"end", {{"line", 1}, {"character", 35}}}});
+}
+
+namespace {
+
+// Everything an analysis answers from, as text: the index (every name's and expression's
+// range, hover, definition and token), the outline, the hints and the diagnostics.
+std::string everything(const Analysis& a) {
+    std::string out;
+    auto range = [](SourceRange r) { return fmt::format("{}:{}-{}", r.file, r.begin, r.end); };
+    for (const Occurrence& o : a.occurrences)
+        out += fmt::format("{} {} {} {}\n", range(o.range), o.hover ? *o.hover : "", o.definition ? range(*o.definition) : "",
+                           static_cast<int>(o.token.type));
+    std::function<void(const std::vector<Symbol>&)> symbols = [&](const std::vector<Symbol>& list) {
+        for (const Symbol& s : list) {
+            out += fmt::format("symbol {} {} {} {}\n", s.name, s.detail, range(s.range), range(s.selection));
+            symbols(s.children);
+        }
+    };
+    symbols(a.symbols);
+    for (const Hint& h : a.hints) out += fmt::format("hint {} {}\n", range(h.at), h.label);
+    for (const Diagnostic& d : a.diagnostics) out += fmt::format("diagnostic {} {}\n", range(d.range), d.message);
+    return out;
+}
+
+std::string slurp(const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+}  // namespace
+
+TEST_CASE("analysis through a document's parse cache: what a fresh analysis answers, on every sample, after edits") {
+    int samples = 0;
+    for (const auto& e : std::filesystem::directory_iterator(PSYS_SAMPLES_DIR)) {
+        if (e.path().extension() != ".psys") continue;
+        std::string path = e.path().string(), text = slurp(path);
+        CAPTURE(path);
+        ParseCache cache;
+        CHECK(everything(analyze(path, text, {.cache = &cache})) == everything(analyze(path, text)));
+        // Every declaration moved by a line; then one broken (its hovers carried by the salvage).
+        for (std::string edit : {"// moved\n" + text, "// moved\nobject broken { pos = ; }\n" + text}) {
+            cache.sweep();
+            CHECK(everything(analyze(path, edit, {.salvage = true, .cache = &cache})) ==
+                  everything(analyze(path, edit, {.salvage = true})));
+        }
+        ++samples;
+    }
+    CHECK(samples > 20);
 }
