@@ -1,6 +1,8 @@
 #include "lsp/analysis.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <exception>
 
@@ -66,6 +68,7 @@ Analysis analyze(const std::string& path, std::string text, const AnalyzeOptions
     a.sources = std::make_unique<SourceManager>();
     DiagnosticEngine diags(*a.sources);
     diags.setLimit(kMaxPublished);
+    size_t passDiagnostics = SIZE_MAX;  // where the passes' diagnostics start
     try {
         std::unique_ptr<ast::Program> program = loadProgramFromText(path, std::move(text), *a.sources, diags, options.open, options.cache);
         if (program && stop()) return a;  // a newer text is on its way: this one is not wanted
@@ -90,8 +93,14 @@ Analysis analyze(const std::string& path, std::string text, const AnalyzeOptions
             compile.beforePasses = [&](ir::Module& module, opt::PassErrors& messages) {
                 if (!stop()) tune::chooseMethods(module, trials, tune, messages);
             };
-            if (options.passes && diags.errorCount() == 0 && !stop())
+            passDiagnostics = diags.all().size();
+            a.passHints = a.hints.size();
+            if (options.passes && diags.errorCount() == 0 && !stop()) {
+                auto passesStarted = std::chrono::steady_clock::now();
                 if (auto module = compileProgram(program.get(), *a.sources, diags, compile)) methodHints(*module, a);
+                a.passesRan = true;
+                a.passesMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - passesStarted).count();
+            }
         }
     } catch (const std::exception& e) {
         // The front end's own failure must not end the editing session: it is reported
@@ -105,6 +114,7 @@ Analysis analyze(const std::string& path, std::string text, const AnalyzeOptions
     for (int f = 0; f < a.sources->count(); ++f)
         if (f != a.mainFile) a.imported.insert(sourceKey(a.sources->file(f).path()));
     a.diagnostics = diags.all();
+    a.passDiagnostics = std::min(passDiagnostics, a.diagnostics.size());
     a.hiddenErrors = diags.hiddenErrors();
     a.hiddenWarnings = diags.hiddenWarnings();
     if (options.salvage && !a.parsed && !stop())
@@ -138,6 +148,8 @@ std::optional<Analysis> salvaged(const std::string& path, const Analysis& broken
     }
     s.sources = std::move(sources);
     s.diagnostics = broken.diagnostics;
+    s.passesRan = false;
+    s.passDiagnostics = s.diagnostics.size();
     s.hiddenErrors = broken.hiddenErrors;
     s.hiddenWarnings = broken.hiddenWarnings;
     s.recovered = true;

@@ -90,6 +90,13 @@ struct Analysis {
     // (lsp/recover.h): this text has syntax errors, `diagnostics` are its own.
     bool recovered = false;
     double milliseconds = 0;  // how long the analysis took
+    // The compiler's passes ran (a clean front end, AnalyzeOptions::passes), taking this
+    // long; their warnings are diagnostics[passDiagnostics…] and their hints (each
+    // object's method) hints[passHints…]. An analysis without them may hold the last
+    // ones carried through the edits since (carryPasses, lsp/recover.h): the same places.
+    bool passesRan = false;
+    double passesMs = 0;
+    size_t passDiagnostics = 0, passHints = 0;
     std::vector<Diagnostic> diagnostics;  // at most kMaxPublished errors and as many warnings
     int hiddenErrors = 0, hiddenWarnings = 0;  // counted past that, not kept
     std::vector<Occurrence> occurrences;  // every file's, in the order found

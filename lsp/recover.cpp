@@ -195,6 +195,8 @@ Analysis recover(const Analysis& good, const Analysis& current, const std::strin
     out.milliseconds = current.milliseconds;
     out.recovered = true;
     out.diagnostics = current.diagnostics;
+    out.passesRan = current.passesRan;
+    out.passDiagnostics = current.passDiagnostics;
     out.hiddenErrors = current.hiddenErrors;
     out.hiddenWarnings = current.hiddenWarnings;
     EditMap edit(good.sources->file(good.mainFile).text(), text);
@@ -214,6 +216,7 @@ Analysis recover(const Analysis& good, const Analysis& current, const std::strin
         if (move.symbol(s)) out.symbols.push_back(std::move(s));
     for (const Hint& h : good.hints)
         if (auto at = move.strict(h.at)) out.hints.push_back({*at, h.label, h.kind});
+    out.passHints = out.hints.size();
     if (readsOnly) return out;
     for (const Scope& s : good.scopes)
         if (auto range = move.spanning(s.range)) out.scopes.push_back({*range, s.names, s.pure});
@@ -222,6 +225,46 @@ Analysis recover(const Analysis& good, const Analysis& current, const std::strin
     out.imported = good.imported;  // (the current text's imports, as far as it parsed, too)
     out.imported.insert(current.imported.begin(), current.imported.end());
     return out;
+}
+
+void carryPasses(const Analysis& passed, Analysis& fresh) {
+    if (passed.mainFile < 0 || fresh.mainFile < 0 || !passed.passesRan) return;
+    EditMap edit(passed.sources->file(passed.mainFile).text(), fresh.sources->file(fresh.mainFile).text());
+    Mover move{edit, passed.mainFile};
+    // The files by number in each analysis (an edit to the imports renumbers them): an
+    // imported file's places carry where it is loaded with the same text.
+    auto place = [&](SourceRange r) -> std::optional<SourceRange> {
+        if (!r.valid()) return r;
+        if (r.file == passed.mainFile) {
+            auto moved = move.strict(r);
+            if (moved) moved->file = fresh.mainFile;
+            return moved;
+        }
+        const SourceFile& from = passed.sources->file(r.file);
+        for (int f = 0; f < fresh.sources->count(); ++f)
+            if (f != fresh.mainFile && fresh.sources->file(f).path() == from.path())
+                return fresh.sources->file(f).text() == from.text() ? std::optional(SourceRange{f, r.begin, r.end}) : std::nullopt;
+        return std::nullopt;
+    };
+    for (size_t i = passed.passDiagnostics; i < passed.diagnostics.size(); ++i) {
+        Diagnostic d = passed.diagnostics[i];
+        auto range = place(d.range);
+        if (!range) continue;
+        std::optional<uint32_t> focus;
+        if (d.focus && range->file == fresh.mainFile && d.range.file == passed.mainFile) focus = edit.toCurrent(*d.focus);
+        else if (d.focus) focus = d.focus;
+        d.range = *range, d.focus = focus;
+        std::vector<DiagnosticNote> notes;
+        for (DiagnosticNote& n : d.notes)
+            if (auto at = place(n.range)) notes.push_back({*at, std::move(n.message)});
+        std::vector<FixIt> fixes;
+        for (FixIt& f : d.fixes)
+            if (auto at = place(f.range)) fixes.push_back({std::move(f.title), *at, std::move(f.replacement)});
+        d.notes = std::move(notes), d.fixes = std::move(fixes);
+        fresh.diagnostics.push_back(std::move(d));
+    }
+    for (size_t i = passed.passHints; i < passed.hints.size(); ++i)
+        if (auto at = place(passed.hints[i].at)) fresh.hints.push_back({*at, passed.hints[i].label, passed.hints[i].kind});
 }
 
 }  // namespace psys::lsp

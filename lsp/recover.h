@@ -45,4 +45,10 @@ private:
 // need (occurrences, symbols, hints), not the names completion and rename look up.
 Analysis recover(const Analysis& good, const Analysis& current, const std::string& text, bool readsOnly = false);
 
+// The passes' warnings and hints of `passed` added to `fresh`, an analysis of a later text
+// whose passes have not run (yet): each moved through the edits between the two texts, and
+// dropped where an edit touched it (or, in an imported file, where that file changed).
+// The editor keeps showing an unstable decay's warning while the passes run again.
+void carryPasses(const Analysis& passed, Analysis& fresh);
+
 }  // namespace psys::lsp

@@ -335,7 +335,18 @@ void Server::analyse(Document& doc) {
 }
 
 void Server::install(Document& doc, Analysis analysis) {
+    bool clean = analysis.parsed && !analysis.recovered && analysis.passDiagnostics == analysis.diagnostics.size() &&
+                 std::none_of(analysis.diagnostics.begin(), analysis.diagnostics.end(),
+                              [](const Diagnostic& d) { return d.severity == Severity::Error; });
+    if (analysis.passesRan) {
+        doc.passesMs = analysis.passesMs;
+        doc.passesDue = false;
+    } else if (clean && doc.passed) {
+        carryPasses(*doc.passed, analysis);
+        doc.passesDue = true;
+    }
     auto fresh = std::make_shared<const Analysis>(std::move(analysis));
+    if (fresh->passesRan) doc.passed = fresh;
     doc.moved.reset(), doc.map.reset();  // (of the analysis this one replaces)
     doc.movedAt = doc.mapAt = UINT64_MAX;
     if (fresh->parsed && !fresh->recovered) doc.lastParsed = fresh;
@@ -387,16 +398,28 @@ void Server::idle() {
     auto now = Clock::now();
     for (auto& [uri, doc] : docs_) {
         if (!doc.dirty || now - doc.changedAt < options_.debounce) continue;
-        auto cancelled = std::make_shared<std::atomic<bool>>(false);
-        pending_ = Pending{uri, doc.edits, cancelled,
-                           std::async(std::launch::async,
-                                      [path = doc.path, text = doc.text, open = openTexts(&doc), cancelled,
-                                       salvage = !doc.lastParsed, parses = doc.parses] {
-                                          return analyze(path, text, {.cancelled = cancelled.get(), .open = &open,
-                                                                      .salvage = salvage, .cache = parses.get()});
-                                      })};
-        return;
+        return start(doc, doc.passesMs <= options_.quickAnalysisMs);
     }
+    // Once every edit is analysed, the passes the slow ones were left out of.
+    for (auto& [uri, doc] : docs_)
+        if (doc.passesDue && !doc.dirty) return start(doc, true);
+}
+
+void Server::start(Document& doc, bool passes) {
+    auto cancelled = std::make_shared<std::atomic<bool>>(false);
+    pending_ = Pending{doc.uri, doc.edits, cancelled,
+                       std::async(std::launch::async,
+                                  [path = doc.path, text = doc.text, open = openTexts(&doc), cancelled,
+                                   salvage = !doc.lastParsed, parses = doc.parses, passes] {
+                                      return analyze(path, text, {.cancelled = cancelled.get(), .open = &open,
+                                                                  .salvage = salvage, .passes = passes,
+                                                                  .cache = parses.get()});
+                                  })};
+}
+
+bool Server::busy() const {
+    return pending_.has_value() || indexing_ ||
+           std::any_of(docs_.begin(), docs_.end(), [](const auto& d) { return d.second.passesDue && !d.second.dirty; });
 }
 
 std::optional<std::chrono::milliseconds> Server::nextDeadline() const {
@@ -406,6 +429,7 @@ std::optional<std::chrono::milliseconds> Server::nextDeadline() const {
     std::optional<std::chrono::milliseconds> next;
     auto now = Clock::now();
     for (const auto& [uri, doc] : docs_) {
+        if (doc.passesDue && !doc.dirty) return std::chrono::milliseconds(0);
         if (!doc.dirty) continue;
         auto left = std::chrono::duration_cast<std::chrono::milliseconds>(doc.changedAt + options_.debounce - now);
         left = std::max(left, std::chrono::milliseconds(0));

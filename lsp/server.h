@@ -66,8 +66,9 @@ public:
     // Publishes the analysis that has finished in the background, if any, and starts the
     // next of the documents whose debounce has run out.
     void idle();
-    // An analysis is running in the background (a document's or the workspace index's).
-    bool busy() const { return pending_.has_value() || indexing_; }
+    // An analysis is running in the background (a document's or the workspace index's),
+    // or a document's passes are still to run.
+    bool busy() const;
     // Waits for the background analysis and publishes it (if its text is still current).
     void settle();
     // How long until idle() has work (nullopt: none pending).
@@ -94,6 +95,13 @@ private:
         // Its declarations as last parsed: an analysis parses only what the edits changed
         // (shared with the analysis running in the background).
         std::shared_ptr<ParseCache> parses = std::make_shared<ParseCache>();
+        // The last analysis the compiler's passes ran in, and how long they took. Where
+        // they are slow, an edit's analysis publishes the front end's diagnostics first
+        // (with the passes' last warnings carried through the edits), and the passes run
+        // after it, in an analysis of their own (`passesDue`).
+        std::shared_ptr<const Analysis> passed;
+        double passesMs = 0;
+        bool passesDue = false;
     };
     struct Pending {
         std::string uri;
@@ -101,6 +109,8 @@ private:
         std::shared_ptr<std::atomic<bool>> cancelled;
         std::future<Analysis> result;
     };
+    // Starts `doc`'s analysis in the background (the passes in it or not).
+    void start(Document& doc, bool passes);
 
     nlohmann::json dispatch(const std::string& method, const Field& params, bool* found);
     // lsp/server_requests.cpp: the requests about documents: reads, then edits.

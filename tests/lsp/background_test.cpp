@@ -201,3 +201,84 @@ TEST_CASE("reads never wait on a slow analysis: they answer from the last one, m
     REQUIRE(fresh.is_object());
     CHECK(fresh["contents"]["value"].get<std::string>().find("const lift") != std::string::npos);
 }
+
+TEST_CASE("slow passes: an edit publishes the front end's diagnostics first, with the passes' last warnings moved, then the passes'") {
+    std::vector<json> out;
+    ServerOptions options;
+    options.debounce = std::chrono::milliseconds(0);
+    options.quickAnalysisMs = 0;  // every analysis's passes count as slow
+    Server server(options, [&](const json& m) { out.push_back(m); });
+    server.handle({{"jsonrpc", "2.0"}, {"id", 1}, {"method", "initialize"}, {"params", json::object()}});
+    std::string uri = "file:///tmp/passes.psys";
+    std::string text = "object drag {\n    vel = vec3(0, 10, 0) + integrate(vec3(0, -9.8, 0) - 180 * vel);\n"
+                       "    point(vel, white, 1);\n}\nspawn drag;\n";
+    // Each publication for `uri`: (version, the lines of its warnings, whether it has an error).
+    struct Published {
+        int version;
+        std::vector<int> warnings;
+        bool error;
+    };
+    auto published = [&] {
+        std::vector<Published> list;
+        for (const json& m : out) {
+            if (m.value("method", "") != "textDocument/publishDiagnostics" || m["params"]["uri"] != uri) continue;
+            Published p{m["params"]["version"].get<int>(), {}, false};
+            for (const json& d : m["params"]["diagnostics"]) {
+                if (d["severity"] == 1) p.error = true;
+                if (d["severity"] == 2 && d["message"].get<std::string>().find("decays") != std::string::npos)
+                    p.warnings.push_back(d["range"]["start"]["line"].get<int>());
+            }
+            list.push_back(p);
+        }
+        return list;
+    };
+    auto settle = [&] {
+        for (int i = 0; i < 100000 && (server.busy() || server.nextDeadline()); ++i) {
+            server.idle();
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+    };
+    auto change = [&](int version, const std::string& with) {
+        server.handle(message("textDocument/didChange", {{"textDocument", {{"uri", uri}, {"version", version}}},
+                                                         {"contentChanges", {{{"text", with}}}}}));
+    };
+    server.handle(message("textDocument/didOpen", {{"textDocument", {{"uri", uri}, {"version", 1}, {"text", text}}}}));
+    settle();
+    auto first = published();
+    REQUIRE(first.size() == 1);  // the first analysis runs the passes in it
+    CHECK(first[0].warnings == std::vector<int>{1});
+
+    // A line above: the warning is carried a line down at once, then the passes say it again.
+    out.clear();
+    change(2, "// drag\n" + text);
+    settle();
+    auto moved = published();
+    REQUIRE(moved.size() == 2);
+    CHECK(moved[0].version == 2);
+    CHECK(moved[0].warnings == std::vector<int>{2});
+    CHECK(moved[1].version == 2);
+    CHECK(moved[1].warnings == std::vector<int>{2});
+
+    // An edit inside the warned equation: not carried (what it warned of may be gone); the
+    // passes find the decay still too fast.
+    out.clear();
+    std::string faster = "// drag\n" + text;
+    faster.replace(faster.find("180"), 3, "190");
+    change(3, faster);
+    settle();
+    auto touched = published();
+    REQUIRE(touched.size() == 2);
+    CHECK(touched[0].warnings.empty());
+    CHECK(touched[1].warnings == std::vector<int>{2});
+
+    // A type error: no passes to run, nothing carried, one publication.
+    out.clear();
+    std::string wrong = faster;
+    wrong.replace(wrong.find("point(vel"), 9, "point(true");
+    change(4, wrong);
+    settle();
+    auto broken = published();
+    REQUIRE(broken.size() == 1);
+    CHECK(broken[0].error);
+    CHECK(broken[0].warnings.empty());
+}
