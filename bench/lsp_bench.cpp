@@ -56,10 +56,12 @@ struct Client {
     // Every message is written out as psysc lsp's transport would (its JSON text); the
     // bench keeps notifications and small answers to look at.
     size_t written = 0;
-    Server server{psys::lsp::ServerOptions{.debounce = std::chrono::milliseconds(0), .version = "bench"}, [this](const json& m) {
+    Server server{psys::lsp::ServerOptions{.debounce = std::chrono::milliseconds(0), .version = "bench"},
+                  [this](const json& m) {
                       written += m.dump().size();
                       if (!m.contains("result") || m["result"].size() < 100) out.push_back(m);
-                  }};
+                  },
+                  [this](const std::string& text) { written += text.size(); }};
     int id = 1;
 
     json request(const std::string& method, json params) {

@@ -30,7 +30,10 @@ std::variant<nlohmann::json, std::string> formatting(const std::string& path, co
 // `offset` is a byte offset in the main file. Each returns the protocol's `null` when there is nothing.
 nlohmann::json hover(const Analysis& a, uint32_t offset);
 nlohmann::json definition(const Analysis& a, uint32_t offset);
-nlohmann::json documentSymbols(const Analysis& a);
+// The outline (textDocument/documentSymbol's answer) as JSON text: of an analysis's main
+// file, or of symbols moved into `file`.
+std::string documentSymbols(const Analysis& a);
+std::string documentSymbols(const SourceFile& file, const std::vector<Symbol>& symbols);
 // The hints whose place is in [begin, end] of the main file.
 nlohmann::json inlayHints(const Analysis& a, uint32_t begin, uint32_t end);
 

@@ -20,11 +20,16 @@ uint64_t count(const Field& at, const char* field) {
 }  // namespace
 
 // Columns in UTF-16 units from the line's start (SourceFile keeps a running count).
-nlohmann::json position(const SourceFile& file, uint32_t offset) {
+LineCharacter lineCharacter(const SourceFile& file, uint32_t offset) {
     LineColumn lc = file.lineColumn(offset);
     uint32_t start = file.offset({lc.line, 1});
     uint32_t end = start + static_cast<uint32_t>(file.lineText(lc.line).size());
-    return {{"line", lc.line - 1}, {"character", file.utf16Before(std::min(offset, end)) - file.utf16Before(start)}};
+    return {lc.line - 1, static_cast<uint32_t>(file.utf16Before(std::min(offset, end)) - file.utf16Before(start))};
+}
+
+nlohmann::json position(const SourceFile& file, uint32_t offset) {
+    LineCharacter at = lineCharacter(file, offset);
+    return {{"line", at.line}, {"character", at.character}};
 }
 
 nlohmann::json range(const SourceFile& file, uint32_t begin, uint32_t end) {

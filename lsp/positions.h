@@ -13,6 +13,11 @@
 
 namespace psys::lsp {
 
+// The protocol's line and character (UTF-16 units from the line's start) of a byte offset.
+struct LineCharacter {
+    uint32_t line, character;
+};
+LineCharacter lineCharacter(const SourceFile& file, uint32_t offset);
 nlohmann::json position(const SourceFile& file, uint32_t offset);
 nlohmann::json range(const SourceFile& file, uint32_t begin, uint32_t end);
 // The byte offset of a protocol position (clamped to the line and the text).

@@ -212,8 +212,7 @@ Analysis recover(const Analysis& good, const Analysis& current, const std::strin
         }
         out.occurrences.push_back(std::move(moved));
     }
-    for (Symbol s : good.symbols)
-        if (move.symbol(s)) out.symbols.push_back(std::move(s));
+    out.symbols = movedSymbols(good, edit);
     for (const Hint& h : good.hints)
         if (auto at = move.strict(h.at)) out.hints.push_back({*at, h.label, h.kind});
     out.passHints = out.hints.size();
@@ -224,6 +223,14 @@ Analysis recover(const Analysis& good, const Analysis& current, const std::strin
     out.members = good.members;
     out.imported = good.imported;  // (the current text's imports, as far as it parsed, too)
     out.imported.insert(current.imported.begin(), current.imported.end());
+    return out;
+}
+
+std::vector<Symbol> movedSymbols(const Analysis& a, const EditMap& edit) {
+    Mover move{edit, a.mainFile};
+    std::vector<Symbol> out;
+    for (Symbol s : a.symbols)
+        if (move.symbol(s)) out.push_back(std::move(s));
     return out;
 }
 

@@ -45,6 +45,10 @@ private:
 // need (occurrences, symbols, hints), not the names completion and rename look up.
 Analysis recover(const Analysis& good, const Analysis& current, const std::string& text, bool readsOnly = false);
 
+// `a`'s outline moved through `edit` (from `a`'s main text): a symbol whose name an edit
+// touched is left out, one with an edit inside it spans it.
+std::vector<Symbol> movedSymbols(const Analysis& a, const EditMap& edit);
+
 // The passes' warnings and hints of `passed` added to `fresh`, an analysis of a later text
 // whose passes have not run (yet): each moved through the edits between the two texts, and
 // dropped where an edit touched it (or, in an imported file, where that file changed).

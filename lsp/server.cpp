@@ -73,16 +73,24 @@ void Server::handle(const json& m) {
             if (notification) return;  // notifications the server does not know are ignored, as the protocol says
             throw RequestError{error::kMethodNotFound, "no method `" + method + "`"};
         }
-        if (!notification) {
+        if (!notification && textResult_) {
+            std::string text = R"({"id":)" + id.dump() + R"(,"jsonrpc":"2.0","result":)" + *textResult_ + "}";
+            if (sendText_) sendText_(text);
+            else send_(json::parse(text));
+        } else if (!notification) {
             json answer = {{"jsonrpc", "2.0"}, {"id", id}};
-            answer["result"] = std::move(result);  // (not copied: an outline can be 15,000 symbols)
+            answer["result"] = std::move(result);
             send_(answer);
         }
+        textResult_.reset();
     } catch (const RequestError& e) {
+        textResult_.reset();
         if (!notification) send_(errorResponse(id, e.code, e.message));
     } catch (const InvalidParams& e) {
+        textResult_.reset();
         if (!notification) send_(errorResponse(id, error::kInvalidParams, std::string("invalid params: ") + e.what()));
     } catch (const std::exception& e) {
+        textResult_.reset();
         if (!notification) send_(errorResponse(id, error::kInternalError, e.what()));
     }
 }
@@ -441,7 +449,8 @@ std::optional<std::chrono::milliseconds> Server::nextDeadline() const {
 int serve(int in, int out, ServerOptions options) {
     std::signal(SIGPIPE, SIG_IGN);  // a client that goes away is an end of input, not a signal
     Transport transport(in, out);
-    Server server(std::move(options), [&transport](const json& m) { transport.write(m); });
+    Server server(std::move(options), [&transport](const json& m) { transport.write(m); },
+                  [&transport](const std::string& text) { transport.writeText(text); });
     for (;;) {
         Incoming next = transport.read(server.nextDeadline());
         switch (next.kind) {

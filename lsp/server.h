@@ -56,7 +56,12 @@ struct RequestError {
 class Server {
 public:
     using Send = std::function<void(const nlohmann::json&)>;
-    Server(ServerOptions options, Send send) : options_(std::move(options)), send_(std::move(send)) {}
+    // A message as its JSON text: an answer too big to build as a tree (an outline of
+    // 15,000 symbols) is written as text. Without one, such an answer is parsed back into
+    // a tree and goes through `send`.
+    using SendText = std::function<void(const std::string&)>;
+    Server(ServerOptions options, Send send, SendText sendText = {})
+        : options_(std::move(options)), send_(std::move(send)), sendText_(std::move(sendText)) {}
     ~Server() {
         if (pending_) pending_->cancelled->store(true);  // its future waits for it to stop
     }
@@ -131,6 +136,11 @@ private:
     // about mapped back into its text, the answer mapped forward (no copy of the index).
     // Nullopt where readable() is what answers.
     std::optional<nlohmann::json> throughEdits(const Field& params, bool definition);
+    // The outline as JSON text (readable()'s, or the last analysis's symbols moved
+    // through the edits where readable() would move the whole analysis).
+    std::string outline(const Field& params);
+    // From the text of `doc`'s analysis to its text now (made once per edit).
+    const EditMap& editMap(Document& doc);
     // Every open document's analysis, and every other file's of the workspace index.
     std::vector<const Analysis*> analyses();
     nlohmann::json withUris(nlohmann::json answer) const;
@@ -147,6 +157,8 @@ private:
 
     ServerOptions options_;
     Send send_;
+    SendText sendText_;
+    std::optional<std::string> textResult_;  // a request's answer written as JSON text (outline)
     std::map<std::string, Document> docs_;  // by URI
     std::optional<Pending> pending_;        // the analysis running in the background
     WorkspaceIndex index_;                  // the workspace folders' files

@@ -48,7 +48,10 @@ json Server::request(const std::string& method, const Field& params, bool* found
         json found = definition(a, offset(a));
         return found.is_null() ? found : withUris(json::array({found}))[0];  // (the editor's spelling of its URIs)
     }
-    if (method == "textDocument/documentSymbol") return documentSymbols(readable(params));
+    if (method == "textDocument/documentSymbol") {
+        textResult_ = outline(params);
+        return nullptr;
+    }
     if (method == "textDocument/semanticTokens/full" || method == "textDocument/semanticTokens/full/delta") {
         json tokens = semanticTokens(readable(params));
         Document& doc = openDocument(params);
@@ -111,6 +114,25 @@ json Server::request(const std::string& method, const Field& params, bool* found
     return editRequest(method, params, found);
 }
 
+const EditMap& Server::editMap(Document& doc) {
+    if (doc.mapAt != doc.edits) {
+        const Analysis& a = *doc.analysis;
+        doc.map = std::make_shared<const EditMap>(a.sources->file(a.mainFile).text(), doc.text);
+        doc.mapAt = doc.edits;
+    }
+    return *doc.map;
+}
+
+std::string Server::outline(const Field& params) {
+    Document& doc = openDocument(params);
+    bool running = pending_ && pending_->uri == doc.uri;
+    bool moves = doc.analysis && doc.analysis->parsed && (doc.dirty || running) &&
+                 doc.analysis->milliseconds >= options_.quickAnalysisMs && doc.movedAt != doc.edits;
+    if (!moves) return documentSymbols(readable(params));
+    SourceFile now(doc.path, doc.text);
+    return documentSymbols(now, movedSymbols(*doc.analysis, editMap(doc)));
+}
+
 std::optional<json> Server::throughEdits(const Field& params, bool wantDefinition) {
     Document& doc = openDocument(params);
     bool running = pending_ && pending_->uri == doc.uri;
@@ -119,18 +141,15 @@ std::optional<json> Server::throughEdits(const Field& params, bool wantDefinitio
     // The place asked about, in the text the last analysis read; what is there, moved back
     // into the text as it is (nothing where the edits since touched it).
     const Analysis& a = *doc.analysis;
-    if (doc.mapAt != doc.edits) {
-        doc.map = std::make_shared<const EditMap>(a.sources->file(a.mainFile).text(), doc.text);
-        doc.mapAt = doc.edits;
-    }
+    const EditMap& map = editMap(doc);
     SourceFile now(doc.path, doc.text);
     uint32_t cursor = offsetOf(now, params["position"]);
-    auto older = doc.map->toOlder(cursor);
+    auto older = map.toOlder(cursor);
     const Occurrence* o = older ? a.at(a.mainFile, *older) : nullptr;
     auto moved = [&](SourceRange r) -> std::optional<SourceRange> {
         if (r.file != a.mainFile) return r;
-        if (doc.map->touches(r.begin, r.end)) return std::nullopt;  // edited inside
-        auto b = doc.map->toCurrent(r.begin, true), e = doc.map->toCurrent(r.end);
+        if (map.touches(r.begin, r.end)) return std::nullopt;  // edited inside
+        auto b = map.toCurrent(r.begin, true), e = map.toCurrent(r.end);
         if (!b || !e || *e < *b) return std::nullopt;
         return SourceRange{r.file, *b, *e};
     };

@@ -109,7 +109,10 @@ Incoming Transport::read(std::optional<std::chrono::milliseconds> wait) {
 
 void Transport::write(const nlohmann::json& message) {
     // Invalid UTF-8 in a message (a file's bytes in a diagnostic) becomes U+FFFD rather than an exception.
-    std::string body = message.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+    writeText(message.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+}
+
+void Transport::writeText(const std::string& body) {
     std::string frame = "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body;
     const char* p = frame.data();
     size_t left = frame.size();

@@ -35,6 +35,8 @@ public:
     // The next message; Timeout when none is complete within `wait` (nullopt: wait for ever).
     Incoming read(std::optional<std::chrono::milliseconds> wait);
     void write(const nlohmann::json& message);
+    // A message already written as JSON text.
+    void writeText(const std::string& body);
 
     // A message larger than this is refused (read past and answered with a parse error).
     static constexpr size_t kMaxMessage = 64u << 20;
