@@ -186,9 +186,23 @@ void DiagnosticEngine::print(std::ostream& out, bool colour) const {
         for (const DiagnosticNote& n : d.notes)
             printOne(out, sources_, Severity::Note, n.range, std::nullopt, n.message, colour, program_);
     }
-    if (hiddenErrors() > 0 || hiddenWarnings() > 0)
-        out << fmt::format("(the first {} errors and {} warnings are shown; {} more errors and {} more warnings are not)\n",
-                           std::min(errors_, limit_), std::min(warnings_, limit_), hiddenErrors(), hiddenWarnings());
+    if (hiddenErrors() > 0 || hiddenWarnings() > 0) {
+        // Only the kinds there are: "the first 50 warnings are shown; 2449 more warnings are not".
+        auto count = [](int n, const char* more, const char* what) {
+            return fmt::format("{} {}{}{}", n, more, what, n == 1 ? "" : "s");
+        };
+        auto both = [](std::vector<std::string> parts) {
+            return parts.size() == 2 ? parts[0] + " and " + parts[1] : parts[0];
+        };
+        std::vector<std::string> shown, hidden;
+        if (errors_ > 0) shown.push_back(count(std::min(errors_, limit_), "", "error"));
+        if (warnings_ > 0) shown.push_back(count(std::min(warnings_, limit_), "", "warning"));
+        if (hiddenErrors() > 0) hidden.push_back(count(hiddenErrors(), "more ", "error"));
+        if (hiddenWarnings() > 0) hidden.push_back(count(hiddenWarnings(), "more ", "warning"));
+        out << fmt::format("(the first {} {} shown; {} {} not)\n", both(shown),
+                           shown.size() == 1 && std::min(errors_ + warnings_, limit_) == 1 ? "is" : "are", both(hidden),
+                           hidden.size() == 1 && hiddenErrors() + hiddenWarnings() == 1 ? "is" : "are");
+    }
     if (errors_ > 0 || warnings_ > 0) {
         std::vector<std::string> parts;
         if (errors_ > 0) parts.push_back(fmt::format("{} error{}", errors_, errors_ == 1 ? "" : "s"));

@@ -66,6 +66,8 @@ public:
     int errorCount() const { return errors_; }
     int warningCount() const { return warnings_; }
     const std::vector<Diagnostic>& all() const { return diagnostics_; }
+    // The diagnostics kept, moved out (the engine keeps its counts).
+    std::vector<Diagnostic> take() { return std::move(diagnostics_); }
 
     // While suppressed, reports are dropped (used for trial passes of type inference).
     void setSuppressed(bool suppressed) { suppressed_ = suppressed; }

@@ -113,7 +113,7 @@ Analysis analyze(const std::string& path, std::string text, const AnalyzeOptions
             if (a.sources->file(f).path() == path) a.mainFile = f;
     for (int f = 0; f < a.sources->count(); ++f)
         if (f != a.mainFile) a.imported.insert(sourceKey(a.sources->file(f).path()));
-    a.diagnostics = diags.all();
+    a.diagnostics = diags.take();
     a.passDiagnostics = std::min(passDiagnostics, a.diagnostics.size());
     a.hiddenErrors = diags.hiddenErrors();
     a.hiddenWarnings = diags.hiddenWarnings();

@@ -354,6 +354,9 @@ void Server::install(Document& doc, Analysis analysis) {
         doc.passesDue = true;
     }
     auto fresh = std::make_shared<const Analysis>(std::move(analysis));
+    // The analysis replaced is freed after the diagnostics are out (100,000 occurrences
+    // take a while to free).
+    std::shared_ptr<const Analysis> replaced = doc.analysis;
     if (fresh->passesRan) doc.passed = fresh;
     doc.moved.reset(), doc.map.reset();  // (of the analysis this one replaces)
     doc.movedAt = doc.mapAt = UINT64_MAX;
@@ -368,6 +371,7 @@ void Server::install(Document& doc, Analysis analysis) {
     doc.dirty = false;
     doc.parses->sweep();  // (what neither this text nor the one before used)
     publish(doc);
+    replaced.reset();
 }
 
 void Server::publish(Document& doc) {

@@ -86,8 +86,15 @@ TEST_CASE("past 50 errors and 50 warnings, the rest are counted and not kept") {
     CHECK(diags.warningCount() == 3);
     CHECK(diags.all().size() == 53);
     std::string text = diags.render();
-    CHECK(text.find("(the first 50 errors and 3 warnings are shown; 20 more errors and 0 more warnings are not)\n"
+    CHECK(text.find("(the first 50 errors and 3 warnings are shown; 20 more errors are not)\n"
                     "70 errors and 3 warnings generated.\n") != std::string::npos);
+    // Only the kinds there are, in the singular where one.
+    for (int i = 0; i < 48; ++i) diags.warning({f, 0, 1}, "odd");
+    CHECK(diags.render().find("(the first 50 errors and 50 warnings are shown; 20 more errors and 1 more warning are not)\n") !=
+          std::string::npos);
+    DiagnosticEngine warnings(sources);
+    for (int i = 0; i < 2499; ++i) warnings.warning({f, 0, 1}, "odd");
+    CHECK(warnings.render().find("(the first 50 warnings are shown; 2449 more warnings are not)\n") != std::string::npos);
 }
 
 TEST_CASE("a line with control characters or bytes that are not UTF-8 prints as spaces and '?', the caret under its character") {
