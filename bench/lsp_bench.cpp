@@ -7,7 +7,8 @@
 //   edit → diagnostics      an edit inside one object until the new diagnostics are published
 //   edit → the passes'      … and until the compiler's passes have run on it (their warnings published)
 //   hover while analysing   a hover sent 200 ms after an edit, while its analysis runs
-//   hover, symbols, format  on an analysed text, and right after an edit
+//   hover, symbols, format  on an analysed text, and right after an edit; formatting a text laid
+//                           out already, and one with a line to re-indent
 //   index, references, rename   the workspace: the index built, a function's uses across 20 files
 #include <algorithm>
 #include <chrono>
@@ -114,7 +115,8 @@ void bigFileRows(int repeat, const std::filesystem::path& dir, std::vector<Row>&
     Row open{"open → diagnostics (20,005 lines)", {}}, edit{"edit → diagnostics", {}},
         passes{"edit → the passes' warnings too", {}}, during{"hover 200 ms after an edit", {}},
         hover{"hover (analysed)", {}}, symbols{"documentSymbol (analysed)", {}}, symbolsEdited{"documentSymbol after an edit", {}},
-        format{"formatting", {}}, hoverEdited{"hover right after an edit", {}};
+        format{"formatting (laid out already)", {}}, reformat{"formatting (a line to re-indent)", {}},
+        hoverEdited{"hover right after an edit", {}};
     for (int r = 0; r < repeat; ++r) {
         Client c;
         c.request("initialize", json::object());
@@ -168,8 +170,19 @@ void bigFileRows(int repeat, const std::filesystem::path& dir, std::vector<Row>&
         c.request("textDocument/hover", {{"textDocument", doc}, {"position", at(5006, 40)}});
         during.ms.push_back(msSince(t));
         c.until([&] { return !c.server.busy(); });
+        // A line indented two spaces too far: the layout changes the text, and its tokens are checked.
+        ++version;
+        json indent = {{"range", {{"start", at(5009, 0)}, {"end", at(5009, 0)}}}, {"text", "  "}};
+        c.notify("textDocument/didChange", {{"textDocument", {{"uri", uri}, {"version", version}}},
+                                            {"contentChanges", json::array({indent})}});
+        c.until([&] { return !c.server.busy() && !c.server.nextDeadline(); });
+        t = Clock::now();
+        json edits = c.request("textDocument/formatting", {{"textDocument", doc}, {"options", {{"tabSize", 4}, {"insertSpaces", true}}}});
+        reformat.ms.push_back(msSince(t));
+        if (edits["result"].size() != 1) std::fprintf(stderr, "formatting: %zu edits, not 1\n", edits["result"].size());
     }
-    for (Row* row : {&open, &edit, &passes, &during, &hoverEdited, &hover, &symbols, &symbolsEdited, &format}) rows.push_back(*row);
+    for (Row* row : {&open, &edit, &passes, &during, &hoverEdited, &hover, &symbols, &symbolsEdited, &format, &reformat})
+        rows.push_back(*row);
 }
 
 void workspaceRows(int repeat, const std::filesystem::path& dir, std::vector<Row>& rows) {

@@ -74,24 +74,32 @@ void addGap(std::string_view whole, size_t from, std::string_view gap, std::vect
     }
 }
 
-// The tokens and comments of `text` in order. Null when the lexer meets a character the
-// language does not have.
-std::optional<std::vector<Atom>> atomsOf(const std::string& text) {
+// The tokens of `text`. Null when the lexer meets a character the language does not have.
+std::optional<std::vector<LexedToken>> lex(const std::string& text) {
     antlr4::ANTLRInputStream input(text);
     PsysLexer lexer(&input);
     lexer.removeErrorListeners();
     std::vector<uint32_t> offsets = codePointOffsets(text);
-    std::vector<Atom> atoms;
-    uint32_t at = 0;
-    int newlines = 0;
+    std::vector<LexedToken> out;
     for (const auto& token : lexer.getAllTokens()) {
         if (token->getType() == PsysLexer::UNKNOWN_CHAR) return std::nullopt;
-        uint32_t begin = offsets[token->getStartIndex()], end = offsets[token->getStopIndex() + 1];
-        addGap(text, at, std::string_view(text).substr(at, begin - at), atoms, newlines);
-        atoms.push_back({Kind::Token, static_cast<int>(token->getType()), text.substr(begin, end - begin), newlines,
-                         false});
+        out.push_back({static_cast<int>(token->getType()), offsets[token->getStartIndex()],
+                       offsets[token->getStopIndex() + 1]});
+    }
+    return out;
+}
+
+// The tokens and comments of `text` in order, from its tokens.
+std::vector<Atom> atomsOf(const std::string& text, const std::vector<LexedToken>& tokens) {
+    std::vector<Atom> atoms;
+    atoms.reserve(tokens.size() + tokens.size() / 8);  // (and the comments)
+    uint32_t at = 0;
+    int newlines = 0;
+    for (const LexedToken& token : tokens) {
+        addGap(text, at, std::string_view(text).substr(at, token.begin - at), atoms, newlines);
+        atoms.push_back({Kind::Token, token.type, text.substr(token.begin, token.end - token.begin), newlines, false});
         newlines = 0;
-        at = end;
+        at = token.end;
     }
     addGap(text, at, std::string_view(text).substr(at), atoms, newlines);
     // An attribute ends at its name or at the `)` that closes its arguments.
@@ -451,21 +459,24 @@ bool sameAtoms(const std::vector<Atom>& a, const std::vector<Atom>& b) {
 
 std::optional<std::string> formatSource(int file, const SourceManager& sources, DiagnosticEngine& diags,
                                         const LayoutOptions& options) {
-    if (!options.parses && !parseModule(file, sources, diags)) return std::nullopt;
+    if (!options.parses && !options.tokens && !parseModule(file, sources, diags)) return std::nullopt;
     // A UTF-8 byte order mark stays where the file had it, outside the layout (as a token
     // it came out of the layout elsewhere, and formatting refused the file).
     static const std::string kByteOrderMark = "\xEF\xBB\xBF";
     const std::string& whole = sources.file(file).text();
     bool marked = whole.rfind(kByteOrderMark, 0) == 0;
     std::string text = marked ? whole.substr(kByteOrderMark.size()) : whole;
-    auto atoms = atomsOf(text);
-    if (!atoms) return std::nullopt;  // the parser has reported the character
+    auto tokens = options.tokens && !marked ? std::optional(*options.tokens) : lex(text);
+    if (!tokens) return std::nullopt;  // the parser has reported the character
+    std::vector<Atom> atoms = atomsOf(text, *tokens);
     Layout layout(options.width);
-    for (const Atom& atom : *atoms) layout.add(atom);
+    for (const Atom& atom : atoms) layout.add(atom);
     layout.finish();
     std::string out = layout.text();
-    auto again = atomsOf(out);
-    if (!again || !sameAtoms(*atoms, *again)) {
+    // (A file already laid out, formatted again on save, is its own text: the same tokens.)
+    if (out == text) return whole;
+    auto again = lex(out);
+    if (!again || !sameAtoms(atoms, atomsOf(out, *again))) {
         diags.error({file, 0, 0}, "internal error: formatting would change the tokens of this file; it is left as it "
                                   "is (please report it)");
         return std::nullopt;

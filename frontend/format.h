@@ -4,8 +4,10 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "frontend/diagnostics.h"
+#include "frontend/parse.h"
 
 namespace psys {
 
@@ -19,8 +21,12 @@ struct LayoutOptions {
     // the line of the innermost bracket still open; 0: lines are never broken.
     int width = 100;
     // The caller knows the text parses (an editor that has just analysed it), so it is not
-    // parsed again here (it is still lexed, twice: the check of the tokens stays).
+    // parsed again here (it is still lexed; and once more, the check of the tokens, where
+    // the layout changes it).
     bool parses = false;
+    // The text's tokens where the caller has them (the language server's parse cache,
+    // frontend/parse_cache.h): the text parses, and is not lexed again.
+    const std::vector<LexedToken>* tokens = nullptr;
 };
 
 std::optional<std::string> formatSource(int file, const SourceManager& sources, DiagnosticEngine& diags,

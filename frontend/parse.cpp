@@ -467,7 +467,7 @@ std::optional<SourceRange> unparsable(int file, const std::string& text, Diagnos
 }  // namespace
 
 std::unique_ptr<Module> parseText(int file, std::string_view text, uint32_t shift, DiagnosticEngine& diags,
-                                  bool report) {
+                                  bool report, std::vector<LexedToken>* lexed) {
     antlr4::ANTLRInputStream input(text.data(), text.size());
     grammar::PsysLexer lexer(&input);
     lexer.removeErrorListeners();
@@ -500,6 +500,11 @@ std::unique_ptr<Module> parseText(int file, std::string_view text, uint32_t shif
         tree = parser.file();
     }
     if (diags.errorCount() > errorsBefore || parser.getNumberOfSyntaxErrors() > 0) return nullptr;
+    if (lexed)
+        for (antlr4::Token* t : tokens.getTokens())
+            if (t->getType() != antlr4::Token::EOF)
+                lexed->push_back({static_cast<int>(t->getType()), offsets[t->getStartIndex()] - shift,
+                                  offsets[t->getStopIndex() + 1] - shift});
     AstBuilder builder(file, std::move(offsets), diags);
     return builder.build(tree);
 }

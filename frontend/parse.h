@@ -24,8 +24,17 @@ std::unique_ptr<ast::Module> parseModule(int file, const SourceManager& sources,
 // declaration's start on, as a sequence of declarations; ranges are the file's. Where it
 // does not parse: null, its syntax errors worded and reported when `report`, else at
 // once. (An unknown type name is reported by the AST's builder, which returns the module.)
+// Its tokens in `tokens` where given (the bytes of `text`, from 0), when it parses.
+struct LexedToken;
 std::unique_ptr<ast::Module> parseText(int file, std::string_view text, uint32_t shift, DiagnosticEngine& diags,
-                                       bool report);
+                                       bool report, std::vector<LexedToken>* tokens = nullptr);
+
+// A token as the lexer found it: its type (grammar/Psys.g4's) and bytes [begin, end).
+// Comments and white space are skipped, not tokens.
+struct LexedToken {
+    int type;
+    uint32_t begin, end;
+};
 
 // Character index (ANTLR decodes UTF-8 into code points) → byte offset, plus one past the end.
 std::vector<uint32_t> codePointOffsets(const std::string& text);

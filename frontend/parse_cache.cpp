@@ -90,10 +90,12 @@ std::unique_ptr<ast::Module> ParseCache::parse(int file, const std::string& text
             // Parsed alone at offset 0, errors kept apart: one that does not parse alone,
             // or names an unknown type, is parsed again below with the rest of the file.
             DiagnosticEngine quiet(diags.sources());
-            auto alone = parseText(file, key, 0, quiet, false);
+            std::vector<LexedToken> tokens;
+            auto alone = parseText(file, key, 0, quiet, false, &tokens);
             if (alone && quiet.errorCount() == 0) {
                 auto fresh = std::make_shared<Piece>();
                 fresh->decls = std::move(alone->decls);
+                fresh->tokens = std::move(tokens);
                 std::lock_guard lock(mutex_);
                 fresh->used = generation_;
                 ++counts_.parsed;
@@ -116,6 +118,22 @@ std::unique_ptr<ast::Module> ParseCache::parse(int file, const std::string& text
         from = tops[k].end;
     }
     return module;
+}
+
+std::optional<std::vector<LexedToken>> ParseCache::tokens(const std::string& text) {
+    std::vector<LexedToken> out;
+    out.reserve(text.size() / 4);
+    uint32_t from = 0;
+    std::lock_guard lock(mutex_);
+    for (const TopDeclaration& top : topLevelDeclarations(text)) {
+        if (top.unfinished) return std::nullopt;
+        auto it = pieces_.find(text.substr(from, top.end - from));
+        if (it == pieces_.end()) return std::nullopt;
+        it->second->used = generation_;
+        for (LexedToken t : it->second->tokens) out.push_back({t.type, t.begin + from, t.end + from});
+        from = top.end;
+    }
+    return out;
 }
 
 void ParseCache::sweep() {

@@ -13,12 +13,14 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
 #include "frontend/ast.h"
 #include "frontend/diagnostics.h"
+#include "frontend/parse.h"
 
 namespace psys {
 
@@ -38,6 +40,9 @@ class ParseCache {
 public:
     // The module of `text` (the file `file`), or null with its syntax errors reported.
     std::unique_ptr<ast::Module> parse(int file, const std::string& text, DiagnosticEngine& diags);
+    // The tokens of `text` where every declaration of it is held (as parsed: it has no
+    // syntax error), so that the layout need not lex it again (frontend/format.h).
+    std::optional<std::vector<LexedToken>> tokens(const std::string& text);
     // Forgets the declarations that no parse has used since the sweep before this one
     // (the last two texts' are kept: an analysis of the next may start from either).
     void sweep();
@@ -51,6 +56,7 @@ public:
 private:
     struct Piece {
         std::vector<ast::DeclPtr> decls;  // as parsed at offset 0
+        std::vector<LexedToken> tokens;
         uint64_t used = 0;                // the generation that last used it
     };
     std::shared_ptr<const Piece> find(const std::string& text);

@@ -34,12 +34,14 @@ nlohmann::json codeActions(const Analysis& a, uint32_t begin, uint32_t end) {
 namespace {
 
 // The text laid out canonically, or why it cannot be.
-std::optional<std::string> formatted(const std::string& path, const std::string& text, bool parses, std::string& why) {
+std::optional<std::string> formatted(const std::string& path, const std::string& text, bool parses,
+                                     const std::vector<LexedToken>* tokens, std::string& why) {
     SourceManager sources;
     DiagnosticEngine diags(sources);
     int file = sources.add(path, text);
     LayoutOptions layout;
     layout.parses = parses;
+    layout.tokens = tokens;
     auto out = formatSource(file, sources, diags, layout);
     if (!out) {
         if (diags.all().empty()) why = "the file cannot be formatted";
@@ -57,9 +59,10 @@ bool blank(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
 }  // namespace
 
 std::variant<nlohmann::json, std::string> rangeFormatting(const std::string& path, const std::string& text, uint32_t begin,
-                                                          uint32_t end, bool parses) {
+                                                          uint32_t end, bool parses,
+                                                          const std::vector<LexedToken>* tokens) {
     std::string why;
-    auto out = formatted(path, text, parses, why);
+    auto out = formatted(path, text, parses, tokens, why);
     if (!out) return why;
     // The layout changes only white space (frontend/format.h: the same tokens, comments
     // kept), so the two texts' other characters pair up one to one, and each run of white
@@ -84,9 +87,10 @@ std::variant<nlohmann::json, std::string> rangeFormatting(const std::string& pat
     return edits;
 }
 
-std::variant<nlohmann::json, std::string> formatting(const std::string& path, const std::string& text, bool parses) {
+std::variant<nlohmann::json, std::string> formatting(const std::string& path, const std::string& text, bool parses,
+                                                     const std::vector<LexedToken>* tokens) {
     std::string why;
-    auto out = formatted(path, text, parses, why);
+    auto out = formatted(path, text, parses, tokens, why);
     if (!out) return why;
     // One edit over what differs, not the whole text, so the editor keeps its cursor and marks.
     size_t prefix = 0, suffix = 0;

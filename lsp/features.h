@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "frontend/parse.h"
 #include "lsp/analysis.h"
 
 namespace psys::lsp {
@@ -24,8 +25,10 @@ nlohmann::json diagnosticJson(const Analysis& a, const Diagnostic& d);
 // lsp/actions.cpp: the quick fixes of the main file's diagnostics that meet bytes [begin,
 // end] (CodeAction[]); the edits that lay `text` out canonically, or why not (syntax errors).
 nlohmann::json codeActions(const Analysis& a, uint32_t begin, uint32_t end);
-// `parses`: the text is known to parse (its analysis is current), so it is not parsed again.
-std::variant<nlohmann::json, std::string> formatting(const std::string& path, const std::string& text, bool parses = false);
+// `parses`: the text is known to parse (its analysis is current), so it is not parsed again;
+// `tokens`, where given, are its tokens (the document's parse cache), so it is not lexed.
+std::variant<nlohmann::json, std::string> formatting(const std::string& path, const std::string& text, bool parses = false,
+                                                     const std::vector<LexedToken>* tokens = nullptr);
 
 // `offset` is a byte offset in the main file. Each returns the protocol's `null` when there is nothing.
 nlohmann::json hover(const Analysis& a, uint32_t offset);
@@ -66,7 +69,8 @@ nlohmann::json resolveCompletion(nlohmann::json item);
 // lsp/actions.cpp: the formatting edits that fall in bytes [begin, end] of `text` (each
 // run of white space between two tokens is its own edit).
 std::variant<nlohmann::json, std::string> rangeFormatting(const std::string& path, const std::string& text, uint32_t begin,
-                                                          uint32_t end, bool parses = false);
+                                                          uint32_t end, bool parses = false,
+                                                          const std::vector<LexedToken>* tokens = nullptr);
 
 // The language's own words by category (keywords, functions, constants, variables,
 // types, attributes, integrators): `psysc builtins`, which the editor grammars' tests read.

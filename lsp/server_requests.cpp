@@ -201,15 +201,19 @@ json Server::editRequest(const std::string& method, const Field& params, bool* f
         bool running = pending_ && pending_->uri == doc.uri;
         return !doc.dirty && !running && doc.analysis && doc.analysis->parsed && !doc.analysis->recovered;
     };
+    // (Where the analysis is current, the text's tokens are its parse's.)
+    auto tokens = [&](const Document& doc) { return parses(doc) ? doc.parses->tokens(doc.text) : std::nullopt; };
     if (method == "textDocument/formatting") {
         Document& doc = openDocument(params);
-        return orRefuse(formatting(doc.path, doc.text, parses(doc)));
+        auto lexed = tokens(doc);
+        return orRefuse(formatting(doc.path, doc.text, parses(doc), lexed ? &*lexed : nullptr));
     }
     if (method == "textDocument/rangeFormatting") {
         Document& doc = openDocument(params);
         SourceFile f(doc.path, doc.text);
+        auto lexed = tokens(doc);
         return orRefuse(rangeFormatting(doc.path, doc.text, offsetOf(f, params["range"]["start"]),
-                                        offsetOf(f, params["range"]["end"]), parses(doc)));
+                                        offsetOf(f, params["range"]["end"]), parses(doc), lexed ? &*lexed : nullptr));
     }
     *found = false;
     return nullptr;

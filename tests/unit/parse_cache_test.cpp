@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "frontend/format.h"
 #include "frontend/frontend.h"
 #include "frontend/loader.h"
 #include "frontend/parse_cache.h"
@@ -69,6 +70,36 @@ TEST_CASE("a parse through the cache is the whole file's parse: every sample, li
         ++files;
     }
     CHECK(files > 150);
+}
+
+TEST_CASE("the layout from the cache's tokens is the layout from lexing: every file that parses, and re-indented") {
+    int laidOut = 0;
+    for (const fs::path& path : sources()) {
+        std::string text = test::readFile(path.string());
+        std::string shallow = text;
+        for (size_t at = 0; (at = shallow.find("\n    ", at)) != std::string::npos; at += 3) shallow.replace(at, 5, "\n  ");
+        for (const std::string& t : {text, shallow}) {
+            ParseCache cache;
+            if (parsed(path.string(), t, &cache).find("error") != std::string::npos) continue;
+            auto tokens = cache.tokens(t);
+            CAPTURE(path.string());
+            REQUIRE(tokens);
+            SourceManager sources;
+            DiagnosticEngine diags(sources);
+            int file = sources.add(path.string(), t);
+            LayoutOptions fromCache;
+            fromCache.tokens = &*tokens;
+            CHECK(formatSource(file, sources, diags, fromCache) == formatSource(file, sources, diags));
+            ++laidOut;
+        }
+    }
+    CHECK(laidOut > 100);
+    // A text the cache has not seen all of: no tokens.
+    ParseCache cache;
+    parsed("t.psys", "object a { point(vec3(0)); }\nspawn a;\n", &cache);
+    CHECK(cache.tokens("object a { point(vec3(0)); }\nspawn a;\n"));
+    CHECK_FALSE(cache.tokens("object b { point(vec3(0)); }\nspawn a;\n"));
+    CHECK_FALSE(cache.tokens("object a { point(vec3(0)); }\nspawn a;\nobject"));
 }
 
 TEST_CASE("an edit inside one declaration parses that declaration only") {
