@@ -11,6 +11,12 @@
 // reading while it runs: edits, requests about the other documents, completion and
 // signature help (from the last text that parsed), shutdown. An edit to the document being
 // analysed cancels that analysis (it stops at its next phase and is never published).
+//
+// An edit's analysis parses only the top-level declarations it changed (the document's
+// frontend/parse_cache.h). Where the compiler's passes took long on the document (their
+// warnings: an unstable decay, an integral with no closed form), an edit's analysis leaves
+// them out: its diagnostics are published with the passes' last warnings carried through
+// the edits, and the passes run after, in an analysis of their own, published again.
 #pragma once
 
 #include <atomic>
