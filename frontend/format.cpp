@@ -462,12 +462,16 @@ std::optional<std::string> formatSource(int file, const SourceManager& sources, 
     if (!options.parses && !options.tokens && !parseModule(file, sources, diags)) return std::nullopt;
     // A UTF-8 byte order mark stays where the file had it, outside the layout (as a token
     // it came out of the layout elsewhere, and formatting refused the file).
-    static const std::string kByteOrderMark = "\xEF\xBB\xBF";
     const std::string& whole = sources.file(file).text();
     bool marked = whole.rfind(kByteOrderMark, 0) == 0;
     std::string text = marked ? whole.substr(kByteOrderMark.size()) : whole;
-    auto tokens = options.tokens && !marked ? std::optional(*options.tokens) : lex(text);
-    if (!tokens) return std::nullopt;  // the parser has reported the character
+    const std::vector<LexedToken>* tokens = options.tokens && !marked ? options.tokens : nullptr;
+    std::optional<std::vector<LexedToken>> lexed;
+    if (!tokens) {
+        lexed = lex(text);
+        if (!lexed) return std::nullopt;  // the parser has reported the character
+        tokens = &*lexed;
+    }
     std::vector<Atom> atoms = atomsOf(text, *tokens);
     Layout layout(options.width);
     for (const Atom& atom : atoms) layout.add(atom);
@@ -481,7 +485,7 @@ std::optional<std::string> formatSource(int file, const SourceManager& sources, 
                                   "is (please report it)");
         return std::nullopt;
     }
-    return marked ? kByteOrderMark + out : out;
+    return marked ? std::string(kByteOrderMark) + out : out;
 }
 
 }  // namespace psys

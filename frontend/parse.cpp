@@ -477,6 +477,9 @@ std::unique_ptr<Module> parseText(int file, std::string_view text, uint32_t shif
     SilentListener silent;
     parser.addErrorListener(&silent);
     std::vector<uint32_t> offsets = codePointOffsets(std::string(text));
+    // ANTLR's stream has dropped a leading byte order mark: its first character is the
+    // one after it.
+    if (text.starts_with(kByteOrderMark)) offsets.erase(offsets.begin());
     if (shift)
         for (uint32_t& o : offsets) o += shift;
 

@@ -36,6 +36,9 @@ struct LexedToken {
     uint32_t begin, end;
 };
 
+// A UTF-8 byte order mark: ANTLR's input stream drops one at the start of its text.
+inline constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";
+
 // Character index (ANTLR decodes UTF-8 into code points) → byte offset, plus one past the end.
 std::vector<uint32_t> codePointOffsets(const std::string& text);
 

@@ -1,7 +1,6 @@
 // Parsing by top-level declaration, reusing the unchanged ones (frontend/parse_cache.h).
 #include "frontend/parse_cache.h"
 
-#include <cctype>
 #include <string_view>
 
 #include "frontend/parse.h"
@@ -42,7 +41,7 @@ std::vector<TopDeclaration> topLevelDeclarations(const std::string& text) {
             i = end == std::string::npos ? text.size() : end + 1;
             continue;
         }
-        if (std::isspace(static_cast<unsigned char>(c))) continue;
+        if (c == ' ' || c == '\t' || c == '\r' || c == '\n') continue;  // (the lexer's white space, no more)
         // (An object's attributes on the lines before it are its own.)
         bool lineStart = i == 0 || text[i - 1] == '\n' || text[i - 1] == '\r';
         if (lineStart && (c == '@' || topKeyword(text, i)) && start != std::string::npos &&
@@ -85,16 +84,19 @@ std::unique_ptr<ast::Module> ParseCache::parse(int file, const std::string& text
     for (size_t k = 0; k < tops.size(); ++k) {
         declsBefore.push_back(module->decls.size());
         std::string key = text.substr(from, tops[k].end - from);
-        std::shared_ptr<const Piece> piece = tops[k].unfinished ? nullptr : find(key);
-        if (!piece && !tops[k].unfinished) {
+        // (A byte order mark the lexer drops at the start of its input, not elsewhere: a
+        // piece after the first that starts with one is parsed with what comes before.)
+        bool alone = !tops[k].unfinished && !(k > 0 && key.rfind(kByteOrderMark, 0) == 0);
+        std::shared_ptr<const Piece> piece = alone ? find(key) : nullptr;
+        if (!piece && alone) {
             // Parsed alone at offset 0, errors kept apart: one that does not parse alone,
             // or names an unknown type, is parsed again below with the rest of the file.
             DiagnosticEngine quiet(diags.sources());
             std::vector<LexedToken> tokens;
-            auto alone = parseText(file, key, 0, quiet, false, &tokens);
-            if (alone && quiet.errorCount() == 0) {
+            auto module = parseText(file, key, 0, quiet, false, &tokens);
+            if (module && quiet.errorCount() == 0) {
                 auto fresh = std::make_shared<Piece>();
-                fresh->decls = std::move(alone->decls);
+                fresh->decls = std::move(module->decls);
                 fresh->tokens = std::move(tokens);
                 std::lock_guard lock(mutex_);
                 fresh->used = generation_;

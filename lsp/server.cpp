@@ -339,7 +339,11 @@ const Analysis& Server::readable(const Field& params) {
 
 void Server::analyse(Document& doc) {
     SourceOverrides open = openTexts(&doc);
-    install(doc, analyze(doc.path, doc.text, {.open = &open, .salvage = !doc.lastParsed, .cache = doc.parses.get()}));
+    // (Without the passes where they are slow, as in the background: a read that waits
+    // for an analysis waits no longer than the last one took.)
+    install(doc, analyze(doc.path, doc.text, {.open = &open, .salvage = !doc.lastParsed,
+                                              .passes = doc.passesMs <= options_.quickAnalysisMs,
+                                              .cache = doc.parses.get()}));
 }
 
 void Server::install(Document& doc, Analysis analysis) {
@@ -349,9 +353,11 @@ void Server::install(Document& doc, Analysis analysis) {
     if (analysis.passesRan) {
         doc.passesMs = analysis.passesMs;
         doc.passesDue = false;
-    } else if (clean && doc.passed) {
-        carryPasses(*doc.passed, analysis);
-        doc.passesDue = true;
+    } else {
+        // The passes run on a clean program only: due where the front end is clean, and
+        // not (whatever was due before) where it is not.
+        if (clean && doc.passed) carryPasses(*doc.passed, analysis);
+        doc.passesDue = clean;
     }
     auto fresh = std::make_shared<const Analysis>(std::move(analysis));
     // The analysis replaced is freed after the diagnostics are out (100,000 occurrences
@@ -369,7 +375,10 @@ void Server::install(Document& doc, Analysis analysis) {
     else
         doc.analysis = fresh;
     doc.dirty = false;
-    doc.parses->sweep();  // (what neither this text nor the one before used)
+    if (doc.sweptAt != doc.edits) {  // (once a text: its passes' analysis comes after its first)
+        doc.parses->sweep();            // what neither this text nor the one before used
+        doc.sweptAt = doc.edits;
+    }
     publish(doc);
     replaced.reset();
 }

@@ -113,6 +113,7 @@ private:
         std::shared_ptr<const Analysis> passed;
         double passesMs = 0;
         bool passesDue = false;
+        uint64_t sweptAt = UINT64_MAX;  // the edit count of the text the parse cache was last swept at
     };
     struct Pending {
         std::string uri;

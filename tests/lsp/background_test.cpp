@@ -282,3 +282,48 @@ TEST_CASE("slow passes: an edit publishes the front end's diagnostics first, wit
     CHECK(broken[0].error);
     CHECK(broken[0].warnings.empty());
 }
+
+TEST_CASE("slow passes: an error typed before they run leaves nothing due (no analysis after analysis)") {
+    std::vector<json> out;
+    ServerOptions options;
+    options.debounce = std::chrono::milliseconds(0);
+    options.quickAnalysisMs = 0;  // every analysis's passes count as slow
+    Server server(options, [&](const json& m) { out.push_back(m); });
+    server.handle({{"jsonrpc", "2.0"}, {"id", 1}, {"method", "initialize"}, {"params", json::object()}});
+    std::string uri = "file:///tmp/due.psys";
+    std::string text = "object drag {\n    vel = vec3(0, 10, 0) + integrate(vec3(0, -9.8, 0) - 180 * vel);\n"
+                       "    point(vel, white, 1);\n}\nspawn drag;\n";
+    auto settle = [&] {
+        int rounds = 0;
+        for (; rounds < 5000 && (server.busy() || server.nextDeadline()); ++rounds) {
+            server.idle();
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+        return rounds;
+    };
+    auto change = [&](int version, const std::string& with) {
+        server.handle(message("textDocument/didChange", {{"textDocument", {{"uri", uri}, {"version", version}}},
+                                                         {"contentChanges", {{{"text", with}}}}}));
+    };
+    server.handle(message("textDocument/didOpen", {{"textDocument", {{"uri", uri}, {"version", 1}, {"text", text}}}}));
+    settle();
+    // A clean edit: its front end published, its passes due; then, before they run, a type
+    // error and a syntax error, each analysed on its own.
+    for (const std::string& broken : {std::string("point(true"), std::string("point(vel, white, 1")}) {
+        out.clear();
+        change(2, "// x\n" + text);
+        for (int i = 0; i < 5000 && out.empty(); ++i) {
+            server.idle();
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+        REQUIRE_FALSE(out.empty());
+        std::string wrong = text;
+        wrong.replace(wrong.find("point(vel"), 9, broken);
+        change(3, wrong);
+        CHECK(settle() < 5000);
+        CHECK_FALSE(server.busy());
+        int published = 0;
+        for (const json& m : out) published += m.value("method", "") == "textDocument/publishDiagnostics" && m["params"]["version"] == 3;
+        CHECK(published == 1);
+    }
+}

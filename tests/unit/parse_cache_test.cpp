@@ -11,6 +11,7 @@
 #include "frontend/format.h"
 #include "frontend/frontend.h"
 #include "frontend/loader.h"
+#include "frontend/parse.h"
 #include "frontend/parse_cache.h"
 #include "test_support.h"
 
@@ -145,6 +146,27 @@ TEST_CASE("a syntax error through the cache: the same errors, and the declaratio
     int before = cache.counts().parsed;
     CHECK(parsed("t.psys", text, &cache) == parsed("t.psys", text, nullptr));
     CHECK(cache.counts().parsed == before);
+}
+
+TEST_CASE("byte order marks and white space the lexer does not skip: through the cache as in a whole parse") {
+    std::string bom(kByteOrderMark);
+    for (const std::string& text : {bom + "object o { point(vec3(zork), white, 1); }\nspawn o;\n",
+                                    "const a = 1;" + bom + "const b = 2;\n", "const a = 1;\n" + bom + "const b = 2;\n",
+                                    std::string("spawn comet;\n\f"), std::string("const a = 1;\v\nconst b = 2;\n")}) {
+        CAPTURE(text);
+        ParseCache cache;
+        std::string whole = parsed("t.psys", text, nullptr);
+        CHECK(parsed("t.psys", text, &cache) == whole);
+        cache.sweep();
+        CHECK(parsed("t.psys", text, &cache) == whole);
+    }
+    // A mark at the start of a file is not a character of it: `zork` is where it is.
+    SourceManager sources;
+    DiagnosticEngine diags(sources);
+    std::string text = bom + "object o { point(vec3(zork), white, 1); }\nspawn o;\n";
+    checkText("t.psys", text, sources, diags);
+    REQUIRE(diags.errorCount() == 1);
+    CHECK(text.substr(diags.all()[0].range.begin, 4) == "zork");
 }
 
 TEST_CASE("top-level declarations: by brackets and semicolons, attributes with their object") {
