@@ -202,16 +202,47 @@ TEST_CASE("reads never wait on a slow analysis: they answer from the last one, m
     CHECK(fresh["contents"]["value"].get<std::string>().find("const lift") != std::string::npos);
 }
 
-TEST_CASE("slow passes: an edit publishes the front end's diagnostics first, with the passes' last warnings moved, then the passes'") {
+namespace {
+
+// A server whose every analysis's passes count as slow, with one document open (an
+// object whose decay is too fast for its integrator: the passes warn).
+struct SlowPasses {
     std::vector<json> out;
-    ServerOptions options;
-    options.debounce = std::chrono::milliseconds(0);
-    options.quickAnalysisMs = 0;  // every analysis's passes count as slow
-    Server server(options, [&](const json& m) { out.push_back(m); });
-    server.handle({{"jsonrpc", "2.0"}, {"id", 1}, {"method", "initialize"}, {"params", json::object()}});
+    Server server{options(), [this](const json& m) { out.push_back(m); }};
     std::string uri = "file:///tmp/passes.psys";
     std::string text = "object drag {\n    vel = vec3(0, 10, 0) + integrate(vec3(0, -9.8, 0) - 180 * vel);\n"
                        "    point(vel, white, 1);\n}\nspawn drag;\n";
+    static ServerOptions options() {
+        ServerOptions o;
+        o.debounce = std::chrono::milliseconds(0);
+        o.quickAnalysisMs = 0;
+        return o;
+    }
+    SlowPasses() {
+        server.handle({{"jsonrpc", "2.0"}, {"id", 1}, {"method", "initialize"}, {"params", json::object()}});
+        server.handle(message("textDocument/didOpen", {{"textDocument", {{"uri", uri}, {"version", 1}, {"text", text}}}}));
+    }
+    // Runs the server's loop until nothing is left to do; how many turns it took.
+    int settle() {
+        int rounds = 0;
+        for (; rounds < 5000 && (server.busy() || server.nextDeadline()); ++rounds) {
+            server.idle();
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+        return rounds;
+    }
+    void change(int version, const std::string& with) {
+        server.handle(message("textDocument/didChange", {{"textDocument", {{"uri", uri}, {"version", version}}},
+                                                         {"contentChanges", {{{"text", with}}}}}));
+    }
+};
+
+}  // namespace
+
+TEST_CASE("slow passes: an edit publishes the front end's diagnostics first, with the passes' last warnings moved, then the passes'") {
+    SlowPasses s;
+    std::vector<json>& out = s.out;
+    const std::string &uri = s.uri, &text = s.text;
     // Each publication for `uri`: (version, the lines of its warnings, whether it has an error).
     struct Published {
         int version;
@@ -232,17 +263,8 @@ TEST_CASE("slow passes: an edit publishes the front end's diagnostics first, wit
         }
         return list;
     };
-    auto settle = [&] {
-        for (int i = 0; i < 100000 && (server.busy() || server.nextDeadline()); ++i) {
-            server.idle();
-            std::this_thread::sleep_for(std::chrono::milliseconds(1));
-        }
-    };
-    auto change = [&](int version, const std::string& with) {
-        server.handle(message("textDocument/didChange", {{"textDocument", {{"uri", uri}, {"version", version}}},
-                                                         {"contentChanges", {{{"text", with}}}}}));
-    };
-    server.handle(message("textDocument/didOpen", {{"textDocument", {{"uri", uri}, {"version", 1}, {"text", text}}}}));
+    auto settle = [&] { s.settle(); };
+    auto change = [&](int version, const std::string& with) { s.change(version, with); };
     settle();
     auto first = published();
     REQUIRE(first.size() == 1);  // the first analysis runs the passes in it
@@ -284,28 +306,12 @@ TEST_CASE("slow passes: an edit publishes the front end's diagnostics first, wit
 }
 
 TEST_CASE("slow passes: an error typed before they run leaves nothing due (no analysis after analysis)") {
-    std::vector<json> out;
-    ServerOptions options;
-    options.debounce = std::chrono::milliseconds(0);
-    options.quickAnalysisMs = 0;  // every analysis's passes count as slow
-    Server server(options, [&](const json& m) { out.push_back(m); });
-    server.handle({{"jsonrpc", "2.0"}, {"id", 1}, {"method", "initialize"}, {"params", json::object()}});
-    std::string uri = "file:///tmp/due.psys";
-    std::string text = "object drag {\n    vel = vec3(0, 10, 0) + integrate(vec3(0, -9.8, 0) - 180 * vel);\n"
-                       "    point(vel, white, 1);\n}\nspawn drag;\n";
-    auto settle = [&] {
-        int rounds = 0;
-        for (; rounds < 5000 && (server.busy() || server.nextDeadline()); ++rounds) {
-            server.idle();
-            std::this_thread::sleep_for(std::chrono::milliseconds(1));
-        }
-        return rounds;
-    };
-    auto change = [&](int version, const std::string& with) {
-        server.handle(message("textDocument/didChange", {{"textDocument", {{"uri", uri}, {"version", version}}},
-                                                         {"contentChanges", {{{"text", with}}}}}));
-    };
-    server.handle(message("textDocument/didOpen", {{"textDocument", {{"uri", uri}, {"version", 1}, {"text", text}}}}));
+    SlowPasses s;
+    std::vector<json>& out = s.out;
+    const std::string& text = s.text;
+    Server& server = s.server;
+    auto settle = [&] { return s.settle(); };
+    auto change = [&](int version, const std::string& with) { s.change(version, with); };
     settle();
     // A clean edit: its front end published, its passes due; then, before they run, a type
     // error and a syntax error, each analysed on its own.
