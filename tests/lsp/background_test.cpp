@@ -208,17 +208,19 @@ namespace {
 // object whose decay is too fast for its integrator: the passes warn).
 struct SlowPasses {
     std::vector<json> out;
-    Server server{options(), [this](const json& m) { out.push_back(m); }};
+    Server server;
     std::string uri = "file:///tmp/passes.psys";
     std::string text = "object drag {\n    vel = vec3(0, 10, 0) + integrate(vec3(0, -9.8, 0) - 180 * vel);\n"
                        "    point(vel, white, 1);\n}\nspawn drag;\n";
-    static ServerOptions options() {
+    static ServerOptions options(std::chrono::milliseconds debounce) {
         ServerOptions o;
-        o.debounce = std::chrono::milliseconds(0);
+        o.debounce = debounce;
         o.quickAnalysisMs = 0;
         return o;
     }
-    SlowPasses() {
+    // (The document is analysed as it opens, the passes in that analysis.)
+    explicit SlowPasses(std::chrono::milliseconds debounce = std::chrono::milliseconds(0))
+        : server(options(debounce), [this](const json& m) { out.push_back(m); }) {
         server.handle({{"jsonrpc", "2.0"}, {"id", 1}, {"method", "initialize"}, {"params", json::object()}});
         server.handle(message("textDocument/didOpen", {{"textDocument", {{"uri", uri}, {"version", 1}, {"text", text}}}}));
     }
@@ -332,4 +334,22 @@ TEST_CASE("slow passes: an error typed before they run leaves nothing due (no an
         for (const json& m : out) published += m.value("method", "") == "textDocument/publishDiagnostics" && m["params"]["version"] == 3;
         CHECK(published == 1);
     }
+}
+
+TEST_CASE("slow passes: a request that waits for the edited text's analysis does not wait for the passes") {
+    SlowPasses s(std::chrono::milliseconds(60000));  // edits wait: the request analyses
+    CHECK_FALSE(s.server.busy());
+    s.change(2, "// x\n" + s.text);
+    s.out.clear();
+    s.server.handle({{"jsonrpc", "2.0"}, {"id", 2}, {"method", "textDocument/references"},
+                     {"params", {{"textDocument", {{"uri", s.uri}}}, {"position", {{"line", 2}, {"character", 5}}},
+                                 {"context", {{"includeDeclaration", true}}}}}});
+    // Answered after the front end alone (its diagnostics out, the warning carried a line
+    // down); the passes are left to run in the background.
+    bool warned = false;
+    for (const json& m : s.out)
+        if (m.value("method", "") == "textDocument/publishDiagnostics")
+            for (const json& d : m["params"]["diagnostics"]) warned |= d["range"]["start"]["line"] == 2;
+    CHECK(warned);
+    CHECK(s.server.busy());
 }
