@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <csignal>
+#include <utility>
 #include <variant>
 
 #include "lsp/features.h"
@@ -68,29 +69,27 @@ void Server::handle(const json& m) {
             throw RequestError{error::kServerNotInitialized, "the server has not been initialised"};
         if (shutdown_) throw RequestError{error::kInvalidRequest, "the server is shutting down: only `exit` is accepted"};
         bool found = false;
+        textResult_.reset();
         json result = dispatch(method, Field(params, ""), &found);
+        std::optional<std::string> text = std::exchange(textResult_, std::nullopt);
         if (!found) {
             if (notification) return;  // notifications the server does not know are ignored, as the protocol says
             throw RequestError{error::kMethodNotFound, "no method `" + method + "`"};
         }
-        if (!notification && textResult_) {
-            std::string text = R"({"id":)" + id.dump() + R"(,"jsonrpc":"2.0","result":)" + *textResult_ + "}";
-            if (sendText_) sendText_(text);
-            else send_(json::parse(text));
+        if (!notification && text) {
+            std::string answer = R"({"id":)" + id.dump() + R"(,"jsonrpc":"2.0","result":)" + *text + "}";
+            if (sendText_) sendText_(answer);
+            else send_(json::parse(answer));
         } else if (!notification) {
             json answer = {{"jsonrpc", "2.0"}, {"id", id}};
             answer["result"] = std::move(result);
             send_(answer);
         }
-        textResult_.reset();
     } catch (const RequestError& e) {
-        textResult_.reset();
         if (!notification) send_(errorResponse(id, e.code, e.message));
     } catch (const InvalidParams& e) {
-        textResult_.reset();
         if (!notification) send_(errorResponse(id, error::kInvalidParams, std::string("invalid params: ") + e.what()));
     } catch (const std::exception& e) {
-        textResult_.reset();
         if (!notification) send_(errorResponse(id, error::kInternalError, e.what()));
     }
 }
@@ -325,11 +324,14 @@ Server::Document& Server::document(const Field& params) {
     return it->second;
 }
 
+bool Server::answersFromLast(const Document& doc) const {
+    bool running = pending_ && pending_->uri == doc.uri;
+    return doc.analysis && (doc.dirty || running) && doc.analysis->milliseconds >= options_.quickAnalysisMs;
+}
+
 const Analysis& Server::readable(const Field& params) {
     Document& doc = openDocument(params);
-    bool running = pending_ && pending_->uri == doc.uri;
-    if (!doc.analysis || (!doc.dirty && !running)) return *document(params).analysis;
-    if (doc.analysis->milliseconds < options_.quickAnalysisMs) return *document(params).analysis;
+    if (!answersFromLast(doc)) return *document(params).analysis;
     if (doc.movedAt != doc.edits) {
         doc.moved = std::make_shared<const Analysis>(recover(*doc.analysis, *doc.analysis, doc.text, true));
         doc.movedAt = doc.edits;

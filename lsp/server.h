@@ -139,6 +139,10 @@ private:
     // analysis moved through the edits since (lsp/recover.h), which knows nothing of what
     // they changed until the new analysis is in.
     const Analysis& readable(const Field& params);
+    // Whether reads about `doc` answer from its last analysis (moved through the edits
+    // since) rather than wait for one of its text: that text is not analysed yet, and the
+    // last analysis took longer than quickAnalysisMs.
+    bool answersFromLast(const Document& doc) const;
     // Hover and definition where readable() would move the last analysis: the place asked
     // about mapped back into its text, the answer mapped forward (no copy of the index).
     // Nullopt where readable() is what answers.

@@ -125,19 +125,14 @@ const EditMap& Server::editMap(Document& doc) {
 
 std::string Server::outline(const Field& params) {
     Document& doc = openDocument(params);
-    bool running = pending_ && pending_->uri == doc.uri;
-    bool moves = doc.analysis && doc.analysis->parsed && (doc.dirty || running) &&
-                 doc.analysis->milliseconds >= options_.quickAnalysisMs && doc.movedAt != doc.edits;
-    if (!moves) return documentSymbols(readable(params));
+    if (!answersFromLast(doc) || !doc.analysis->parsed || doc.movedAt == doc.edits) return documentSymbols(readable(params));
     SourceFile now(doc.path, doc.text);
     return documentSymbols(now, movedSymbols(*doc.analysis, editMap(doc)));
 }
 
 std::optional<json> Server::throughEdits(const Field& params, bool wantDefinition) {
     Document& doc = openDocument(params);
-    bool running = pending_ && pending_->uri == doc.uri;
-    if (!doc.analysis || !doc.analysis->parsed || (!doc.dirty && !running)) return std::nullopt;
-    if (doc.analysis->milliseconds < options_.quickAnalysisMs || doc.movedAt == doc.edits) return std::nullopt;
+    if (!answersFromLast(doc) || !doc.analysis->parsed || doc.movedAt == doc.edits) return std::nullopt;
     // The place asked about, in the text the last analysis read; what is there, moved back
     // into the text as it is (nothing where the edits since touched it).
     const Analysis& a = *doc.analysis;
