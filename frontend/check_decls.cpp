@@ -235,7 +235,7 @@ void Checker::reportUnused() {
                 diags_.warning(eq->nameRanges[0], fmt::format("equation `{}` is never used", eq->names[0]));
         for (auto& child : object.children) visit(*child);
     };
-    bool anySpawn = false;
+    bool anySpawn = elsewhere_.spawns;
     for (auto& module : program_.modules)
         for (auto& decl : module->decls) anySpawn |= decl->kind == DeclKind::Spawn || decl->kind == DeclKind::Trigger;
     for (auto& module : program_.modules) {
@@ -281,8 +281,8 @@ void Checker::run() {
             if (decl->kind == DeclKind::Spawn) checkSpawn(static_cast<SpawnDecl&>(*decl));
         }
     reportInstancedFoldExterns();
-    if (diags_.errorCount() == 0) checkInlinedSize();
-    if (diags_.errorCount() == 0) reportUnused();
+    if (diags_.errorCount() + elsewhere_.errors == 0) checkInlinedSize();
+    if (diags_.errorCount() + elsewhere_.errors == 0) reportUnused();
 }
 
 }  // namespace psys::detail

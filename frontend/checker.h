@@ -18,6 +18,7 @@
 
 #include "frontend/ast.h"
 #include "frontend/diagnostics.h"
+#include "frontend/frontend.h"
 
 namespace psys::detail {
 
@@ -46,7 +47,8 @@ struct ObjectScope {
 
 class Checker {
 public:
-    Checker(ast::Program& program, DiagnosticEngine& diags) : program_(program), diags_(diags) {}
+    Checker(ast::Program& program, DiagnosticEngine& diags, CheckedElsewhere elsewhere = {})
+        : program_(program), diags_(diags), elsewhere_(elsewhere) {}
     void run();
 
 private:
@@ -122,6 +124,7 @@ private:
 
     ast::Program& program_;
     DiagnosticEngine& diags_;
+    CheckedElsewhere elsewhere_;  // where program_ is part of a program
 
     std::map<std::string, ast::Decl*> globals_;
     std::multimap<std::string, const ast::ObjectDecl*> nestedObjects_;

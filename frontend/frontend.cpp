@@ -5,8 +5,8 @@
 
 namespace psys {
 
-void checkProgram(ast::Program& program, DiagnosticEngine& diags) {
-    detail::Checker(program, diags).run();
+void checkProgram(ast::Program& program, DiagnosticEngine& diags, CheckedElsewhere elsewhere) {
+    detail::Checker(program, diags, elsewhere).run();
 }
 
 namespace {

@@ -65,8 +65,9 @@ fs::path importTarget(const std::string& path, const fs::path& importer, const S
 
 class Loader {
 public:
-    Loader(SourceManager& sources, DiagnosticEngine& diags, const SourceOverrides* overrides, ParseCache* cache)
-        : sources_(sources), diags_(diags), overrides_(overrides), cache_(cache) {}
+    Loader(SourceManager& sources, DiagnosticEngine& diags, const SourceOverrides* overrides, ParseCache* cache,
+           const std::vector<bool>* keep = nullptr)
+        : sources_(sources), diags_(diags), overrides_(overrides), cache_(cache), keep_(keep) {}
 
     std::unique_ptr<ast::Program> run(const std::string& displayPath, std::string text) {
         program_ = std::make_unique<ast::Program>();
@@ -78,7 +79,7 @@ public:
         std::string key = canonicalKey(displayPath);
         int file = sources_.add(displayPath.string(), std::move(text));
         sources_.setImportedAt(file, importedAt);
-        auto module = parseModule(file, sources_, diags_, cache_);
+        auto module = parseModule(file, sources_, diags_, cache_, stack_.empty() ? keep_ : nullptr);
         if (!module) return false;
         stack_.push_back({key, displayPath.string()});
         bool ok = true;
@@ -142,6 +143,7 @@ private:
     DiagnosticEngine& diags_;
     const SourceOverrides* overrides_;
     ParseCache* cache_;
+    const std::vector<bool>* keep_;  // the main file's pieces to load
     std::unique_ptr<ast::Program> program_;
     std::map<std::string, int> loaded_;
     std::vector<std::pair<std::string, std::string>> stack_;  // (canonical, display) of files being loaded
@@ -226,8 +228,9 @@ std::unique_ptr<ast::Program> loadProgram(const std::string& mainPath, SourceMan
 
 std::unique_ptr<ast::Program> loadProgramFromText(const std::string& displayPath, std::string text,
                                                   SourceManager& sources, DiagnosticEngine& diags,
-                                                  const SourceOverrides* overrides, ParseCache* cache) {
-    return Loader(sources, diags, overrides, cache).run(displayPath, std::move(text));
+                                                  const SourceOverrides* overrides, ParseCache* cache,
+                                                  const std::vector<bool>* keep) {
+    return Loader(sources, diags, overrides, cache, keep).run(displayPath, std::move(text));
 }
 
 std::string sourceKey(const std::filesystem::path& path) {

@@ -48,10 +48,12 @@ class ParseCache;
 // The same for a main file given as text (tests, the viewer's editor buffer); imports are
 // resolved relative to the directory of `displayPath`, and read from `overrides` where
 // it holds their text. Every file is parsed through `cache` where one is given
-// (frontend/parse_cache.h: an editor's document, analysed after each edit).
+// (frontend/parse_cache.h: an editor's document, analysed after each edit), and only the
+// main file's pieces that `keep` flags are in its module where that is given (the language
+// server re-checking what an edit touched: lsp/incremental.h).
 std::unique_ptr<ast::Program> loadProgramFromText(const std::string& displayPath, std::string text,
                                                   SourceManager& sources, DiagnosticEngine& diags,
                                                   const SourceOverrides* overrides = nullptr,
-                                                  ParseCache* cache = nullptr);
+                                                  ParseCache* cache = nullptr, const std::vector<bool>* keep = nullptr);
 
 }  // namespace psys

@@ -512,10 +512,11 @@ std::unique_ptr<Module> parseText(int file, std::string_view text, uint32_t shif
     return builder.build(tree);
 }
 
-std::unique_ptr<Module> parseModule(int file, const SourceManager& sources, DiagnosticEngine& diags, ParseCache* cache) {
+std::unique_ptr<Module> parseModule(int file, const SourceManager& sources, DiagnosticEngine& diags, ParseCache* cache,
+                                    const std::vector<bool>* keep) {
     const std::string& text = sources.file(file).text();
     if (unparsable(file, text, diags)) return nullptr;
-    auto module = cache ? cache->parse(file, text, diags) : parseText(file, text, 0, diags, true);
+    auto module = cache ? cache->parse(file, text, diags, keep) : parseText(file, text, 0, diags, true);
     if (module) module->path = sources.file(file).path();
     return module;
 }

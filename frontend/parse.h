@@ -16,9 +16,10 @@ class ParseCache;
 
 // Returns null when the file has syntax errors (they are reported to `diags`, several per
 // file: the parser recovers and goes on). With a cache, the file's top-level declarations
-// that an earlier parse through it saw are copied rather than parsed again (the same AST).
+// that an earlier parse through it saw are copied rather than parsed again (the same AST),
+// and only those `keep` flags are in the module where it is given (ParseCache::parse).
 std::unique_ptr<ast::Module> parseModule(int file, const SourceManager& sources, DiagnosticEngine& diags,
-                                         ParseCache* cache = nullptr);
+                                         ParseCache* cache = nullptr, const std::vector<bool>* keep = nullptr);
 
 // Parses `text`, the bytes [shift, shift + text.size()) of `file` from a top-level
 // declaration's start on, as a sequence of declarations; ranges are the file's. Where it

@@ -1,7 +1,10 @@
 // Parsing by top-level declaration, reusing the unchanged ones (frontend/parse_cache.h).
 #include "frontend/parse_cache.h"
 
+#include <algorithm>
 #include <string_view>
+
+#include "PsysLexer.h"
 
 #include "frontend/parse.h"
 
@@ -73,10 +76,62 @@ std::shared_ptr<const ParseCache::Piece> ParseCache::find(const std::string& tex
     return it->second;
 }
 
-std::unique_ptr<ast::Module> ParseCache::parse(int file, const std::string& text, DiagnosticEngine& diags) {
+namespace {
+
+void declaredNames(const ast::ObjectDecl& o, std::vector<std::string>& out) {
+    for (const auto& child : o.children) {
+        out.push_back(child->name);
+        declaredNames(*child, out);
+    }
+}
+
+void sortUnique(std::vector<std::string>& names) {
+    std::sort(names.begin(), names.end());
+    names.erase(std::unique(names.begin(), names.end()), names.end());
+}
+
+// What lsp/incremental.h relates pieces by: the names a piece uses (a member after a `.` is
+// the type's before it, not a declaration of the file) and the ones it declares.
+void relate(ParsedPiece& piece, std::string_view text) {
+    for (size_t i = 0; i < piece.tokens.size(); ++i) {
+        const LexedToken& t = piece.tokens[i];
+        if (t.type != grammar::PsysLexer::IDENT) continue;
+        if (i > 0 && text.substr(piece.tokens[i - 1].begin, piece.tokens[i - 1].end - piece.tokens[i - 1].begin) == ".")
+            continue;
+        piece.mentions.emplace_back(text.substr(t.begin, t.end - t.begin));
+    }
+    sortUnique(piece.mentions);
+    for (const ast::DeclPtr& d : piece.decls) {
+        if (!d->name.empty()) piece.declares.push_back(d->name);
+        if (d->kind == ast::DeclKind::Object) declaredNames(static_cast<const ast::ObjectDecl&>(*d), piece.declares);
+    }
+    sortUnique(piece.declares);
+}
+
+}  // namespace
+
+std::shared_ptr<const ParseCache::Piece> ParseCache::piece(int file, std::string text, DiagnosticEngine& diags) {
+    if (auto found = find(text)) return found;
+    // Parsed alone at offset 0, errors kept apart: one that does not parse alone, or names
+    // an unknown type, is parsed again with the rest of the file.
+    DiagnosticEngine quiet(diags.sources());
+    auto fresh = std::make_shared<Piece>();
+    auto module = parseText(file, text, 0, quiet, false, &fresh->tokens);
+    if (!module || quiet.errorCount() > 0) return nullptr;
+    fresh->decls = std::move(module->decls);
+    relate(*fresh, text);
+    std::lock_guard lock(mutex_);
+    fresh->used = generation_;
+    ++counts_.parsed;
+    return pieces_.emplace(std::move(text), std::move(fresh)).first->second;
+}
+
+std::unique_ptr<ast::Module> ParseCache::parse(int file, const std::string& text, DiagnosticEngine& diags,
+                                               const std::vector<bool>* keep) {
     auto module = std::make_unique<ast::Module>();
     module->file = file;
     std::vector<TopDeclaration> tops = topLevelDeclarations(text);
+    if (keep && keep->size() != tops.size()) keep = nullptr;
     // The pieces cover the text: each from the end of the one before to its own end (the
     // comments and white space before a declaration are its piece's).
     std::vector<size_t> declsBefore;  // module->decls.size() where each piece starts
@@ -87,24 +142,8 @@ std::unique_ptr<ast::Module> ParseCache::parse(int file, const std::string& text
         // (A byte order mark the lexer drops at the start of its input, not elsewhere: a
         // piece after the first that starts with one is parsed with what comes before.)
         bool alone = !tops[k].unfinished && !(k > 0 && key.rfind(kByteOrderMark, 0) == 0);
-        std::shared_ptr<const Piece> piece = alone ? find(key) : nullptr;
-        if (!piece && alone) {
-            // Parsed alone at offset 0, errors kept apart: one that does not parse alone,
-            // or names an unknown type, is parsed again below with the rest of the file.
-            DiagnosticEngine quiet(diags.sources());
-            std::vector<LexedToken> tokens;
-            auto module = parseText(file, key, 0, quiet, false, &tokens);
-            if (module && quiet.errorCount() == 0) {
-                auto fresh = std::make_shared<Piece>();
-                fresh->decls = std::move(module->decls);
-                fresh->tokens = std::move(tokens);
-                std::lock_guard lock(mutex_);
-                fresh->used = generation_;
-                ++counts_.parsed;
-                piece = pieces_.emplace(std::move(key), std::move(fresh)).first->second;
-            }
-        }
-        if (!piece) {
+        std::shared_ptr<const Piece> found = alone ? piece(file, std::move(key), diags) : nullptr;
+        if (!found) {
             // From the declaration before this one (a missing token is reported just after
             // the last one matched, maybe that declaration's end) to the end of the file:
             // the whole file's parse from there on, the same errors at the same places.
@@ -116,10 +155,27 @@ std::unique_ptr<ast::Module> ParseCache::parse(int file, const std::string& text
             for (auto& d : rest->decls) module->decls.push_back(std::move(d));
             return module;
         }
-        for (const ast::DeclPtr& d : piece->decls) module->decls.push_back(ast::cloneParsed(*d, file, from));
+        if (!keep || (*keep)[k])
+            for (const ast::DeclPtr& d : found->decls) module->decls.push_back(ast::cloneParsed(*d, file, from));
         from = tops[k].end;
     }
     return module;
+}
+
+std::optional<std::vector<PieceAt>> ParseCache::pieces(const std::string& text) {
+    std::vector<PieceAt> out;
+    SourceManager noSources;  // (a piece's syntax errors are not reported: it is not a piece then)
+    DiagnosticEngine none(noSources);
+    uint32_t from = 0;
+    for (const TopDeclaration& top : topLevelDeclarations(text)) {
+        std::string key = text.substr(from, top.end - from);
+        if (top.unfinished || (from > 0 && key.rfind(kByteOrderMark, 0) == 0)) return std::nullopt;
+        auto found = piece(0, std::move(key), none);  // (any file: a copy gets its own)
+        if (!found) return std::nullopt;
+        out.push_back({from, top.end, found});
+        from = top.end;
+    }
+    return out;
 }
 
 std::optional<std::vector<LexedToken>> ParseCache::tokens(const std::string& text) {

@@ -35,11 +35,33 @@ struct TopDeclaration {
 // one before is unfinished, so that a missing `}` does not swallow the rest of the file.
 std::vector<TopDeclaration> topLevelDeclarations(const std::string& text);
 
+// A top-level declaration's text as parsed alone (at offset 0), and the names that the
+// language server's incremental analysis relates declarations by (lsp/incremental.h).
+struct ParsedPiece {
+    std::vector<ast::DeclPtr> decls;
+    std::vector<LexedToken> tokens;
+    std::vector<std::string> mentions;  // its identifiers but those after a `.`, sorted, once each
+    std::vector<std::string> declares;  // its declarations' names and their nested objects', sorted
+    uint64_t used = 0;                  // the generation that last used it
+};
+
+// A piece of a text: the declaration parsed, and the comments and white space before it.
+struct PieceAt {
+    uint32_t begin, end;
+    std::shared_ptr<const ParsedPiece> parsed;
+};
+
 // One per document (shared between the threads that analyse it).
 class ParseCache {
 public:
     // The module of `text` (the file `file`), or null with its syntax errors reported.
-    std::unique_ptr<ast::Module> parse(int file, const std::string& text, DiagnosticEngine& diags);
+    // Where `keep` is given (one flag a piece of `pieces(text)`), only the pieces flagged are
+    // in the module: the rest of the file is known from elsewhere.
+    std::unique_ptr<ast::Module> parse(int file, const std::string& text, DiagnosticEngine& diags,
+                                       const std::vector<bool>* keep = nullptr);
+    // Every piece of `text`, each parsed alone; nullopt where one does not parse alone (a
+    // syntax error, an unfinished declaration).
+    std::optional<std::vector<PieceAt>> pieces(const std::string& text);
     // The tokens of `text` where every declaration of it is held (as parsed: it has no
     // syntax error), so that the layout need not lex it again (frontend/format.h).
     std::optional<std::vector<LexedToken>> tokens(const std::string& text);
@@ -54,12 +76,10 @@ public:
     Counts counts() const;
 
 private:
-    struct Piece {
-        std::vector<ast::DeclPtr> decls;  // as parsed at offset 0
-        std::vector<LexedToken> tokens;
-        uint64_t used = 0;                // the generation that last used it
-    };
+    using Piece = ParsedPiece;
     std::shared_ptr<const Piece> find(const std::string& text);
+    // The piece of `text` found or parsed alone; null where it does not parse alone.
+    std::shared_ptr<const Piece> piece(int file, std::string text, DiagnosticEngine& diags);
 
     mutable std::mutex mutex_;
     std::unordered_map<std::string, std::shared_ptr<Piece>> pieces_;

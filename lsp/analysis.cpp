@@ -12,6 +12,7 @@
 #include "interp/interpreter.h"
 #include "frontend/frontend.h"
 #include "frontend/loader.h"
+#include "lsp/incremental.h"
 #include "lsp/index_builder.h"
 #include "lsp/salvage.h"
 #include "opt/passes.h"
@@ -64,10 +65,12 @@ Analysis analyze(const std::string& path, std::string text, const AnalyzeOptions
     auto started = std::chrono::steady_clock::now();
     const std::atomic<bool>* cancelled = options.cancelled;
     auto stop = [&] { return cancelled && cancelled->load(std::memory_order_relaxed); };
+    if (options.previous && options.cache && !options.passes)
+        if (auto again = reanalyze(path, text, *options.previous, options)) return std::move(*again);
     Analysis a;
     a.sources = std::make_unique<SourceManager>();
     DiagnosticEngine diags(*a.sources);
-    diags.setLimit(kMaxPublished);
+    diags.setLimit(kMaxKept);
     size_t passDiagnostics = SIZE_MAX;  // where the passes' diagnostics start
     try {
         std::unique_ptr<ast::Program> program = loadProgramFromText(path, std::move(text), *a.sources, diags, options.open, options.cache);
@@ -77,6 +80,9 @@ Analysis analyze(const std::string& path, std::string text, const AnalyzeOptions
             a.parsed = true;
             a.mainFile = program->main().file;
             buildIndex(*program, *a.sources, a);
+            a.instanced = program->instanced;
+            if (options.cache)
+                if (auto pieces = options.cache->pieces(a.sources->file(a.mainFile).text())) a.pieces = std::move(*pieces);
             // What `psysc check` reports beyond the front end comes from the passes: an
             // integral with no closed form under @integrator(exact), a decay past the
             // integrator's stability limit. They run on a clean program only.
@@ -113,10 +119,14 @@ Analysis analyze(const std::string& path, std::string text, const AnalyzeOptions
             if (a.sources->file(f).path() == path) a.mainFile = f;
     for (int f = 0; f < a.sources->count(); ++f)
         if (f != a.mainFile) a.imported.insert(sourceKey(a.sources->file(f).path()));
-    a.diagnostics = diags.take();
-    a.passDiagnostics = std::min(passDiagnostics, a.diagnostics.size());
-    a.hiddenErrors = diags.hiddenErrors();
-    a.hiddenWarnings = diags.hiddenWarnings();
+    {
+        int hiddenErrors = diags.hiddenErrors(), hiddenWarnings = diags.hiddenWarnings();
+        std::vector<Diagnostic> all = diags.take();
+        size_t front = std::min(passDiagnostics, all.size());
+        std::vector<Diagnostic> passes(std::make_move_iterator(all.begin() + long(front)), std::make_move_iterator(all.end()));
+        all.resize(front);
+        publishable(a, std::move(all), std::move(passes), hiddenErrors, hiddenWarnings);
+    }
     if (options.salvage && !a.parsed && !stop())
         if (auto s = salvaged(path, a, options)) a = std::move(*s);
     a.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started).count();
@@ -136,6 +146,7 @@ std::optional<Analysis> salvaged(const std::string& path, const Analysis& broken
     if (!blanked) return std::nullopt;
     AnalyzeOptions again = options;
     again.salvage = false;
+    again.previous = nullptr;
     Analysis s = analyze(path, *blanked, again);
     if (!s.parsed || s.mainFile < 0) return std::nullopt;
     // The index over the text as it is (the blanked one has spaces where the broken
@@ -153,6 +164,7 @@ std::optional<Analysis> salvaged(const std::string& path, const Analysis& broken
     s.hiddenErrors = broken.hiddenErrors;
     s.hiddenWarnings = broken.hiddenWarnings;
     s.recovered = true;
+    s.frontEnd = nullptr;
     s.imported.insert(broken.imported.begin(), broken.imported.end());
     return s;
 }

@@ -81,6 +81,16 @@ struct Scope {
 // that, a note at the top of the file says how many more there are. 50,000 errors of a
 // broken generated file would be megabytes of JSON on every keystroke.
 constexpr int kMaxPublished = 1000;
+// An analysis keeps every front-end diagnostic up to this many (for the next text's
+// analysis to carry: lsp/incremental.h); past it, the next is a whole one.
+constexpr int kMaxKept = 10 * kMaxPublished;
+
+// Where one of the main file's top-level declarations' entries start in an analysis's
+// index (buildIndex walks the imports', then the main file's declarations in order).
+struct IndexMark {
+    uint32_t begin = 0;  // the declaration's first byte (the end of the file: past the last)
+    size_t occurrences = 0, symbols = 0, globals = 0, scopes = 0, hints = 0, integrating = 0, members = 0;
+};
 
 struct Analysis {
     std::unique_ptr<SourceManager> sources;
@@ -97,7 +107,9 @@ struct Analysis {
     bool passesRan = false;
     double passesMs = 0;
     size_t passDiagnostics = 0, passHints = 0;
-    std::vector<Diagnostic> diagnostics;  // at most kMaxPublished errors and as many warnings
+    // The front end's (in the order of their places) then the passes': at most
+    // kMaxPublished errors and as many warnings, the first in the file.
+    std::vector<Diagnostic> diagnostics;
     int hiddenErrors = 0, hiddenWarnings = 0;  // counted past that, not kept
     std::vector<Occurrence> occurrences;  // every file's, in the order found
     std::vector<Symbol> symbols;          // the main file's declarations
@@ -109,6 +121,17 @@ struct Analysis {
     // The files the main file imports, directly or not (their sourceKey): an edit to one of
     // them, open in the editor, calls for this document to be analysed again.
     std::set<std::string> imported;
+
+    // For the analysis of the next text to re-check only what its edit touched
+    // (lsp/incremental.h): the main file's pieces as parsed (ParseCache::pieces), each of
+    // its declarations' first index entries (and one past the last), every front-end
+    // diagnostic (null where there were more than kMaxKept), whether the program reads
+    // `instance`; and whether this analysis was made so.
+    std::vector<PieceAt> pieces;
+    std::vector<IndexMark> marks;
+    std::shared_ptr<const std::vector<Diagnostic>> frontEnd;
+    bool instanced = false;
+    bool incremental = false;
 
     // The innermost occurrence at `offset` of `file` (its end counts: the cursor just after a name).
     const Occurrence* at(int file, uint32_t offset) const;
@@ -130,6 +153,10 @@ struct AnalyzeOptions {
     // Where given, the files are parsed through it (frontend/parse_cache.h): a document's
     // analysis after an edit parses only the declarations the edit changed.
     ParseCache* cache = nullptr;
+    // Where given (with `cache`, and without the passes), the last analysis of the
+    // document that parsed: only the declarations the edit since can change are checked
+    // again where that is enough (lsp/incremental.h).
+    const Analysis* previous = nullptr;
 };
 
 // Runs the front end over `text` as the file `path` (imports are read relative to it),

@@ -39,7 +39,15 @@ public:
 
     void module(const Module& m, bool main) {
         main_ = main;
-        for (const DeclPtr& d : m.decls) decl(*d, main);
+        for (const DeclPtr& d : m.decls) {
+            if (main) out_.marks.push_back(mark(d->range.begin));
+            decl(*d, main);
+        }
+    }
+
+    IndexMark mark(uint32_t begin) const {
+        return {begin, out_.occurrences.size(), out_.symbols.size(), out_.globals.size(), out_.scopes.size(),
+                out_.hints.size(), out_.integrating.size(), out_.members.size()};
     }
 
 private:
@@ -365,6 +373,7 @@ std::string signature(const TriggerDecl& t) {
 void buildIndex(const Program& program, const SourceManager&, Analysis& out) {
     Walker walker(program, out);
     for (const auto& m : program.modules) walker.module(*m, m.get() == program.modules.back().get());
+    out.marks.push_back(walker.mark(UINT32_MAX));
 }
 
 }  // namespace psys::lsp

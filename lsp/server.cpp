@@ -343,9 +343,9 @@ void Server::analyse(Document& doc) {
     SourceOverrides open = openTexts(&doc);
     // (Without the passes where they are slow, as in the background: a read that waits
     // for an analysis waits no longer than the last one took.)
-    install(doc, analyze(doc.path, doc.text, {.open = &open, .salvage = !doc.lastParsed,
-                                              .passes = doc.passesMs <= options_.quickAnalysisMs,
-                                              .cache = doc.parses.get()}));
+    bool passes = doc.passesMs <= options_.quickAnalysisMs;
+    install(doc, analyze(doc.path, doc.text, {.open = &open, .salvage = !doc.lastParsed, .passes = passes,
+                                              .cache = doc.parses.get(), .previous = doc.lastParsed.get()}));
 }
 
 void Server::install(Document& doc, Analysis analysis) {
@@ -433,10 +433,10 @@ void Server::start(Document& doc, bool passes) {
     pending_ = Pending{doc.uri, doc.edits, cancelled,
                        std::async(std::launch::async,
                                   [path = doc.path, text = doc.text, open = openTexts(&doc), cancelled,
-                                   salvage = !doc.lastParsed, parses = doc.parses, passes] {
+                                   salvage = !doc.lastParsed, parses = doc.parses, passes, previous = doc.lastParsed] {
                                       return analyze(path, text, {.cancelled = cancelled.get(), .open = &open,
                                                                   .salvage = salvage, .passes = passes,
-                                                                  .cache = parses.get()});
+                                                                  .cache = parses.get(), .previous = previous.get()});
                                   })};
 }
 

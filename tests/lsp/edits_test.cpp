@@ -168,33 +168,6 @@ TEST_CASE("diagnostics: a type error covers the operands that disagree, in UTF-1
 
 namespace {
 
-// Everything an analysis answers from, as text: the index (every name's and expression's
-// range, hover, definition and token), the outline, the hints and the diagnostics.
-std::string everything(const Analysis& a) {
-    std::string out;
-    auto range = [](SourceRange r) { return fmt::format("{}:{}-{}", r.file, r.begin, r.end); };
-    for (const Occurrence& o : a.occurrences)
-        out += fmt::format("{} {} {} {}\n", range(o.range), o.hover ? *o.hover : "", o.definition ? range(*o.definition) : "",
-                           static_cast<int>(o.token.type));
-    std::function<void(const std::vector<Symbol>&)> symbols = [&](const std::vector<Symbol>& list) {
-        for (const Symbol& s : list) {
-            out += fmt::format("symbol {} {} {} {}\n", s.name, s.detail, range(s.range), range(s.selection));
-            symbols(s.children);
-        }
-    };
-    symbols(a.symbols);
-    for (const Hint& h : a.hints) out += fmt::format("hint {} {}\n", range(h.at), h.label);
-    for (const Diagnostic& d : a.diagnostics) out += fmt::format("diagnostic {} {}\n", range(d.range), d.message);
-    return out;
-}
-
-std::string slurp(const std::string& path) {
-    std::ifstream in(path);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
 }  // namespace
 
 TEST_CASE("analysis through a document's parse cache: what a fresh analysis answers, on every sample, after edits") {

@@ -8,11 +8,14 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <functional>
+#include <sstream>
 #include <fstream>
 #include <limits>
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "lsp/analysis.h"
@@ -22,6 +25,46 @@
 namespace psys::lsp::test {
 
 using nlohmann::json;
+
+// Everything an analysis answers from, as text: the index (every name's and expression's
+// range, hover, definition and token; scopes, file-scope names, members), the outline,
+// the hints and the diagnostics (with their notes and fixes, and how many are hidden).
+inline std::string everything(const Analysis& a) {
+    std::string out;
+    auto range = [](SourceRange r) { return fmt::format("{}:{}-{}", r.file, r.begin, r.end); };
+    for (const Occurrence& o : a.occurrences)
+        out += fmt::format("{} {} {} {}\n", range(o.range), o.hover ? *o.hover : "", o.definition ? range(*o.definition) : "",
+                           static_cast<int>(o.token.type));
+    std::function<void(const std::vector<Symbol>&)> symbols = [&](const std::vector<Symbol>& list) {
+        for (const Symbol& s : list) {
+            out += fmt::format("symbol {} {} {} {}\n", s.name, s.detail, range(s.range), range(s.selection));
+            symbols(s.children);
+        }
+    };
+    symbols(a.symbols);
+    auto names = [&](const std::vector<Name>& list) {
+        for (const Name& n : list) out += fmt::format("  {} {} {} {}\n", n.label, n.detail, n.documentation, int(n.kind));
+    };
+    for (const Scope& s : a.scopes) out += fmt::format("scope {} {}\n", range(s.range), s.pure), names(s.names);
+    out += "globals\n", names(a.globals);
+    for (const auto& [object, members] : a.members) out += "members " + object + "\n", names(members);
+    for (SourceRange r : a.integrating) out += "integrating " + range(r) + "\n";
+    for (const Hint& h : a.hints) out += fmt::format("hint {} {}\n", range(h.at), h.label);
+    for (const Diagnostic& d : a.diagnostics) {
+        out += fmt::format("diagnostic {} {} {}\n", range(d.range), d.message, d.focus ? int(*d.focus) : -1);
+        for (const DiagnosticNote& n : d.notes) out += fmt::format("  note {} {}\n", range(n.range), n.message);
+        for (const FixIt& f : d.fixes) out += fmt::format("  fix {} {} {}\n", f.title, range(f.range), f.replacement);
+    }
+    out += fmt::format("hidden {} {}\n", a.hiddenErrors, a.hiddenWarnings);
+    return out;
+}
+
+inline std::string slurp(const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
 
 inline const char* kFireworks = R"(extern sparks: float = 50;
 fn gravity(m: float) -> vec3 = vec3(0, -9.82 * m, 0);
