@@ -232,10 +232,11 @@ void Checker::reportUnused() {
     std::function<void(const ObjectDecl&)> visit = [&](const ObjectDecl& object) {
         for (auto& eq : object.equations)
             if (!usedEquations_.count(eq.get()) && !eq->isTuple())
-                diags_.warning(eq->nameRanges[0], fmt::format("equation `{}` is never used", eq->names[0]));
+                diags_.warning(eq->nameRanges[0], fmt::format("equation `{}` is never used", eq->names[0])).report =
+                    ProgramReport::Unused;
         for (auto& child : object.children) visit(*child);
     };
-    bool anySpawn = elsewhere_.spawns;
+    bool anySpawn = options_.spawnsElsewhere;
     for (auto& module : program_.modules)
         for (auto& decl : module->decls) anySpawn |= decl->kind == DeclKind::Spawn || decl->kind == DeclKind::Trigger;
     for (auto& module : program_.modules) {
@@ -246,7 +247,8 @@ void Checker::reportUnused() {
             // Only the main file's objects: a library may declare objects its users never create.
             if (anySpawn && module.get() == program_.modules.back().get() && !createdObjects_.count(&object))
                 diags_.warning(object.nameRange, fmt::format("object `{}` is never created: nothing spawns or emits it",
-                                                             object.name));
+                                                             object.name))
+                    .report = ProgramReport::Unused;
         }
     }
 }
@@ -281,8 +283,8 @@ void Checker::run() {
             if (decl->kind == DeclKind::Spawn) checkSpawn(static_cast<SpawnDecl&>(*decl));
         }
     reportInstancedFoldExterns();
-    if (diags_.errorCount() + elsewhere_.errors == 0) checkInlinedSize();
-    if (diags_.errorCount() + elsewhere_.errors == 0) reportUnused();
+    if (diags_.errorCount() == 0 || options_.allReports) checkInlinedSize();
+    if (diags_.errorCount() == 0 || options_.allReports) reportUnused();
 }
 
 }  // namespace psys::detail

@@ -389,8 +389,7 @@ Type Checker::checkCall(CallExpr& call, const Context& ctx) {
         reportUnknown("function", call.callee, call.calleeRange, [&] {
             std::vector<std::string> candidates;
             for (auto& f : builtinFunctions()) candidates.emplace_back(f.name);
-            for (auto& [n, d] : globals_)
-                if (d->kind == DeclKind::Fn) candidates.push_back(n);
+            for (std::string& n : globalNames({DeclKind::Fn})) candidates.push_back(std::move(n));
             return candidates;
         });
         return Type::error();

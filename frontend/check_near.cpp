@@ -67,10 +67,10 @@ Type Checker::checkNear(CallExpr& call, const Context& ctx) {
                 return Type::error();
             }
             std::vector<std::string> types;
-            for (const auto& [name, decl] : globals_)
-                if (decl->kind == DeclKind::Object && name != named) types.push_back(name);
-            for (const auto& [name, object] : nestedObjects_)
-                if (name != named) types.push_back(name);
+            for (std::string& name : globalNames({DeclKind::Object}))
+                if (name != named) types.push_back(std::move(name));
+            for (std::string& name : nestedNames())
+                if (name != named) types.push_back(std::move(name));
             suggestion = closestName(named, types);
         }
         Diagnostic& d = diags_.error(typeArg.range, fmt::format("the first argument of `{}` must name an object type (the "

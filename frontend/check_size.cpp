@@ -90,7 +90,8 @@ void equations(const ObjectDecl& o, InlinedSize& size, DiagnosticEngine& diags) 
     for (const EquationPtr& eq : o.equations)
         if (uint64_t n = size.of(*eq->value); n > kMaxInlinedOperations)
             diags.error(eq->range, fmt::format("equation `{}` is {} once its function calls are inlined, more than the "
-                                               "{} an equation may be", eq->names[0], operations(n), kMaxInlinedOperations));
+                                               "{} an equation may be", eq->names[0], operations(n), kMaxInlinedOperations))
+                .report = ProgramReport::InlinedSize;
     for (const auto& child : o.children) equations(*child, size, diags);
 }
 
@@ -111,9 +112,11 @@ void Checker::checkInlinedSize() {
             bool throughAnother = false;
             for (const FnDecl* callee : size.callees(fn)) throughAnother |= tooLarge.count(callee) > 0;
             if (throughAnother) continue;
-            diags_.error(fn.nameRange, fmt::format("function `{}` is {} once the calls in it are inlined, more than the "
-                                                   "{} a function may be", fn.name, operations(n), kMaxInlinedOperations))
-                .notes.push_back({fn.nameRange, "every call is inlined: a function that calls another twice doubles it"});
+            Diagnostic& d = diags_.error(fn.nameRange, fmt::format("function `{}` is {} once the calls in it are inlined, more "
+                                                                   "than the {} a function may be",
+                                                                   fn.name, operations(n), kMaxInlinedOperations));
+            d.notes.push_back({fn.nameRange, "every call is inlined: a function that calls another twice doubles it"});
+            d.report = ProgramReport::InlinedSize;
         }
     if (!tooLarge.empty()) return;  // the functions are the error; their callers would only repeat it
     for (auto& module : program_.modules)

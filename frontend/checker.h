@@ -47,8 +47,8 @@ struct ObjectScope {
 
 class Checker {
 public:
-    Checker(ast::Program& program, DiagnosticEngine& diags, CheckedElsewhere elsewhere = {})
-        : program_(program), diags_(diags), elsewhere_(elsewhere) {}
+    Checker(ast::Program& program, DiagnosticEngine& diags, CheckOptions options = {})
+        : program_(program), diags_(diags), options_(options) {}
     void run();
 
 private:
@@ -64,6 +64,11 @@ private:
                        const std::function<std::vector<std::string>()>& candidates);
     std::vector<std::string> namesInScope(const Context& ctx) const;
     const ast::ObjectDecl* enclosingObject(const std::string& name, const Context& ctx, int* depth) const;
+    // For did-you-mean: the names of the program's top-level declarations of the kinds
+    // given, and its nested objects' (with repeats), each in name order; the ones declared
+    // elsewhere too (CheckOptions).
+    std::vector<std::string> globalNames(std::initializer_list<ast::DeclKind> kinds) const;
+    std::vector<std::string> nestedNames() const;
 
     // check_expr.cpp
     Type check(ast::Expr& expr, const Context& ctx);
@@ -124,7 +129,8 @@ private:
 
     ast::Program& program_;
     DiagnosticEngine& diags_;
-    CheckedElsewhere elsewhere_;  // where program_ is part of a program
+    CheckOptions options_;
+    mutable std::optional<std::map<std::string, ast::DeclKind>> everyGlobal_;  // globalNames's, once
 
     std::map<std::string, ast::Decl*> globals_;
     std::multimap<std::string, const ast::ObjectDecl*> nestedObjects_;

@@ -218,4 +218,14 @@ std::string DiagnosticEngine::render(bool colour) const {
     return out.str();
 }
 
+PublishedReports publishedReports(const std::vector<Diagnostic>& all) {
+    bool placeErrors = false, sizeErrors = false;
+    for (const Diagnostic& d : all) {
+        if (d.severity != Severity::Error) continue;
+        placeErrors |= d.report == ProgramReport::None;
+        sizeErrors |= d.report == ProgramReport::InlinedSize;
+    }
+    return {!placeErrors, !placeErrors && !sizeErrors};
+}
+
 }  // namespace psys

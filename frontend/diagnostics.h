@@ -9,6 +9,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cstdint>
 #include <iosfwd>
 #include <optional>
 #include <string>
@@ -26,6 +27,11 @@ struct DiagnosticNote {
     std::string message;
 };
 
+// The reports on a whole program, made where it has no other error (frontend.h's
+// CheckOptions::allReports): the functions and equations too large once inlined, then
+// (where none is) the equations never used and the objects never created.
+enum class ProgramReport : uint8_t { None, InlinedSize, Unused };
+
 // An edit that does what a diagnostic suggests: the editor offers it as a quick fix.
 struct FixIt {
     std::string title;  // what the editor lists: "Change to `vel`"
@@ -42,7 +48,18 @@ struct Diagnostic {
     // The byte the caret marks and `line:column` names, inside `range` (nullopt: its
     // start): the operator of a binary expression whose operands' types disagree.
     std::optional<uint32_t> focus;
+    ProgramReport report = ProgramReport::None;
 };
+
+// Which of the program reports in `all` (a check's with CheckOptions::allReports) a check
+// without it makes: the sizes where nothing else is an error, the unused where nothing is.
+struct PublishedReports {
+    bool inlinedSize = false, unused = false;
+    bool operator()(const Diagnostic& d) const {
+        return d.report == ProgramReport::None || (d.report == ProgramReport::InlinedSize ? inlinedSize : unused);
+    }
+};
+PublishedReports publishedReports(const std::vector<Diagnostic>& all);
 
 class DiagnosticEngine {
 public:

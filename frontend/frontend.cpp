@@ -5,8 +5,8 @@
 
 namespace psys {
 
-void checkProgram(ast::Program& program, DiagnosticEngine& diags, CheckedElsewhere elsewhere) {
-    detail::Checker(program, diags, elsewhere).run();
+void checkProgram(ast::Program& program, DiagnosticEngine& diags, CheckOptions options) {
+    detail::Checker(program, diags, options).run();
 }
 
 namespace {

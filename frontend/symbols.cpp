@@ -65,26 +65,24 @@ std::string closestName(const std::string& name, const std::vector<std::string>&
     return best;
 }
 
+namespace {
+
+// What the language defines `name` as, where it does (the end of "`name` is …"), else null.
+const char* languageDefines(const std::string& name) {
+    if (name == kInstanceName) return "a built-in value (the instance an object belongs to: `instance.pos`, …)";
+    if (isBuiltinVariable(name)) return "a built-in variable";
+    if (findBuiltinConstant(name) >= 0) return "a built-in constant";
+    if (Type::fromName(name)) return "a type";
+    return nullptr;
+}
+
+}  // namespace
+
 // A user's name may not redefine what the language defines.
 bool Checker::checkDeclarableName(const std::string& name, SourceRange range, const char* what) {
-    if (name == kInstanceName) {
-        diags_.error(range, fmt::format("cannot declare {} named `instance`: `instance` is a built-in value (the "
-                                        "instance an object belongs to: `instance.pos`, …)", what));
-        return false;
-    }
-    if (isBuiltinVariable(name)) {
-        diags_.error(range, fmt::format("cannot declare {} named `{}`: `{}` is a built-in variable", what, name, name));
-        return false;
-    }
-    if (findBuiltinConstant(name) >= 0) {
-        diags_.error(range, fmt::format("cannot declare {} named `{}`: `{}` is a built-in constant", what, name, name));
-        return false;
-    }
-    if (Type::fromName(name)) {
-        diags_.error(range, fmt::format("cannot declare {} named `{}`: `{}` is a type", what, name, name));
-        return false;
-    }
-    return true;
+    const char* is = languageDefines(name);
+    if (is) diags_.error(range, fmt::format("cannot declare {} named `{}`: `{}` is {}", what, name, name, is));
+    return is == nullptr;
 }
 
 void Checker::declareGlobal(Decl& decl) {
@@ -130,6 +128,28 @@ void Checker::collectGlobals() {
     }
 }
 
+std::vector<std::string> Checker::globalNames(std::initializer_list<DeclKind> kinds) const {
+    if (!everyGlobal_) {
+        everyGlobal_.emplace();
+        for (const auto& [name, decl] : globals_) everyGlobal_->emplace(name, decl->kind);
+        // (As declareGlobal would: the first of a name, none the language defines.)
+        for (const auto& [name, kind] : options_.declaredElsewhere)
+            if (findBuiltinFunction(name) < 0 && languageDefines(name) == nullptr) everyGlobal_->emplace(name, kind);
+    }
+    std::vector<std::string> out;
+    for (const auto& [name, kind] : *everyGlobal_)
+        if (std::find(kinds.begin(), kinds.end(), kind) != kinds.end()) out.push_back(name);
+    return out;
+}
+
+std::vector<std::string> Checker::nestedNames() const {
+    std::vector<std::string> out;
+    for (const auto& [name, object] : nestedObjects_) out.push_back(name);
+    out.insert(out.end(), options_.nestedElsewhere.begin(), options_.nestedElsewhere.end());
+    std::stable_sort(out.begin(), out.end());
+    return out;
+}
+
 // The enclosing object called `name`, if any, and how many levels up it is.
 const ObjectDecl* Checker::enclosingObject(const std::string& name, const Context& ctx, int* depth) const {
     if (ctx.where != Where::Object || !ctx.object) return nullptr;
@@ -158,8 +178,7 @@ std::vector<std::string> Checker::namesInScope(const Context& ctx) const {
     }
     if (ctx.trigger)
         for (auto& p : ctx.trigger->params) names.push_back(p.name);
-    for (auto& [n, d] : globals_)
-        if (d->kind == DeclKind::Const || d->kind == DeclKind::Extern) names.push_back(n);
+    for (std::string& n : globalNames({DeclKind::Const, DeclKind::Extern})) names.push_back(std::move(n));
     for (auto& c : builtinConstants()) names.emplace_back(c.name);
     return names;
 }
@@ -333,9 +352,7 @@ const ObjectDecl* Checker::findEmitTarget(const std::string& name, SourceRange r
         return nullptr;
     }
     reportUnknown("object", name, range, [&] {
-        std::vector<std::string> candidates;
-        for (auto& [n, d] : globals_)
-            if (d->kind == DeclKind::Object) candidates.push_back(n);
+        std::vector<std::string> candidates = globalNames({DeclKind::Object});
         if (ctx.where == Where::Object && ctx.object)
             for (auto& child : ctx.object->children) candidates.push_back(child->name);
         return candidates;

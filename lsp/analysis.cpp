@@ -76,7 +76,9 @@ Analysis analyze(const std::string& path, std::string text, const AnalyzeOptions
         std::unique_ptr<ast::Program> program = loadProgramFromText(path, std::move(text), *a.sources, diags, options.open, options.cache);
         if (program && stop()) return a;  // a newer text is on its way: this one is not wanted
         if (program) {
-            checkProgram(*program, diags);
+            // (Every report on the whole program made, and published where a whole check
+            // makes it: the next text's analysis may carry it.)
+            checkProgram(*program, diags, {.allReports = true});
             a.parsed = true;
             a.mainFile = program->main().file;
             buildIndex(*program, *a.sources, a);

@@ -68,9 +68,10 @@ std::optional<Plan> plan(const std::string& before, const std::vector<PieceAt>& 
                 for (size_t user : it->second) check(user);
         objectsUsed(now[k].parsed->mentions);
     }
-    // What the pieces checked again use, transitively; every import and file attribute.
+    // What the pieces checked again use, transitively; every import and file attribute,
+    // and the first piece (where a quick fix puts an import in a file without one).
     for (size_t k = 0; k < n; ++k) {
-        p.loaded[k] = p.checked[k] || declares(*now[k].parsed, ast::DeclKind::Import) ||
+        p.loaded[k] = p.checked[k] || k == 0 || declares(*now[k].parsed, ast::DeclKind::Import) ||
                       declares(*now[k].parsed, ast::DeclKind::Attribute);
         if (p.loaded[k]) work.push_back(k);
     }
@@ -165,10 +166,6 @@ IndexMark markOf(const Analysis& a) {
             a.integrating.size(), a.members.size()};
 }
 
-int errors(const std::vector<Diagnostic>& list) {
-    return int(std::count_if(list.begin(), list.end(), [](const Diagnostic& d) { return d.severity == Severity::Error; }));
-}
-
 // The same imported files, with the same texts, numbered the same.
 bool sameImports(const Analysis& previous, const SourceManager& sources, int mainFile) {
     if (sources.count() != previous.sources->count() || mainFile != previous.mainFile) return false;
@@ -182,6 +179,43 @@ bool sameImports(const Analysis& previous, const SourceManager& sources, int mai
 void objectNames(const ast::ObjectDecl& o, std::vector<std::string>& out) {
     out.push_back(o.name);
     for (const auto& child : o.children) objectNames(*child, out);
+}
+
+// An imported file that names a declaration of the main file (one namespace): its check
+// depends on the main file's, which this does not follow.
+bool importUsesMain(const SourceManager& sources, int mainFile, const std::vector<PieceAt>& now, ParseCache& cache) {
+    std::unordered_map<std::string_view, bool> declared;
+    for (const PieceAt& p : now)
+        for (const std::string& name : p.parsed->declares) declared[name] = true;
+    for (int f = 0; f < sources.count(); ++f) {
+        if (f == mainFile) continue;
+        auto pieces = cache.pieces(sources.file(f).text());
+        if (!pieces) return true;
+        for (const PieceAt& p : *pieces)
+            for (const std::string& name : p.parsed->mentions)
+                if (declared.count(name)) return true;
+    }
+    return false;
+}
+
+// What the pieces not loaded declare, for the checker's did-you-mean.
+void declaredElsewhere(const std::vector<PieceAt>& now, const std::vector<bool>& loaded, CheckOptions& out) {
+    for (size_t k = 0; k < now.size(); ++k) {
+        if (loaded[k]) continue;
+        for (const ast::DeclPtr& d : now[k].parsed->decls) {
+            switch (d->kind) {
+                case ast::DeclKind::Const: case ast::DeclKind::Fn: case ast::DeclKind::Extern:
+                case ast::DeclKind::Trigger: case ast::DeclKind::Object: break;
+                default: continue;
+            }
+            out.declaredElsewhere.emplace_back(d->name, d->kind);
+            if (d->kind == ast::DeclKind::Object) {
+                std::vector<std::string> nested;
+                objectNames(static_cast<const ast::ObjectDecl&>(*d), nested);
+                out.nestedElsewhere.insert(out.nestedElsewhere.end(), nested.begin() + 1, nested.end());
+            }
+        }
+    }
 }
 
 // An object of an imported file that a piece checked again names: its equations' uses are
@@ -220,32 +254,38 @@ std::optional<Analysis> reanalyze(const std::string& path, const std::string& te
     auto program = loadProgramFromText(path, text, *a.sources, diags, options.open, options.cache, &p->loaded);
     if (!program || diags.errorCount() > 0) return std::nullopt;
     a.mainFile = program->main().file;
-    if (!sameImports(previous, *a.sources, a.mainFile) || usesImportedObject(*program, *now, p->checked))
+    if (!sameImports(previous, *a.sources, a.mainFile) || usesImportedObject(*program, *now, p->checked) ||
+        importUsesMain(*a.sources, a.mainFile, *now, *options.cache))
         return std::nullopt;
 
     PieceMover mover(previous.mainFile, previous.pieces, *now, p->checked);
-    CheckedElsewhere elsewhere;
-    for (const Diagnostic& d : *previous.frontEnd)
-        elsewhere.errors += d.severity == Severity::Error && !mover.inChecked(d.range);
+    CheckOptions check{.allReports = true};
+    declaredElsewhere(*now, p->loaded, check);
     for (size_t k = 0; k < now->size(); ++k)
         if (!p->loaded[k])
-            elsewhere.spawns |= declares(*(*now)[k].parsed, ast::DeclKind::Spawn) ||
-                                declares(*(*now)[k].parsed, ast::DeclKind::Trigger);
-    checkProgram(*program, diags, elsewhere);
+            check.spawnsElsewhere |= declares(*(*now)[k].parsed, ast::DeclKind::Spawn) ||
+                                     declares(*(*now)[k].parsed, ast::DeclKind::Trigger);
+    checkProgram(*program, diags, check);
     if (program->instanced || diags.hiddenErrors() > 0 || diags.hiddenWarnings() > 0) return std::nullopt;
 
-    // The diagnostics: the checked pieces' new ones, everything else's moved.
+    // The diagnostics: the checked pieces' new ones, everything else's moved; every report
+    // on the whole program among them (whether it is published is the whole program's
+    // question: publishable). A function too large once inlined silences the equations'
+    // sizes everywhere: not followed.
     PieceMover fresh(a.mainFile, *now, *now, p->checked);  // (inChecked on the new text's places)
     std::vector<Diagnostic> all;
-    int checkedErrors = 0;
     for (Diagnostic& d : diags.take())
-        if (fresh.inChecked(d.range)) checkedErrors += d.severity == Severity::Error, all.push_back(std::move(d));
-    if ((errors(*previous.frontEnd) == 0) != (elsewhere.errors + checkedErrors == 0)) return std::nullopt;
+        if (fresh.inChecked(d.range)) all.push_back(std::move(d));
     for (const Diagnostic& d : *previous.frontEnd) {
         if (mover.inChecked(d.range)) continue;
         all.push_back(d);
         if (!mover.move(all.back())) return std::nullopt;
     }
+    if (std::any_of(all.begin(), all.end(), [](const Diagnostic& d) { return d.report == ProgramReport::InlinedSize; }))
+        return std::nullopt;
+    // (A whole check keeps the first kMaxKept in the order it makes them, and offers no
+    // did-you-mean past them.)
+    if (all.size() >= size_t(kMaxKept)) return std::nullopt;
 
     // The index: the imports' and the unchanged declarations' from the last analysis
     // (moved), the checked ones' from this program's.
@@ -290,7 +330,9 @@ void publishable(Analysis& a, std::vector<Diagnostic> frontEnd, std::vector<Diag
         a.frontEnd = std::make_shared<const std::vector<Diagnostic>>(frontEnd);
     a.diagnostics.clear();
     int shownErrors = 0, shownWarnings = 0;
+    PublishedReports published = publishedReports(frontEnd);
     for (Diagnostic& d : frontEnd) {
+        if (!published(d)) continue;
         int& shown = d.severity == Severity::Error ? shownErrors : shownWarnings;
         int& hidden = d.severity == Severity::Error ? hiddenErrors : hiddenWarnings;
         if (d.severity != Severity::Error && d.severity != Severity::Warning) {

@@ -13,15 +13,17 @@
 //     are read and whether it is created may change: every other user of it is checked
 //     too, by the rule before).
 // They are checked in a program of their own with what they use (the closure of the
-// names used; the imports whole), told how many errors the rest has and whether it spawns
-// (frontend.h's CheckedElsewhere: "never used" and "never created" are reported only
-// where a program has no error). Their diagnostics and index entries replace theirs in the
-// last analysis; everything else is the last analysis's, moved to its place in the new
-// text. What this cannot follow is analysed whole: a new or removed name, a changed import
-// or file attribute, an imported object used by what changed, a program that reads
-// `instance` (an extern read in a fold's term is an error then, wherever it is), and an
-// edit that makes a program with errors clean or a clean one not (the program-wide
-// reports appear or go).
+// names used; the imports whole), told whether the rest spawns. Their diagnostics and
+// index entries replace theirs in the last analysis; everything else is the last
+// analysis's, moved to its place in the new text. The reports on the whole program
+// ("never used", "never created", sizes once inlined) are made by every analysis whether
+// or not it has errors (frontend.h's CheckOptions::allReports) and kept, and published
+// only where a whole check would make them: so an edit that makes a program clean, or a
+// clean one not, is followed too. What this cannot follow is analysed whole: a new or
+// removed name, a changed import or file attribute, an imported object used by what
+// changed, a program that reads `instance` (an extern read in a fold's term is an error
+// then, wherever it is), and a function too large once inlined (no equation's size is
+// reported then, anywhere).
 // Tests: tests/lsp/incremental_test.cpp compares every sample's analysis after edits with
 // a whole one's.
 #pragma once
