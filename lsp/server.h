@@ -15,8 +15,10 @@
 // An edit's analysis parses only the top-level declarations it changed (the document's
 // frontend/parse_cache.h). Where the compiler's passes took long on the document (their
 // warnings: an unstable decay, an integral with no closed form), an edit's analysis leaves
-// them out: its diagnostics are published with the passes' last warnings carried through
-// the edits, and the passes run after, in an analysis of their own, published again.
+// them out: it checks again only the declarations the edit can change, from the last
+// analysis that parsed (lsp/incremental.h), and its diagnostics are published with the
+// passes' last warnings carried through the edits; the passes run after, in a whole
+// analysis of their own, published again.
 #pragma once
 
 #include <atomic>
