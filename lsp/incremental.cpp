@@ -233,6 +233,32 @@ bool usesImportedObject(const ast::Program& program, const std::vector<PieceAt>&
     return false;
 }
 
+// The index of the new text: the imports' and the unchanged declarations' from the last
+// analysis (moved), the checked ones' from the checked program's; false where a place of
+// the last analysis lies in a piece checked again.
+bool mergeIndex(Analysis& a, const Analysis& previous, const Analysis& checked, const PieceMover& mover,
+                const PieceMover& fresh, const std::vector<bool>& isChecked, const std::vector<PieceAt>& now) {
+    if (!append(a, previous, IndexMark{}, previous.marks.front(), nullptr)) return false;
+    size_t next = 0;  // the checked program's next main declaration
+    for (size_t i = 0; i + 1 < previous.marks.size(); ++i) {
+        size_t k = mover.pieceOf(previous.marks[i].begin);
+        a.marks.push_back(markOf(a));
+        if (isChecked[k]) {
+            while (next + 1 < checked.marks.size() && fresh.pieceOf(checked.marks[next].begin) < k) ++next;
+            if (next + 1 >= checked.marks.size() || fresh.pieceOf(checked.marks[next].begin) != k) return false;
+            a.marks.back().begin = checked.marks[next].begin;
+            append(a, checked, checked.marks[next], checked.marks[next + 1], nullptr);
+            ++next;
+        } else {
+            a.marks.back().begin = previous.marks[i].begin - previous.pieces[k].begin + now[k].begin;
+            if (!append(a, previous, previous.marks[i], previous.marks[i + 1], &mover)) return false;
+        }
+    }
+    a.marks.push_back(markOf(a));
+    a.marks.back().begin = UINT32_MAX;
+    return true;
+}
+
 }  // namespace
 
 std::optional<Analysis> reanalyze(const std::string& path, const std::string& text, const Analysis& previous,
@@ -287,28 +313,9 @@ std::optional<Analysis> reanalyze(const std::string& path, const std::string& te
     // did-you-mean past them.)
     if (all.size() >= size_t(kMaxKept)) return std::nullopt;
 
-    // The index: the imports' and the unchanged declarations' from the last analysis
-    // (moved), the checked ones' from this program's.
     Analysis checked;
     buildIndex(*program, *a.sources, checked);
-    if (!append(a, previous, IndexMark{}, previous.marks.front(), nullptr)) return std::nullopt;
-    size_t next = 0;  // the checked program's next main declaration
-    for (size_t i = 0; i + 1 < previous.marks.size(); ++i) {
-        size_t k = mover.pieceOf(previous.marks[i].begin);
-        a.marks.push_back(markOf(a));
-        if (p->checked[k]) {
-            while (next + 1 < checked.marks.size() && fresh.pieceOf(checked.marks[next].begin) < k) ++next;
-            if (next + 1 >= checked.marks.size() || fresh.pieceOf(checked.marks[next].begin) != k) return std::nullopt;
-            a.marks.back().begin = checked.marks[next].begin;
-            append(a, checked, checked.marks[next], checked.marks[next + 1], nullptr);
-            ++next;
-        } else {
-            a.marks.back().begin = previous.marks[i].begin - previous.pieces[k].begin + (*now)[k].begin;
-            if (!append(a, previous, previous.marks[i], previous.marks[i + 1], &mover)) return std::nullopt;
-        }
-    }
-    a.marks.push_back(markOf(a));
-    a.marks.back().begin = UINT32_MAX;
+    if (!mergeIndex(a, previous, checked, mover, fresh, p->checked, *now)) return std::nullopt;
 
     a.parsed = true;
     a.incremental = true;
